@@ -1,0 +1,69 @@
+//! Command-line parsing and the exit-code policy (CONTRACT: exit codes). Only this module prints.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Simulate a coin rolling without slipping and record it as MCAP datasets for Foxglove.
+///
+/// Exit codes: 0 success; 1 error (bad scene or flag, I/O, numerical failure) or, for `verify`, a failed
+/// check; 2 usage error or, for `verify`, an unreadable file; 130 interrupted.
+#[derive(Debug, Parser)]
+#[command(name = "coin-log", version, about, long_about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {}
+
+/// What a command ended with; the one place exit codes are decided (CONTRACT: exit codes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// 0: finished.
+    Success,
+    /// 1: a check failed, or an error or numerical failure.
+    Failure,
+    /// 2: unreadable input or usage error.
+    Unusable,
+    /// 130: interrupted by SIGINT.
+    Interrupted,
+}
+
+impl From<Outcome> for ExitCode {
+    fn from(o: Outcome) -> Self {
+        ExitCode::from(match o {
+            Outcome::Success => 0,
+            Outcome::Failure => 1,
+            Outcome::Unusable => 2,
+            Outcome::Interrupted => 130,
+        })
+    }
+}
+
+/// Parses the command line, runs the command and maps the result to an exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(outcome) => outcome.into(),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            Outcome::Failure.into()
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<Outcome> {
+    match cli.command {}
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,106 @@
+//! Time stepping, generic over an [`OdeSystem`]; knows nothing about coins.
+//!
+//! A [`Stepper`] advances one accepted step at a time and interpolates inside the last step (dense output),
+//! so that [`run`] can sample at exact output times and locate events by root finding without shortening
+//! steps. Methods: [`Rk4`] here; the adaptive pairs and the implicit Gauss method live beside it.
+
+mod driver;
+mod hermite;
+mod rk4;
+
+pub use driver::{
+    run, EventFunctions, Flow, NoEvents, RunOutcome, RunSettings, Termination, MAX_EVENTS,
+};
+pub use hermite::hermite_interpolate;
+pub use rk4::Rk4;
+
+use thiserror::Error;
+
+/// A system of first-order ODEs y' = f(t, y) of fixed dimension `N`.
+pub trait OdeSystem<const N: usize> {
+    /// Writes f(t, y) into `dydt`. Must not allocate.
+    fn rhs(&self, t: f64, y: &[f64; N], dydt: &mut [f64; N]);
+}
+
+/// Work counters of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Right-hand side evaluations, including those spent on rejected steps and on Newton iterations.
+    pub rhs_evaluations: u64,
+    /// Rejected steps (adaptive methods).
+    pub rejected_steps: u64,
+}
+
+/// Why a step could not be taken. Every variant carries the time it happened at.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum StepError {
+    /// The state or its derivative became NaN or infinite.
+    #[error("non-finite state at t = {t}")]
+    NonFinite {
+        /// Time of the last finite state.
+        t: f64,
+    },
+    /// The adaptive step size fell below what the time's floating-point spacing allows.
+    #[error(
+        "step size underflow at t = {t} (h = {h:e}); the problem is too stiff or singular here"
+    )]
+    StepSizeUnderflow {
+        /// Time.
+        t: f64,
+        /// Last attempted step.
+        h: f64,
+    },
+    /// The implicit stage equations did not converge.
+    #[error("stage equations did not converge at t = {t} (h = {h:e}, residual {residual:e} after {iterations} iterations); reduce the step")]
+    NewtonFailure {
+        /// Time at the start of the step.
+        t: f64,
+        /// Step.
+        h: f64,
+        /// Iterations made.
+        iterations: u32,
+        /// Last residual norm.
+        residual: f64,
+    },
+}
+
+/// One integration method: takes accepted steps and interpolates within the last one.
+pub trait Stepper<const N: usize> {
+    /// Starts at (t0, y0). `t_end` lets adaptive methods bound their initial step.
+    ///
+    /// # Errors
+    /// [`StepError::NonFinite`] if f(t0, y0) is not finite.
+    fn init<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t_end: f64,
+    ) -> Result<(), StepError>;
+
+    /// Takes one accepted step that ends no later than `t_limit`.
+    ///
+    /// # Errors
+    /// A [`StepError`]; the stepper then still holds the last good step.
+    fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError>;
+
+    /// Time at the end of the last accepted step.
+    fn t(&self) -> f64;
+    /// State at the end of the last accepted step.
+    fn y(&self) -> &[f64; N];
+    /// Time at the start of the last accepted step.
+    fn t_previous(&self) -> f64;
+    /// Dense output: the solution at `t` in [`t_previous`, `t`], written into `out`.
+    fn interpolate(&self, t: f64, out: &mut [f64; N]);
+    /// Work counters so far.
+    fn stats(&self) -> Stats;
+}
+
+/// Checks that every component is finite.
+#[must_use]
+#[inline]
+pub fn all_finite<const N: usize>(y: &[f64; N]) -> bool {
+    y.iter().all(|v| v.is_finite())
+}

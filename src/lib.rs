@@ -1,0 +1,11 @@
+//! coin-log: a coin rolling without slipping on a horizontal table, simulated to many digits and recorded
+//! as MCAP datasets for Foxglove.
+//!
+//! The physics is that of `shared/physics/NOTES.md` (cited as "NOTES §n" and "eq (n)"): a thin axisymmetric
+//! body in rim contact with a flat table, no slip, no dissipation. Dependencies point one way:
+//! [`model`] → [`integrate`] → scene → record / verify → the `coin-log` binary.
+
+pub mod integrate;
+pub mod model;
+pub mod simulation;
+pub mod units;

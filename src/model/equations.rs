@@ -1,0 +1,121 @@
+//! The equations of motion of the rolling coin, eqs (14)–(19) of NOTES §2, plus ẋ and ż.
+
+use super::params::CoinParams;
+use super::state::{StateRate, STATE_LEN};
+
+/// The rolling coin as an ODE system: [`CoinParams`] with the coefficients of eqs (14)–(16) precomputed,
+/// so that one right-hand side evaluation is a handful of multiplications and one `sin_cos` pair per angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coin {
+    params: CoinParams,
+    /// (I_Z + Ma²)/(I_X + Ma²), eq (14).
+    gyro_x: f64,
+    /// I_X/(I_X + Ma²), eq (14).
+    centrifugal_x: f64,
+    /// Mga/(I_X + Ma²), eq (14).
+    gravity_x: f64,
+    /// I_Z/I_X, eq (15).
+    ratio_zx: f64,
+    /// Ma²/(I_Z + Ma²), eq (16).
+    rolling_z: f64,
+}
+
+/// Angular accelerations (ω̇_X, ω̇_Y, ω̇_Z), eqs (14)–(16).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngularAcceleration {
+    /// ω̇_X [rad/time²].
+    pub x: f64,
+    /// ω̇_Y [rad/time²].
+    pub y: f64,
+    /// ω̇_Z [rad/time²].
+    pub z: f64,
+}
+
+impl Coin {
+    /// The ODE system for these parameters.
+    #[must_use]
+    pub fn new(params: CoinParams) -> Self {
+        let ma2 = params.ma2();
+        let ix = params.inertia_x();
+        let iz = params.inertia_z();
+        Self {
+            params,
+            gyro_x: (iz + ma2) / (ix + ma2),
+            centrifugal_x: ix / (ix + ma2),
+            gravity_x: params.mass() * params.gravity() * params.radius() / (ix + ma2),
+            ratio_zx: iz / ix,
+            rolling_z: ma2 / (iz + ma2),
+        }
+    }
+
+    /// The body parameters.
+    #[must_use]
+    pub fn params(&self) -> &CoinParams {
+        &self.params
+    }
+
+    /// Angular accelerations from eqs (14)–(16), given θ and ω (lean frame).
+    ///
+    /// (I_X + Ma²) ω̇_X = −(I_Z + Ma²) ω_Y ω_Z − I_X ω_Y² tan θ + Mga sin θ   (14)
+    /// I_X ω̇_Y = I_X ω_X ω_Y tan θ + I_Z ω_Z ω_X                              (15)
+    /// (I_Z + Ma²) ω̇_Z = Ma² ω_X ω_Y                                          (16)
+    ///
+    /// ```
+    /// use coin_log::model::{Coin, CoinParams};
+    /// // Unit thin disk (note §5): ω̇_X = −6/5 ω_Y ω_Z − 1/5 ω_Y² tan θ + 4/5 sin θ.
+    /// let coin = Coin::new(CoinParams::unit_disk());
+    /// let acc = coin.angular_acceleration(0.0, 0.0, 1.0, 2.0);
+    /// assert!((acc.x - (-12.0 / 5.0)).abs() < 1e-15);
+    /// ```
+    #[must_use]
+    #[inline]
+    pub fn angular_acceleration(
+        &self,
+        theta: f64,
+        omega_x: f64,
+        omega_y: f64,
+        omega_z: f64,
+    ) -> AngularAcceleration {
+        let (sin_t, cos_t) = theta.sin_cos();
+        let tan_t = sin_t / cos_t;
+        self.angular_acceleration_trig(sin_t, tan_t, omega_x, omega_y, omega_z)
+    }
+
+    #[inline]
+    fn angular_acceleration_trig(
+        &self,
+        sin_t: f64,
+        tan_t: f64,
+        wx: f64,
+        wy: f64,
+        wz: f64,
+    ) -> AngularAcceleration {
+        AngularAcceleration {
+            x: -self.gyro_x * wy * wz - self.centrifugal_x * wy * wy * tan_t
+                + self.gravity_x * sin_t,
+            y: wx * wy * tan_t + self.ratio_zx * wz * wx,
+            z: self.rolling_z * wx * wy,
+        }
+    }
+
+    /// The right-hand side: eqs (14)–(19) and the centre's velocity
+    /// ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ), ż = a(ω_Z sin φ + ω_X cos θ cos φ) (NOTES §2).
+    /// Writes into a caller-owned buffer; no allocation.
+    #[inline]
+    pub fn derivative(&self, y: &[f64; STATE_LEN], dydt: &mut StateRate) {
+        let [theta, phi, _psi, wx, wy, wz, _x, _z] = *y;
+        let (sin_t, cos_t) = theta.sin_cos();
+        let (sin_p, cos_p) = phi.sin_cos();
+        let tan_t = sin_t / cos_t;
+        let acc = self.angular_acceleration_trig(sin_t, tan_t, wx, wy, wz);
+        let a = self.params.radius();
+        dydt[0] = wx; // (17)
+        dydt[1] = wy / cos_t; // (18)
+        dydt[2] = wz + wy * tan_t; // (19)
+        dydt[3] = acc.x; // (14)
+        dydt[4] = acc.y; // (15)
+        dydt[5] = acc.z; // (16)
+        dydt[6] = a * (-wz * cos_p + wx * cos_t * sin_p);
+        dydt[7] = a * (wz * sin_p + wx * cos_t * cos_p);
+    }
+}

@@ -1,0 +1,1 @@
+//! Chaplygin–Appell integrals C1, C2 (NOTES §6).

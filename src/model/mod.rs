@@ -1,0 +1,21 @@
+//! The rolling coin: parameters, state, equations of motion and derived quantities (NOTES §1–§6).
+//! Pure functions; no I/O and no knowledge of integrators or files.
+
+mod derived;
+mod equations;
+pub mod invariants;
+mod params;
+mod stability;
+mod state;
+mod steady;
+
+pub use derived::{
+    centre, contact_point, energy, orientation, reaction, Energy, Quaternion, Reaction, Vec3,
+};
+pub use equations::{AngularAcceleration, Coin};
+pub use params::{CoinParams, Inertia, ParamError};
+pub use stability::{
+    centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
+};
+pub use state::{State, StateRate, STATE_LEN};
+pub use steady::{steady_omega_y, Branch, Steady, SteadyError, SteadyKind};

@@ -1,0 +1,155 @@
+//! Body parameters of the coin: mass M, radius a, gravity g and the axisymmetric inertia (NOTES §1–§2).
+
+use thiserror::Error;
+
+/// A problem with one body parameter: the field, its value and the allowed range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ParamError {
+    /// A parameter is NaN, infinite, zero or negative.
+    #[error("`{name}` = {value} is not allowed: it must be a finite number > 0")]
+    NotPositive {
+        /// Name of the field (`mass`, `radius`, `gravity`, `inertia_x`, `inertia_z`).
+        name: &'static str,
+        /// The value that was given.
+        value: f64,
+    },
+    /// Both a shape and explicit inertias were given, or only one inertia.
+    #[error("{0}")]
+    InertiaSpec(String),
+}
+
+/// How the axisymmetric inertia is specified.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Inertia {
+    /// Thin uniform disk: I_X = Ma²/4, I_Z = Ma²/2 (NOTES §2).
+    ThinDisk,
+    /// Thin ring: I_X = Ma²/2, I_Z = Ma² (NOTES §2).
+    Hoop,
+    /// Explicit moments about a diameter (`inertia_x`) and the symmetry axis (`inertia_z`), in M·length².
+    Explicit {
+        /// Moment of inertia about a diameter, I_X = I_Y [mass·length²].
+        inertia_x: f64,
+        /// Moment of inertia about the symmetry axis, I_Z [mass·length²].
+        inertia_z: f64,
+    },
+}
+
+/// Validated body parameters, in any consistent set of units.
+///
+/// Built only through [`CoinParams::new`], so every field is finite and positive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoinParams {
+    mass: f64,
+    radius: f64,
+    gravity: f64,
+    inertia_x: f64,
+    inertia_z: f64,
+}
+
+fn positive(name: &'static str, value: f64, errors: &mut Vec<ParamError>) {
+    if !(value.is_finite() && value > 0.0) {
+        errors.push(ParamError::NotPositive { name, value });
+    }
+}
+
+impl CoinParams {
+    /// Validates M, a, g and the inertia; reports every bad field at once.
+    ///
+    /// ```
+    /// use coin_log::model::{CoinParams, Inertia};
+    /// let p = CoinParams::new(1.0, 1.0, 1.0, Inertia::ThinDisk).unwrap();
+    /// assert_eq!(p.inertia_z(), 0.5);
+    /// assert!(CoinParams::new(-1.0, 1.0, 1.0, Inertia::Hoop).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// One [`ParamError`] per field that is not a finite positive number.
+    pub fn new(
+        mass: f64,
+        radius: f64,
+        gravity: f64,
+        inertia: Inertia,
+    ) -> Result<Self, Vec<ParamError>> {
+        let mut errors = Vec::new();
+        positive("mass", mass, &mut errors);
+        positive("radius", radius, &mut errors);
+        positive("gravity", gravity, &mut errors);
+        let ma2 = mass * radius * radius;
+        let (inertia_x, inertia_z) = match inertia {
+            Inertia::ThinDisk => (ma2 / 4.0, ma2 / 2.0),
+            Inertia::Hoop => (ma2 / 2.0, ma2),
+            Inertia::Explicit {
+                inertia_x,
+                inertia_z,
+            } => {
+                positive("inertia_x", inertia_x, &mut errors);
+                positive("inertia_z", inertia_z, &mut errors);
+                (inertia_x, inertia_z)
+            }
+        };
+        if errors.is_empty() {
+            Ok(Self {
+                mass,
+                radius,
+                gravity,
+                inertia_x,
+                inertia_z,
+            })
+        } else {
+            Err(errors)
+        }
+    }
+
+    /// The note's unit thin disk: M = a = g = 1.
+    #[must_use]
+    pub fn unit_disk() -> Self {
+        Self {
+            mass: 1.0,
+            radius: 1.0,
+            gravity: 1.0,
+            inertia_x: 0.25,
+            inertia_z: 0.5,
+        }
+    }
+
+    /// Mass M [mass].
+    #[must_use]
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+    /// Radius a [length].
+    #[must_use]
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+    /// Gravitational acceleration g [length/time²].
+    #[must_use]
+    pub fn gravity(&self) -> f64 {
+        self.gravity
+    }
+    /// Moment of inertia about a diameter, I_X = I_Y [mass·length²].
+    #[must_use]
+    pub fn inertia_x(&self) -> f64 {
+        self.inertia_x
+    }
+    /// Moment of inertia about the symmetry axis, I_Z [mass·length²].
+    #[must_use]
+    pub fn inertia_z(&self) -> f64 {
+        self.inertia_z
+    }
+    /// M a² [mass·length²].
+    #[must_use]
+    pub fn ma2(&self) -> f64 {
+        self.mass * self.radius * self.radius
+    }
+    /// The natural time unit √(a/g) (NOTES §2).
+    #[must_use]
+    pub fn time_unit(&self) -> f64 {
+        (self.radius / self.gravity).sqrt()
+    }
+    /// The energy scale M g a used to make energy drift relative (CONTRACT, verify).
+    #[must_use]
+    pub fn energy_scale(&self) -> f64 {
+        self.mass * self.gravity * self.radius
+    }
+}

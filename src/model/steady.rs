@@ -1,0 +1,237 @@
+//! Steady motions (NOTES §4) and their analytic properties.
+//!
+//! In every steady motion ω_X = 0 and θ, ω_Y, ω_Z are constant; eq (14) then reduces to the steady family
+//! I_X tan θ ω_Y² + (I_Z + Ma²) ω_Z ω_Y − Mga sin θ = 0, which gives ω_Y for a chosen θ and ω_Z.
+
+use super::equations::Coin;
+use super::state::State;
+use thiserror::Error;
+
+/// Which root of the steady family's quadratic in ω_Y (NOTES §4 item 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Branch {
+    /// ω_Y = (−B + √D) / (2A): for θ, ω_Z > 0 the large, outer circle of the note.
+    Plus,
+    /// ω_Y = (−B − √D) / (2A).
+    Minus,
+}
+
+/// A steady motion to build.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SteadyKind {
+    /// Upright, rolling straight: θ = ω_X = ω_Y = 0, ω_Z constant (NOTES §4 item 1).
+    Straight {
+        /// Spin about the normal [rad/time].
+        omega_z: f64,
+    },
+    /// Centre at rest, the coin rolling round it: ω_Z = 0, ω_Y² = Mga cos θ / I_X (NOTES §4 item 2).
+    CentreFixed {
+        /// Lean [rad], 0 < |θ| < π/2.
+        theta: f64,
+        /// Sign of ω_Y: `Plus` gives ω_Y > 0.
+        branch: Branch,
+    },
+    /// Circular rolling on either branch (NOTES §4 item 3).
+    Circle {
+        /// Lean [rad], 0 < |θ| < π/2.
+        theta: f64,
+        /// Spin about the normal [rad/time].
+        omega_z: f64,
+        /// Root of the steady quadratic.
+        branch: Branch,
+    },
+    /// Spinning upright in place about the vertical diameter: θ = 0, ω_Z = 0, ω_Y = Ω (NOTES §5).
+    SpinUpright {
+        /// Ω [rad/time].
+        omega_y: f64,
+    },
+}
+
+impl SteadyKind {
+    /// The contract's name of the kind (`steady_kind` metadata).
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Straight { .. } => "straight",
+            Self::CentreFixed { .. } => "centre-fixed",
+            Self::Circle { .. } => "circle",
+            Self::SpinUpright { .. } => "spin-upright",
+        }
+    }
+}
+
+/// A steady motion that cannot be built, with the reason and the allowed range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SteadyError {
+    /// θ outside the open interval where the motion exists.
+    #[error("steady `{kind}`: theta = {theta} is outside the allowed range {range}")]
+    Theta {
+        /// The steady kind.
+        kind: &'static str,
+        /// The value given.
+        theta: f64,
+        /// The allowed range, in words.
+        range: &'static str,
+    },
+    /// A non-finite rate.
+    #[error("steady `{kind}`: `{name}` = {value} must be a finite number")]
+    NotFinite {
+        /// The steady kind.
+        kind: &'static str,
+        /// The field.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
+}
+
+/// A steady motion: its initial state and analytic properties (NOTES §4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Steady {
+    /// What was asked for.
+    pub kind: SteadyKind,
+    /// Initial state at t = 0 (φ = ψ = x = z = 0).
+    pub state: State,
+    /// Heading rate φ̇ = ω_Y / cos θ, eq (18) [rad/time].
+    pub phi_dot: f64,
+    /// Spin rate ψ̇ = ω_Z + ω_Y tan θ, eq (19) [rad/time].
+    pub psi_dot: f64,
+    /// Radius of the circle traced by the centre [length]; `None` for straight rolling (infinite).
+    pub r_g: Option<f64>,
+    /// Radius of the circle traced by the contact point [length]; `None` for straight rolling.
+    pub r_c: Option<f64>,
+}
+
+/// ω_Y on the steady family for given θ and ω_Z (NOTES §4): the root of
+/// I_X tan θ ω_Y² + (I_Z + Ma²) ω_Z ω_Y − Mga sin θ = 0 on `branch`, computed without cancellation.
+/// Requires tan θ ≠ 0.
+#[must_use]
+pub fn steady_omega_y(coin: &Coin, theta: f64, omega_z: f64, branch: Branch) -> f64 {
+    let p = coin.params();
+    let qa = p.inertia_x() * theta.tan();
+    let qb = (p.inertia_z() + p.ma2()) * omega_z;
+    let qc = -p.mass() * p.gravity() * p.radius() * theta.sin();
+    // D = B² − 4AC ≥ 0 always, since A·C = −I_X Mga tan θ sin θ ≤ 0.
+    let root_d = (qb * qb - 4.0 * qa * qc).sqrt();
+    // Stable quadratic formula: q = −½(B + sgn(B)√D); roots q/A and C/q. The root (−B + √D)/(2A) is q/A
+    // when B < 0 and C/q when B ≥ 0.
+    let sign_b = if qb < 0.0 { -1.0 } else { 1.0 };
+    let q = -0.5 * (qb + sign_b * root_d);
+    let plus_is_q_over_a = qb < 0.0;
+    let big = q / qa;
+    let small = if q == 0.0 { 0.0 } else { qc / q };
+    match (branch, plus_is_q_over_a) {
+        (Branch::Plus, true) | (Branch::Minus, false) => big,
+        (Branch::Plus, false) | (Branch::Minus, true) => small,
+    }
+}
+
+fn check_finite(kind: &'static str, name: &'static str, value: f64) -> Result<(), SteadyError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(SteadyError::NotFinite { kind, name, value })
+    }
+}
+
+fn check_lean(kind: &'static str, theta: f64) -> Result<(), SteadyError> {
+    let ok = theta.is_finite() && theta != 0.0 && theta.abs() < std::f64::consts::FRAC_PI_2;
+    if ok {
+        Ok(())
+    } else {
+        Err(SteadyError::Theta {
+            kind,
+            theta,
+            range: "0 < |theta| < pi/2 (a leaning coin; use `straight` for theta = 0)",
+        })
+    }
+}
+
+impl Steady {
+    /// Builds the steady motion `kind` for `coin`.
+    ///
+    /// ```
+    /// use coin_log::model::{Branch, Coin, CoinParams, Steady, SteadyKind};
+    /// let coin = Coin::new(CoinParams::unit_disk());
+    /// let s = Steady::new(&coin, SteadyKind::Circle { theta: 0.3, omega_z: 1.0, branch: Branch::Plus }).unwrap();
+    /// assert!((s.r_g.unwrap() - 4.897855).abs() < 1e-6); // NOTES §4 example
+    /// ```
+    ///
+    /// # Errors
+    /// [`SteadyError`] when θ is outside the range where the motion exists, or a rate is not finite.
+    pub fn new(coin: &Coin, kind: SteadyKind) -> Result<Self, SteadyError> {
+        let p = coin.params();
+        let a = p.radius();
+        let name = kind.name();
+        let (theta, omega_y, omega_z) = match kind {
+            SteadyKind::Straight { omega_z } => {
+                check_finite(name, "omega_z", omega_z)?;
+                (0.0, 0.0, omega_z)
+            }
+            SteadyKind::SpinUpright { omega_y } => {
+                check_finite(name, "omega_y", omega_y)?;
+                (0.0, omega_y, 0.0)
+            }
+            SteadyKind::CentreFixed { theta, branch } => {
+                check_lean(name, theta)?;
+                let magnitude = (p.mass() * p.gravity() * a * theta.cos() / p.inertia_x()).sqrt();
+                (
+                    theta,
+                    if branch == Branch::Plus {
+                        magnitude
+                    } else {
+                        -magnitude
+                    },
+                    0.0,
+                )
+            }
+            SteadyKind::Circle {
+                theta,
+                omega_z,
+                branch,
+            } => {
+                check_lean(name, theta)?;
+                check_finite(name, "omega_z", omega_z)?;
+                (theta, steady_omega_y(coin, theta, omega_z, branch), omega_z)
+            }
+        };
+        let state = State {
+            theta,
+            omega_y,
+            omega_z,
+            ..State::default()
+        };
+        let (st, ct) = theta.sin_cos();
+        let phi_dot = omega_y / ct;
+        let psi_dot = omega_z + omega_y * st / ct;
+        let (r_g, r_c) = match kind {
+            SteadyKind::Straight { .. } => (None, None),
+            SteadyKind::SpinUpright { .. } => (Some(0.0), Some(0.0)),
+            // R_G = a|ω_Z cos θ / ω_Y|, R_C = a|ω_Z cos θ / ω_Y + sin θ| (NOTES §4 item 3; item 2 with ω_Z = 0).
+            SteadyKind::CentreFixed { .. } | SteadyKind::Circle { .. } => {
+                let signed = omega_z * ct / omega_y;
+                (Some(a * signed.abs()), Some(a * (signed + st).abs()))
+            }
+        };
+        Ok(Self {
+            kind,
+            state,
+            phi_dot,
+            psi_dot,
+            r_g,
+            r_c,
+        })
+    }
+
+    /// Centre of the circle traced by the coin's centre, in the table plane (x, z), for a motion that
+    /// starts from `start` (any φ₀, x₀, z₀): C = p₀ + (a ω_Z / φ̇)(sin φ₀, cos φ₀). `None` when φ̇ = 0.
+    #[must_use]
+    pub fn circle_centre(&self, coin: &Coin, start: &State) -> Option<(f64, f64)> {
+        if self.phi_dot == 0.0 {
+            return None;
+        }
+        let scale = coin.params().radius() * start.omega_z / self.phi_dot;
+        let (sp, cp) = start.phi.sin_cos();
+        Some((start.x + scale * sp, start.z + scale * cp))
+    }
+}
