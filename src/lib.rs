@@ -7,5 +7,6 @@
 
 pub mod integrate;
 pub mod model;
+pub mod record;
 pub mod simulation;
 pub mod units;

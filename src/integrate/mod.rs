@@ -6,12 +6,14 @@
 
 mod driver;
 mod hermite;
+mod method;
 mod rk4;
 
 pub use driver::{
     run, EventFunctions, Flow, NoEvents, RunOutcome, RunSettings, Termination, MAX_EVENTS,
 };
 pub use hermite::hermite_interpolate;
+pub use method::{run_method, Method, MethodConfig, UnknownMethod};
 pub use rk4::Rk4;
 
 use thiserror::Error;

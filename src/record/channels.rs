@@ -1,0 +1,145 @@
+//! The channels of the data contract (CONTRACT: Channels): name, topic, schema name and schema bytes.
+//! The schema bytes are the files in `schemas/`, embedded at build time, so a log's schema is the file.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// Schema encoding of every channel.
+pub const SCHEMA_ENCODING: &str = "jsonschema";
+/// Message encoding of every channel.
+pub const MESSAGE_ENCODING: &str = "json";
+
+/// A recordable channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Channel {
+    /// ω in the lean frame.
+    Omega,
+    /// θ, φ, ψ.
+    Angles,
+    /// Orientation quaternion.
+    Quaternion,
+    /// Centre position.
+    Position,
+    /// Contact point.
+    Contact,
+    /// Reaction of the table.
+    Reaction,
+    /// Energy.
+    Energy,
+    /// Chaplygin integrals C1, C2.
+    Invariants,
+    /// Foxglove frame transforms.
+    Tf,
+    /// Foxglove scene (coin and track).
+    Scene,
+}
+
+impl Channel {
+    /// Every channel, in the contract's order (also the order channels are registered in a file).
+    pub const ALL: [Channel; 10] = [
+        Self::Omega,
+        Self::Angles,
+        Self::Quaternion,
+        Self::Position,
+        Self::Contact,
+        Self::Reaction,
+        Self::Energy,
+        Self::Invariants,
+        Self::Tf,
+        Self::Scene,
+    ];
+
+    /// The channel's name in scene files and `--channels`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Omega => "omega",
+            Self::Angles => "angles",
+            Self::Quaternion => "quaternion",
+            Self::Position => "position",
+            Self::Contact => "contact",
+            Self::Reaction => "reaction",
+            Self::Energy => "energy",
+            Self::Invariants => "invariants",
+            Self::Tf => "tf",
+            Self::Scene => "scene",
+        }
+    }
+
+    /// MCAP topic.
+    #[must_use]
+    pub fn topic(self) -> &'static str {
+        match self {
+            Self::Omega => "/coin/omega",
+            Self::Angles => "/coin/angles",
+            Self::Quaternion => "/coin/quaternion",
+            Self::Position => "/coin/position",
+            Self::Contact => "/coin/contact",
+            Self::Reaction => "/coin/reaction",
+            Self::Energy => "/coin/energy",
+            Self::Invariants => "/coin/invariants",
+            Self::Tf => "/tf",
+            Self::Scene => "/scene",
+        }
+    }
+
+    /// Schema name.
+    #[must_use]
+    pub fn schema_name(self) -> &'static str {
+        match self {
+            Self::Omega => "coin_log.AngularVelocity",
+            Self::Angles => "coin_log.Angles",
+            Self::Quaternion => "coin_log.Quaternion",
+            Self::Position | Self::Contact => "coin_log.Position",
+            Self::Reaction => "coin_log.Reaction",
+            Self::Energy => "coin_log.Energy",
+            Self::Invariants => "coin_log.Invariants",
+            Self::Tf => "foxglove.FrameTransform",
+            Self::Scene => "foxglove.SceneUpdate",
+        }
+    }
+
+    /// The channel with this topic.
+    #[must_use]
+    pub fn from_topic(topic: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.topic() == topic)
+    }
+}
+
+/// The bytes of `schemas/<name>.json` for a schema name this tool writes.
+#[must_use]
+pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
+    Some(match schema_name {
+        "coin_log.AngularVelocity" => include_bytes!("../../schemas/coin_log.AngularVelocity.json"),
+        "coin_log.Angles" => include_bytes!("../../schemas/coin_log.Angles.json"),
+        "coin_log.Quaternion" => include_bytes!("../../schemas/coin_log.Quaternion.json"),
+        "coin_log.Position" => include_bytes!("../../schemas/coin_log.Position.json"),
+        "coin_log.Reaction" => include_bytes!("../../schemas/coin_log.Reaction.json"),
+        "coin_log.Energy" => include_bytes!("../../schemas/coin_log.Energy.json"),
+        "coin_log.Invariants" => include_bytes!("../../schemas/coin_log.Invariants.json"),
+        "foxglove.FrameTransform" => include_bytes!("../../schemas/foxglove.FrameTransform.json"),
+        "foxglove.SceneUpdate" => include_bytes!("../../schemas/foxglove.SceneUpdate.json"),
+        _ => return None,
+    })
+}
+
+impl fmt::Display for Channel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown channel name, with the list of valid ones.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown channel `{0}`; valid channels: omega, angles, quaternion, position, contact, reaction, energy, invariants, tf, scene")]
+pub struct UnknownChannel(pub String);
+
+impl FromStr for Channel {
+    type Err = UnknownChannel;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| UnknownChannel(s.to_string()))
+    }
+}
