@@ -1,5 +1,9 @@
 //! Command-line parsing and the exit-code policy (CONTRACT: exit codes). Only this module prints.
 
+mod record;
+mod scenes;
+mod verify;
+
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -15,7 +19,14 @@ pub struct Cli {
 }
 
 #[derive(Debug, Subcommand)]
-enum Command {}
+enum Command {
+    /// Integrate a scene and write its trajectory as an MCAP file.
+    Record(record::RecordArgs),
+    /// Re-read stored logs and judge them from the file alone.
+    Verify(verify::VerifyArgs),
+    /// List the built-in scenes, or print one as TOML.
+    Scenes(scenes::ScenesArgs),
+}
 
 /// What a command ended with; the one place exit codes are decided (CONTRACT: exit codes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,7 +65,11 @@ pub fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> anyhow::Result<Outcome> {
-    match cli.command {}
+    match cli.command {
+        Command::Record(args) => record::run(args),
+        Command::Verify(args) => verify::run(args),
+        Command::Scenes(args) => scenes::run(args),
+    }
 }
 
 #[cfg(test)]
