@@ -5,6 +5,9 @@
 //! radians): rk4's truncation error on these smooth periodic motions is ~1e-12, so 1e-9 is tight enough
 //! to catch any error in the steady relations (which would show as an O(1e-3..1) drift).
 
+// Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
+#![allow(clippy::unwrap_used)]
+
 mod common;
 
 use coin_log::model::{

@@ -1,7 +1,8 @@
 //! Helpers shared by the model tests: small vector algebra written here (not the library's), the angle →
 //! quaternion and lean-frame constructions of NOTES §1 done independently, a fixed-step rk4 trajectory
 //! recorder, parameter sets, and the reporting helper that prints measured vs expected vs tolerance.
-#![allow(dead_code)] // each test binary uses a different subset of these helpers
+#![allow(dead_code)]
+// each test binary uses a different subset of these helpers
 // Test helpers are not #[test] functions, so clippy.toml's allow-unwrap-in-tests does not reach them; a
 // failed unwrap here is a failed test, which is what we want.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
