@@ -96,14 +96,15 @@ pub struct RecordOptions {
     pub compression: Compression,
 }
 
-/// The file could not be written; the caller should discard it.
+/// The file could not be written; the caller should discard it. The cause (e.g. "No space left on
+/// device") is the error's `source`.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
     /// The MCAP writer failed (usually an I/O error: disk full, file gone).
-    #[error("writing the MCAP file failed: {0}")]
+    #[error("writing the MCAP file failed")]
     Write(#[from] mcap::McapError),
     /// Flushing the finished file failed.
-    #[error("writing the MCAP file failed: {0}")]
+    #[error("writing the MCAP file failed")]
     Io(#[from] std::io::Error),
 }
 
