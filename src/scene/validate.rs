@@ -88,9 +88,14 @@ impl Problems<'_> {
     }
 }
 
-/// A number as the user would write it (`-1`, `0.5`, `NaN`, `inf`).
+/// A number as the user would write it (`-1`, `0.5`, `1e-9`, `NaN`, `inf`).
 fn number(value: f64) -> String {
-    format!("{value}")
+    let magnitude = value.abs();
+    if value.is_finite() && value != 0.0 && !(1e-4..1e16).contains(&magnitude) {
+        ryu::Buffer::new().format_finite(value).to_string()
+    } else {
+        format!("{value}")
+    }
 }
 
 fn numbers(values: &[f64]) -> String {
@@ -480,7 +485,7 @@ fn check_steady(
                     "initial.steady.theta",
                     number(theta),
                     format!(
-                        "is outside 0 < |θ| < π/2 − {margin} (run.flat_margin): a steady circle needs a leaning coin; use kind = \"straight\" for θ = 0"
+                        "is outside 0 < |θ| < π/2 − {margin} (run.flat_margin): this steady motion needs a leaning coin; use kind = \"straight\" for θ = 0"
                     ),
                 );
             }
