@@ -418,3 +418,43 @@ fn ctrl_c_finishes_the_file_marked_interrupted() {
         coin_log::units::log_time(result.termination_time).unwrap()
     );
 }
+
+#[test]
+fn a_numerical_failure_finishes_the_file_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    // ω_Z = 1e150 is finite, but the first step overflows: the state becomes non-finite.
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "wobble",
+            "--integrator",
+            "rk4",
+            "--set",
+            "initial.omega=[0, 0, 1e150]",
+            "-o",
+            "f.mcap",
+        ],
+    );
+    let err = stderr(&out);
+    println!("exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1);
+    assert!(
+        err.contains("non-finite") && err.contains("f.mcap"),
+        "{err}"
+    );
+    let file = read_back(&std::fs::read(dir.path().join("f.mcap")).unwrap());
+    let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+    println!(
+        "termination {} at {}, {} messages",
+        result.termination,
+        result.termination_time,
+        file.messages.len()
+    );
+    assert_eq!(result.termination, "non-finite");
+    assert_eq!(
+        file.on_topic("/coin/omega").len(),
+        1,
+        "the sample at t = 0 is in the file"
+    );
+}

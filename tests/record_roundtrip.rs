@@ -580,3 +580,33 @@ fn a_run_ended_by_an_event_writes_a_last_sample_at_the_event_time() {
         check_recording(name, &scene, &bytes, &summary);
     }
 }
+
+#[test]
+fn a_sample_that_cannot_be_written_whole_is_not_written_at_all() {
+    // ω_Z = 1e200: the state is finite but its energy overflows, so the first sample cannot be formatted.
+    let file = presets::preset("wobble").unwrap();
+    let file = scene::file_with_sets(&file, &["initial.omega=[0, 0, 1e200]".into()]).unwrap();
+    let scene = scene::resolve(
+        &file,
+        &FlagOverrides {
+            integrator: Some("rk4".into()),
+            ..FlagOverrides::default()
+        },
+    )
+    .unwrap();
+    let (bytes, summary) = record_to_memory(&scene, &RecordOptions::default());
+    let back = read_back(&bytes);
+    println!(
+        "termination {}: {:?}; {} samples, {} messages",
+        summary.termination.name(),
+        summary.termination,
+        summary.samples,
+        back.messages.len()
+    );
+    assert_eq!(summary.termination.name(), "non-finite");
+    assert_eq!(
+        (summary.samples, summary.messages, back.messages.len()),
+        (0, 0, 0)
+    );
+    assert!(back.topics().is_empty(), "no channel without messages");
+}

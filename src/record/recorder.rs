@@ -237,9 +237,15 @@ struct Sampler<W: Write + Seek> {
     out: Output<W>,
     coin: Coin,
     on: [bool; Channel::ALL.len()],
+    /// The formatted messages of the current sample, back to back.
     buffer: Vec<u8>,
+    /// (channel, start, end) of each message in `buffer`.
+    staged: [(Channel, usize, usize); Channel::ALL.len()],
+    staged_len: usize,
     foxglove: Option<(Foxglove3d, FoxgloveBatch)>,
     drift: Drift,
+    /// Samples written.
+    samples: u64,
 }
 
 impl<W: Write + Seek> Sampler<W> {
@@ -248,23 +254,27 @@ impl<W: Write + Seek> Sampler<W> {
         self.on[channel as usize]
     }
 
-    /// Formats one message into the reused buffer and writes it.
+    /// Formats one message into the sample's buffer; it is written once the whole sample is formatted.
     #[inline]
-    fn emit(
+    fn stage(
         &mut self,
         channel: Channel,
-        log_time: u64,
         format: impl FnOnce(&mut Vec<u8>) -> Result<(), NonFiniteField>,
     ) -> Result<(), SampleError> {
-        self.buffer.clear();
+        let start = self.buffer.len();
         format(&mut self.buffer)?;
-        self.out.write(channel, log_time, &self.buffer)
+        self.staged[self.staged_len] = (channel, start, self.buffer.len());
+        self.staged_len += 1;
+        Ok(())
     }
 
+    /// Writes the sample (t, y): all its messages or, if one cannot be formatted, none.
     fn sample(&mut self, t: f64, y: &[f64; STATE_LEN], last: bool) -> Result<(), SampleError> {
         let ns = log_time(t)?;
         let s = State::from_array(y);
         let coin = self.coin;
+        self.buffer.clear();
+        self.staged_len = 0;
         if self.on(Channel::Omega) {
             let m = AngularVelocity {
                 t,
@@ -272,7 +282,7 @@ impl<W: Write + Seek> Sampler<W> {
                 y: s.omega_y,
                 z: s.omega_z,
             };
-            self.emit(Channel::Omega, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Omega, |b| m.write_json(b))?;
         }
         if self.on(Channel::Angles) {
             let m = Angles {
@@ -281,7 +291,7 @@ impl<W: Write + Seek> Sampler<W> {
                 phi: s.phi,
                 psi: s.psi,
             };
-            self.emit(Channel::Angles, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Angles, |b| m.write_json(b))?;
         }
         if self.on(Channel::Quaternion) {
             let q = orientation(&s);
@@ -292,7 +302,7 @@ impl<W: Write + Seek> Sampler<W> {
                 z: q.z,
                 w: q.w,
             };
-            self.emit(Channel::Quaternion, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Quaternion, |b| m.write_json(b))?;
         }
         if self.on(Channel::Position) {
             let c = centre(&coin, &s);
@@ -302,7 +312,7 @@ impl<W: Write + Seek> Sampler<W> {
                 y: c.y,
                 z: c.z,
             };
-            self.emit(Channel::Position, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Position, |b| m.write_json(b))?;
         }
         if self.on(Channel::Contact) {
             let c = contact_point(&coin, &s);
@@ -312,7 +322,7 @@ impl<W: Write + Seek> Sampler<W> {
                 y: c.y,
                 z: c.z,
             };
-            self.emit(Channel::Contact, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Contact, |b| m.write_json(b))?;
         }
         if self.on(Channel::Reaction) {
             let r = reaction(&coin, &s);
@@ -324,11 +334,10 @@ impl<W: Write + Seek> Sampler<W> {
                 friction: r.friction,
                 normal: r.normal,
             };
-            self.emit(Channel::Reaction, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Reaction, |b| m.write_json(b))?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
         let e = energy(&coin, &s);
-        self.track(&s, e.total);
         if self.on(Channel::Energy) {
             let m = EnergyMessage {
                 t,
@@ -336,15 +345,22 @@ impl<W: Write + Seek> Sampler<W> {
                 kinetic: e.kinetic,
                 potential: e.potential,
             };
-            self.emit(Channel::Energy, ns, |b| m.write_json(b))?;
+            self.stage(Channel::Energy, |b| m.write_json(b))?;
         }
         if let Some((foxglove, batch)) = &mut self.foxglove {
             batch.clear();
             foxglove.sample(t, ns, &s, last, batch)?;
+        }
+        for &(channel, start, end) in &self.staged[..self.staged_len] {
+            self.out.write(channel, ns, &self.buffer[start..end])?;
+        }
+        if let Some((_, batch)) = &self.foxglove {
             for (channel, data) in batch.iter() {
                 self.out.write(channel, ns, data)?;
             }
         }
+        self.track(&s, e.total);
+        self.samples += 1;
         Ok(())
     }
 
@@ -407,8 +423,11 @@ pub fn record<W: Write + Seek>(
         },
         coin,
         on,
-        buffer: Vec::with_capacity(256),
+        buffer: Vec::with_capacity(1024),
+        staged: [(Channel::Omega, 0, 0); Channel::ALL.len()],
+        staged_len: 0,
         foxglove,
+        samples: 0,
         drift: Drift {
             energy0,
             energy_scale: energy0.abs().max(params.energy_scale()),
@@ -434,7 +453,7 @@ pub fn record<W: Write + Seek>(
     let events = CoinEvents::new(coin, scene.run.flat_margin, scene.friction);
     let mut pending: Option<(f64, [f64; STATE_LEN])> = None;
     let mut error: Option<SampleError> = None;
-    let mut samples: u64 = 0;
+    let mut observed: u64 = 0;
     let outcome = run_method(
         &scene.run.method,
         &coin,
@@ -448,8 +467,8 @@ pub fn record<W: Write + Seek>(
                     return Flow::Stop;
                 }
             }
-            samples += 1;
-            if samples % PROGRESS_INTERVAL == 0 {
+            observed += 1;
+            if observed % PROGRESS_INTERVAL == 0 {
                 progress(t);
             }
             if stop.load(Ordering::Relaxed) {
@@ -486,6 +505,7 @@ pub fn record<W: Write + Seek>(
     let Sampler {
         out: mut output,
         drift,
+        samples,
         ..
     } = sampler;
     let stats = outcome.stats;
