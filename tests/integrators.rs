@@ -563,3 +563,51 @@ fn gauss4_solves_its_stage_equations_for_a_fast_spinning_coin() {
         assert!(error <= 1e-6, "h = {h}: energy error {error:.3e}");
     }
 }
+
+#[test]
+fn dop853_computes_its_dense_output_stages_only_in_sampled_steps() {
+    let (coin, y0) = wobbling_coin();
+    // Samples only at t0 and t_end (a step end): no interpolation, 12 evaluations per accepted step,
+    // 11 per rejected one (the FSAL stage is evaluated only on acceptance), plus f(t0) and hinit's one.
+    let (_, stats) = final_state(&config(Method::Dop853, 1e-10), &coin, &y0, 10.0);
+    let expected = 2 + 12 * stats.steps + 11 * stats.rejected_steps;
+    println!("unsampled: {stats:?}, expected rhs {expected}");
+    assert_eq!(stats.rhs_evaluations, expected);
+    // Sampled every 0.01 (several samples per step): 3 more evaluations in every step.
+    let (_, sampled_stats) = sampled_every(&config(Method::Dop853, 1e-10), &coin, &y0, 10.0, 0.01);
+    let expected = 2 + 15 * sampled_stats.steps + 11 * sampled_stats.rejected_steps;
+    println!("sampled: {sampled_stats:?}, expected rhs ≤ {expected}");
+    assert!(sampled_stats.rhs_evaluations <= expected);
+    assert!(sampled_stats.rhs_evaluations > stats.rhs_evaluations);
+}
+
+#[test]
+fn adaptive_methods_stay_accurate_at_rtol_1e_14_and_atol_1e_16() {
+    let t_end = 20.0;
+    let exact = kepler_exact(t_end);
+    for method in [Method::Dopri5, Method::Dop853] {
+        let tight = MethodConfig {
+            method,
+            rtol: 1e-14,
+            atol: 1e-16,
+            step: 0.0,
+        };
+        let (y, stats) = final_state(&tight, &Kepler, &kepler_exact(0.0), t_end);
+        let error = max_difference(&y, &exact);
+        println!("{method} rtol 1e-14 atol 1e-16 on Kepler to t = {t_end}: error {error:.3e} (expected ≤ 1e-11), {stats:?}");
+        assert!(error <= 1e-11, "{method}: error {error:.3e}");
+    }
+}
+
+#[test]
+fn methods_parse_from_their_names_and_dop853_is_the_default() {
+    for &method in Method::ALL {
+        assert_eq!(method.name().parse::<Method>(), Ok(method));
+    }
+    assert_eq!(Method::default(), Method::Dop853);
+    let error = "rk45".parse::<Method>().unwrap_err().to_string();
+    println!("{error}");
+    assert!(error.contains("rk4, dopri5, dop853, gauss4"));
+    assert!(Method::Dopri5.is_adaptive() && Method::Dop853.is_adaptive());
+    assert!(!Method::Rk4.is_adaptive() && !Method::Gauss4.is_adaptive());
+}
