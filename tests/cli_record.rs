@@ -1,5 +1,7 @@
 //! `coin-log record` and `coin-log scenes` as a user runs them: exit codes, messages that name key and
 //! value, an output folder left untouched on error, determinism across processes, Ctrl-C.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common_record;
 

@@ -1,5 +1,7 @@
 //! Recordings read back with the `mcap` crate match the contract and the library's own computation, bit
 //! for bit; writing failures surface as errors; the same scene gives the same bytes.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common_record;
 
@@ -32,7 +34,6 @@ fn preset_scene(name: &str, flags: FlagOverrides) -> Scene {
         .expect("duration");
     let flags = FlagOverrides {
         duration: flags.duration.or(Some(duration.min(TEST_DURATION))),
-        integrator: flags.integrator.or(Some("rk4".into())), // TEMP until dop853 lands
         ..flags
     };
     scene::resolve(&file, &flags).unwrap_or_else(|e| panic!("{name}: {e}"))

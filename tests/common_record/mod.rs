@@ -1,6 +1,7 @@
 //! Helpers shared by the record tests: reading a recording back, a validator for our flat JSON schemas,
 //! running the binary in a temporary folder.
-#![allow(dead_code, missing_docs)]
+// Test helpers: a failed read is a failed test, so they panic with a message.
+#![allow(dead_code, missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::collections::BTreeMap;
 use std::path::Path;
