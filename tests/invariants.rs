@@ -11,8 +11,11 @@ use coin_log::integrate::{Flow, Rk4, RunSettings, Termination};
 use coin_log::model::{Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
 use coin_log::simulation::{simulate, CoinEvents};
 
+use std::f64::consts::FRAC_PI_6;
+
 const FLAT_LIMIT: f64 = 1.5705;
 
+#[allow(clippy::unwrap_used)] // a test helper: invalid parameters are a bug in the test
 fn params(inertia: Inertia) -> CoinParams {
     CoinParams::new(1.0, 1.0, 1.0, inertia).unwrap()
 }
@@ -103,7 +106,20 @@ fn reference(mu: f64, taus: &[f64]) -> (Vec<[f64; 4]>, f64) {
 fn thetas() -> Vec<f64> {
     let mut t: Vec<f64> = (0..=30).map(|i| 0.05 * f64::from(i)).collect();
     t.extend([
-        1e-3, 0.52, 0.5235, 0.5237, 0.53, 1.52, 1.55, 1.56, 1.565, 1.569, 1.57, 1.5704, FLAT_LIMIT,
+        1e-3,
+        0.52,
+        FRAC_PI_6 - 1e-9,
+        FRAC_PI_6,
+        FRAC_PI_6 + 1e-9,
+        0.53,
+        1.52,
+        1.55,
+        1.56,
+        1.565,
+        1.569,
+        1.57,
+        1.5704,
+        FLAT_LIMIT,
     ]);
     t.sort_by(f64::total_cmp);
     t
