@@ -229,7 +229,13 @@ impl Chaplygin {
         1.0 / self.inverse_k
     }
 
-    /// Number of series terms summed on each side of s = ½ (about the cost of one evaluation).
+    /// |s| where the two expansions meet (½ for μ ≤ 4): exposed so tests can probe both sides of it.
+    #[must_use]
+    pub fn split_sin(&self) -> f64 {
+        self.split_sin
+    }
+
+    /// Number of series terms summed on each side of the split (about the cost of one evaluation).
     #[must_use]
     pub fn terms(&self) -> (usize, usize) {
         (self.centre.len(), self.edge.len())
