@@ -7,8 +7,8 @@
 //! only τ ≈ 8.8. Classical RK4 at h ≈ 2.5e-4 with compensated (Kahan) accumulation, run again at h/2 and
 //! Richardson-extrapolated; the difference between the two runs is printed as the reference's own error.
 
-use coin_log::integrate::{Flow, Rk4, RunSettings, Termination};
-use coin_log::model::{Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
+use coin_log::model::{energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
 use coin_log::simulation::{simulate, CoinEvents};
 
 use std::f64::consts::FRAC_PI_6;
@@ -532,4 +532,96 @@ fn basis_is_continuous_across_the_split_and_keeps_its_wronskian_for_random_bodie
         "200 random μ in [1e-6, 100]: max relative jump across the split {worst_jump:.2e} (tolerance 1e-13), \
          max Wronskian error {worst_wronskian:.2e} (tolerance 1e-13)"
     );
+}
+
+/// Issue 4: E, C1, C2 drift ≤ 1e-11 over 100 time units on the wobble with dop853 at rtol 1e-12.
+const DOP853_DRIFT_TOLERANCE: f64 = 1e-11;
+
+#[test]
+fn energy_c1_and_c2_drift_below_1e_11_over_100_time_units_with_dop853_at_rtol_1e_12() {
+    // The issue's bound is for the wobble; the deep lean (not in the issue) gets 1e-10: its energy drift
+    // measured 1.2e-11 at these tolerances.
+    let cases = [
+        (
+            "thin disk",
+            params(Inertia::ThinDisk),
+            wobble(),
+            DOP853_DRIFT_TOLERANCE,
+        ),
+        (
+            "hoop",
+            params(Inertia::Hoop),
+            wobble(),
+            DOP853_DRIFT_TOLERANCE,
+        ),
+        (
+            "μ = 0.1",
+            params_with_mu(0.1),
+            wobble(),
+            DOP853_DRIFT_TOLERANCE,
+        ),
+        (
+            "μ = 2.7",
+            params_with_mu(2.7),
+            wobble(),
+            DOP853_DRIFT_TOLERANCE,
+        ),
+        (
+            "thin disk, deep lean",
+            params(Inertia::ThinDisk),
+            deep_lean(),
+            1e-10,
+        ),
+    ];
+    for (name, p, initial, bound) in cases {
+        let coin = Coin::new(p);
+        let ch = Chaplygin::new(&p).unwrap();
+        let e0 = energy(&coin, &initial).total;
+        let c0 = ch.of_state(&initial);
+        // Contract definitions: max|E − E₀| / max(|E₀|, Mga), max|C − C₀| / (|C1₀| + |C2₀|).
+        let energy_scale = e0.abs().max(p.energy_scale());
+        let c_scale = c0.c1.abs() + c0.c2.abs();
+        let (mut energy_drift, mut c1_drift, mut c2_drift) = (0.0_f64, 0.0_f64, 0.0_f64);
+        let config = MethodConfig {
+            method: Method::Dop853,
+            rtol: 1e-12,
+            atol: 1e-12,
+            step: 0.0,
+        };
+        let outcome = run_method(
+            &config,
+            &coin,
+            &initial.to_array(),
+            &RunSettings {
+                t0: 0.0,
+                t_end: 100.0,
+                sample_interval: 0.01,
+            },
+            &CoinEvents::new(coin, 1e-3, None),
+            |_, y| {
+                let state = State::from_array(y);
+                energy_drift =
+                    energy_drift.max((energy(&coin, &state).total - e0).abs() / energy_scale);
+                let c = ch.of_state(&state);
+                c1_drift = c1_drift.max((c.c1 - c0.c1).abs() / c_scale);
+                c2_drift = c2_drift.max((c.c2 - c0.c2).abs() / c_scale);
+                Flow::Continue
+            },
+        );
+        println!(
+            "{name}: dop853 rtol = atol = 1e-12 to t = {:.3} ({:?}, {} steps): drift E {energy_drift:.2e}, \
+             C1 {c1_drift:.2e}, C2 {c2_drift:.2e} (tolerance {bound:.0e})",
+            outcome.t_last, outcome.termination, outcome.stats.steps
+        );
+        assert!(
+            matches!(outcome.termination, Termination::Completed),
+            "{name} did not complete"
+        );
+        for (quantity, drift) in [("E", energy_drift), ("C1", c1_drift), ("C2", c2_drift)] {
+            assert!(
+                drift <= bound,
+                "{name}: {quantity} drift {drift:.2e} > {bound:.0e}"
+            );
+        }
+    }
 }
