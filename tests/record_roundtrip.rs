@@ -6,9 +6,12 @@
 mod common_record;
 
 use coin_log::integrate::{run_method, Flow, RunSettings};
-use coin_log::model::{centre, contact_point, energy, orientation, reaction, State, STATE_LEN};
+use coin_log::model::{
+    centre, contact_point, energy, orientation, reaction, Chaplygin, State, STATE_LEN,
+};
 use coin_log::record::messages::{
-    Angles, AngularVelocity, EnergyMessage, Position, QuaternionMessage, ReactionMessage,
+    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
+    ReactionMessage,
 };
 use coin_log::record::{
     self, run_metadata, Channel, Compression, Foxglove3d, FoxgloveBatch, RecordOptions,
@@ -71,6 +74,7 @@ fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
     let (tf, scene_on) = (scene.records(Channel::Tf), scene.records(Channel::Scene));
     let mut foxglove = Foxglove3d::new(&coin, scene.thickness, tf, scene_on);
     let mut batch = FoxgloveBatch::default();
+    let chaplygin = Chaplygin::new(&scene.params).unwrap();
     let mut out = Vec::new();
     let last = samples.len() - 1;
     for (k, (t, y)) in samples.iter().enumerate() {
@@ -161,6 +165,16 @@ fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
             .write_json(b)
             .unwrap()
         });
+        push(Channel::Invariants, &|b| {
+            let c = chaplygin.of_state(&s);
+            InvariantsMessage {
+                t,
+                c1: c.c1,
+                c2: c.c2,
+            }
+            .write_json(b)
+            .unwrap()
+        });
         if tf || scene_on {
             batch.clear();
             foxglove.sample(t, ns, &s, k == last, &mut batch).unwrap();
@@ -178,7 +192,7 @@ fn per_sample_channels(scene: &Scene) -> Vec<Channel> {
         .channels
         .iter()
         .copied()
-        .filter(|c| !matches!(c, Channel::Tf | Channel::Scene | Channel::Invariants))
+        .filter(|c| !matches!(c, Channel::Tf | Channel::Scene))
         .collect()
 }
 
@@ -333,8 +347,12 @@ fn check_recording(name: &str, scene: &Scene, bytes: &[u8], summary: &RecordSumm
     );
     assert_eq!(result.steps, summary.stats.steps);
     println!(
-        "{name:<18} {:>6} samples {:>7} messages {:>8} bytes, termination {} at t = {}, energy drift {:.2e}",
-        summary.samples, summary.messages, summary.bytes, summary.termination.name(), summary.termination_time, summary.energy_drift
+        "{name:<18} {:>6} samples {:>7} messages {:>8} bytes, termination {} at t = {}, energy drift {:.2e}, C1/C2 drift {:?}",
+        summary.samples, summary.messages, summary.bytes, summary.termination.name(), summary.termination_time, summary.energy_drift, summary.invariant_drift
+    );
+    assert_eq!(
+        summary.invariant_drift.is_some(),
+        scene.records(Channel::Invariants)
     );
 }
 

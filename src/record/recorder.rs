@@ -13,15 +13,18 @@
 use super::channels::{schema_bytes, Channel, MESSAGE_ENCODING, SCHEMA_ENCODING};
 use super::foxglove::{Foxglove3d, FoxgloveBatch};
 use super::messages::{
-    Angles, AngularVelocity, EnergyMessage, NonFiniteField, Position, QuaternionMessage,
-    ReactionMessage,
+    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField, Position,
+    QuaternionMessage, ReactionMessage,
 };
 use super::metadata::{
     ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use super::summary::{Failure, RecordSummary, Termination};
 use crate::integrate::{run_method, Flow, RunSettings, Termination as RunEnd};
-use crate::model::{centre, contact_point, energy, orientation, reaction, Coin, State, STATE_LEN};
+use crate::model::{
+    centre, contact_point, energy, orientation, reaction, Chaplygin, Coin, InvariantsError, State,
+    STATE_LEN,
+};
 use crate::scene::Scene;
 use crate::simulation::CoinEvents;
 use crate::units::{log_time, TimeError};
@@ -106,6 +109,9 @@ pub enum RecordError {
     /// Flushing the finished file failed.
     #[error("writing the MCAP file failed")]
     Io(#[from] std::io::Error),
+    /// C1, C2 cannot be evaluated for this body (μ too large; no validated scene has such a body).
+    #[error("the `invariants` channel cannot be recorded for this body")]
+    Invariants(#[from] InvariantsError),
 }
 
 /// The `mcap` writer options of every coin-log file.
@@ -227,6 +233,9 @@ struct Drift {
     energy0: f64,
     energy_scale: f64,
     energy: f64,
+    /// (C1₀, C2₀), the scale |C1₀| + |C2₀| (1 when both are 0) and max |C − C₀| / scale.
+    invariants0: Option<(f64, f64, f64)>,
+    invariants: f64,
     steady: Option<[f64; 4]>,
     time_unit: f64,
     steady_residual: f64,
@@ -243,6 +252,8 @@ struct Sampler<W: Write + Seek> {
     staged: [(Channel, usize, usize); Channel::ALL.len()],
     staged_len: usize,
     foxglove: Option<(Foxglove3d, FoxgloveBatch)>,
+    /// C1, C2, only when the `invariants` channel is recorded.
+    chaplygin: Option<Chaplygin>,
     drift: Drift,
     /// Samples written.
     samples: u64,
@@ -347,6 +358,15 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Energy, |b| m.write_json(b))?;
         }
+        let invariants = self.chaplygin.as_ref().map(|c| c.of_state(&s));
+        if let Some(c) = invariants {
+            let m = InvariantsMessage {
+                t,
+                c1: c.c1,
+                c2: c.c2,
+            };
+            self.stage(Channel::Invariants, |b| m.write_json(b))?;
+        }
         if let Some((foxglove, batch)) = &mut self.foxglove {
             batch.clear();
             foxglove.sample(t, ns, &s, last, batch)?;
@@ -360,8 +380,22 @@ impl<W: Write + Seek> Sampler<W> {
             }
         }
         self.track(&s, e.total);
+        if let Some(c) = invariants {
+            self.track_invariants(c.c1, c.c2);
+        }
         self.samples += 1;
         Ok(())
+    }
+
+    #[inline]
+    fn track_invariants(&mut self, c1: f64, c2: f64) {
+        let d = &mut self.drift;
+        let (c10, c20, scale) = *d.invariants0.get_or_insert_with(|| {
+            let scale = c1.abs() + c2.abs();
+            (c1, c2, if scale > 0.0 { scale } else { 1.0 })
+        });
+        let deviation = (c1 - c10).abs().max((c2 - c20).abs()) / scale;
+        d.invariants = d.invariants.max(deviation);
     }
 
     #[inline]
@@ -395,16 +429,23 @@ pub fn record<W: Write + Seek>(
     mut progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
     let coin = scene.coin();
+    let params = scene.params;
+    let mut on = [false; Channel::ALL.len()];
+    for c in &scene.channels {
+        on[*c as usize] = true;
+    }
+    // Before the first byte: a body whose C1, C2 cannot be evaluated leaves no half-written file.
+    let chaplygin = if on[Channel::Invariants as usize] {
+        Some(Chaplygin::new(&params)?)
+    } else {
+        None
+    };
     let mut writer = write_options(options).create(writer)?;
     writer.write_metadata(&mcap::records::Metadata {
         name: RUN_METADATA_NAME.to_string(),
         metadata: run_metadata(scene).to_map(),
     })?;
 
-    let mut on = [false; Channel::ALL.len()];
-    for c in &scene.channels {
-        on[*c as usize] = true;
-    }
     let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
     let foxglove = (tf || scene_on).then(|| {
         (
@@ -412,8 +453,8 @@ pub fn record<W: Write + Seek>(
             FoxgloveBatch::default(),
         )
     });
-    let params = scene.params;
     let energy0 = energy(&coin, &scene.initial).total;
+
     let mut sampler = Sampler {
         out: Output {
             writer,
@@ -427,11 +468,14 @@ pub fn record<W: Write + Seek>(
         staged: [(Channel::Omega, 0, 0); Channel::ALL.len()],
         staged_len: 0,
         foxglove,
+        chaplygin,
         samples: 0,
         drift: Drift {
             energy0,
             energy_scale: energy0.abs().max(params.energy_scale()),
             energy: 0.0,
+            invariants0: None,
+            invariants: 0.0,
             steady: scene.unperturbed_steady().map(|s| {
                 [
                     s.state.theta,
@@ -532,7 +576,7 @@ pub fn record<W: Write + Seek>(
         termination,
         termination_time,
         energy_drift: drift.energy,
-        invariant_drift: None,
+        invariant_drift: drift.invariants0.map(|_| drift.invariants),
         steady_residual: drift.steady.map(|_| drift.steady_residual),
     })
 }
