@@ -42,7 +42,7 @@ pub fn preset(name: &str) -> Option<SceneFile> {
                 ..steady_initial(straight(0.3))
             },
             ..steady(
-                "Straight rolling at ω_Z = 0.3 < ω_c = 1/√3 with a 1e-6 tilt: the tilt grows like e^{λt} until the coin falls (NOTES §5)",
+                "Straight rolling at ω_Z = 0.3 < ω_c = 1/√3 with a 1e-6 tilt: the tilt grows like e^{λt}, λ = 0.764, to about 1 rad by t = 19 (NOTES §5)",
                 straight(0.3),
                 20.0,
             )
