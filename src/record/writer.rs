@@ -794,7 +794,8 @@ impl<W: Write> McapWriter<W> {
         end_record(&mut b, at);
         self.out.write_all(&b)?;
 
-        // The summary CRC starts here (a fresh hasher), at the summary's first byte.
+        // The summary CRC starts at the summary's first byte, after DataEnd.
+        self.out.crc = crc32fast::Hasher::new();
         let summary_start = self.out.position;
         let mut groups: Vec<(u8, u64, u64)> = Vec::new();
         let mut group = |out: &mut Output<W>, opcode: u8, bytes: &[u8]| -> io::Result<()> {
