@@ -1,0 +1,4 @@
+//! The hard-case suite (issue 8, `bench stability`).
+
+/// Case names.
+pub const SUITE: &[&str] = &[];
