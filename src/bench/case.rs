@@ -298,6 +298,17 @@ pub fn analytic_steady_state(coin: &Coin, steady: &Steady, start: &State, t: f64
 /// # Errors
 /// [`BenchError::ReferenceFailed`] when the numerical reference does not reach the end of the case.
 pub fn reference_trajectory(case: &BenchCase) -> Result<Reference, BenchError> {
+    reference_trajectory_with(case, &case.settings())
+}
+
+/// Like [`reference_trajectory`] on the sample grid of `settings`.
+///
+/// # Errors
+/// As [`reference_trajectory`].
+pub fn reference_trajectory_with(
+    case: &BenchCase,
+    settings: &RunSettings,
+) -> Result<Reference, BenchError> {
     if let Some(steady) = case.steady {
         return Ok(Reference::Analytic {
             steady,
@@ -317,7 +328,7 @@ pub fn reference_trajectory(case: &BenchCase) -> Result<Reference, BenchError> {
         },
     };
     let mut trajectory = Trajectory::default();
-    run_sampled(&config, case, &mut trajectory);
+    run_sampled_with(&config, case, settings, &mut trajectory);
     if !trajectory.completed() && trajectory.outcome.is_some() {
         // An event ends the reference and the runs alike: judge the common samples.
         if !matches!(

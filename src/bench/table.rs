@@ -1,6 +1,7 @@
 //! Text tables and CSV of bench results, returned as strings (the CLI prints or writes them).
 
 use super::precision::PrecisionRow;
+use super::stability::StabilityRow;
 
 /// The CSV header of `bench precision` (issue 8, fixed column set).
 pub const PRECISION_CSV_HEADER: &str = "scene,integrator,tolerance,step,state_error,energy_error,invariant_error,wall_seconds,rhs_evaluations,steps,rejected";
@@ -107,6 +108,73 @@ pub fn precision_table(rows: &[PrecisionRow]) -> String {
                 r.steps.to_string(),
                 r.rejected.to_string(),
                 r.termination.clone(),
+            ]
+        })
+        .collect();
+    render(&header, &body)
+}
+
+/// The CSV header of `bench stability`.
+pub const STABILITY_CSV_HEADER: &str = "case,integrator,setting,termination,end_time,max_error,energy_drift,wall_seconds,quantity,measured,expected";
+
+/// The stability rows as CSV with [`STABILITY_CSV_HEADER`] (settings and quantities contain no commas).
+#[must_use]
+pub fn stability_csv(rows: &[StabilityRow]) -> String {
+    let mut out = String::from(STABILITY_CSV_HEADER);
+    out.push('\n');
+    for r in rows {
+        let fields = [
+            r.case.clone(),
+            r.integrator.name().to_string(),
+            r.setting.clone(),
+            r.termination.clone(),
+            number(Some(r.end_time)),
+            number(r.max_error),
+            number(Some(r.energy_drift)),
+            number(Some(r.wall_seconds)),
+            r.quantity.clone(),
+            number(r.measured),
+            number(r.expected),
+        ];
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// The stability rows as a text table.
+#[must_use]
+pub fn stability_table(rows: &[StabilityRow]) -> String {
+    let header = [
+        "case",
+        "integrator",
+        "setting",
+        "end",
+        "t end",
+        "max error",
+        "energy drift",
+        "wall [s]",
+        "quantity",
+        "measured",
+        "expected",
+    ];
+    let body: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.case.clone(),
+                r.integrator.name().to_string(),
+                r.setting.clone(),
+                r.termination.clone(),
+                format!("{:.6}", r.end_time),
+                short(r.max_error),
+                short(Some(r.energy_drift)),
+                short(Some(r.wall_seconds)),
+                r.quantity.clone(),
+                r.measured
+                    .map_or_else(|| "-".into(), |v| format!("{v:.10e}")),
+                r.expected
+                    .map_or_else(|| "-".into(), |v| format!("{v:.10e}")),
             ]
         })
         .collect();

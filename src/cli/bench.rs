@@ -5,7 +5,7 @@ use anyhow::Context;
 use coin_log::bench::plot::work_precision_svg;
 use coin_log::bench::precision::{precision_bench, PrecisionOptions};
 use coin_log::bench::presets::{bench_case, DEFAULT_PRECISION_SCENES};
-use coin_log::bench::table::{precision_csv, precision_table};
+use coin_log::bench::table::{precision_csv, precision_table, stability_csv, stability_table};
 use coin_log::bench::{nominal_order, stability};
 use coin_log::integrate::Method;
 use std::fs;
@@ -113,6 +113,10 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
 
 fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     create_dir(&args.out)?;
-    let _ = stability::SUITE;
-    anyhow::bail!("`coin-log bench stability` is not built yet")
+    let rows = stability::run_suite(&stability::SuiteOptions::full())?;
+    print!("{}", stability_table(&rows));
+    let csv_path = args.out.join("stability.csv");
+    write(&csv_path, &stability_csv(&rows))?;
+    println!("CSV: {}", csv_path.display());
+    Ok(Outcome::Success)
 }
