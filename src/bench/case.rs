@@ -79,16 +79,10 @@ pub fn method_by_name(name: &str) -> Option<Method> {
     name.parse().ok()
 }
 
-/// The classical order of a method, by name: the slope its work-precision line should have.
+/// The classical order of a method: the slope its work-precision line should have.
 #[must_use]
-pub fn nominal_order(method: Method) -> Option<u32> {
-    match method.name() {
-        "rk4" | "gauss4" => Some(4),
-        "dopri5" => Some(5),
-        "gauss6" => Some(6),
-        "dop853" => Some(8),
-        _ => None,
-    }
+pub fn nominal_order(method: Method) -> u32 {
+    method.order()
 }
 
 /// The contract's default settings of a method, the step scaled to the case's time unit.

@@ -56,12 +56,12 @@ impl PrecisionOptions {
         }
     }
 
-    /// A reduced sweep for tests: atol = 1e-6, 1e-8, ..., 1e-14, 5 fixed steps, one timed run.
+    /// A reduced sweep for tests: atol = 1e-6, 1e-8, ..., 1e-16, 5 fixed steps, one timed run.
     #[must_use]
     pub fn reduced() -> Self {
         Self {
             repeats: 1,
-            adaptive_atols: (3..=7).map(|k| 10f64.powi(-2 * k)).collect(),
+            adaptive_atols: (3..=8).map(|k| 10f64.powi(-2 * k)).collect(),
             fixed_points: 5,
         }
     }
@@ -272,7 +272,7 @@ pub fn fixed_steps(
     points: usize,
 ) -> Vec<f64> {
     let interval = case.settings().sample_interval;
-    let order = f64::from(nominal_order(method).unwrap_or(4));
+    let order = f64::from(nominal_order(method));
     let mut buffer = Trajectory::default();
     let mut pilot = interval;
     let mut pilot_error = f64::INFINITY;

@@ -90,10 +90,9 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         println!("scene {} — reference: {}", report.scene, report.reference);
         print!("{}", precision_table(&report.rows));
         for s in &report.slopes {
-            let expected =
-                nominal_order(s.integrator).map_or_else(|| "?".to_string(), |p| format!("-{p}"));
+            let expected = nominal_order(s.integrator);
             println!(
-                "  {:>8}: slope {} (vs time), {} (vs RHS evaluations), order {expected}, {} points",
+                "  {:>8}: slope {} (vs time), {} (vs RHS evaluations), order -{expected}, {} points",
                 s.integrator.name(),
                 s.time.map_or_else(|| "-".into(), |v| format!("{v:.2}")),
                 s.work.map_or_else(|| "-".into(), |v| format!("{v:.2}")),
