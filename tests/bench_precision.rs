@@ -50,6 +50,29 @@ fn dop853_reaches_a_state_error_of_1e_10_on_wobble() {
 }
 
 #[test]
+fn energy_and_invariant_errors_shrink_with_the_tolerance() {
+    let dop853: Vec<_> = wobble_report()
+        .rows
+        .iter()
+        .filter(|r| r.integrator == Method::Dop853)
+        .collect();
+    let (loose, tight) = (dop853[0], dop853[dop853.len() - 1]);
+    let (c_loose, c_tight) = (
+        loose.invariant_error.unwrap(),
+        tight.invariant_error.unwrap(),
+    );
+    println!(
+        "dop853 atol {:e}: E {:e}, C1/C2 {c_loose:e}; atol {:e}: E {:e}, C1/C2 {c_tight:e} (≤ 1e-11)",
+        loose.tolerance.unwrap(),
+        loose.energy_error,
+        tight.tolerance.unwrap(),
+        tight.energy_error
+    );
+    assert!(tight.energy_error <= 1e-11 && c_tight <= 1e-11);
+    assert!(loose.energy_error > 1e3 * tight.energy_error && c_loose > 1e3 * c_tight);
+}
+
+#[test]
 fn measured_slopes_match_the_orders_of_the_integrators() {
     let report = wobble_report();
     for slope in &report.slopes {

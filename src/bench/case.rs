@@ -5,6 +5,7 @@ use super::BenchError;
 use crate::integrate::{
     run_method, Flow, Method, MethodConfig, RunOutcome, RunSettings, StepError, Termination,
 };
+use crate::model::invariants::Chaplygin;
 use crate::model::{energy, Coin, State, Steady, STATE_LEN};
 use crate::simulation::CoinEvents;
 
@@ -398,27 +399,20 @@ pub fn energy_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> f64 {
     worst
 }
 
-/// The Chaplygin–Appell integrals (C1, C2) of a state (NOTES §6), when the model provides them.
-#[must_use]
-pub fn invariants_of(_coin: &Coin, _state: &State) -> Option<(f64, f64)> {
-    // Wired to `model::invariants::Chaplygin` once it lands on main.
-    None
-}
-
 /// Invariant drift (CONTRACT, verify): max|C − C₀| / (|C1₀| + |C2₀|) over the samples and both
-/// integrals; `None` when the invariants are not available.
+/// Chaplygin–Appell integrals (NOTES §6); `None` when they cannot be built for the body or vanish.
 #[must_use]
 pub fn invariant_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> Option<f64> {
-    let first = states.first()?;
-    let (c1_0, c2_0) = invariants_of(coin, &State::from_array(first))?;
-    let scale = c1_0.abs() + c2_0.abs();
-    if scale == 0.0 {
+    let chaplygin = Chaplygin::new(coin.params()).ok()?;
+    let first = chaplygin.of_state(&State::from_array(states.first()?));
+    let scale = first.c1.abs() + first.c2.abs();
+    if scale == 0.0 || !scale.is_finite() {
         return None;
     }
     let mut worst = 0.0_f64;
     for y in states {
-        let (c1, c2) = invariants_of(coin, &State::from_array(y))?;
-        let d = (c1 - c1_0).abs().max((c2 - c2_0).abs()) / scale;
+        let c = chaplygin.of_state(&State::from_array(y));
+        let d = (c.c1 - first.c1).abs().max((c.c2 - first.c2).abs()) / scale;
         if d.is_nan() {
             return Some(f64::INFINITY);
         }
