@@ -9,5 +9,6 @@ pub mod bench;
 pub mod integrate;
 pub mod model;
 pub mod record;
+pub mod scene;
 pub mod simulation;
 pub mod units;
