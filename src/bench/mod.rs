@@ -25,7 +25,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum BenchError {
     /// A scene name that is not a built-in.
-    #[error("unknown scene `{name}`; built-in scenes for the bench: {valid}")]
+    #[error("no built-in scene `{name}`; built-in scenes: {valid}")]
     UnknownScene {
         /// What was given.
         name: String,

@@ -4,10 +4,12 @@ use super::Outcome;
 use anyhow::Context;
 use coin_log::bench::plot::work_precision_svg;
 use coin_log::bench::precision::{precision_bench, PrecisionOptions};
-use coin_log::bench::presets::{bench_case, DEFAULT_PRECISION_SCENES};
+use coin_log::bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
 use coin_log::bench::table::{precision_csv, precision_table, stability_csv, stability_table};
+use coin_log::bench::BenchCase;
 use coin_log::bench::{nominal_order, stability};
 use coin_log::integrate::Method;
+use coin_log::scene::presets;
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -35,7 +37,7 @@ enum BenchCommand {
 /// Arguments of `coin-log bench precision`.
 #[derive(Debug, clap::Args)]
 struct PrecisionArgs {
-    /// Built-in scenes (default: wobble, circle-plus, high-spin).
+    /// Built-in scene names or `.toml` scene files (default: wobble, circle-plus, high-spin).
     scenes: Vec<String>,
     /// Folder for `precision.csv` and `precision-<scene>.svg` (created if missing).
     #[arg(long, default_value = "bench-results")]
@@ -68,6 +70,20 @@ fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
     fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
 }
 
+/// A built-in scene by name, or a `.toml` scene file by path (named by its stem).
+fn load_case(arg: &str) -> anyhow::Result<BenchCase> {
+    let path = Path::new(arg);
+    if presets::preset(arg).is_some() || !(path.exists() || arg.ends_with(".toml")) {
+        return Ok(bench_case(arg)?);
+    }
+    let text = fs::read_to_string(path)
+        .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
+    Ok(bench_case_from_toml(&stem, &text)?)
+}
+
 fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
     let names: Vec<String> = if args.scenes.is_empty() {
         DEFAULT_PRECISION_SCENES
@@ -80,8 +96,8 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
     // Resolve every scene before the (long) runs, so a typo fails at once.
     let cases = names
         .iter()
-        .map(|n| bench_case(n))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|n| load_case(n))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     create_dir(&args.out)?;
     let options = PrecisionOptions::full(args.repeats as usize);
     let mut all_rows = Vec::new();
