@@ -41,16 +41,16 @@ pub struct BenchCase {
     /// The steady motion the scene starts on, when it is unperturbed: then the analytic trajectory is the
     /// reference. `None` for every other scene (the reference is then a tight dop853 run).
     pub steady: Option<Steady>,
-    /// Duration [time].
+    /// Duration \[time\].
     pub duration: f64,
-    /// The run ends at |θ| ≥ π/2 − `flat_margin` [rad].
+    /// The run ends at |θ| ≥ π/2 − `flat_margin` \[rad\].
     pub flat_margin: f64,
     /// Friction coefficient μ; with it the run ends at a slip.
     pub friction: Option<f64>,
 }
 
 impl BenchCase {
-    /// The natural time unit √(a/g) [time].
+    /// The natural time unit √(a/g) \[time\].
     #[must_use]
     pub fn time_unit(&self) -> f64 {
         self.coin.params().time_unit()

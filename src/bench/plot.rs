@@ -14,7 +14,7 @@ const PALETTE: [RGBColor; 6] = [
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
 ];
-/// Size of the diagram [px].
+/// Size of the diagram \[px\].
 const SIZE: (u32, u32) = (800, 560);
 
 /// The work-precision diagram of one scene: log10 state error against log10 wall time, one line per

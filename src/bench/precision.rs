@@ -84,7 +84,7 @@ pub struct PrecisionRow {
     pub energy_error: f64,
     /// C1, C2 drift, CONTRACT definition; `None` when the invariants are not available.
     pub invariant_error: Option<f64>,
-    /// Median wall time of the run [s].
+    /// Median wall time of the run \[s\].
     pub wall_seconds: f64,
     /// Right-hand side evaluations.
     pub rhs_evaluations: u64,
@@ -207,7 +207,7 @@ pub fn slopes_of(integrator: Method, rows: &[PrecisionRow]) -> Slope {
     }
 }
 
-/// Runs `config` once as a warm-up and `repeats` more times, returning the median wall time [s]; the
+/// Runs `config` once as a warm-up and `repeats` more times, returning the median wall time \[s\]; the
 /// samples of the last run are left in `out`.
 fn timed_runs(
     config: &MethodConfig,

@@ -31,7 +31,7 @@ use std::time::Instant;
 pub const STABLE_ENERGY_DRIFT: f64 = 1e-2;
 /// Relative width to which the largest stable step is bisected.
 const BISECTION_WIDTH: f64 = 1e-3;
-/// Lean of the fast-spin circles [rad].
+/// Lean of the fast-spin circles \[rad\].
 const FAST_SPIN_TILT: f64 = 0.2;
 /// Nudge of the fast-spin cases: a nutation whose peak angular acceleration σ²δθ is this fraction of
 /// g/a, so the motion wobbles (the step limit is that of a real nutation, not of round-off growing from
@@ -41,7 +41,7 @@ const FAST_SPIN_NUDGE: f64 = 1e-3;
 const NEAR_FLAT_KICK: f64 = 0.5;
 /// Relative perturbation of the spin in the marginal-stability cases.
 const MARGINAL_OFFSET: f64 = 1e-3;
-/// Initial tilt of the marginal-stability cases [rad]: small enough for the linear theory (relative
+/// Initial tilt of the marginal-stability cases \[rad\]: small enough for the linear theory (relative
 /// nonlinear terms ~ δθ² ≈ 1e-7 at t = 30), large enough to be far above the integration error.
 const MARGINAL_TILT: f64 = 1e-6;
 /// Adaptive tolerances of the suite's tight runs (event location to 1e-9 needs them).
@@ -107,7 +107,7 @@ pub struct StabilityRow {
     pub max_error: Option<f64>,
     /// Energy drift, CONTRACT definition.
     pub energy_drift: f64,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_seconds: f64,
     /// What the case measures (`event time`, `largest stable h·σ`, ...).
     pub quantity: String,
@@ -603,7 +603,7 @@ pub struct DriftHistory {
     pub checkpoints: Vec<(f64, f64)>,
     /// How the run ended.
     pub termination: String,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_seconds: f64,
 }
 
