@@ -10,3 +10,4 @@ pub mod model;
 pub mod record;
 pub mod simulation;
 pub mod units;
+pub mod verify;
