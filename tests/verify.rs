@@ -54,3 +54,148 @@ fn a_recorded_steady_circle_passes_the_steady_check() {
     assert_eq!(r.exit_code, 0, "{}", show(&r));
     assert_eq!(status(&r, CheckId::Steady), Status::Pass);
 }
+
+/// Verifies a copy of `spec`'s recording in which `edit` changed messages; prints the report.
+fn tampered(spec: &Spec, edit: impl FnMut(Edit<'_>)) -> FileReport {
+    let (dir, good) = recorded(spec, "good.mcap");
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&good, &bad, edit);
+    let r = verify_file(&bad, &Options::default());
+    println!("{}", show(&r));
+    r
+}
+
+fn assert_fails(r: &FileReport, id: CheckId, low: f64, high: f64) {
+    let c = r.check(id).unwrap();
+    let value = c.value.unwrap();
+    println!(
+        "{id}: measured {value:e}, tolerance {:e}, expected in [{low:e}, {high:e}]",
+        c.tolerance.unwrap()
+    );
+    assert_eq!(c.status, Status::Fail, "{}", show(r));
+    assert!(
+        (low..=high).contains(&value),
+        "{id}: measured {value:e} outside [{low:e}, {high:e}]"
+    );
+    assert_eq!(r.exit_code, 1);
+}
+
+#[test]
+fn verify_flags_a_log_with_one_energy_message_nudged_by_1e_6() {
+    let r = tampered(&wobble(), |e| {
+        if e.topic == "/coin/energy" && e.index == 500 {
+            let total: f64 = serde_json::from_slice::<serde_json::Value>(e.data).unwrap()["total"]
+                .as_f64()
+                .unwrap();
+            nudge(e.data, "total", 1e-6 * total);
+        }
+    });
+    // 1e-6 of E relative to max(|E0|, Mga) = |E0|: 1e-6.
+    assert_fails(&r, CheckId::Energy, 0.9e-6, 1.1e-6);
+}
+
+#[test]
+fn verify_flags_a_log_with_one_position_moved_by_1e_4() {
+    let r = tampered(&wobble(), |e| {
+        if e.topic == "/coin/position" && e.index == 500 {
+            nudge(e.data, "x", 1e-4);
+        }
+    });
+    // The nearest weight 4/5 divides by h = 0.01: 8e-3 of a·max|ω| ≈ 1.02.
+    assert_fails(&r, CheckId::Constraint, 5e-3, 1e-2);
+}
+
+#[test]
+fn verify_flags_a_log_with_one_omega_sample_changed_by_1e_5() {
+    let r = tampered(&wobble(), |e| {
+        if e.topic == "/coin/omega" && e.index == 500 {
+            nudge(e.data, "z", 1e-5);
+        }
+    });
+    // δE ≈ (Ma² + I_Z) ω_Z δω_Z = 1.5e-5 ω_Z, relative to E0 ≈ 1.7.
+    assert_fails(&r, CheckId::Energy, 1e-6, 1e-5);
+    assert_eq!(r.check(CheckId::Constraint).unwrap().status, Status::Fail);
+}
+
+#[test]
+fn verify_flags_a_steady_log_with_theta_shifted_by_1e_5_throughout() {
+    let r = tampered(&steady_circle(), |e| {
+        if e.topic == "/coin/angles" {
+            nudge(e.data, "theta", 1e-5);
+        }
+    });
+    assert_fails(&r, CheckId::Steady, 0.9e-5, 1e-4);
+}
+
+#[test]
+fn negative_control_numbers_appear_in_the_json_output() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&good, &bad, |e| {
+        if e.topic == "/coin/position" && e.index == 500 {
+            nudge(e.data, "x", 1e-4);
+        }
+    });
+    let (code, stdout, stderr) = coin_log(&["verify", "--json", bad.to_str().unwrap()]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let checks = v["files"][0]["checks"].as_array().unwrap();
+    let c = checks.iter().find(|c| c["id"] == "constraint").unwrap();
+    println!("{c}");
+    assert_eq!(c["status"], "fail");
+    assert!(c["value"].as_f64().unwrap() > 1e-3);
+    assert_eq!(v["files"][0]["exit_code"], 1);
+}
+
+#[test]
+fn a_log_on_which_no_physics_check_can_run_fails() {
+    let spec = Spec {
+        channels: vec![coin_log::record::Channel::Energy],
+        ..wobble()
+    };
+    let (_dir, path) = recorded(&spec, "energy-only.mcap");
+    let r = verify_file(&path, &Options::default());
+    println!("{}", show(&r));
+    assert_eq!(r.exit_code, 1);
+    let energy = r.check(CheckId::Energy).unwrap();
+    assert_eq!(energy.status, Status::Fail);
+    assert!(energy.reason.starts_with("required check could not run"));
+    let constraint = r.check(CheckId::Constraint).unwrap();
+    assert_eq!(constraint.status, Status::Fail);
+}
+
+#[test]
+fn the_json_output_has_exactly_the_contract_fields() {
+    let (_dir, path) = recorded(&wobble(), "wobble.mcap");
+    let (code, stdout, _) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let keys = |v: &serde_json::Value| {
+        let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+        k.sort();
+        k
+    };
+    assert_eq!(keys(&v), ["files"]);
+    assert_eq!(keys(&v["files"][0]), ["checks", "exit_code", "path"]);
+    let ids: Vec<&str> = v["files"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            assert_eq!(keys(c), ["id", "reason", "status", "tolerance", "value"]);
+            c["id"].as_str().unwrap()
+        })
+        .collect();
+    assert_eq!(
+        ids,
+        [
+            "integrity",
+            "energy",
+            "invariants",
+            "steady",
+            "constraint",
+            "consistency",
+            "validity"
+        ]
+    );
+}

@@ -168,15 +168,16 @@ impl Assembler {
     }
 
     fn flush_ready(&mut self, out: &mut impl FnMut(&Sample)) {
-        // A sample is final when all declared slots are in, or when every declared slot has moved past it
-        // (each channel's log times increase).
+        // A sample is final when every declared slot has moved past it (each channel's log times
+        // increase), or when all declared slots are in and a later sample has begun (a channel record
+        // may be written just before its first message, so "all declared" alone can be premature).
         let horizon = (0..SLOTS)
             .filter(|i| self.declared & (1 << i) != 0)
             .map(|i| self.last[i].unwrap_or(0))
             .min()
             .unwrap_or(0);
         while let Some(front) = self.pending.front() {
-            let done = front.present == self.declared
+            let done = (front.present == self.declared && self.pending.len() > 1)
                 || front.log_time < horizon
                 || self.pending.len() > MAX_PENDING;
             if !done {
