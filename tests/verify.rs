@@ -199,3 +199,16 @@ fn the_json_output_has_exactly_the_contract_fields() {
         ]
     );
 }
+
+#[test]
+fn recordings_by_every_integrator_pass_at_default_tolerances() {
+    for &method in coin_log::integrate::Method::ALL {
+        for (name, spec) in [("wobble", wobble()), ("circle", steady_circle())] {
+            let spec = Spec { method, ..spec };
+            let (_dir, path) = recorded(&spec, "run.mcap");
+            let r = verify_file(&path, &Options::default());
+            println!("{method} {name}:\n{}", show(&r));
+            assert_eq!(r.exit_code, 0, "{method} {name}\n{}", show(&r));
+        }
+    }
+}

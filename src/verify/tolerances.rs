@@ -4,7 +4,7 @@
 //!
 //!   ε = max(rtol, atol / a)                          for adaptive methods (dopri5, dop853),
 //!   ε = max(rtol, atol / a, (h Ω)^p)                 for fixed-step methods of order p with step h
-//!                                                    (rk4 and gauss4: p = 4; gauss6: p = 6),
+//!                                                    (rk4 and gauss4: p = 4; the order of `Method`),
 //!
 //! the accuracy the integrator was asked for, per unit time. Then
 //!
@@ -18,6 +18,8 @@
 //! Recomputations of a stored quantity from other stored values (energy against `/coin/energy`, the
 //! quaternion, contact point, height, reaction and invariants against their inputs) repeat the recorder's
 //! arithmetic on the same numbers, so they are held to [`RECOMPUTE_TOLERANCE`].
+
+use crate::integrate::Method;
 
 /// Contract ceiling of the energy drift tolerance.
 pub const ENERGY_CEILING: f64 = 1e-6;
@@ -70,13 +72,15 @@ pub struct RunAccuracy<'a> {
     pub max_omega: f64,
 }
 
-/// Order of a fixed-step method, `None` for adaptive ones.
+/// Order of a fixed-step method, `None` for adaptive ones and unknown names (treated as adaptive: rtol and
+/// atol then carry the accuracy).
 #[must_use]
 pub fn fixed_step_order(integrator: &str) -> Option<i32> {
-    match integrator {
-        "rk4" | "gauss4" => Some(4),
-        "gauss6" => Some(6),
-        _ => None,
+    let method: Method = integrator.parse().ok()?;
+    if method.is_adaptive() {
+        None
+    } else {
+        i32::try_from(method.order()).ok()
     }
 }
 

@@ -2,7 +2,7 @@
 //! the recorder is used), and rewriting a file with one message changed (negative controls).
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
 
-use coin_log::integrate::{Flow, Rk4, RunSettings, Termination};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
 use coin_log::model::{
     centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State, Steady,
 };
@@ -13,7 +13,7 @@ use coin_log::record::{
     schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
     RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use coin_log::simulation::{simulate, CoinEvents};
+use coin_log::simulation::CoinEvents;
 use coin_log::units::log_time;
 use std::collections::BTreeMap;
 use std::io::BufWriter;
@@ -41,6 +41,9 @@ pub struct Spec {
     pub step: f64,
     pub channels: Vec<Channel>,
     pub compression: Option<mcap::Compression>,
+    pub method: Method,
+    pub rtol: f64,
+    pub atol: f64,
     pub chunk_size: Option<u64>,
 }
 
@@ -53,7 +56,7 @@ pub fn wobble() -> Spec {
             omega_z: 1.0,
             ..State::default()
         },
-        scene: "description = \"wobble\"\n[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"\n[initial]\ntheta = 0.3\nomega = [0.0, 0.195, 1.0]\n[run]\nduration = 10.0\nintegrator = \"rk4\"\nstep = 0.001\n".into(),
+        scene: "description = \"wobble\"\n[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"\n[initial]\ntheta = 0.3\nomega = [0.0, 0.195, 1.0]\n[run]\nduration = 10.0\nintegrator = \"dop853\"\n".into(),
         steady: None,
         duration: 10.0,
         rate: 100.0,
@@ -61,6 +64,9 @@ pub fn wobble() -> Spec {
         channels: CHANNELS.to_vec(),
         compression: Some(mcap::Compression::Zstd),
         chunk_size: None,
+        method: Method::Dop853,
+        rtol: 1e-10,
+        atol: 1e-12,
     }
 }
 
@@ -78,7 +84,7 @@ pub fn steady_circle() -> Spec {
     .unwrap();
     Spec {
         initial: steady.state,
-        scene: "description = \"steady circle\"\n[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"\n[initial]\nsteady = { kind = \"circle\", theta = 0.3, omega_z = 1.0, branch = \"+\" }\n[run]\nduration = 10.0\nintegrator = \"rk4\"\nstep = 0.001\n".into(),
+        scene: "description = \"steady circle\"\n[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"\n[initial]\nsteady = { kind = \"circle\", theta = 0.3, omega_z = 1.0, branch = \"+\" }\n[run]\nduration = 10.0\nintegrator = \"dop853\"\n".into(),
         steady: Some(steady),
         ..wobble()
     }
@@ -190,9 +196,9 @@ pub fn record(spec: &Spec, path: &Path) {
         inertia_z: p.inertia_z(),
         friction: None,
         time_unit: p.time_unit(),
-        integrator: "rk4".into(),
-        rtol: 1e-10,
-        atol: 1e-12,
+        integrator: spec.method.name().into(),
+        rtol: spec.rtol,
+        atol: spec.atol,
         step: spec.step,
         rate: spec.rate,
         steady_kind: spec
@@ -222,39 +228,38 @@ pub fn record(spec: &Spec, path: &Path) {
         .map(|c| (*c, add_channel(&mut w, &mut schemas, *c)))
         .collect();
     let mut sequence = 0u32;
-    let mut stepper = Rk4::new(spec.step);
+    let config = MethodConfig {
+        method: spec.method,
+        rtol: spec.rtol,
+        atol: spec.atol,
+        step: spec.step,
+    };
     let settings = RunSettings {
         t0: 0.0,
         t_end: spec.duration,
         sample_interval: 1.0 / spec.rate,
     };
     let events = CoinEvents::new(coin, 1e-4, None);
-    let outcome = simulate(
-        &coin,
-        &mut stepper,
-        &spec.initial,
-        &settings,
-        &events,
-        |t, y| {
-            let s = State::from_array(y);
-            let lt = log_time(t).unwrap();
-            for (c, id) in &ids {
-                let data = message_json(&coin, *c, t, &s);
-                w.write_to_known_channel(
-                    &mcap::records::MessageHeader {
-                        channel_id: *id,
-                        sequence,
-                        log_time: lt,
-                        publish_time: lt,
-                    },
-                    &data,
-                )
-                .unwrap();
-                sequence += 1;
-            }
-            Flow::Continue
-        },
-    );
+    let y0 = spec.initial.to_array();
+    let outcome = run_method(&config, &coin, &y0, &settings, &events, |t, y| {
+        let s = State::from_array(y);
+        let lt = log_time(t).unwrap();
+        for (c, id) in &ids {
+            let data = message_json(&coin, *c, t, &s);
+            w.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: *id,
+                    sequence,
+                    log_time: lt,
+                    publish_time: lt,
+                },
+                &data,
+            )
+            .unwrap();
+            sequence += 1;
+        }
+        Flow::Continue
+    });
     let termination = match outcome.termination {
         Termination::Completed => "completed".to_string(),
         Termination::Event { index, .. } => CoinEvents::event(index).name().to_string(),
