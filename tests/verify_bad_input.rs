@@ -2,6 +2,8 @@
 //! message. Unreadable, not MCAP, not coin-log, truncated or corrupt: exit 2 and a clear message, never a
 //! panic; a readable file with a defect in its content (non-monotonic times, a malformed message): exit 1.
 
+#![allow(clippy::unwrap_used)]
+
 mod common_verify;
 
 use common_verify::*;
