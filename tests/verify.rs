@@ -212,3 +212,24 @@ fn recordings_by_every_integrator_pass_at_default_tolerances() {
         }
     }
 }
+
+/// Writes a long recording for measuring `verify` by hand (not a timed test):
+/// `VERIFY_LONG=/tmp/long.mcap cargo test --release --test verify -- --ignored write_a_long_recording`,
+/// then `/usr/bin/time -v target/release/coin-log verify /tmp/long.mcap`.
+#[test]
+#[ignore = "writes a large file for manual throughput measurement"]
+fn write_a_long_recording() {
+    let path = std::env::var("VERIFY_LONG").unwrap_or_else(|_| "/tmp/long.mcap".into());
+    let duration: f64 = std::env::var("VERIFY_LONG_DURATION")
+        .ok()
+        .and_then(|d| d.parse().ok())
+        .unwrap_or(1000.0);
+    let spec = Spec {
+        duration,
+        rate: 1000.0,
+        ..wobble()
+    };
+    record(&spec, std::path::Path::new(&path));
+    let r = verify_file(std::path::Path::new(&path), &Options::default());
+    println!("{}", show(&r));
+}

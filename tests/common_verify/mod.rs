@@ -210,12 +210,13 @@ pub fn record(spec: &Spec, path: &Path) {
         r_c: spec.steady.and_then(|s| s.r_c),
     };
     let file = BufWriter::new(std::fs::File::create(path).unwrap());
-    let mut w = mcap::WriteOptions::new()
+    let mut options = mcap::WriteOptions::new()
         .compression(spec.compression)
-        .chunk_size(spec.chunk_size)
-        .library("coin-log/test")
-        .create(file)
-        .unwrap();
+        .library("coin-log/test");
+    if spec.chunk_size.is_some() {
+        options = options.chunk_size(spec.chunk_size);
+    }
+    let mut w = options.create(file).unwrap();
     w.write_metadata(&mcap::records::Metadata {
         name: RUN_METADATA_NAME.into(),
         metadata: run.to_map(),
