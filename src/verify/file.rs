@@ -415,9 +415,25 @@ fn unusable(path: &str, problem: String) -> FileReport {
 
 /// Judges one file (see [`super::verify_file`]).
 pub fn verify_file(path: &Path, options: &Options) -> FileReport {
-    let shown = path.display().to_string();
     let mut judge = Judge::default();
     let (structure, error) = reader::read(path, &mut judge);
+    verdict(path.display().to_string(), judge, structure, error, options)
+}
+
+/// Judges an MCAP held in memory (see [`super::verify_bytes`]).
+pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
+    let mut judge = Judge::default();
+    let (structure, error) = reader::read_from(bytes, bytes.len() as u64, &mut judge);
+    verdict(name.to_string(), judge, structure, error, options)
+}
+
+fn verdict(
+    shown: String,
+    mut judge: Judge,
+    structure: reader::Structure,
+    error: Option<reader::ReadError>,
+    options: &Options,
+) -> FileReport {
     let mut problem = None;
     if let Some(e) = &error {
         match e.kind {

@@ -36,6 +36,12 @@ pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     file::verify_file(path, options)
 }
 
+/// Judges an MCAP file held in memory, named `name` in the report (for tests and fuzzing).
+#[must_use]
+pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
+    file::verify_bytes(name, bytes, options)
+}
+
 /// Judges several files.
 #[must_use]
 pub fn verify_files(paths: &[impl AsRef<Path>], options: &Options) -> Report {

@@ -202,8 +202,27 @@ fn wire_error(what: &str, at: u64, e: WireError) -> ReadError {
 /// Reads `path` to its end, passing records to `visitor`. The [`Structure`] is returned in both cases, so
 /// that a truncated or corrupt file still reports how far it was read.
 pub fn read(path: &Path, visitor: &mut impl Visitor) -> (Structure, Option<ReadError>) {
+    match open(path) {
+        Ok((file, len)) => read_from(file, len, visitor),
+        Err(e) => (Structure::default(), Some(e)),
+    }
+}
+
+/// Reads an MCAP stream of `len` bytes from `source` (see [`read`]).
+pub fn read_from(
+    source: impl Read,
+    len: u64,
+    visitor: &mut impl Visitor,
+) -> (Structure, Option<ReadError>) {
     let mut book = Book::default();
-    let error = read_into(path, visitor, &mut book).err();
+    let error = if len == 0 {
+        Some(ReadError {
+            kind: ReadErrorKind::NotMcap,
+            detail: "empty file (0 bytes), not an MCAP file".into(),
+        })
+    } else {
+        read_into(source, len, visitor, &mut book).err()
+    };
     if error.is_none() {
         book.finish();
     }
@@ -223,18 +242,15 @@ fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
         });
     }
     let file = std::fs::File::open(path).map_err(io)?;
-    let len = meta.len();
-    if len == 0 {
-        return Err(ReadError {
-            kind: ReadErrorKind::NotMcap,
-            detail: "empty file (0 bytes), not an MCAP file".into(),
-        });
-    }
-    Ok((file, len))
+    Ok((file, meta.len()))
 }
 
-fn read_into(path: &Path, visitor: &mut impl Visitor, book: &mut Book) -> Result<(), ReadError> {
-    let (mut file, file_len) = open(path)?;
+fn read_into(
+    mut file: impl Read,
+    file_len: u64,
+    visitor: &mut impl Visitor,
+    book: &mut Book,
+) -> Result<(), ReadError> {
     book.s.file_len = file_len;
     book.pos = MAGIC_LEN;
     let limit = usize::try_from(file_len).unwrap_or(usize::MAX);
