@@ -194,7 +194,7 @@ fn a_truncated_file_is_judged_on_its_readable_messages_and_is_unusable() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!(n > 1000 && n < 7007, "judged {n} messages");
+    assert!(n > 1000 && n < 8008, "judged {n} messages");
     assert!(err.trim_end().ends_with("messages read before it"));
 }
 
@@ -256,7 +256,7 @@ fn a_flipped_byte_in_the_summary_fails_its_crc() {
     let prefix = format!("error: {}: corrupt summary section: CRC 0x", path.display());
     assert!(err.starts_with(&prefix), "{err}");
     assert!(
-        err.trim_end().ends_with("judged the 7007 messages read"),
+        err.trim_end().ends_with("judged the 8008 messages read"),
         "{err}"
     );
 }
@@ -279,7 +279,7 @@ fn a_summary_record_claiming_a_huge_length_is_refused_without_allocating_it() {
     assert_eq!(
         err.trim(),
         format!(
-            "error: {}: record (opcode {op:#04x}) at byte {first} claims 1152921504606846976 bytes, more than the file's {len}: the file is corrupt or crafted; judged the 7007 messages read before it",
+            "error: {}: record (opcode {op:#04x}) at byte {first} claims 1152921504606846976 bytes, more than the file's {len}: the file is corrupt or crafted; judged the 8008 messages read before it",
             path.display()
         )
     );
@@ -307,7 +307,7 @@ fn a_summary_with_huge_counts_and_sizes_but_a_valid_crc_fails_integrity_only() {
     println!("{out}{err}");
     assert_eq!(code, 1);
     assert!(
-        out.contains("statistics: message_count = 4611686018427387904, the file has 7007"),
+        out.contains("statistics: message_count = 4611686018427387904, the file has 8008"),
         "{out}"
     );
     assert!(

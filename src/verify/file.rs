@@ -13,6 +13,7 @@ use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::wire::MessageHeader;
 use super::Options;
+use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Inertia};
 use crate::record::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
@@ -66,14 +67,15 @@ impl Checks {
     }
 }
 
-/// C1, C2 at (θ, ω_Y, ω_Z), when this build has them.
-fn invariants_of(_ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> {
-    |_, _, _| None
+/// C1, C2 at (θ, ω_Y, ω_Z), when they can be evaluated for these parameters.
+fn invariants_of(ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> + '_ {
+    move |theta, omega_y, omega_z| {
+        ctx.chaplygin.as_ref().ok().map(|c| {
+            let i = c.evaluate(theta, omega_y, omega_z);
+            (i.c1, i.c2)
+        })
+    }
 }
-
-/// Why the invariants check cannot run in this build, if it cannot.
-const INVARIANTS_MISSING: Option<&str> =
-    Some("C1, C2 are not available in this build (model::invariants is pending)");
 
 /// Schema names of the `coin_log.*` types and their fields, for schemas of another version.
 fn fields_of(schema: &str) -> Option<&'static [&'static str]> {
@@ -215,11 +217,14 @@ impl Judge {
         };
         let coin = Coin::new(params);
         let steady = steady::plan(&coin, &run);
+        let chaplygin = Chaplygin::new(&params)
+            .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
         self.ctx = Some(Context {
             coin,
             run,
             result: None,
             steady,
+            chaplygin,
         });
     }
 }
@@ -500,7 +505,8 @@ fn verdict(
     let mut results = vec![
         integrity::finish(&problems, &read, &judge.notes),
         c.energy.finish(&ctx, &tol),
-        c.invariants.finish(&tol, INVARIANTS_MISSING),
+        c.invariants
+            .finish(&tol, ctx.chaplygin.as_ref().err().map(String::as_str)),
         c.steady.finish(&ctx, &tol),
         c.constraint.finish(ctx.coin.params().radius(), &tol),
         c.consistency.finish(),

@@ -3,11 +3,13 @@
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
 
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
+use coin_log::model::invariants::Chaplygin;
 use coin_log::model::{
     centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State, Steady,
 };
 use coin_log::record::messages::{
-    Angles, AngularVelocity, EnergyMessage, Position, QuaternionMessage, ReactionMessage,
+    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
+    ReactionMessage,
 };
 use coin_log::record::{
     schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
@@ -19,8 +21,8 @@ use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-/// The channels written by [`record`] (no Foxglove channels, no invariants until C1, C2 exist).
-pub const CHANNELS: [Channel; 7] = [
+/// The channels written by [`record`] (no Foxglove channels).
+pub const CHANNELS: [Channel; 8] = [
     Channel::Omega,
     Channel::Angles,
     Channel::Quaternion,
@@ -28,6 +30,7 @@ pub const CHANNELS: [Channel; 7] = [
     Channel::Contact,
     Channel::Reaction,
     Channel::Energy,
+    Channel::Invariants,
 ];
 
 /// What to record.
@@ -172,6 +175,16 @@ pub fn message_json(coin: &Coin, c: Channel, t: f64, s: &State) -> Vec<u8> {
                 total: e.total,
                 kinetic: e.kinetic,
                 potential: e.potential,
+            }
+            .write_json(&mut buf)
+        }
+        Channel::Invariants => {
+            let chaplygin = Chaplygin::new(coin.params()).unwrap();
+            let i = chaplygin.of_state(s);
+            InvariantsMessage {
+                t,
+                c1: i.c1,
+                c2: i.c2,
             }
             .write_json(&mut buf)
         }

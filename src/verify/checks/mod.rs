@@ -10,6 +10,7 @@ pub mod steady;
 pub mod validity;
 
 use super::samples::Sample;
+use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, Steady};
 use crate::record::{ResultMetadata, RunMetadata};
 
@@ -24,6 +25,8 @@ pub struct Context {
     pub result: Option<ResultMetadata>,
     /// The steady motion the scene asks for, or why the steady check does not apply.
     pub steady: Result<Steady, String>,
+    /// C1, C2 for these parameters (NOTES §6), or why they cannot be evaluated.
+    pub chaplygin: Result<Chaplygin, String>,
 }
 
 /// Run-wide quantities the tolerances and scales need.
