@@ -5,26 +5,28 @@ use super::Outcome;
 use coin_log::verify::{self, FileReport, Options, Report};
 use std::path::PathBuf;
 
-/// Arguments of `coin-log verify`.
-///
-/// Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata,
-/// the physics is recomputed from the stored channels (never re-simulated). Checks: integrity, energy,
-/// invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance and
-/// pass/fail, or skip with the reason. A file on which integrity, energy and at least one of constraint /
-/// steady cannot run fails.
-///
-/// Default tolerances, from the recorded integrator settings: with τ = √(a/g), T the recorded span,
-/// Ω = max(max|ω|, 1/τ) and ε = max(rtol, atol/a), or for fixed-step methods of order p with step h
-/// (rk4, gauss4: p = 4; gauss6: p = 6) ε = max(rtol, atol/a, (hΩ)^p):
-///   energy (and invariant) drift:  min(1e-6, max(1e-12, 100 ε (1 + T/τ)))
-///   constraint and steady residual: min(1e-6, max(1e-10, 1000 ε (1 + T/τ)))
-/// Stored values recomputed from other stored values (energy, quaternion, contact, height, reaction,
-/// invariants) agree to 1e-12 relative; N ≥ 0 and |F| ≤ μN to 1e-12 Mg.
-///
-/// Exit codes: 0 every check that ran passed; 1 a check failed; 2 a file is unreadable, truncated,
-/// corrupt, not MCAP or not a coin-log file, or a usage error. With several files, the worst (2 > 1 > 0).
+/// What `coin-log verify --help` adds after the options: the checks, the tolerance formula, exit codes.
+const AFTER_HELP: &str = "\
+Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata,
+the physics is recomputed from the stored channels (never re-simulated). Checks: integrity, energy,
+invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance and
+pass/fail, or skip with the reason. A file on which integrity, energy and at least one of constraint /
+steady cannot run fails.
+
+Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
+W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a), or for fixed-step methods of order p with step h
+(rk4, gauss4: p = 4) eps = max(rtol, atol/a, (h W)^p):
+  energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
+  constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
+Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
+reaction) must agree to 1e-12 relative; N >= 0 and |F| <= mu N are held to 1e-12 Mg.
+
+Exit codes: 0 every check that ran passed; 1 a check failed; 2 a file is unreadable, truncated, corrupt,
+not MCAP or not a coin-log file, or a usage error. With several files, the worst (2 > 1 > 0).";
+
+/// Arguments of `coin-log verify` (the checks and tolerance formula are in `AFTER_HELP`).
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(after_help = AFTER_HELP)]
 pub struct VerifyArgs {
     /// MCAP files written by `coin-log record`.
     #[arg(required = true, value_name = "FILE")]
