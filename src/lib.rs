@@ -8,6 +8,7 @@
 pub mod integrate;
 pub mod model;
 pub mod record;
+pub mod scene;
 pub mod simulation;
 pub mod units;
 pub mod verify;
