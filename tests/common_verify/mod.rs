@@ -385,3 +385,23 @@ pub fn coin_log(args: &[&str]) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// Records built-in scene `scene` with the real recorder (`coin-log record`), plus `extra` flags.
+pub fn record_scene(dir: &Path, scene: &str, extra: &[&str]) -> PathBuf {
+    let path = dir.join(format!("{scene}.mcap"));
+    let mut args = vec!["record", scene, "-o", path.to_str().unwrap(), "--overwrite"];
+    args.extend_from_slice(extra);
+    let (code, out, err) = coin_log(&args);
+    assert_eq!(code, 0, "coin-log record {scene}: {out}{err}");
+    path
+}
+
+/// The built-in scene names (`coin-log scenes`).
+pub fn scene_names() -> Vec<String> {
+    let (code, out, err) = coin_log(&["scenes"]);
+    assert_eq!(code, 0, "{err}");
+    out.lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_string)
+        .collect()
+}
