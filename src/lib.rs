@@ -12,3 +12,4 @@ pub mod record;
 pub mod scene;
 pub mod simulation;
 pub mod units;
+pub mod verify;
