@@ -515,7 +515,6 @@ impl<'a> Writer<'a> {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::model::{centre, CoinParams};
