@@ -3,6 +3,9 @@
 //! `coin`, the track in `table`, Foxglove timestamps equal to log times, `/scene` at ≈ 30 per time unit,
 //! and the shipped layout (`/scene` visible, following `world`, the plots on numeric fields).
 
+// Helpers outside #[test] functions panic on any failure by design.
+#![allow(clippy::unwrap_used)]
+
 mod support;
 
 use serde_json::Value;
