@@ -87,6 +87,13 @@ impl CoinParams {
                 (inertia_x, inertia_z)
             }
         };
+        // A shape's inertias (M a²/4, ...) can still overflow to inf or underflow to 0 when M and a are
+        // valid; check them then (not when M or a is already reported, to name each problem once).
+        let scale_ok = [mass, radius].iter().all(|v| v.is_finite() && *v > 0.0);
+        if scale_ok && !matches!(inertia, Inertia::Explicit { .. }) {
+            positive("inertia_x", inertia_x, &mut errors);
+            positive("inertia_z", inertia_z, &mut errors);
+        }
         if errors.is_empty() {
             Ok(Self {
                 mass,
