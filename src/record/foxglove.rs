@@ -156,6 +156,9 @@ pub struct Foxglove3d {
     next_track_id: u64,
     /// Table centre (x, z), snapped.
     table_centre: [f64; 2],
+    /// Log time of the latest sample, and whether it had a scene update (for [`Self::finish`]).
+    last_log_time: u64,
+    last_had_scene: bool,
 }
 
 impl Foxglove3d {
@@ -172,6 +175,8 @@ impl Foxglove3d {
             track: Vec::with_capacity(64),
             next_track_id: 0,
             table_centre: [0.0, 0.0],
+            last_log_time: 0,
+            last_had_scene: false,
         }
     }
 
@@ -210,25 +215,47 @@ impl Foxglove3d {
                 self.write_coin_transform(buf, log_time, s)
             })?;
         }
+        self.last_had_scene = false;
         if self.scene {
             self.add_track_point(s)?;
             let slot = scene_slot(t);
             if first || last || slot > self.last_scene_slot {
                 self.last_scene_slot = slot;
-                let track_id = self.next_track_id;
-                let with_track = self.track.len() >= 2;
-                out.push(Channel::Scene, |buf| {
-                    self.write_scene(buf, log_time, with_track.then_some(track_id))
-                })?;
-                if with_track {
-                    self.next_track_id += 1;
-                    let tail = self.track[self.track.len() - 1];
-                    self.track.clear();
-                    self.track.push(tail);
-                }
+                self.push_scene(log_time, out)?;
             }
         }
         self.started = true;
+        self.last_log_time = log_time;
+        Ok(())
+    }
+
+    /// Ends the output: if the latest sample had no `/scene` update (a recorder that learns only after the
+    /// fact that a sample was the last one), appends one at that sample's log time, so the scene shows the
+    /// final state and the whole track. Does nothing otherwise, or if no sample was given.
+    ///
+    /// # Errors
+    /// [`NonFiniteField`] if a value is not finite.
+    pub fn finish(&mut self, out: &mut FoxgloveBatch) -> Result<(), NonFiniteField> {
+        if self.scene && self.started && !self.last_had_scene {
+            self.push_scene(self.last_log_time, out)?;
+        }
+        Ok(())
+    }
+
+    /// Appends a `/scene` update with the pending track, then starts the next piece of track.
+    fn push_scene(&mut self, log_time: u64, out: &mut FoxgloveBatch) -> Result<(), NonFiniteField> {
+        let track_id = self.next_track_id;
+        let with_track = self.track.len() >= 2;
+        out.push(Channel::Scene, |buf| {
+            self.write_scene(buf, log_time, with_track.then_some(track_id))
+        })?;
+        self.last_had_scene = true;
+        if with_track {
+            self.next_track_id += 1;
+            let tail = self.track[self.track.len() - 1];
+            self.track.clear();
+            self.track.push(tail);
+        }
         Ok(())
     }
 
@@ -911,6 +938,48 @@ mod tests {
         assert!(fox
             .sample(0.02, 20_000_000, &bad, false, &mut batch)
             .is_err());
+    }
+
+    #[test]
+    fn finish_adds_the_final_scene_only_when_the_last_sample_had_none() {
+        let coin = unit_coin();
+        let mut batch = FoxgloveBatch::default();
+        // Samples to t = 0.06, none flagged `last` (the recorder learns of the end afterwards).
+        let mut fox = Foxglove3d::new(&coin, 0.05, false, true);
+        let mut scenes = Vec::new();
+        for k in 0..=6 {
+            let t = f64::from(k) * 0.01;
+            batch.clear();
+            fox.sample(t, log_time(t).unwrap(), &state_at(t), false, &mut batch)
+                .unwrap();
+            scenes.push(batch.len());
+        }
+        batch.clear();
+        fox.finish(&mut batch).unwrap();
+        let finished = batch.len();
+        println!("scene updates per sample {scenes:?}, finish added {finished}");
+        // t = 0.06: round(1.8) = 2 = the slot of t = 0.05 (round(1.5) = 2), so no update at 0.06.
+        assert_eq!(scenes[6], 0);
+        assert_eq!(finished, 1);
+        let (_, bytes) = batch.iter().next().unwrap();
+        let v: Value = serde_json::from_slice(bytes).unwrap();
+        let track = entities(&v)
+            .iter()
+            .find(|e| e["id"].as_str().unwrap().starts_with("track-"));
+        assert!(track.is_some(), "the final piece of track is published");
+        assert_eq!(time_of(&entities(&v)[0]), 60_000_000);
+        // After a sample flagged `last`, finish adds nothing.
+        batch.clear();
+        fox.sample(0.07, 70_000_000, &state_at(0.07), true, &mut batch)
+            .unwrap();
+        batch.clear();
+        fox.finish(&mut batch).unwrap();
+        assert!(batch.is_empty());
+    }
+
+    fn time_of(entity: &Value) -> u64 {
+        entity["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
+            + entity["timestamp"]["nsec"].as_u64().unwrap()
     }
 
     #[test]
