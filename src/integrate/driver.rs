@@ -126,7 +126,7 @@ where
         return outcome(Termination::Stopped { t: t0 }, stepper, t0);
     }
 
-    // Tolerance for "this grid point is t_end": half a nanosecond-scale ulp budget relative to the span.
+    // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly).
     let grid_slack = 1e-9 * settings.sample_interval;
     let mut k: u64 = 1;
     let mut t_last = t0;
@@ -137,12 +137,17 @@ where
         }
         let t_new = stepper.t();
         let reached_end = t_new >= settings.t_end;
+        let mut dense_ready = false;
 
         // Event check at the end of the step; locate the earliest crossing on the dense output.
         events.evaluate(t_new, stepper.y(), &mut g_new[..n_events]);
         let mut event: Option<(usize, f64)> = None;
         for i in 0..n_events {
             if g_old[i] > 0.0 && g_new[i] <= 0.0 {
+                if !dense_ready {
+                    stepper.prepare_interpolation(sys);
+                    dense_ready = true;
+                }
                 let t_root = locate(stepper, events, i, n_events, &mut buffer);
                 if event.is_none_or(|(_, t)| t_root < t) {
                     event = Some((i, t_root));
@@ -151,18 +156,23 @@ where
         }
         let t_stop = event.map_or(t_new, |(_, t)| t);
 
-        // Samples on the grid up to the step's end (or the event).
+        // Samples on the grid up to the step's end (or strictly before the event).
         loop {
             let mut t_k = sample_time(settings, k);
-            if t_k > settings.t_end - grid_slack && reached_end && event.is_none() {
-                t_k = settings.t_end; // the last sample is exactly t_end
+            if t_k > settings.t_end - grid_slack {
+                t_k = settings.t_end;
             }
             if t_k > t_stop || (event.is_some() && t_k >= t_stop) {
                 break;
             }
+            #[allow(clippy::float_cmp)] // exact: a grid time that is the step's end uses y itself
             let flow = if t_k == t_new {
                 observe(t_k, stepper.y())
             } else {
+                if !dense_ready {
+                    stepper.prepare_interpolation(sys);
+                    dense_ready = true;
+                }
                 stepper.interpolate(t_k, &mut buffer);
                 observe(t_k, &buffer)
             };
@@ -176,12 +186,13 @@ where
             }
         }
         if let Some((index, t)) = event {
+            // The last sample is the state at the event.
             stepper.interpolate(t, &mut buffer);
             let _ = observe(t, &buffer);
             return outcome(Termination::Event { index, t }, stepper, t);
         }
         if reached_end {
-            // t_end fell between grid points already emitted; emit it.
+            // Unreachable in practice (the grid loop emits t_end); kept so t_end is always sampled.
             if t_last < settings.t_end {
                 let _ = observe(settings.t_end, stepper.y());
                 t_last = settings.t_end;
@@ -219,7 +230,7 @@ fn locate<const N: usize, M: Stepper<N>, E: EventFunctions<N>>(
         }
         // Illinois false position, safeguarded by bisection when it would land at the ends.
         let mut t = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-        if !(t > lo && t < hi) || !t.is_finite() {
+        if !(t > lo && t < hi && t.is_finite()) {
             t = 0.5 * (lo + hi);
         }
         let g_t = eval(t, buffer);

@@ -3,6 +3,7 @@
 
 /// Interpolates at `t` ∈ [t0, t0 + h] from (y0, f0) at t0 and (y1, f1) at t0 + h.
 #[inline]
+#[allow(clippy::too_many_arguments)] // the two end points with their derivatives, as in the formula
 pub fn hermite_interpolate<const N: usize>(
     t0: f64,
     h: f64,

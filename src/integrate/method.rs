@@ -1,26 +1,37 @@
 //! The user-facing choice of integrator (CONTRACT: Integrators) and the one dispatch from it to a stepper.
 
 use super::driver::{run, EventFunctions, Flow, RunOutcome, RunSettings};
-use super::{OdeSystem, Rk4};
+use super::{Dop853, Dopri5, Gauss4, OdeSystem, Rk4};
 use std::fmt;
 use std::str::FromStr;
 
 /// An integration method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Method {
     /// Classical fourth-order Runge–Kutta, fixed step.
     Rk4,
+    /// Dormand–Prince 5(4), adaptive, 4th-order dense output.
+    Dopri5,
+    /// Dormand–Prince 8(5,3), adaptive, 7th-order dense output. The default.
+    #[default]
+    Dop853,
+    /// 2-stage Gauss–Legendre (order 4, symmetric, implicit), fixed step.
+    Gauss4,
 }
 
 impl Method {
     /// Every method.
-    pub const ALL: &'static [Method] = &[Method::Rk4];
+    pub const ALL: &'static [Method] =
+        &[Method::Rk4, Method::Dopri5, Method::Dop853, Method::Gauss4];
 
     /// Name in scene files and `--integrator`.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Self::Rk4 => "rk4",
+            Self::Dopri5 => "dopri5",
+            Self::Dop853 => "dop853",
+            Self::Gauss4 => "gauss4",
         }
     }
 
@@ -28,7 +39,18 @@ impl Method {
     #[must_use]
     pub fn is_adaptive(self) -> bool {
         match self {
-            Self::Rk4 => false,
+            Self::Rk4 | Self::Gauss4 => false,
+            Self::Dopri5 | Self::Dop853 => true,
+        }
+    }
+
+    /// Classical order of the method (of the propagated solution for the adaptive pairs).
+    #[must_use]
+    pub fn order(self) -> u32 {
+        match self {
+            Self::Rk4 | Self::Gauss4 => 4,
+            Self::Dopri5 => 5,
+            Self::Dop853 => 8,
         }
     }
 }
@@ -98,6 +120,30 @@ where
         Method::Rk4 => run(
             sys,
             &mut Rk4::new(config.step),
+            y0,
+            settings,
+            events,
+            observe,
+        ),
+        Method::Gauss4 => run(
+            sys,
+            &mut Gauss4::new(config.step),
+            y0,
+            settings,
+            events,
+            observe,
+        ),
+        Method::Dopri5 => run(
+            sys,
+            &mut Dopri5::new(config.rtol, config.atol),
+            y0,
+            settings,
+            events,
+            observe,
+        ),
+        Method::Dop853 => run(
+            sys,
+            &mut Dop853::new(config.rtol, config.atol),
             y0,
             settings,
             events,

@@ -2,16 +2,26 @@
 //!
 //! A [`Stepper`] advances one accepted step at a time and interpolates inside the last step (dense output),
 //! so that [`run`] can sample at exact output times and locate events by root finding without shortening
-//! steps. Methods: [`Rk4`] here; the adaptive pairs and the implicit Gauss method live beside it.
+//! steps. Methods, one file each: [`Rk4`] and [`Gauss4`] (fixed step), [`Dopri5`] and [`Dop853`]
+//! (adaptive embedded pairs with error control). All four are written here rather than taken from a crate:
+//! none offers dense output at arbitrary times, event location hooks, work statistics and no per-step
+//! heap allocation together, correct down to rtol 1e-13.
 
+mod control;
+mod dop853;
+mod dopri5;
 mod driver;
+mod gauss4;
 mod hermite;
 mod method;
 mod rk4;
 
+pub use dop853::Dop853;
+pub use dopri5::Dopri5;
 pub use driver::{
     run, EventFunctions, Flow, NoEvents, RunOutcome, RunSettings, Termination, MAX_EVENTS,
 };
+pub use gauss4::Gauss4;
 pub use hermite::hermite_interpolate;
 pub use method::{run_method, Method, MethodConfig, UnknownMethod};
 pub use rk4::Rk4;
@@ -94,6 +104,10 @@ pub trait Stepper<const N: usize> {
     fn y(&self) -> &[f64; N];
     /// Time at the start of the last accepted step.
     fn t_previous(&self) -> f64;
+    /// Makes the full dense output of the last step available, for methods that compute it lazily
+    /// (dop853's three extra stages). [`run`] calls it before the first [`Stepper::interpolate`] in a
+    /// step; without it, such methods interpolate at lower order. Default: nothing to do.
+    fn prepare_interpolation<S: OdeSystem<N>>(&mut self, _sys: &S) {}
     /// Dense output: the solution at `t` in [`t_previous`, `t`], written into `out`.
     fn interpolate(&self, t: f64, out: &mut [f64; N]);
     /// Work counters so far.

@@ -1,0 +1,278 @@
+//! DOPRI5: the explicit embedded Runge–Kutta pair 5(4) of Dormand & Prince (J. Comp. Appl. Math. 6, 1980,
+//! 19–26) with the step-size control, Lund (PI) stabilisation, initial step and 4th-order continuous
+//! extension of Hairer's `dopri5.f` (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4–II.6,
+//! Table 5.2 and the dense output of §II.6, eq. (6.12)).
+//!
+//! Written by hand rather than taken from a crate: none offers dense output at arbitrary times together
+//! with event location hooks, work statistics, no per-step heap allocation and correct behaviour at
+//! rtol 1e-13 (see also [`Dop853`](super::Dop853)).
+
+use super::control::{initial_step, step_underflows, weight, Controller, ControllerState};
+use super::{all_finite, OdeSystem, Stats, StepError, Stepper};
+
+/// Nodes cᵢ (HNW I, Table 5.2).
+const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+
+/// Rows of the Runge–Kutta matrix as (stage index, aᵢⱼ); row 6 is the 5th-order solution b (FSAL).
+const A: [&[(usize, f64)]; 7] = [
+    &[],
+    &[(0, 1.0 / 5.0)],
+    &[(0, 3.0 / 40.0), (1, 9.0 / 40.0)],
+    &[(0, 44.0 / 45.0), (1, -56.0 / 15.0), (2, 32.0 / 9.0)],
+    &[
+        (0, 19372.0 / 6561.0),
+        (1, -25360.0 / 2187.0),
+        (2, 64448.0 / 6561.0),
+        (3, -212.0 / 729.0),
+    ],
+    &[
+        (0, 9017.0 / 3168.0),
+        (1, -355.0 / 33.0),
+        (2, 46732.0 / 5247.0),
+        (3, 49.0 / 176.0),
+        (4, -5103.0 / 18656.0),
+    ],
+    &[
+        (0, 35.0 / 384.0),
+        (2, 500.0 / 1113.0),
+        (3, 125.0 / 192.0),
+        (4, -2187.0 / 6784.0),
+        (5, 11.0 / 84.0),
+    ],
+];
+
+/// Error estimator b − b̂ (5th minus 4th order), over stages 1..7 (`e1..e7` of `dopri5.f`).
+const E: [(usize, f64); 6] = [
+    (0, 71.0 / 57600.0),
+    (2, -71.0 / 16695.0),
+    (3, 71.0 / 1920.0),
+    (4, -17253.0 / 339200.0),
+    (5, 22.0 / 525.0),
+    (6, -1.0 / 40.0),
+];
+
+/// Dense output coefficients `d1..d7` of `dopri5.f` (Shampine's 4th-order continuous extension).
+const D: [(usize, f64); 6] = [
+    (0, -12715105075.0 / 11282082432.0),
+    (2, 87487479700.0 / 32700410799.0),
+    (3, -10690763975.0 / 1880347072.0),
+    (4, 701980252875.0 / 199316789632.0),
+    (5, -1453857185.0 / 822651844.0),
+    (6, 69997945.0 / 29380423.0),
+];
+
+/// Step controller of `dopri5.f`: safety 0.9, step ratio in [0.2, 10], β = 0.04, exponent 1/5 − 0.75β.
+const CONTROLLER: Controller = Controller {
+    safety: 0.9,
+    min_ratio: 0.2,
+    max_ratio: 10.0,
+    exponent: 0.2 - 0.04 * 0.75,
+    beta: 0.04,
+};
+
+/// Order used by the initial step guess (the propagated solution's order).
+const ORDER: i32 = 5;
+
+/// Step shrink factor after a trial step produced non-finite values.
+pub(crate) const NON_FINITE_SHRINK: f64 = 0.1;
+
+/// The Dormand–Prince 5(4) pair with error control and 4th-order dense output.
+#[derive(Debug, Clone)]
+pub struct Dopri5<const N: usize> {
+    rtol: f64,
+    atol: f64,
+    max_step: Option<f64>,
+    h_max: f64,
+    h: f64,
+    control: ControllerState,
+    t: f64,
+    t_prev: f64,
+    y: [f64; N],
+    f: [f64; N],
+    h_last: f64,
+    /// Coefficients r₁..r₅ of the continuous extension over the last step (`rcont` of `dopri5.f`).
+    dense: [[f64; N]; 5],
+    stats: Stats,
+}
+
+impl<const N: usize> Dopri5<N> {
+    /// A stepper keeping the local error per step below atol + rtol·|y| (in Hairer's RMS norm).
+    #[must_use]
+    pub fn new(rtol: f64, atol: f64) -> Self {
+        Self {
+            rtol,
+            atol,
+            max_step: None,
+            h_max: f64::INFINITY,
+            h: 0.0,
+            control: ControllerState::default(),
+            t: 0.0,
+            t_prev: 0.0,
+            y: [0.0; N],
+            f: [0.0; N],
+            h_last: 0.0,
+            dense: [[0.0; N]; 5],
+            stats: Stats::default(),
+        }
+    }
+
+    /// Caps the step size (default: the whole span t_end − t0).
+    #[must_use]
+    pub fn with_max_step(mut self, max_step: f64) -> Self {
+        self.max_step = Some(max_step);
+        self
+    }
+}
+
+impl<const N: usize> Stepper<N> for Dopri5<N> {
+    fn init<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t_end: f64,
+    ) -> Result<(), StepError> {
+        self.t = t0;
+        self.t_prev = t0;
+        self.y = *y0;
+        self.h_last = 0.0;
+        self.control = ControllerState::default();
+        self.stats = Stats::default();
+        self.h_max = self
+            .max_step
+            .unwrap_or(f64::INFINITY)
+            .min((t_end - t0).abs());
+        sys.rhs(t0, y0, &mut self.f);
+        self.stats.rhs_evaluations += 1;
+        for (i, row) in self.dense.iter_mut().enumerate() {
+            *row = if i == 0 { *y0 } else { [0.0; N] };
+        }
+        if !(all_finite(y0) && all_finite(&self.f)) {
+            return Err(StepError::NonFinite { t: t0 });
+        }
+        self.h = initial_step(
+            sys, t0, y0, &self.f, ORDER, self.rtol, self.atol, self.h_max,
+        );
+        self.stats.rhs_evaluations += 1;
+        Ok(())
+    }
+
+    fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
+        let mut k = [[0.0; N]; 7];
+        let mut y_stage = [0.0; N];
+        let mut non_finite = false;
+        loop {
+            let remaining = t_limit - self.t;
+            if remaining <= 0.0 {
+                return Ok(());
+            }
+            if step_underflows(self.t, self.h) {
+                return Err(if non_finite {
+                    StepError::NonFinite { t: self.t }
+                } else {
+                    StepError::StepSizeUnderflow {
+                        t: self.t,
+                        h: self.h,
+                    }
+                });
+            }
+            // Stretch the step by up to 1 % to land on t_limit instead of leaving a sliver (dopri5.f).
+            let last = self.t + 1.01 * self.h >= t_limit;
+            let h = if last { remaining } else { self.h };
+            let t_new = if last { t_limit } else { self.t + h };
+
+            k[0] = self.f;
+            for s in 1..7 {
+                combine(&self.y, h, A[s], &k, &mut y_stage);
+                let t_stage = if s == 6 { t_new } else { self.t + C[s] * h };
+                sys.rhs(t_stage, &y_stage, &mut k[s]);
+            }
+            // y_stage now holds the 5th-order solution at t_new, k[6] = f(t_new, y_new) (FSAL).
+            self.stats.rhs_evaluations += 6;
+
+            let mut err = 0.0;
+            for i in 0..N {
+                let sk = weight(self.rtol, self.atol, self.y[i], y_stage[i]);
+                let e: f64 = E.iter().map(|&(j, e)| e * k[j][i]).sum();
+                err += (h * e / sk).powi(2);
+            }
+            #[allow(clippy::cast_precision_loss)]
+            let err = (err / N as f64).sqrt();
+
+            if !err.is_finite() || !all_finite(&y_stage) || !all_finite(&k[6]) {
+                non_finite = true;
+                self.stats.rejected_steps += 1;
+                self.control.rejected = true;
+                self.h = h * NON_FINITE_SHRINK;
+                continue;
+            }
+            if err > 1.0 {
+                self.stats.rejected_steps += 1;
+                self.h = CONTROLLER.rejected(&mut self.control, h, err);
+                continue;
+            }
+
+            // Accepted: continuous extension (dopri5.f, after label 'dense output').
+            for i in 0..N {
+                let ydiff = y_stage[i] - self.y[i];
+                let bspl = h * k[0][i] - ydiff;
+                self.dense[0][i] = self.y[i];
+                self.dense[1][i] = ydiff;
+                self.dense[2][i] = bspl;
+                self.dense[3][i] = ydiff - h * k[6][i] - bspl;
+                self.dense[4][i] = h * D.iter().map(|&(j, d)| d * k[j][i]).sum::<f64>();
+            }
+            self.h = CONTROLLER.accepted(&mut self.control, h, err, self.h_max);
+            self.t_prev = self.t;
+            self.t = t_new;
+            self.h_last = h;
+            self.y = y_stage;
+            self.f = k[6];
+            self.stats.steps += 1;
+            return Ok(());
+        }
+    }
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+    fn y(&self) -> &[f64; N] {
+        &self.y
+    }
+    fn t_previous(&self) -> f64 {
+        self.t_prev
+    }
+    fn interpolate(&self, t: f64, out: &mut [f64; N]) {
+        let s = if self.h_last == 0.0 {
+            0.0
+        } else {
+            (t - self.t_prev) / self.h_last
+        };
+        let s1 = 1.0 - s;
+        let r = &self.dense;
+        for i in 0..N {
+            out[i] = r[0][i] + s * (r[1][i] + s1 * (r[2][i] + s * (r[3][i] + s1 * r[4][i])));
+        }
+    }
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+}
+
+/// out = y + h·Σⱼ aⱼ·kⱼ over the non-zero entries of one tableau row.
+#[inline]
+pub(crate) fn combine<const N: usize>(
+    y: &[f64; N],
+    h: f64,
+    row: &[(usize, f64)],
+    k: &[[f64; N]],
+    out: &mut [f64; N],
+) {
+    for i in 0..N {
+        let mut sum = 0.0;
+        for &(j, a) in row {
+            sum += a * k[j][i];
+        }
+        out[i] = y[i] + h * sum;
+    }
+}

@@ -1,0 +1,410 @@
+//! The 2-stage Gauss–Legendre collocation method (Butcher 1964; Hairer, Lubich & Wanner, *Geometric
+//! Numerical Integration*, 2nd ed., §II.1.3, Table 1.1 and §VIII.5–6 for solving the stage equations):
+//! order 4, symmetric, symplectic, A-stable. Fixed step, landing on t0 + n·h like [`Rk4`](super::Rk4),
+//! with cubic Hermite dense output.
+//!
+//! The stage equations Zᵢ = h·Σⱼ aᵢⱼ f(t + cⱼh, y + Zⱼ) are solved to round-off by simplified Newton
+//! iterations with the matrix I − h·(A ⊗ J), J a finite-difference Jacobian. J and the LU factors are
+//! kept across steps while the iteration contracts quickly, and refreshed when it slows down or the step
+//! changes; the iteration starts from the previous step's collocation polynomial. Symmetry (and hence
+//! the bounded energy error) needs the stage equations solved to round-off, not to a tolerance.
+
+// Index loops over stages and components read like the formulas (Zᵢ, aᵢⱼ, J[i][j]).
+#![allow(clippy::needless_range_loop)]
+
+use super::{all_finite, hermite_interpolate, OdeSystem, Stats, StepError, Stepper};
+
+/// √3/6, the half-distance of the Gauss nodes from 1/2.
+const SQRT3_6: f64 = 0.288_675_134_594_812_882_254_574_390_250_978_7;
+
+/// √3.
+const SQRT3: f64 = 1.732_050_807_568_877_293_527_446_341_505_872_4;
+
+/// Nodes c = 1/2 ∓ √3/6.
+const C: [f64; 2] = [0.5 - SQRT3_6, 0.5 + SQRT3_6];
+
+/// Runge–Kutta matrix A = [[1/4, 1/4 − √3/6], [1/4 + √3/6, 1/4]] (weights b = [1/2, 1/2]).
+const A: [[f64; 2]; 2] = [[0.25, 0.25 - SQRT3_6], [0.25 + SQRT3_6, 0.25]];
+
+/// Most Newton iterations per attempt; with a fresh Jacobian the iteration gains several digits each
+/// time, so this is only reached when the step is far too large for the problem.
+const MAX_ITERATIONS: u32 = 30;
+
+/// Round-off plateau: once the scaled correction is below this and stops decreasing, the stage values
+/// are as accurate as floating point allows.
+const ROUND_OFF_PLATEAU: f64 = 1e-12;
+
+/// Extrapolate the previous step's polynomial only over at most this many of its steps.
+const MAX_EXTRAPOLATION_RATIO: f64 = 2.0;
+
+/// A contraction rate above this marks the Jacobian stale; it is recomputed at the next step.
+const SLOW_CONTRACTION: f64 = 0.01;
+
+/// Relative finite-difference increment for the Jacobian: √ε balances truncation and round-off.
+const JACOBIAN_INCREMENT: f64 = 1.490_116_119_384_765_6e-8;
+
+/// 2-stage Gauss–Legendre with a fixed step `h`. The last step is shortened to land on `t_limit`.
+#[derive(Debug, Clone)]
+pub struct Gauss4<const N: usize> {
+    h: f64,
+    t0: f64,
+    n: u64,
+    t: f64,
+    t_prev: f64,
+    y: [f64; N],
+    f: [f64; N],
+    y_prev: [f64; N],
+    f_prev: [f64; N],
+    /// Stage increments of the last accepted step, to extrapolate the next step's starting guess.
+    z_last: [[f64; N]; 2],
+    /// Step of `z_last` (0 when there is none).
+    h_z_last: f64,
+    /// Jacobian, row-major N×N.
+    jacobian: Vec<f64>,
+    jacobian_stale: bool,
+    /// LU factors of I − h·(A ⊗ J), row-major 2N×2N, with row pivots; built for step `h_lu`.
+    lu: Vec<f64>,
+    pivots: Vec<usize>,
+    h_lu: f64,
+    /// Newton right-hand side / correction, length 2N.
+    work: Vec<f64>,
+    stats: Stats,
+}
+
+impl<const N: usize> Gauss4<N> {
+    /// A stepper with fixed step `h` (> 0).
+    #[must_use]
+    pub fn new(h: f64) -> Self {
+        Self {
+            h,
+            t0: 0.0,
+            n: 0,
+            t: 0.0,
+            t_prev: 0.0,
+            y: [0.0; N],
+            f: [0.0; N],
+            y_prev: [0.0; N],
+            f_prev: [0.0; N],
+            z_last: [[0.0; N]; 2],
+            h_z_last: 0.0,
+            jacobian: vec![0.0; N * N],
+            jacobian_stale: true,
+            lu: vec![0.0; 4 * N * N],
+            pivots: vec![0; 2 * N],
+            h_lu: 0.0,
+            work: vec![0.0; 2 * N],
+            stats: Stats::default(),
+        }
+    }
+
+    /// J ≈ ∂f/∂y at (t, y) by forward differences from the known f(t, y); N evaluations.
+    fn update_jacobian<S: OdeSystem<N>>(&mut self, sys: &S) {
+        let mut y = self.y;
+        let mut f = [0.0; N];
+        for j in 0..N {
+            let delta = JACOBIAN_INCREMENT * self.y[j].abs().max(1.0);
+            y[j] = self.y[j] + delta;
+            let delta = y[j] - self.y[j]; // the increment actually representable
+            sys.rhs(self.t, &y, &mut f);
+            for i in 0..N {
+                self.jacobian[i * N + j] = (f[i] - self.f[i]) / delta;
+            }
+            y[j] = self.y[j];
+        }
+        self.stats.rhs_evaluations += N as u64;
+        self.jacobian_stale = false;
+        self.h_lu = 0.0;
+    }
+
+    /// LU factors (partial pivoting) of I − h·(A ⊗ J). Returns false if the matrix is singular.
+    fn factor(&mut self, h: f64) -> bool {
+        let m = 2 * N;
+        for a in 0..2 {
+            for i in 0..N {
+                let r = a * N + i;
+                for b in 0..2 {
+                    for j in 0..N {
+                        let c = b * N + j;
+                        let identity = if r == c { 1.0 } else { 0.0 };
+                        self.lu[r * m + c] = identity - h * A[a][b] * self.jacobian[i * N + j];
+                    }
+                }
+            }
+        }
+        for col in 0..m {
+            let mut pivot = col;
+            for r in col + 1..m {
+                if self.lu[r * m + col].abs() > self.lu[pivot * m + col].abs() {
+                    pivot = r;
+                }
+            }
+            self.pivots[col] = pivot;
+            if self.lu[pivot * m + col] == 0.0 || !self.lu[pivot * m + col].is_finite() {
+                return false;
+            }
+            if pivot != col {
+                for c in 0..m {
+                    self.lu.swap(col * m + c, pivot * m + c);
+                }
+            }
+            let diagonal = self.lu[col * m + col];
+            for r in col + 1..m {
+                let factor = self.lu[r * m + col] / diagonal;
+                self.lu[r * m + col] = factor;
+                for c in col + 1..m {
+                    self.lu[r * m + c] -= factor * self.lu[col * m + c];
+                }
+            }
+        }
+        self.h_lu = h;
+        true
+    }
+
+    /// Solves (LU) x = `work` in place.
+    fn solve(&mut self) {
+        let m = 2 * N;
+        for col in 0..m {
+            self.work.swap(col, self.pivots[col]);
+        }
+        for r in 0..m {
+            let mut sum = self.work[r];
+            for c in 0..r {
+                sum -= self.lu[r * m + c] * self.work[c];
+            }
+            self.work[r] = sum;
+        }
+        for r in (0..m).rev() {
+            let mut sum = self.work[r];
+            for c in r + 1..m {
+                sum -= self.lu[r * m + c] * self.work[c];
+            }
+            self.work[r] = sum / self.lu[r * m + r];
+        }
+    }
+
+    /// Starting guess for the stage increments: the previous step's collocation polynomial
+    /// w(s) (w(0) = 0, w(cᵢ) = Zᵢ, s in units of the previous step) extrapolated,
+    /// Zᵢ ≈ w(1 + r·cᵢ) − w(1) with r = h / h_previous; explicit Euler without a previous step.
+    fn initial_guess(&self, h: f64) -> [[f64; N]; 2] {
+        let mut z = [[0.0; N]; 2];
+        let ratio = h / self.h_z_last;
+        if self.h_z_last > 0.0 && ratio <= MAX_EXTRAPOLATION_RATIO {
+            let w = |s: f64, i: usize| {
+                self.z_last[0][i] * s * (s - C[1]) / (C[0] * (C[0] - C[1]))
+                    + self.z_last[1][i] * s * (s - C[0]) / (C[1] * (C[1] - C[0]))
+            };
+            for (a, za) in z.iter_mut().enumerate() {
+                for (i, zi) in za.iter_mut().enumerate() {
+                    *zi = w(1.0 + ratio * C[a], i) - w(1.0, i);
+                }
+            }
+        } else {
+            for (a, za) in z.iter_mut().enumerate() {
+                for (i, zi) in za.iter_mut().enumerate() {
+                    *zi = C[a] * h * self.f[i];
+                }
+            }
+        }
+        z
+    }
+
+    /// One simplified Newton solve of the stage equations, improving `z` in place until it is exact to
+    /// round-off. On failure returns the iteration count and the last correction norm (NaN: non-finite).
+    fn newton<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        h: f64,
+        z: &mut [[f64; N]; 2],
+    ) -> Result<(), (u32, f64)> {
+        let mut stage_f = [[0.0; N]; 2];
+        let mut previous_norm = f64::INFINITY;
+        let mut y_stage = [0.0; N];
+        for iteration in 1..=MAX_ITERATIONS {
+            for a in 0..2 {
+                for i in 0..N {
+                    y_stage[i] = self.y[i] + z[a][i];
+                }
+                sys.rhs(self.t + C[a] * h, &y_stage, &mut stage_f[a]);
+            }
+            self.stats.rhs_evaluations += 2;
+            for a in 0..2 {
+                for i in 0..N {
+                    let residual =
+                        z[a][i] - h * (A[a][0] * stage_f[0][i] + A[a][1] * stage_f[1][i]);
+                    self.work[a * N + i] = -residual;
+                }
+            }
+            if !self.work.iter().all(|v| v.is_finite()) {
+                return Err((iteration, f64::NAN));
+            }
+            self.solve();
+            let mut norm = 0.0_f64;
+            for a in 0..2 {
+                for i in 0..N {
+                    let dz = self.work[a * N + i];
+                    z[a][i] += dz;
+                    norm = norm.max(dz.abs() / self.y[i].abs().max(1.0));
+                }
+            }
+            if !norm.is_finite() {
+                return Err((iteration, norm));
+            }
+            // Converged to round-off: the correction, or the one the contraction rate predicts next,
+            // is below ε; or the corrections stopped decreasing at round-off level.
+            // (No rate is known after the first iteration: then only a correction below ε counts.)
+            let rate = if iteration == 1 {
+                1.0
+            } else {
+                norm / previous_norm
+            };
+            if norm <= f64::EPSILON
+                || (rate < 1.0 && rate * norm <= f64::EPSILON)
+                || (rate >= 1.0 && norm <= ROUND_OFF_PLATEAU)
+            {
+                return Ok(());
+            }
+            if rate >= 1.0 && iteration > 1 {
+                return Err((iteration, norm)); // diverging above round-off
+            }
+            // Slow contraction far above round-off means J is out of date (near round-off the ratio of
+            // successive corrections is noise and says nothing about J).
+            if iteration > 1 && rate > SLOW_CONTRACTION && norm > ROUND_OFF_PLATEAU {
+                self.jacobian_stale = true;
+            }
+            previous_norm = norm;
+        }
+        Err((MAX_ITERATIONS, previous_norm))
+    }
+}
+
+impl<const N: usize> Stepper<N> for Gauss4<N> {
+    fn init<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t0: f64,
+        y0: &[f64; N],
+        _t_end: f64,
+    ) -> Result<(), StepError> {
+        self.t0 = t0;
+        self.n = 0;
+        self.t = t0;
+        self.t_prev = t0;
+        self.y = *y0;
+        self.y_prev = *y0;
+        sys.rhs(t0, y0, &mut self.f);
+        self.f_prev = self.f;
+        self.h_z_last = 0.0;
+        self.jacobian_stale = true;
+        self.h_lu = 0.0;
+        self.stats = Stats {
+            rhs_evaluations: 1,
+            ..Stats::default()
+        };
+        if all_finite(y0) && all_finite(&self.f) {
+            Ok(())
+        } else {
+            Err(StepError::NonFinite { t: t0 })
+        }
+    }
+
+    fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
+        // Times as t0 + n·h (not accumulated) so that fixed steps land exactly on the sample grid.
+        #[allow(clippy::cast_precision_loss)]
+        let mut t_new = self.t0 + (self.n + 1) as f64 * self.h;
+        let mut full = true;
+        if t_new > t_limit {
+            t_new = t_limit;
+            full = false;
+        }
+        let h = t_new - self.t;
+        // First attempt with the kept Jacobian; if it fails, once more with a fresh one.
+        let mut failure = (0, f64::NAN);
+        let mut solution = None;
+        for _attempt in 0..2 {
+            let fresh = self.jacobian_stale;
+            if fresh {
+                self.update_jacobian(sys);
+            }
+            #[allow(clippy::float_cmp)] // exact: the LU was built for this very step value
+            let lu_current = self.h_lu == h;
+            if !lu_current && !self.factor(h) {
+                failure = (0, f64::INFINITY);
+            } else {
+                let mut z = self.initial_guess(h);
+                match self.newton(sys, h, &mut z) {
+                    Ok(()) => {
+                        solution = Some(z);
+                        break;
+                    }
+                    Err(e) => failure = e,
+                }
+            }
+            self.jacobian_stale = true;
+            if fresh {
+                break; // failed with an up-to-date Jacobian: another one will not help
+            }
+        }
+        let Some(z) = solution else {
+            if failure.1.is_nan() {
+                return Err(StepError::NonFinite { t: self.t });
+            }
+            return Err(StepError::NewtonFailure {
+                t: self.t,
+                h,
+                iterations: failure.0,
+                residual: failure.1,
+            });
+        };
+
+        // y₁ = y₀ + h·Σ bᵢ f(Yᵢ) = y₀ + bᵀA⁻¹Z = y₀ + √3·(Z₂ − Z₁), from the final (round-off exact) Z
+        // without two more evaluations (HLW, §VIII.6.3).
+        let mut y_new = [0.0; N];
+        for i in 0..N {
+            y_new[i] = self.y[i] + SQRT3 * (z[1][i] - z[0][i]);
+        }
+        let mut f_new = [0.0; N];
+        sys.rhs(t_new, &y_new, &mut f_new);
+        self.stats.rhs_evaluations += 1;
+        if !(all_finite(&y_new) && all_finite(&f_new)) {
+            return Err(StepError::NonFinite { t: self.t });
+        }
+        self.t_prev = self.t;
+        self.y_prev = self.y;
+        self.f_prev = self.f;
+        self.t = t_new;
+        self.y = y_new;
+        self.f = f_new;
+        self.z_last = z;
+        self.h_z_last = h;
+        if full {
+            self.n += 1;
+        }
+        self.stats.steps += 1;
+        Ok(())
+    }
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+    fn y(&self) -> &[f64; N] {
+        &self.y
+    }
+    fn t_previous(&self) -> f64 {
+        self.t_prev
+    }
+    fn interpolate(&self, t: f64, out: &mut [f64; N]) {
+        hermite_interpolate(
+            self.t_prev,
+            self.t - self.t_prev,
+            &self.y_prev,
+            &self.f_prev,
+            &self.y,
+            &self.f,
+            t,
+            out,
+        );
+    }
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+}
