@@ -24,12 +24,39 @@ fn recording(duration: f64) -> Vec<(String, u64, Value)> {
     read_messages(&path)
 }
 
+/// The committed recordings (made by `coin-log record`), read back, with their names.
+fn datasets() -> Vec<(String, Vec<(String, u64, Value)>)> {
+    let mut files: Vec<_> = std::fs::read_dir(repo().join("datasets"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| (p.display().to_string(), read_messages(&p)))
+        .collect()
+}
+
+/// A fresh 2-time-unit recording and every committed dataset.
+fn recordings() -> Vec<(String, Vec<(String, u64, Value)>)> {
+    let mut all = vec![("fresh circle".to_string(), recording(2.0))];
+    all.extend(datasets());
+    all
+}
+
 #[test]
 fn the_frames_form_the_tree_world_table_coin_with_one_parent_each() {
-    let messages = recording(2.0);
+    for (name, messages) in recordings() {
+        println!("{name}:");
+        check_frame_tree(&messages);
+    }
+}
+
+fn check_frame_tree(messages: &[(String, u64, Value)]) {
     let mut parents: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     let mut first_seen: BTreeMap<String, u64> = BTreeMap::new();
-    for (topic, lt, v) in &messages {
+    for (topic, lt, v) in messages {
         if topic == "/tf" {
             let child = v["child_frame_id"].as_str().unwrap().to_string();
             let parent = v["parent_frame_id"].as_str().unwrap().to_string();
@@ -38,7 +65,7 @@ fn the_frames_form_the_tree_world_table_coin_with_one_parent_each() {
             parents.entry(child).or_default().insert(parent);
         }
     }
-    println!("parents: {parents:?}");
+    println!("  parents: {parents:?}");
     let expected: BTreeMap<String, BTreeSet<String>> = [
         ("table".to_string(), BTreeSet::from(["world".to_string()])),
         ("coin".to_string(), BTreeSet::from(["table".to_string()])),
@@ -72,13 +99,25 @@ fn the_frames_form_the_tree_world_table_coin_with_one_parent_each() {
         .position(|(t, _, v)| t == "/tf" && v["child_frame_id"] == "coin")
         .unwrap();
     assert!(first_table < first_scene && first_coin < first_scene);
-    assert_eq!(first_seen["table"], 0);
-    assert_eq!(first_seen["coin"], 0);
+    let t0 = messages[0].1;
+    assert_eq!(first_seen["table"], t0);
+    assert_eq!(first_seen["coin"], t0);
 }
 
 #[test]
 fn the_coin_is_a_cylinder_in_the_coin_frame_and_the_track_lies_in_the_table_frame() {
-    let messages = recording(2.0);
+    for (name, messages) in datasets() {
+        let (scenes, points) = check_scene_entities(&messages);
+        println!("{name}: {scenes} scene updates, {points} track points");
+        assert!(scenes > 0);
+    }
+    let (scenes, track_points) = check_scene_entities(&recording(2.0));
+    println!("{scenes} scene updates, {track_points} new track points (expected 200: one per sample after the first)");
+    assert_eq!(track_points, 200);
+}
+
+/// Checks every scene entity; returns (scene updates, new track points).
+fn check_scene_entities(messages: &[(String, u64, Value)]) -> (usize, usize) {
     let mut track_points = 0;
     let mut scenes = 0;
     for (topic, _, v) in messages.iter().filter(|(t, _, _)| t == "/scene") {
@@ -107,15 +146,13 @@ fn the_coin_is_a_cylinder_in_the_coin_frame_and_the_track_lies_in_the_table_fram
             }
         }
     }
-    println!("{scenes} scene updates, {track_points} new track points (expected 200: one per sample after the first)");
-    assert_eq!(track_points, 200);
+    (scenes, track_points)
 }
 
 #[test]
 fn every_foxglove_timestamp_equals_its_log_time() {
-    let messages = recording(2.0);
     let mut checked = 0;
-    for (topic, lt, v) in &messages {
+    for (topic, lt, v) in recordings().iter().flat_map(|(_, m)| m) {
         let stamps: Vec<&Value> = match topic.as_str() {
             "/tf" => vec![&v["timestamp"]],
             "/scene" => v["entities"]
