@@ -12,6 +12,9 @@ use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use support::{read_messages, record_circle, repo, Damage};
 
+/// (topic, log time, message) of every message of a file.
+type Messages = Vec<(String, u64, Value)>;
+
 fn time_ns(stamp: &Value) -> u64 {
     stamp["sec"].as_u64().unwrap() * 1_000_000_000 + stamp["nsec"].as_u64().unwrap()
 }
@@ -25,7 +28,7 @@ fn recording(duration: f64) -> Vec<(String, u64, Value)> {
 }
 
 /// The committed recordings (made by `coin-log record`), read back, with their names.
-fn datasets() -> Vec<(String, Vec<(String, u64, Value)>)> {
+fn datasets() -> Vec<(String, Messages)> {
     let mut files: Vec<_> = std::fs::read_dir(repo().join("datasets"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -39,7 +42,7 @@ fn datasets() -> Vec<(String, Vec<(String, u64, Value)>)> {
 }
 
 /// A fresh 2-time-unit recording and every committed dataset.
-fn recordings() -> Vec<(String, Vec<(String, u64, Value)>)> {
+fn recordings() -> Vec<(String, Messages)> {
     let mut all = vec![("fresh circle".to_string(), recording(2.0))];
     all.extend(datasets());
     all
