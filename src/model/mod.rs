@@ -13,6 +13,7 @@ pub use derived::{
     centre, contact_point, energy, orientation, reaction, Energy, Quaternion, Reaction, Vec3,
 };
 pub use equations::{AngularAcceleration, Coin};
+pub use invariants::{Chaplygin, Invariants, InvariantsError, LegendreBasis};
 pub use params::{CoinParams, Inertia, ParamError};
 pub use stability::{
     centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
