@@ -5,11 +5,12 @@
 
 use coin_log::integrate::{Flow, Rk4, RunSettings};
 use coin_log::model::{
-    centre, contact_point, energy, orientation, reaction, Branch, Coin, CoinParams, State, Steady,
-    SteadyKind,
+    centre, contact_point, energy, orientation, reaction, Branch, Chaplygin, Coin, CoinParams,
+    State, Steady, SteadyKind,
 };
 use coin_log::record::messages::{
-    Angles, AngularVelocity, EnergyMessage, Position, QuaternionMessage, ReactionMessage,
+    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
+    ReactionMessage,
 };
 use coin_log::record::{
     schema_bytes, Channel, Foxglove3d, FoxgloveBatch, MESSAGE_ENCODING, SCHEMA_ENCODING,
@@ -62,6 +63,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         Channel::Contact,
         Channel::Reaction,
         Channel::Energy,
+        Channel::Invariants,
         Channel::Tf,
         Channel::Scene,
     ];
@@ -94,6 +96,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         sample_interval: 0.01,
     };
     let events = CoinEvents::new(coin, 1e-4, None);
+    let chaplygin = Chaplygin::new(coin.params()).unwrap();
     let mut rk4 = Rk4::new(1e-3);
     simulate(
         &coin,
@@ -122,7 +125,8 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
             let q = orientation(&s);
             let e = energy(&coin, &s);
             let r = reaction(&coin, &s);
-            let msgs: [(Channel, &Writer); 7] = [
+            let c = chaplygin.of_state(&s);
+            let msgs: [(Channel, &Writer); 8] = [
                 (Channel::Omega, &|b| {
                     AngularVelocity {
                         t,
@@ -192,6 +196,15 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
                         total: e.total,
                         kinetic: e.kinetic,
                         potential: e.potential,
+                    }
+                    .write_json(b)
+                    .unwrap()
+                }),
+                (Channel::Invariants, &|b| {
+                    InvariantsMessage {
+                        t,
+                        c1: c.c1,
+                        c2: c.c2,
                     }
                     .write_json(b)
                     .unwrap()
