@@ -8,5 +8,6 @@
 pub mod integrate;
 pub mod model;
 pub mod record;
+pub mod scene;
 pub mod simulation;
 pub mod units;

@@ -1,0 +1,149 @@
+//! The scene file exactly as written (CONTRACT: Scene files): every table refuses unknown keys, every
+//! optional key is an `Option`, names (shape, integrator, channels, steady kind) stay strings so that
+//! validation can report every bad one at once with its key, value and allowed values.
+
+use serde::{Deserialize, Serialize};
+
+/// A scene file: `description`, `[body]`, `[initial]`, `[run]`, `[record]`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// One line saying what the scene shows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+    /// The coin.
+    pub body: BodyFile,
+    /// The initial state.
+    pub initial: InitialFile,
+    /// Duration, sampling and integrator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub run: Option<RunFile>,
+    /// What to record.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub record: Option<RecordFile>,
+}
+
+/// `[body]`: M, a, g, the inertia (a shape or both moments), μ and the display thickness.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyFile {
+    /// M > 0 [mass].
+    pub mass: f64,
+    /// a > 0 [length].
+    pub radius: f64,
+    /// g > 0 [length/time²].
+    pub gravity: f64,
+    /// `thin-disk` or `hoop`; or give both `inertia_x` and `inertia_z` instead.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<String>,
+    /// I_X, moment about a diameter [mass·length²].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia_x: Option<f64>,
+    /// I_Z, moment about the symmetry axis [mass·length²].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia_z: Option<f64>,
+    /// μ: with it, |F| > μN ends the run (slip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// Display thickness, as a fraction of a (default 0.05).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+}
+
+/// `[initial]`: an explicit state (θ and ω, optionally φ, ψ, x, z) or a steady motion, plus an optional kick.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialFile {
+    /// θ [rad].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta: Option<f64>,
+    /// (ω_X, ω_Y, ω_Z) in the lean frame [rad/time].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub omega: Option<Vec<f64>>,
+    /// φ [rad] (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phi: Option<f64>,
+    /// ψ [rad] (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub psi: Option<f64>,
+    /// Centre x [length] (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x: Option<f64>,
+    /// Centre z [length] (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<f64>,
+    /// A steady motion (NOTES §4) whose ω the solver fills in.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steady: Option<SteadyFile>,
+    /// A kick added to the initial state of either form.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub perturbation: Option<PerturbationFile>,
+}
+
+/// `steady = { kind = ..., ... }`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SteadyFile {
+    /// `straight`, `centre-fixed`, `circle` or `spin-upright`.
+    pub kind: String,
+    /// θ [rad] (`centre-fixed`, `circle`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta: Option<f64>,
+    /// ω_Y [rad/time] (`spin-upright`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub omega_y: Option<f64>,
+    /// ω_Z [rad/time] (`straight`, `circle`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub omega_z: Option<f64>,
+    /// `+` or `-` (`centre-fixed`, `circle`; default `+`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub branch: Option<String>,
+}
+
+/// `perturbation = { theta = ..., omega = [...] }`: added to the initial state.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PerturbationFile {
+    /// Added to θ [rad].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta: Option<f64>,
+    /// Added to (ω_X, ω_Y, ω_Z) [rad/time].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub omega: Option<Vec<f64>>,
+}
+
+/// `[run]`: every key optional, defaults in [`super::defaults`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunFile {
+    /// Duration [time].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration: Option<f64>,
+    /// Samples per time unit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate: Option<f64>,
+    /// Integrator name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<String>,
+    /// Relative tolerance (adaptive methods).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (adaptive methods).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
+    /// Step (fixed-step methods) [time].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
+    /// The run ends at |θ| ≥ π/2 − flat_margin [rad].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flat_margin: Option<f64>,
+}
+
+/// `[record]`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordFile {
+    /// Channel names.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channels: Option<Vec<String>>,
+}

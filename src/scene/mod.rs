@@ -1,0 +1,270 @@
+//! What to simulate (CONTRACT: Scene files). Two stages: [`SceneFile`] mirrors the TOML exactly (unknown keys
+//! refused), [`Scene`] is the validated, resolved scene (defaults filled in, steady motions solved, the step
+//! fitted to the sampling grid). Only a [`Scene`] reaches the recorder.
+//!
+//! Loading goes: text or preset → TOML table → `--set KEY=VALUE` edits ([`apply_set`]) → [`SceneFile`] →
+//! explicit flags ([`FlagOverrides`]) → [`Scene::from_file`], which reports every problem at once.
+
+mod file;
+mod overrides;
+pub mod presets;
+mod validate;
+
+pub use file::{
+    BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
+};
+pub use overrides::{apply_set, FlagOverrides};
+
+use crate::integrate::MethodConfig;
+use crate::model::{Coin, CoinParams, Inertia, State, Steady};
+use crate::record::Channel;
+use std::fmt;
+
+/// Defaults of the optional scene keys (CONTRACT: Scene files).
+pub mod defaults {
+    /// Samples per time unit.
+    pub const RATE: f64 = 100.0;
+    /// Integrator name.
+    pub const INTEGRATOR: &str = "dop853";
+    /// Relative tolerance: close to what dop853 can deliver in double precision over tens of time units.
+    pub const RTOL: f64 = 1e-10;
+    /// Absolute tolerance: two digits below RTOL so that components through zero do not starve the step.
+    pub const ATOL: f64 = 1e-12;
+    /// Fixed step for rk4/gauss4, before being rounded down to divide 1/rate.
+    pub const STEP: f64 = 1e-3;
+    /// Flat-landing margin [rad]: tan θ ≈ 1e4 there, still well inside double precision.
+    pub const FLAT_MARGIN: f64 = 1e-4;
+    /// Display thickness, a fraction of the radius (a 500-yen coin is 1.8 mm thick for 13.25 mm radius).
+    pub const THICKNESS: f64 = 0.05;
+    /// Steady branch when none is given.
+    pub const BRANCH: &str = "+";
+}
+
+/// Largest number of samples a scene may ask for (duration × rate): 10¹¹, far beyond any disk.
+pub const MAX_SAMPLES: f64 = 1e11;
+
+/// One thing wrong with a scene: the key, the value found and what is allowed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Problem {
+    /// Dotted key (`body.mass`).
+    pub key: String,
+    /// The value found, TOML-like (`-1`, `"dop854"`, `NaN`), or empty when the key is missing.
+    pub value: String,
+    /// What is wrong and what is allowed (`is outside (0, ∞)`).
+    pub reason: String,
+    /// The command-line flag that set the value, if any (`--rate`).
+    pub flag: Option<String>,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.value.is_empty() {
+            write!(f, "`{}` {}", self.key, self.reason)?;
+        } else {
+            write!(f, "`{}` = {} {}", self.key, self.value, self.reason)?;
+        }
+        if let Some(flag) = &self.flag {
+            write!(f, " (set by `{flag}`)")?;
+        }
+        Ok(())
+    }
+}
+
+/// Why a scene could not be loaded.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// The TOML does not parse or does not fit the scene's keys and types (serde's message, alone).
+    #[error("{0}")]
+    Parse(String),
+    /// A `--set KEY=VALUE` that cannot be applied.
+    #[error("`--set {arg}`: {reason}")]
+    Set {
+        /// The argument as given.
+        arg: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// No built-in scene of that name.
+    #[error("no built-in scene `{name}` and no such file; built-in scenes: {valid}")]
+    UnknownPreset {
+        /// The name given.
+        name: String,
+        /// The valid names, comma-separated.
+        valid: String,
+    },
+    /// Values out of range, missing or contradictory; every problem found.
+    #[error("{}", format_problems(.0))]
+    Invalid(Vec<Problem>),
+}
+
+fn format_problems(problems: &[Problem]) -> String {
+    match problems {
+        [one] => one.to_string(),
+        many => {
+            let mut s = format!("{} problems:", many.len());
+            for p in many {
+                s.push_str("\n  ");
+                s.push_str(&p.to_string());
+            }
+            s
+        }
+    }
+}
+
+/// How the initial state was specified.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InitialSpec {
+    /// θ and ω given.
+    Explicit,
+    /// Solved from a steady motion (NOTES §4).
+    Steady(Steady),
+}
+
+/// Duration, sampling and integration settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunConfig {
+    /// Duration [time], > 0.
+    pub duration: f64,
+    /// Samples per time unit, > 0.
+    pub rate: f64,
+    /// Method with rtol, atol and the step actually used (rounded down to divide 1/rate).
+    pub method: MethodConfig,
+    /// The run ends at |θ| ≥ π/2 − flat_margin [rad].
+    pub flat_margin: f64,
+}
+
+impl RunConfig {
+    /// Distance between samples, 1/rate [time].
+    #[must_use]
+    pub fn sample_interval(&self) -> f64 {
+        1.0 / self.rate
+    }
+}
+
+/// A validated scene: everything the recorder needs, nothing left to check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// One line.
+    pub description: String,
+    /// M, a, g, I_X, I_Z.
+    pub params: CoinParams,
+    /// How the inertia was given (kept to write the scene back).
+    pub inertia: Inertia,
+    /// μ, if given.
+    pub friction: Option<f64>,
+    /// Display thickness, fraction of a.
+    pub thickness: f64,
+    /// The state at t = 0, perturbation included.
+    pub initial: State,
+    /// The state before the perturbation (the explicit state or the steady motion, with φ, ψ, x, z).
+    pub base: State,
+    /// How the initial state was specified.
+    pub spec: InitialSpec,
+    /// The perturbation (θ, ω_X, ω_Y, ω_Z) added to the initial state; zeros when none.
+    pub perturbation: [f64; 4],
+    /// Run settings.
+    pub run: RunConfig,
+    /// Channels to record, in the contract's order, each once.
+    pub channels: Vec<Channel>,
+}
+
+impl Scene {
+    /// Validates and resolves a scene file; reports every problem found.
+    ///
+    /// # Errors
+    /// [`SceneError::Invalid`] with one [`Problem`] per bad, missing or contradictory key.
+    pub fn from_file(file: &SceneFile) -> Result<Self, SceneError> {
+        validate::scene_from_file(file, &[])
+    }
+
+    /// The coin (precomputed right-hand side).
+    #[must_use]
+    pub fn coin(&self) -> Coin {
+        Coin::new(self.params)
+    }
+
+    /// The steady motion the scene starts on, when it was given as one and not perturbed: then the whole
+    /// run should stay on it (the `steady_kind` of the metadata).
+    #[must_use]
+    pub fn unperturbed_steady(&self) -> Option<&Steady> {
+        match &self.spec {
+            InitialSpec::Steady(s) if self.perturbation.iter().all(|&p| p == 0.0) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// True when `channel` is recorded.
+    #[must_use]
+    pub fn records(&self, channel: Channel) -> bool {
+        self.channels.contains(&channel)
+    }
+
+    /// The resolved scene as a file: every default written out, so it reads back to the same scene.
+    #[must_use]
+    pub fn to_file(&self) -> SceneFile {
+        validate::file_from_scene(self)
+    }
+
+    /// The resolved scene as TOML text (the `scene` key of the `coin-log` metadata).
+    #[must_use]
+    pub fn to_toml(&self) -> String {
+        to_toml(&self.to_file())
+    }
+}
+
+/// A scene file as TOML text.
+#[must_use]
+pub fn to_toml(file: &SceneFile) -> String {
+    // Serialising plain structs of numbers, strings and arrays cannot fail; an empty string would only
+    // make the result refuse to parse back, which the tests check.
+    toml::to_string(file).unwrap_or_default()
+}
+
+/// Parses scene TOML text and applies `--set` edits, giving the raw file (not yet validated).
+///
+/// # Errors
+/// [`SceneError::Parse`] for bad TOML or a key/type that does not fit; [`SceneError::Set`] for a bad edit.
+pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneError> {
+    if sets.is_empty() {
+        // Straight from the text: serde's message then points at the line.
+        return toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string().trim().into()));
+    }
+    let mut table: toml::Table =
+        toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string().trim().into()))?;
+    for set in sets {
+        apply_set(&mut table, set)?;
+    }
+    file_from_table(table)
+}
+
+/// A preset (or any file) with `--set` edits applied.
+///
+/// # Errors
+/// As [`parse_with_sets`].
+pub fn file_with_sets(file: &SceneFile, sets: &[String]) -> Result<SceneFile, SceneError> {
+    if sets.is_empty() {
+        return Ok(file.clone());
+    }
+    let mut table =
+        toml::Table::try_from(file).map_err(|e| SceneError::Parse(e.to_string().trim().into()))?;
+    for set in sets {
+        apply_set(&mut table, set)?;
+    }
+    file_from_table(table)
+}
+
+fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
+    toml::Value::Table(table)
+        .try_into::<SceneFile>()
+        .map_err(|e| SceneError::Parse(e.to_string().trim().replace('\n', " ")))
+}
+
+/// Resolves a raw file with command-line flags on top into a validated scene; problems caused by a flag
+/// name the flag.
+///
+/// # Errors
+/// [`SceneError::Invalid`] listing every problem.
+pub fn resolve(file: &SceneFile, flags: &FlagOverrides) -> Result<Scene, SceneError> {
+    let (file, provenance) = flags.apply(file);
+    validate::scene_from_file(&file, &provenance)
+}

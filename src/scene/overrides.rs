@@ -1,0 +1,155 @@
+//! Changing a scene from the command line: `--set KEY=VALUE` edits the TOML table before it is read
+//! (CONTRACT: `--set`), then the explicit flags (`--duration`, `--rate`, ...) apply on top.
+
+use super::file::{RecordFile, RunFile, SceneFile};
+use super::SceneError;
+
+/// Applies one `KEY=VALUE` to a scene table. KEY is a dotted path (`initial.steady.branch`); missing
+/// tables on the way are created. VALUE is parsed as a TOML value (`0.3`, `[1, 2, 3]`, `"hoop"`,
+/// `{ kind = "straight", omega_z = 1.0 }`), or taken as a bare string when it does not parse (`hoop`, `+`).
+///
+/// ```
+/// let mut t = toml::Table::new();
+/// coin_log::scene::apply_set(&mut t, "run.rate=250").unwrap();
+/// coin_log::scene::apply_set(&mut t, "body.shape=hoop").unwrap();
+/// assert_eq!(t["run"]["rate"].as_integer(), Some(250));
+/// assert_eq!(t["body"]["shape"].as_str(), Some("hoop"));
+/// ```
+///
+/// # Errors
+/// [`SceneError::Set`] when there is no `=`, the key is empty or has an empty part, or a part of the path
+/// is a value rather than a table.
+pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
+    let error = |reason: String| SceneError::Set {
+        arg: arg.to_string(),
+        reason,
+    };
+    let Some((key, raw)) = arg.split_once('=') else {
+        return Err(error(
+            "expected KEY=VALUE, e.g. `--set initial.theta=0.4`".into(),
+        ));
+    };
+    let key = key.trim();
+    let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(error(format!(
+            "`{key}` is not a dotted key like `run.rate` or `initial.steady.kind`"
+        )));
+    }
+    let value = parse_value(raw.trim());
+    let (last, path) = parts
+        .split_last()
+        .ok_or_else(|| error("the key is empty".into()))?;
+    let mut current = table;
+    for (depth, part) in path.iter().enumerate() {
+        let entry = current
+            .entry((*part).to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        current = match entry {
+            toml::Value::Table(t) => t,
+            other => {
+                return Err(error(format!(
+                    "`{}` is {} = {}, not a table, so it has no key `{}`",
+                    parts[..=depth].join("."),
+                    other.type_str(),
+                    other,
+                    parts[depth + 1]
+                )))
+            }
+        };
+    }
+    current.insert((*last).to_string(), value);
+    Ok(())
+}
+
+/// VALUE as TOML, else as a bare string.
+fn parse_value(raw: &str) -> toml::Value {
+    let parsed = toml::from_str::<toml::Table>(&format!("value = {raw}"))
+        .ok()
+        .filter(|t| t.len() == 1)
+        .and_then(|mut t| t.remove("value"));
+    parsed.unwrap_or_else(|| toml::Value::String(raw.to_string()))
+}
+
+/// The explicit `record` flags that override scene keys (applied after `--set`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FlagOverrides {
+    /// `--duration` → `run.duration`.
+    pub duration: Option<f64>,
+    /// `--rate` → `run.rate`.
+    pub rate: Option<f64>,
+    /// `--integrator` → `run.integrator`.
+    pub integrator: Option<String>,
+    /// `--rtol` → `run.rtol`.
+    pub rtol: Option<f64>,
+    /// `--atol` → `run.atol`.
+    pub atol: Option<f64>,
+    /// `--step` → `run.step`.
+    pub step: Option<f64>,
+    /// `--channels` → `record.channels`.
+    pub channels: Option<Vec<String>>,
+}
+
+impl FlagOverrides {
+    /// The file with the flags applied, and which keys came from which flag.
+    #[must_use]
+    pub fn apply(&self, file: &SceneFile) -> (SceneFile, Vec<(&'static str, &'static str)>) {
+        let mut file = file.clone();
+        let mut provenance = Vec::new();
+        let run = file.run.get_or_insert_with(RunFile::default);
+        let mut set = |slot: &mut Option<f64>, value: Option<f64>, key, flag| {
+            if let Some(v) = value {
+                *slot = Some(v);
+                provenance.push((key, flag));
+            }
+        };
+        set(
+            &mut run.duration,
+            self.duration,
+            "run.duration",
+            "--duration",
+        );
+        set(&mut run.rate, self.rate, "run.rate", "--rate");
+        set(&mut run.rtol, self.rtol, "run.rtol", "--rtol");
+        set(&mut run.atol, self.atol, "run.atol", "--atol");
+        set(&mut run.step, self.step, "run.step", "--step");
+        if let Some(name) = &self.integrator {
+            run.integrator = Some(name.clone());
+            provenance.push(("run.integrator", "--integrator"));
+        }
+        if let Some(channels) = &self.channels {
+            file.record.get_or_insert_with(RecordFile::default).channels = Some(channels.clone());
+            provenance.push(("record.channels", "--channels"));
+        }
+        (file, provenance)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_that_are_not_toml_become_bare_strings() {
+        assert_eq!(parse_value("+"), toml::Value::String("+".into()));
+        assert_eq!(
+            parse_value("thin-disk"),
+            toml::Value::String("thin-disk".into())
+        );
+        assert_eq!(parse_value("1e-6"), toml::Value::Float(1e-6));
+        assert_eq!(parse_value("\"+\""), toml::Value::String("+".into()));
+        assert_eq!(
+            parse_value("1\nx = 2"),
+            toml::Value::String("1\nx = 2".into())
+        );
+    }
+
+    #[test]
+    fn a_set_through_a_value_is_refused_naming_the_value() {
+        let mut t: toml::Table = toml::from_str("[body]\nmass = 1.0").unwrap();
+        let e = apply_set(&mut t, "body.mass.x=1").unwrap_err().to_string();
+        assert!(e.contains("`body.mass` is float"), "{e}");
+        assert!(apply_set(&mut t, "run..rate=1").is_err());
+        assert!(apply_set(&mut t, "run.rate").is_err());
+    }
+}

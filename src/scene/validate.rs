@@ -1,0 +1,782 @@
+//! [`SceneFile`] → [`Scene`]: every range check of CONTRACT, all problems collected before failing, and the
+//! way back (a resolved scene as a file with every default written out).
+
+use super::file::{
+    BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
+};
+use super::{defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, MAX_SAMPLES};
+use crate::integrate::{Method, MethodConfig};
+use crate::model::{Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind};
+use crate::record::Channel;
+use std::f64::consts::FRAC_PI_2;
+
+/// Collects problems, naming the flag that set a key when one did.
+struct Problems<'a> {
+    list: Vec<Problem>,
+    provenance: &'a [(&'static str, &'static str)],
+}
+
+impl Problems<'_> {
+    fn push(&mut self, key: &str, value: String, reason: impl Into<String>) {
+        let flag = self
+            .provenance
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, f)| (*f).to_string());
+        self.list.push(Problem {
+            key: key.to_string(),
+            value,
+            reason: reason.into(),
+            flag,
+        });
+    }
+
+    fn missing(&mut self, key: &str, reason: impl Into<String>) {
+        self.push(key, String::new(), reason);
+    }
+
+    /// A required number that must be finite and > 0.
+    fn positive(&mut self, key: &str, value: f64) -> bool {
+        let ok = value.is_finite() && value > 0.0;
+        if !ok {
+            self.push(
+                key,
+                number(value),
+                "is outside (0, ∞): give a finite number > 0",
+            );
+        }
+        ok
+    }
+
+    /// Any finite number.
+    fn finite(&mut self, key: &str, value: f64) -> bool {
+        let ok = value.is_finite();
+        if !ok {
+            self.push(key, number(value), "is not a finite number");
+        }
+        ok
+    }
+
+    /// A vector of three finite numbers.
+    fn vector3(&mut self, key: &str, value: &[f64]) -> Option<[f64; 3]> {
+        match value {
+            [x, y, z] => {
+                let ok = [*x, *y, *z].iter().all(|v| v.is_finite());
+                if ok {
+                    Some([*x, *y, *z])
+                } else {
+                    self.push(
+                        key,
+                        numbers(value),
+                        "has a non-finite component: give three finite numbers",
+                    );
+                    None
+                }
+            }
+            _ => {
+                self.push(
+                    key,
+                    numbers(value),
+                    format!(
+                        "has {} components: give three, [ω_X, ω_Y, ω_Z]",
+                        value.len()
+                    ),
+                );
+                None
+            }
+        }
+    }
+}
+
+/// A number as the user would write it (`-1`, `0.5`, `1e-9`, `NaN`, `inf`).
+fn number(value: f64) -> String {
+    let magnitude = value.abs();
+    if value.is_finite() && value != 0.0 && !(1e-4..1e16).contains(&magnitude) {
+        ryu::Buffer::new().format_finite(value).to_string()
+    } else {
+        format!("{value}")
+    }
+}
+
+fn numbers(values: &[f64]) -> String {
+    let parts: Vec<String> = values.iter().map(|v| number(*v)).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+fn quoted(s: &str) -> String {
+    format!("{s:?}")
+}
+
+/// The lean range allowed by a flat margin, in words.
+fn lean_range(margin: f64) -> String {
+    format!("is outside (−π/2 + {margin}, π/2 − {margin}) (run.flat_margin = {margin}): a rolling coin must lean less than flat")
+}
+
+pub(super) fn scene_from_file(
+    file: &SceneFile,
+    provenance: &[(&'static str, &'static str)],
+) -> Result<Scene, SceneError> {
+    let mut problems = Problems {
+        list: Vec::new(),
+        provenance,
+    };
+    let run_file = file.run.clone().unwrap_or_default();
+    let flat_margin = run_file.flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+    let margin_ok = flat_margin.is_finite() && flat_margin > 0.0 && flat_margin < FRAC_PI_2;
+    let body = check_body(&file.body, &mut problems);
+    let initial = body.as_ref().and_then(|(params, ..)| {
+        check_initial(
+            &file.initial,
+            params,
+            margin_ok.then_some(flat_margin),
+            &mut problems,
+        )
+    });
+    // Without a valid body the initial state cannot be solved; still check what can be checked alone.
+    if body.is_none() {
+        check_initial_alone(
+            &file.initial,
+            margin_ok.then_some(flat_margin),
+            &mut problems,
+        );
+    }
+    let run = check_run(&run_file, flat_margin, margin_ok, &mut problems);
+    let channels = check_channels(file.record.as_ref(), &mut problems);
+    match (body, initial, run, channels) {
+        (
+            Some((params, inertia, friction, thickness)),
+            Some((base, spec, perturbation)),
+            Some(run),
+            Some(channels),
+        ) if problems.list.is_empty() => Ok(Scene {
+            description: file.description.clone().unwrap_or_default(),
+            params,
+            inertia,
+            friction,
+            thickness,
+            initial: perturbed(&base, &perturbation),
+            base,
+            spec,
+            perturbation,
+            run,
+            channels,
+        }),
+        _ => Err(SceneError::Invalid(problems.list)),
+    }
+}
+
+type Body = (CoinParams, Inertia, Option<f64>, f64);
+
+fn check_body(body: &BodyFile, problems: &mut Problems) -> Option<Body> {
+    let mut ok = problems.positive("body.mass", body.mass);
+    ok &= problems.positive("body.radius", body.radius);
+    ok &= problems.positive("body.gravity", body.gravity);
+    let inertia = match (&body.shape, body.inertia_x, body.inertia_z) {
+        (Some(shape), None, None) => match shape.as_str() {
+            "thin-disk" => Some(Inertia::ThinDisk),
+            "hoop" => Some(Inertia::Hoop),
+            other => {
+                problems.push(
+                    "body.shape",
+                    quoted(other),
+                    "is not a known shape: use \"thin-disk\" or \"hoop\", or give inertia_x and inertia_z instead",
+                );
+                None
+            }
+        },
+        (Some(shape), _, _) => {
+            problems.push(
+                "body.shape",
+                quoted(shape),
+                "is given together with inertia_x/inertia_z: give either a shape or both inertias, not both",
+            );
+            None
+        }
+        (None, Some(ix), Some(iz)) => {
+            let good =
+                problems.positive("body.inertia_x", ix) & problems.positive("body.inertia_z", iz);
+            if good && iz > 2.0 * ix {
+                problems.push(
+                    "body.inertia_z",
+                    number(iz),
+                    format!(
+                        "is more than 2·inertia_x = {}: no rigid axisymmetric body has I_Z > 2 I_X",
+                        number(2.0 * ix)
+                    ),
+                );
+                None
+            } else {
+                good.then_some(Inertia::Explicit {
+                    inertia_x: ix,
+                    inertia_z: iz,
+                })
+            }
+        }
+        (None, Some(_), None) => {
+            problems.missing(
+                "body.inertia_z",
+                "is missing: inertia_x needs inertia_z too",
+            );
+            None
+        }
+        (None, None, Some(_)) => {
+            problems.missing(
+                "body.inertia_x",
+                "is missing: inertia_z needs inertia_x too",
+            );
+            None
+        }
+        (None, None, None) => {
+            problems.missing(
+                "body.shape",
+                "is missing: give shape = \"thin-disk\" or \"hoop\", or both inertia_x and inertia_z",
+            );
+            None
+        }
+    };
+    if let Some(mu) = body.friction {
+        ok &= problems.positive("body.friction", mu);
+    }
+    let thickness = body.thickness.unwrap_or(defaults::THICKNESS);
+    ok &= problems.positive("body.thickness", thickness);
+    let inertia = inertia?;
+    if !ok {
+        return None;
+    }
+    let params = CoinParams::new(body.mass, body.radius, body.gravity, inertia).ok()?;
+    Some((params, inertia, body.friction, thickness))
+}
+
+type Initial = (State, InitialSpec, [f64; 4]);
+
+/// Checks of `[initial]` that need no body (used when the body is invalid).
+fn check_initial_alone(initial: &InitialFile, flat_margin: Option<f64>, problems: &mut Problems) {
+    if let Some(theta) = initial.theta {
+        if problems.finite("initial.theta", theta) {
+            let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+            if theta.abs() >= FRAC_PI_2 - margin {
+                problems.push("initial.theta", number(theta), lean_range(margin));
+            }
+        }
+    }
+    for (key, value) in [
+        ("initial.phi", initial.phi),
+        ("initial.psi", initial.psi),
+        ("initial.x", initial.x),
+        ("initial.z", initial.z),
+    ] {
+        if let Some(v) = value {
+            problems.finite(key, v);
+        }
+    }
+    if let Some(omega) = &initial.omega {
+        problems.vector3("initial.omega", omega);
+    }
+}
+
+fn check_initial(
+    initial: &InitialFile,
+    params: &CoinParams,
+    flat_margin: Option<f64>,
+    problems: &mut Problems,
+) -> Option<Initial> {
+    let before = problems.list.len();
+    let mut offsets = [0.0; 4]; // φ, ψ, x, z
+    for (slot, (key, value)) in offsets.iter_mut().zip([
+        ("initial.phi", initial.phi),
+        ("initial.psi", initial.psi),
+        ("initial.x", initial.x),
+        ("initial.z", initial.z),
+    ]) {
+        if let Some(v) = value {
+            if problems.finite(key, v) {
+                *slot = v;
+            }
+        }
+    }
+    let in_lean_range = |theta: f64| flat_margin.is_none_or(|m| theta.abs() < FRAC_PI_2 - m);
+    let margin_text = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+    let coin = Coin::new(*params);
+    let base: Option<(State, InitialSpec)> = match (&initial.steady, initial.theta, &initial.omega)
+    {
+        (Some(steady), theta, omega) => {
+            if let Some(t) = theta {
+                problems.push("initial.theta", number(t), "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion");
+            }
+            if let Some(o) = omega {
+                problems.push("initial.omega", numbers(o), "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion");
+            }
+            check_steady(steady, &coin, margin_text, &in_lean_range, problems)
+                .map(|s| (s.state, InitialSpec::Steady(s)))
+        }
+        (None, Some(theta), Some(omega)) => {
+            let theta_ok = problems.finite("initial.theta", theta);
+            if theta_ok && !in_lean_range(theta) {
+                problems.push("initial.theta", number(theta), lean_range(margin_text));
+            }
+            problems
+                .vector3("initial.omega", omega)
+                .map(|[wx, wy, wz]| {
+                    (
+                        State {
+                            theta,
+                            omega_x: wx,
+                            omega_y: wy,
+                            omega_z: wz,
+                            ..State::default()
+                        },
+                        InitialSpec::Explicit,
+                    )
+                })
+        }
+        (None, None, omega) => {
+            if let Some(o) = omega {
+                problems.vector3("initial.omega", o);
+            }
+            problems.missing("initial.theta", "is missing: give theta and omega, or a steady motion (initial.steady = { kind = ... })");
+            None
+        }
+        (None, Some(theta), None) => {
+            problems.finite("initial.theta", theta);
+            problems.missing(
+                "initial.omega",
+                "is missing: theta needs omega = [ω_X, ω_Y, ω_Z]",
+            );
+            None
+        }
+    };
+    let perturbation = initial
+        .perturbation
+        .as_ref()
+        .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
+    let (mut state, spec) = base?;
+    let perturbation = perturbation?;
+    state.phi += offsets[0];
+    state.psi += offsets[1];
+    state.x += offsets[2];
+    state.z += offsets[3];
+    let kicked = perturbed(&state, &perturbation);
+    if perturbation[0] != 0.0 && !in_lean_range(kicked.theta) {
+        problems.push(
+            "initial.perturbation.theta",
+            number(perturbation[0]),
+            format!(
+                "takes theta to {}, which {}",
+                number(kicked.theta),
+                lean_range(margin_text)
+            ),
+        );
+    }
+    (problems.list.len() == before).then_some((state, spec, perturbation))
+}
+
+/// `base` with the perturbation (θ, ω_X, ω_Y, ω_Z) added.
+pub(super) fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
+    State {
+        theta: base.theta + perturbation[0],
+        omega_x: base.omega_x + perturbation[1],
+        omega_y: base.omega_y + perturbation[2],
+        omega_z: base.omega_z + perturbation[3],
+        ..*base
+    }
+}
+
+fn check_perturbation(p: &PerturbationFile, problems: &mut Problems) -> Option<[f64; 4]> {
+    let theta = p.theta.unwrap_or(0.0);
+    let theta_ok = problems.finite("initial.perturbation.theta", theta);
+    let omega = match &p.omega {
+        Some(o) => problems.vector3("initial.perturbation.omega", o),
+        None => Some([0.0; 3]),
+    };
+    let [wx, wy, wz] = omega?;
+    theta_ok.then_some([theta, wx, wy, wz])
+}
+
+/// The keys each steady kind takes.
+fn steady_keys(kind: &str) -> Option<&'static [&'static str]> {
+    Some(match kind {
+        "straight" => &["omega_z"],
+        "centre-fixed" => &["theta", "branch"],
+        "circle" => &["theta", "omega_z", "branch"],
+        "spin-upright" => &["omega_y"],
+        _ => return None,
+    })
+}
+
+fn check_steady(
+    steady: &SteadyFile,
+    coin: &Coin,
+    margin: f64,
+    in_lean_range: &dyn Fn(f64) -> bool,
+    problems: &mut Problems,
+) -> Option<Steady> {
+    let before = problems.list.len();
+    let Some(allowed) = steady_keys(&steady.kind) else {
+        problems.push(
+            "initial.steady.kind",
+            quoted(&steady.kind),
+            "is not a steady motion: use \"straight\", \"centre-fixed\", \"circle\" or \"spin-upright\"",
+        );
+        return None;
+    };
+    let given = [
+        ("theta", steady.theta.map(number)),
+        ("omega_y", steady.omega_y.map(number)),
+        ("omega_z", steady.omega_z.map(number)),
+        ("branch", steady.branch.as_deref().map(quoted)),
+    ];
+    for (name, value) in &given {
+        if let Some(v) = value {
+            if !allowed.contains(name) {
+                problems.push(
+                    &format!("initial.steady.{name}"),
+                    v.clone(),
+                    format!(
+                        "does not apply to a \"{}\" steady motion, which takes: kind, {}",
+                        steady.kind,
+                        allowed.join(", ")
+                    ),
+                );
+            }
+        }
+    }
+    let mut required = |name: &str, value: Option<f64>| -> f64 {
+        let key = format!("initial.steady.{name}");
+        match value {
+            Some(v) => {
+                problems.finite(&key, v);
+                v
+            }
+            None => {
+                if allowed.contains(&name) {
+                    problems.missing(
+                        &key,
+                        format!(
+                            "is missing: a \"{}\" steady motion needs {}",
+                            steady.kind,
+                            allowed.join(", ")
+                        ),
+                    );
+                }
+                0.0
+            }
+        }
+    };
+    let kind = match steady.kind.as_str() {
+        "straight" => SteadyKind::Straight {
+            omega_z: required("omega_z", steady.omega_z),
+        },
+        "spin-upright" => SteadyKind::SpinUpright {
+            omega_y: required("omega_y", steady.omega_y),
+        },
+        kind => {
+            let theta = required("theta", steady.theta);
+            let omega_z = if kind == "circle" {
+                required("omega_z", steady.omega_z)
+            } else {
+                0.0
+            };
+            let branch = match steady.branch.as_deref().unwrap_or(defaults::BRANCH) {
+                "+" => Branch::Plus,
+                "-" => Branch::Minus,
+                other => {
+                    problems.push(
+                        "initial.steady.branch",
+                        quoted(other),
+                        "is not a branch: use \"+\" or \"-\"",
+                    );
+                    Branch::Plus
+                }
+            };
+            if theta.is_finite()
+                && (theta == 0.0 || !in_lean_range(theta))
+                && steady.theta.is_some()
+            {
+                problems.push(
+                    "initial.steady.theta",
+                    number(theta),
+                    format!(
+                        "is outside 0 < |θ| < π/2 − {margin} (run.flat_margin): this steady motion needs a leaning coin; use kind = \"straight\" for θ = 0"
+                    ),
+                );
+            }
+            if kind == "circle" {
+                SteadyKind::Circle {
+                    theta,
+                    omega_z,
+                    branch,
+                }
+            } else {
+                SteadyKind::CentreFixed { theta, branch }
+            }
+        }
+    };
+    if problems.list.len() != before {
+        return None;
+    }
+    match Steady::new(coin, kind) {
+        Ok(s) if s.state.is_finite() => Some(s),
+        Ok(s) => {
+            problems.push(
+                "initial.steady",
+                format!("{{ kind = \"{}\" }}", steady.kind),
+                format!(
+                    "has no finite solution here (ω_Y = {})",
+                    number(s.state.omega_y)
+                ),
+            );
+            None
+        }
+        Err(e) => {
+            problems.push(
+                "initial.steady",
+                format!("{{ kind = \"{}\" }}", steady.kind),
+                format!("cannot be built: {e}"),
+            );
+            None
+        }
+    }
+}
+
+fn check_run(
+    run: &RunFile,
+    flat_margin: f64,
+    margin_ok: bool,
+    problems: &mut Problems,
+) -> Option<RunConfig> {
+    let before = problems.list.len();
+    let duration = match run.duration {
+        Some(d) => {
+            if problems.positive("run.duration", d) && crate::units::log_time(d).is_err() {
+                problems.push(
+                    "run.duration",
+                    number(d),
+                    "is too long: log times must fit in 64-bit nanoseconds (duration < 1.8e10)",
+                );
+            }
+            d
+        }
+        None => {
+            problems.missing(
+                "run.duration",
+                "is missing: give the run's length in time units, e.g. duration = 20.0",
+            );
+            f64::NAN
+        }
+    };
+    let rate = run.rate.unwrap_or(defaults::RATE);
+    if problems.positive("run.rate", rate) && duration.is_finite() && duration * rate > MAX_SAMPLES
+    {
+        problems.push(
+            "run.rate",
+            number(rate),
+            format!(
+                "gives {:e} samples over duration {}: more than {MAX_SAMPLES:e}",
+                duration * rate,
+                number(duration)
+            ),
+        );
+    }
+    let integrator = run.integrator.as_deref().unwrap_or(defaults::INTEGRATOR);
+    let method = match integrator.parse::<Method>() {
+        Ok(m) => Some(m),
+        Err(e) => {
+            problems.push(
+                "run.integrator",
+                quoted(integrator),
+                format!("is not a known integrator: use one of {}", e.valid),
+            );
+            None
+        }
+    };
+    let rtol = run.rtol.unwrap_or(defaults::RTOL);
+    problems.positive("run.rtol", rtol);
+    let atol = run.atol.unwrap_or(defaults::ATOL);
+    problems.positive("run.atol", atol);
+    let step = run.step.unwrap_or(defaults::STEP);
+    problems.positive("run.step", step);
+    if !margin_ok {
+        problems.push(
+            "run.flat_margin",
+            number(flat_margin),
+            "is outside (0, π/2): give a small positive angle, e.g. 1e-4",
+        );
+    }
+    if problems.list.len() != before {
+        return None;
+    }
+    Some(RunConfig {
+        duration,
+        rate,
+        method: MethodConfig {
+            method: method?,
+            rtol,
+            atol,
+            step: fitted_step(step, 1.0 / rate),
+        },
+        flat_margin,
+    })
+}
+
+/// The largest step ≤ `step` that divides the sample interval into a whole number of steps, so that fixed
+/// steps land on the sample grid. A relative slack of 1e-12 keeps 0.01/0.001 = 10.000000000000002 at 10.
+#[allow(clippy::cast_precision_loss)]
+pub(super) fn fitted_step(step: f64, interval: f64) -> f64 {
+    let ratio = interval / step;
+    let steps = (ratio * (1.0 - 1e-12)).ceil().max(1.0);
+    interval / steps
+}
+
+fn check_channels(record: Option<&RecordFile>, problems: &mut Problems) -> Option<Vec<Channel>> {
+    let Some(names) = record.and_then(|r| r.channels.as_ref()) else {
+        return Some(Channel::ALL.to_vec());
+    };
+    let before = problems.list.len();
+    let mut channels = Vec::new();
+    for name in names {
+        match name.parse::<Channel>() {
+            Ok(c) if channels.contains(&c) => problems.push(
+                "record.channels",
+                quoted(name),
+                "is listed twice: list each channel once",
+            ),
+            Ok(c) => channels.push(c),
+            Err(_) => problems.push(
+                "record.channels",
+                quoted(name),
+                "is not a channel: use omega, angles, quaternion, position, contact, reaction, energy, invariants, tf, scene",
+            ),
+        }
+    }
+    if names.is_empty() {
+        problems.push(
+            "record.channels",
+            "[]".into(),
+            "is empty: list at least one channel (omega, angles, quaternion, position, contact, reaction, energy, invariants, tf, scene)",
+        );
+    }
+    channels.sort();
+    (problems.list.len() == before).then_some(channels)
+}
+
+pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
+    let p = &scene.params;
+    let (shape, inertia_x, inertia_z) = match scene.inertia {
+        Inertia::ThinDisk => (Some("thin-disk".to_string()), None, None),
+        Inertia::Hoop => (Some("hoop".to_string()), None, None),
+        Inertia::Explicit {
+            inertia_x,
+            inertia_z,
+        } => (None, Some(inertia_x), Some(inertia_z)),
+    };
+    let s = &scene.base;
+    let [dt, dwx, dwy, dwz] = scene.perturbation;
+    let perturbed = scene.perturbation.iter().any(|&v| v != 0.0);
+    let (theta, omega, steady) = match &scene.spec {
+        InitialSpec::Explicit => (
+            Some(s.theta),
+            Some(vec![s.omega_x, s.omega_y, s.omega_z]),
+            None,
+        ),
+        InitialSpec::Steady(st) => (None, None, Some(steady_file(&st.kind))),
+    };
+    // Steady motions start at φ = ψ = x = z = 0, so these are the file's offsets in both forms.
+    let nonzero = |v: f64| Some(v).filter(|v| *v != 0.0);
+    SceneFile {
+        description: Some(scene.description.clone()),
+        body: BodyFile {
+            mass: p.mass(),
+            radius: p.radius(),
+            gravity: p.gravity(),
+            shape,
+            inertia_x,
+            inertia_z,
+            friction: scene.friction,
+            thickness: Some(scene.thickness),
+        },
+        initial: InitialFile {
+            theta,
+            omega,
+            phi: nonzero(s.phi),
+            psi: nonzero(s.psi),
+            x: nonzero(s.x),
+            z: nonzero(s.z),
+            steady,
+            perturbation: perturbed.then(|| PerturbationFile {
+                theta: Some(dt),
+                omega: Some(vec![dwx, dwy, dwz]),
+            }),
+        },
+        run: Some(RunFile {
+            duration: Some(scene.run.duration),
+            rate: Some(scene.run.rate),
+            integrator: Some(scene.run.method.method.name().to_string()),
+            rtol: Some(scene.run.method.rtol),
+            atol: Some(scene.run.method.atol),
+            step: Some(scene.run.method.step),
+            flat_margin: Some(scene.run.flat_margin),
+        }),
+        record: Some(RecordFile {
+            channels: Some(
+                scene
+                    .channels
+                    .iter()
+                    .map(|c| c.name().to_string())
+                    .collect(),
+            ),
+        }),
+    }
+}
+
+fn steady_file(kind: &SteadyKind) -> SteadyFile {
+    let branch = |b: &Branch| Some(if *b == Branch::Plus { "+" } else { "-" }.to_string());
+    let name = kind.name().to_string();
+    match kind {
+        SteadyKind::Straight { omega_z } => SteadyFile {
+            kind: name,
+            omega_z: Some(*omega_z),
+            ..SteadyFile::default()
+        },
+        SteadyKind::SpinUpright { omega_y } => SteadyFile {
+            kind: name,
+            omega_y: Some(*omega_y),
+            ..SteadyFile::default()
+        },
+        SteadyKind::CentreFixed { theta, branch: b } => SteadyFile {
+            kind: name,
+            theta: Some(*theta),
+            branch: branch(b),
+            ..SteadyFile::default()
+        },
+        SteadyKind::Circle {
+            theta,
+            omega_z,
+            branch: b,
+        } => SteadyFile {
+            kind: name,
+            theta: Some(*theta),
+            omega_z: Some(*omega_z),
+            branch: branch(b),
+            ..SteadyFile::default()
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fitted_step;
+
+    #[test]
+    fn the_step_is_rounded_down_to_divide_the_sample_interval() {
+        for (step, interval, expected) in [
+            (1e-3, 0.01, 1e-3),
+            (3e-3, 0.01, 0.0025),
+            (1.0, 0.01, 0.01),
+            (0.004, 0.01, 0.01 / 3.0),
+        ] {
+            let got = fitted_step(step, interval);
+            println!("step {step}, interval {interval}: got {got}, expected {expected}");
+            assert!((got - expected).abs() <= 1e-18, "{got} vs {expected}");
+        }
+    }
+}

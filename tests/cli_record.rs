@@ -1,0 +1,462 @@
+//! `coin-log record` and `coin-log scenes` as a user runs them: exit codes, messages that name key and
+//! value, an output folder left untouched on error, determinism across processes, Ctrl-C.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common_record;
+
+use coin_log::record::{ResultMetadata, RESULT_METADATA_NAME};
+use common_record::{coin_log, listing, read_back};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const VALID: &str = r#"description = "test"
+[body]
+mass = 1.0
+radius = 1.0
+gravity = 1.0
+shape = "thin-disk"
+[initial]
+theta = 0.3
+omega = [0.0, 0.2, 1.0]
+[run]
+duration = 1.0
+integrator = "rk4"
+"#;
+
+fn code(output: &std::process::Output) -> i32 {
+    output.status.code().expect("exited normally")
+}
+
+fn stderr(output: &std::process::Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Runs `record` on a scene file holding `text` plus `args`; checks exit code 1, that stderr names every
+/// `needle`, and that the folder holds nothing but the scene file afterwards.
+fn refused(text: &str, args: &[&str], needles: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bad.toml"), text).unwrap();
+    let before = listing(dir.path());
+    let mut all = vec!["record", "bad.toml"];
+    all.extend_from_slice(args);
+    let out = coin_log(dir.path(), &all);
+    let err = stderr(&out);
+    println!("{args:?} → exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1, "exit code; stderr: {err}");
+    for needle in needles {
+        assert!(err.contains(needle), "stderr should name {needle:?}: {err}");
+    }
+    assert!(
+        err.starts_with("error: scene `bad.toml`"),
+        "says where: {err}"
+    );
+    assert_eq!(listing(dir.path()), before, "the folder is unchanged");
+}
+
+#[test]
+fn a_scene_with_an_unknown_key_is_refused_naming_the_key() {
+    refused(&VALID.replace("mass = 1.0", "masss = 1.0"), &[], &["masss"]);
+    refused(VALID, &["--set", "run.speed=2"], &["speed", "run"]);
+}
+
+#[test]
+fn a_value_of_the_wrong_type_is_refused_naming_key_and_value() {
+    refused(
+        &VALID.replace("mass = 1.0", "mass = \"heavy\""),
+        &[],
+        &["mass", "heavy"],
+    );
+    refused(VALID, &["--set", "run.rate=fast"], &["run.rate", "fast"]);
+}
+
+#[test]
+fn a_nan_is_refused_naming_key_and_value() {
+    refused(
+        &VALID.replace("radius = 1.0", "radius = nan"),
+        &[],
+        &["`body.radius` = NaN"],
+    );
+    refused(VALID, &["--rtol", "NaN"], &["`run.rtol` = NaN", "--rtol"]);
+}
+
+#[test]
+fn a_tilt_of_half_pi_is_refused_either_way() {
+    for theta in ["1.5707963267948966", "-1.5707963267948966"] {
+        let text = VALID.replace("theta = 0.3", &format!("theta = {theta}"));
+        refused(&text, &[], &[&format!("`initial.theta` = {theta}"), "π/2"]);
+    }
+}
+
+#[test]
+fn a_mass_that_is_not_positive_is_refused() {
+    refused(
+        &VALID.replace("mass = 1.0", "mass = 0.0"),
+        &[],
+        &["`body.mass` = 0", "(0, ∞)"],
+    );
+    refused(
+        &VALID.replace("mass = 1.0", "mass = -1.0"),
+        &[],
+        &["`body.mass` = -1", "(0, ∞)"],
+    );
+    refused(VALID, &["--set", "body.mass=-2"], &["`body.mass` = -2"]);
+}
+
+#[test]
+fn a_rate_of_zero_is_refused_naming_the_flag() {
+    refused(VALID, &["--rate", "0"], &["`run.rate` = 0", "--rate"]);
+    refused(
+        &VALID.replace("duration = 1.0", "duration = 1.0\nrate = 0"),
+        &[],
+        &["`run.rate` = 0"],
+    );
+}
+
+#[test]
+fn a_duration_that_is_not_positive_is_refused() {
+    refused(
+        VALID,
+        &["--duration=0"],
+        &["`run.duration` = 0", "--duration"],
+    );
+    refused(VALID, &["--duration=-5"], &["`run.duration` = -5"]);
+}
+
+#[test]
+fn an_unknown_channel_is_refused_naming_it() {
+    refused(
+        VALID,
+        &["--channels", "omega,spin"],
+        &["`record.channels` = \"spin\"", "--channels"],
+    );
+    refused(
+        &format!("{VALID}[record]\nchannels = [\"omega\", \"wobble\"]\n"),
+        &[],
+        &["`record.channels` = \"wobble\""],
+    );
+}
+
+#[test]
+fn an_unknown_integrator_is_refused_naming_it() {
+    refused(
+        VALID,
+        &["--integrator", "euler"],
+        &["`run.integrator` = \"euler\"", "rk4"],
+    );
+}
+
+#[test]
+fn a_shape_together_with_inertias_is_refused() {
+    let text = VALID.replace(
+        "shape = \"thin-disk\"",
+        "shape = \"hoop\"\ninertia_x = 0.5\ninertia_z = 1.0",
+    );
+    refused(&text, &[], &["`body.shape` = \"hoop\"", "inertia"]);
+}
+
+#[test]
+fn every_problem_is_listed_at_once() {
+    let text = VALID
+        .replace("mass = 1.0", "mass = -1.0")
+        .replace("gravity = 1.0", "gravity = 0.0");
+    refused(
+        &text,
+        &["--rate", "0"],
+        &[
+            "3 problems",
+            "`body.mass` = -1",
+            "`body.gravity` = 0",
+            "`run.rate` = 0",
+        ],
+    );
+}
+
+#[test]
+fn an_existing_output_is_never_replaced_without_overwrite() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), VALID).unwrap();
+    std::fs::write(dir.path().join("scene.mcap"), "precious").unwrap();
+    let before = listing(dir.path());
+    let out = coin_log(dir.path(), &["record", "scene.toml"]);
+    let err = stderr(&out);
+    println!("exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1);
+    assert!(
+        err.contains("scene.mcap") && err.contains("--overwrite"),
+        "{err}"
+    );
+    assert_eq!(listing(dir.path()), before);
+    assert_eq!(
+        std::fs::read(dir.path().join("scene.mcap")).unwrap(),
+        b"precious"
+    );
+
+    let out = coin_log(dir.path(), &["record", "scene.toml", "--overwrite"]);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert_eq!(listing(dir.path()), before);
+    assert!(std::fs::read(dir.path().join("scene.mcap"))
+        .unwrap()
+        .starts_with(b"\x89MCAP0\r\n"));
+}
+
+#[test]
+fn an_unwritable_folder_is_an_error_that_leaves_nothing_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), VALID).unwrap();
+    let before = listing(dir.path());
+    let out = coin_log(
+        dir.path(),
+        &["record", "scene.toml", "-o", "missing/folder/x.mcap"],
+    );
+    let err = stderr(&out);
+    println!("exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1);
+    assert!(err.contains("missing/folder"), "{err}");
+    assert_eq!(listing(dir.path()), before);
+}
+
+#[test]
+fn an_unknown_scene_name_lists_the_built_ins() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(dir.path(), &["record", "wobbel"]);
+    let err = stderr(&out);
+    println!("exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1);
+    assert!(err.contains("wobbel") && err.contains("wobble"), "{err}");
+    assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn a_flag_that_does_not_parse_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(dir.path(), &["record", "wobble", "--rate", "fast"]);
+    println!("exit {}: {}", code(&out), stderr(&out));
+    assert_eq!(code(&out), 2);
+    assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn a_recording_lands_under_the_scene_name_with_a_json_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "circle-plus",
+            "--duration",
+            "2",
+            "--integrator",
+            "rk4",
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    println!("{summary}");
+    assert_eq!(listing(dir.path()), vec!["circle-plus.mcap".to_string()]);
+    assert_eq!(summary["termination"], "completed");
+    assert_eq!(summary["samples"], 201);
+    let bytes = std::fs::read(dir.path().join("circle-plus.mcap")).unwrap();
+    assert_eq!(summary["bytes"], bytes.len() as u64);
+    assert!(summary["steady_residual"].as_f64().unwrap() < 1e-9);
+    for key in [
+        "messages",
+        "wall_time_s",
+        "steps",
+        "rhs_evaluations",
+        "rejected_steps",
+        "energy_drift",
+        "termination_time",
+    ] {
+        assert!(summary.get(key).is_some(), "{key} in {summary}");
+    }
+}
+
+#[test]
+fn a_physical_event_ends_the_run_normally() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "topple",
+            "--integrator",
+            "rk4",
+            "--json",
+            "-o",
+            "t.mcap",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    println!("{summary}");
+    assert_eq!(summary["termination"], "flat-landing");
+    let file = read_back(&std::fs::read(dir.path().join("t.mcap")).unwrap());
+    let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+    assert_eq!(result.termination, "flat-landing");
+}
+
+#[test]
+fn two_processes_write_byte_identical_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["a.mcap", "b.mcap"] {
+        let out = coin_log(
+            dir.path(),
+            &[
+                "record",
+                "wobble",
+                "--duration",
+                "5",
+                "--integrator",
+                "rk4",
+                "-o",
+                name,
+            ],
+        );
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+    }
+    let a = std::fs::read(dir.path().join("a.mcap")).unwrap();
+    let b = std::fs::read(dir.path().join("b.mcap")).unwrap();
+    println!("a.mcap {} bytes, b.mcap {} bytes", a.len(), b.len());
+    assert!(a == b, "the two files differ");
+}
+
+#[test]
+fn the_scenes_command_lists_and_shows_every_built_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(dir.path(), &["scenes"]);
+    assert_eq!(code(&out), 0);
+    let list = String::from_utf8(out.stdout).unwrap();
+    print!("{list}");
+    assert_eq!(list.lines().count(), coin_log::scene::presets::NAMES.len());
+    for name in coin_log::scene::presets::NAMES {
+        let out = coin_log(dir.path(), &["scenes", "--show", name]);
+        assert_eq!(code(&out), 0);
+        let shown = String::from_utf8(out.stdout).unwrap();
+        let file =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("datasets/scenes/{name}.toml"));
+        assert_eq!(
+            shown,
+            std::fs::read_to_string(file).unwrap(),
+            "{name}: `scenes --show` and the dataset file differ; regenerate the file"
+        );
+    }
+    let out = coin_log(dir.path(), &["scenes", "--show", "nope"]);
+    assert_eq!(code(&out), 1);
+}
+
+/// Sends SIGINT to a long recording and checks that it finishes the file, marked interrupted, exit 130.
+#[test]
+fn ctrl_c_finishes_the_file_marked_interrupted() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_coin-log"))
+        .args([
+            "record",
+            "long-horizon",
+            "--rate",
+            "1000",
+            "--duration",
+            "100000",
+            "--integrator",
+            "rk4",
+            "-o",
+            "long.mcap",
+        ])
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the temporary file: the signal handler is installed right after it is created.
+    let started = Instant::now();
+    while listing(dir.path()).is_empty() {
+        assert!(
+            started.elapsed() < Duration::from_secs(30),
+            "no temporary file appeared"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let exit = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the recording did not stop within 60 s of SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let out = child.wait_with_output().unwrap();
+    println!(
+        "exit {:?}, stdout:\n{}stderr: {}",
+        exit.code(),
+        String::from_utf8_lossy(&out.stdout),
+        stderr(&out)
+    );
+    assert_eq!(exit.code(), Some(130));
+    assert_eq!(listing(dir.path()), vec!["long.mcap".to_string()]);
+    let file = read_back(&std::fs::read(dir.path().join("long.mcap")).unwrap());
+    let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+    println!(
+        "termination {} at t = {}, {} messages",
+        result.termination,
+        result.termination_time,
+        file.messages.len()
+    );
+    assert_eq!(result.termination, "interrupted");
+    assert!(result.termination_time > 0.0 && result.termination_time < 100_000.0);
+    let last = file.on_topic("/coin/omega").last().unwrap().log_time;
+    assert_eq!(
+        last,
+        coin_log::units::log_time(result.termination_time).unwrap()
+    );
+}
+
+#[test]
+fn a_numerical_failure_finishes_the_file_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    // ω_Z = 1e150 is finite, but the first step overflows: the state becomes non-finite.
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "wobble",
+            "--integrator",
+            "rk4",
+            "--set",
+            "initial.omega=[0, 0, 1e150]",
+            "-o",
+            "f.mcap",
+        ],
+    );
+    let err = stderr(&out);
+    println!("exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1);
+    assert!(
+        err.contains("non-finite") && err.contains("f.mcap"),
+        "{err}"
+    );
+    let file = read_back(&std::fs::read(dir.path().join("f.mcap")).unwrap());
+    let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+    println!(
+        "termination {} at {}, {} messages",
+        result.termination,
+        result.termination_time,
+        file.messages.len()
+    );
+    assert_eq!(result.termination, "non-finite");
+    assert_eq!(
+        file.on_topic("/coin/omega").len(),
+        1,
+        "the sample at t = 0 is in the file"
+    );
+}

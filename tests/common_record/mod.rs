@@ -1,0 +1,159 @@
+//! Helpers shared by the record tests: reading a recording back, a validator for our flat JSON schemas,
+//! running the binary in a temporary folder.
+// Test helpers: a failed read is a failed test, so they panic with a message.
+#![allow(dead_code, missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// One message as read back.
+#[derive(Debug, Clone)]
+pub struct ReadMessage {
+    pub topic: String,
+    pub schema_name: String,
+    pub log_time: u64,
+    pub publish_time: u64,
+    pub sequence: u32,
+    pub data: Vec<u8>,
+}
+
+/// A recording read back with the mcap crate.
+#[derive(Debug)]
+pub struct ReadBack {
+    pub messages: Vec<ReadMessage>,
+    pub summary: mcap::Summary,
+    /// Metadata records by name, with their offsets in the file.
+    pub metadata: BTreeMap<String, (u64, BTreeMap<String, String>)>,
+    /// Schema name → schema data.
+    pub schemas: BTreeMap<String, Vec<u8>>,
+}
+
+impl ReadBack {
+    pub fn topics(&self) -> Vec<String> {
+        let mut topics: Vec<String> = self
+            .summary
+            .channels
+            .values()
+            .map(|c| c.topic.clone())
+            .collect();
+        topics.sort();
+        topics
+    }
+
+    pub fn on_topic(&self, topic: &str) -> Vec<&ReadMessage> {
+        self.messages.iter().filter(|m| m.topic == topic).collect()
+    }
+}
+
+pub fn read_back(bytes: &[u8]) -> ReadBack {
+    let summary = mcap::Summary::read(bytes)
+        .expect("summary readable")
+        .expect("file has a summary");
+    let mut messages = Vec::new();
+    for m in mcap::MessageStream::new(bytes).expect("message stream") {
+        let m = m.expect("message readable");
+        messages.push(ReadMessage {
+            topic: m.channel.topic.clone(),
+            schema_name: m
+                .channel
+                .schema
+                .as_ref()
+                .map(|s| s.name.clone())
+                .unwrap_or_default(),
+            log_time: m.log_time,
+            publish_time: m.publish_time,
+            sequence: m.sequence,
+            data: m.data.into_owned(),
+        });
+    }
+    let mut metadata = BTreeMap::new();
+    for index in &summary.metadata_indexes {
+        let record = mcap::read::metadata(bytes, index).expect("metadata readable");
+        metadata.insert(record.name.clone(), (index.offset, record.metadata));
+    }
+    let schemas = summary
+        .schemas
+        .values()
+        .map(|s| (s.name.clone(), s.data.to_vec()))
+        .collect();
+    ReadBack {
+        messages,
+        summary,
+        metadata,
+        schemas,
+    }
+}
+
+/// The bytes of `schemas/<name>.json`.
+pub fn schema_file(name: &str) -> Vec<u8> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("schemas")
+        .join(format!("{name}.json"));
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Validates a message against one of our flat schemas: an object, every property of the schema present,
+/// every value a JSON number, no property the schema does not declare (`additionalProperties: false`).
+pub fn validate_flat(schema: &serde_json::Value, message: &[u8]) -> Result<(), String> {
+    let value: serde_json::Value =
+        serde_json::from_slice(message).map_err(|e| format!("not JSON: {e}"))?;
+    let object = value.as_object().ok_or("not an object")?;
+    if schema["type"] != "object" {
+        return Err("schema is not an object schema".into());
+    }
+    if schema["additionalProperties"] != false {
+        return Err("schema allows additional properties".into());
+    }
+    let properties = schema["properties"]
+        .as_object()
+        .ok_or("schema has no properties")?;
+    let required: Vec<&str> = schema["required"]
+        .as_array()
+        .ok_or("schema has no required list")?
+        .iter()
+        .filter_map(|v| v.as_str())
+        .collect();
+    for (name, spec) in properties {
+        if spec["type"] != "number" {
+            return Err(format!("schema property `{name}` is not a number"));
+        }
+        if !required.contains(&name.as_str()) {
+            return Err(format!("schema property `{name}` is not required"));
+        }
+    }
+    for name in &required {
+        match object.get(*name) {
+            None => return Err(format!("missing field `{name}`")),
+            Some(v) if !v.is_number() => {
+                return Err(format!("field `{name}` = {v} is not a number"))
+            }
+            Some(_) => {}
+        }
+    }
+    for name in object.keys() {
+        if !properties.contains_key(name) {
+            return Err(format!("extra field `{name}`"));
+        }
+    }
+    Ok(())
+}
+
+/// Runs the binary with `args` in `dir`.
+pub fn coin_log(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_coin-log"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("coin-log runs")
+}
+
+/// File names in `dir`, sorted (hidden temporary files included).
+pub fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .expect("readable folder")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}

@@ -1,0 +1,364 @@
+//! Scene files: the built-ins and their files agree, resolved scenes read back to themselves, unknown keys
+//! and bad values are refused naming key, value and range, all at once.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use coin_log::model::{Branch, SteadyKind};
+use coin_log::scene::{
+    self, presets, FlagOverrides, InitialSpec, Problem, Scene, SceneError, SceneFile,
+};
+use std::path::Path;
+
+fn scene_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/scenes")
+}
+
+/// The problems of an invalid scene text (with `--set` edits and flags).
+fn problems(text: &str, sets: &[&str], flags: FlagOverrides) -> Vec<Problem> {
+    let sets: Vec<String> = sets.iter().map(|s| (*s).to_string()).collect();
+    let file = scene::parse_with_sets(text, &sets).expect("parses");
+    match scene::resolve(&file, &flags) {
+        Err(SceneError::Invalid(p)) => p,
+        other => panic!("expected problems, got {other:?}"),
+    }
+}
+
+const VALID: &str = r#"
+description = "test"
+[body]
+mass = 1.0
+radius = 1.0
+gravity = 1.0
+shape = "thin-disk"
+[initial]
+theta = 0.3
+omega = [0.0, 0.2, 1.0]
+[run]
+duration = 2.0
+integrator = "rk4"
+"#;
+
+fn valid() -> Scene {
+    let file = scene::parse_with_sets(VALID, &[]).unwrap();
+    Scene::from_file(&file).unwrap()
+}
+
+#[test]
+fn every_scene_file_parses_validates_and_equals_its_built_in() {
+    let mut files: Vec<String> = std::fs::read_dir(scene_dir())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    let mut names: Vec<String> = presets::NAMES.iter().map(|n| format!("{n}.toml")).collect();
+    names.sort();
+    assert_eq!(files, names, "datasets/scenes holds exactly the built-ins");
+    for name in presets::NAMES {
+        let text = std::fs::read_to_string(scene_dir().join(format!("{name}.toml"))).unwrap();
+        let file = scene::parse_with_sets(&text, &[]).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let preset = presets::preset(name).unwrap();
+        assert_eq!(file, preset, "{name}: file and built-in differ");
+        let scene = Scene::from_file(&file).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(scene, Scene::from_file(&preset).unwrap());
+        println!(
+            "{name:<18} {} θ0 = {:.6} ω0 = ({:.6}, {:.6}, {:.6}), {} samples",
+            match scene.spec {
+                InitialSpec::Explicit => "explicit".to_string(),
+                InitialSpec::Steady(s) => format!("steady {}", s.kind.name()),
+            },
+            scene.initial.theta,
+            scene.initial.omega_x,
+            scene.initial.omega_y,
+            scene.initial.omega_z,
+            scene.run.duration * scene.run.rate + 1.0
+        );
+    }
+}
+
+#[test]
+fn every_resolved_scene_reads_back_to_itself_from_its_toml() {
+    for name in presets::NAMES {
+        let scene = Scene::from_file(&presets::preset(name).unwrap()).unwrap();
+        let text = scene.to_toml();
+        let back = Scene::from_file(&scene::parse_with_sets(&text, &[]).unwrap())
+            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        assert_eq!(back, scene, "{name}:\n{text}");
+    }
+    let scene = valid();
+    let back = Scene::from_file(&scene::parse_with_sets(&scene.to_toml(), &[]).unwrap()).unwrap();
+    assert_eq!(back, scene);
+}
+
+#[test]
+fn defaults_are_those_of_the_contract() {
+    let s = valid();
+    println!("{:?}", s.run);
+    assert_eq!(s.run.rate, 100.0);
+    assert_eq!(s.run.method.rtol, 1e-10);
+    assert_eq!(s.run.method.atol, 1e-12);
+    assert_eq!(s.run.method.step, 1e-3);
+    assert_eq!(s.run.flat_margin, 1e-4);
+    assert_eq!(s.thickness, 0.05);
+    assert_eq!(s.channels, coin_log::record::Channel::ALL.to_vec());
+    assert_eq!(scene::defaults::INTEGRATOR, "dop853");
+    assert_eq!(
+        scene::defaults::INTEGRATOR,
+        coin_log::integrate::Method::default().name(),
+        "the scene default is the library's default method"
+    );
+}
+
+#[test]
+fn the_step_is_rounded_down_to_divide_the_sample_interval() {
+    let flags = FlagOverrides {
+        rate: Some(30.0),
+        step: Some(0.004),
+        ..FlagOverrides::default()
+    };
+    let scene = scene::resolve(&scene::parse_with_sets(VALID, &[]).unwrap(), &flags).unwrap();
+    let interval = 1.0 / 30.0;
+    let ratio = interval / scene.run.method.step;
+    println!(
+        "step {} for interval {interval}: {ratio} steps per sample",
+        scene.run.method.step
+    );
+    assert!(scene.run.method.step <= 0.004);
+    assert!((ratio - ratio.round()).abs() < 1e-9 && ratio.round() == 9.0);
+}
+
+#[test]
+fn a_steady_scene_is_solved_from_its_kind_and_a_perturbation_is_added() {
+    let text = VALID.replace(
+        "theta = 0.3\nomega = [0.0, 0.2, 1.0]",
+        "steady = { kind = \"circle\", theta = 0.3, omega_z = 1.0, branch = \"-\" }\nperturbation = { theta = 1e-6, omega = [0.0, 0.0, 1e-3] }",
+    );
+    let scene = Scene::from_file(&scene::parse_with_sets(&text, &[]).unwrap()).unwrap();
+    let InitialSpec::Steady(steady) = scene.spec else {
+        panic!("not steady")
+    };
+    println!("steady {:?}, initial {:?}", steady.state, scene.initial);
+    assert_eq!(
+        steady.kind,
+        SteadyKind::Circle {
+            theta: 0.3,
+            omega_z: 1.0,
+            branch: Branch::Minus
+        }
+    );
+    assert_eq!(scene.initial.theta, 0.3 + 1e-6);
+    assert_eq!(scene.initial.omega_z, 1.0 + 1e-3);
+    assert_eq!(scene.initial.omega_y, steady.state.omega_y);
+    assert!(
+        scene.unperturbed_steady().is_none(),
+        "a kicked steady motion is not steady"
+    );
+}
+
+#[test]
+fn set_edits_the_scene_before_the_flags_apply() {
+    let file = scene::parse_with_sets(
+        VALID,
+        &[
+            "initial.theta=0.4".into(),
+            "body.shape=hoop".into(),
+            "run.rate=50".into(),
+            "record.channels=[\"omega\", \"energy\"]".into(),
+        ],
+    )
+    .unwrap();
+    let flags = FlagOverrides {
+        rate: Some(20.0),
+        ..FlagOverrides::default()
+    };
+    let scene = scene::resolve(&file, &flags).unwrap();
+    println!(
+        "θ0 {}, I_Z {}, rate {}, channels {:?}",
+        scene.initial.theta,
+        scene.params.inertia_z(),
+        scene.run.rate,
+        scene.channels
+    );
+    assert_eq!(scene.initial.theta, 0.4);
+    assert_eq!(scene.params.inertia_z(), 1.0);
+    assert_eq!(scene.run.rate, 20.0, "the flag wins over --set");
+    assert_eq!(scene.channels.len(), 2);
+}
+
+#[test]
+fn a_scene_with_an_unknown_key_is_rejected_naming_the_key() {
+    let text = VALID.replace("mass = 1.0", "mass = 1.0\nmasss = 2.0");
+    let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+    println!("{e}");
+    assert!(e.contains("masss"), "{e}");
+    for (table, key) in [
+        ("[run]", "speed"),
+        ("[initial]", "omega_q"),
+        ("[record]", "topics"),
+    ] {
+        let text =
+            format!("{VALID}\n{table}\n{key} = 1\n").replace("[run]\nduration", "[run]\nduration");
+        // TOML refuses a table declared twice; append the key to the existing table instead.
+        let text = if table == "[record]" {
+            text
+        } else {
+            VALID.replace(table, &format!("{table}\n{key} = 1"))
+        };
+        let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+        println!("{table} {key}: {e}");
+        assert!(e.contains(key), "{e}");
+    }
+    let e = scene::parse_with_sets(VALID, &["initial.steady.colour=1".into()])
+        .unwrap_err()
+        .to_string();
+    println!("--set initial.steady.colour: {e}");
+    assert!(e.contains("colour"), "{e}");
+}
+
+#[test]
+fn a_scene_with_a_wrong_type_is_rejected_naming_the_key() {
+    let text = VALID.replace("mass = 1.0", "mass = \"heavy\"");
+    let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+    println!("{e}");
+    assert!(e.contains("mass") && e.contains("heavy"), "{e}");
+    let e = scene::parse_with_sets(VALID, &["run.rate=fast".into()])
+        .unwrap_err()
+        .to_string();
+    println!("{e}");
+    assert!(e.contains("run.rate") && e.contains("fast"), "{e}");
+}
+
+#[test]
+fn every_problem_is_reported_at_once_with_key_value_and_range() {
+    let text = VALID
+        .replace("mass = 1.0", "mass = -1.0")
+        .replace("gravity = 1.0", "gravity = nan")
+        .replace("theta = 0.3", "theta = 1.5707963267948966")
+        .replace("duration = 2.0", "duration = 0.0\nrate = 0\nrtol = -1e-9")
+        .replace("integrator = \"rk4\"", "integrator = \"dop854\"");
+    let text = format!("{text}\n[record]\nchannels = [\"omega\", \"spin\"]\n");
+    let found = problems(&text, &[], FlagOverrides::default());
+    for p in &found {
+        println!("{p}");
+    }
+    let keys: Vec<&str> = found.iter().map(|p| p.key.as_str()).collect();
+    for (key, value) in [
+        ("body.mass", "-1"),
+        ("body.gravity", "NaN"),
+        ("run.duration", "0"),
+        ("run.rate", "0"),
+        ("run.rtol", "-1e-9"),
+        ("run.integrator", "\"dop854\""),
+        ("record.channels", "\"spin\""),
+    ] {
+        let p = found
+            .iter()
+            .find(|p| p.key == key)
+            .unwrap_or_else(|| panic!("no problem for {key} in {keys:?}"));
+        assert_eq!(p.value, value, "{key}");
+    }
+    assert!(found.iter().any(|p| p.reason.contains("(0, ∞)")));
+}
+
+#[test]
+fn a_tilt_of_plus_or_minus_half_pi_is_refused() {
+    for theta in ["1.5707963267948966", "-1.5707963267948966", "1.5707", "2.0"] {
+        let text = VALID.replace("theta = 0.3", &format!("theta = {theta}"));
+        let found = problems(&text, &[], FlagOverrides::default());
+        println!("θ0 = {theta}: {}", found[0]);
+        assert_eq!(found[0].key, "initial.theta");
+        assert!(found[0].reason.contains("π/2"));
+    }
+}
+
+#[test]
+fn a_shape_together_with_inertias_is_refused() {
+    let text = VALID.replace(
+        "shape = \"thin-disk\"",
+        "shape = \"thin-disk\"\ninertia_x = 0.25\ninertia_z = 0.5",
+    );
+    let found = problems(&text, &[], FlagOverrides::default());
+    println!("{}", found[0]);
+    assert_eq!(found[0].key, "body.shape");
+    let text = VALID.replace("shape = \"thin-disk\"", "inertia_x = 0.25");
+    let found = problems(&text, &[], FlagOverrides::default());
+    println!("{}", found[0]);
+    assert_eq!(found[0].key, "body.inertia_z");
+    let text = VALID.replace("shape = \"thin-disk\"", "inertia_x = 0.25\ninertia_z = 0.5");
+    let scene = Scene::from_file(&scene::parse_with_sets(&text, &[]).unwrap()).unwrap();
+    assert_eq!(scene.params.inertia_z(), 0.5);
+}
+
+#[test]
+fn a_problem_set_by_a_flag_names_the_flag() {
+    let flags = FlagOverrides {
+        rate: Some(0.0),
+        channels: Some(vec!["omega".into(), "bogus".into()]),
+        ..FlagOverrides::default()
+    };
+    let found = problems(VALID, &[], flags);
+    for p in &found {
+        println!("{p}");
+    }
+    assert_eq!(
+        found[0].to_string(),
+        "`run.rate` = 0 is outside (0, ∞): give a finite number > 0 (set by `--rate`)"
+    );
+    assert!(found[1].to_string().contains("--channels"));
+}
+
+#[test]
+fn steady_motions_check_their_own_keys() {
+    let cases = [
+        ("{ kind = \"spiral\" }", "initial.steady.kind"),
+        ("{ kind = \"straight\" }", "initial.steady.omega_z"),
+        (
+            "{ kind = \"straight\", omega_z = 1.0, theta = 0.2 }",
+            "initial.steady.theta",
+        ),
+        (
+            "{ kind = \"circle\", theta = 0.0, omega_z = 1.0 }",
+            "initial.steady.theta",
+        ),
+        (
+            "{ kind = \"circle\", theta = 0.3, omega_z = 1.0, branch = \"x\" }",
+            "initial.steady.branch",
+        ),
+        (
+            "{ kind = \"centre-fixed\", theta = 1.5707 }",
+            "initial.steady.theta",
+        ),
+    ];
+    for (steady, key) in cases {
+        let text = VALID.replace(
+            "theta = 0.3\nomega = [0.0, 0.2, 1.0]",
+            &format!("steady = {steady}"),
+        );
+        let found = problems(&text, &[], FlagOverrides::default());
+        println!("{steady}: {}", found[0]);
+        assert_eq!(found[0].key, key);
+    }
+}
+
+#[test]
+fn a_scene_file_round_trips_through_toml() {
+    for name in presets::NAMES {
+        let file = presets::preset(name).unwrap();
+        let back: SceneFile = toml::from_str(&scene::to_toml(&file)).unwrap();
+        assert_eq!(back, file, "{name}");
+    }
+}
+
+#[test]
+fn a_tilt_beyond_flat_is_reported_even_when_the_body_is_invalid() {
+    let text = VALID
+        .replace("shape = \"thin-disk\"\n", "")
+        .replace("theta = 0.3", "theta = 1.6");
+    let found = problems(&text, &[], FlagOverrides::default());
+    for p in &found {
+        println!("{p}");
+    }
+    assert!(found.iter().any(|p| p.key == "body.shape"));
+    assert!(found
+        .iter()
+        .any(|p| p.key == "initial.theta" && p.reason.contains("π/2")));
+}
