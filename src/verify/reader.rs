@@ -77,7 +77,7 @@ impl fmt::Display for ReadError {
 /// What the structural pass found.
 #[derive(Debug, Default)]
 pub struct Structure {
-    /// File size [bytes].
+    /// File size \[bytes\].
     pub file_len: u64,
     /// Messages read.
     pub messages: u64,

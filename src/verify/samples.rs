@@ -62,7 +62,7 @@ pub enum Value {
 /// The stored values at one log time.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Sample {
-    /// Log time [ns].
+    /// Log time \[ns\].
     pub log_time: u64,
     /// Simulation time (of the first message of the sample).
     pub t: f64,

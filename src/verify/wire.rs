@@ -129,9 +129,9 @@ pub struct MessageHeader {
     pub channel_id: u16,
     /// Sequence number.
     pub sequence: u32,
-    /// Log time [ns].
+    /// Log time \[ns\].
     pub log_time: u64,
-    /// Publish time [ns].
+    /// Publish time \[ns\].
     pub publish_time: u64,
 }
 

@@ -1,5 +1,5 @@
 //! The physics checks. Each is a running accumulator: `observe` sees every sample once, in time order, and
-//! keeps only maxima, sums and a short window; `finish` turns them into a [`CheckResult`].
+//! keeps only maxima, sums and a short window; `finish` turns them into a [`CheckResult`](crate::verify::CheckResult).
 
 pub mod consistency;
 pub mod constraint;

@@ -9,7 +9,7 @@ use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
 
-/// Smallest heading range over which a circle is fitted [rad]: shorter arcs make the radius ill-conditioned.
+/// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
 const MIN_ARC: f64 = 0.5;
 
 /// The steady motion a log's scene asks for, or why the check does not apply.
