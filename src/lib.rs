@@ -5,9 +5,11 @@
 //! body in rim contact with a flat table, no slip, no dissipation. Dependencies point one way:
 //! [`model`] → [`integrate`] → scene → record / verify → the `coin-log` binary.
 
+pub mod bench;
 pub mod integrate;
 pub mod model;
 pub mod record;
 pub mod scene;
 pub mod simulation;
 pub mod units;
+pub mod verify;

@@ -347,3 +347,18 @@ fn a_scene_file_round_trips_through_toml() {
         assert_eq!(back, file, "{name}");
     }
 }
+
+#[test]
+fn a_tilt_beyond_flat_is_reported_even_when_the_body_is_invalid() {
+    let text = VALID
+        .replace("shape = \"thin-disk\"\n", "")
+        .replace("theta = 0.3", "theta = 1.6");
+    let found = problems(&text, &[], FlagOverrides::default());
+    for p in &found {
+        println!("{p}");
+    }
+    assert!(found.iter().any(|p| p.key == "body.shape"));
+    assert!(found
+        .iter()
+        .any(|p| p.key == "initial.theta" && p.reason.contains("π/2")));
+}

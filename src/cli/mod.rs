@@ -1,5 +1,6 @@
 //! Command-line parsing and the exit-code policy (CONTRACT: exit codes). Only this module prints.
 
+mod bench;
 mod record;
 mod scenes;
 mod verify;
@@ -26,6 +27,8 @@ enum Command {
     Verify(verify::VerifyArgs),
     /// List the built-in scenes, or print one as TOML.
     Scenes(scenes::ScenesArgs),
+    /// Benchmarks: error against cost of every integrator, and the hard-case stability suite.
+    Bench(bench::BenchArgs),
 }
 
 /// What a command ended with; the one place exit codes are decided (CONTRACT: exit codes).
@@ -69,6 +72,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Record(args) => record::run(args),
         Command::Verify(args) => verify::run(args),
         Command::Scenes(args) => scenes::run(args),
+        Command::Bench(args) => bench::run(args),
     }
 }
 

@@ -1,11 +1,115 @@
-//! `coin-log verify` (placeholder until its issue lands; owned by the helper building it).
+//! `coin-log verify`: prints each file's checks as a table (or the contract's JSON) and maps the worst
+//! verdict to the exit code.
 
 use super::Outcome;
+use coin_log::verify::{self, FileReport, Options, Report};
+use std::path::PathBuf;
 
-/// Arguments of `coin-log verify`.
+/// What `coin-log verify --help` adds after the options: the checks, the tolerance formula, exit codes.
+const AFTER_HELP: &str = "\
+Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata,
+the physics is recomputed from the stored channels (never re-simulated). Checks: integrity, energy,
+invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance and
+pass/fail, or skip with the reason. A file on which integrity, energy and at least one of constraint /
+steady cannot run fails.
+
+Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
+W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a), or for fixed-step methods of order p with step h
+(rk4, gauss4: p = 4) eps = max(rtol, atol/a, (h W)^p):
+  energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
+  constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
+Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
+reaction) must agree to 1e-12 relative; N >= 0 and |F| <= mu N are held to 1e-12 Mg.
+
+Exit codes: 0 every check that ran passed; 1 a check failed; 2 a file is unreadable, truncated, corrupt,
+not MCAP or not a coin-log file, or a usage error. With several files, the worst (2 > 1 > 0).";
+
+/// Arguments of `coin-log verify` (the checks and tolerance formula are in `AFTER_HELP`).
 #[derive(Debug, clap::Args)]
-pub struct VerifyArgs {}
+#[command(after_help = AFTER_HELP)]
+pub struct VerifyArgs {
+    /// MCAP files written by `coin-log record`.
+    #[arg(required = true, value_name = "FILE")]
+    files: Vec<PathBuf>,
+    /// Print `{"files": [{"path", "exit_code", "checks": [{"id", "status", "value", "tolerance", "reason"}]}]}`.
+    #[arg(long)]
+    json: bool,
+    /// Energy (and invariant) drift tolerance, replacing the default derived from rtol/atol.
+    #[arg(long, value_name = "X", value_parser = positive)]
+    energy_tol: Option<f64>,
+    /// Constraint and steady residual tolerance, replacing the default derived from rtol/atol.
+    #[arg(long, value_name = "X", value_parser = positive)]
+    residual_tol: Option<f64>,
+}
 
-pub fn run(_args: VerifyArgs) -> anyhow::Result<Outcome> {
-    anyhow::bail!("`coin-log verify` is not built yet")
+fn positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("`{s}` is not a finite number > 0")),
+    }
+}
+
+/// Runs `coin-log verify`.
+pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
+    let options = Options {
+        energy_tol: args.energy_tol,
+        residual_tol: args.residual_tol,
+    };
+    let report = verify::verify_files(&args.files, &options);
+    for file in &report.files {
+        if let Some(problem) = &file.problem {
+            eprintln!("error: {}: {problem}", file.path);
+        }
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", table(&report));
+    }
+    Ok(match report.exit_code() {
+        0 => Outcome::Success,
+        1 => Outcome::Failure,
+        _ => Outcome::Unusable,
+    })
+}
+
+fn number(x: Option<f64>) -> String {
+    x.map_or_else(|| "-".into(), |v| format!("{v:.3e}"))
+}
+
+fn file_table(f: &FileReport, out: &mut String) {
+    let verdict = match f.exit_code {
+        0 => "ok",
+        1 => "FAILED",
+        _ => "UNUSABLE",
+    };
+    out.push_str(&format!("{}: {verdict} (exit {})\n", f.path, f.exit_code));
+    if let Some(p) = &f.problem {
+        out.push_str(&format!("  {p}\n"));
+    }
+    if f.checks.is_empty() {
+        return;
+    }
+    out.push_str(&format!(
+        "  {:<12} {:<6} {:>10} {:>10}  {}\n",
+        "check", "status", "value", "tolerance", "reason"
+    ));
+    for c in &f.checks {
+        out.push_str(&format!(
+            "  {:<12} {:<6} {:>10} {:>10}  {}\n",
+            c.id.as_str(),
+            c.status.to_string(),
+            number(c.value),
+            number(c.tolerance),
+            c.reason
+        ));
+    }
+}
+
+fn table(report: &Report) -> String {
+    let mut out = String::new();
+    for f in &report.files {
+        file_table(f, &mut out);
+    }
+    out
 }

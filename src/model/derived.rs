@@ -163,7 +163,7 @@ pub fn energy(coin: &Coin, s: &State) -> Energy {
 /// The table's reaction on the coin (NOTES §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reaction {
-    /// R = M dv/dt + Mg e_y, world components [force].
+    /// R = M dv/dt + Mg e_y, world components \[force\].
     pub force: Vec3,
     /// Friction magnitude F = √(R_x² + R_z²) (NOTES §3, corrected; §8 item 4).
     pub friction: f64,

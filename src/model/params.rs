@@ -119,12 +119,12 @@ impl CoinParams {
         }
     }
 
-    /// Mass M [mass].
+    /// Mass M \[mass\].
     #[must_use]
     pub fn mass(&self) -> f64 {
         self.mass
     }
-    /// Radius a [length].
+    /// Radius a \[length\].
     #[must_use]
     pub fn radius(&self) -> f64 {
         self.radius

@@ -7,11 +7,11 @@ pub const STATE_LEN: usize = 8;
 /// θ, φ, ψ, ω_X, ω_Y, ω_Z, x, z.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct State {
-    /// Lean θ [rad]: 0 is upright, ±π/2 lying flat.
+    /// Lean θ \[rad\]: 0 is upright, ±π/2 lying flat.
     pub theta: f64,
-    /// Heading φ [rad], rotation about the world's vertical y axis (unwrapped).
+    /// Heading φ \[rad\], rotation about the world's vertical y axis (unwrapped).
     pub phi: f64,
-    /// Spin ψ [rad], rotation about the coin's normal (unwrapped).
+    /// Spin ψ \[rad\], rotation about the coin's normal (unwrapped).
     pub psi: f64,
     /// ω_X [rad/time]: angular velocity about the horizontal lean-frame axis X.
     pub omega_x: f64,
@@ -19,9 +19,9 @@ pub struct State {
     pub omega_y: f64,
     /// ω_Z [rad/time]: angular velocity about the coin's normal Z.
     pub omega_z: f64,
-    /// Centre x coordinate on the table plane [length].
+    /// Centre x coordinate on the table plane \[length\].
     pub x: f64,
-    /// Centre z coordinate on the table plane [length].
+    /// Centre z coordinate on the table plane \[length\].
     pub z: f64,
 }
 

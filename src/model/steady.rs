@@ -26,14 +26,14 @@ pub enum SteadyKind {
     },
     /// Centre at rest, the coin rolling round it: ω_Z = 0, ω_Y² = Mga cos θ / I_X (NOTES §4 item 2).
     CentreFixed {
-        /// Lean [rad], 0 < |θ| < π/2.
+        /// Lean \[rad\], 0 < |θ| < π/2.
         theta: f64,
         /// Sign of ω_Y: `Plus` gives ω_Y > 0.
         branch: Branch,
     },
     /// Circular rolling on either branch (NOTES §4 item 3).
     Circle {
-        /// Lean [rad], 0 < |θ| < π/2.
+        /// Lean \[rad\], 0 < |θ| < π/2.
         theta: f64,
         /// Spin about the normal [rad/time].
         omega_z: f64,
@@ -96,9 +96,9 @@ pub struct Steady {
     pub phi_dot: f64,
     /// Spin rate ψ̇ = ω_Z + ω_Y tan θ, eq (19) [rad/time].
     pub psi_dot: f64,
-    /// Radius of the circle traced by the centre [length]; `None` for straight rolling (infinite).
+    /// Radius of the circle traced by the centre \[length\]; `None` for straight rolling (infinite).
     pub r_g: Option<f64>,
-    /// Radius of the circle traced by the contact point [length]; `None` for straight rolling.
+    /// Radius of the circle traced by the contact point \[length\]; `None` for straight rolling.
     pub r_c: Option<f64>,
 }
 

@@ -91,7 +91,7 @@ message!(
 });
 
 message!(
-    /// `/coin/angles`: θ, φ, ψ [rad], φ and ψ unwrapped.
+    /// `/coin/angles`: θ, φ, ψ \[rad\], φ and ψ unwrapped.
     Angles, "coin_log.Angles", {
     /// Simulation time.
     t,
@@ -119,7 +119,7 @@ message!(
 });
 
 message!(
-    /// `/coin/position` (centre) and `/coin/contact` (contact point), world frame, y up [length].
+    /// `/coin/position` (centre) and `/coin/contact` (contact point), world frame, y up \[length\].
     Position, "coin_log.Position", {
     /// Simulation time.
     t,
@@ -132,7 +132,7 @@ message!(
 });
 
 message!(
-    /// `/coin/reaction`: R (world frame), F and N [force].
+    /// `/coin/reaction`: R (world frame), F and N \[force\].
     ReactionMessage, "coin_log.Reaction", {
     /// Simulation time.
     t,

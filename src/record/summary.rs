@@ -75,7 +75,7 @@ pub struct RecordSummary {
     pub samples: u64,
     /// Messages written, all channels.
     pub messages: u64,
-    /// Size of the finished file [bytes].
+    /// Size of the finished file \[bytes\].
     pub bytes: u64,
     /// Integrator work.
     pub stats: Stats,

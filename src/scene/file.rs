@@ -27,9 +27,9 @@ pub struct SceneFile {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyFile {
-    /// M > 0 [mass].
+    /// M > 0 \[mass\].
     pub mass: f64,
-    /// a > 0 [length].
+    /// a > 0 \[length\].
     pub radius: f64,
     /// g > 0 [length/time²].
     pub gravity: f64,
@@ -54,22 +54,22 @@ pub struct BodyFile {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialFile {
-    /// θ [rad].
+    /// θ \[rad\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub theta: Option<f64>,
     /// (ω_X, ω_Y, ω_Z) in the lean frame [rad/time].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub omega: Option<Vec<f64>>,
-    /// φ [rad] (default 0).
+    /// φ \[rad\] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phi: Option<f64>,
-    /// ψ [rad] (default 0).
+    /// ψ \[rad\] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub psi: Option<f64>,
-    /// Centre x [length] (default 0).
+    /// Centre x \[length\] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub x: Option<f64>,
-    /// Centre z [length] (default 0).
+    /// Centre z \[length\] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub z: Option<f64>,
     /// A steady motion (NOTES §4) whose ω the solver fills in.
@@ -86,7 +86,7 @@ pub struct InitialFile {
 pub struct SteadyFile {
     /// `straight`, `centre-fixed`, `circle` or `spin-upright`.
     pub kind: String,
-    /// θ [rad] (`centre-fixed`, `circle`).
+    /// θ \[rad\] (`centre-fixed`, `circle`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub theta: Option<f64>,
     /// ω_Y [rad/time] (`spin-upright`).
@@ -104,7 +104,7 @@ pub struct SteadyFile {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PerturbationFile {
-    /// Added to θ [rad].
+    /// Added to θ \[rad\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub theta: Option<f64>,
     /// Added to (ω_X, ω_Y, ω_Z) [rad/time].
@@ -116,7 +116,7 @@ pub struct PerturbationFile {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunFile {
-    /// Duration [time].
+    /// Duration \[time\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub duration: Option<f64>,
     /// Samples per time unit.
@@ -131,10 +131,10 @@ pub struct RunFile {
     /// Absolute tolerance (adaptive methods).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub atol: Option<f64>,
-    /// Step (fixed-step methods) [time].
+    /// Step (fixed-step methods) \[time\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f64>,
-    /// The run ends at |θ| ≥ π/2 − flat_margin [rad].
+    /// The run ends at |θ| ≥ π/2 − flat_margin \[rad\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flat_margin: Option<f64>,
 }

@@ -32,7 +32,7 @@ pub mod defaults {
     pub const ATOL: f64 = 1e-12;
     /// Fixed step for rk4/gauss4, before being rounded down to divide 1/rate.
     pub const STEP: f64 = 1e-3;
-    /// Flat-landing margin [rad]: tan θ ≈ 1e4 there, still well inside double precision.
+    /// Flat-landing margin \[rad\]: tan θ ≈ 1e4 there, still well inside double precision.
     pub const FLAT_MARGIN: f64 = 1e-4;
     /// Display thickness, a fraction of the radius (a 500-yen coin is 1.8 mm thick for 13.25 mm radius).
     pub const THICKNESS: f64 = 0.05;
@@ -123,18 +123,18 @@ pub enum InitialSpec {
 /// Duration, sampling and integration settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunConfig {
-    /// Duration [time], > 0.
+    /// Duration \[time\], > 0.
     pub duration: f64,
     /// Samples per time unit, > 0.
     pub rate: f64,
     /// Method with rtol, atol and the step actually used (rounded down to divide 1/rate).
     pub method: MethodConfig,
-    /// The run ends at |θ| ≥ π/2 − flat_margin [rad].
+    /// The run ends at |θ| ≥ π/2 − flat_margin \[rad\].
     pub flat_margin: f64,
 }
 
 impl RunConfig {
-    /// Distance between samples, 1/rate [time].
+    /// Distance between samples, 1/rate \[time\].
     #[must_use]
     pub fn sample_interval(&self) -> f64 {
         1.0 / self.rate

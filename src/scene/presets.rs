@@ -94,10 +94,17 @@ pub fn preset(name: &str) -> Option<SceneFile> {
                 }),
                 ..steady_initial(straight(50.0))
             },
+            // 1000 samples per unit: at ω_Z = 50 the spin turns 0.05 rad between samples, so the stored
+            // trajectory resolves the motion and `verify` can difference it (at 100 it cannot).
+            run: Some(RunFile {
+                duration: Some(5.0),
+                rate: Some(1000.0),
+                ..RunFile::default()
+            }),
             ..steady(
-                "Straight rolling at ω_Z = 50 kicked by a 0.01 tilt: fast spin, a small fast wobble",
+                "Straight rolling at ω_Z = 50 kicked by a 0.01 tilt: fast spin, a small fast wobble, sampled at 1 kHz",
                 straight(50.0),
-                20.0,
+                5.0,
             )
         },
         "near-flat" => SceneFile {

@@ -134,7 +134,11 @@ pub(super) fn scene_from_file(
     });
     // Without a valid body the initial state cannot be solved; still check what can be checked alone.
     if body.is_none() {
-        check_initial_alone(&file.initial, &mut problems);
+        check_initial_alone(
+            &file.initial,
+            margin_ok.then_some(flat_margin),
+            &mut problems,
+        );
     }
     let run = check_run(&run_file, flat_margin, margin_ok, &mut problems);
     let channels = check_channels(file.record.as_ref(), &mut problems);
@@ -246,9 +250,16 @@ fn check_body(body: &BodyFile, problems: &mut Problems) -> Option<Body> {
 type Initial = (State, InitialSpec, [f64; 4]);
 
 /// Checks of `[initial]` that need no body (used when the body is invalid).
-fn check_initial_alone(initial: &InitialFile, problems: &mut Problems) {
+fn check_initial_alone(initial: &InitialFile, flat_margin: Option<f64>, problems: &mut Problems) {
+    if let Some(theta) = initial.theta {
+        if problems.finite("initial.theta", theta) {
+            let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+            if theta.abs() >= FRAC_PI_2 - margin {
+                problems.push("initial.theta", number(theta), lean_range(margin));
+            }
+        }
+    }
     for (key, value) in [
-        ("initial.theta", initial.theta),
         ("initial.phi", initial.phi),
         ("initial.psi", initial.psi),
         ("initial.x", initial.x),

@@ -1,0 +1,422 @@
+//! What a benchmark runs (a coin, an initial state, a duration), how a run is sampled, the references it
+//! is judged against, and the error measures shared by the precision and stability benches.
+
+use super::BenchError;
+use crate::integrate::{
+    run_method, Flow, Method, MethodConfig, RunOutcome, RunSettings, StepError, Termination,
+};
+use crate::model::invariants::Chaplygin;
+use crate::model::{energy, Coin, State, Steady, STATE_LEN};
+use crate::simulation::CoinEvents;
+
+/// Samples per natural time unit √(a/g) at which errors are measured (issue 8: "100 per time unit").
+pub const SAMPLES_PER_TIME_UNIT: f64 = 100.0;
+
+/// Flat-landing margin of the bench runs: the contract's scene default (`run.flat_margin`).
+pub const DEFAULT_FLAT_MARGIN: f64 = 1e-4;
+
+/// Default relative tolerance of adaptive methods (the contract's scene default `run.rtol`).
+const DEFAULT_RTOL: f64 = 1e-10;
+/// Default absolute tolerance of adaptive methods (the contract's scene default `run.atol`).
+const DEFAULT_ATOL: f64 = 1e-12;
+/// Default fixed step in natural time units (the contract's scene default `run.step`).
+const DEFAULT_STEP: f64 = 1e-3;
+
+/// Reference tolerances (issue 8): dop853 at atol 1e-16, rtol 1e-14.
+const REFERENCE_ATOL: f64 = 1e-16;
+/// See [`REFERENCE_ATOL`].
+const REFERENCE_RTOL: f64 = 1e-14;
+/// If dop853 is not available, rk4 at this step (natural units) stands in as the numerical reference.
+const FALLBACK_REFERENCE_STEP: f64 = 2.5e-4;
+
+/// One benchmark scene: the body, where it starts, how long it runs and what ends it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchCase {
+    /// Scene name (kebab-case).
+    pub name: String,
+    /// The body and its equations.
+    pub coin: Coin,
+    /// State at t = 0.
+    pub initial: State,
+    /// The steady motion the scene starts on, when it is unperturbed: then the analytic trajectory is the
+    /// reference. `None` for every other scene (the reference is then a tight dop853 run).
+    pub steady: Option<Steady>,
+    /// Duration \[time\].
+    pub duration: f64,
+    /// The run ends at |θ| ≥ π/2 − `flat_margin` \[rad\].
+    pub flat_margin: f64,
+    /// Friction coefficient μ; with it the run ends at a slip.
+    pub friction: Option<f64>,
+}
+
+impl BenchCase {
+    /// The natural time unit √(a/g) \[time\].
+    #[must_use]
+    pub fn time_unit(&self) -> f64 {
+        self.coin.params().time_unit()
+    }
+
+    /// The sample grid of the error measures: 100 samples per natural time unit.
+    #[must_use]
+    pub fn settings(&self) -> RunSettings {
+        RunSettings {
+            t0: 0.0,
+            t_end: self.duration,
+            sample_interval: self.time_unit() / SAMPLES_PER_TIME_UNIT,
+        }
+    }
+
+    /// The physical events of the case.
+    #[must_use]
+    pub fn events(&self) -> CoinEvents {
+        CoinEvents::new(self.coin, self.flat_margin, self.friction)
+    }
+}
+
+/// A method looked up by its contract name (`rk4`, `dopri5`, `dop853`, `gauss4`); `None` if this build
+/// does not have it.
+#[must_use]
+pub fn method_by_name(name: &str) -> Option<Method> {
+    name.parse().ok()
+}
+
+/// The classical order of a method: the slope its work-precision line should have.
+#[must_use]
+pub fn nominal_order(method: Method) -> u32 {
+    method.order()
+}
+
+/// The contract's default settings of a method, the step scaled to the case's time unit.
+#[must_use]
+pub fn default_config(method: Method, time_unit: f64) -> MethodConfig {
+    MethodConfig {
+        method,
+        rtol: DEFAULT_RTOL,
+        atol: DEFAULT_ATOL,
+        step: DEFAULT_STEP * time_unit,
+    }
+}
+
+/// The samples of one run and how it ended. Buffers are reused between runs so that timed repeats do not
+/// allocate.
+#[derive(Debug, Clone, Default)]
+pub struct Trajectory {
+    /// Sample times.
+    pub times: Vec<f64>,
+    /// States at the sample times.
+    pub states: Vec<[f64; STATE_LEN]>,
+    /// How the run ended; `None` before the first run.
+    pub outcome: Option<RunOutcome>,
+}
+
+impl Trajectory {
+    /// An empty trajectory with room for `samples` samples.
+    #[must_use]
+    pub fn with_capacity(samples: usize) -> Self {
+        Self {
+            times: Vec::with_capacity(samples),
+            states: Vec::with_capacity(samples),
+            outcome: None,
+        }
+    }
+
+    /// The termination as the contract names it (`completed`, `flat-landing`, `lift-off`, `slip`,
+    /// `step-size-underflow`, `non-finite`; `newton-failure` for the implicit methods).
+    #[must_use]
+    pub fn termination_name(&self) -> String {
+        self.outcome.as_ref().map_or_else(
+            || "not-run".to_string(),
+            |o| termination_name(&o.termination),
+        )
+    }
+
+    /// True when the run reached its end time.
+    #[must_use]
+    pub fn completed(&self) -> bool {
+        matches!(
+            self.outcome.as_ref().map(|o| &o.termination),
+            Some(Termination::Completed)
+        )
+    }
+}
+
+/// The contract's name of a termination.
+#[must_use]
+pub fn termination_name(termination: &Termination) -> String {
+    match termination {
+        Termination::Completed => "completed".to_string(),
+        Termination::Event { index, .. } => CoinEvents::event(*index).name().to_string(),
+        Termination::Stopped { .. } => "interrupted".to_string(),
+        Termination::Failed(e) => step_error_name(e).to_string(),
+    }
+}
+
+#[allow(unreachable_patterns)] // StepError may grow variants in the integrators' branch
+fn step_error_name(e: &StepError) -> &'static str {
+    match e {
+        StepError::NonFinite { .. } => "non-finite",
+        StepError::StepSizeUnderflow { .. } => "step-size-underflow",
+        StepError::NewtonFailure { .. } => "newton-failure",
+        _ => "failed",
+    }
+}
+
+/// Runs `config` on `case`, storing every sample in `out` (cleared first).
+pub fn run_sampled(config: &MethodConfig, case: &BenchCase, out: &mut Trajectory) {
+    run_sampled_with(config, case, &case.settings(), out);
+}
+
+/// Like [`run_sampled`] with explicit run settings.
+pub fn run_sampled_with(
+    config: &MethodConfig,
+    case: &BenchCase,
+    settings: &RunSettings,
+    out: &mut Trajectory,
+) {
+    out.times.clear();
+    out.states.clear();
+    let (times, states) = (&mut out.times, &mut out.states);
+    let outcome = run_method(
+        config,
+        &case.coin,
+        &case.initial.to_array(),
+        settings,
+        &case.events(),
+        |t, y| {
+            times.push(t);
+            states.push(*y);
+            Flow::Continue
+        },
+    );
+    out.outcome = Some(outcome);
+}
+
+/// Which reference a case's errors are measured against.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ReferenceKind {
+    /// The analytic steady trajectory (θ, ω constant, φ = φ̇t, ψ = ψ̇t, centre on its circle).
+    Analytic,
+    /// A tight numerical run.
+    Numerical(MethodConfig),
+}
+
+impl std::fmt::Display for ReferenceKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Analytic => f.write_str("analytic steady trajectory"),
+            Self::Numerical(c) if c.method.is_adaptive() => {
+                write!(f, "{} at atol {:e}, rtol {:e}", c.method, c.atol, c.rtol)
+            }
+            Self::Numerical(c) => write!(f, "{} at step {:e}", c.method, c.step),
+        }
+    }
+}
+
+/// The trajectory errors are measured against.
+#[derive(Debug, Clone)]
+pub enum Reference {
+    /// The analytic steady motion from the case's initial state.
+    Analytic {
+        /// The steady motion.
+        steady: Steady,
+        /// Its state at t = 0 (φ₀, ψ₀, x₀, z₀ may be non-zero).
+        start: State,
+    },
+    /// A tight numerical run on the same sample grid.
+    Numerical {
+        /// How it was computed.
+        config: MethodConfig,
+        /// Its samples.
+        trajectory: Trajectory,
+    },
+}
+
+impl Reference {
+    /// Which reference this is.
+    #[must_use]
+    pub fn kind(&self) -> ReferenceKind {
+        match self {
+            Self::Analytic { .. } => ReferenceKind::Analytic,
+            Self::Numerical { config, .. } => ReferenceKind::Numerical(*config),
+        }
+    }
+
+    /// The reference state at sample `index`, time `t`.
+    #[must_use]
+    pub fn state_at(&self, coin: &Coin, index: usize, t: f64) -> Option<[f64; STATE_LEN]> {
+        match self {
+            Self::Analytic { steady, start } => Some(analytic_steady_state(coin, steady, start, t)),
+            Self::Numerical { trajectory, .. } => trajectory.states.get(index).copied(),
+        }
+    }
+}
+
+/// The state at time `t` of a steady motion started from `start` (NOTES §4): θ and ω constant,
+/// φ = φ₀ + φ̇t, ψ = ψ₀ + ψ̇t, the centre on its circle about C = p₀ + r(sin φ₀, cos φ₀), r = aω_Z/φ̇:
+/// x = C_x − r sin φ, z = C_z − r cos φ (from ẋ = −aω_Z cos φ, ż = aω_Z sin φ at ω_X = 0); a straight
+/// line x = x₀ − aω_Z cos φ₀ t, z = z₀ + aω_Z sin φ₀ t when φ̇ = 0.
+#[must_use]
+pub fn analytic_steady_state(coin: &Coin, steady: &Steady, start: &State, t: f64) -> [f64; 8] {
+    let a = coin.params().radius();
+    let phi = start.phi + steady.phi_dot * t;
+    let psi = start.psi + steady.psi_dot * t;
+    let (x, z) = if steady.phi_dot == 0.0 {
+        let (s0, c0) = start.phi.sin_cos();
+        (
+            start.x - a * start.omega_z * c0 * t,
+            start.z + a * start.omega_z * s0 * t,
+        )
+    } else {
+        // x − x₀ = −r(sin φ − sin φ₀) = −2r cos(φ̄) sin(φ̇t/2), z − z₀ = 2r sin(φ̄) sin(φ̇t/2), φ̄ the mean
+        // angle: no cancellation for small t.
+        let r = a * start.omega_z / steady.phi_dot;
+        let half = 0.5 * steady.phi_dot * t;
+        let mean = start.phi + half;
+        let chord = 2.0 * r * half.sin();
+        (start.x - chord * mean.cos(), start.z + chord * mean.sin())
+    };
+    [
+        start.theta,
+        phi,
+        psi,
+        start.omega_x,
+        start.omega_y,
+        start.omega_z,
+        x,
+        z,
+    ]
+}
+
+/// The reference of a case: analytic when the case is an unperturbed steady motion, otherwise dop853 at
+/// atol 1e-16, rtol 1e-14 (rk4 at a small step in a build without dop853).
+///
+/// # Errors
+/// [`BenchError::ReferenceFailed`] when the numerical reference does not reach the end of the case.
+pub fn reference_trajectory(case: &BenchCase) -> Result<Reference, BenchError> {
+    reference_trajectory_with(case, &case.settings())
+}
+
+/// Like [`reference_trajectory`] on the sample grid of `settings`.
+///
+/// # Errors
+/// As [`reference_trajectory`].
+pub fn reference_trajectory_with(
+    case: &BenchCase,
+    settings: &RunSettings,
+) -> Result<Reference, BenchError> {
+    if let Some(steady) = case.steady {
+        return Ok(Reference::Analytic {
+            steady,
+            start: case.initial,
+        });
+    }
+    let config = match method_by_name("dop853") {
+        Some(method) => MethodConfig {
+            method,
+            rtol: REFERENCE_RTOL,
+            atol: REFERENCE_ATOL,
+            step: 0.0,
+        },
+        None => MethodConfig {
+            step: FALLBACK_REFERENCE_STEP * case.time_unit(),
+            ..default_config(Method::Rk4, case.time_unit())
+        },
+    };
+    let mut trajectory = Trajectory::default();
+    run_sampled_with(&config, case, settings, &mut trajectory);
+    if !trajectory.completed() && trajectory.outcome.is_some() {
+        // An event ends the reference and the runs alike: judge the common samples.
+        if !matches!(
+            trajectory.outcome.as_ref().map(|o| &o.termination),
+            Some(Termination::Event { .. })
+        ) {
+            return Err(BenchError::ReferenceFailed {
+                scene: case.name.clone(),
+                reference: ReferenceKind::Numerical(config).to_string(),
+                termination: trajectory.termination_name(),
+            });
+        }
+    }
+    Ok(Reference::Numerical { config, trajectory })
+}
+
+/// The dimensionless difference of two states: the largest of |Δθ|, |Δφ|, |Δψ|, |Δω_i|·T (T = √(a/g)),
+/// |Δx|/a, |Δz|/a.
+#[must_use]
+pub fn state_difference(coin: &Coin, y: &[f64; STATE_LEN], r: &[f64; STATE_LEN]) -> f64 {
+    let p = coin.params();
+    let (t_unit, a) = (p.time_unit(), p.radius());
+    let scale = [1.0, 1.0, 1.0, t_unit, t_unit, t_unit, 1.0 / a, 1.0 / a];
+    let mut worst = 0.0_f64;
+    for i in 0..STATE_LEN {
+        let d = (y[i] - r[i]).abs() * scale[i];
+        if d.is_nan() {
+            return f64::INFINITY;
+        }
+        worst = worst.max(d);
+    }
+    worst
+}
+
+/// State error of a run (issue 8): the largest [`state_difference`] over the samples, against the
+/// reference on the same grid. Infinite when the run stopped before the reference did (or vice versa):
+/// a run that ends early is not accurate.
+#[must_use]
+pub fn state_error(case: &BenchCase, run: &Trajectory, reference: &Reference) -> f64 {
+    if let Reference::Numerical { trajectory, .. } = reference {
+        if trajectory.states.len() != run.states.len() {
+            return f64::INFINITY;
+        }
+    } else if !run.completed() {
+        return f64::INFINITY;
+    }
+    let mut worst = 0.0_f64;
+    for (i, (t, y)) in run.times.iter().zip(&run.states).enumerate() {
+        match reference.state_at(&case.coin, i, *t) {
+            Some(r) => worst = worst.max(state_difference(&case.coin, y, &r)),
+            None => return f64::INFINITY,
+        }
+    }
+    worst
+}
+
+/// Energy drift (CONTRACT, verify): max|E − E₀| / max(|E₀|, Mga) over the samples.
+#[must_use]
+pub fn energy_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> f64 {
+    let Some(first) = states.first() else {
+        return 0.0;
+    };
+    let e0 = energy(coin, &State::from_array(first)).total;
+    let scale = e0.abs().max(coin.params().energy_scale());
+    let mut worst = 0.0_f64;
+    for y in states {
+        let d = (energy(coin, &State::from_array(y)).total - e0).abs() / scale;
+        if d.is_nan() {
+            return f64::INFINITY;
+        }
+        worst = worst.max(d);
+    }
+    worst
+}
+
+/// Invariant drift (CONTRACT, verify): max|C − C₀| / (|C1₀| + |C2₀|) over the samples and both
+/// Chaplygin–Appell integrals (NOTES §6); `None` when they cannot be built for the body or vanish.
+#[must_use]
+pub fn invariant_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> Option<f64> {
+    let chaplygin = Chaplygin::new(coin.params()).ok()?;
+    let first = chaplygin.of_state(&State::from_array(states.first()?));
+    let scale = first.c1.abs() + first.c2.abs();
+    if scale == 0.0 || !scale.is_finite() {
+        return None;
+    }
+    let mut worst = 0.0_f64;
+    for y in states {
+        let c = chaplygin.of_state(&State::from_array(y));
+        let d = (c.c1 - first.c1).abs().max((c.c2 - first.c2).abs()) / scale;
+        if d.is_nan() {
+            return Some(f64::INFINITY);
+        }
+        worst = worst.max(d);
+    }
+    Some(worst)
+}

@@ -1,0 +1,61 @@
+//! Benchmarks of accuracy, cost and robustness (issue 8): work-precision sweeps of every integrator on a
+//! scene ([`precision`]), a fixed suite of hard cases ([`stability`]), and their output as tables, CSV
+//! ([`table`]) and SVG work-precision diagrams ([`plot`]).
+//!
+//! The library returns rows; only the `coin-log bench` command prints them or writes files.
+//! The physics of the hard cases is NOTES §5 and §7.
+
+mod case;
+pub mod plot;
+pub mod precision;
+pub mod presets;
+pub mod stability;
+
+pub mod table;
+
+pub use case::{
+    analytic_steady_state, default_config, energy_drift, invariant_drift, method_by_name,
+    nominal_order, reference_trajectory, run_sampled, state_difference, state_error, BenchCase,
+    Reference, ReferenceKind, Trajectory, DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
+};
+
+use thiserror::Error;
+
+/// Why a benchmark could not run.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum BenchError {
+    /// A scene name that is not a built-in.
+    #[error("no built-in scene `{name}`; built-in scenes: {valid}")]
+    UnknownScene {
+        /// What was given.
+        name: String,
+        /// Comma-separated valid names.
+        valid: String,
+    },
+    /// The scene's parameters or steady motion are invalid.
+    #[error("scene `{scene}`: {reason}")]
+    InvalidScene {
+        /// Scene name.
+        scene: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The reference run did not reach the end of the scene.
+    #[error("scene `{scene}`: the reference run ({reference}) ended early: {termination}")]
+    ReferenceFailed {
+        /// Scene name.
+        scene: String,
+        /// Which reference.
+        reference: String,
+        /// How it ended.
+        termination: String,
+    },
+    /// Drawing the SVG failed.
+    #[error("drawing the work-precision diagram of `{scene}`: {reason}")]
+    Plot {
+        /// Scene name.
+        scene: String,
+        /// The drawing backend's message.
+        reason: String,
+    },
+}

@@ -1,0 +1,110 @@
+//! Work-precision diagrams as SVG (plotters' SVG backend only: no system fonts are needed, text is
+//! written as SVG `<text>` elements).
+
+use super::precision::PrecisionReport;
+use super::BenchError;
+use plotters::prelude::*;
+
+/// Line colours, one per integrator in order.
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+];
+/// Size of the diagram \[px\].
+const SIZE: (u32, u32) = (800, 560);
+
+/// The work-precision diagram of one scene: log10 state error against log10 wall time, one line per
+/// integrator, its measured slope in the legend. Returns the SVG document.
+///
+/// # Errors
+/// [`BenchError::Plot`] if drawing fails (it does not for finite data).
+pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError> {
+    let fail = |e: &dyn std::fmt::Display| BenchError::Plot {
+        scene: report.scene.clone(),
+        reason: e.to_string(),
+    };
+    let series: Vec<(String, Vec<(f64, f64)>)> = report
+        .slopes
+        .iter()
+        .map(|slope| {
+            let mut points: Vec<(f64, f64)> = report
+                .rows
+                .iter()
+                .filter(|r| r.integrator == slope.integrator)
+                .filter(|r| r.state_error > 0.0 && r.state_error.is_finite())
+                .filter(|r| r.wall_seconds > 0.0)
+                .map(|r| (r.wall_seconds.log10(), r.state_error.log10()))
+                .collect();
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let label = match slope.time {
+                Some(s) => format!("{} (slope {s:.2})", slope.integrator),
+                None => slope.integrator.to_string(),
+            };
+            (label, points)
+        })
+        .collect();
+    let all = series.iter().flat_map(|(_, p)| p.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (-6.0, 0.0, -16.0, 0.0);
+    }
+    let (x0, x1) = (x0.floor() - 0.1, x1.ceil() + 0.1);
+    let (y0, y1) = (y0.floor() - 0.5, y1.ceil() + 0.5);
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{}: work-precision ({})", report.scene, report.reference),
+                ("sans-serif", 18),
+            )
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(56)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("log10 wall time [s]")
+            .y_desc("log10 state error")
+            .draw()
+            .map_err(|e| fail(&e))?;
+        for (i, (label, points)) in series.iter().enumerate() {
+            let colour = PALETTE[i % PALETTE.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    colour.stroke_width(2),
+                ))
+                .map_err(|e| fail(&e))?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .map_err(|e| fail(&e))?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| fail(&e))?;
+        root.present().map_err(|e| fail(&e))?;
+    }
+    Ok(svg)
+}

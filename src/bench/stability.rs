@@ -1,0 +1,897 @@
+//! The hard-case suite (issue 8, `bench stability`; NOTES §5, §7): every case run with every integrator,
+//! each reporting how the run ended, its error, energy drift and time, plus the case's own measurement
+//! against its expectation:
+//! - fast spin (ω_Z = 50, 500 on a steady circle at tilt 0.2, nudged): the largest stable fixed step of
+//!   rk4 and gauss4 by bisection, as h·σ with σ the nutation frequency;
+//! - near flat (θ = 1.5, 1.56, 1.5705): centre-fixed steady motion, and kicked towards flat (tan θ in the
+//!   thousands);
+//! - flat landing (θ₀ = 0.6) and lift-off (θ₀ = 0.2) of a coin released without spin, against the
+//!   quadrature of the energy integral;
+//! - marginal stability of straight rolling at ω_c(1 ± 1e-3) and ω_c, against the linear theory (t² growth
+//!   at ω_c);
+//! - long horizon on a wobbling motion: energy drift against time;
+//! - scale invariance: M, a, g over 1e-3 … 1e3, disk and hoop, against the unit-scale run.
+//!
+//! Horizons are options ([`SuiteOptions`]) so that the tests run the same cases shorter.
+
+use super::case::{reference_trajectory_with, run_sampled_with, termination_name, Trajectory};
+use super::{
+    default_config, energy_drift, method_by_name, reference_trajectory, state_error, BenchCase,
+    BenchError, DEFAULT_FLAT_MARGIN,
+};
+use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
+use crate::model::{
+    energy, straight_lambda_squared, Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
+    STATE_LEN,
+};
+use std::f64::consts::{FRAC_PI_2, TAU};
+use std::time::Instant;
+
+/// Stability criterion of the fast-spin bisection (issue 8): energy drift below 1e-2.
+pub const STABLE_ENERGY_DRIFT: f64 = 1e-2;
+/// Relative width to which the largest stable step is bisected.
+const BISECTION_WIDTH: f64 = 1e-3;
+/// Lean of the fast-spin circles \[rad\].
+const FAST_SPIN_TILT: f64 = 0.2;
+/// Nudge of the fast-spin cases: a nutation whose peak angular acceleration σ²δθ is this fraction of
+/// g/a, so the motion wobbles (the step limit is that of a real nutation, not of round-off growing from
+/// an exact fixed point) while N stays near Mg (a larger nutation at ω_Z = 500 lifts the coin off).
+const FAST_SPIN_NUDGE: f64 = 1e-3;
+/// Kick of the near-flat cases: the nutation amplitude as a fraction of the distance to the flat event.
+const NEAR_FLAT_KICK: f64 = 0.5;
+/// Relative perturbation of the spin in the marginal-stability cases.
+const MARGINAL_OFFSET: f64 = 1e-3;
+/// Initial tilt of the marginal-stability cases \[rad\]: small enough for the linear theory (relative
+/// nonlinear terms ~ δθ² ≈ 1e-7 at t = 30), large enough to be far above the integration error.
+const MARGINAL_TILT: f64 = 1e-6;
+/// Adaptive tolerances of the suite's tight runs (event location to 1e-9 needs them).
+const TIGHT_RTOL: f64 = 1e-12;
+/// See [`TIGHT_RTOL`].
+const TIGHT_ATOL: f64 = 1e-14;
+
+/// Horizons of the suite; the bench uses [`SuiteOptions::full`], the tests [`SuiteOptions::quick`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SuiteOptions {
+    /// Nutation periods of the fast-spin stability runs (issue 8: 100).
+    pub nutation_periods: f64,
+    /// Nutation periods of the near-flat runs.
+    pub near_flat_periods: f64,
+    /// Horizon of the marginal-stability runs [natural time units].
+    pub marginal_horizon: f64,
+    /// Horizon of the long run (issue 8: 10⁴) and the checkpoints at which its drift is reported.
+    pub long_horizon: f64,
+    /// Horizon of the scale-invariance runs [natural time units].
+    pub scale_horizon: f64,
+}
+
+impl SuiteOptions {
+    /// The bench's horizons.
+    #[must_use]
+    pub fn full() -> Self {
+        Self {
+            nutation_periods: 100.0,
+            near_flat_periods: 20.0,
+            marginal_horizon: 30.0,
+            long_horizon: 1e4,
+            scale_horizon: 10.0,
+        }
+    }
+
+    /// Shorter horizons for tests: 100 nutation periods still, long horizon 10³, marginal 20.
+    #[must_use]
+    pub fn quick() -> Self {
+        Self {
+            nutation_periods: 100.0,
+            near_flat_periods: 10.0,
+            marginal_horizon: 20.0,
+            long_horizon: 1e3,
+            scale_horizon: 5.0,
+        }
+    }
+}
+
+/// One line of the suite's report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StabilityRow {
+    /// Case name, e.g. `fast-spin-50`.
+    pub case: String,
+    /// Integrator.
+    pub integrator: Method,
+    /// Its settings, in words (`rtol 1e-12 atol 1e-14`, `h 1e-3`).
+    pub setting: String,
+    /// How the run ended (`completed`, `flat-landing`, `lift-off`, ...).
+    pub termination: String,
+    /// Time of the last sample.
+    pub end_time: f64,
+    /// Max state error against the case's reference, when it has one.
+    pub max_error: Option<f64>,
+    /// Energy drift, CONTRACT definition.
+    pub energy_drift: f64,
+    /// Wall time \[s\].
+    pub wall_seconds: f64,
+    /// What the case measures (`event time`, `largest stable h·σ`, ...).
+    pub quantity: String,
+    /// Its measured value.
+    pub measured: Option<f64>,
+    /// The expected value, when there is one.
+    pub expected: Option<f64>,
+}
+
+/// Settings of a method in the suite: tight tolerances for adaptive methods, `step` for fixed ones.
+#[must_use]
+pub fn suite_config(method: Method, step: f64) -> MethodConfig {
+    MethodConfig {
+        method,
+        rtol: TIGHT_RTOL,
+        atol: TIGHT_ATOL,
+        step,
+    }
+}
+
+fn describe(config: &MethodConfig) -> String {
+    if config.method.is_adaptive() {
+        format!("rtol {:e} atol {:e}", config.rtol, config.atol)
+    } else {
+        format!("h {:.3e}", config.step)
+    }
+}
+
+fn unit_disk() -> Coin {
+    Coin::new(CoinParams::unit_disk())
+}
+
+/// Runs one configuration on a case and makes its row (error against `reference` when given).
+fn row_for(
+    case_name: &str,
+    config: &MethodConfig,
+    case: &BenchCase,
+    settings: &RunSettings,
+    reference: Option<&super::Reference>,
+) -> (StabilityRow, Trajectory) {
+    let mut run = Trajectory::default();
+    let start = Instant::now();
+    run_sampled_with(config, case, settings, &mut run);
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let row = StabilityRow {
+        case: case_name.to_string(),
+        integrator: config.method,
+        setting: describe(config),
+        termination: run.termination_name(),
+        end_time: run.outcome.as_ref().map_or(0.0, |o| o.t_last),
+        max_error: reference.map(|r| state_error(case, &run, r)),
+        energy_drift: energy_drift(&case.coin, &run.states),
+        wall_seconds,
+        quantity: String::new(),
+        measured: None,
+        expected: None,
+    };
+    (row, run)
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Fast spin
+
+/// Nutation frequency σ of a steady motion (NOTES §5): the linearisation of eqs (14)–(17) in
+/// (θ, ω_X, ω_Y, ω_Z) about ω_X = 0 has eigenvalues 0, 0, ±iσ (the steady family is two-dimensional), so
+/// σ² = −tr(J²)/2 = −(∂ω̇_X/∂θ + ∂ω̇_X/∂ω_Y · ∂ω̇_Y/∂ω_X + ∂ω̇_X/∂ω_Z · ∂ω̇_Z/∂ω_X). `None` when σ² ≤ 0
+/// (an unstable steady motion).
+#[must_use]
+pub fn nutation_frequency(coin: &Coin, steady: &Steady) -> Option<f64> {
+    let p = coin.params();
+    let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
+    let mga = p.mass() * p.gravity() * p.radius();
+    let (theta, wy, wz) = (
+        steady.state.theta,
+        steady.state.omega_y,
+        steady.state.omega_z,
+    );
+    let (st, ct) = theta.sin_cos();
+    let tan_t = st / ct;
+    let (gyro, centrifugal, grav) = ((iz + ma2) / (ix + ma2), ix / (ix + ma2), mga / (ix + ma2));
+    // Eq (14) derivatives.
+    let dx_dtheta = -centrifugal * wy * wy / (ct * ct) + grav * ct;
+    let dx_dwy = -gyro * wz - 2.0 * centrifugal * wy * tan_t;
+    let dx_dwz = -gyro * wy;
+    // Eqs (15), (16) derivatives with respect to ω_X at ω_X = 0.
+    let dy_dwx = wy * tan_t + iz / ix * wz;
+    let dz_dwx = ma2 / (iz + ma2) * wy;
+    let sigma2 = -(dx_dtheta + dx_dwy * dy_dwx + dx_dwz * dz_dwx);
+    (sigma2 > 0.0).then(|| sigma2.sqrt())
+}
+
+/// The fast-spin case: the steady circle at tilt 0.2 and spin `omega_z`, nudged to a nutation of
+/// peak angular acceleration 1e-3 g/a, for `periods` nutation periods, and its σ.
+///
+/// # Errors
+/// [`BenchError::InvalidScene`] if the steady motion cannot be built or is unstable.
+pub fn fast_spin_case(omega_z: f64, periods: f64) -> Result<(BenchCase, f64), BenchError> {
+    let coin = unit_disk();
+    let name = format!("fast-spin-{omega_z}");
+    let invalid = |reason: String| BenchError::InvalidScene {
+        scene: name.clone(),
+        reason,
+    };
+    let steady = Steady::new(
+        &coin,
+        SteadyKind::Circle {
+            theta: FAST_SPIN_TILT,
+            omega_z,
+            branch: Branch::Plus,
+        },
+    )
+    .map_err(|e| invalid(e.to_string()))?;
+    let sigma = nutation_frequency(&coin, &steady)
+        .ok_or_else(|| invalid("the steady circle is unstable".into()))?;
+    let mut initial = steady.state;
+    let p = coin.params();
+    // δθ = nudge·(g/a)/σ², so δω_X = σ δθ.
+    initial.omega_x += FAST_SPIN_NUDGE * p.gravity() / p.radius() / sigma;
+    Ok((
+        BenchCase {
+            name,
+            coin,
+            initial,
+            steady: None,
+            duration: periods * TAU / sigma,
+            flat_margin: DEFAULT_FLAT_MARGIN,
+            friction: None,
+        },
+        sigma,
+    ))
+}
+
+/// Whether `method` at fixed step `h` is stable on `case`: the run completes and its energy drift (on
+/// samples 20 per nutation period) stays below [`STABLE_ENERGY_DRIFT`].
+#[must_use]
+pub fn is_stable(method: Method, h: f64, case: &BenchCase, sigma: f64) -> bool {
+    let settings = RunSettings {
+        t0: 0.0,
+        t_end: case.duration,
+        sample_interval: TAU / sigma / 20.0,
+    };
+    let mut run = Trajectory::default();
+    run_sampled_with(&suite_config(method, h), case, &settings, &mut run);
+    run.completed() && energy_drift(&case.coin, &run.states) < STABLE_ENERGY_DRIFT
+}
+
+/// The largest stable fixed step (bisected in log h between 1e-2/σ and min(100/σ, duration/4)), or the
+/// upper end if that is stable too. Returns (h, whether the upper end was reached).
+#[must_use]
+pub fn largest_stable_step(method: Method, case: &BenchCase, sigma: f64) -> (f64, bool) {
+    let mut lo = 1e-2 / sigma;
+    let mut hi = (100.0 / sigma).min(case.duration / 4.0);
+    if is_stable(method, hi, case, sigma) {
+        return (hi, true);
+    }
+    if !is_stable(method, lo, case, sigma) {
+        return (0.0, false);
+    }
+    while hi / lo > 1.0 + BISECTION_WIDTH {
+        let mid = (lo * hi).sqrt();
+        if is_stable(method, mid, case, sigma) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (lo, false)
+}
+
+/// Fast spin at `omega_z`: every integrator at tight settings (fixed step 0.05/σ), then the largest stable
+/// step of each fixed-step method, reported as h·σ.
+///
+/// # Errors
+/// [`BenchError`] if the case or its reference cannot be built.
+pub fn fast_spin(omega_z: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError> {
+    let (case, sigma) = fast_spin_case(omega_z, options.nutation_periods)?;
+    let settings = RunSettings {
+        sample_interval: TAU / sigma / 20.0,
+        ..case.settings()
+    };
+    let reference = reference_trajectory_with(&case, &settings)?;
+    let mut rows = Vec::new();
+    for &method in Method::ALL {
+        let config = suite_config(method, 0.05 / sigma);
+        let (mut row, _) = row_for(&case.name, &config, &case, &settings, Some(&reference));
+        row.quantity = "nutation σ".into();
+        row.measured = Some(sigma);
+        rows.push(row);
+    }
+    for &method in Method::ALL.iter().filter(|m| !m.is_adaptive()) {
+        let start = Instant::now();
+        let (h, capped) = largest_stable_step(method, &case, sigma);
+        // h = 0: not even the smallest step searched is stable; the row shows that run.
+        let config = suite_config(method, if h > 0.0 { h } else { 1e-2 / sigma });
+        let (mut row, _) = row_for(&case.name, &config, &case, &settings, None);
+        row.wall_seconds = start.elapsed().as_secs_f64();
+        row.quantity = if capped {
+            "largest stable h·σ (≥, search cap)".into()
+        } else {
+            "largest stable h·σ".into()
+        };
+        row.measured = Some(h * sigma);
+        row.expected = (method.name() == "rk4").then_some(RK4_STABILITY_LIMIT);
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// rk4's stability limit on the imaginary axis, 2√2 (Hairer & Wanner II, §IV.2): the expected h·σ.
+pub const RK4_STABILITY_LIMIT: f64 = 2.0 * std::f64::consts::SQRT_2;
+
+// ---------------------------------------------------------------------------------------------------------
+// Near flat
+
+/// Near flat at lean `theta`: the centre-fixed steady motion (analytic reference) and the same kicked in
+/// ω_X so that the nutation reaches half-way to the flat event (dop853 reference), each for `periods`
+/// nutation periods with every integrator (fixed step 0.02/σ).
+///
+/// # Errors
+/// [`BenchError`] if the steady motion or the reference cannot be built.
+pub fn near_flat(theta: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError> {
+    let coin = unit_disk();
+    let steady = Steady::new(
+        &coin,
+        SteadyKind::CentreFixed {
+            theta,
+            branch: Branch::Plus,
+        },
+    )
+    .map_err(|e| BenchError::InvalidScene {
+        scene: format!("near-flat-{theta}"),
+        reason: e.to_string(),
+    })?;
+    let sigma = nutation_frequency(&coin, &steady).unwrap_or(1.0);
+    let gap = FRAC_PI_2 - DEFAULT_FLAT_MARGIN - theta;
+    let steady_case = BenchCase {
+        name: format!("near-flat-{theta}-steady"),
+        coin,
+        initial: steady.state,
+        steady: Some(steady),
+        duration: options.near_flat_periods * TAU / sigma,
+        flat_margin: DEFAULT_FLAT_MARGIN,
+        friction: None,
+    };
+    let mut kicked = steady_case.clone();
+    kicked.name = format!("near-flat-{theta}-kicked");
+    kicked.steady = None;
+    kicked.initial.omega_x += NEAR_FLAT_KICK * gap * sigma;
+    let mut rows = Vec::new();
+    for case in [&steady_case, &kicked] {
+        let reference = reference_trajectory(case)?;
+        for &method in Method::ALL {
+            let config = suite_config(method, 0.02 / sigma);
+            let (mut row, run) = row_for(
+                &case.name,
+                &config,
+                case,
+                &case.settings(),
+                Some(&reference),
+            );
+            row.quantity = "max tan θ".into();
+            row.measured = run
+                .states
+                .iter()
+                .map(|y| y[0].tan().abs())
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Flat landing and lift-off
+
+/// Nodes and weights of n-point Gauss–Legendre quadrature on [−1, 1] (Newton on P_n from Chebyshev
+/// guesses; Abramowitz & Stegun 25.4.29).
+#[must_use]
+#[allow(clippy::cast_precision_loss)]
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    let nf = n as f64;
+    (1..=n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 - 0.25) / (nf + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                // P_n(x) and P_n'(x) by the three-term recurrence.
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let kf = k as f64;
+                    let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = nf * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// Time for a coin released at rest at lean θ₀ (no spin) to reach lean θ₁, from the energy integral
+/// (I_X + Ma²)θ̇²/2 = Mga(cos θ₀ − cos θ): t = ∫ dθ / √(2K(cos θ₀ − cos θ)), K = Mga/(I_X + Ma²). The
+/// 1/√ singularity at θ₀ is removed by θ = θ₀ + u²: t = ∫₀^√(θ₁−θ₀) u du / √(K sin(θ₀ + u²/2) sin(u²/2)),
+/// a smooth integrand, by composite 20-point Gauss–Legendre on 64 panels (converged to round-off).
+#[must_use]
+#[allow(clippy::cast_precision_loss)]
+pub fn release_time(coin: &Coin, theta0: f64, theta1: f64) -> f64 {
+    let p = coin.params();
+    let k = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
+    let u_end = (theta1 - theta0).max(0.0).sqrt();
+    let integrand = |u: f64| {
+        let half = 0.5 * u * u;
+        u / (k * (theta0 + half).sin() * half.sin()).sqrt()
+    };
+    let rule = gauss_legendre(20);
+    let panels = 64;
+    let width = u_end / f64::from(panels);
+    let mut total = 0.0;
+    for j in 0..panels {
+        let centre = (f64::from(j) + 0.5) * width;
+        for &(x, w) in &rule {
+            total += 0.5 * width * w * integrand(centre + 0.5 * width * x);
+        }
+    }
+    total
+}
+
+/// The lean at which a coin released at rest at θ₀ leaves the table, if it does before `theta_max`:
+/// N/(Mg) = 1 − (a/g)(θ̇² cos θ + θ̈ sin θ) with θ̇² = 2K(cos θ₀ − cos θ), θ̈ = K sin θ (NOTES §3), first
+/// zero by bisection to round-off.
+#[must_use]
+pub fn lift_off_lean(coin: &Coin, theta0: f64, theta_max: f64) -> Option<f64> {
+    let p = coin.params();
+    let k = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
+    let ratio = p.radius() / p.gravity();
+    let normal = |t: f64| {
+        let (s, c) = t.sin_cos();
+        1.0 - ratio * (2.0 * k * (theta0.cos() - c) * c + k * s * s)
+    };
+    // Scan for the first sign change, then bisect.
+    let scan = 2000;
+    let mut lo = theta0;
+    for i in 1..=scan {
+        let hi = theta0 + (theta_max - theta0) * f64::from(i) / f64::from(scan);
+        if normal(hi) <= 0.0 {
+            let mut hi = hi;
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if normal(mid) <= 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return Some(hi);
+        }
+        lo = hi;
+    }
+    None
+}
+
+/// A coin released at rest at lean `theta0`: the expected event (flat landing at π/2 − flat_margin or
+/// lift-off, whichever comes first) and its time by [`release_time`]; every integrator locates it
+/// (fixed step 1e-3).
+#[must_use]
+pub fn release(theta0: f64, case_name: &str) -> Vec<StabilityRow> {
+    let coin = unit_disk();
+    let flat = FRAC_PI_2 - DEFAULT_FLAT_MARGIN;
+    let (expected_event, theta1) = match lift_off_lean(&coin, theta0, flat) {
+        Some(t) => ("lift-off", t),
+        None => ("flat-landing", flat),
+    };
+    let expected_time = release_time(&coin, theta0, theta1);
+    let case = BenchCase {
+        name: case_name.to_string(),
+        coin,
+        initial: State {
+            theta: theta0,
+            ..State::default()
+        },
+        steady: None,
+        duration: 4.0 * expected_time + 1.0,
+        flat_margin: DEFAULT_FLAT_MARGIN,
+        friction: None,
+    };
+    Method::ALL
+        .iter()
+        .map(|&method| {
+            let config = suite_config(method, 1e-3);
+            let (mut row, run) = row_for(case_name, &config, &case, &case.settings(), None);
+            let located = match run.outcome.as_ref().map(|o| &o.termination) {
+                Some(Termination::Event { t, .. }) => Some(*t),
+                _ => None,
+            };
+            row.quantity = format!("{expected_event} time");
+            row.measured = located;
+            row.expected = Some(expected_time);
+            row.max_error = Some(located.map_or(f64::INFINITY, |t| (t - expected_time).abs()));
+            row
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Marginal stability
+
+/// Linear theory of straight rolling at spin Ω from a tilt δθ₀ at rest (NOTES §5): with
+/// G = Mga/(I_X + Ma²) and λ² = [`straight_lambda_squared`], θ̈ = λ²θ + (G − λ²)θ₀, so
+/// θ(t) = θ₀(1 + G(cosh λt − 1)/λ²) (with (1 − cos σt)/σ² for λ² = −σ² < 0 and t²/2 at λ² = 0: the
+/// thin disk's δθ₀(1 + 2t²/5) at ω_c).
+#[must_use]
+pub fn straight_tilt_linear(coin: &Coin, omega_z0: f64, theta0: f64, t: f64) -> f64 {
+    let p = coin.params();
+    let g = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
+    let l2 = straight_lambda_squared(coin, omega_z0);
+    let growth = if l2.abs() * t * t < 1e-8 {
+        // Series: t²/2 + λ²t⁴/24 (the closed forms cancel here).
+        0.5 * t * t + l2 * t.powi(4) / 24.0
+    } else if l2 > 0.0 {
+        let l = l2.sqrt();
+        ((l * t).cosh() - 1.0) / l2
+    } else {
+        let s = (-l2).sqrt();
+        (1.0 - (s * t).cos()) / (-l2)
+    };
+    theta0 * (1.0 + g * growth)
+}
+
+/// Straight rolling at ω_c(1 + `offset`) from a tilt of 1e-6 for `horizon` time units: the largest
+/// relative deviation of θ from [`straight_tilt_linear`] over the samples, every integrator (fixed step
+/// 1e-2).
+#[must_use]
+pub fn marginal(offset: f64, horizon: f64) -> Vec<StabilityRow> {
+    let coin = unit_disk();
+    let omega = crate::model::critical_spin(&coin) * (1.0 + offset);
+    let case = BenchCase {
+        name: format!("marginal-wc{offset:+e}"),
+        coin,
+        initial: State {
+            theta: MARGINAL_TILT,
+            omega_z: omega,
+            ..State::default()
+        },
+        steady: None,
+        duration: horizon,
+        flat_margin: DEFAULT_FLAT_MARGIN,
+        friction: None,
+    };
+    Method::ALL
+        .iter()
+        .map(|&method| {
+            let config = suite_config(method, 1e-2);
+            let (mut row, run) = row_for(&case.name, &config, &case, &case.settings(), None);
+            let deviation = run
+                .times
+                .iter()
+                .zip(&run.states)
+                .map(|(t, y)| {
+                    let linear = straight_tilt_linear(&coin, omega, MARGINAL_TILT, *t);
+                    ((y[0] - linear) / linear).abs()
+                })
+                .fold(0.0, f64::max);
+            let last = run.states.last().map_or(0.0, |y| y[0]);
+            row.max_error = Some(deviation);
+            row.quantity = "θ(T)/θ₀".into();
+            row.measured = Some(last / MARGINAL_TILT);
+            row.expected = Some(
+                straight_tilt_linear(&coin, omega, MARGINAL_TILT, row.end_time) / MARGINAL_TILT,
+            );
+            row
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Long horizon
+
+/// Energy drift of one long run, reported at checkpoints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DriftHistory {
+    /// The method and its settings.
+    pub config: MethodConfig,
+    /// (t, max relative energy error over [0, t]) at each checkpoint reached.
+    pub checkpoints: Vec<(f64, f64)>,
+    /// How the run ended.
+    pub termination: String,
+    /// Wall time \[s\].
+    pub wall_seconds: f64,
+}
+
+/// The wobbling motion of the long-horizon case (issue 4's: θ₀ = 0.5, ω = (0.3, 0.2, 1.5)).
+#[must_use]
+pub fn wobble_state() -> State {
+    State {
+        theta: 0.5,
+        omega_x: 0.3,
+        omega_y: 0.2,
+        omega_z: 1.5,
+        ..State::default()
+    }
+}
+
+/// Runs `config` on the wobble to `horizon`, streaming the energy error (samples every 0.1 time units,
+/// nothing stored) and recording its running maximum at t = 10, 100, 1000, ... and at the horizon.
+#[must_use]
+pub fn drift_history(config: &MethodConfig, horizon: f64) -> DriftHistory {
+    let coin = unit_disk();
+    let initial = wobble_state();
+    let e0 = energy(&coin, &initial).total;
+    let scale = e0.abs().max(coin.params().energy_scale());
+    let mut checkpoints = Vec::new();
+    let mut next = 10.0_f64.min(horizon);
+    let mut worst = 0.0_f64;
+    let settings = RunSettings {
+        t0: 0.0,
+        t_end: horizon,
+        sample_interval: 0.1,
+    };
+    let events = crate::simulation::CoinEvents::new(coin, DEFAULT_FLAT_MARGIN, None);
+    let start = Instant::now();
+    let outcome = run_method(
+        config,
+        &coin,
+        &initial.to_array(),
+        &settings,
+        &events,
+        |t, y: &[f64; STATE_LEN]| {
+            let d = (energy(&coin, &State::from_array(y)).total - e0).abs() / scale;
+            worst = worst.max(if d.is_nan() { f64::INFINITY } else { d });
+            if t >= next * (1.0 - 1e-12) {
+                checkpoints.push((t, worst));
+                next = (next * 10.0).min(horizon);
+                if t >= horizon {
+                    next = f64::INFINITY;
+                }
+            }
+            Flow::Continue
+        },
+    );
+    DriftHistory {
+        config: *config,
+        checkpoints,
+        termination: termination_name(&outcome.termination),
+        wall_seconds: start.elapsed().as_secs_f64(),
+    }
+}
+
+/// Fixed step of the long-horizon runs: large enough that the truncation error of the energy (≈ 1e-8 for
+/// gauss4) stands above round-off, so a drift, or its absence, is visible.
+pub const LONG_HORIZON_STEP: f64 = 0.1;
+
+/// Settings of the long-horizon runs: contract defaults for adaptive methods, [`LONG_HORIZON_STEP`] for
+/// fixed ones.
+#[must_use]
+pub fn long_horizon_config(method: Method) -> MethodConfig {
+    MethodConfig {
+        step: LONG_HORIZON_STEP,
+        ..default_config(method, 1.0)
+    }
+}
+
+/// The long-horizon case: every integrator on the wobble to `horizon`, one row per checkpoint, and the
+/// growth exponent of the drift (slope of log drift against log t: ≈ 1 for a linear drift, ≈ 0 bounded).
+#[must_use]
+pub fn long_horizon(horizon: f64) -> Vec<StabilityRow> {
+    let mut rows = Vec::new();
+    for &method in Method::ALL {
+        let history = drift_history(&long_horizon_config(method), horizon);
+        let growth = super::precision::fit_slope(&history.checkpoints);
+        for &(t, drift) in &history.checkpoints {
+            rows.push(StabilityRow {
+                case: "long-horizon".into(),
+                integrator: method,
+                setting: describe(&history.config),
+                termination: history.termination.clone(),
+                end_time: t,
+                max_error: None,
+                energy_drift: drift,
+                wall_seconds: history.wall_seconds,
+                quantity: "drift growth exponent".into(),
+                measured: growth,
+                expected: None,
+            });
+        }
+    }
+    rows
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Scale invariance
+
+/// The (M, a, g) triples of the scale-invariance case.
+pub const SCALES: &[(f64, f64, f64)] = &[
+    (1e-3, 1.0, 1.0),
+    (1e3, 1.0, 1.0),
+    (1.0, 1e-3, 1.0),
+    (1.0, 1e3, 1.0),
+    (1.0, 1.0, 1e-3),
+    (1.0, 1.0, 1e3),
+    (1e3, 1e-3, 1e3),
+    (1e-3, 1e3, 1e-3),
+];
+
+/// The state made dimensionless: angles as they are, ω·√(a/g), x/a, z/a.
+#[must_use]
+pub fn dimensionless(coin: &Coin, y: &[f64; STATE_LEN]) -> [f64; STATE_LEN] {
+    let p = coin.params();
+    let (t, a) = (p.time_unit(), p.radius());
+    [
+        y[0],
+        y[1],
+        y[2],
+        y[3] * t,
+        y[4] * t,
+        y[5] * t,
+        y[6] / a,
+        y[7] / a,
+    ]
+}
+
+/// The wobble on a coin of (M, a, g, shape), scaled: ω by √(g/a), horizon and step by √(a/g).
+///
+/// # Errors
+/// [`BenchError::InvalidScene`] for non-positive parameters.
+pub fn scaled_wobble(
+    (mass, radius, gravity): (f64, f64, f64),
+    inertia: Inertia,
+    horizon: f64,
+) -> Result<BenchCase, BenchError> {
+    let params =
+        CoinParams::new(mass, radius, gravity, inertia).map_err(|e| BenchError::InvalidScene {
+            scene: "scale".into(),
+            reason: format!("{e:?}"),
+        })?;
+    let coin = Coin::new(params);
+    let t = params.time_unit();
+    let mut initial = wobble_state();
+    initial.omega_x /= t;
+    initial.omega_y /= t;
+    initial.omega_z /= t;
+    Ok(BenchCase {
+        name: format!("scale-M{mass:e}-a{radius:e}-g{gravity:e}"),
+        coin,
+        initial,
+        steady: None,
+        duration: horizon * t,
+        flat_margin: DEFAULT_FLAT_MARGIN,
+        friction: None,
+    })
+}
+
+/// Largest dimensionless difference between the wobble at scale `scale` and at unit scale, same shape,
+/// with `method` (adaptive: rtol 1e-13, atol 1e-15 times the scale of each run's state; fixed: h = 1e-3
+/// natural units), sampled 100 times per natural time unit.
+///
+/// # Errors
+/// [`BenchError::InvalidScene`] for non-positive parameters.
+pub fn scale_difference(
+    method: Method,
+    scale: (f64, f64, f64),
+    inertia: Inertia,
+    horizon: f64,
+) -> Result<(f64, Trajectory), BenchError> {
+    let unit = scaled_wobble((1.0, 1.0, 1.0), inertia, horizon)?;
+    let scaled = scaled_wobble(scale, inertia, horizon)?;
+    let config_for = |case: &BenchCase| MethodConfig {
+        method,
+        rtol: 1e-13,
+        // The smallest state scale of the run (ω ~ 1/T, lengths ~ a) times 1e-15: pure relative control.
+        atol: 1e-15 * case.coin.params().radius().min(1.0 / case.time_unit()),
+        step: 1e-3 * case.time_unit(),
+    };
+    let mut a = Trajectory::default();
+    let mut b = Trajectory::default();
+    run_sampled_with(&config_for(&unit), &unit, &unit.settings(), &mut a);
+    run_sampled_with(&config_for(&scaled), &scaled, &scaled.settings(), &mut b);
+    if a.states.len() != b.states.len() {
+        return Ok((f64::INFINITY, b));
+    }
+    let worst = a
+        .states
+        .iter()
+        .zip(&b.states)
+        .map(|(ya, yb)| {
+            let (da, db) = (
+                dimensionless(&unit.coin, ya),
+                dimensionless(&scaled.coin, yb),
+            );
+            da.iter()
+                .zip(&db)
+                .map(|(u, v)| (u - v).abs())
+                .fold(0.0, f64::max)
+        })
+        .fold(
+            0.0,
+            |m: f64, d: f64| if d.is_nan() { f64::INFINITY } else { m.max(d) },
+        );
+    Ok((worst, b))
+}
+
+/// Scale invariance: for disk and hoop and every integrator, the worst agreement over [`SCALES`].
+///
+/// # Errors
+/// [`BenchError::InvalidScene`] (never for the built-in scales).
+pub fn scale_invariance(horizon: f64) -> Result<Vec<StabilityRow>, BenchError> {
+    let mut rows = Vec::new();
+    for (shape, inertia) in [("disk", Inertia::ThinDisk), ("hoop", Inertia::Hoop)] {
+        for &method in Method::ALL {
+            let start = Instant::now();
+            let mut worst = (0.0_f64, SCALES[0]);
+            let mut drift = 0.0_f64;
+            let mut termination = String::from("completed");
+            for &scale in SCALES {
+                let (d, run) = scale_difference(method, scale, inertia, horizon)?;
+                if d > worst.0 || d.is_nan() {
+                    worst = (d, scale);
+                }
+                let coin = Coin::new(CoinParams::new(scale.0, scale.1, scale.2, inertia).map_err(
+                    |e| BenchError::InvalidScene {
+                        scene: "scale".into(),
+                        reason: format!("{e:?}"),
+                    },
+                )?);
+                drift = drift.max(energy_drift(&coin, &run.states));
+                if !run.completed() {
+                    termination = run.termination_name();
+                }
+            }
+            rows.push(StabilityRow {
+                case: format!("scale-invariance-{shape}"),
+                integrator: method,
+                setting: format!(
+                    "worst at M={:e} a={:e} g={:e}",
+                    worst.1 .0, worst.1 .1, worst.1 .2
+                ),
+                termination,
+                end_time: horizon,
+                max_error: Some(worst.0),
+                energy_drift: drift,
+                wall_seconds: start.elapsed().as_secs_f64(),
+                quantity: "max dimensionless difference".into(),
+                measured: Some(worst.0),
+                expected: Some(0.0),
+            });
+        }
+    }
+    Ok(rows)
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+/// The whole suite.
+///
+/// # Errors
+/// [`BenchError`] if a case cannot be built (never for the built-in cases).
+pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError> {
+    let mut rows = Vec::new();
+    for omega_z in [50.0, 500.0] {
+        rows.extend(fast_spin(omega_z, options)?);
+    }
+    for theta in [1.5, 1.56, 1.5705] {
+        rows.extend(near_flat(theta, options)?);
+    }
+    rows.extend(release(0.6, "flat-landing"));
+    rows.extend(release(0.2, "lift-off"));
+    for offset in [MARGINAL_OFFSET, 0.0, -MARGINAL_OFFSET] {
+        rows.extend(marginal(offset, options.marginal_horizon));
+    }
+    rows.extend(long_horizon(options.long_horizon));
+    rows.extend(scale_invariance(options.scale_horizon)?);
+    Ok(rows)
+}
+
+/// Whether `method` is in this build (the suite's tests name dop853 and gauss4).
+#[must_use]
+pub fn available(name: &str) -> bool {
+    method_by_name(name).is_some()
+}

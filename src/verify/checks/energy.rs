@@ -1,0 +1,81 @@
+//! `energy`: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ (NOTES §3) recomputed from
+//! the stored ω and θ; drift = max|E − E₀| / max(|E₀|, Mga) (CONTRACT); agreement of `/coin/energy` with
+//! the recomputed total, kinetic and potential parts, in the same units.
+
+use super::{fmt_num, worst, Context, Max};
+use crate::model::energy;
+use crate::verify::report::{CheckId, CheckResult};
+use crate::verify::samples::Sample;
+use crate::verify::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
+
+/// Running state of the energy check.
+#[derive(Debug, Default, Clone)]
+pub struct EnergyCheck {
+    e0: Option<f64>,
+    drift: Max,
+    agreement: Max,
+    samples: u64,
+    stored: u64,
+}
+
+impl EnergyCheck {
+    /// Accounts for one sample.
+    pub fn observe(&mut self, s: &Sample, ctx: &Context) {
+        let Some(state) = s.state() else { return };
+        let e = energy(&ctx.coin, &state);
+        let e0 = *self.e0.get_or_insert(e.total);
+        self.samples += 1;
+        self.drift.offer((e.total - e0).abs(), s.t);
+        if let Some(m) = s.energy {
+            self.stored += 1;
+            let d = (m.total - e.total)
+                .abs()
+                .max((m.kinetic - e.kinetic).abs())
+                .max((m.potential - e.potential).abs());
+            self.agreement.offer(d, s.t);
+        }
+    }
+
+    /// The result.
+    #[must_use]
+    pub fn finish(&self, ctx: &Context, tol: &Tolerances) -> CheckResult {
+        let Some(e0) = self.e0 else {
+            return CheckResult::skip(
+                CheckId::Energy,
+                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed",
+            );
+        };
+        let scale = e0.abs().max(ctx.coin.params().energy_scale());
+        let drift = self.drift.value / scale;
+        let agreement = self.agreement.value / scale;
+        let mut measures = vec![(drift, tol.energy, "drift")];
+        if self.stored > 0 {
+            measures.push((agreement, RECOMPUTE_TOLERANCE, "agreement"));
+        }
+        let Some((value, tolerance, which)) = worst(&measures) else {
+            return CheckResult::skip(CheckId::Energy, "nothing measured");
+        };
+        let stored = if self.stored > 0 {
+            format!(
+                "; /coin/energy differs from E recomputed by {} (worst at t = {}, tolerance {})",
+                fmt_num(agreement),
+                fmt_num(self.agreement.t),
+                fmt_num(RECOMPUTE_TOLERANCE)
+            )
+        } else {
+            "; no /coin/energy channel to compare".into()
+        };
+        CheckResult::measured(
+            CheckId::Energy,
+            value,
+            tolerance,
+            format!(
+                "{which} is the worst measure: drift max|E - E0|/max(|E0|, Mga) = {} over {} samples (worst at t = {}, tolerance {}){stored}",
+                fmt_num(drift),
+                self.samples,
+                fmt_num(self.drift.t),
+                fmt_num(tol.energy),
+            ),
+        )
+    }
+}

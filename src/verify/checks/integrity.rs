@@ -1,0 +1,23 @@
+//! `integrity`: the file's structure (magic, summary, chunk and message indexes, CRCs, statistics against
+//! the real counts), its schemas (the tool's bytes, or another version whose shape is checked), every
+//! message parsed strictly into its type, and log times monotonic per channel and equal to round(t·10⁹).
+//! The value is the number of problems found; the tolerance is 0.
+
+use crate::verify::problems::Problems;
+use crate::verify::report::{CheckId, CheckResult};
+
+/// The integrity result from the problems found and a description of what was read.
+#[must_use]
+pub fn finish(problems: &Problems, read: &str, notes: &[String]) -> CheckResult {
+    let mut reason = if problems.is_empty() {
+        format!("{read}: structure, indexes, CRCs, statistics, schemas, message shapes and times are consistent")
+    } else {
+        format!("{read}: {}", problems.summary())
+    };
+    for n in notes {
+        reason.push_str("; ");
+        reason.push_str(n);
+    }
+    #[allow(clippy::cast_precision_loss)]
+    CheckResult::measured(CheckId::Integrity, problems.total() as f64, 0.0, reason)
+}

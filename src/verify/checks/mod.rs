@@ -1,0 +1,117 @@
+//! The physics checks. Each is a running accumulator: `observe` sees every sample once, in time order, and
+//! keeps only maxima, sums and a short window; `finish` turns them into a [`CheckResult`](crate::verify::CheckResult).
+
+pub mod consistency;
+pub mod constraint;
+pub mod energy;
+pub mod integrity;
+pub mod invariants;
+pub mod steady;
+pub mod validity;
+
+use super::samples::Sample;
+use crate::model::invariants::Chaplygin;
+use crate::model::{Coin, Steady};
+use crate::record::{ResultMetadata, RunMetadata};
+
+/// What the checks know about the run besides its samples: the file's metadata.
+#[derive(Debug, Clone)]
+pub struct Context {
+    /// The coin built from the metadata's M, a, g, I_X, I_Z.
+    pub coin: Coin,
+    /// The `coin-log` record.
+    pub run: RunMetadata,
+    /// The `coin-log.result` record, if the run finished writing it.
+    pub result: Option<ResultMetadata>,
+    /// The steady motion the scene asks for, or why the steady check does not apply.
+    pub steady: Result<Steady, String>,
+    /// C1, C2 for these parameters (NOTES §6), or why they cannot be evaluated.
+    pub chaplygin: Result<Chaplygin, String>,
+}
+
+/// Run-wide quantities the tolerances and scales need.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RunStats {
+    /// First sample time.
+    pub first_t: Option<f64>,
+    /// Last sample time.
+    pub last_t: f64,
+    /// Samples seen.
+    pub samples: u64,
+    /// max|ω| over samples with ω.
+    pub max_omega: f64,
+}
+
+impl RunStats {
+    /// Accounts for one sample.
+    pub fn observe(&mut self, s: &Sample) {
+        self.first_t.get_or_insert(s.t);
+        self.last_t = s.t;
+        self.samples += 1;
+        if let Some(w) = s.omega {
+            self.max_omega = self.max_omega.max(norm3(w.x, w.y, w.z));
+        }
+    }
+
+    /// Recorded span T.
+    #[must_use]
+    pub fn span(&self) -> f64 {
+        self.first_t.map_or(0.0, |t0| self.last_t - t0)
+    }
+}
+
+/// Euclidean norm of three components.
+#[must_use]
+pub fn norm3(x: f64, y: f64, z: f64) -> f64 {
+    (x * x + y * y + z * z).sqrt()
+}
+
+/// The worst of several (value, tolerance, label) measures: the one with the largest value/tolerance.
+#[must_use]
+pub fn worst<'a>(measures: &[(f64, f64, &'a str)]) -> Option<(f64, f64, &'a str)> {
+    let ratio = |m: &(f64, f64, &str)| {
+        if m.0.is_nan() {
+            f64::INFINITY
+        } else {
+            m.0 / m.1
+        }
+    };
+    measures
+        .iter()
+        .copied()
+        .max_by(|a, b| ratio(a).total_cmp(&ratio(b)))
+}
+
+/// Shortest readable form of a number for reasons: 3 significant digits.
+#[must_use]
+pub fn fmt_num(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else if (1e-3..1e4).contains(&x.abs()) {
+        format!("{x:.4}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// A running maximum that remembers when it happened.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Max {
+    /// The maximum so far (NaN wins: a NaN residual is a failure).
+    pub value: f64,
+    /// Time of the maximum.
+    pub t: f64,
+}
+
+impl Max {
+    /// Offers a value at time t.
+    pub fn offer(&mut self, value: f64, t: f64) {
+        if value > self.value || (value.is_nan() && !self.value.is_nan()) {
+            self.value = value;
+            self.t = t;
+        }
+    }
+}

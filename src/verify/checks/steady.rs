@@ -1,0 +1,284 @@
+//! `steady`: a steady motion (NOTES §4) stays steady. At every sample the right-hand side of eqs (14)–(16)
+//! must vanish, θ and ω must equal the steady values, and the circles traced by the stored centre and
+//! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
+
+use super::{fmt_num, norm3, worst, Context, Max};
+use crate::model::{Branch, Coin, Steady, SteadyKind};
+use crate::record::RunMetadata;
+use crate::verify::report::{CheckId, CheckResult};
+use crate::verify::samples::Sample;
+use crate::verify::tolerances::Tolerances;
+
+/// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
+const MIN_ARC: f64 = 0.5;
+
+/// The steady motion a log's scene asks for, or why the check does not apply.
+///
+/// # Errors
+/// A sentence saying why there is no steady motion to compare with.
+pub fn plan(coin: &Coin, run: &RunMetadata) -> Result<Steady, String> {
+    if run.steady_kind == "none" {
+        return Err("not a steady scene (steady_kind = none)".into());
+    }
+    let scene: toml::Table = run
+        .scene
+        .parse()
+        .map_err(|e| format!("the metadata's scene TOML does not parse: {e}"))?;
+    let initial = scene
+        .get("initial")
+        .and_then(toml::Value::as_table)
+        .ok_or("the metadata's scene has no [initial] table")?;
+    if initial.contains_key("perturbation") {
+        return Err(
+            "the scene perturbs its steady motion, so it is not expected to stay steady".into(),
+        );
+    }
+    let steady = initial
+        .get("steady")
+        .and_then(toml::Value::as_table)
+        .ok_or("steady_kind is set but the scene has no initial.steady table")?;
+    let number = |key: &str| -> Result<f64, String> {
+        let v = steady
+            .get(key)
+            .ok_or_else(|| format!("initial.steady has no `{key}`"))?;
+        v.as_float()
+            .or_else(|| v.as_integer().map(|i| i as f64))
+            .ok_or_else(|| format!("initial.steady.{key} = {v} is not a number"))
+    };
+    let branch = match steady.get("branch").and_then(toml::Value::as_str) {
+        None | Some("+") => Branch::Plus,
+        Some("-") => Branch::Minus,
+        Some(other) => {
+            return Err(format!(
+                "initial.steady.branch = {other:?} is not \"+\" or \"-\""
+            ))
+        }
+    };
+    let kind = match run.steady_kind.as_str() {
+        "straight" => SteadyKind::Straight {
+            omega_z: number("omega_z")?,
+        },
+        "centre-fixed" => SteadyKind::CentreFixed {
+            theta: number("theta")?,
+            branch,
+        },
+        "circle" => SteadyKind::Circle {
+            theta: number("theta")?,
+            omega_z: number("omega_z")?,
+            branch,
+        },
+        "spin-upright" => SteadyKind::SpinUpright {
+            omega_y: number("omega_y")?,
+        },
+        other => return Err(format!("unknown steady_kind {other:?}")),
+    };
+    Steady::new(coin, kind).map_err(|e| format!("the scene's steady motion cannot be built: {e}"))
+}
+
+/// Streaming least-squares circle fit (Kåsa), in coordinates shifted to the first point.
+#[derive(Debug, Default, Clone, Copy)]
+struct CircleFit {
+    origin: Option<(f64, f64)>,
+    n: f64,
+    su: f64,
+    sv: f64,
+    suu: f64,
+    svv: f64,
+    suv: f64,
+    suuu: f64,
+    svvv: f64,
+    suvv: f64,
+    suuv: f64,
+    max_offset: f64,
+}
+
+impl CircleFit {
+    fn add(&mut self, x: f64, z: f64) {
+        let (x0, z0) = *self.origin.get_or_insert((x, z));
+        let (u, v) = (x - x0, z - z0);
+        self.n += 1.0;
+        self.su += u;
+        self.sv += v;
+        self.suu += u * u;
+        self.svv += v * v;
+        self.suv += u * v;
+        self.suuu += u * u * u;
+        self.svvv += v * v * v;
+        self.suvv += u * v * v;
+        self.suuv += u * u * v;
+        self.max_offset = self.max_offset.max(u.hypot(v));
+    }
+
+    /// The fitted radius, if the system is solvable.
+    fn radius(&self) -> Option<f64> {
+        let m = [
+            [self.suu, self.suv, self.su],
+            [self.suv, self.svv, self.sv],
+            [self.su, self.sv, self.n],
+        ];
+        let r = [
+            -(self.suuu + self.suvv),
+            -(self.suuv + self.svvv),
+            -(self.suu + self.svv),
+        ];
+        let det = |m: &[[f64; 3]; 3]| {
+            m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+        };
+        let d = det(&m);
+        if d == 0.0 || !d.is_finite() {
+            return None;
+        }
+        let mut sol = [0.0; 3];
+        for (k, s) in sol.iter_mut().enumerate() {
+            let mut mk = m;
+            for (row, rk) in mk.iter_mut().zip(r) {
+                row[k] = rk;
+            }
+            *s = det(&mk) / d;
+        }
+        let [dd, ee, ff] = sol;
+        let r2 = 0.25 * (dd * dd + ee * ee) - ff;
+        (r2 >= 0.0).then(|| r2.sqrt())
+    }
+}
+
+/// Running state of the steady check.
+#[derive(Debug, Default, Clone)]
+pub struct SteadyCheck {
+    acceleration: Max,
+    theta: Max,
+    omega: Max,
+    max_omega: f64,
+    samples: u64,
+    centre: CircleFit,
+    contact: CircleFit,
+    phi_range: Option<(f64, f64)>,
+}
+
+impl SteadyCheck {
+    /// Accounts for one sample.
+    pub fn observe(&mut self, s: &Sample, ctx: &Context) {
+        let Ok(steady) = &ctx.steady else { return };
+        let (Some(w), Some(a)) = (s.omega, s.angles) else {
+            return;
+        };
+        self.samples += 1;
+        let acc = ctx.coin.angular_acceleration(a.theta, w.x, w.y, w.z);
+        self.acceleration
+            .offer(acc.x.abs().max(acc.y.abs()).max(acc.z.abs()), s.t);
+        self.theta.offer((a.theta - steady.state.theta).abs(), s.t);
+        let e = &steady.state;
+        self.omega.offer(
+            (w.x - e.omega_x)
+                .abs()
+                .max((w.y - e.omega_y).abs())
+                .max((w.z - e.omega_z).abs()),
+            s.t,
+        );
+        self.max_omega = self.max_omega.max(norm3(w.x, w.y, w.z));
+        let (lo, hi) = self.phi_range.get_or_insert((a.phi, a.phi));
+        *lo = lo.min(a.phi);
+        *hi = hi.max(a.phi);
+        if let Some(p) = s.position {
+            self.centre.add(p.x, p.z);
+        }
+        if let Some(c) = s.contact {
+            self.contact.add(c.x, c.z);
+        }
+    }
+
+    /// The result.
+    #[must_use]
+    pub fn finish(&self, ctx: &Context, tol: &Tolerances) -> CheckResult {
+        let steady = match &ctx.steady {
+            Ok(s) => s,
+            Err(reason) => return CheckResult::skip(CheckId::Steady, reason.clone()),
+        };
+        if self.samples == 0 {
+            return CheckResult::skip(
+                CheckId::Steady,
+                "no sample has both /coin/omega and /coin/angles",
+            );
+        }
+        let p = ctx.coin.params();
+        let a = p.radius();
+        let omega_scale = self.max_omega.max(1.0 / p.time_unit());
+        let acc_scale =
+            self.max_omega * self.max_omega + p.energy_scale() / (p.inertia_x() + p.ma2());
+        let mut measures = vec![
+            (self.acceleration.value / acc_scale, tol.residual, "rhs"),
+            (self.theta.value, tol.residual, "theta"),
+            (self.omega.value / omega_scale, tol.residual, "omega"),
+        ];
+        let mut notes = Vec::new();
+        // The metadata's steady values against those recomputed from the scene.
+        let meta = [
+            (ctx.run.phi_dot, Some(steady.phi_dot), omega_scale),
+            (ctx.run.psi_dot, Some(steady.psi_dot), omega_scale),
+            (ctx.run.r_g, steady.r_g, a),
+            (ctx.run.r_c, steady.r_c, a),
+        ];
+        let meta_dev = meta
+            .iter()
+            .map(|(m, s, scale)| match (m, s) {
+                (Some(m), Some(s)) => (m - s).abs() / scale,
+                (None, None) => 0.0,
+                _ => f64::INFINITY,
+            })
+            .fold(0.0, f64::max);
+        measures.push((meta_dev, tol.residual, "metadata"));
+        let arc = self.phi_range.map_or(0.0, |(lo, hi)| hi - lo);
+        let mut radii = |fit: &CircleFit, expected: Option<f64>, name: &'static str| match expected
+        {
+            None => notes.push(format!("{name}: straight rolling, no circle")),
+            Some(0.0) => {
+                measures.push((fit.max_offset / a, tol.residual, name));
+                notes.push(format!(
+                    "{name}: stays within {} of its start",
+                    fmt_num(fit.max_offset)
+                ));
+            }
+            Some(_) if fit.n < 3.0 => notes.push(format!("{name}: not stored")),
+            Some(_) if arc < MIN_ARC => notes.push(format!(
+                "{name}: the run turns only {} rad, too little to fit a circle",
+                fmt_num(arc)
+            )),
+            Some(r) => match fit.radius() {
+                Some(fitted) => {
+                    measures.push(((fitted - r).abs() / r.max(a), tol.residual, name));
+                    notes.push(format!(
+                        "{name}: fitted {} vs {}",
+                        fmt_num(fitted),
+                        fmt_num(r)
+                    ));
+                }
+                None => notes.push(format!("{name}: the circle fit is singular")),
+            },
+        };
+        radii(&self.centre, steady.r_g, "R_G");
+        radii(&self.contact, steady.r_c, "R_C");
+        let Some((value, tolerance, which)) = worst(&measures) else {
+            return CheckResult::skip(CheckId::Steady, "nothing measured");
+        };
+        CheckResult::measured(
+            CheckId::Steady,
+            value,
+            tolerance,
+            format!(
+                "{} steady motion over {} samples; worst measure {which}: |ω̇|/(|ω|² + Mga/(I_X + Ma²)) = {} (t = {}), |θ - θs| = {} rad (t = {}), |ω - ωs|/|ω| = {} (t = {}), metadata φ̇, ψ̇, R_G, R_C off by {}; {}",
+                steady.kind.name(),
+                self.samples,
+                fmt_num(self.acceleration.value / acc_scale),
+                fmt_num(self.acceleration.t),
+                fmt_num(self.theta.value),
+                fmt_num(self.theta.t),
+                fmt_num(self.omega.value / omega_scale),
+                fmt_num(self.omega.t),
+                fmt_num(meta_dev),
+                notes.join(", "),
+            ),
+        )
+    }
+}

@@ -1,0 +1,564 @@
+//! Judging one file: the [`Visitor`] that turns records into typed samples and feeds the checks, and the
+//! verdict with its exit code.
+
+use super::checks::{
+    consistency::ConsistencyCheck, constraint::ConstraintCheck, energy::EnergyCheck, integrity,
+    invariants::InvariantsCheck, steady, steady::SteadyCheck, validity::ValidityCheck, Context,
+    RunStats,
+};
+use super::problems::Problems;
+use super::reader::{self, ReadErrorKind, Visitor};
+use super::report::{CheckId, CheckResult, FileReport, Status};
+use super::samples::{Assembler, Sample, Slot, Value};
+use super::tolerances::{RunAccuracy, Tolerances};
+use super::wire::MessageHeader;
+use super::Options;
+use crate::model::invariants::Chaplygin;
+use crate::model::{Coin, CoinParams, Inertia};
+use crate::record::messages::{
+    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
+    ReactionMessage,
+};
+use crate::record::{
+    schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
+    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+};
+use crate::units::log_time;
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
+use std::path::Path;
+
+/// What a channel id stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Coin(Slot),
+    Foxglove,
+    Unknown,
+}
+
+#[derive(Debug, Clone)]
+struct ChannelState {
+    kind: Kind,
+    topic: String,
+    last: Option<u64>,
+}
+
+/// The physics checks' running state.
+#[derive(Debug, Default)]
+struct Checks {
+    stats: RunStats,
+    energy: EnergyCheck,
+    invariants: InvariantsCheck,
+    steady: SteadyCheck,
+    constraint: ConstraintCheck,
+    consistency: ConsistencyCheck,
+    validity: ValidityCheck,
+}
+
+impl Checks {
+    fn observe(&mut self, s: &Sample, ctx: &Context) {
+        self.stats.observe(s);
+        self.energy.observe(s, ctx);
+        self.invariants.observe(s, invariants_of(ctx));
+        self.steady.observe(s, ctx);
+        self.constraint.observe(s, ctx.coin.params().radius());
+        self.consistency.observe(s, ctx);
+        self.validity.observe(s, ctx);
+    }
+}
+
+/// C1, C2 at (θ, ω_Y, ω_Z), when they can be evaluated for these parameters.
+fn invariants_of(ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> + '_ {
+    move |theta, omega_y, omega_z| {
+        ctx.chaplygin.as_ref().ok().map(|c| {
+            let i = c.evaluate(theta, omega_y, omega_z);
+            (i.c1, i.c2)
+        })
+    }
+}
+
+/// Schema names of the `coin_log.*` types and their fields, for schemas of another version.
+fn fields_of(schema: &str) -> Option<&'static [&'static str]> {
+    Some(match schema {
+        AngularVelocity::SCHEMA => AngularVelocity::FIELDS,
+        Angles::SCHEMA => Angles::FIELDS,
+        QuaternionMessage::SCHEMA => QuaternionMessage::FIELDS,
+        Position::SCHEMA => Position::FIELDS,
+        ReactionMessage::SCHEMA => ReactionMessage::FIELDS,
+        EnergyMessage::SCHEMA => EnergyMessage::FIELDS,
+        InvariantsMessage::SCHEMA => InvariantsMessage::FIELDS,
+        _ => return None,
+    })
+}
+
+/// Whether a JSON schema of another version describes exactly `fields`, all required numbers, closed.
+fn shape_matches(data: &[u8], fields: &[&str]) -> Result<(), String> {
+    let v: serde_json::Value =
+        serde_json::from_slice(data).map_err(|e| format!("is not JSON: {e}"))?;
+    let props = v
+        .get("properties")
+        .and_then(serde_json::Value::as_object)
+        .ok_or("has no `properties`")?;
+    let mut names: Vec<&str> = props.keys().map(String::as_str).collect();
+    names.sort_unstable();
+    let mut want: Vec<&str> = fields.to_vec();
+    want.sort_unstable();
+    if names != want {
+        return Err(format!(
+            "has properties {names:?}, the message type has {want:?}"
+        ));
+    }
+    for (k, p) in props {
+        if p.get("type").and_then(serde_json::Value::as_str) != Some("number") {
+            return Err(format!("types `{k}` as something other than a number"));
+        }
+    }
+    let required: Vec<&str> = v
+        .get("required")
+        .and_then(serde_json::Value::as_array)
+        .map(|r| r.iter().filter_map(serde_json::Value::as_str).collect())
+        .unwrap_or_default();
+    if let Some(missing) = fields.iter().find(|f| !required.contains(f)) {
+        return Err(format!("does not require `{missing}`"));
+    }
+    if v.get("additionalProperties") != Some(&serde_json::Value::Bool(false)) {
+        return Err("allows additional properties".into());
+    }
+    Ok(())
+}
+
+/// The visitor that judges one log while it streams by.
+#[derive(Default)]
+struct Judge {
+    channels: Vec<Option<ChannelState>>,
+    schemas: BTreeMap<u16, String>,
+    ctx: Option<Context>,
+    run_error: Option<String>,
+    result_error: Option<String>,
+    library: String,
+    problems: Problems,
+    notes: Vec<String>,
+    assembler: Assembler,
+    checks: Checks,
+}
+
+impl Judge {
+    fn parse(slot: Slot, data: &[u8]) -> Result<(f64, Value), serde_json::Error> {
+        Ok(match slot {
+            Slot::Omega => {
+                let m: AngularVelocity = serde_json::from_slice(data)?;
+                (m.t, Value::Omega(m))
+            }
+            Slot::Angles => {
+                let m: Angles = serde_json::from_slice(data)?;
+                (m.t, Value::Angles(m))
+            }
+            Slot::Quaternion => {
+                let m: QuaternionMessage = serde_json::from_slice(data)?;
+                (m.t, Value::Quaternion(m))
+            }
+            Slot::Position => {
+                let m: Position = serde_json::from_slice(data)?;
+                (m.t, Value::Position(m))
+            }
+            Slot::Contact => {
+                let m: Position = serde_json::from_slice(data)?;
+                (m.t, Value::Contact(m))
+            }
+            Slot::Reaction => {
+                let m: ReactionMessage = serde_json::from_slice(data)?;
+                (m.t, Value::Reaction(m))
+            }
+            Slot::Energy => {
+                let m: EnergyMessage = serde_json::from_slice(data)?;
+                (m.t, Value::Energy(m))
+            }
+            Slot::Invariants => {
+                let m: InvariantsMessage = serde_json::from_slice(data)?;
+                (m.t, Value::Invariants(m))
+            }
+        })
+    }
+
+    fn run_metadata(&mut self, entries: &BTreeMap<String, String>) {
+        let run = match RunMetadata::from_map(entries) {
+            Ok(run) => run,
+            Err(e) => {
+                self.run_error = Some(format!("its `coin-log` metadata is unusable: {e}"));
+                return;
+            }
+        };
+        if run.format_version != FORMAT_VERSION {
+            self.run_error = Some(format!(
+                "its `coin-log` metadata has format_version {:?}; this tool reads {FORMAT_VERSION:?}",
+                run.format_version
+            ));
+            return;
+        }
+        let params = CoinParams::new(
+            run.mass,
+            run.radius,
+            run.gravity,
+            Inertia::Explicit {
+                inertia_x: run.inertia_x,
+                inertia_z: run.inertia_z,
+            },
+        );
+        let params = match params {
+            Ok(p) => p,
+            Err(errors) => {
+                let list: Vec<String> = errors.iter().map(ToString::to_string).collect();
+                self.run_error = Some(format!(
+                    "its `coin-log` metadata has unusable body parameters: {}",
+                    list.join("; ")
+                ));
+                return;
+            }
+        };
+        let coin = Coin::new(params);
+        let steady = steady::plan(&coin, &run);
+        let chaplygin = Chaplygin::new(&params)
+            .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
+        self.ctx = Some(Context {
+            coin,
+            run,
+            result: None,
+            steady,
+            chaplygin,
+        });
+    }
+}
+
+impl Visitor for Judge {
+    fn library(&mut self, library: &str) {
+        self.library = library.to_string();
+    }
+
+    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
+        self.schemas.insert(id, name.to_string());
+        if encoding != SCHEMA_ENCODING {
+            self.problems.push_with(|| {
+                format!("schema `{name}` has encoding {encoding:?}, not {SCHEMA_ENCODING:?}")
+            });
+        }
+        match schema_bytes(name) {
+            Some(ours) if ours == data => {}
+            Some(_) => match fields_of(name) {
+                Some(fields) => match shape_matches(data, fields) {
+                    Ok(()) => self.notes.push(format!(
+                        "schema `{name}` is another version than this tool's, with the same message shape"
+                    )),
+                    Err(e) => self.problems.push_with(|| {
+                        format!("schema `{name}` is another version than this tool's and {e}")
+                    }),
+                },
+                None => self.notes.push(format!(
+                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
+                )),
+            },
+            None => self
+                .problems
+                .push_with(|| format!("schema `{name}` is not one of coin-log's")),
+        }
+    }
+
+    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
+        let kind = match Channel::from_topic(topic) {
+            None => {
+                self.problems
+                    .push_with(|| format!("topic `{topic}` is not one of coin-log's"));
+                Kind::Unknown
+            }
+            Some(c) => {
+                let schema = self.schemas.get(&schema_id).map_or("", String::as_str);
+                if schema != c.schema_name() {
+                    self.problems.push_with(|| {
+                        format!(
+                            "topic `{topic}` has schema `{schema}`, the contract says `{}`",
+                            c.schema_name()
+                        )
+                    });
+                }
+                if message_encoding != MESSAGE_ENCODING {
+                    self.problems.push_with(|| {
+                        format!("topic `{topic}` has message encoding {message_encoding:?}, not {MESSAGE_ENCODING:?}")
+                    });
+                }
+                match c {
+                    Channel::Omega => Kind::Coin(Slot::Omega),
+                    Channel::Angles => Kind::Coin(Slot::Angles),
+                    Channel::Quaternion => Kind::Coin(Slot::Quaternion),
+                    Channel::Position => Kind::Coin(Slot::Position),
+                    Channel::Contact => Kind::Coin(Slot::Contact),
+                    Channel::Reaction => Kind::Coin(Slot::Reaction),
+                    Channel::Energy => Kind::Coin(Slot::Energy),
+                    Channel::Invariants => Kind::Coin(Slot::Invariants),
+                    Channel::Tf | Channel::Scene => Kind::Foxglove,
+                }
+            }
+        };
+        if let Kind::Coin(slot) = kind {
+            self.assembler.declare(slot);
+        }
+        let i = usize::from(id);
+        if self.channels.len() <= i {
+            self.channels.resize(i + 1, None);
+        }
+        self.channels[i] = Some(ChannelState {
+            kind,
+            topic: topic.to_string(),
+            last: None,
+        });
+    }
+
+    fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
+        if name == RUN_METADATA_NAME {
+            if self.ctx.is_some() || self.run_error.is_some() {
+                self.problems
+                    .push_with(|| "more than one `coin-log` metadata record".into());
+                return;
+            }
+            self.run_metadata(entries);
+        } else if name == RESULT_METADATA_NAME {
+            match (ResultMetadata::from_map(entries), self.ctx.as_mut()) {
+                (Ok(r), Some(ctx)) => ctx.result = Some(r),
+                (Ok(_), None) => {}
+                (Err(e), _) => self.result_error = Some(e.to_string()),
+            }
+        }
+    }
+
+    fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
+        if self.ctx.is_none() {
+            return ControlFlow::Break(());
+        }
+        let Some(Some(channel)) = self.channels.get_mut(usize::from(h.channel_id)) else {
+            let id = h.channel_id;
+            self.problems.push_with(|| {
+                format!("a message on channel {id}, which no channel record declares")
+            });
+            return ControlFlow::Continue(());
+        };
+        let lt = h.log_time;
+        if h.publish_time != lt {
+            let (topic, p) = (channel.topic.clone(), h.publish_time);
+            self.problems
+                .push_with(|| format!("{topic}: publish_time {p} differs from log_time {lt}"));
+        }
+        if let Some(last) = channel.last {
+            // One coin_log message per sample: strictly increasing. /tf and /scene may carry several
+            // messages at one time (the static world → table transform and the coin's at t = 0).
+            let strict = matches!(channel.kind, Kind::Coin(_));
+            if lt < last || (strict && lt == last) {
+                let topic = channel.topic.clone();
+                let what = if strict {
+                    "increasing"
+                } else {
+                    "non-decreasing"
+                };
+                self.problems.push_with(|| {
+                    format!("{topic}: log times not {what}: {lt} ns after {last} ns")
+                });
+            }
+        }
+        channel.last = Some(lt);
+        let kind = channel.kind;
+        match kind {
+            Kind::Coin(slot) => {
+                let (t, value) = match Self::parse(slot, data) {
+                    Ok(v) => v,
+                    Err(e) => {
+                        let topic = self.topic(h.channel_id);
+                        self.problems.push_with(|| {
+                            format!("{topic}: message at {lt} ns does not parse: {e}")
+                        });
+                        return ControlFlow::Continue(());
+                    }
+                };
+                match log_time(t) {
+                    Ok(expected) if expected == lt => {}
+                    Ok(expected) => {
+                        let topic = self.topic(h.channel_id);
+                        self.problems.push_with(|| {
+                            format!("{topic}: log_time {lt} ns is not round(t·1e9) = {expected} ns for t = {t}")
+                        });
+                    }
+                    Err(e) => {
+                        let topic = self.topic(h.channel_id);
+                        self.problems.push_with(|| format!("{topic}: {e}"));
+                    }
+                }
+                let checks = &mut self.checks;
+                let Some(ctx) = self.ctx.as_ref() else {
+                    return ControlFlow::Break(());
+                };
+                self.assembler
+                    .push(slot, lt, t, value, &mut |s| checks.observe(s, ctx));
+            }
+            Kind::Foxglove => {
+                if let Err(e) = serde_json::from_slice::<serde::de::IgnoredAny>(data) {
+                    let topic = self.topic(h.channel_id);
+                    self.problems
+                        .push_with(|| format!("{topic}: message at {lt} ns is not JSON: {e}"));
+                }
+            }
+            Kind::Unknown => {}
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+impl Judge {
+    fn topic(&self, id: u16) -> String {
+        self.channels
+            .get(usize::from(id))
+            .and_then(Option::as_ref)
+            .map_or_else(String::new, |c| c.topic.clone())
+    }
+}
+
+fn unusable(path: &str, problem: String) -> FileReport {
+    FileReport {
+        path: path.to_string(),
+        exit_code: 2,
+        checks: Vec::new(),
+        problem: Some(problem),
+    }
+}
+
+/// Judges one file (see [`super::verify_file`]).
+pub fn verify_file(path: &Path, options: &Options) -> FileReport {
+    let mut judge = Judge::default();
+    let (structure, error) = reader::read(path, &mut judge);
+    verdict(path.display().to_string(), judge, structure, error, options)
+}
+
+/// Judges an MCAP held in memory (see [`super::verify_bytes`]).
+pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
+    let mut judge = Judge::default();
+    let (structure, error) = reader::read_from(bytes, bytes.len() as u64, &mut judge);
+    verdict(name.to_string(), judge, structure, error, options)
+}
+
+fn verdict(
+    shown: String,
+    mut judge: Judge,
+    structure: reader::Structure,
+    error: Option<reader::ReadError>,
+    options: &Options,
+) -> FileReport {
+    let mut problem = None;
+    if let Some(e) = &error {
+        match e.kind {
+            ReadErrorKind::Io | ReadErrorKind::NotMcap => {
+                return unusable(&shown, e.detail.clone())
+            }
+            ReadErrorKind::Stopped => {}
+            ReadErrorKind::Truncated | ReadErrorKind::Corrupt => problem = Some(e.detail.clone()),
+        }
+    }
+    let Some(mut ctx) = judge.ctx.take() else {
+        let why = judge.run_error.take().unwrap_or_else(|| {
+            let by = if judge.library.is_empty() {
+                String::new()
+            } else {
+                format!(" (written by `{}`)", judge.library)
+            };
+            format!("not a coin-log file: it has no `coin-log` metadata record before its first message{by}")
+        });
+        return unusable(
+            &shown,
+            problem.map_or(why.clone(), |p| format!("{why}; {p}")),
+        );
+    };
+    let checks = &mut judge.checks;
+    judge.assembler.finish(&mut |s| checks.observe(s, &ctx));
+    if let Some(e) = &judge.result_error {
+        judge
+            .problems
+            .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
+    }
+    if ctx.result.is_none() && error.is_none() {
+        judge.problems.push_with(|| {
+            "no `coin-log.result` metadata record (the run did not finish writing)".into()
+        });
+    }
+    let mut problems = structure.problems.clone();
+    problems.extend(&judge.problems);
+    if let Some(p) = &problem {
+        problems.push_with(|| p.clone());
+    }
+    let stats = judge.checks.stats;
+    let run = &ctx.run;
+    let tol = Tolerances::derive(
+        &RunAccuracy {
+            integrator: &run.integrator,
+            rtol: run.rtol,
+            atol: run.atol,
+            step: run.step,
+            radius: run.radius,
+            time_unit: ctx.coin.params().time_unit(),
+            span: stats.span(),
+            max_omega: stats.max_omega,
+        },
+        options.energy_tol,
+        options.residual_tol,
+    );
+    let read = format!(
+        "{} messages in {} chunks, {} samples",
+        structure.messages, structure.chunks, stats.samples
+    );
+    ctx.result = ctx.result.take();
+    let c = &judge.checks;
+    let mut results = vec![
+        integrity::finish(&problems, &read, &judge.notes),
+        c.energy.finish(&ctx, &tol),
+        c.invariants
+            .finish(&tol, ctx.chaplygin.as_ref().err().map(String::as_str)),
+        c.steady.finish(&ctx, &tol),
+        c.constraint.finish(ctx.coin.params().radius(), &tol),
+        c.consistency.finish(),
+        c.validity.finish(&ctx),
+    ];
+    require_physics(&mut results);
+    let failed = results.iter().any(|r| r.status == Status::Fail);
+    let exit_code = if problem.is_some() {
+        2
+    } else {
+        u8::from(failed)
+    };
+    FileReport {
+        path: shown,
+        exit_code,
+        checks: results,
+        problem,
+    }
+}
+
+/// CONTRACT: a file in which integrity, energy and at least one of constraint / steady could not run
+/// fails, whatever else passed. The check that could not run is turned into a failure saying so.
+fn require_physics(results: &mut [CheckResult]) {
+    let skipped = |results: &[CheckResult], id: CheckId| {
+        results
+            .iter()
+            .any(|r| r.id == id && r.status == Status::Skip)
+    };
+    let fail = |results: &mut [CheckResult], id: CheckId, why: &str| {
+        if let Some(r) = results.iter_mut().find(|r| r.id == id) {
+            r.status = Status::Fail;
+            r.reason = format!("{why}: {}", r.reason);
+        }
+    };
+    for id in [CheckId::Integrity, CheckId::Energy] {
+        if skipped(results, id) {
+            fail(results, id, "required check could not run");
+        }
+    }
+    if skipped(results, CheckId::Constraint) && skipped(results, CheckId::Steady) {
+        fail(
+            results,
+            CheckId::Constraint,
+            "neither constraint nor steady could run, so the motion is not verified",
+        );
+    }
+}

@@ -1,0 +1,54 @@
+//! `coin-log verify`: judge a stored log from the file alone (CONTRACT: verify).
+//!
+//! The parameters come from the file's `coin-log` metadata; the physics is recomputed from the stored
+//! channels, never re-simulated. The file is read once, as a stream ([`reader`]), in memory bounded by its
+//! largest record: messages are parsed into their strict types, grouped by log time into samples
+//! ([`samples`]), and each check keeps running maxima and a short window ([`checks`]). Tolerances follow
+//! from the recorded integrator settings ([`tolerances`]).
+
+pub mod checks;
+mod file;
+pub mod problems;
+pub mod reader;
+pub mod report;
+pub mod samples;
+pub mod tolerances;
+pub mod wire;
+
+pub use report::{CheckId, CheckResult, FileReport, Report, Status};
+pub use tolerances::Tolerances;
+
+use std::path::Path;
+
+/// Tolerance overrides (`--energy-tol`, `--residual-tol`); `None` keeps the derived defaults.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Options {
+    /// Energy drift tolerance (and invariant drift).
+    pub energy_tol: Option<f64>,
+    /// Constraint and steady residual tolerance.
+    pub residual_tol: Option<f64>,
+}
+
+/// Judges one file. Never fails: an unreadable file is a report with exit code 2 and the reason in
+/// [`FileReport::problem`].
+#[must_use]
+pub fn verify_file(path: &Path, options: &Options) -> FileReport {
+    file::verify_file(path, options)
+}
+
+/// Judges an MCAP file held in memory, named `name` in the report (for tests and fuzzing).
+#[must_use]
+pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
+    file::verify_bytes(name, bytes, options)
+}
+
+/// Judges several files.
+#[must_use]
+pub fn verify_files(paths: &[impl AsRef<Path>], options: &Options) -> Report {
+    Report {
+        files: paths
+            .iter()
+            .map(|p| verify_file(p.as_ref(), options))
+            .collect(),
+    }
+}

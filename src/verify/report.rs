@@ -1,0 +1,164 @@
+//! What `verify` reports: one [`CheckResult`] per check id and file, serialised exactly as CONTRACT's
+//! `--json` shape (`{"files": [{"path", "exit_code", "checks": [{"id", "status", "value", "tolerance",
+//! "reason"}]}]}`).
+
+use serde::Serialize;
+use std::fmt;
+
+/// The checks, with the contract's ids (CONTRACT: verify).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CheckId {
+    /// File structure, indexes, CRCs, statistics, schemas, message shapes and times.
+    Integrity,
+    /// Energy recomputed from the stored state; its drift and agreement with `/coin/energy`.
+    Energy,
+    /// Chaplygin–Appell integrals C1, C2 (NOTES §6).
+    Invariants,
+    /// Steady motions stay steady (NOTES §4).
+    Steady,
+    /// The rolling constraint: centre velocity from positions against a(−ω_Z e_X + ω_X e_Z).
+    Constraint,
+    /// Channels agree with each other (quaternion, contact, height, reaction).
+    Consistency,
+    /// The model is valid: N ≥ 0 and |F| ≤ μN.
+    Validity,
+}
+
+impl CheckId {
+    /// Every check, in report order.
+    pub const ALL: [CheckId; 7] = [
+        Self::Integrity,
+        Self::Energy,
+        Self::Invariants,
+        Self::Steady,
+        Self::Constraint,
+        Self::Consistency,
+        Self::Validity,
+    ];
+
+    /// The contract's id.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Integrity => "integrity",
+            Self::Energy => "energy",
+            Self::Invariants => "invariants",
+            Self::Steady => "steady",
+            Self::Constraint => "constraint",
+            Self::Consistency => "consistency",
+            Self::Validity => "validity",
+        }
+    }
+}
+
+impl fmt::Display for CheckId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Outcome of one check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Ran and the value is within tolerance.
+    Pass,
+    /// Ran and the value is outside tolerance (or the file cannot support it).
+    Fail,
+    /// Could not run; the reason says why.
+    Skip,
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Pass => "pass",
+            Self::Fail => "fail",
+            Self::Skip => "skip",
+        })
+    }
+}
+
+/// One check's result: the measured value, its tolerance, and a sentence saying what was measured.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CheckResult {
+    /// Which check.
+    pub id: CheckId,
+    /// Pass, fail or skip.
+    pub status: Status,
+    /// The measured value (dimensionless unless the reason says otherwise); `None` when skipped.
+    pub value: Option<f64>,
+    /// The tolerance it was held to.
+    pub tolerance: Option<f64>,
+    /// What was measured, where the worst case is, or why the check could not run.
+    pub reason: String,
+}
+
+impl CheckResult {
+    /// A check that ran: pass when `value ≤ tolerance`.
+    #[must_use]
+    pub fn measured(id: CheckId, value: f64, tolerance: f64, reason: String) -> Self {
+        let status = if value <= tolerance {
+            Status::Pass
+        } else {
+            Status::Fail
+        };
+        Self {
+            id,
+            status,
+            value: Some(value),
+            tolerance: Some(tolerance),
+            reason,
+        }
+    }
+
+    /// A check that could not run.
+    #[must_use]
+    pub fn skip(id: CheckId, reason: impl Into<String>) -> Self {
+        Self {
+            id,
+            status: Status::Skip,
+            value: None,
+            tolerance: None,
+            reason: reason.into(),
+        }
+    }
+}
+
+/// The verdict on one file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FileReport {
+    /// The path as given.
+    pub path: String,
+    /// 0 every check that ran passed, 1 a check failed, 2 unreadable / not MCAP / not a coin-log file.
+    pub exit_code: u8,
+    /// The checks, in [`CheckId::ALL`] order (empty when the file could not be read at all).
+    pub checks: Vec<CheckResult>,
+    /// Why the file is unusable (exit code 2), for the human output; not part of the JSON.
+    #[serde(skip)]
+    pub problem: Option<String>,
+}
+
+impl FileReport {
+    /// The result of check `id`, if it is in the report.
+    #[must_use]
+    pub fn check(&self, id: CheckId) -> Option<&CheckResult> {
+        self.checks.iter().find(|c| c.id == id)
+    }
+}
+
+/// The verdict on several files (the `--json` document).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// One entry per file, in the order given.
+    pub files: Vec<FileReport>,
+}
+
+impl Report {
+    /// The worst exit code: 2 > 1 > 0.
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        self.files.iter().map(|f| f.exit_code).max().unwrap_or(0)
+    }
+}

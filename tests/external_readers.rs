@@ -1,0 +1,110 @@
+//! Independent readers in CI (issue 6): every committed dataset and a fresh recording are read with
+//! `@mcap/core`'s indexed reader (the library Foxglove uses; `scripts/readers/check.mjs`) and with the
+//! Python `mcap` package (`scripts/readers/check.py`): all messages decoded, counts equal to the statistics,
+//! `foxglove.*` messages valid against `@foxglove/schemas`, `coin_log.*` against `schemas/`.
+//! A negative control proves the readers refuse a file that breaks the schema.
+//!
+//! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
+
+mod support;
+
+use std::path::PathBuf;
+use std::process::Command;
+use support::{record_circle, repo, Damage};
+
+fn python() -> PathBuf {
+    let p = repo().join(".venv/bin/python");
+    assert!(
+        p.exists(),
+        "{} is missing: run scripts/test (it creates the venv with the Python `mcap` and `jsonschema` packages)",
+        p.display()
+    );
+    p
+}
+
+fn node_readers() -> PathBuf {
+    let dir = repo().join("scripts/readers");
+    assert!(
+        dir.join("node_modules/@mcap/core").exists(),
+        "scripts/readers/node_modules is missing: run scripts/test (it runs `npm ci` there)"
+    );
+    dir
+}
+
+/// Runs both readers on `files`; returns (success, output) of each.
+fn run_readers(files: &[PathBuf]) -> [(bool, String); 2] {
+    let node = Command::new("node")
+        .arg(node_readers().join("check.mjs"))
+        .args(files)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("cannot run `node` ({e}): install Node.js 20 and run scripts/test")
+        });
+    let py = Command::new(python())
+        .arg(repo().join("scripts/readers/check.py"))
+        .args(files)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
+    [node, py].map(|o| {
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        (o.status.success(), text)
+    })
+}
+
+fn datasets() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(repo().join("datasets"))
+        .map(|d| {
+            d.filter_map(Result::ok)
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
+#[test]
+fn both_independent_readers_accept_every_dataset_and_a_fresh_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let fresh = dir.path().join("fresh-circle.mcap");
+    record_circle(&fresh, 3.0, Damage::None);
+    let mut files = datasets();
+    files.push(fresh);
+    let [(node_ok, node_out), (py_ok, py_out)] = run_readers(&files);
+    println!("--- @mcap/core (check.mjs)\n{node_out}--- python mcap (check.py)\n{py_out}");
+    assert!(node_ok, "@mcap/core reader refused a file:\n{node_out}");
+    assert!(py_ok, "python mcap reader refused a file:\n{py_out}");
+    for out in [&node_out, &py_out] {
+        assert!(
+            out.contains(&format!("{} passed, 0 failed", files.len())),
+            "every file checked: {out}"
+        );
+    }
+}
+
+#[test]
+fn both_readers_refuse_a_scene_entity_without_a_required_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad-scene.mcap");
+    record_circle(&bad, 1.0, Damage::SceneEntityWithoutMetadata);
+    let [(node_ok, node_out), (py_ok, py_out)] = run_readers(&[bad]);
+    println!("--- check.mjs\n{node_out}--- check.py\n{py_out}");
+    assert!(!node_ok && node_out.contains("metadata"), "{node_out}");
+    assert!(!py_ok && py_out.contains("metadata"), "{py_out}");
+}
+
+#[test]
+fn both_readers_refuse_a_coin_log_message_with_an_undeclared_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad-energy.mcap");
+    record_circle(&bad, 1.0, Damage::EnergyWithExtraField);
+    let [(node_ok, node_out), (py_ok, py_out)] = run_readers(&[bad]);
+    println!("--- check.mjs\n{node_out}--- check.py\n{py_out}");
+    assert!(!node_ok && node_out.contains("power"), "{node_out}");
+    assert!(!py_ok && py_out.contains("power"), "{py_out}");
+}

@@ -1,0 +1,284 @@
+//! `coin-log verify` on good recordings and on negative controls: each tampered file must fail the right
+//! check, by id, with the measured number in the report.
+#![allow(clippy::unwrap_used)]
+
+mod common_verify;
+
+use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status};
+use common_verify::*;
+
+fn show(r: &FileReport) -> String {
+    r.checks
+        .iter()
+        .map(|c| {
+            format!(
+                "{:<12} {:<5} value {:?} tol {:?}  {}",
+                c.id.as_str(),
+                c.status.to_string(),
+                c.value,
+                c.tolerance,
+                c.reason
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn status(r: &FileReport, id: CheckId) -> Status {
+    r.check(id).unwrap().status
+}
+
+#[test]
+fn a_recorded_wobble_passes_every_check_that_runs() {
+    let (_dir, path) = recorded(&wobble(), "wobble.mcap");
+    let r = verify_file(&path, &Options::default());
+    println!("{}", show(&r));
+    assert_eq!(r.exit_code, 0, "{}", show(&r));
+    for id in [
+        CheckId::Integrity,
+        CheckId::Energy,
+        CheckId::Constraint,
+        CheckId::Consistency,
+        CheckId::Validity,
+    ] {
+        assert_eq!(status(&r, id), Status::Pass, "{id}\n{}", show(&r));
+    }
+    assert_eq!(status(&r, CheckId::Steady), Status::Skip);
+}
+
+#[test]
+fn a_recorded_steady_circle_passes_the_steady_check() {
+    let (_dir, path) = recorded(&steady_circle(), "circle.mcap");
+    let r = verify_file(&path, &Options::default());
+    println!("{}", show(&r));
+    assert_eq!(r.exit_code, 0, "{}", show(&r));
+    assert_eq!(status(&r, CheckId::Steady), Status::Pass);
+}
+
+/// Verifies a copy of built-in scene `scene`, recorded by `coin-log record` with default settings, in which
+/// `edit` changed messages; prints the report.
+fn tampered(scene: &str, edit: impl FnMut(Edit<'_>)) -> FileReport {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), scene, &[]);
+    let clean = verify_file(&good, &Options::default());
+    assert_eq!(
+        clean.exit_code,
+        0,
+        "the untouched recording must pass\n{}",
+        show(&clean)
+    );
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&good, &bad, edit);
+    let r = verify_file(&bad, &Options::default());
+    println!("{}", show(&r));
+    r
+}
+
+fn assert_fails(r: &FileReport, id: CheckId, low: f64, high: f64) {
+    let c = r.check(id).unwrap();
+    let value = c.value.unwrap();
+    println!(
+        "{id}: measured {value:e}, tolerance {:e}, expected in [{low:e}, {high:e}]",
+        c.tolerance.unwrap()
+    );
+    assert_eq!(c.status, Status::Fail, "{}", show(r));
+    assert!(
+        (low..=high).contains(&value),
+        "{id}: measured {value:e} outside [{low:e}, {high:e}]"
+    );
+    assert_eq!(r.exit_code, 1);
+}
+
+#[test]
+fn verify_flags_a_log_with_one_energy_message_nudged_by_1e_6() {
+    let r = tampered("wobble", |e| {
+        if e.topic == "/coin/energy" && e.index == 500 {
+            let total: f64 = serde_json::from_slice::<serde_json::Value>(e.data).unwrap()["total"]
+                .as_f64()
+                .unwrap();
+            nudge(e.data, "total", 1e-6 * total);
+        }
+    });
+    // 1e-6 of E relative to max(|E0|, Mga) = |E0|: 1e-6.
+    assert_fails(&r, CheckId::Energy, 0.9e-6, 1.1e-6);
+}
+
+#[test]
+fn verify_flags_a_log_with_one_position_moved_by_1e_4() {
+    let r = tampered("wobble", |e| {
+        if e.topic == "/coin/position" && e.index == 500 {
+            nudge(e.data, "x", 1e-4);
+        }
+    });
+    // The nearest weight 4/5 divides by h = 0.01: 8e-3 relative to a·max|ω| ≈ 1.6.
+    assert_fails(&r, CheckId::Constraint, 2e-3, 1e-2);
+}
+
+#[test]
+fn verify_flags_a_log_with_one_omega_sample_changed_by_1e_5() {
+    let r = tampered("wobble", |e| {
+        if e.topic == "/coin/omega" && e.index == 500 {
+            nudge(e.data, "z", 1e-5);
+        }
+    });
+    // δE ≈ (Ma² + I_Z) ω_Z δω_Z = 1.5e-5 ω_Z, relative to E0 ≈ 2.6 (ω_Z ≈ 1.5).
+    assert_fails(&r, CheckId::Energy, 1e-6, 1e-5);
+    assert_eq!(r.check(CheckId::Constraint).unwrap().status, Status::Fail);
+}
+
+#[test]
+fn verify_flags_a_steady_log_with_theta_shifted_by_1e_5_throughout() {
+    let r = tampered("circle-plus", |e| {
+        if e.topic == "/coin/angles" {
+            nudge(e.data, "theta", 1e-5);
+        }
+    });
+    assert_fails(&r, CheckId::Steady, 0.9e-5, 1e-4);
+}
+
+#[test]
+fn negative_control_numbers_appear_in_the_json_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), "wobble", &[]);
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&good, &bad, |e| {
+        if e.topic == "/coin/position" && e.index == 500 {
+            nudge(e.data, "x", 1e-4);
+        }
+    });
+    let (code, stdout, stderr) = coin_log(&["verify", "--json", bad.to_str().unwrap()]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let checks = v["files"][0]["checks"].as_array().unwrap();
+    let c = checks.iter().find(|c| c["id"] == "constraint").unwrap();
+    println!("{c}");
+    assert_eq!(c["status"], "fail");
+    assert!(c["value"].as_f64().unwrap() > 1e-3);
+    assert_eq!(v["files"][0]["exit_code"], 1);
+}
+
+#[test]
+fn a_log_on_which_no_physics_check_can_run_fails() {
+    let spec = Spec {
+        channels: vec![coin_log::record::Channel::Energy],
+        ..wobble()
+    };
+    let (_dir, path) = recorded(&spec, "energy-only.mcap");
+    let r = verify_file(&path, &Options::default());
+    println!("{}", show(&r));
+    assert_eq!(r.exit_code, 1);
+    let energy = r.check(CheckId::Energy).unwrap();
+    assert_eq!(energy.status, Status::Fail);
+    assert!(energy.reason.starts_with("required check could not run"));
+    let constraint = r.check(CheckId::Constraint).unwrap();
+    assert_eq!(constraint.status, Status::Fail);
+}
+
+#[test]
+fn the_json_output_has_exactly_the_contract_fields() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "wobble", &[]);
+    let (code, stdout, _) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let keys = |v: &serde_json::Value| {
+        let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+        k.sort();
+        k
+    };
+    assert_eq!(keys(&v), ["files"]);
+    assert_eq!(keys(&v["files"][0]), ["checks", "exit_code", "path"]);
+    let ids: Vec<&str> = v["files"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            assert_eq!(keys(c), ["id", "reason", "status", "tolerance", "value"]);
+            c["id"].as_str().unwrap()
+        })
+        .collect();
+    assert_eq!(
+        ids,
+        [
+            "integrity",
+            "energy",
+            "invariants",
+            "steady",
+            "constraint",
+            "consistency",
+            "validity"
+        ]
+    );
+}
+
+#[test]
+fn every_built_in_scene_recorded_with_default_settings_verifies() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = scene_names();
+    assert!(names.len() >= 10, "scenes: {names:?}");
+    for name in &names {
+        let path = record_scene(dir.path(), name, &[]);
+        let r = verify_file(&path, &Options::default());
+        println!("{name}:\n{}", show(&r));
+        assert_eq!(r.exit_code, 0, "{name}\n{}", show(&r));
+    }
+}
+
+/// `high-spin` (ω_Z = 50) recorded at 100 samples per unit instead of its 1000: h·|ω| = 0.5, the
+/// constraint's finite difference does not resolve the motion, and verify must fail the file (no motion
+/// check ran) rather than pass it.
+#[test]
+fn an_undersampled_recording_fails_because_no_motion_check_can_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "high-spin", &["--rate", "100"]);
+    let r = verify_file(&path, &Options::default());
+    println!("high-spin at rate 100:\n{}", show(&r));
+    assert_eq!(r.exit_code, 1, "{}", show(&r));
+    let c = r.check(CheckId::Constraint).unwrap();
+    assert!(
+        c.reason
+            .contains("the sampling does not resolve the motion"),
+        "{}",
+        c.reason
+    );
+}
+
+#[test]
+fn recordings_by_every_integrator_pass_at_default_tolerances() {
+    for &method in coin_log::integrate::Method::ALL {
+        for (name, spec) in [("wobble", wobble()), ("circle", steady_circle())] {
+            let spec = Spec { method, ..spec };
+            let (_dir, path) = recorded(&spec, "run.mcap");
+            let r = verify_file(&path, &Options::default());
+            println!("{method} {name}:\n{}", show(&r));
+            assert_eq!(r.exit_code, 0, "{method} {name}\n{}", show(&r));
+        }
+    }
+}
+
+/// Writes a long recording for measuring `verify` by hand (not a timed test):
+/// `VERIFY_LONG=/tmp/long.mcap cargo test --release --test verify -- --ignored write_a_long_recording`,
+/// then `/usr/bin/time -v target/release/coin-log verify /tmp/long.mcap`.
+#[test]
+#[ignore = "writes a large file for manual throughput measurement"]
+fn write_a_long_recording() {
+    let path = std::env::var("VERIFY_LONG").unwrap_or_else(|_| "/tmp/long.mcap".into());
+    let duration: f64 = std::env::var("VERIFY_LONG_DURATION")
+        .ok()
+        .and_then(|d| d.parse().ok())
+        .unwrap_or(1000.0);
+    let compression = match std::env::var("VERIFY_LONG_COMPRESSION").as_deref() {
+        Ok("none") => None,
+        Ok("lz4") => Some(mcap::Compression::Lz4),
+        _ => Some(mcap::Compression::Zstd),
+    };
+    let spec = Spec {
+        duration,
+        rate: 1000.0,
+        compression,
+        ..wobble()
+    };
+    record(&spec, std::path::Path::new(&path));
+    let r = verify_file(std::path::Path::new(&path), &Options::default());
+    println!("{}", show(&r));
+}

@@ -1,0 +1,377 @@
+//! `coin-log verify` on broken input: each case builds the broken file and asserts the exact exit code and
+//! message. Unreadable, not MCAP, not coin-log, truncated or corrupt: exit 2 and a clear message, never a
+//! panic; a readable file with a defect in its content (non-monotonic times, a malformed message): exit 1.
+
+#![allow(clippy::unwrap_used)]
+
+mod common_verify;
+
+use common_verify::*;
+use std::path::Path;
+
+/// The top-level records of an MCAP file: (opcode, offset, body length).
+fn records(bytes: &[u8]) -> Vec<(u8, usize, usize)> {
+    let mut out = Vec::new();
+    let mut at = 8;
+    while at + 9 <= bytes.len() - 8 {
+        let op = bytes[at];
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        out.push((op, at, len));
+        at += 9 + len;
+    }
+    out
+}
+
+/// CRC-32 (IEEE), as MCAP uses.
+fn crc32(data: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in data {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+fn verify(path: &Path) -> (i32, String, String) {
+    coin_log(&["verify", path.to_str().unwrap()])
+}
+
+fn small_chunks(compression: Option<mcap::Compression>) -> Spec {
+    Spec {
+        chunk_size: Some(16 * 1024),
+        compression,
+        ..wobble()
+    }
+}
+
+#[test]
+fn a_missing_file_is_unreadable() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("nope.mcap");
+    let (code, _, err) = verify(&path);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: cannot read: No such file or directory (os error 2)",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn a_directory_is_not_an_mcap_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, _, err) = verify(dir.path());
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: is a directory, not an MCAP file",
+            dir.path().display()
+        )
+    );
+}
+
+#[test]
+fn an_empty_file_is_not_an_mcap_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("empty.mcap");
+    std::fs::write(&path, b"").unwrap();
+    let (code, _, err) = verify(&path);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: empty file (0 bytes), not an MCAP file",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn a_text_file_is_not_an_mcap_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("notes.mcap");
+    std::fs::write(&path, b"these are notes, not a recording\n").unwrap();
+    let (code, _, err) = verify(&path);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: not an MCAP file (it does not start with the MCAP magic bytes)",
+            path.display()
+        )
+    );
+    std::fs::write(&path, b"abc").unwrap();
+    let (code, _, err) = verify(&path);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: not an MCAP file (3 bytes, shorter than an MCAP header)",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn an_mcap_from_another_tool_is_not_a_coin_log_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("other.mcap");
+    let mut w = mcap::WriteOptions::new()
+        .library("other-tool")
+        .create(std::io::BufWriter::new(
+            std::fs::File::create(&path).unwrap(),
+        ))
+        .unwrap();
+    let ch = w
+        .add_channel(0, "/foo", "json", &std::collections::BTreeMap::new())
+        .unwrap();
+    w.write_to_known_channel(
+        &mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: 0,
+            publish_time: 0,
+        },
+        b"{}",
+    )
+    .unwrap();
+    w.finish().unwrap();
+    drop(w);
+    let (code, _, err) = verify(&path);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: not a coin-log file: it has no `coin-log` metadata record before its first message (written by `other-tool`)",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn a_truncated_file_is_judged_on_its_readable_messages_and_is_unusable() {
+    let (dir, good) = recorded(&small_chunks(Some(mcap::Compression::Zstd)), "good.mcap");
+    let bytes = std::fs::read(&good).unwrap();
+    let cut = bytes.len() / 2;
+    let path = dir.path().join("truncated.mcap");
+    std::fs::write(&path, &bytes[..cut]).unwrap();
+    let recs = records(&bytes);
+    let (_, inside, _) = *recs
+        .iter()
+        .find(|(_, at, len)| *at < cut && at + 9 + len > cut)
+        .unwrap();
+    let (code, out, err) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    println!("{err}");
+    assert_eq!(code, 2);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let file = &v["files"][0];
+    let energy = file["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"] == "energy")
+        .unwrap();
+    assert_eq!(energy["status"], "pass", "{energy}");
+    let integrity = file["checks"].as_array().unwrap()[0].clone();
+    assert_eq!(integrity["status"], "fail");
+    let prefix = format!(
+        "error: {}: truncated: the file ends at byte {cut} inside the record that starts at byte {inside}, before the MCAP footer; judged the ",
+        path.display()
+    );
+    assert!(err.starts_with(&prefix), "{err}\nexpected prefix {prefix}");
+    let n: u64 = err[prefix.len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(n > 1000 && n < 8008, "judged {n} messages");
+    assert!(err.trim_end().ends_with("messages read before it"));
+}
+
+#[test]
+fn a_flipped_byte_in_an_uncompressed_chunk_fails_its_crc() {
+    let (dir, good) = recorded(&small_chunks(None), "good.mcap");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let (_, chunk, _) = *records(&bytes).iter().find(|r| r.0 == 0x06).unwrap();
+    // The digit of the first message's "t":0 inside the chunk.
+    let at = chunk
+        + bytes[chunk..]
+            .windows(5)
+            .position(|w| w == b"{\"t\":")
+            .unwrap()
+        + 5;
+    bytes[at] ^= 0x01;
+    let path = dir.path().join("flipped.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let (code, _, err) = verify(&path);
+    println!("{err}");
+    assert_eq!(code, 2);
+    let prefix = format!(
+        "error: {}: corrupt chunk at byte {chunk}: CRC 0x",
+        path.display()
+    );
+    assert!(err.starts_with(&prefix), "{err}");
+    assert!(
+        err.contains("of its records does not match the stored 0x"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_flipped_byte_in_a_compressed_chunk_is_reported_with_the_chunk_offset() {
+    let (dir, good) = recorded(&small_chunks(Some(mcap::Compression::Zstd)), "good.mcap");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let (_, chunk, len) = *records(&bytes).iter().find(|r| r.0 == 0x06).unwrap();
+    bytes[chunk + 9 + len / 2] ^= 0x40;
+    let path = dir.path().join("flipped.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let (code, _, err) = verify(&path);
+    println!("{err}");
+    assert_eq!(code, 2);
+    let prefix = format!("error: {}: corrupt chunk at byte {chunk}: ", path.display());
+    assert!(err.starts_with(&prefix), "{err}");
+}
+
+#[test]
+fn a_flipped_byte_in_the_summary_fails_its_crc() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let (_, stats, _) = *records(&bytes).iter().find(|r| r.0 == 0x0B).unwrap();
+    bytes[stats + 9] ^= 0x01; // message_count
+    let path = dir.path().join("flipped.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let (code, _, err) = verify(&path);
+    println!("{err}");
+    assert_eq!(code, 2);
+    let prefix = format!("error: {}: corrupt summary section: CRC 0x", path.display());
+    assert!(err.starts_with(&prefix), "{err}");
+    assert!(
+        err.trim_end().ends_with("judged the 8008 messages read"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_summary_record_claiming_a_huge_length_is_refused_without_allocating_it() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let len = bytes.len();
+    let (op, first, _) = *records(&bytes)
+        .iter()
+        .skip_while(|r| r.0 != 0x0F)
+        .nth(1)
+        .unwrap();
+    bytes[first + 1..first + 9].copy_from_slice(&(1u64 << 60).to_le_bytes());
+    let path = dir.path().join("huge.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let (code, _, err) = verify(&path);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        format!(
+            "error: {}: record (opcode {op:#04x}) at byte {first} claims 1152921504606846976 bytes, more than the file's {len}: the file is corrupt or crafted; judged the 8008 messages read before it",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn a_summary_with_huge_counts_and_sizes_but_a_valid_crc_fails_integrity_only() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let recs = records(&bytes);
+    let (_, index, _) = *recs.iter().find(|r| r.0 == 0x08).unwrap();
+    // chunk_length and message_count claim 2^62.
+    bytes[index + 9 + 24..index + 9 + 32].copy_from_slice(&(1u64 << 62).to_le_bytes());
+    let (_, stats, _) = *recs.iter().find(|r| r.0 == 0x0B).unwrap();
+    bytes[stats + 9..stats + 17].copy_from_slice(&(1u64 << 62).to_le_bytes());
+    // Re-sign the summary so that only the claims are wrong.
+    let footer = bytes.len() - 8 - 29;
+    let summary_start =
+        u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap()) as usize;
+    let crc = crc32(&bytes[summary_start..footer + 9 + 16]);
+    bytes[footer + 9 + 16..footer + 9 + 20].copy_from_slice(&crc.to_le_bytes());
+    let path = dir.path().join("claims.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let (code, out, err) = verify(&path);
+    println!("{out}{err}");
+    assert_eq!(code, 1);
+    assert!(
+        out.contains("statistics: message_count = 4611686018427387904, the file has 8008"),
+        "{out}"
+    );
+    assert!(
+        out.contains("chunk indexes do not match the chunks"),
+        "{out}"
+    );
+}
+
+#[test]
+fn non_monotonic_log_times_fail_integrity() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let path = dir.path().join("backwards.mcap");
+    rewrite(&good, &path, |e| {
+        if e.topic == "/coin/omega" && e.index == 11 {
+            *e.log_time = 90_000_000;
+        }
+    });
+    let (code, out, err) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let integrity = &v["files"][0]["checks"][0];
+    println!("{integrity}");
+    assert_eq!(integrity["id"], "integrity");
+    assert_eq!(integrity["status"], "fail");
+    let reason = integrity["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("/coin/omega: log times not increasing: 90000000 ns after 100000000 ns"),
+        "{reason}"
+    );
+    assert!(
+        reason.contains(
+            "/coin/omega: log_time 90000000 ns is not round(t·1e9) = 110000000 ns for t = 0.11"
+        ),
+        "{reason}"
+    );
+}
+
+#[test]
+fn a_message_with_an_unknown_field_fails_integrity() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let path = dir.path().join("extra.mcap");
+    rewrite(&good, &path, |e| {
+        if e.topic == "/coin/energy" && e.index == 3 {
+            e.data.pop();
+            e.data.extend_from_slice(b",\"extra\":1}");
+        }
+    });
+    let (code, out, _) = verify(&path);
+    println!("{out}");
+    assert_eq!(code, 1);
+    assert!(
+        out.contains("/coin/energy: message at 30000000 ns does not parse: unknown field `extra`"),
+        "{out}"
+    );
+}
+
+#[test]
+fn several_files_exit_with_the_worst_code() {
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let empty = dir.path().join("empty.mcap");
+    std::fs::write(&empty, b"").unwrap();
+    let (code, out, _) = coin_log(&["verify", good.to_str().unwrap(), empty.to_str().unwrap()]);
+    println!("{out}");
+    assert_eq!(code, 2);
+    let (code, _, _) = coin_log(&["verify", good.to_str().unwrap()]);
+    assert_eq!(code, 0);
+}
