@@ -1,11 +1,12 @@
 //! The compression bound of issue 9: the time one thread takes to zstd-compress the bytes of a recording,
 //! chunk by chunk as `record::writer` does, and the JSON payloads alone in pieces of the same size.
 //!
-//! `cargo run --release --example compression_bound -- FILE.mcap [LEVEL...]` (default: the writer's level).
-//! Prints, per level, the median of 5 passes: seconds, MB/s, messages/s and the compressed size.
+//! `cargo run --release --example compression_bound -- FILE.mcap [LEVEL...]`. Prints the median of 5 passes
+//! (seconds, MB/s, messages/s, compressed size) for the writer's own `ChunkCompressor` (zstd at its level,
+//! lz4, none: what a recording costs to compress), then for each zstd LEVEL given.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use coin_log::record::writer::{DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
+use coin_log::record::writer::{ChunkCompression, ChunkCompressor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
 use mcap::records::Record;
 use std::io::Read;
 use std::time::Instant;
@@ -17,10 +18,7 @@ fn main() {
     let path = args
         .next()
         .expect("usage: compression_bound FILE.mcap [LEVEL...]");
-    let mut levels: Vec<i32> = args.map(|a| a.parse().expect("a zstd level")).collect();
-    if levels.is_empty() {
-        levels.push(ZSTD_LEVEL);
-    }
+    let levels: Vec<i32> = args.map(|a| a.parse().expect("a zstd level")).collect();
     let bytes = std::fs::read(&path).unwrap();
 
     // The uncompressed records of every chunk, as the writer handed them to its worker.
@@ -58,26 +56,66 @@ fn main() {
         chunks.len(),
         payloads.len()
     );
+    let report = |what: &str, seconds: f64, len: usize, compressed: usize| {
+        #[allow(clippy::cast_precision_loss)]
+        let (mb, msgs, ratio) = (
+            len as f64 / seconds / 1e6,
+            messages as f64 / seconds / 1e6,
+            len as f64 / compressed.max(1) as f64,
+        );
+        println!("{what}: {seconds:.3} s, {mb:.0} MB/s, {msgs:.2} M messages/s, {compressed} bytes ({ratio:.2}x)");
+    };
+    for compression in [
+        ChunkCompression::Zstd,
+        ChunkCompression::Lz4,
+        ChunkCompression::None,
+    ] {
+        let mut compressor = ChunkCompressor::new(compression);
+        let (seconds, compressed) = median_pass(&chunk_refs, |piece, out| {
+            compressor.compress(piece, out).unwrap();
+            crc32fast::hash(piece);
+            if out.is_empty() {
+                piece.len() // stored as is
+            } else {
+                out.len()
+            }
+        });
+        let name = match compression {
+            ChunkCompression::Zstd => format!("zstd level {ZSTD_LEVEL}"),
+            other => format!("{other:?}").to_lowercase(),
+        };
+        report(
+            &format!("writer's {name} + CRC, chunk records"),
+            seconds,
+            records_len,
+            compressed,
+        );
+    }
     for level in levels {
+        let mut compressor = zstd::bulk::Compressor::new(level).unwrap();
         for (what, input, len) in [
             ("chunk records", &chunk_refs, records_len),
             ("JSON payloads", &pieces, payloads.len()),
         ] {
-            let (seconds, compressed) = time_compression(input, level);
-            #[allow(clippy::cast_precision_loss)]
-            let (mb, msgs) = (len as f64 / seconds / 1e6, messages as f64 / seconds);
-            println!(
-                "zstd level {level:>2}, {what}: {seconds:.3} s, {mb:.0} MB/s, {:.2} M messages/s, {compressed} bytes ({:.2}x)",
-                msgs / 1e6,
-                len as f64 / compressed as f64
+            let (seconds, compressed) = median_pass(input, |piece, out| {
+                out.reserve(zstd::compress_bound(piece.len()));
+                compressor.compress_to_buffer(piece, out).unwrap()
+            });
+            report(
+                &format!("zstd level {level:>2}, {what}"),
+                seconds,
+                len,
+                compressed,
             );
         }
     }
 }
 
-/// Median seconds of `PASSES` single-threaded passes, and the compressed size.
-fn time_compression(input: &[&[u8]], level: i32) -> (f64, usize) {
-    let mut compressor = zstd::bulk::Compressor::new(level).unwrap();
+/// Median seconds of `PASSES` single-threaded passes of `compress` over `input`, and the compressed size.
+fn median_pass(
+    input: &[&[u8]],
+    mut compress: impl FnMut(&[u8], &mut Vec<u8>) -> usize,
+) -> (f64, usize) {
     let mut out = Vec::new();
     let mut times = Vec::new();
     let mut compressed = 0;
@@ -86,8 +124,7 @@ fn time_compression(input: &[&[u8]], level: i32) -> (f64, usize) {
         let start = Instant::now();
         for piece in input {
             out.clear();
-            out.reserve(zstd::compress_bound(piece.len()));
-            compressed += compressor.compress_to_buffer(piece, &mut out).unwrap();
+            compressed += compress(piece, &mut out);
         }
         times.push(start.elapsed().as_secs_f64());
     }

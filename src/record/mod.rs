@@ -19,4 +19,4 @@ pub use recorder::{
     COMPRESSION_THREADS,
 };
 pub use summary::{Failure, RecordSummary, Termination};
-pub use writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
+pub use writer::{ChunkCompression, ChunkCompressor, McapWriter, WriteError, WriterOptions};

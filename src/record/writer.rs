@@ -319,46 +319,63 @@ impl Drop for Workers {
 
 /// A worker's loop: compress each chunk it is sent, send it back, until either channel closes.
 fn compress_chunks(compression: ChunkCompression, jobs: &Receiver<Job>, done: &Sender<Done>) {
-    let mut zstd = None;
+    let mut compressor = ChunkCompressor::new(compression);
     while let Ok(mut job) = jobs.recv() {
         let crc = crc32fast::hash(&job.records);
-        let result = compress(compression, &mut zstd, &job.records, &mut job.compressed);
+        let result = compressor.compress(&job.records, &mut job.compressed);
         if done.send(Done { job, crc, result }).is_err() {
             break;
         }
     }
 }
 
-/// Compresses `records` into `out` in one call.
-fn compress(
+/// Compresses whole chunks exactly as the writer's workers do (one call per chunk, one thread), so that
+/// a benchmark can time the compression bound on the same code.
+pub struct ChunkCompressor {
     compression: ChunkCompression,
-    zstd: &mut Option<zstd::bulk::Compressor<'static>>,
-    records: &[u8],
-    out: &mut Vec<u8>,
-) -> io::Result<()> {
-    out.clear();
-    match compression {
-        ChunkCompression::None => Ok(()),
-        ChunkCompression::Zstd => {
-            let compressor = match zstd {
-                Some(c) => c,
-                None => zstd.insert(zstd::bulk::Compressor::new(ZSTD_LEVEL)?),
-            };
-            out.reserve(zstd::compress_bound(records.len()));
-            compressor.compress_to_buffer(records, out)?;
-            Ok(())
+    /// Created at the first zstd chunk and kept: its context is reused from chunk to chunk.
+    zstd: Option<zstd::bulk::Compressor<'static>>,
+}
+
+impl ChunkCompressor {
+    /// A compressor for `compression`.
+    #[must_use]
+    pub fn new(compression: ChunkCompression) -> Self {
+        Self {
+            compression,
+            zstd: None,
         }
-        ChunkCompression::Lz4 => {
-            // The same frame parameters as the `mcap` crate's lz4 chunks: no block checksums (the chunk
-            // CRC covers the data), lz4's defaults otherwise.
-            let mut encoder = lz4::EncoderBuilder::new()
-                .level(LZ4_LEVEL)
-                .block_checksum(lz4::liblz4::BlockChecksum::NoBlockChecksum)
-                .build(mem::take(out))?;
-            encoder.write_all(records)?;
-            let (buffer, result) = encoder.finish();
-            *out = buffer;
-            result
+    }
+
+    /// Replaces `out` with the compressed `records` (leaves it empty for [`ChunkCompression::None`]).
+    ///
+    /// # Errors
+    /// The compressor's error (in practice only when out of memory).
+    pub fn compress(&mut self, records: &[u8], out: &mut Vec<u8>) -> io::Result<()> {
+        out.clear();
+        match self.compression {
+            ChunkCompression::None => Ok(()),
+            ChunkCompression::Zstd => {
+                let compressor = match &mut self.zstd {
+                    Some(c) => c,
+                    None => self.zstd.insert(zstd::bulk::Compressor::new(ZSTD_LEVEL)?),
+                };
+                out.reserve(zstd::compress_bound(records.len()));
+                compressor.compress_to_buffer(records, out)?;
+                Ok(())
+            }
+            ChunkCompression::Lz4 => {
+                // The same frame parameters as the `mcap` crate's lz4 chunks: no block checksums (the
+                // chunk CRC covers the data), lz4's defaults otherwise.
+                let mut encoder = lz4::EncoderBuilder::new()
+                    .level(LZ4_LEVEL)
+                    .block_checksum(lz4::liblz4::BlockChecksum::NoBlockChecksum)
+                    .build(mem::take(out))?;
+                encoder.write_all(records)?;
+                let (buffer, result) = encoder.finish();
+                *out = buffer;
+                result
+            }
         }
     }
 }
