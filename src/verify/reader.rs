@@ -1,7 +1,7 @@
 //! The streaming MCAP reader of `verify`: one pass over the file in memory bounded by the largest record
 //! (never by the file's length).
 //!
-//! Reading is a two-thread pipeline ([`super::prefetch`]): a worker runs the mcap crate's sans-io
+//! Reading is a two-thread pipeline (the private `prefetch` module): a worker runs the mcap crate's sans-io
 //! `LinearReader` over the file (chunks whole, so that file offsets are known), feeds each chunk to a
 //! second reader that decompresses it and checks its CRC, and hands the records over in batches; this
 //! thread walks them in file order. Along the way it keeps what the structural checks need as running
