@@ -346,18 +346,19 @@ impl Visitor for Judge {
                 .push_with(|| format!("{topic}: publish_time {p} differs from log_time {lt}"));
         }
         if let Some(last) = channel.last {
-            // A coin sample has one message per channel; Foxglove channels may carry several messages at
-            // one time (`/tf` publishes world → table and table → coin together at t = 0).
-            let repeats_allowed = channel.kind == Kind::Foxglove;
-            if lt < last || (lt == last && !repeats_allowed) {
+            // One coin_log message per sample: strictly increasing. /tf and /scene may carry several
+            // messages at one time (the static world → table transform and the coin's at t = 0).
+            let strict = matches!(channel.kind, Kind::Coin(_));
+            if lt < last || (strict && lt == last) {
                 let topic = channel.topic.clone();
-                let what = if repeats_allowed {
-                    "decreasing"
+                let what = if strict {
+                    "increasing"
                 } else {
-                    "not increasing"
+                    "non-decreasing"
                 };
-                self.problems
-                    .push_with(|| format!("{topic}: log times {what}: {lt} ns after {last} ns"));
+                self.problems.push_with(|| {
+                    format!("{topic}: log times not {what}: {lt} ns after {last} ns")
+                });
             }
         }
         channel.last = Some(lt);
