@@ -8,6 +8,7 @@
 
 pub mod checks;
 mod file;
+mod json;
 mod prefetch;
 pub mod problems;
 pub mod reader;

@@ -24,7 +24,7 @@ const MIN_CHUNK_RECORD_LIMIT: usize = 1 << 24;
 /// A batch is handed over once it holds this many bytes (about one decompressed chunk).
 pub const BATCH_BYTES: usize = 1 << 20;
 /// Batches in flight between the threads: enough to keep both busy, few enough to bound memory.
-pub const QUEUE: usize = 2;
+pub const QUEUE: usize = 4;
 
 /// One step of the read, in file order.
 #[derive(Debug)]
