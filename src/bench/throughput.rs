@@ -56,9 +56,9 @@ pub const INTEGRATION_ERROR: f64 = 1e-10;
 /// atol values tried for the integration workload, loosest first (rtol = min(1e3·atol, 1e-3)).
 const INTEGRATION_ATOLS: [f64; 7] = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14];
 /// RHS evaluations per timed repeat.
-const RHS_EVALUATIONS: u32 = 2_000_000;
+pub const RHS_EVALUATIONS: u32 = 2_000_000;
 /// Timed integration runs per repeat (one run lasts well under a millisecond).
-const INTEGRATION_RUNS: u32 = 200;
+pub const INTEGRATION_RUNS: u32 = 200;
 
 /// Targets of issue 9.
 pub mod targets {
