@@ -7,6 +7,7 @@ pub mod messages;
 pub mod metadata;
 pub mod recorder;
 pub mod summary;
+pub mod writer;
 
 pub use channels::{schema_bytes, Channel, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING};
 pub use foxglove::{Foxglove3d, FoxgloveBatch};
@@ -18,3 +19,4 @@ pub use recorder::{
     COMPRESSION_THREADS,
 };
 pub use summary::{Failure, RecordSummary, Termination};
+pub use writer::{ChunkCompression, ChunkCompressor, McapWriter, WriteError, WriterOptions};

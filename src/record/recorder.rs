@@ -2,9 +2,10 @@
 //! Channels, Metadata records).
 //!
 //! The file is chunked (zstd by default), indexed, with statistics, summary offsets and CRCs; the `coin-log`
-//! metadata record comes before the first message and `coin-log.result` after the last. Nothing in it
-//! depends on the machine: the zstd worker count is pinned to [`COMPRESSION_THREADS`], there are no
-//! timestamps, and channels are registered in the order of their first message.
+//! metadata record comes before the first message and `coin-log.result` after the last. It is written by
+//! [`McapWriter`], which compresses chunks on [`COMPRESSION_THREADS`] worker threads while this thread
+//! integrates. Nothing in it depends on the machine: the bytes do not depend on the worker count or on
+//! timing, there are no timestamps, and channels are registered in the order of their first message.
 //!
 //! Hot path (issue 9): per sample only the requested quantities are computed; each message is formatted
 //! into one reused buffer and written with a precomputed channel id. Samples are written one sample late
@@ -20,6 +21,7 @@ use super::metadata::{
     ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use super::summary::{Failure, RecordSummary, Termination};
+use super::writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::integrate::{run_method, Flow, RunSettings, Termination as RunEnd};
 use crate::model::{
     centre, contact_point, energy, orientation, reaction, Chaplygin, Coin, InvariantsError, State,
@@ -34,9 +36,9 @@ use std::io::{Seek, Write};
 use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// zstd worker threads, pinned so that the bytes never depend on the machine's core count. One worker
-/// lets compression of a chunk overlap with the simulation on the calling thread.
-pub const COMPRESSION_THREADS: u32 = 1;
+/// Chunk compression worker threads. One worker lets compression of a chunk overlap with the simulation
+/// on the calling thread (the machine the targets are set on has 2 cores); the bytes do not depend on it.
+pub const COMPRESSION_THREADS: usize = 1;
 
 /// How often (in samples) `progress` is called: rare enough to cost nothing, often enough for a bar.
 const PROGRESS_INTERVAL: u64 = 4096;
@@ -44,7 +46,7 @@ const PROGRESS_INTERVAL: u64 = 4096;
 /// Chunk compression (`--compression`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Compression {
-    /// zstd at its default level (the default).
+    /// zstd at [`super::writer::ZSTD_LEVEL`] (the default).
     #[default]
     Zstd,
     /// lz4.
@@ -67,11 +69,11 @@ impl Compression {
         }
     }
 
-    fn to_mcap(self) -> Option<mcap::Compression> {
+    fn to_chunk(self) -> ChunkCompression {
         match self {
-            Self::Zstd => Some(mcap::Compression::Zstd),
-            Self::Lz4 => Some(mcap::Compression::Lz4),
-            Self::None => None,
+            Self::Zstd => ChunkCompression::Zstd,
+            Self::Lz4 => ChunkCompression::Lz4,
+            Self::None => ChunkCompression::None,
         }
     }
 }
@@ -105,7 +107,7 @@ pub struct RecordOptions {
 pub enum RecordError {
     /// The MCAP writer failed (usually an I/O error: disk full, file gone).
     #[error("writing the MCAP file failed")]
-    Write(#[from] mcap::McapError),
+    Write(#[from] WriteError),
     /// Flushing the finished file failed.
     #[error("writing the MCAP file failed")]
     Io(#[from] std::io::Error),
@@ -114,22 +116,17 @@ pub enum RecordError {
     Invariants(#[from] InvariantsError),
 }
 
-/// The `mcap` writer options of every coin-log file.
+/// The writer options of every coin-log file (chunked, indexed, statistics, summary offsets and CRCs are
+/// always on in [`McapWriter`]).
 #[must_use]
-pub fn write_options(options: &RecordOptions) -> mcap::WriteOptions {
-    mcap::WriteOptions::new()
-        .compression(options.compression.to_mcap())
-        .compression_threads(COMPRESSION_THREADS)
-        .library(format!("coin-log/{}", env!("CARGO_PKG_VERSION")))
-        .use_chunks(true)
-        .emit_statistics(true)
-        .emit_summary_offsets(true)
-        .emit_message_indexes(true)
-        .emit_chunk_indexes(true)
-        .emit_metadata_indexes(true)
-        .calculate_chunk_crcs(true)
-        .calculate_data_section_crc(true)
-        .calculate_summary_section_crc(true)
+pub fn write_options(options: &RecordOptions) -> WriterOptions {
+    WriterOptions {
+        workers: COMPRESSION_THREADS,
+        ..WriterOptions::new(
+            options.compression.to_chunk(),
+            format!("coin-log/{}", env!("CARGO_PKG_VERSION")),
+        )
+    }
 }
 
 /// The `coin-log` metadata record of a scene.
@@ -163,12 +160,12 @@ pub fn run_metadata(scene: &Scene) -> RunMetadata {
 
 /// Why writing a sample stopped the run.
 enum SampleError {
-    Write(mcap::McapError),
+    Write(WriteError),
     Failure(Failure),
 }
 
-impl From<mcap::McapError> for SampleError {
-    fn from(e: mcap::McapError) -> Self {
+impl From<WriteError> for SampleError {
+    fn from(e: WriteError) -> Self {
         Self::Write(e)
     }
 }
@@ -185,7 +182,7 @@ impl From<TimeError> for SampleError {
 
 /// The writer with its channels: registers a channel at its first message, numbers messages per channel.
 struct Output<W: Write + Seek> {
-    writer: mcap::Writer<W>,
+    writer: McapWriter<W>,
     ids: [Option<u16>; Channel::ALL.len()],
     sequence: [u32; Channel::ALL.len()],
     messages: u64,
@@ -199,20 +196,16 @@ impl<W: Write + Seek> Output<W> {
             Some(id) => id,
             None => self.register(channel)?,
         };
-        let header = mcap::records::MessageHeader {
-            channel_id,
-            sequence: self.sequence[index],
-            log_time,
-            publish_time: log_time,
-        };
-        self.sequence[index] = self.sequence[index].wrapping_add(1);
-        self.writer.write_to_known_channel(&header, data)?;
+        let sequence = self.sequence[index];
+        self.sequence[index] = sequence.wrapping_add(1);
+        self.writer
+            .write_message(channel_id, sequence, log_time, log_time, data)?;
         self.messages += 1;
         Ok(())
     }
 
     #[cold]
-    fn register(&mut self, channel: Channel) -> Result<u16, mcap::McapError> {
+    fn register(&mut self, channel: Channel) -> Result<u16, WriteError> {
         let schema_name = channel.schema_name();
         // Every channel's schema is one of the embedded files (a test checks it).
         let data = schema_bytes(schema_name).unwrap_or_default();
@@ -440,11 +433,8 @@ pub fn record<W: Write + Seek>(
     } else {
         None
     };
-    let mut writer = write_options(options).create(writer)?;
-    writer.write_metadata(&mcap::records::Metadata {
-        name: RUN_METADATA_NAME.to_string(),
-        metadata: run_metadata(scene).to_map(),
-    })?;
+    let mut writer = McapWriter::new(writer, &write_options(options))?;
+    writer.write_metadata(RUN_METADATA_NAME, &run_metadata(scene).to_map())?;
 
     let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
     let foxglove = (tf || scene_on).then(|| {
@@ -553,9 +543,9 @@ pub fn record<W: Write + Seek>(
         ..
     } = sampler;
     let stats = outcome.stats;
-    output.writer.write_metadata(&mcap::records::Metadata {
-        name: RESULT_METADATA_NAME.to_string(),
-        metadata: ResultMetadata {
+    output.writer.write_metadata(
+        RESULT_METADATA_NAME,
+        &ResultMetadata {
             steps: stats.steps,
             rhs_evaluations: stats.rhs_evaluations,
             rejected_steps: stats.rejected_steps,
@@ -563,10 +553,8 @@ pub fn record<W: Write + Seek>(
             termination_time,
         }
         .to_map(),
-    })?;
-    output.writer.finish()?;
-    let mut inner = output.writer.into_inner();
-    let bytes = inner.stream_position()?;
+    )?;
+    let (mut inner, bytes) = output.writer.finish()?;
     inner.flush()?;
     Ok(RecordSummary {
         samples,
