@@ -1,7 +1,11 @@
 //! `bench throughput` (issue 9) on a tiny workload: the library's rows are sane (counts agree, times
 //! positive, the bound ratio finite), and `record --json` / `verify --json` carry `peak_rss_bytes`. No
 //! timing assertions: the numbers depend on the machine.
-#![allow(clippy::unwrap_used, clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)]
 
 use coin_log::bench::throughput::{
     self, compression_bound, record_run, recording_path, ThroughputOptions,

@@ -7,8 +7,9 @@
 //!   contact, reaction, energy at 1 kHz with zstd, in a child process of the `coin-log` binary (its
 //!   `--json` summary gives the wall time and the peak RSS);
 //! - **compression bound**: the time to zstd-compress the same JSON message bytes (read back from that
-//!   file) in chunks of the recorder's size, at its level, with its number of zstd workers; the ratio
-//!   record time / bound says how close recording is to what compression alone costs;
+//!   file) in chunks of the recorder's size with the recorder's own [`ChunkCompressor`], on one thread
+//!   as each compression worker does; the ratio record time / bound says how close recording is to what
+//!   compression alone costs;
 //! - **verify**: `coin-log verify --json` of that file in its own child process (every check on);
 //! - **integration**: dop853 on `wobble` (30 time units) at the loosest tolerance whose state error against
 //!   the dop853 reference (atol 1e-16) is ≤ 1e-10, and one RHS evaluation (`Coin::derivative`).
@@ -20,7 +21,8 @@ use super::precision::rtol_for;
 use super::presets::bench_case;
 use super::{reference_trajectory, run_sampled, state_error, BenchError, Trajectory};
 use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings};
-use crate::record::{Channel, COMPRESSION_THREADS};
+use crate::record::writer::{DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
+use crate::record::{Channel, ChunkCompression, ChunkCompressor, COMPRESSION_THREADS};
 use crate::verify::reader::{self, Visitor};
 use crate::verify::wire::MessageHeader;
 use std::collections::BTreeMap;
@@ -45,10 +47,8 @@ pub const CHANNELS: [Channel; 7] = [
 ];
 /// Samples per time unit of the record workload (1 kHz).
 pub const RATE: f64 = 1000.0;
-/// zstd level of the recorder's chunks: the mcap writer's level 0, which zstd reads as its default.
-pub const ZSTD_LEVEL: i32 = zstd::DEFAULT_COMPRESSION_LEVEL;
-/// Uncompressed bytes per chunk of the recorder (the mcap writer's default chunk size).
-pub const CHUNK_SIZE: usize = 1 << 20;
+/// Uncompressed bytes per chunk: the recorder's ([`DEFAULT_CHUNK_SIZE`]).
+pub const CHUNK_SIZE: usize = DEFAULT_CHUNK_SIZE;
 /// Duration of the integration workload (the `wobble` scene's) \[time units\].
 pub const INTEGRATION_DURATION: f64 = 30.0;
 /// Largest state error of the integration workload against the reference (issue 9).
@@ -377,7 +377,7 @@ pub struct Bound {
 
 /// Collects message bytes into chunks and compresses each, timing only the compression.
 struct Compressing {
-    compressor: zstd::bulk::Compressor<'static>,
+    compressor: ChunkCompressor,
     chunk: Vec<u8>,
     out: Vec<u8>,
     bound: Bound,
@@ -390,12 +390,10 @@ impl Compressing {
             return;
         }
         let start = Instant::now();
-        let result = self
-            .compressor
-            .compress_to_buffer(&self.chunk, &mut self.out);
+        let result = self.compressor.compress(&self.chunk, &mut self.out);
         self.bound.seconds += start.elapsed().as_secs_f64();
         match result {
-            Ok(n) => self.bound.compressed_bytes += n as u64,
+            Ok(()) => self.bound.compressed_bytes += self.out.len() as u64,
             Err(e) => self.error = Some(e),
         }
         self.chunk.clear();
@@ -422,21 +420,17 @@ impl Visitor for Compressing {
     }
 }
 
-/// The compression bound of the recording at `path`: its message bytes compressed in [`CHUNK_SIZE`]
-/// chunks at [`ZSTD_LEVEL`] with [`COMPRESSION_THREADS`] zstd workers, as the recorder does.
+/// The compression bound of the recording at `path`: its JSON message bytes compressed in
+/// [`CHUNK_SIZE`] pieces by the recorder's own [`ChunkCompressor`] (zstd at [`ZSTD_LEVEL`]), on one thread
+/// as each of the recorder's [`COMPRESSION_THREADS`] workers does.
 ///
 /// # Errors
 /// [`ThroughputError`] if the file cannot be read back or zstd fails.
 pub fn compression_bound(path: &Path) -> Result<Bound, ThroughputError> {
-    let mut compressor =
-        zstd::bulk::Compressor::new(ZSTD_LEVEL).map_err(ThroughputError::Compress)?;
-    compressor
-        .set_parameter(zstd::zstd_safe::CParameter::NbWorkers(COMPRESSION_THREADS))
-        .map_err(ThroughputError::Compress)?;
     let mut visitor = Compressing {
-        compressor,
+        compressor: ChunkCompressor::new(ChunkCompression::Zstd),
         chunk: Vec::with_capacity(CHUNK_SIZE + (CHUNK_SIZE >> 2)),
-        out: Vec::with_capacity(zstd::zstd_safe::compress_bound(CHUNK_SIZE << 1)),
+        out: Vec::new(),
         bound: Bound::default(),
         error: None,
     };
@@ -515,7 +509,7 @@ pub fn record_and_verify(
         }
     };
     let bound_workload = format!(
-        "zstd bound {duration} u (level {ZSTD_LEVEL}, {} KiB chunks, {COMPRESSION_THREADS} worker)",
+        "zstd bound {duration} u (level {ZSTD_LEVEL}, {} KiB chunks, 1 thread; recorder: {COMPRESSION_THREADS} worker(s))",
         CHUNK_SIZE >> 10
     );
     let verify_workload = format!("verify {duration} u, every check");
