@@ -187,7 +187,11 @@ fn the_json_output_has_exactly_the_contract_fields() {
         k
     };
     assert_eq!(keys(&v), ["files"]);
-    assert_eq!(keys(&v["files"][0]), ["checks", "exit_code", "path"]);
+    // The contract's fields plus `peak_rss_bytes` (issue 9), an allowed extension.
+    assert_eq!(
+        keys(&v["files"][0]),
+        ["checks", "exit_code", "path", "peak_rss_bytes"]
+    );
     let ids: Vec<&str> = v["files"][0]["checks"]
         .as_array()
         .unwrap()

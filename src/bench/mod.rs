@@ -10,6 +10,7 @@ pub mod plot;
 pub mod precision;
 pub mod presets;
 pub mod stability;
+pub mod throughput;
 
 pub mod table;
 

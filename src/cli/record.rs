@@ -4,6 +4,7 @@
 
 use super::Outcome;
 use anyhow::{anyhow, bail, Context};
+use coin_log::bench::throughput::peak_rss_bytes;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary, Termination};
 use coin_log::scene::{self, presets, FlagOverrides, Scene, SceneFile};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -293,6 +294,7 @@ fn print_summary(
             "steady_residual": s.steady_residual,
             "termination": s.termination.name(),
             "termination_time": s.termination_time,
+            "peak_rss_bytes": peak_rss_bytes(),
         });
         println!("{}", serde_json::to_string(&json)?);
         return Ok(());

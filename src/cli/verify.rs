@@ -2,6 +2,7 @@
 //! verdict to the exit code.
 
 use super::Outcome;
+use coin_log::bench::throughput::peak_rss_bytes;
 use coin_log::verify::{self, FileReport, Options, Report};
 use std::path::PathBuf;
 
@@ -55,14 +56,23 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
         energy_tol: args.energy_tol,
         residual_tol: args.residual_tol,
     };
-    let report = verify::verify_files(&args.files, &options);
+    // One file at a time, so that each file's report carries the process's peak RSS after it.
+    let mut report = Report { files: Vec::new() };
+    let mut peaks = Vec::new();
+    for path in &args.files {
+        report.files.push(verify::verify_file(path, &options));
+        peaks.push(peak_rss_bytes());
+    }
     for file in &report.files {
         if let Some(problem) = &file.problem {
             eprintln!("error: {}: {problem}", file.path);
         }
     }
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        println!(
+            "{}",
+            serde_json::to_string(&with_peak_rss(&report, &peaks)?)?
+        );
     } else {
         print!("{}", table(&report));
     }
@@ -71,6 +81,23 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
         1 => Outcome::Failure,
         _ => Outcome::Unusable,
     })
+}
+
+/// The contract's JSON plus `peak_rss_bytes` in each file object: the process's peak resident set size
+/// (VmHWM) once that file was judged, `null` where the system does not report it.
+fn with_peak_rss(report: &Report, peaks: &[Option<u64>]) -> anyhow::Result<serde_json::Value> {
+    let mut json = serde_json::to_value(report)?;
+    if let Some(files) = json
+        .get_mut("files")
+        .and_then(serde_json::Value::as_array_mut)
+    {
+        for (file, peak) in files.iter_mut().zip(peaks) {
+            if let Some(object) = file.as_object_mut() {
+                object.insert("peak_rss_bytes".into(), serde_json::json!(peak));
+            }
+        }
+    }
+    Ok(json)
 }
 
 fn number(x: Option<f64>) -> String {

@@ -6,6 +6,7 @@ use super::checks::{
     invariants::InvariantsCheck, steady, steady::SteadyCheck, validity::ValidityCheck, Context,
     RunStats,
 };
+use super::json;
 use super::problems::Problems;
 use super::reader::{self, ReadErrorKind, Visitor};
 use super::report::{CheckId, CheckResult, FileReport, Status};
@@ -143,40 +144,46 @@ struct Judge {
 }
 
 impl Judge {
+    /// Parses a `coin_log.*` message strictly: the recorder's own form on the fast path ([`json`]), any
+    /// other form (or an error) by serde_json.
     fn parse(slot: Slot, data: &[u8]) -> Result<(f64, Value), serde_json::Error> {
+        /// `$ty { fields in schema order }` read by the fast path, else by serde.
+        macro_rules! typed {
+            ($variant:ident, $ty:ident { $($f:ident),+ }) => {{
+                let m: $ty = match json::parse_numbers(data, &[$(stringify!($f)),+]) {
+                    Some([$($f),+]) => $ty { $($f),+ },
+                    None => serde_json::from_slice(data)?,
+                };
+                (m.t, Value::$variant(m))
+            }};
+        }
         Ok(match slot {
-            Slot::Omega => {
-                let m: AngularVelocity = serde_json::from_slice(data)?;
-                (m.t, Value::Omega(m))
-            }
-            Slot::Angles => {
-                let m: Angles = serde_json::from_slice(data)?;
-                (m.t, Value::Angles(m))
-            }
-            Slot::Quaternion => {
-                let m: QuaternionMessage = serde_json::from_slice(data)?;
-                (m.t, Value::Quaternion(m))
-            }
-            Slot::Position => {
-                let m: Position = serde_json::from_slice(data)?;
-                (m.t, Value::Position(m))
-            }
-            Slot::Contact => {
-                let m: Position = serde_json::from_slice(data)?;
-                (m.t, Value::Contact(m))
-            }
-            Slot::Reaction => {
-                let m: ReactionMessage = serde_json::from_slice(data)?;
-                (m.t, Value::Reaction(m))
-            }
-            Slot::Energy => {
-                let m: EnergyMessage = serde_json::from_slice(data)?;
-                (m.t, Value::Energy(m))
-            }
-            Slot::Invariants => {
-                let m: InvariantsMessage = serde_json::from_slice(data)?;
-                (m.t, Value::Invariants(m))
-            }
+            Slot::Omega => typed!(Omega, AngularVelocity { t, x, y, z }),
+            Slot::Angles => typed!(Angles, Angles { t, theta, phi, psi }),
+            Slot::Quaternion => typed!(Quaternion, QuaternionMessage { t, x, y, z, w }),
+            Slot::Position => typed!(Position, Position { t, x, y, z }),
+            Slot::Contact => typed!(Contact, Position { t, x, y, z }),
+            Slot::Reaction => typed!(
+                Reaction,
+                ReactionMessage {
+                    t,
+                    x,
+                    y,
+                    z,
+                    friction,
+                    normal
+                }
+            ),
+            Slot::Energy => typed!(
+                Energy,
+                EnergyMessage {
+                    t,
+                    total,
+                    kinetic,
+                    potential
+                }
+            ),
+            Slot::Invariants => typed!(Invariants, InvariantsMessage { t, c1, c2 }),
         })
     }
 
@@ -560,5 +567,53 @@ fn require_physics(results: &mut [CheckResult]) {
             CheckId::Constraint,
             "neither constraint nor steady could run, so the motion is not verified",
         );
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// The fast path only pays off if it reads the fields in the order the recorder writes them.
+    #[test]
+    fn the_fast_path_reads_what_the_recorder_writes() {
+        let mut buf = Vec::new();
+        let m = ReactionMessage {
+            t: 0.5,
+            x: 0.1,
+            y: -0.2,
+            z: 1e-17,
+            friction: 3.0,
+            normal: 0.75,
+        };
+        m.write_json(&mut buf).unwrap();
+        assert_eq!(
+            ReactionMessage::FIELDS,
+            ["t", "x", "y", "z", "friction", "normal"]
+        );
+        let (t, v) = Judge::parse(Slot::Reaction, &buf).unwrap();
+        assert_eq!(t.to_bits(), 0.5_f64.to_bits());
+        assert!(matches!(v, Value::Reaction(r) if r == m));
+        for (slot, fields) in [
+            (Slot::Omega, AngularVelocity::FIELDS),
+            (Slot::Angles, Angles::FIELDS),
+            (Slot::Quaternion, QuaternionMessage::FIELDS),
+            (Slot::Position, Position::FIELDS),
+            (Slot::Energy, EnergyMessage::FIELDS),
+            (Slot::Invariants, InvariantsMessage::FIELDS),
+        ] {
+            let text: Vec<String> = fields.iter().map(|f| format!("\"{f}\":1")).collect();
+            let text = format!("{{{}}}", text.join(","));
+            let fields_fast: &[&str] = match slot {
+                Slot::Omega | Slot::Position => &["t", "x", "y", "z"],
+                Slot::Angles => &["t", "theta", "phi", "psi"],
+                Slot::Quaternion => &["t", "x", "y", "z", "w"],
+                Slot::Energy => &["t", "total", "kinetic", "potential"],
+                _ => &["t", "c1", "c2"],
+            };
+            assert_eq!(fields, fields_fast, "{slot:?}");
+            assert!(Judge::parse(slot, text.as_bytes()).is_ok(), "{text}");
+        }
     }
 }

@@ -8,6 +8,8 @@
 
 pub mod checks;
 mod file;
+mod json;
+mod prefetch;
 pub mod problems;
 pub mod reader;
 pub mod report;

@@ -1,32 +1,31 @@
-//! The streaming MCAP reader of `verify`: one pass over the file with the mcap crate's sans-io
-//! [`LinearReader`], in memory bounded by the largest record (never by the file's length).
+//! The streaming MCAP reader of `verify`: one pass over the file in memory bounded by the largest record
+//! (never by the file's length).
 //!
-//! The outer reader yields every top-level record, chunks whole, so that file offsets are known; each chunk
-//! is fed to a second reader that decompresses it as a stream and checks its CRC. Along the way this module
-//! keeps what the structural checks need as running digests rather than lists: per chunk and channel a hash
-//! of the (log time, offset) pairs its message index must list, a hash of every chunk's index entry, the
-//! real counts for the statistics record, the summary's groups for the summary offsets. Every length is
-//! checked against the file's size before anything is allocated for it.
+//! Reading is a two-thread pipeline (the private `prefetch` module): a worker runs the mcap crate's sans-io
+//! `LinearReader` over the file (chunks whole, so that file offsets are known), feeds each chunk to a
+//! second reader that decompresses it and checks its CRC, and hands the records over in batches; this
+//! thread walks them in file order. Along the way it keeps what the structural checks need as running
+//! digests rather than lists: per chunk and channel a hash of the (log time, offset) pairs its message
+//! index must list, a hash of every chunk's index entry, the real counts for the statistics record, the
+//! summary's groups for the summary offsets. Every length is checked against the file's size before
+//! anything is allocated for it.
 
+use super::prefetch::{self, Batch, Event};
 use super::problems::Problems;
 use super::wire::{self, Cursor, MessageHeader, WireError};
 use mcap::records::op;
-use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use std::collections::BTreeMap;
 use std::fmt;
 use std::io::Read;
 use std::ops::ControlFlow;
 use std::path::Path;
+use std::sync::mpsc::{self, Receiver, SyncSender};
 
-/// Bytes asked of the file per read (larger reads than the reader's minimum requests).
-const READ_BLOCK: usize = 1 << 18;
 /// Bytes of an opcode and a record length.
 const RECORD_PREFIX: u64 = 9;
 /// MCAP magic length.
 const MAGIC_LEN: u64 = 8;
-/// Smallest record-length limit inside chunks (a chunk's records may decompress beyond the file's size).
-const MIN_CHUNK_RECORD_LIMIT: usize = 1 << 24;
 /// How many metadata records and summary groups are remembered for the index checks (more are counted).
 const MAX_REMEMBERED: usize = 1024;
 
@@ -141,6 +140,8 @@ struct ChunkBook {
     per_channel: BTreeMap<u16, IndexDigest>,
     index_offsets: BTreeMap<u16, u64>,
     index_length: u64,
+    /// Messages read before this chunk (for error messages).
+    messages_before: u64,
 }
 
 impl ChunkBook {
@@ -210,7 +211,7 @@ pub fn read(path: &Path, visitor: &mut impl Visitor) -> (Structure, Option<ReadE
 
 /// Reads an MCAP stream of `len` bytes from `source` (see [`read`]).
 pub fn read_from(
-    source: impl Read,
+    source: impl Read + Send,
     len: u64,
     visitor: &mut impl Visitor,
 ) -> (Structure, Option<ReadError>) {
@@ -246,48 +247,63 @@ fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
 }
 
 fn read_into(
-    mut file: impl Read,
+    file: impl Read + Send,
     file_len: u64,
     visitor: &mut impl Visitor,
     book: &mut Book,
 ) -> Result<(), ReadError> {
     book.s.file_len = file_len;
     book.pos = MAGIC_LEN;
-    let limit = usize::try_from(file_len).unwrap_or(usize::MAX);
-    let mut outer = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_emit_chunks(true)
-            .with_validate_data_section_crc(true)
-            .with_validate_summary_section_crc(true)
-            .with_check_finishes_after_end_magic(true)
-            .with_record_length_limit(limit),
-    );
-    let mut inner = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_skip_start_magic(true)
-            .with_skip_end_magic(true)
-            .with_validate_chunk_crcs(true)
-            .with_record_length_limit(limit.max(MIN_CHUNK_RECORD_LIMIT)),
-    );
-    let mut read_so_far: u64 = 0;
-    while let Some(event) = outer.next_event() {
-        match event {
-            Ok(LinearReadEvent::ReadRequest(need)) => {
-                let buf = outer.insert(need.max(READ_BLOCK));
-                let n = file.read(buf).map_err(|e| ReadError {
-                    kind: ReadErrorKind::Io,
-                    detail: format!("read error at byte {read_so_far}: {e}"),
-                })?;
-                read_so_far += n as u64;
-                outer.notify_read(n);
+    let (to_consumer, batches) = mpsc::sync_channel(prefetch::QUEUE);
+    let (to_producer, recycled) = mpsc::sync_channel(prefetch::QUEUE + 2);
+    std::thread::scope(|scope| {
+        scope.spawn(move || {
+            prefetch::produce(
+                file,
+                file_len,
+                &prefetch::Producer {
+                    to_consumer,
+                    recycled,
+                },
+            );
+        });
+        // Returning drops `batches`, which ends the worker at its next send.
+        consume(&batches, &to_producer, visitor, book)
+    })
+}
+
+/// The checking half of the pipeline: walks the worker's events in file order.
+fn consume(
+    batches: &Receiver<Batch>,
+    to_producer: &SyncSender<Batch>,
+    visitor: &mut impl Visitor,
+    book: &mut Book,
+) -> Result<(), ReadError> {
+    while let Ok(batch) = batches.recv() {
+        for event in &batch.events {
+            match event {
+                Event::Outer { opcode, body } => {
+                    let data = &batch.bytes[body.clone()];
+                    let at = book.pos;
+                    book.pos += RECORD_PREFIX + data.len() as u64;
+                    book.top_level(*opcode, data, at, visitor)?;
+                }
+                Event::Inner { opcode, body } => {
+                    book.chunk_inner(*opcode, &batch.bytes[body.clone()], visitor)?;
+                }
+                Event::ChunkEnd => book.chunk_end()?,
+                Event::InnerError(e) => return Err(book.chunk_error(e)),
+                Event::OuterError(e) => return Err(book.classify(e)),
+                Event::Io(detail) => {
+                    return Err(ReadError {
+                        kind: ReadErrorKind::Io,
+                        detail: detail.clone(),
+                    })
+                }
             }
-            Ok(LinearReadEvent::Record { opcode, data }) => {
-                let at = book.pos;
-                book.pos += RECORD_PREFIX + data.len() as u64;
-                book.top_level(opcode, data, at, &mut inner, visitor)?;
-            }
-            Err(e) => return Err(book.classify(&e)),
         }
+        // The worker reuses the batch if it has room for it; otherwise it is freed here.
+        let _ = to_producer.try_send(batch);
     }
     Ok(())
 }
@@ -384,7 +400,6 @@ impl Book {
         opcode: u8,
         data: &[u8],
         at: u64,
-        inner: &mut LinearReader,
         visitor: &mut impl Visitor,
     ) -> Result<(), ReadError> {
         if opcode != op::MESSAGE_INDEX {
@@ -418,7 +433,7 @@ impl Book {
                 self.s.library = library.to_string();
                 visitor.library(library);
             }
-            op::CHUNK => self.chunk_record(data, at, inner, visitor)?,
+            op::CHUNK => self.chunk_record(data, at)?,
             op::MESSAGE_INDEX => self.message_index(data, at)?,
             op::FOOTER => self.footer(data, at)?,
             op::DATA_END => {
@@ -430,13 +445,7 @@ impl Book {
         Ok(())
     }
 
-    fn chunk_record(
-        &mut self,
-        data: &[u8],
-        at: u64,
-        inner: &mut LinearReader,
-        visitor: &mut impl Visitor,
-    ) -> Result<(), ReadError> {
+    fn chunk_record(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
         let header = wire::chunk_header(data).map_err(|e| wire_error("chunk", at, e))?;
         let mut compression = Digest::default();
         compression.push_bytes(header.compression);
@@ -448,48 +457,36 @@ impl Book {
             uncompressed_size: header.uncompressed_size,
             compressed_size: header.compressed_size,
             compression,
+            messages_before: self.s.messages,
             ..ChunkBook::default()
         });
-        let expected = header.uncompressed_size;
-        let total = usize::try_from(RECORD_PREFIX + data.len() as u64).unwrap_or(usize::MAX);
-        let buf = inner.insert(total);
-        buf[0] = op::CHUNK;
-        buf[1..9].copy_from_slice(&(data.len() as u64).to_le_bytes());
-        buf[9..].copy_from_slice(data);
-        inner.notify_read(total);
-        let messages_before = self.s.messages;
-        while let Some(event) = inner.next_event() {
-            match event {
-                Ok(LinearReadEvent::ReadRequest(_)) => break,
-                Ok(LinearReadEvent::Record { opcode, data }) => {
-                    let offset = self.chunk.as_ref().map_or(0, |c| c.offset);
-                    if let Some(c) = self.chunk.as_mut() {
-                        c.offset += RECORD_PREFIX + data.len() as u64;
-                    }
-                    if opcode == op::MESSAGE {
-                        self.message(data, at, Some(offset), visitor)?;
-                    } else {
-                        self.record(opcode, data, at, visitor)?;
-                    }
-                }
-                Err(e) => {
-                    let read = self.s.messages;
-                    let inside = read - messages_before;
-                    return Err(corrupt(match e {
-                        McapError::BadChunkCrc { saved, calculated } => format!(
-                            "corrupt chunk at byte {at}: CRC {calculated:#010x} of its records does \
-                             not match the stored {saved:#010x}; judged the {read} messages read \
-                             ({inside} of them from this chunk)"
-                        ),
-                        other => format!(
-                            "corrupt chunk at byte {at}: {other}; judged the {read} messages read \
-                             before it"
-                        ),
-                    }));
-                }
-            }
+        Ok(())
+    }
+
+    /// A record inside the current chunk.
+    fn chunk_inner(
+        &mut self,
+        opcode: u8,
+        data: &[u8],
+        visitor: &mut impl Visitor,
+    ) -> Result<(), ReadError> {
+        let (at, offset) = self.chunk.as_ref().map_or((0, 0), |c| (c.start, c.offset));
+        if let Some(c) = self.chunk.as_mut() {
+            c.offset += RECORD_PREFIX + data.len() as u64;
         }
-        let got = self.chunk.as_ref().map_or(0, |c| c.offset);
+        if opcode == op::MESSAGE {
+            self.message(data, at, Some(offset), visitor)
+        } else {
+            self.record(opcode, data, at, visitor)
+        }
+    }
+
+    /// The current chunk's records are read: they must fill its claimed size.
+    fn chunk_end(&self) -> Result<(), ReadError> {
+        let (at, got, expected) = self
+            .chunk
+            .as_ref()
+            .map_or((0, 0, 0), |c| (c.start, c.offset, c.uncompressed_size));
         if got != expected {
             return Err(corrupt(format!(
                 "corrupt chunk at byte {at}: its records decompress to {got} bytes, its header claims \
@@ -497,6 +494,25 @@ impl Book {
             )));
         }
         Ok(())
+    }
+
+    fn chunk_error(&self, e: &McapError) -> ReadError {
+        let (at, before) = self
+            .chunk
+            .as_ref()
+            .map_or((0, 0), |c| (c.start, c.messages_before));
+        let read = self.s.messages;
+        let inside = read - before;
+        corrupt(match e {
+            McapError::BadChunkCrc { saved, calculated } => format!(
+                "corrupt chunk at byte {at}: CRC {calculated:#010x} of its records does not match \
+                 the stored {saved:#010x}; judged the {read} messages read ({inside} of them from \
+                 this chunk)"
+            ),
+            other => format!(
+                "corrupt chunk at byte {at}: {other}; judged the {read} messages read before it"
+            ),
+        })
     }
 
     fn message(

@@ -1,0 +1,813 @@
+//! The throughput bench (issue 9, `bench throughput`): how fast `record` and `verify` run on the real
+//! channel set and code paths, in how much memory, against the bound the machine sets, and what the
+//! integration itself costs.
+//!
+//! Workloads, each repeated and reported as the median:
+//! - **record**: `coin-log record wobble` with the seven channels omega, angles, quaternion, position,
+//!   contact, reaction, energy at 1 kHz with zstd, in a child process of the `coin-log` binary (its
+//!   `--json` summary gives the wall time and the peak RSS);
+//! - **compression bound**: the time to zstd-compress the same JSON message bytes (read back from that
+//!   file) in chunks of the recorder's size with the recorder's own [`ChunkCompressor`], on one thread
+//!   as each compression worker does; the ratio record time / bound says how close recording is to what
+//!   compression alone costs;
+//! - **verify**: `coin-log verify --json` of that file in its own child process (every check on);
+//! - **integration**: dop853 on `wobble` (30 time units) at the loosest tolerance whose state error against
+//!   the dop853 reference (atol 1e-16) is ≤ 1e-10, and one RHS evaluation (`Coin::derivative`).
+//!
+//! Record and verify run at two durations, so that their peak RSS shows whether memory grows with the
+//! length of the run. The library returns rows; `coin-log bench throughput` prints them.
+
+use super::precision::rtol_for;
+use super::presets::bench_case;
+use super::{reference_trajectory, run_sampled, state_error, BenchError, Trajectory};
+use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings};
+use crate::record::writer::{DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
+use crate::record::{Channel, ChunkCompression, ChunkCompressor, COMPRESSION_THREADS};
+use crate::verify::reader::{self, Visitor};
+use crate::verify::wire::MessageHeader;
+use std::collections::BTreeMap;
+use std::fmt;
+use std::hint::black_box;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// The scene of the record and verify workloads.
+pub const SCENE: &str = "wobble";
+/// The seven channels of issue 9, in the contract's order.
+pub const CHANNELS: [Channel; 7] = [
+    Channel::Omega,
+    Channel::Angles,
+    Channel::Quaternion,
+    Channel::Position,
+    Channel::Contact,
+    Channel::Reaction,
+    Channel::Energy,
+];
+/// Samples per time unit of the record workload (1 kHz).
+pub const RATE: f64 = 1000.0;
+/// Uncompressed bytes per chunk: the recorder's ([`DEFAULT_CHUNK_SIZE`]).
+pub const CHUNK_SIZE: usize = DEFAULT_CHUNK_SIZE;
+/// Duration of the integration workload (the `wobble` scene's) \[time units\].
+pub const INTEGRATION_DURATION: f64 = 30.0;
+/// Largest state error of the integration workload against the reference (issue 9).
+pub const INTEGRATION_ERROR: f64 = 1e-10;
+/// atol values tried for the integration workload, loosest first (rtol = min(1e3·atol, 1e-3)).
+const INTEGRATION_ATOLS: [f64; 7] = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14];
+/// RHS evaluations per timed repeat.
+pub const RHS_EVALUATIONS: u32 = 2_000_000;
+/// Timed integration runs per repeat (one run lasts well under a millisecond).
+pub const INTEGRATION_RUNS: u32 = 200;
+
+/// Targets of issue 9.
+pub mod targets {
+    /// Recording, messages per second.
+    pub const RECORD_MESSAGES_PER_SECOND: f64 = 3e6;
+    /// Record time over the compression bound.
+    pub const BOUND_RATIO: f64 = 2.0;
+    /// Verify, messages per second.
+    pub const VERIFY_MESSAGES_PER_SECOND: f64 = 2e6;
+    /// Peak RSS of record and verify \[bytes\].
+    pub const PEAK_RSS_BYTES: f64 = 64.0 * 1024.0 * 1024.0;
+    /// dop853 on wobble \[s\].
+    pub const INTEGRATION_SECONDS: f64 = 0.5e-3;
+    /// One RHS evaluation \[s\].
+    pub const RHS_SECONDS: f64 = 50e-9;
+}
+
+/// What the bench runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThroughputOptions {
+    /// The `coin-log` binary run as a child process for record and verify.
+    pub exe: PathBuf,
+    /// Folder for the recordings (one file per duration, replaced on each repeat).
+    pub dir: PathBuf,
+    /// Durations of the record and verify workloads \[time units\], shortest first.
+    pub durations: Vec<f64>,
+    /// Timed repeats; the median is reported.
+    pub repeats: usize,
+}
+
+/// A target and which side of it is good.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Target {
+    /// The measured value should be at least this.
+    AtLeast(f64),
+    /// The measured value should be below this.
+    Below(f64),
+    /// The measured value should be at most this.
+    AtMost(f64),
+}
+
+impl Target {
+    /// Whether `value` meets the target.
+    #[must_use]
+    pub fn met(self, value: f64) -> bool {
+        match self {
+            Self::AtLeast(t) => value >= t,
+            Self::Below(t) => value < t,
+            Self::AtMost(t) => value <= t,
+        }
+    }
+}
+
+impl fmt::Display for Target {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::AtLeast(t) => write!(f, "≥ {t:e}"),
+            Self::Below(t) => write!(f, "< {t:e}"),
+            Self::AtMost(t) => write!(f, "≤ {t:e}"),
+        }
+    }
+}
+
+/// One measured quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThroughputRow {
+    /// The workload (`record wobble 100 u @ 1 kHz`, `integrate dop853 wobble 30 u`, ...).
+    pub workload: String,
+    /// What is measured (`messages/s`, `peak RSS`, ...).
+    pub quantity: String,
+    /// The median over the repeats.
+    pub value: f64,
+    /// Unit of `value` (`1/s`, `B`, `s`, ...).
+    pub unit: String,
+    /// Issue 9's target, when it sets one.
+    pub target: Option<Target>,
+    /// Anything needed to read the value (settings, counts).
+    pub note: String,
+}
+
+impl ThroughputRow {
+    /// Whether the value meets its target (`None` without one).
+    #[must_use]
+    pub fn met(&self) -> Option<bool> {
+        self.target.map(|t| t.met(self.value))
+    }
+}
+
+/// The bench's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThroughputReport {
+    /// Cores available to this process (`std::thread::available_parallelism`).
+    pub cores: usize,
+    /// The rows, workload by workload.
+    pub rows: Vec<ThroughputRow>,
+}
+
+/// Why the throughput bench could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ThroughputError {
+    /// A child process could not be started.
+    #[error("cannot run `{command}`: {source}")]
+    Spawn {
+        /// The command line.
+        command: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A child process failed or printed something unexpected.
+    #[error("`{command}` {reason}")]
+    Child {
+        /// The command line.
+        command: String,
+        /// What went wrong, with its stderr.
+        reason: String,
+    },
+    /// The recording could not be read back for the compression bound.
+    #[error("reading back `{path}`: {detail}")]
+    ReadBack {
+        /// The file.
+        path: String,
+        /// Why.
+        detail: String,
+    },
+    /// zstd failed.
+    #[error("zstd compression failed: {0}")]
+    Compress(std::io::Error),
+    /// The integration workload could not be set up.
+    #[error(transparent)]
+    Bench(#[from] BenchError),
+    /// No tolerance reached the required state error.
+    #[error("dop853 on wobble does not reach a state error of {INTEGRATION_ERROR:e} at atol down to 1e-14 (best {best:e})")]
+    Accuracy {
+        /// The smallest error reached.
+        best: f64,
+    },
+}
+
+/// This process's peak resident set size (`VmHWM` of `/proc/self/status`) \[bytes\]; `None` where the
+/// system does not report it.
+#[must_use]
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let mut words = line.split_whitespace().skip(1);
+    let value: u64 = words.next()?.parse().ok()?;
+    match words.next() {
+        Some("kB") => value.checked_mul(1024),
+        _ => None,
+    }
+}
+
+/// The median of `values` (the mean of the middle two for an even count); NaN when empty.
+#[must_use]
+pub fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// The `--channels` value of the workload.
+#[must_use]
+pub fn channel_list() -> String {
+    CHANNELS
+        .iter()
+        .map(|c| c.name())
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// Runs a child `coin-log` and returns its parsed JSON stdout and wall time; `allowed` exit codes pass.
+fn child_json(exe: &Path, args: &[String]) -> Result<(serde_json::Value, f64), ThroughputError> {
+    let command = format!("{} {}", exe.display(), args.join(" "));
+    let start = Instant::now();
+    let output =
+        Command::new(exe)
+            .args(args)
+            .output()
+            .map_err(|source| ThroughputError::Spawn {
+                command: command.clone(),
+                source,
+            })?;
+    let wall = start.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if !output.status.success() {
+        return Err(ThroughputError::Child {
+            command,
+            reason: format!("exited with {}: {stderr}", output.status),
+        });
+    }
+    let json = serde_json::from_slice(&output.stdout).map_err(|e| ThroughputError::Child {
+        command: command.clone(),
+        reason: format!("printed no JSON ({e}): {stderr}"),
+    })?;
+    Ok((json, wall))
+}
+
+fn field_f64(json: &serde_json::Value, key: &str) -> Option<f64> {
+    json.get(key).and_then(serde_json::Value::as_f64)
+}
+
+/// One record run, as its `--json` summary reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordRun {
+    /// Messages written.
+    pub messages: u64,
+    /// File size \[bytes\].
+    pub bytes: u64,
+    /// The recorder's wall time \[s\].
+    pub seconds: f64,
+    /// Its peak RSS \[bytes\], if reported.
+    pub peak_rss: Option<u64>,
+}
+
+/// Records the workload for `duration` time units into `path` in a child process.
+///
+/// # Errors
+/// [`ThroughputError`] if the child cannot run, fails, or reports nonsense.
+pub fn record_run(exe: &Path, path: &Path, duration: f64) -> Result<RecordRun, ThroughputError> {
+    let args: Vec<String> = [
+        "record",
+        SCENE,
+        "--duration",
+        &duration.to_string(),
+        "--rate",
+        &RATE.to_string(),
+        "--channels",
+        &channel_list(),
+        "--compression",
+        "zstd",
+        "-o",
+        &path.display().to_string(),
+        "--overwrite",
+        "--json",
+    ]
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    let (json, _) = child_json(exe, &args)?;
+    let bad = |what: &str| ThroughputError::Child {
+        command: format!("{} record", exe.display()),
+        reason: format!("printed a summary without `{what}`: {json}"),
+    };
+    let termination = json.get("termination").and_then(serde_json::Value::as_str);
+    if termination != Some("completed") {
+        return Err(ThroughputError::Child {
+            command: format!("{} record", exe.display()),
+            reason: format!("ended with termination {termination:?}, not completed"),
+        });
+    }
+    Ok(RecordRun {
+        messages: json
+            .get("messages")
+            .and_then(serde_json::Value::as_u64)
+            .ok_or_else(|| bad("messages"))?,
+        bytes: json
+            .get("bytes")
+            .and_then(serde_json::Value::as_u64)
+            .ok_or_else(|| bad("bytes"))?,
+        seconds: field_f64(&json, "wall_time_s").ok_or_else(|| bad("wall_time_s"))?,
+        peak_rss: json
+            .get("peak_rss_bytes")
+            .and_then(serde_json::Value::as_u64),
+    })
+}
+
+/// One verify run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerifyRun {
+    /// Wall time of the child process \[s\].
+    pub seconds: f64,
+    /// Its peak RSS \[bytes\], if reported.
+    pub peak_rss: Option<u64>,
+}
+
+/// Verifies `path` in a child process; the file must pass (exit 0).
+///
+/// # Errors
+/// [`ThroughputError`] if the child cannot run or the file does not pass.
+pub fn verify_run(exe: &Path, path: &Path) -> Result<VerifyRun, ThroughputError> {
+    let args = vec![
+        "verify".to_string(),
+        path.display().to_string(),
+        "--json".to_string(),
+    ];
+    let (json, seconds) = child_json(exe, &args)?;
+    let file = json.get("files").and_then(|f| f.get(0));
+    Ok(VerifyRun {
+        seconds,
+        peak_rss: file
+            .and_then(|f| f.get("peak_rss_bytes"))
+            .and_then(serde_json::Value::as_u64),
+    })
+}
+
+/// The compression bound of one file: its JSON message bytes and the time zstd takes on them.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Bound {
+    /// Messages read back.
+    pub messages: u64,
+    /// Their JSON bytes.
+    pub json_bytes: u64,
+    /// Compressed bytes.
+    pub compressed_bytes: u64,
+    /// Time spent compressing \[s\] (reading the file back is not counted).
+    pub seconds: f64,
+}
+
+/// Collects message bytes into chunks and compresses each, timing only the compression.
+struct Compressing {
+    compressor: ChunkCompressor,
+    chunk: Vec<u8>,
+    out: Vec<u8>,
+    bound: Bound,
+    error: Option<std::io::Error>,
+}
+
+impl Compressing {
+    fn flush(&mut self) {
+        if self.chunk.is_empty() || self.error.is_some() {
+            return;
+        }
+        let start = Instant::now();
+        let result = self.compressor.compress(&self.chunk, &mut self.out);
+        self.bound.seconds += start.elapsed().as_secs_f64();
+        match result {
+            Ok(()) => self.bound.compressed_bytes += self.out.len() as u64,
+            Err(e) => self.error = Some(e),
+        }
+        self.chunk.clear();
+    }
+}
+
+impl Visitor for Compressing {
+    fn schema(&mut self, _: u16, _: &str, _: &str, _: &[u8]) {}
+    fn channel(&mut self, _: u16, _: u16, _: &str, _: &str) {}
+    fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
+    fn library(&mut self, _: &str) {}
+    fn message(&mut self, _: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
+        self.bound.messages += 1;
+        self.bound.json_bytes += data.len() as u64;
+        self.chunk.extend_from_slice(data);
+        if self.chunk.len() >= CHUNK_SIZE {
+            self.flush();
+        }
+        if self.error.is_some() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// The compression bound of the recording at `path`: its JSON message bytes compressed in
+/// [`CHUNK_SIZE`] pieces by the recorder's own [`ChunkCompressor`] (zstd at [`ZSTD_LEVEL`]), on one thread
+/// as each of the recorder's [`COMPRESSION_THREADS`] workers does.
+///
+/// # Errors
+/// [`ThroughputError`] if the file cannot be read back or zstd fails.
+pub fn compression_bound(path: &Path) -> Result<Bound, ThroughputError> {
+    let mut visitor = Compressing {
+        compressor: ChunkCompressor::new(ChunkCompression::Zstd),
+        chunk: Vec::with_capacity(CHUNK_SIZE + (CHUNK_SIZE >> 2)),
+        out: Vec::new(),
+        bound: Bound::default(),
+        error: None,
+    };
+    let (_, error) = reader::read(path, &mut visitor);
+    visitor.flush();
+    if let Some(e) = visitor.error {
+        return Err(ThroughputError::Compress(e));
+    }
+    if let Some(e) = error {
+        return Err(ThroughputError::ReadBack {
+            path: path.display().to_string(),
+            detail: e.detail,
+        });
+    }
+    Ok(visitor.bound)
+}
+
+/// The recording of `duration` in `dir`.
+#[must_use]
+pub fn recording_path(dir: &Path, duration: f64) -> PathBuf {
+    dir.join(format!("throughput-{duration}.mcap"))
+}
+
+#[allow(clippy::cast_precision_loss)]
+fn rate(count: u64, seconds: f64) -> f64 {
+    count as f64 / seconds
+}
+
+#[allow(clippy::cast_precision_loss)]
+fn as_f64(x: u64) -> f64 {
+    x as f64
+}
+
+/// Record, bound and verify at one duration: `repeats` runs each, medians.
+///
+/// # Errors
+/// [`ThroughputError`] from any run.
+#[allow(clippy::cast_precision_loss)]
+pub fn record_and_verify(
+    options: &ThroughputOptions,
+    duration: f64,
+) -> Result<Vec<ThroughputRow>, ThroughputError> {
+    let path = recording_path(&options.dir, duration);
+    let (mut records, mut bounds, mut verifies) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..options.repeats.max(1) {
+        records.push(record_run(&options.exe, &path, duration)?);
+        bounds.push(compression_bound(&path)?);
+        verifies.push(verify_run(&options.exe, &path)?);
+    }
+    let last = records[records.len() - 1];
+    let bound = bounds[bounds.len() - 1];
+    let messages = last.messages;
+    let record_s = median(&records.iter().map(|r| r.seconds).collect::<Vec<_>>());
+    let bound_s = median(&bounds.iter().map(|b| b.seconds).collect::<Vec<_>>());
+    let verify_s = median(&verifies.iter().map(|v| v.seconds).collect::<Vec<_>>());
+    let peak = |runs: &mut dyn Iterator<Item = Option<u64>>| {
+        let v: Vec<f64> = runs.flatten().map(as_f64).collect();
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            median(&v)
+        }
+    };
+    let record_rss = peak(&mut records.iter().map(|r| r.peak_rss));
+    let verify_rss = peak(&mut verifies.iter().map(|v| v.peak_rss));
+    let workload = format!("record {SCENE} {duration} u @ 1 kHz, 7 channels, zstd");
+    let counts = format!("{messages} messages, {} JSON bytes", bound.json_bytes);
+    let row = |workload: &str, quantity: &str, value: f64, unit: &str, target, note: &str| {
+        ThroughputRow {
+            workload: workload.to_string(),
+            quantity: quantity.to_string(),
+            value,
+            unit: unit.to_string(),
+            target,
+            note: note.to_string(),
+        }
+    };
+    let bound_workload = format!(
+        "zstd bound {duration} u (level {ZSTD_LEVEL}, {} KiB chunks, 1 thread; recorder: {COMPRESSION_THREADS} worker(s))",
+        CHUNK_SIZE >> 10
+    );
+    let verify_workload = format!("verify {duration} u, every check");
+    Ok(vec![
+        row(
+            &workload,
+            "messages/s",
+            rate(messages, record_s),
+            "1/s",
+            Some(Target::AtLeast(targets::RECORD_MESSAGES_PER_SECOND)),
+            &format!("{counts}, {record_s:.3} s"),
+        ),
+        row(
+            &workload,
+            "JSON MB/s",
+            as_f64(bound.json_bytes) / record_s / 1e6,
+            "MB/s",
+            None,
+            "uncompressed message bytes per second",
+        ),
+        row(
+            &workload,
+            "file MB/s",
+            as_f64(last.bytes) / record_s / 1e6,
+            "MB/s",
+            None,
+            "file bytes per second",
+        ),
+        row(
+            &workload,
+            "file size",
+            as_f64(last.bytes),
+            "B",
+            None,
+            &format!(
+                "{:.1} B/message, JSON/file {:.2}",
+                as_f64(last.bytes) / as_f64(messages),
+                as_f64(bound.json_bytes) / as_f64(last.bytes)
+            ),
+        ),
+        row(
+            &workload,
+            "peak RSS",
+            record_rss,
+            "B",
+            Some(Target::Below(targets::PEAK_RSS_BYTES)),
+            "VmHWM of the record process",
+        ),
+        row(
+            &bound_workload,
+            "compression time",
+            bound_s,
+            "s",
+            None,
+            &format!(
+                "{:.0} MB/s, ratio {:.2}",
+                as_f64(bound.json_bytes) / bound_s / 1e6,
+                as_f64(bound.json_bytes) / as_f64(bound.compressed_bytes)
+            ),
+        ),
+        row(
+            &bound_workload,
+            "record time / bound",
+            record_s / bound_s,
+            "",
+            Some(Target::AtMost(targets::BOUND_RATIO)),
+            "",
+        ),
+        row(
+            &verify_workload,
+            "messages/s",
+            rate(messages, verify_s),
+            "1/s",
+            Some(Target::AtLeast(targets::VERIFY_MESSAGES_PER_SECOND)),
+            &format!("{verify_s:.3} s wall of the verify process"),
+        ),
+        row(
+            &verify_workload,
+            "peak RSS",
+            verify_rss,
+            "B",
+            Some(Target::Below(targets::PEAK_RSS_BYTES)),
+            "VmHWM of the verify process",
+        ),
+    ])
+}
+
+/// dop853 on `wobble` at the loosest tolerance meeting [`INTEGRATION_ERROR`], timed over
+/// [`INTEGRATION_RUNS`] runs per repeat, and one RHS evaluation.
+///
+/// # Errors
+/// [`ThroughputError`] if the reference cannot be built or no tolerance is accurate enough.
+pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, ThroughputError> {
+    let case = bench_case(SCENE)?;
+    let reference = reference_trajectory(&case)?;
+    let mut run = Trajectory::default();
+    let mut best = f64::INFINITY;
+    let mut chosen = None;
+    for atol in INTEGRATION_ATOLS {
+        let config = MethodConfig {
+            method: Method::Dop853,
+            rtol: rtol_for(atol),
+            atol,
+            step: 0.0,
+        };
+        run_sampled(&config, &case, &mut run);
+        let error = state_error(&case, &run, &reference);
+        best = best.min(error);
+        if run.completed() && error <= INTEGRATION_ERROR {
+            chosen = Some((config, error));
+            break;
+        }
+    }
+    let (config, error) = chosen.ok_or(ThroughputError::Accuracy { best })?;
+    let settings = RunSettings {
+        t0: 0.0,
+        t_end: case.duration,
+        sample_interval: case.duration,
+    };
+    let events = case.events();
+    let y0 = case.initial.to_array();
+    let mut stats = None;
+    let mut per_run = Vec::new();
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        for _ in 0..INTEGRATION_RUNS {
+            let outcome = run_method(
+                &config,
+                &case.coin,
+                black_box(&y0),
+                &settings,
+                &events,
+                |_, y| {
+                    black_box(y);
+                    Flow::Continue
+                },
+            );
+            stats = Some(outcome.stats);
+        }
+        per_run.push(start.elapsed().as_secs_f64() / f64::from(INTEGRATION_RUNS));
+    }
+    let mut per_rhs = Vec::new();
+    let mut dy = [0.0; crate::model::STATE_LEN];
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        for _ in 0..RHS_EVALUATIONS {
+            case.coin.derivative(black_box(&y0), black_box(&mut dy));
+        }
+        per_rhs.push(start.elapsed().as_secs_f64() / f64::from(RHS_EVALUATIONS));
+    }
+    let stats = stats.unwrap_or_default();
+    Ok(vec![
+        ThroughputRow {
+            workload: format!(
+                "integrate dop853 {SCENE} {} u, atol {:e} rtol {:e}",
+                case.duration, config.atol, config.rtol
+            ),
+            quantity: "wall time".into(),
+            value: median(&per_run),
+            unit: "s".into(),
+            target: Some(Target::Below(targets::INTEGRATION_SECONDS)),
+            note: format!(
+                "state error {error:.2e} ≤ {INTEGRATION_ERROR:e} vs dop853 atol 1e-16; {} steps, {} RHS evaluations",
+                stats.steps, stats.rhs_evaluations
+            ),
+        },
+        ThroughputRow {
+            workload: "Coin::derivative".into(),
+            quantity: "time per RHS evaluation".into(),
+            value: median(&per_rhs),
+            unit: "s".into(),
+            target: Some(Target::Below(targets::RHS_SECONDS)),
+            note: format!("{RHS_EVALUATIONS} evaluations per repeat"),
+        },
+    ])
+}
+
+/// The whole bench: record, bound and verify at every duration, then the integration cost.
+///
+/// # Errors
+/// [`ThroughputError`] from any workload.
+pub fn run(options: &ThroughputOptions) -> Result<ThroughputReport, ThroughputError> {
+    let mut rows = Vec::new();
+    for &duration in &options.durations {
+        rows.extend(record_and_verify(options, duration)?);
+    }
+    rows.extend(integration_cost(options.repeats)?);
+    Ok(ThroughputReport {
+        cores: std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+        rows,
+    })
+}
+
+/// The CSV header of `bench throughput`.
+pub const CSV_HEADER: &str = "workload,quantity,value,unit,target,met,note";
+
+/// A CSV field, quoted when it holds a comma or a quote.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The rows as CSV with [`CSV_HEADER`]; values as shortest round-trip numbers.
+#[must_use]
+pub fn csv(report: &ThroughputReport) -> String {
+    let mut out = String::from(CSV_HEADER);
+    out.push('\n');
+    for r in &report.rows {
+        let fields = [
+            csv_field(&r.workload),
+            csv_field(&r.quantity),
+            super::table::number(Some(r.value)),
+            csv_field(&r.unit),
+            r.target
+                .map_or_else(String::new, |t| csv_field(&t.to_string())),
+            r.met().map_or_else(String::new, |m| m.to_string()),
+            csv_field(&r.note),
+        ];
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// A value in its unit for people: rates as `2.41 M/s`, bytes as MiB, short times in µs or ns.
+#[must_use]
+pub fn human(value: f64, unit: &str) -> String {
+    if !value.is_finite() {
+        return "-".into();
+    }
+    match unit {
+        "1/s" => format!("{:.3} M/s", value / 1e6),
+        "B" => format!("{:.1} MiB", value / f64::from(1 << 20)),
+        "s" if value < 1e-6 => format!("{:.1} ns", value * 1e9),
+        "s" if value < 1e-3 => format!("{:.1} µs", value * 1e6),
+        "s" => format!("{value:.3} s"),
+        "" => format!("{value:.2}"),
+        other => format!("{value:.1} {other}"),
+    }
+}
+
+fn human_target(target: Target, unit: &str) -> String {
+    match target {
+        Target::AtLeast(t) => format!("≥ {}", human(t, unit)),
+        Target::Below(t) => format!("< {}", human(t, unit)),
+        Target::AtMost(t) => format!("≤ {}", human(t, unit)),
+    }
+}
+
+/// The rows as a text table.
+#[must_use]
+pub fn table(report: &ThroughputReport) -> String {
+    let header = ["workload", "quantity", "median", "target", "met", "note"];
+    let body: Vec<Vec<String>> = report
+        .rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.workload.clone(),
+                r.quantity.clone(),
+                human(r.value, &r.unit),
+                r.target
+                    .map_or_else(|| "-".into(), |t| human_target(t, &r.unit)),
+                r.met()
+                    .map_or_else(|| "-".into(), |m| if m { "yes" } else { "NO" }.into()),
+                r.note.clone(),
+            ]
+        })
+        .collect();
+    super::table::render(&header, &body)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn medians_of_odd_and_even_counts() {
+        assert!((median(&[3.0, 1.0, 2.0]) - 2.0).abs() < 1e-15);
+        assert!((median(&[4.0, 1.0, 2.0, 3.0]) - 2.5).abs() < 1e-15);
+        assert!(median(&[]).is_nan());
+    }
+
+    #[test]
+    fn targets_say_which_side_is_good() {
+        assert!(Target::AtLeast(2.0).met(2.0));
+        assert!(!Target::Below(2.0).met(2.0));
+        assert!(Target::AtMost(2.0).met(2.0));
+    }
+
+    #[test]
+    fn peak_rss_is_reported_on_linux() {
+        if cfg!(target_os = "linux") {
+            let rss = peak_rss_bytes().unwrap_or(0);
+            assert!(rss > 1 << 20, "VmHWM {rss} B");
+        }
+    }
+}
