@@ -607,7 +607,8 @@ pub struct DriftHistory {
     pub wall_seconds: f64,
 }
 
-/// The wobbling motion of the long-horizon case (issue 4's: θ₀ = 0.5, ω = (0.3, 0.2, 1.5)).
+/// The wobbling motion of issue 4 and of the built-in `wobble` scene (θ₀ = 0.5, ω = (0.3, 0.2, 1.5), unit
+/// thin disk): the long-horizon case here, and the motion of the integrator tests and benchmarks.
 #[must_use]
 pub fn wobble_state() -> State {
     State {
