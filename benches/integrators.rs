@@ -2,24 +2,15 @@
 //! ω = (0.3, 0.2, 1.5), 30 time units, sampled at 100 per unit) and of one C1/C2 evaluation, so that a
 //! speed regression shows next to the accuracy tests. CI only compiles them (`cargo bench --no-run`).
 
+use coin_log::bench::stability::wobble_state;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunSettings};
-use coin_log::model::{Chaplygin, Coin, CoinParams, State};
+use coin_log::model::{Chaplygin, Coin, CoinParams};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
-fn wobble() -> State {
-    State {
-        theta: 0.5,
-        omega_x: 0.3,
-        omega_y: 0.2,
-        omega_z: 1.5,
-        ..State::default()
-    }
-}
-
 fn integrators(c: &mut Criterion) {
     let coin = Coin::new(CoinParams::unit_disk());
-    let y0 = wobble().to_array();
+    let y0 = wobble_state().to_array();
     let settings = RunSettings {
         t0: 0.0,
         t_end: 30.0,

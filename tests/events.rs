@@ -1,8 +1,9 @@
 //! Events end a run at the right time: a coin released from rest falls about its contact point, and the
-//! energy integral (I_X + Ma²)·θ̇²/2 = Mga(cos θ₀ − cos θ) gives the time to reach any tilt by quadrature,
-//! independently of the integrators. The flat landing (|θ| = π/2 − flat_margin) and the lift-off
+//! energy integral (I_X + Ma²)·θ̇²/2 = Mga(cos θ₀ − cos θ) gives the time to reach any tilt by quadrature
+//! ([`release_time`], checked in its own unit tests), independently of the integrators. The flat landing (|θ| = π/2 − flat_margin) and the lift-off
 //! (N = 0, NOTES §3/§7) must be located at those times to 1e-9.
 
+use coin_log::bench::stability::release_time;
 use coin_log::integrate::{
     run_method, EventFunctions, Flow, Method, MethodConfig, RunSettings, Termination,
 };
@@ -15,63 +16,6 @@ const FLAT_MARGIN: f64 = 1e-4;
 
 /// Required agreement of the event time with the quadrature (issue 4).
 const TIME_TOLERANCE: f64 = 1e-9;
-
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on Pₙ from the Chebyshev guesses).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    #[allow(clippy::cast_precision_loss)]
-    let nf = n as f64;
-    (0..n)
-        .map(|i| {
-            #[allow(clippy::cast_precision_loss)]
-            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (nf + 0.5)).cos();
-            let mut derivative = 1.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    #[allow(clippy::cast_precision_loss)]
-                    let kf = k as f64;
-                    let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                derivative = nf * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / derivative;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * derivative * derivative))
-        })
-        .collect()
-}
-
-/// Time for a coin released at rest at θ₀ to reach θ₁, by quadrature of the energy integral:
-/// θ̇² = k (cos θ₀ − cos θ), k = 2Mga/(I_X + Ma²). The 1/√ singularity at θ₀ is removed by θ = θ₀ + u²,
-/// and cos θ₀ − cos θ = 2 sin(θ₀ + u²/2) sin(u²/2) keeps full precision near u = 0:
-/// t = ∫₀^√(θ₁−θ₀) 2u du / √(2k sin(θ₀ + u²/2) sin(u²/2)), composite 20-point Gauss–Legendre.
-fn quadrature_time(coin: &Coin, theta0: f64, theta1: f64) -> f64 {
-    let p = coin.params();
-    let k = 2.0 * p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
-    let integrand = |u: f64| {
-        let half = 0.5 * u * u;
-        2.0 * u / (2.0 * k * (theta0 + half).sin() * half.sin()).sqrt()
-    };
-    let rule = gauss_legendre(20);
-    let upper = (theta1 - theta0).sqrt();
-    let panels = 40;
-    #[allow(clippy::cast_precision_loss)]
-    let width = upper / panels as f64;
-    let mut sum = 0.0;
-    for j in 0..panels {
-        #[allow(clippy::cast_precision_loss)]
-        let mid = (j as f64 + 0.5) * width;
-        for &(x, w) in &rule {
-            sum += 0.5 * width * w * integrand(mid + 0.5 * width * x);
-        }
-    }
-    sum
-}
 
 /// Tilt where the falling coin's normal force vanishes: with c = cos θ and ω_Y = ω_Z = 0,
 /// N/M = g − a(ω_X² cos θ + ω̇_X sin θ) with ω_X² = k(c₀ − c), ω̇_X = (k/2) sin θ, so
@@ -148,7 +92,7 @@ fn configurations() -> Vec<MethodConfig> {
 fn check_event(config: &MethodConfig, theta0: f64, expected: PhysicalEvent, theta_event: f64) {
     let coin = Coin::new(CoinParams::unit_disk());
     let ended = release(config, theta0);
-    let t_expected = quadrature_time(&coin, theta0, theta_event);
+    let t_expected = release_time(&coin, theta0, theta_event);
     let error = (ended.t - t_expected).abs();
     println!(
         "{} θ₀ = {theta0}: {} at t = {:.15} (quadrature {t_expected:.15}, |Δt| = {error:.2e}, tolerance {TIME_TOLERANCE:.0e}); θ there {:.12} (expected {theta_event:.12})",
@@ -222,18 +166,6 @@ fn a_disk_released_at_0_2_without_spin_leaves_the_table_at_the_quadrature_time()
     for config in configurations() {
         check_event(&config, 0.2, PhysicalEvent::LiftOff, theta_lift);
     }
-}
-
-#[test]
-fn the_quadrature_agrees_with_the_closed_form_near_the_release_point() {
-    // For small θ − θ₀ the motion is θ ≈ θ₀ + (k sin θ₀/4) t², so t ≈ √(4(θ − θ₀)/(k sin θ₀)).
-    let coin = Coin::new(CoinParams::unit_disk());
-    let (theta0, dtheta) = (0.6, 1e-8);
-    let k = 1.6;
-    let expected = (4.0 * dtheta / (k * f64::sin(theta0))).sqrt();
-    let measured = quadrature_time(&coin, theta0, theta0 + dtheta);
-    println!("quadrature {measured:.15e} vs small-angle closed form {expected:.15e}");
-    assert!((measured / expected - 1.0).abs() < 1e-7);
 }
 
 /// y' = 1: trivial system for the driver's sampling rules.

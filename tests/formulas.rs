@@ -8,7 +8,7 @@ mod common;
 use coin_log::model::{
     centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State,
 };
-use common::{rate_unit, V3};
+use common::{rate_unit, wobbling, V3};
 
 /// Eighth-order central difference weights for the first derivative (offsets −4..4, times 1/H).
 const FD1: [f64; 9] = [
@@ -37,20 +37,6 @@ const FD2: [f64; 9] = [
 
 fn fd(weights: &[f64; 9], values: &[f64], i: usize, scale: f64) -> f64 {
     (0..9).map(|k| weights[k] * values[i + k - 4]).sum::<f64>() * scale
-}
-
-fn wobbling(p: &CoinParams) -> State {
-    let w = rate_unit(p);
-    State {
-        theta: 0.4,
-        phi: 0.3,
-        psi: -0.2,
-        omega_x: 0.35 * w,
-        omega_y: -0.6 * w,
-        omega_z: 2.2 * w,
-        x: 0.1 * p.radius(),
-        z: -0.2 * p.radius(),
-    }
 }
 
 fn cases() -> [(&'static str, CoinParams); 3] {

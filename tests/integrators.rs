@@ -2,6 +2,7 @@
 //! of convergence, energy conservation on the wobbling coin, bounded energy error of the symmetric
 //! method (with rk4 as the drifting control), dense output and behaviour at a finite-time blow-up.
 
+use coin_log::bench::stability::wobble_state;
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Stats, StepError,
     Termination,
@@ -288,14 +289,7 @@ fn every_method_shows_its_order_on_the_kepler_problem() {
 /// The wobbling unit thin disk of the issue: θ₀ = 0.5, ω = (0.3, 0.2, 1.5).
 fn wobbling_coin() -> (Coin, [f64; STATE_LEN]) {
     let coin = Coin::new(CoinParams::unit_disk());
-    let state = State {
-        theta: 0.5,
-        omega_x: 0.3,
-        omega_y: 0.2,
-        omega_z: 1.5,
-        ..State::default()
-    };
-    (coin, state.to_array())
+    (coin, wobble_state().to_array())
 }
 
 /// Samples of a run on a grid of `SAMPLES` points.

@@ -5,27 +5,13 @@
 
 mod common;
 
-use coin_log::model::{Coin, CoinParams, State};
-use common::rate_unit;
+use coin_log::model::{Coin, CoinParams};
+use common::{rate_unit, wobbling};
 
 /// Error floor below which a ratio is not trusted: 1e3 × machine epsilon (issue 3).
 const FLOOR: f64 = 1e3 * f64::EPSILON;
 /// Allowed deviation of the observed order from 4.
 const ORDER_SLACK: f64 = 0.15;
-
-fn wobbling(p: &CoinParams) -> State {
-    let w = rate_unit(p);
-    State {
-        theta: 0.4,
-        phi: 0.3,
-        psi: -0.2,
-        omega_x: 0.35 * w,
-        omega_y: -0.6 * w,
-        omega_z: 2.2 * w,
-        x: 0.1 * p.radius(),
-        z: -0.2 * p.radius(),
-    }
-}
 
 /// Largest component error, each scaled by its natural unit (radians, √(g/a), a).
 fn scaled_error(p: &CoinParams, y: &[f64; 8], reference: &[f64; 8]) -> f64 {

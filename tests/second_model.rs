@@ -10,7 +10,7 @@ use coin_log::integrate::{
 };
 use coin_log::model::{centre, contact_point, orientation, Coin, CoinParams, State, STATE_LEN};
 use common::newton_euler::{NewtonEuler, NE_LEN};
-use common::{max_diff, quat_distance, rate_unit, world_omega};
+use common::{max_diff, quat_distance, rate_unit, wobbling, world_omega};
 
 /// Duration of the comparison [time units of the parameters].
 const DURATION: f64 = 20.0;
@@ -21,21 +21,6 @@ const STEP_NATURAL: f64 = 5e-4;
 /// quaternion (dimensionless). Both models are exact up to rk4's truncation error (~1e-12 per unit time),
 /// so 1e-9 leaves room for error growth on a wobbling motion, and is ~1e8 below a sign error.
 const AGREEMENT: f64 = 1e-9;
-
-/// A generic wobbling state: lean 0.4, every ω component nonzero, in the body's natural rate unit.
-fn wobbling(p: &CoinParams) -> State {
-    let w = rate_unit(p);
-    State {
-        theta: 0.4,
-        phi: 0.3,
-        psi: -0.2,
-        omega_x: 0.35 * w,
-        omega_y: -0.6 * w,
-        omega_z: 2.2 * w,
-        x: 0.1 * p.radius(),
-        z: -0.2 * p.radius(),
-    }
-}
 
 /// The largest scaled disagreements between an 8-state angle model and the Newton–Euler model over the
 /// run, sampled 200 times: (centre, contact point, quaternion, world ω).

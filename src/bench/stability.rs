@@ -607,7 +607,8 @@ pub struct DriftHistory {
     pub wall_seconds: f64,
 }
 
-/// The wobbling motion of the long-horizon case (issue 4's: θ₀ = 0.5, ω = (0.3, 0.2, 1.5)).
+/// The wobbling motion of issue 4 and of the built-in `wobble` scene (θ₀ = 0.5, ω = (0.3, 0.2, 1.5), unit
+/// thin disk): the long-horizon case here, and the motion of the integrator tests and benchmarks.
 #[must_use]
 pub fn wobble_state() -> State {
     State {
@@ -894,4 +895,63 @@ pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError
 #[must_use]
 pub fn available(name: &str) -> bool {
     method_by_name(name).is_some()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{release_time, CoinParams};
+    use crate::model::Coin;
+
+    /// K = Mga/(I_X + Ma²) of the unit thin disk: 1/(1/4 + 1).
+    const UNIT_DISK_K: f64 = 0.8;
+
+    #[test]
+    fn the_release_time_agrees_with_the_closed_form_near_the_release_point() {
+        // For small θ − θ₀ the motion is θ ≈ θ₀ + (K sin θ₀/2) t², so t ≈ √(2(θ − θ₀)/(K sin θ₀)).
+        let coin = Coin::new(CoinParams::unit_disk());
+        let (theta0, dtheta) = (0.6, 1e-8);
+        let expected = (2.0 * dtheta / (UNIT_DISK_K * f64::sin(theta0))).sqrt();
+        let measured = release_time(&coin, theta0, theta0 + dtheta);
+        println!("quadrature {measured:.15e} vs small-angle closed form {expected:.15e}");
+        assert!((measured / expected - 1.0).abs() < 1e-7);
+    }
+
+    /// The same integral by another rule and another form of the integrand: composite Simpson on
+    /// t = ∫₀^√(θ₁−θ₀) 2v dv / √(2K(cos θ₀ − cos(θ₀ + v²))), whose value at v = 0 is its limit
+    /// 2/√(2K sin θ₀).
+    fn simpson_release_time(theta0: f64, theta1: f64, intervals: u32) -> f64 {
+        let k = UNIT_DISK_K;
+        let integrand = |v: f64| {
+            if v == 0.0 {
+                2.0 / (2.0 * k * theta0.sin()).sqrt()
+            } else {
+                2.0 * v / (2.0 * k * (theta0.cos() - (theta0 + v * v).cos())).sqrt()
+            }
+        };
+        let width = (theta1 - theta0).sqrt() / f64::from(intervals);
+        let mut sum = integrand(0.0) + integrand(width * f64::from(intervals));
+        for j in 1..intervals {
+            let weight = if j % 2 == 1 { 4.0 } else { 2.0 };
+            sum += weight * integrand(width * f64::from(j));
+        }
+        sum * width / 3.0
+    }
+
+    #[test]
+    fn the_release_time_agrees_with_simpsons_rule_on_the_direct_integrand() {
+        let coin = Coin::new(CoinParams::unit_disk());
+        for (theta0, theta1) in [
+            (0.6, std::f64::consts::FRAC_PI_2 - 1e-4),
+            (0.2, 1.07),
+            (1.0, 1.3),
+        ] {
+            let measured = release_time(&coin, theta0, theta1);
+            let expected = simpson_release_time(theta0, theta1, 20_000);
+            let relative = (measured / expected - 1.0).abs();
+            println!(
+                "θ₀ = {theta0}, θ₁ = {theta1}: Gauss–Legendre {measured:.15} vs Simpson {expected:.15}, relative difference {relative:.1e} (tolerance 1e-10)"
+            );
+            assert!(relative < 1e-10);
+        }
+    }
 }

@@ -1,8 +1,10 @@
 //! Pieces shared by the adaptive embedded pairs ([`Dopri5`](super::Dopri5), [`Dop853`](super::Dop853)):
-//! the mixed error norm, the initial step guess and the step-size controller of Hairer's codes
-//! (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4 and the Fortran `dopri5.f` / `dop853.f`).
+//! the mixed error norm, the initial step guess, the step-size controller of Hairer's codes
+//! (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4 and the Fortran `dopri5.f` / `dop853.f`),
+//! the step bookkeeping around the stages ([`StepSize`]), the tableau row sum and the cubic part of
+//! the continuous extension.
 
-use super::OdeSystem;
+use super::{OdeSystem, Stats, StepError};
 
 /// Smallest step relative to |t| before a step is declared an underflow: a step with 0.1·|h| ≤ ε·|t|
 /// (ε the unit round-off) no longer moves t by more than ~10 ulp, exactly the test of `dop853.f`.
@@ -16,6 +18,13 @@ const HINIT_FALLBACK_STEP: f64 = 1e-6;
 const HINIT_TARGET: f64 = 0.01;
 /// `hinit` treats second derivatives below this as zero.
 const HINIT_TINY_DERIVATIVE: f64 = 1e-15;
+
+/// Step shrink factor after a trial step produced non-finite values.
+const NON_FINITE_SHRINK: f64 = 0.1;
+
+/// A step is stretched by up to this factor to land on `t_limit` instead of leaving a sliver
+/// (`dopri5.f`, `dop853.f`).
+const LAST_STEP_STRETCH: f64 = 1.01;
 
 /// Per-component error weight sk = atol + rtol·max(|y₀ᵢ|, |y₁ᵢ|) (HNW I, eq. (4.10)).
 #[inline]
@@ -141,5 +150,169 @@ pub(crate) fn initial_step<const N: usize, S: OdeSystem<N>>(
         // f(t0 + h, y1) was not finite: start small and let the controller (and its non-finite
         // rejections) find a workable step.
         HINIT_FALLBACK_STEP.min(h_max)
+    }
+}
+
+/// The step size of an adaptive pair between steps, and what both pairs do around their stages: the
+/// trial step towards `t_limit`, the underflow test, and the new step after a rejection or an acceptance.
+#[derive(Debug, Clone)]
+pub(crate) struct StepSize {
+    controller: Controller,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+    /// Cap on the step set by the user, if any.
+    max_step: Option<f64>,
+    /// Cap on the step in this run: `max_step` or the whole span.
+    h_max: f64,
+    /// Next step to try.
+    h: f64,
+    control: ControllerState,
+}
+
+impl StepSize {
+    /// Not started yet.
+    pub fn new(controller: Controller, rtol: f64, atol: f64) -> Self {
+        Self {
+            controller,
+            rtol,
+            atol,
+            max_step: None,
+            h_max: f64::INFINITY,
+            h: 0.0,
+            control: ControllerState::default(),
+        }
+    }
+
+    /// Caps the step size (default: the whole span t_end − t0).
+    pub fn set_max_step(&mut self, max_step: f64) {
+        self.max_step = Some(max_step);
+    }
+
+    /// Resets the controller for a run from `t0` to `t_end`.
+    pub fn start(&mut self, t0: f64, t_end: f64) {
+        self.control = ControllerState::default();
+        self.h_max = self
+            .max_step
+            .unwrap_or(f64::INFINITY)
+            .min((t_end - t0).abs());
+    }
+
+    /// Sets the first step by [`initial_step`] for a method of order `order` (one right-hand side
+    /// evaluation).
+    pub fn guess_first_step<const N: usize, S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t0: f64,
+        y0: &[f64; N],
+        f0: &[f64; N],
+        order: i32,
+    ) {
+        self.h = initial_step(sys, t0, y0, f0, order, self.rtol, self.atol, self.h_max);
+    }
+
+    /// The next trial step from `t` as (h, t_new), or `None` when `t` has reached `t_limit`. A step
+    /// within 1 % of `t_limit` is stretched to end exactly there.
+    ///
+    /// # Errors
+    /// When the step no longer advances `t`: [`StepError::NonFinite`] if non-finite trials shrank it
+    /// (`non_finite`), [`StepError::StepSizeUnderflow`] otherwise.
+    #[inline]
+    pub fn trial(
+        &self,
+        t: f64,
+        t_limit: f64,
+        non_finite: bool,
+    ) -> Result<Option<(f64, f64)>, StepError> {
+        let remaining = t_limit - t;
+        if remaining <= 0.0 {
+            return Ok(None);
+        }
+        if step_underflows(t, self.h) {
+            return Err(if non_finite {
+                StepError::NonFinite { t }
+            } else {
+                StepError::StepSizeUnderflow { t, h: self.h }
+            });
+        }
+        Ok(Some(if t + LAST_STEP_STRETCH * self.h >= t_limit {
+            (remaining, t_limit)
+        } else {
+            (self.h, t + self.h)
+        }))
+    }
+
+    /// The trial step `h` produced non-finite values: shrink it and count the rejection.
+    #[inline]
+    pub fn reject_non_finite(&mut self, h: f64, stats: &mut Stats) {
+        stats.rejected_steps += 1;
+        self.control.rejected = true;
+        self.h = h * NON_FINITE_SHRINK;
+    }
+
+    /// The trial step `h` had scaled error `err` > 1: the controller shrinks it; count the rejection.
+    #[inline]
+    pub fn reject(&mut self, h: f64, err: f64, stats: &mut Stats) {
+        stats.rejected_steps += 1;
+        self.h = self.controller.rejected(&mut self.control, h, err);
+    }
+
+    /// The step `h` was accepted with scaled error `err` ≤ 1: the controller picks the next one.
+    #[inline]
+    pub fn accept(&mut self, h: f64, err: f64) {
+        self.h = self
+            .controller
+            .accepted(&mut self.control, h, err, self.h_max);
+    }
+}
+
+/// out = y + h·Σⱼ aⱼ·kⱼ over the non-zero entries of one tableau row.
+#[inline]
+pub(crate) fn combine<const N: usize>(
+    y: &[f64; N],
+    h: f64,
+    row: &[(usize, f64)],
+    k: &[[f64; N]],
+    out: &mut [f64; N],
+) {
+    for i in 0..N {
+        let mut sum = 0.0;
+        for &(j, a) in row {
+            sum += a * k[j][i];
+        }
+        out[i] = y[i] + h * sum;
+    }
+}
+
+/// The first four coefficients of the continuous extension over a step `h` from (y0, f0) to (y1, f1),
+/// the same in `dopri5.f` and `dop853.f` (`rcont1..4`): with the higher rows zero they are the cubic
+/// Hermite interpolant.
+#[inline]
+pub(crate) fn cubic_dense_output<const N: usize>(
+    h: f64,
+    y0: &[f64; N],
+    f0: &[f64; N],
+    y1: &[f64; N],
+    f1: &[f64; N],
+    dense: &mut [[f64; N]],
+) {
+    for i in 0..N {
+        let ydiff = y1[i] - y0[i];
+        let bspl = h * f0[i] - ydiff;
+        dense[0][i] = y0[i];
+        dense[1][i] = ydiff;
+        dense[2][i] = bspl;
+        dense[3][i] = ydiff - h * f1[i] - bspl;
+    }
+}
+
+/// Where `t` lies in the step of size `h` starting at `t_start`, as a fraction (0 for an empty step).
+#[inline]
+pub(crate) fn step_fraction(t: f64, t_start: f64, h: f64) -> f64 {
+    if h == 0.0 {
+        0.0
+    } else {
+        (t - t_start) / h
     }
 }

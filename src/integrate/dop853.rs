@@ -14,8 +14,7 @@
 // the source digit by digit; the compiler rounds them to the nearest f64.
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
-use super::control::{initial_step, step_underflows, weight, Controller, ControllerState};
-use super::dopri5::{combine, NON_FINITE_SHRINK};
+use super::control::{combine, cubic_dense_output, step_fraction, weight, Controller, StepSize};
 use super::{all_finite, OdeSystem, Stats, StepError, Stepper};
 
 /// Nodes c₁..c₁₆ (`c2..c16` of `dop853.f`; c₁₃ = 1 is the FSAL stage f(t + h, y₁)).
@@ -254,12 +253,7 @@ const ORDER: i32 = 8;
 /// The Dormand–Prince 8(5,3) method with error control and 7th-order dense output.
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
-    rtol: f64,
-    atol: f64,
-    max_step: Option<f64>,
-    h_max: f64,
-    h: f64,
-    control: ControllerState,
+    size: StepSize,
     t: f64,
     t_prev: f64,
     y: [f64; N],
@@ -279,12 +273,7 @@ impl<const N: usize> Dop853<N> {
     #[must_use]
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
-            rtol,
-            atol,
-            max_step: None,
-            h_max: f64::INFINITY,
-            h: 0.0,
-            control: ControllerState::default(),
+            size: StepSize::new(CONTROLLER, rtol, atol),
             t: 0.0,
             t_prev: 0.0,
             y: [0.0; N],
@@ -300,7 +289,7 @@ impl<const N: usize> Dop853<N> {
     /// Caps the step size (default: the whole span t_end − t0).
     #[must_use]
     pub fn with_max_step(mut self, max_step: f64) -> Self {
-        self.max_step = Some(max_step);
+        self.size.set_max_step(max_step);
         self
     }
 }
@@ -318,12 +307,8 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         self.y = *y0;
         self.y_prev = *y0;
         self.h_last = 0.0;
-        self.control = ControllerState::default();
+        self.size.start(t0, t_end);
         self.stats = Stats::default();
-        self.h_max = self
-            .max_step
-            .unwrap_or(f64::INFINITY)
-            .min((t_end - t0).abs());
         self.k = [[0.0; N]; 16];
         sys.rhs(t0, y0, &mut self.k[12]);
         self.k[0] = self.k[12];
@@ -334,16 +319,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         if !(all_finite(y0) && all_finite(&self.k[12])) {
             return Err(StepError::NonFinite { t: t0 });
         }
-        self.h = initial_step(
-            sys,
-            t0,
-            y0,
-            &self.k[12],
-            ORDER,
-            self.rtol,
-            self.atol,
-            self.h_max,
-        );
+        self.size.guess_first_step(sys, t0, y0, &self.k[12], ORDER);
         self.stats.rhs_evaluations += 1;
         Ok(())
     }
@@ -353,24 +329,9 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         let mut y_new = [0.0; N];
         let mut non_finite = false;
         loop {
-            let remaining = t_limit - self.t;
-            if remaining <= 0.0 {
+            let Some((h, t_new)) = self.size.trial(self.t, t_limit, non_finite)? else {
                 return Ok(());
-            }
-            if step_underflows(self.t, self.h) {
-                return Err(if non_finite {
-                    StepError::NonFinite { t: self.t }
-                } else {
-                    StepError::StepSizeUnderflow {
-                        t: self.t,
-                        h: self.h,
-                    }
-                });
-            }
-            // Stretch the step by up to 1 % to land on t_limit instead of leaving a sliver (dop853.f).
-            let last = self.t + 1.01 * self.h >= t_limit;
-            let h = if last { remaining } else { self.h };
-            let t_new = if last { t_limit } else { self.t + h };
+            };
 
             k[0] = self.k[12];
             let mut y_stage = [0.0; N];
@@ -386,7 +347,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
             let mut err5 = 0.0;
             let mut err3 = 0.0;
             for i in 0..N {
-                let sk = weight(self.rtol, self.atol, self.y[i], y_new[i]);
+                let sk = weight(self.size.rtol, self.size.atol, self.y[i], y_new[i]);
                 let b_sum: f64 = A[12].iter().map(|&(j, b)| b * k[j][i]).sum();
                 let e3 = b_sum - BHH.iter().map(|&(j, b)| b * k[j][i]).sum::<f64>();
                 let e5: f64 = ER.iter().map(|&(j, e)| e * k[j][i]).sum();
@@ -402,8 +363,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
 
             let finite = err.is_finite() && all_finite(&y_new);
             if finite && err > 1.0 {
-                self.stats.rejected_steps += 1;
-                self.h = CONTROLLER.rejected(&mut self.control, h, err);
+                self.size.reject(h, err, &mut self.stats);
                 continue;
             }
             if finite {
@@ -412,13 +372,11 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
             }
             if !finite || !all_finite(&k[12]) {
                 non_finite = true;
-                self.stats.rejected_steps += 1;
-                self.control.rejected = true;
-                self.h = h * NON_FINITE_SHRINK;
+                self.size.reject_non_finite(h, &mut self.stats);
                 continue;
             }
 
-            self.h = CONTROLLER.accepted(&mut self.control, h, err, self.h_max);
+            self.size.accept(h, err);
             self.t_prev = self.t;
             self.y_prev = self.y;
             self.t = t_new;
@@ -426,14 +384,14 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
             self.y = y_new;
             self.k[..13].copy_from_slice(&k);
             // The cubic Hermite part of the dense output is free; the rest waits for a request.
-            for i in 0..N {
-                let ydiff = self.y[i] - self.y_prev[i];
-                let bspl = h * self.k[0][i] - ydiff;
-                self.dense[0][i] = self.y_prev[i];
-                self.dense[1][i] = ydiff;
-                self.dense[2][i] = bspl;
-                self.dense[3][i] = ydiff - h * self.k[12][i] - bspl;
-            }
+            cubic_dense_output(
+                h,
+                &self.y_prev,
+                &self.k[0],
+                &self.y,
+                &self.k[12],
+                &mut self.dense,
+            );
             self.dense_ready = false;
             self.stats.steps += 1;
             return Ok(());
@@ -475,11 +433,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
     /// 7th-order dense output (`contd8` of `dop853.f`) once [`Stepper::prepare_interpolation`] ran for
     /// this step; the cubic Hermite interpolant (its first four terms) before that.
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
-        let s = if self.h_last == 0.0 {
-            0.0
-        } else {
-            (t - self.t_prev) / self.h_last
-        };
+        let s = step_fraction(t, self.t_prev, self.h_last);
         let s1 = 1.0 - s;
         let r = &self.dense;
         for i in 0..N {

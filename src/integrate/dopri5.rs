@@ -7,7 +7,7 @@
 //! with event location hooks, work statistics, no per-step heap allocation and correct behaviour at
 //! rtol 1e-13 (see also [`Dop853`](super::Dop853)).
 
-use super::control::{initial_step, step_underflows, weight, Controller, ControllerState};
+use super::control::{combine, cubic_dense_output, step_fraction, weight, Controller, StepSize};
 use super::{all_finite, OdeSystem, Stats, StepError, Stepper};
 
 /// Nodes cᵢ (HNW I, Table 5.2).
@@ -73,18 +73,10 @@ const CONTROLLER: Controller = Controller {
 /// Order used by the initial step guess (the propagated solution's order).
 const ORDER: i32 = 5;
 
-/// Step shrink factor after a trial step produced non-finite values.
-pub(crate) const NON_FINITE_SHRINK: f64 = 0.1;
-
 /// The Dormand–Prince 5(4) pair with error control and 4th-order dense output.
 #[derive(Debug, Clone)]
 pub struct Dopri5<const N: usize> {
-    rtol: f64,
-    atol: f64,
-    max_step: Option<f64>,
-    h_max: f64,
-    h: f64,
-    control: ControllerState,
+    size: StepSize,
     t: f64,
     t_prev: f64,
     y: [f64; N],
@@ -100,12 +92,7 @@ impl<const N: usize> Dopri5<N> {
     #[must_use]
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
-            rtol,
-            atol,
-            max_step: None,
-            h_max: f64::INFINITY,
-            h: 0.0,
-            control: ControllerState::default(),
+            size: StepSize::new(CONTROLLER, rtol, atol),
             t: 0.0,
             t_prev: 0.0,
             y: [0.0; N],
@@ -119,7 +106,7 @@ impl<const N: usize> Dopri5<N> {
     /// Caps the step size (default: the whole span t_end − t0).
     #[must_use]
     pub fn with_max_step(mut self, max_step: f64) -> Self {
-        self.max_step = Some(max_step);
+        self.size.set_max_step(max_step);
         self
     }
 }
@@ -136,12 +123,8 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         self.t_prev = t0;
         self.y = *y0;
         self.h_last = 0.0;
-        self.control = ControllerState::default();
+        self.size.start(t0, t_end);
         self.stats = Stats::default();
-        self.h_max = self
-            .max_step
-            .unwrap_or(f64::INFINITY)
-            .min((t_end - t0).abs());
         sys.rhs(t0, y0, &mut self.f);
         self.stats.rhs_evaluations += 1;
         for (i, row) in self.dense.iter_mut().enumerate() {
@@ -150,9 +133,7 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         if !(all_finite(y0) && all_finite(&self.f)) {
             return Err(StepError::NonFinite { t: t0 });
         }
-        self.h = initial_step(
-            sys, t0, y0, &self.f, ORDER, self.rtol, self.atol, self.h_max,
-        );
+        self.size.guess_first_step(sys, t0, y0, &self.f, ORDER);
         self.stats.rhs_evaluations += 1;
         Ok(())
     }
@@ -162,24 +143,9 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         let mut y_stage = [0.0; N];
         let mut non_finite = false;
         loop {
-            let remaining = t_limit - self.t;
-            if remaining <= 0.0 {
+            let Some((h, t_new)) = self.size.trial(self.t, t_limit, non_finite)? else {
                 return Ok(());
-            }
-            if step_underflows(self.t, self.h) {
-                return Err(if non_finite {
-                    StepError::NonFinite { t: self.t }
-                } else {
-                    StepError::StepSizeUnderflow {
-                        t: self.t,
-                        h: self.h,
-                    }
-                });
-            }
-            // Stretch the step by up to 1 % to land on t_limit instead of leaving a sliver (dopri5.f).
-            let last = self.t + 1.01 * self.h >= t_limit;
-            let h = if last { remaining } else { self.h };
-            let t_new = if last { t_limit } else { self.t + h };
+            };
 
             k[0] = self.f;
             for s in 1..7 {
@@ -192,7 +158,7 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
 
             let mut err = 0.0;
             for i in 0..N {
-                let sk = weight(self.rtol, self.atol, self.y[i], y_stage[i]);
+                let sk = weight(self.size.rtol, self.size.atol, self.y[i], y_stage[i]);
                 let e: f64 = E.iter().map(|&(j, e)| e * k[j][i]).sum();
                 err += (h * e / sk).powi(2);
             }
@@ -201,28 +167,20 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
 
             if !err.is_finite() || !all_finite(&y_stage) || !all_finite(&k[6]) {
                 non_finite = true;
-                self.stats.rejected_steps += 1;
-                self.control.rejected = true;
-                self.h = h * NON_FINITE_SHRINK;
+                self.size.reject_non_finite(h, &mut self.stats);
                 continue;
             }
             if err > 1.0 {
-                self.stats.rejected_steps += 1;
-                self.h = CONTROLLER.rejected(&mut self.control, h, err);
+                self.size.reject(h, err, &mut self.stats);
                 continue;
             }
 
             // Accepted: continuous extension (dopri5.f, after label 'dense output').
-            for i in 0..N {
-                let ydiff = y_stage[i] - self.y[i];
-                let bspl = h * k[0][i] - ydiff;
-                self.dense[0][i] = self.y[i];
-                self.dense[1][i] = ydiff;
-                self.dense[2][i] = bspl;
-                self.dense[3][i] = ydiff - h * k[6][i] - bspl;
-                self.dense[4][i] = h * D.iter().map(|&(j, d)| d * k[j][i]).sum::<f64>();
+            cubic_dense_output(h, &self.y, &k[0], &y_stage, &k[6], &mut self.dense);
+            for (i, r4) in self.dense[4].iter_mut().enumerate() {
+                *r4 = h * D.iter().map(|&(j, d)| d * k[j][i]).sum::<f64>();
             }
-            self.h = CONTROLLER.accepted(&mut self.control, h, err, self.h_max);
+            self.size.accept(h, err);
             self.t_prev = self.t;
             self.t = t_new;
             self.h_last = h;
@@ -243,11 +201,7 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         self.t_prev
     }
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
-        let s = if self.h_last == 0.0 {
-            0.0
-        } else {
-            (t - self.t_prev) / self.h_last
-        };
+        let s = step_fraction(t, self.t_prev, self.h_last);
         let s1 = 1.0 - s;
         let r = &self.dense;
         for i in 0..N {
@@ -256,23 +210,5 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
     }
     fn stats(&self) -> Stats {
         self.stats
-    }
-}
-
-/// out = y + h·Σⱼ aⱼ·kⱼ over the non-zero entries of one tableau row.
-#[inline]
-pub(crate) fn combine<const N: usize>(
-    y: &[f64; N],
-    h: f64,
-    row: &[(usize, f64)],
-    k: &[[f64; N]],
-    out: &mut [f64; N],
-) {
-    for i in 0..N {
-        let mut sum = 0.0;
-        for &(j, a) in row {
-            sum += a * k[j][i];
-        }
-        out[i] = y[i] + h * sum;
     }
 }

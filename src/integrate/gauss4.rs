@@ -12,7 +12,8 @@
 // Index loops over stages and components read like the formulas (Zᵢ, aᵢⱼ, J[i][j]).
 #![allow(clippy::needless_range_loop)]
 
-use super::{all_finite, hermite_interpolate, OdeSystem, Stats, StepError, Stepper};
+use super::fixed::FixedSteps;
+use super::{OdeSystem, Stats, StepError, Stepper};
 
 /// √3/6, the half-distance of the Gauss nodes from 1/2.
 const SQRT3_6: f64 = 0.288_675_134_594_812_882_254_574_390_250_978_7;
@@ -46,15 +47,7 @@ const JACOBIAN_INCREMENT: f64 = 1.490_116_119_384_765_6e-8;
 /// 2-stage Gauss–Legendre with a fixed step `h`. The last step is shortened to land on `t_limit`.
 #[derive(Debug, Clone)]
 pub struct Gauss4<const N: usize> {
-    h: f64,
-    t0: f64,
-    n: u64,
-    t: f64,
-    t_prev: f64,
-    y: [f64; N],
-    f: [f64; N],
-    y_prev: [f64; N],
-    f_prev: [f64; N],
+    steps: FixedSteps<N>,
     /// Stage increments of the last accepted step, to extrapolate the next step's starting guess.
     z_last: [[f64; N]; 2],
     /// Step of `z_last` (0 when there is none).
@@ -76,15 +69,7 @@ impl<const N: usize> Gauss4<N> {
     #[must_use]
     pub fn new(h: f64) -> Self {
         Self {
-            h,
-            t0: 0.0,
-            n: 0,
-            t: 0.0,
-            t_prev: 0.0,
-            y: [0.0; N],
-            f: [0.0; N],
-            y_prev: [0.0; N],
-            f_prev: [0.0; N],
+            steps: FixedSteps::new(h),
             z_last: [[0.0; N]; 2],
             h_z_last: 0.0,
             jacobian: vec![0.0; N * N],
@@ -99,17 +84,17 @@ impl<const N: usize> Gauss4<N> {
 
     /// J ≈ ∂f/∂y at (t, y) by forward differences from the known f(t, y); N evaluations.
     fn update_jacobian<S: OdeSystem<N>>(&mut self, sys: &S) {
-        let mut y = self.y;
+        let mut y = self.steps.y;
         let mut f = [0.0; N];
         for j in 0..N {
-            let delta = JACOBIAN_INCREMENT * self.y[j].abs().max(1.0);
-            y[j] = self.y[j] + delta;
-            let delta = y[j] - self.y[j]; // the increment actually representable
-            sys.rhs(self.t, &y, &mut f);
+            let delta = JACOBIAN_INCREMENT * self.steps.y[j].abs().max(1.0);
+            y[j] = self.steps.y[j] + delta;
+            let delta = y[j] - self.steps.y[j]; // the increment actually representable
+            sys.rhs(self.steps.t, &y, &mut f);
             for i in 0..N {
-                self.jacobian[i * N + j] = (f[i] - self.f[i]) / delta;
+                self.jacobian[i * N + j] = (f[i] - self.steps.f[i]) / delta;
             }
-            y[j] = self.y[j];
+            y[j] = self.steps.y[j];
         }
         self.stats.rhs_evaluations += N as u64;
         self.jacobian_stale = false;
@@ -201,7 +186,7 @@ impl<const N: usize> Gauss4<N> {
         } else {
             for (a, za) in z.iter_mut().enumerate() {
                 for (i, zi) in za.iter_mut().enumerate() {
-                    *zi = C[a] * h * self.f[i];
+                    *zi = C[a] * h * self.steps.f[i];
                 }
             }
         }
@@ -222,9 +207,9 @@ impl<const N: usize> Gauss4<N> {
         for iteration in 1..=MAX_ITERATIONS {
             for a in 0..2 {
                 for i in 0..N {
-                    y_stage[i] = self.y[i] + z[a][i];
+                    y_stage[i] = self.steps.y[i] + z[a][i];
                 }
-                sys.rhs(self.t + C[a] * h, &y_stage, &mut stage_f[a]);
+                sys.rhs(self.steps.t + C[a] * h, &y_stage, &mut stage_f[a]);
             }
             self.stats.rhs_evaluations += 2;
             for a in 0..2 {
@@ -243,7 +228,7 @@ impl<const N: usize> Gauss4<N> {
                 for i in 0..N {
                     let dz = self.work[a * N + i];
                     z[a][i] += dz;
-                    norm = norm.max(dz.abs() / self.y[i].abs().max(1.0));
+                    norm = norm.max(dz.abs() / self.steps.y[i].abs().max(1.0));
                 }
             }
             if !norm.is_finite() {
@@ -285,14 +270,6 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         y0: &[f64; N],
         _t_end: f64,
     ) -> Result<(), StepError> {
-        self.t0 = t0;
-        self.n = 0;
-        self.t = t0;
-        self.t_prev = t0;
-        self.y = *y0;
-        self.y_prev = *y0;
-        sys.rhs(t0, y0, &mut self.f);
-        self.f_prev = self.f;
         self.h_z_last = 0.0;
         self.jacobian_stale = true;
         self.h_lu = 0.0;
@@ -300,23 +277,12 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
             rhs_evaluations: 1,
             ..Stats::default()
         };
-        if all_finite(y0) && all_finite(&self.f) {
-            Ok(())
-        } else {
-            Err(StepError::NonFinite { t: t0 })
-        }
+        self.steps.start(sys, t0, y0)
     }
 
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
-        // Times as t0 + n·h (not accumulated) so that fixed steps land exactly on the sample grid.
-        #[allow(clippy::cast_precision_loss)]
-        let mut t_new = self.t0 + (self.n + 1) as f64 * self.h;
-        let mut full = true;
-        if t_new > t_limit {
-            t_new = t_limit;
-            full = false;
-        }
-        let h = t_new - self.t;
+        let end = self.steps.next_end(t_limit);
+        let h = end.0 - self.steps.t;
         // First attempt with the kept Jacobian; if it fails, once more with a fresh one.
         let mut failure = (0, f64::NAN);
         let mut solution = None;
@@ -346,10 +312,10 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         }
         let Some(z) = solution else {
             if failure.1.is_nan() {
-                return Err(StepError::NonFinite { t: self.t });
+                return Err(StepError::NonFinite { t: self.steps.t });
             }
             return Err(StepError::NewtonFailure {
-                t: self.t,
+                t: self.steps.t,
                 h,
                 iterations: failure.0,
                 residual: failure.1,
@@ -360,49 +326,27 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         // without two more evaluations (HLW, §VIII.6.3).
         let mut y_new = [0.0; N];
         for i in 0..N {
-            y_new[i] = self.y[i] + SQRT3 * (z[1][i] - z[0][i]);
+            y_new[i] = self.steps.y[i] + SQRT3 * (z[1][i] - z[0][i]);
         }
-        let mut f_new = [0.0; N];
-        sys.rhs(t_new, &y_new, &mut f_new);
-        self.stats.rhs_evaluations += 1;
-        if !(all_finite(&y_new) && all_finite(&f_new)) {
-            return Err(StepError::NonFinite { t: self.t });
-        }
-        self.t_prev = self.t;
-        self.y_prev = self.y;
-        self.f_prev = self.f;
-        self.t = t_new;
-        self.y = y_new;
-        self.f = f_new;
+        self.stats.rhs_evaluations += 1; // f(t_new, y_new), in `accept`
+        self.steps.accept(sys, end, &y_new)?;
         self.z_last = z;
         self.h_z_last = h;
-        if full {
-            self.n += 1;
-        }
         self.stats.steps += 1;
         Ok(())
     }
 
     fn t(&self) -> f64 {
-        self.t
+        self.steps.t
     }
     fn y(&self) -> &[f64; N] {
-        &self.y
+        &self.steps.y
     }
     fn t_previous(&self) -> f64 {
-        self.t_prev
+        self.steps.t_prev
     }
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
-        hermite_interpolate(
-            self.t_prev,
-            self.t - self.t_prev,
-            &self.y_prev,
-            &self.f_prev,
-            &self.y,
-            &self.f,
-            t,
-            out,
-        );
+        self.steps.interpolate(t, out);
     }
     fn stats(&self) -> Stats {
         self.stats

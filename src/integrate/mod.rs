@@ -11,6 +11,7 @@ mod control;
 mod dop853;
 mod dopri5;
 mod driver;
+mod fixed;
 mod gauss4;
 mod hermite;
 mod method;

@@ -10,7 +10,7 @@
 pub mod newton_euler;
 
 use coin_log::integrate::{OdeSystem, Rk4, Stepper};
-use coin_log::model::{CoinParams, Inertia};
+use coin_log::model::{CoinParams, Inertia, State};
 
 /// A world-frame vector (y up, NOTES §1).
 pub type V3 = [f64; 3];
@@ -153,6 +153,21 @@ pub fn general() -> CoinParams {
 /// The natural rate unit √(g/a) (NOTES §2).
 pub fn rate_unit(p: &CoinParams) -> f64 {
     (p.gravity() / p.radius()).sqrt()
+}
+
+/// A generic wobbling state: lean 0.4, every ω component nonzero, in the body's natural rate unit.
+pub fn wobbling(p: &CoinParams) -> State {
+    let w = rate_unit(p);
+    State {
+        theta: 0.4,
+        phi: 0.3,
+        psi: -0.2,
+        omega_x: 0.35 * w,
+        omega_y: -0.6 * w,
+        omega_z: 2.2 * w,
+        x: 0.1 * p.radius(),
+        z: -0.2 * p.radius(),
+    }
 }
 
 /// Integrates with the library's fixed-step rk4 for `steps` steps of `h`, keeping every `every`-th state

@@ -1,0 +1,129 @@
+//! What the fixed-step methods ([`Rk4`](super::Rk4), [`Gauss4`](super::Gauss4)) share: the step clock
+//! t0 + n·h and the two ends of the last accepted step with their derivatives, from which the cubic
+//! Hermite dense output interpolates.
+
+use super::{all_finite, hermite_interpolate, OdeSystem, StepError};
+
+/// Clock and last step of a fixed-step method. Only the stages differ between methods: they read the
+/// start of the step (`t`, `y`, `f`), and hand the new state to [`FixedSteps::accept`].
+#[derive(Debug, Clone)]
+pub(crate) struct FixedSteps<const N: usize> {
+    /// The fixed step.
+    h: f64,
+    /// Start of the run.
+    t0: f64,
+    /// Full steps taken since `t0`.
+    n: u64,
+    /// Time at the end of the last accepted step.
+    pub t: f64,
+    /// Time at the start of the last accepted step.
+    pub t_prev: f64,
+    /// State at `t`.
+    pub y: [f64; N],
+    /// f(t, y).
+    pub f: [f64; N],
+    /// State at `t_prev`.
+    pub y_prev: [f64; N],
+    /// f(t_prev, y_prev).
+    pub f_prev: [f64; N],
+}
+
+impl<const N: usize> FixedSteps<N> {
+    /// Not started yet; step `h` (> 0).
+    pub fn new(h: f64) -> Self {
+        Self {
+            h,
+            t0: 0.0,
+            n: 0,
+            t: 0.0,
+            t_prev: 0.0,
+            y: [0.0; N],
+            f: [0.0; N],
+            y_prev: [0.0; N],
+            f_prev: [0.0; N],
+        }
+    }
+
+    /// Starts the clock at `t0` with state `y0`, evaluating f(t0, y0) (one right-hand side evaluation).
+    ///
+    /// # Errors
+    /// [`StepError::NonFinite`] if y0 or f(t0, y0) is not finite.
+    pub fn start<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t0: f64,
+        y0: &[f64; N],
+    ) -> Result<(), StepError> {
+        self.t0 = t0;
+        self.n = 0;
+        self.t = t0;
+        self.t_prev = t0;
+        self.y = *y0;
+        self.y_prev = *y0;
+        sys.rhs(t0, y0, &mut self.f);
+        self.f_prev = self.f;
+        if all_finite(y0) && all_finite(&self.f) {
+            Ok(())
+        } else {
+            Err(StepError::NonFinite { t: t0 })
+        }
+    }
+
+    /// End of the next step and whether it is a full one: t0 + (n + 1)·h, or `t_limit` if that comes
+    /// first. Times are t0 + n·h (not accumulated) so that fixed steps land exactly on the sample grid.
+    #[inline]
+    pub fn next_end(&self, t_limit: f64) -> (f64, bool) {
+        #[allow(clippy::cast_precision_loss)]
+        let t_new = self.t0 + (self.n + 1) as f64 * self.h;
+        if t_new > t_limit {
+            (t_limit, false)
+        } else {
+            (t_new, true)
+        }
+    }
+
+    /// Accepts the step to (`t_new`, `y_new`) returned by [`FixedSteps::next_end`], evaluating
+    /// f(t_new, y_new) (one right-hand side evaluation).
+    ///
+    /// # Errors
+    /// [`StepError::NonFinite`] (at the start of the step, which is kept) if y_new or its derivative is
+    /// not finite.
+    #[inline]
+    pub fn accept<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        (t_new, full): (f64, bool),
+        y_new: &[f64; N],
+    ) -> Result<(), StepError> {
+        let mut f_new = [0.0; N];
+        sys.rhs(t_new, y_new, &mut f_new);
+        if !(all_finite(y_new) && all_finite(&f_new)) {
+            return Err(StepError::NonFinite { t: self.t });
+        }
+        self.t_prev = self.t;
+        self.y_prev = self.y;
+        self.f_prev = self.f;
+        self.t = t_new;
+        self.y = *y_new;
+        self.f = f_new;
+        if full {
+            self.n += 1;
+        }
+        Ok(())
+    }
+
+    /// Cubic Hermite dense output inside the last step.
+    #[inline]
+    pub fn interpolate(&self, t: f64, out: &mut [f64; N]) {
+        hermite_interpolate(
+            self.t_prev,
+            self.t - self.t_prev,
+            &self.y_prev,
+            &self.f_prev,
+            &self.y,
+            &self.f,
+            t,
+            out,
+        );
+    }
+}
