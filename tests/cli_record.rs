@@ -218,6 +218,26 @@ fn an_unwritable_folder_is_an_error_that_leaves_nothing_behind() {
 }
 
 #[test]
+fn a_folder_as_output_is_refused_before_recording_even_with_overwrite() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    let before = listing(dir.path());
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "-o", "out", "--overwrite"],
+    );
+    let err = stderr(&out);
+    println!("exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1);
+    assert!(
+        err.contains("`out` is a folder") && err.contains("wobble.mcap"),
+        "{err}"
+    );
+    assert_eq!(listing(dir.path()), before);
+    assert!(listing(&dir.path().join("out")).is_empty());
+}
+
+#[test]
 fn an_unknown_scene_name_lists_the_built_ins() {
     let dir = tempfile::tempdir().unwrap();
     let out = coin_log(dir.path(), &["record", "wobbel"]);

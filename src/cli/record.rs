@@ -149,6 +149,13 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)));
+    if target.is_dir() {
+        bail!(
+            "`{}` is a folder; give the recording a file name, e.g. -o {}",
+            target.display(),
+            target.join(format!("{}.mcap", source.stem)).display()
+        );
+    }
     if target.exists() && !args.overwrite {
         bail!(
             "`{}` already exists; pass --overwrite to replace it, or choose another file with -o",
