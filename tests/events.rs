@@ -261,3 +261,58 @@ fn an_observer_asking_to_stop_ends_the_run_at_that_sample() {
     assert_eq!(outcome.termination, Termination::Stopped { t: 1.0 });
     assert_eq!(count, 5);
 }
+
+/// An event when the clock's y reaches the value.
+struct Reaches(f64);
+impl EventFunctions<1> for Reaches {
+    fn count(&self) -> usize {
+        1
+    }
+    fn evaluate(&self, _t: f64, y: &[f64; 1], out: &mut [f64]) {
+        out[0] = self.0 - y[0];
+    }
+}
+
+#[test]
+fn an_event_just_after_a_grid_sample_never_repeats_a_nanosecond_of_log_time() {
+    for method in Method::ALL {
+        // The event falls 0.4 ns after the grid sample t = 0.5 (sample interval 0.01).
+        let at = 0.5 + 0.4e-9;
+        let config = MethodConfig {
+            method: *method,
+            rtol: 1e-12,
+            atol: 1e-14,
+            step: 1e-3,
+        };
+        let settings = RunSettings {
+            t0: 0.0,
+            t_end: 1.0,
+            sample_interval: 0.01,
+        };
+        let mut times = Vec::new();
+        let outcome = run_method(&config, &Clock, &[0.0], &settings, &Reaches(at), |t, _| {
+            times.push(coin_log::units::log_time(t).unwrap());
+            Flow::Continue
+        });
+        let Termination::Event { t, .. } = outcome.termination else {
+            panic!(
+                "{method}: expected the event, got {:?}",
+                outcome.termination
+            )
+        };
+        println!(
+            "{method}: event at {t} (expected {at}), last log times {:?}",
+            &times[times.len() - 3..]
+        );
+        assert!(
+            (t - at).abs() <= 1e-12,
+            "{method}: event at {t}, expected {at}"
+        );
+        assert!(
+            times.windows(2).all(|w| w[0] < w[1]),
+            "{method}: log times repeat: {:?}",
+            &times[times.len() - 3..]
+        );
+        assert_eq!(*times.last().unwrap(), 500_000_000);
+    }
+}

@@ -10,6 +10,11 @@ pub const MAX_EVENTS: usize = 8;
 /// ≤ 1e-10 and bisection to 1e-13 costs a few dozen cheap interpolations per event.
 const EVENT_TIME_TOLERANCE: f64 = 1e-13;
 
+/// Grid samples within this time before an event are dropped in favour of the sample at the event, so
+/// that no two samples round to the same nanosecond (CONTRACT: log_time = round(t·10⁹), strictly
+/// increasing per channel).
+pub const EVENT_SAMPLE_GAP: f64 = 2e-9;
+
 /// Scalar functions g_i(t, y) whose crossing from > 0 to ≤ 0 ends a run (flat landing, lift-off, ...).
 pub trait EventFunctions<const N: usize> {
     /// Number of functions (≤ [`MAX_EVENTS`]).
@@ -162,7 +167,9 @@ where
             if t_k > settings.t_end - grid_slack {
                 t_k = settings.t_end;
             }
-            if t_k > t_stop || (event.is_some() && t_k >= t_stop) {
+            // A grid sample closer than EVENT_SAMPLE_GAP before the event gives way to the event's own
+            // sample, so sample times stay apart by more than a nanosecond of log time.
+            if t_k > t_stop || (event.is_some() && t_k > t_stop - EVENT_SAMPLE_GAP) {
                 break;
             }
             #[allow(clippy::float_cmp)] // exact: a grid time that is the step's end uses y itself
@@ -186,10 +193,16 @@ where
             }
         }
         if let Some((index, t)) = event {
-            // The last sample is the state at the event.
-            stepper.interpolate(t, &mut buffer);
-            let _ = observe(t, &buffer);
-            return outcome(Termination::Event { index, t }, stepper, t);
+            // The last sample is the state at the event, unless a sample already stands within
+            // EVENT_SAMPLE_GAP before it (a grid point ending the previous step): that one is the event's
+            // sample to within the log time's nanosecond, and a second would repeat its log time.
+            if t - t_last >= EVENT_SAMPLE_GAP {
+                // (Locating the event prepared the dense output.)
+                stepper.interpolate(t, &mut buffer);
+                let _ = observe(t, &buffer);
+                t_last = t;
+            }
+            return outcome(Termination::Event { index, t }, stepper, t_last);
         }
         if reached_end {
             // Unreachable in practice (the grid loop emits t_end); kept so t_end is always sampled.
