@@ -286,3 +286,115 @@ fn write_a_long_recording() {
     let r = verify_file(std::path::Path::new(&path), &Options::default());
     println!("{}", show(&r));
 }
+
+/// Copies `wobble` recorded by `coin-log record` with schema `name` embedded as `edit` changed it (the JSON
+/// of this tool's schema file), every message unchanged; verifies the copy and prints the report.
+fn with_other_schema(name: &str, edit: impl Fn(&mut serde_json::Value)) -> FileReport {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), "wobble", &[]);
+    let other = dir.path().join("other-version.mcap");
+    let schema_of = |n: &str| {
+        let ours = coin_log::record::schema_bytes(n).unwrap().to_vec();
+        if n != name {
+            return ours;
+        }
+        let mut v: serde_json::Value = serde_json::from_slice(&ours).unwrap();
+        edit(&mut v);
+        let theirs = serde_json::to_vec_pretty(&v).unwrap();
+        assert_ne!(theirs, ours, "the edit must change the schema");
+        theirs
+    };
+    rewrite_with_schemas(&good, &other, &schema_of, |_| {});
+    let r = verify_file(&other, &Options::default());
+    println!("{}", show(&r));
+    r
+}
+
+#[test]
+fn a_schema_of_another_version_differing_only_in_descriptions_is_noted_and_the_file_verifies() {
+    let r = with_other_schema("coin_log.Energy", |v| {
+        v["description"] = "Energy, as an older coin-log described it.".into();
+        v["properties"]["total"]["description"] = "E = T + V.".into();
+    });
+    assert_eq!(r.exit_code, 0, "{}", show(&r));
+    let integrity = r.check(CheckId::Integrity).unwrap();
+    assert_eq!(integrity.status, Status::Pass);
+    assert!(
+        integrity.reason.contains(
+            "schema `coin_log.Energy` is another version than this tool's; the messages conform to it"
+        ),
+        "{}",
+        integrity.reason
+    );
+}
+
+#[test]
+fn a_schema_of_another_version_requiring_a_field_the_messages_lack_fails_integrity() {
+    let r = with_other_schema("coin_log.Energy", |v| {
+        v["properties"]["power"] = serde_json::json!({"type": "number"});
+        v["required"].as_array_mut().unwrap().push("power".into());
+    });
+    assert_eq!(r.exit_code, 1, "{}", show(&r));
+    let integrity = r.check(CheckId::Integrity).unwrap();
+    assert_eq!(integrity.status, Status::Fail);
+    assert!(
+        integrity.reason.contains(
+            "schema `coin_log.Energy` is another version than this tool's and requires `power`, which the messages lack"
+        ),
+        "{}",
+        integrity.reason
+    );
+}
+
+#[test]
+fn a_schema_of_another_version_forbidding_a_field_the_messages_have_fails_integrity() {
+    let r = with_other_schema("coin_log.Angles", |v| {
+        v["properties"].as_object_mut().unwrap().remove("psi");
+        v["required"].as_array_mut().unwrap().retain(|f| f != "psi");
+    });
+    assert_eq!(r.exit_code, 1, "{}", show(&r));
+    let integrity = r.check(CheckId::Integrity).unwrap();
+    assert_eq!(integrity.status, Status::Fail);
+    assert!(
+        integrity.reason.contains(
+            "schema `coin_log.Angles` is another version than this tool's and forbids `psi`, which the messages have"
+        ),
+        "{}",
+        integrity.reason
+    );
+}
+
+#[test]
+fn a_schema_of_another_version_with_an_extra_optional_field_still_validates_the_messages() {
+    let r = with_other_schema("coin_log.Energy", |v| {
+        v["properties"]["power"] = serde_json::json!({"type": "number"});
+        v["required"].as_array_mut().unwrap().retain(|f| f != "t");
+    });
+    assert_eq!(r.exit_code, 0, "{}", show(&r));
+    let integrity = r.check(CheckId::Integrity).unwrap();
+    assert_eq!(integrity.status, Status::Pass);
+    assert!(
+        integrity.reason.contains(
+            "schema `coin_log.Energy` is another version than this tool's; the messages conform to it"
+        ),
+        "{}",
+        integrity.reason
+    );
+}
+
+#[test]
+fn a_schema_of_another_version_typing_a_field_as_a_string_fails_integrity() {
+    let r = with_other_schema("coin_log.AngularVelocity", |v| {
+        v["properties"]["z"]["type"] = "string".into();
+    });
+    assert_eq!(r.exit_code, 1, "{}", show(&r));
+    let integrity = r.check(CheckId::Integrity).unwrap();
+    assert_eq!(integrity.status, Status::Fail);
+    assert!(
+        integrity.reason.contains(
+            "schema `coin_log.AngularVelocity` is another version than this tool's and types `z` as \"string\", the messages have a number"
+        ),
+        "{}",
+        integrity.reason
+    );
+}

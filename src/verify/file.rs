@@ -92,38 +92,39 @@ fn fields_of(schema: &str) -> Option<&'static [&'static str]> {
     })
 }
 
-/// Whether a JSON schema of another version describes exactly `fields`, all required numbers, closed.
-fn shape_matches(data: &[u8], fields: &[&str]) -> Result<(), String> {
-    let v: serde_json::Value =
-        serde_json::from_slice(data).map_err(|e| format!("is not JSON: {e}"))?;
-    let props = v
-        .get("properties")
-        .and_then(serde_json::Value::as_object)
-        .ok_or("has no `properties`")?;
-    let mut names: Vec<&str> = props.keys().map(String::as_str).collect();
-    names.sort_unstable();
-    let mut want: Vec<&str> = fields.to_vec();
-    want.sort_unstable();
-    if names != want {
-        return Err(format!(
-            "has properties {names:?}, the message type has {want:?}"
-        ));
-    }
-    for (k, p) in props {
-        if p.get("type").and_then(serde_json::Value::as_str) != Some("number") {
-            return Err(format!("types `{k}` as something other than a number"));
+/// Whether a JSON schema of another version validates the messages of a type with `fields`: the integrity
+/// check parses every message strictly into its type, so a message that parses has exactly `fields`, each a
+/// number, and it conforms to the schema when the schema requires none but `fields`, types each of them
+/// (where it types it) as a number, and does not forbid (`additionalProperties: false`) one it leaves out.
+fn validates(data: &[u8], fields: &[&str]) -> Result<(), String> {
+    use serde_json::Value;
+    let v: Value = serde_json::from_slice(data).map_err(|e| format!("is not JSON: {e}"))?;
+    if let Some(t) = v.get("type") {
+        if t.as_str() != Some("object") {
+            return Err(format!("types the messages as {t}, not an object"));
         }
     }
-    let required: Vec<&str> = v
-        .get("required")
-        .and_then(serde_json::Value::as_array)
-        .map(|r| r.iter().filter_map(serde_json::Value::as_str).collect())
-        .unwrap_or_default();
-    if let Some(missing) = fields.iter().find(|f| !required.contains(f)) {
-        return Err(format!("does not require `{missing}`"));
+    let props = v.get("properties").and_then(Value::as_object);
+    let required = v.get("required").and_then(Value::as_array);
+    for r in required.into_iter().flatten() {
+        let r = r
+            .as_str()
+            .ok_or("has a `required` entry that is not a string")?;
+        if !fields.contains(&r) {
+            return Err(format!("requires `{r}`, which the messages lack"));
+        }
     }
-    if v.get("additionalProperties") != Some(&serde_json::Value::Bool(false)) {
-        return Err("allows additional properties".into());
+    let closed = v.get("additionalProperties") == Some(&Value::Bool(false));
+    for f in fields {
+        match props.and_then(|p| p.get(*f)) {
+            Some(p) => match p.get("type") {
+                None => {}
+                Some(t) if t.as_str() == Some("number") => {}
+                Some(t) => return Err(format!("types `{f}` as {t}, the messages have a number")),
+            },
+            None if closed => return Err(format!("forbids `{f}`, which the messages have")),
+            None => {}
+        }
     }
     Ok(())
 }
@@ -251,9 +252,9 @@ impl Visitor for Judge {
         match schema_bytes(name) {
             Some(ours) if ours == data => {}
             Some(_) => match fields_of(name) {
-                Some(fields) => match shape_matches(data, fields) {
+                Some(fields) => match validates(data, fields) {
                     Ok(()) => self.notes.push(format!(
-                        "schema `{name}` is another version than this tool's, with the same message shape"
+                        "schema `{name}` is another version than this tool's; the messages conform to it"
                     )),
                     Err(e) => self.problems.push_with(|| {
                         format!("schema `{name}` is another version than this tool's and {e}")

@@ -97,13 +97,14 @@ fn add_channel(
     w: &mut mcap::Writer<BufWriter<std::fs::File>>,
     schemas: &mut BTreeMap<&'static str, u16>,
     c: Channel,
+    schema_of: &dyn Fn(&str) -> Vec<u8>,
 ) -> u16 {
     let name = c.schema_name();
     let schema = match schemas.get(name) {
         Some(id) => *id,
         None => {
             let id = w
-                .add_schema(name, SCHEMA_ENCODING, schema_bytes(name).unwrap())
+                .add_schema(name, SCHEMA_ENCODING, &schema_of(name))
                 .unwrap();
             schemas.insert(name, id);
             id
@@ -239,7 +240,7 @@ pub fn record(spec: &Spec, path: &Path) {
     let ids: Vec<(Channel, u16)> = spec
         .channels
         .iter()
-        .map(|c| (*c, add_channel(&mut w, &mut schemas, *c)))
+        .map(|c| (*c, add_channel(&mut w, &mut schemas, *c, &tool_schema)))
         .collect();
     let mut sequence = 0u32;
     let config = MethodConfig {
@@ -302,9 +303,24 @@ pub struct Edit<'a> {
     pub data: &'a mut Vec<u8>,
 }
 
+/// This tool's bytes of schema `name`.
+fn tool_schema(name: &str) -> Vec<u8> {
+    schema_bytes(name).unwrap().to_vec()
+}
+
 /// Copies the coin-log MCAP `src` to `dst` (same metadata, channels, message order), letting `edit`
 /// change each message (its index counts messages of the same topic from 0).
-pub fn rewrite(src: &Path, dst: &Path, mut edit: impl FnMut(Edit<'_>)) {
+pub fn rewrite(src: &Path, dst: &Path, edit: impl FnMut(Edit<'_>)) {
+    rewrite_with_schemas(src, dst, &tool_schema, edit);
+}
+
+/// [`rewrite`], embedding `schema_of(name)` as the bytes of each schema (e.g. another version's).
+pub fn rewrite_with_schemas(
+    src: &Path,
+    dst: &Path,
+    schema_of: &dyn Fn(&str) -> Vec<u8>,
+    mut edit: impl FnMut(Edit<'_>),
+) {
     let bytes = std::fs::read(src).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let metadata: Vec<mcap::records::Metadata> = summary
@@ -328,7 +344,12 @@ pub fn rewrite(src: &Path, dst: &Path, mut edit: impl FnMut(Edit<'_>)) {
         let m = m.unwrap();
         let topic = m.channel.topic.clone();
         let id = *ids.entry(topic.clone()).or_insert_with(|| {
-            add_channel(&mut w, &mut schemas, Channel::from_topic(&topic).unwrap())
+            add_channel(
+                &mut w,
+                &mut schemas,
+                Channel::from_topic(&topic).unwrap(),
+                schema_of,
+            )
         });
         let index = counts.entry(topic.clone()).or_insert(0);
         let mut data = m.data.to_vec();
