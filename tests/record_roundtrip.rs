@@ -4,15 +4,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common_record;
+mod support;
 
 use coin_log::integrate::{run_method, Flow, RunSettings};
-use coin_log::model::{
-    centre, contact_point, energy, orientation, reaction, Chaplygin, State, STATE_LEN,
-};
-use coin_log::record::messages::{
-    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage,
-};
+use coin_log::model::{Chaplygin, State, STATE_LEN};
 use coin_log::record::{
     self, run_metadata, Channel, Compression, Foxglove3d, FoxgloveBatch, RecordOptions,
     RecordSummary, ResultMetadata, RunMetadata, Termination, RESULT_METADATA_NAME,
@@ -24,6 +19,7 @@ use coin_log::units::log_time;
 use common_record::{read_back, schema_file, validate_flat, ReadBack};
 use std::io::{Cursor, Seek, SeekFrom, Write};
 use std::sync::atomic::AtomicBool;
+use support::{message_json, COIN_CHANNELS};
 
 /// Longest duration used here, so that every built-in scene is exercised quickly.
 const TEST_DURATION: f64 = 4.0;
@@ -50,7 +46,8 @@ fn record_to_memory(scene: &Scene, options: &RecordOptions) -> (Vec<u8>, RecordS
     (cursor.into_inner(), summary)
 }
 
-/// The messages the recorder should write, computed here from the model and the message types.
+/// The messages the recorder should write, computed here from the model and the message types
+/// (`support::message_json`, which shares no code with the recorder).
 fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
     let coin = scene.coin();
     let settings = RunSettings {
@@ -80,101 +77,11 @@ fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
     for (k, (t, y)) in samples.iter().enumerate() {
         let (t, s) = (*t, State::from_array(y));
         let ns = log_time(t).expect("log time");
-        let mut push = |channel: Channel, write: &dyn Fn(&mut Vec<u8>)| {
+        for channel in COIN_CHANNELS {
             if scene.records(channel) {
-                let mut buf = Vec::new();
-                write(&mut buf);
-                out.push((channel, ns, buf));
+                out.push((channel, ns, message_json(&coin, &chaplygin, channel, t, &s)));
             }
-        };
-        push(Channel::Omega, &|b| {
-            AngularVelocity {
-                t,
-                x: s.omega_x,
-                y: s.omega_y,
-                z: s.omega_z,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Angles, &|b| {
-            Angles {
-                t,
-                theta: s.theta,
-                phi: s.phi,
-                psi: s.psi,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Quaternion, &|b| {
-            let q = orientation(&s);
-            QuaternionMessage {
-                t,
-                x: q.x,
-                y: q.y,
-                z: q.z,
-                w: q.w,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Position, &|b| {
-            let c = centre(&coin, &s);
-            Position {
-                t,
-                x: c.x,
-                y: c.y,
-                z: c.z,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Contact, &|b| {
-            let c = contact_point(&coin, &s);
-            Position {
-                t,
-                x: c.x,
-                y: c.y,
-                z: c.z,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Reaction, &|b| {
-            let r = reaction(&coin, &s);
-            ReactionMessage {
-                t,
-                x: r.force.x,
-                y: r.force.y,
-                z: r.force.z,
-                friction: r.friction,
-                normal: r.normal,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Energy, &|b| {
-            let e = energy(&coin, &s);
-            EnergyMessage {
-                t,
-                total: e.total,
-                kinetic: e.kinetic,
-                potential: e.potential,
-            }
-            .write_json(b)
-            .unwrap()
-        });
-        push(Channel::Invariants, &|b| {
-            let c = chaplygin.of_state(&s);
-            InvariantsMessage {
-                t,
-                c1: c.c1,
-                c2: c.c2,
-            }
-            .write_json(b)
-            .unwrap()
-        });
+        }
         if tf || scene_on {
             batch.clear();
             foxglove.sample(t, ns, &s, k == last, &mut batch).unwrap();

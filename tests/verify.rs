@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod common_verify;
+mod support;
 
 use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status};
 use common_verify::*;
@@ -310,21 +311,25 @@ fn with_other_schema(name: &str, edit: impl Fn(&mut serde_json::Value)) -> FileR
     r
 }
 
+/// Asserts the exit code, the integrity status and that the integrity reason contains `text`.
+fn assert_integrity(r: &FileReport, exit_code: u8, status: Status, text: &str) {
+    let integrity = r.check(CheckId::Integrity).unwrap();
+    assert_eq!(r.exit_code, exit_code, "{}", show(r));
+    assert_eq!(integrity.status, status, "{}", show(r));
+    assert!(integrity.reason.contains(text), "{}", integrity.reason);
+}
+
 #[test]
 fn a_schema_of_another_version_differing_only_in_descriptions_is_noted_and_the_file_verifies() {
     let r = with_other_schema("coin_log.Energy", |v| {
         v["description"] = "Energy, as an older coin-log described it.".into();
         v["properties"]["total"]["description"] = "E = T + V.".into();
     });
-    assert_eq!(r.exit_code, 0, "{}", show(&r));
-    let integrity = r.check(CheckId::Integrity).unwrap();
-    assert_eq!(integrity.status, Status::Pass);
-    assert!(
-        integrity.reason.contains(
-            "schema `coin_log.Energy` is another version than this tool's; the messages conform to it"
-        ),
-        "{}",
-        integrity.reason
+    assert_integrity(
+        &r,
+        0,
+        Status::Pass,
+        "schema `coin_log.Energy` is another version than this tool's; the messages conform to it",
     );
 }
 
@@ -334,16 +339,7 @@ fn a_schema_of_another_version_requiring_a_field_the_messages_lack_fails_integri
         v["properties"]["power"] = serde_json::json!({"type": "number"});
         v["required"].as_array_mut().unwrap().push("power".into());
     });
-    assert_eq!(r.exit_code, 1, "{}", show(&r));
-    let integrity = r.check(CheckId::Integrity).unwrap();
-    assert_eq!(integrity.status, Status::Fail);
-    assert!(
-        integrity.reason.contains(
-            "schema `coin_log.Energy` is another version than this tool's and requires `power`, which the messages lack"
-        ),
-        "{}",
-        integrity.reason
-    );
+    assert_integrity(&r, 1, Status::Fail, "schema `coin_log.Energy` is another version than this tool's and requires `power`, which the messages lack");
 }
 
 #[test]
@@ -352,16 +348,7 @@ fn a_schema_of_another_version_forbidding_a_field_the_messages_have_fails_integr
         v["properties"].as_object_mut().unwrap().remove("psi");
         v["required"].as_array_mut().unwrap().retain(|f| f != "psi");
     });
-    assert_eq!(r.exit_code, 1, "{}", show(&r));
-    let integrity = r.check(CheckId::Integrity).unwrap();
-    assert_eq!(integrity.status, Status::Fail);
-    assert!(
-        integrity.reason.contains(
-            "schema `coin_log.Angles` is another version than this tool's and forbids `psi`, which the messages have"
-        ),
-        "{}",
-        integrity.reason
-    );
+    assert_integrity(&r, 1, Status::Fail, "schema `coin_log.Angles` is another version than this tool's and forbids `psi`, which the messages have");
 }
 
 #[test]
@@ -370,15 +357,11 @@ fn a_schema_of_another_version_with_an_extra_optional_field_still_validates_the_
         v["properties"]["power"] = serde_json::json!({"type": "number"});
         v["required"].as_array_mut().unwrap().retain(|f| f != "t");
     });
-    assert_eq!(r.exit_code, 0, "{}", show(&r));
-    let integrity = r.check(CheckId::Integrity).unwrap();
-    assert_eq!(integrity.status, Status::Pass);
-    assert!(
-        integrity.reason.contains(
-            "schema `coin_log.Energy` is another version than this tool's; the messages conform to it"
-        ),
-        "{}",
-        integrity.reason
+    assert_integrity(
+        &r,
+        0,
+        Status::Pass,
+        "schema `coin_log.Energy` is another version than this tool's; the messages conform to it",
     );
 }
 
@@ -387,14 +370,5 @@ fn a_schema_of_another_version_typing_a_field_as_a_string_fails_integrity() {
     let r = with_other_schema("coin_log.AngularVelocity", |v| {
         v["properties"]["z"]["type"] = "string".into();
     });
-    assert_eq!(r.exit_code, 1, "{}", show(&r));
-    let integrity = r.check(CheckId::Integrity).unwrap();
-    assert_eq!(integrity.status, Status::Fail);
-    assert!(
-        integrity.reason.contains(
-            "schema `coin_log.AngularVelocity` is another version than this tool's and types `z` as \"string\", the messages have a number"
-        ),
-        "{}",
-        integrity.reason
-    );
+    assert_integrity(&r, 1, Status::Fail, "schema `coin_log.AngularVelocity` is another version than this tool's and types `z` as \"string\", the messages have a number");
 }

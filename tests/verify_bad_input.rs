@@ -5,6 +5,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod common_verify;
+mod support;
 
 use common_verify::*;
 use std::path::Path;

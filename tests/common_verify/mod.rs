@@ -1,19 +1,17 @@
-//! Test helpers for `verify`: coin-log recordings written with the mcap crate straight from the model (until
-//! the recorder is used), and rewriting a file with one message changed (negative controls).
+//! Test helpers for `verify`: coin-log recordings written with the mcap crate straight from the model (files
+//! the recorder cannot make: odd channel sets, small or uncompressed chunks), and rewriting a file with one
+//! message or schema changed (negative controls). The message JSON and the MCAP registration come from
+//! tests/support: a test crate using this module declares `mod support;` too.
+
+// Every tests/*.rs is its own crate and uses only some of these helpers: the rest are dead code there.
+// Test helpers panic on any setup failure by design.
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
 
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
 use coin_log::model::invariants::Chaplygin;
-use coin_log::model::{
-    centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State, Steady,
-};
-use coin_log::record::messages::{
-    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage,
-};
+use coin_log::model::{Coin, CoinParams, State, Steady};
 use coin_log::record::{
-    schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
-    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use coin_log::simulation::CoinEvents;
 use coin_log::units::log_time;
@@ -21,17 +19,7 @@ use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-/// The channels written by [`record`] (no Foxglove channels).
-pub const CHANNELS: [Channel; 8] = [
-    Channel::Omega,
-    Channel::Angles,
-    Channel::Quaternion,
-    Channel::Position,
-    Channel::Contact,
-    Channel::Reaction,
-    Channel::Energy,
-    Channel::Invariants,
-];
+use crate::support::{add_channel, message_json, tool_schema, write_message, COIN_CHANNELS};
 
 /// What to record.
 #[derive(Debug, Clone)]
@@ -64,7 +52,7 @@ pub fn wobble() -> Spec {
         duration: 10.0,
         rate: 100.0,
         step: 1e-3,
-        channels: CHANNELS.to_vec(),
+        channels: COIN_CHANNELS.to_vec(),
         compression: Some(mcap::Compression::Zstd),
         chunk_size: None,
         method: Method::Dop853,
@@ -91,108 +79,6 @@ pub fn steady_circle() -> Spec {
         steady: Some(steady),
         ..wobble()
     }
-}
-
-fn add_channel(
-    w: &mut mcap::Writer<BufWriter<std::fs::File>>,
-    schemas: &mut BTreeMap<&'static str, u16>,
-    c: Channel,
-    schema_of: &dyn Fn(&str) -> Vec<u8>,
-) -> u16 {
-    let name = c.schema_name();
-    let schema = match schemas.get(name) {
-        Some(id) => *id,
-        None => {
-            let id = w
-                .add_schema(name, SCHEMA_ENCODING, &schema_of(name))
-                .unwrap();
-            schemas.insert(name, id);
-            id
-        }
-    };
-    w.add_channel(schema, c.topic(), MESSAGE_ENCODING, &BTreeMap::new())
-        .unwrap()
-}
-
-/// The JSON of channel `c` at state `s`, time `t`.
-pub fn message_json(coin: &Coin, c: Channel, t: f64, s: &State) -> Vec<u8> {
-    let mut buf = Vec::new();
-    match c {
-        Channel::Omega => AngularVelocity {
-            t,
-            x: s.omega_x,
-            y: s.omega_y,
-            z: s.omega_z,
-        }
-        .write_json(&mut buf),
-        Channel::Angles => Angles {
-            t,
-            theta: s.theta,
-            phi: s.phi,
-            psi: s.psi,
-        }
-        .write_json(&mut buf),
-        Channel::Quaternion => {
-            let q = orientation(s);
-            QuaternionMessage {
-                t,
-                x: q.x,
-                y: q.y,
-                z: q.z,
-                w: q.w,
-            }
-            .write_json(&mut buf)
-        }
-        Channel::Position | Channel::Contact => {
-            let p = if c == Channel::Position {
-                centre(coin, s)
-            } else {
-                contact_point(coin, s)
-            };
-            Position {
-                t,
-                x: p.x,
-                y: p.y,
-                z: p.z,
-            }
-            .write_json(&mut buf)
-        }
-        Channel::Reaction => {
-            let r = reaction(coin, s);
-            ReactionMessage {
-                t,
-                x: r.force.x,
-                y: r.force.y,
-                z: r.force.z,
-                friction: r.friction,
-                normal: r.normal,
-            }
-            .write_json(&mut buf)
-        }
-        Channel::Energy => {
-            let e = energy(coin, s);
-            EnergyMessage {
-                t,
-                total: e.total,
-                kinetic: e.kinetic,
-                potential: e.potential,
-            }
-            .write_json(&mut buf)
-        }
-        Channel::Invariants => {
-            let chaplygin = Chaplygin::new(coin.params()).unwrap();
-            let i = chaplygin.of_state(s);
-            InvariantsMessage {
-                t,
-                c1: i.c1,
-                c2: i.c2,
-            }
-            .write_json(&mut buf)
-        }
-        _ => panic!("channel {c} not written by the test recorder"),
-    }
-    .unwrap();
-    buf
 }
 
 /// Simulates `spec` with rk4 and writes it as a coin-log MCAP at `path`, following CONTRACT.
@@ -242,6 +128,7 @@ pub fn record(spec: &Spec, path: &Path) {
         .iter()
         .map(|c| (*c, add_channel(&mut w, &mut schemas, *c, &tool_schema)))
         .collect();
+    let chaplygin = Chaplygin::new(coin.params()).unwrap();
     let mut sequence = 0u32;
     let config = MethodConfig {
         method: spec.method,
@@ -260,17 +147,8 @@ pub fn record(spec: &Spec, path: &Path) {
         let s = State::from_array(y);
         let lt = log_time(t).unwrap();
         for (c, id) in &ids {
-            let data = message_json(&coin, *c, t, &s);
-            w.write_to_known_channel(
-                &mcap::records::MessageHeader {
-                    channel_id: *id,
-                    sequence,
-                    log_time: lt,
-                    publish_time: lt,
-                },
-                &data,
-            )
-            .unwrap();
+            let data = message_json(&coin, &chaplygin, *c, t, &s);
+            write_message(&mut w, *id, sequence, lt, &data);
             sequence += 1;
         }
         Flow::Continue
@@ -301,11 +179,6 @@ pub struct Edit<'a> {
     pub index: usize,
     pub log_time: &'a mut u64,
     pub data: &'a mut Vec<u8>,
-}
-
-/// This tool's bytes of schema `name`.
-fn tool_schema(name: &str) -> Vec<u8> {
-    schema_bytes(name).unwrap().to_vec()
 }
 
 /// Copies the coin-log MCAP `src` to `dst` (same metadata, channels, message order), letting `edit`
@@ -361,16 +234,7 @@ pub fn rewrite_with_schemas(
             data: &mut data,
         });
         *index += 1;
-        w.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: id,
-                sequence: m.sequence,
-                log_time: lt,
-                publish_time: lt,
-            },
-            &data,
-        )
-        .unwrap();
+        write_message(&mut w, id, m.sequence, lt, &data);
     }
     for m in metadata.iter().filter(|m| m.name != RUN_METADATA_NAME) {
         w.write_metadata(m).unwrap();
