@@ -4,7 +4,7 @@
 //! rolling (bench: 30), a long horizon of 10³ (bench: 10⁴) and 5 time units of scale invariance (bench: 10).
 //! Every run of every case must end completed or at a physical event, never with NaN or a numerical failure.
 
-use coin_log::bench::stability::{dimensionless, scaled_wobble};
+use coin_log::bench::stability::{dimensionless_difference, scaled_wobble};
 use coin_log::bench::stability::{
     drift_history, fast_spin, long_horizon_config, marginal, near_flat, nutation_frequency,
     release, scale_difference, straight_tilt_linear, StabilityRow, SuiteOptions,
@@ -214,21 +214,7 @@ fn scaled_coins_agree_with_the_unit_coin_to_1e_10() {
     let (mut a, mut b) = (Trajectory::default(), Trajectory::default());
     run_sampled(&config, &unit, &mut a);
     run_sampled(&config, &wrong, &mut b);
-    let difference = a
-        .states
-        .iter()
-        .zip(&b.states)
-        .map(|(ya, yb)| {
-            let (da, db) = (
-                dimensionless(&unit.coin, ya),
-                dimensionless(&wrong.coin, yb),
-            );
-            da.iter()
-                .zip(&db)
-                .map(|(u, v)| (u - v).abs())
-                .fold(0.0, f64::max)
-        })
-        .fold(0.0, f64::max);
+    let difference = dimensionless_difference((&unit, &a), (&wrong, &b));
     println!("control: a = 4 without rescaling the spin differs by {difference:e} (≥ 1e-3)");
     assert!(difference >= 1e-3);
 }

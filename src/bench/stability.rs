@@ -794,17 +794,27 @@ pub fn scale_difference(
     let mut b = Trajectory::default();
     run_sampled_with(&config_for(&unit), &unit, &unit.settings(), &mut a);
     run_sampled_with(&config_for(&scaled), &scaled, &scaled.settings(), &mut b);
+    let worst = dimensionless_difference((&unit, &a), (&scaled, &b));
+    Ok((worst, b))
+}
+
+/// Largest difference between two sampled runs in the natural units of their own bodies
+/// ([`dimensionless`]), sample by sample; infinite when the sample counts differ or a value is NaN.
+#[must_use]
+pub fn dimensionless_difference(
+    (case_a, a): (&BenchCase, &Trajectory),
+    (case_b, b): (&BenchCase, &Trajectory),
+) -> f64 {
     if a.states.len() != b.states.len() {
-        return Ok((f64::INFINITY, b));
+        return f64::INFINITY;
     }
-    let worst = a
-        .states
+    a.states
         .iter()
         .zip(&b.states)
         .map(|(ya, yb)| {
             let (da, db) = (
-                dimensionless(&unit.coin, ya),
-                dimensionless(&scaled.coin, yb),
+                dimensionless(&case_a.coin, ya),
+                dimensionless(&case_b.coin, yb),
             );
             da.iter()
                 .zip(&db)
@@ -814,8 +824,7 @@ pub fn scale_difference(
         .fold(
             0.0,
             |m: f64, d: f64| if d.is_nan() { f64::INFINITY } else { m.max(d) },
-        );
-    Ok((worst, b))
+        )
 }
 
 /// Scale invariance: for disk and hoop and every integrator, the worst agreement over [`SCALES`].
