@@ -7,20 +7,14 @@ use crate::integrate::{
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{energy, Coin, State, Steady, STATE_LEN};
+use crate::scene::defaults;
 use crate::simulation::CoinEvents;
 
 /// Samples per natural time unit √(a/g) at which errors are measured (issue 8: "100 per time unit").
 pub const SAMPLES_PER_TIME_UNIT: f64 = 100.0;
 
 /// Flat-landing margin of the bench runs: the contract's scene default (`run.flat_margin`).
-pub const DEFAULT_FLAT_MARGIN: f64 = 1e-4;
-
-/// Default relative tolerance of adaptive methods (the contract's scene default `run.rtol`).
-const DEFAULT_RTOL: f64 = 1e-10;
-/// Default absolute tolerance of adaptive methods (the contract's scene default `run.atol`).
-const DEFAULT_ATOL: f64 = 1e-12;
-/// Default fixed step in natural time units (the contract's scene default `run.step`).
-const DEFAULT_STEP: f64 = 1e-3;
+pub const DEFAULT_FLAT_MARGIN: f64 = defaults::FLAT_MARGIN;
 
 /// Reference tolerances (issue 8): dop853 at atol 1e-16, rtol 1e-14.
 const REFERENCE_ATOL: f64 = 1e-16;
@@ -91,9 +85,10 @@ pub fn nominal_order(method: Method) -> u32 {
 pub fn default_config(method: Method, time_unit: f64) -> MethodConfig {
     MethodConfig {
         method,
-        rtol: DEFAULT_RTOL,
-        atol: DEFAULT_ATOL,
-        step: DEFAULT_STEP * time_unit,
+        rtol: defaults::RTOL,
+        atol: defaults::ATOL,
+        // The scene default step, read in natural time units.
+        step: defaults::STEP * time_unit,
     }
 }
 
