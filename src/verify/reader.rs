@@ -90,6 +90,30 @@ pub struct Structure {
     pub library: String,
 }
 
+/// What a schema or channel record is, given the ones seen before with the same id.
+enum Definition {
+    /// The first record with this id.
+    New,
+    /// The same bytes again (summary or chunk repeats are allowed).
+    Repeated,
+    /// Different bytes under an id already defined.
+    Different,
+}
+
+/// Classifies the record `data` with `id` against `seen` (by digest), remembering it when new.
+fn definition(seen: &mut BTreeMap<u16, Digest>, id: u16, data: &[u8]) -> Definition {
+    let mut d = Digest::default();
+    d.push_bytes(data);
+    match seen.get(&id) {
+        Some(earlier) if *earlier != d => Definition::Different,
+        Some(_) => Definition::Repeated,
+        None => {
+            seen.insert(id, d);
+            Definition::New
+        }
+    }
+}
+
 /// Order-sensitive 64-bit digest of a sequence of integers (not cryptographic: it guards against mistakes
 /// and corruption, which CRCs also catch, not against an adversary).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -595,16 +619,11 @@ impl Book {
                 let name = c.string("name").map_err(err)?.unwrap_or("");
                 let encoding = c.string("encoding").map_err(err)?.unwrap_or("");
                 let body = c.bytes("data").map_err(err)?;
-                let mut d = Digest::default();
-                d.push_bytes(data);
-                match self.schemas.get(&id) {
-                    Some(seen) if *seen != d => {
+                match definition(&mut self.schemas, id, data) {
+                    Definition::New => visitor.schema(id, name, encoding, body),
+                    Definition::Repeated => {}
+                    Definition::Different => {
                         self.problem(|| format!("schema {id} `{name}` at byte {at} differs from its earlier definition"));
-                    }
-                    Some(_) => {}
-                    None => {
-                        self.schemas.insert(id, d);
-                        visitor.schema(id, name, encoding, body);
                     }
                 }
             }
@@ -614,16 +633,11 @@ impl Book {
                 let schema_id = c.u16("schema_id").map_err(err)?;
                 let topic = c.string("topic").map_err(err)?.unwrap_or("");
                 let encoding = c.string("message_encoding").map_err(err)?.unwrap_or("");
-                let mut d = Digest::default();
-                d.push_bytes(data);
-                match self.channels.get(&id) {
-                    Some(seen) if *seen != d => {
+                match definition(&mut self.channels, id, data) {
+                    Definition::New => visitor.channel(id, schema_id, topic, encoding),
+                    Definition::Repeated => {}
+                    Definition::Different => {
                         self.problem(|| format!("channel {id} `{topic}` at byte {at} differs from its earlier definition"));
-                    }
-                    Some(_) => {}
-                    None => {
-                        self.channels.insert(id, d);
-                        visitor.channel(id, schema_id, topic, encoding);
                     }
                 }
             }
