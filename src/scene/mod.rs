@@ -15,9 +15,9 @@ pub use file::{
 };
 pub use overrides::{apply_set, FlagOverrides};
 
+use crate::format::Channel;
 use crate::integrate::MethodConfig;
 use crate::model::{Coin, CoinParams, Inertia, State, Steady};
-use crate::record::Channel;
 use std::fmt;
 
 /// Defaults of the optional scene keys (CONTRACT: Scene files).

@@ -5,9 +5,9 @@ use super::file::{
     BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
 };
 use super::{defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, MAX_SAMPLES};
+use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
 use crate::model::{Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind};
-use crate::record::Channel;
 use std::f64::consts::FRAC_PI_2;
 
 /// Collects problems, naming the flag that set a key when one did.
@@ -547,7 +547,7 @@ fn check_run(
     let before = problems.list.len();
     let duration = match run.duration {
         Some(d) => {
-            if problems.positive("run.duration", d) && crate::units::log_time(d).is_err() {
+            if problems.positive("run.duration", d) && crate::format::log_time(d).is_err() {
                 problems.push(
                     "run.duration",
                     number(d),

@@ -14,17 +14,16 @@ use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::wire::MessageHeader;
 use super::Options;
-use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, CoinParams, Inertia};
-use crate::record::messages::{
+use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage,
 };
-use crate::record::{
-    schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
+use crate::format::{
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
     RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use crate::units::log_time;
+use crate::model::invariants::Chaplygin;
+use crate::model::{Coin, CoinParams, Inertia};
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -60,7 +59,8 @@ impl Checks {
     fn observe(&mut self, s: &Sample, ctx: &Context) {
         self.stats.observe(s);
         self.energy.observe(s, ctx);
-        self.invariants.observe(s, invariants_of(ctx));
+        self.invariants
+            .observe(s, ctx.coin.params(), invariants_of(ctx));
         self.steady.observe(s, ctx);
         self.constraint.observe(s, ctx.coin.params().radius());
         self.consistency.observe(s, ctx);
@@ -500,7 +500,7 @@ fn verdict(
     let run = &ctx.run;
     let tol = Tolerances::derive(
         &RunAccuracy {
-            integrator: &run.integrator,
+            integrator: run.integrator,
             rtol: run.rtol,
             atol: run.atol,
             step: run.step,
@@ -520,7 +520,7 @@ fn verdict(
     let c = &judge.checks;
     let mut results = vec![
         integrity::finish(&problems, &read, &judge.notes),
-        c.energy.finish(&ctx, &tol),
+        c.energy.finish(&tol),
         c.invariants
             .finish(&tol, ctx.chaplygin.as_ref().err().map(String::as_str)),
         c.steady.finish(&ctx, &tol),

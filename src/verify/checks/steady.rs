@@ -3,8 +3,9 @@
 //! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
 
 use super::{fmt_num, norm3, worst, Context, Max};
-use crate::model::{Branch, Coin, Steady, SteadyKind};
-use crate::record::RunMetadata;
+use crate::format::RunMetadata;
+use crate::model::{Coin, Steady};
+use crate::scene::{self, Scene};
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
@@ -12,67 +13,30 @@ use crate::verify::tolerances::Tolerances;
 /// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
 const MIN_ARC: f64 = 0.5;
 
-/// The steady motion a log's scene asks for, or why the check does not apply.
+/// The steady motion a log's scene asks for, or why the check does not apply. The stored scene is read by
+/// the same typed parser and validation as `record` uses; the motion is rebuilt for the metadata's body.
 ///
 /// # Errors
 /// A sentence saying why there is no steady motion to compare with.
 pub fn plan(coin: &Coin, run: &RunMetadata) -> Result<Steady, String> {
-    if run.steady_kind == "none" {
+    let Some(family) = run.steady_kind else {
         return Err("not a steady scene (steady_kind = none)".into());
+    };
+    let file = scene::parse_with_sets(&run.scene, &[])
+        .map_err(|e| format!("the metadata's scene does not parse: {e}"))?;
+    let scene =
+        Scene::from_file(&file).map_err(|e| format!("the metadata's scene is not valid: {e}"))?;
+    let steady = scene.unperturbed_steady().ok_or(
+        "the scene perturbs its steady motion (or has none), so it is not expected to stay steady",
+    )?;
+    if steady.kind.family() != family {
+        return Err(format!(
+            "the metadata says steady_kind = {family}, but its scene's steady motion is {}",
+            steady.kind.family()
+        ));
     }
-    let scene: toml::Table = run
-        .scene
-        .parse()
-        .map_err(|e| format!("the metadata's scene TOML does not parse: {e}"))?;
-    let initial = scene
-        .get("initial")
-        .and_then(toml::Value::as_table)
-        .ok_or("the metadata's scene has no [initial] table")?;
-    if initial.contains_key("perturbation") {
-        return Err(
-            "the scene perturbs its steady motion, so it is not expected to stay steady".into(),
-        );
-    }
-    let steady = initial
-        .get("steady")
-        .and_then(toml::Value::as_table)
-        .ok_or("steady_kind is set but the scene has no initial.steady table")?;
-    let number = |key: &str| -> Result<f64, String> {
-        let v = steady
-            .get(key)
-            .ok_or_else(|| format!("initial.steady has no `{key}`"))?;
-        v.as_float()
-            .or_else(|| v.as_integer().map(|i| i as f64))
-            .ok_or_else(|| format!("initial.steady.{key} = {v} is not a number"))
-    };
-    let branch = match steady.get("branch").and_then(toml::Value::as_str) {
-        None | Some("+") => Branch::Plus,
-        Some("-") => Branch::Minus,
-        Some(other) => {
-            return Err(format!(
-                "initial.steady.branch = {other:?} is not \"+\" or \"-\""
-            ))
-        }
-    };
-    let kind = match run.steady_kind.as_str() {
-        "straight" => SteadyKind::Straight {
-            omega_z: number("omega_z")?,
-        },
-        "centre-fixed" => SteadyKind::CentreFixed {
-            theta: number("theta")?,
-            branch,
-        },
-        "circle" => SteadyKind::Circle {
-            theta: number("theta")?,
-            omega_z: number("omega_z")?,
-            branch,
-        },
-        "spin-upright" => SteadyKind::SpinUpright {
-            omega_y: number("omega_y")?,
-        },
-        other => return Err(format!("unknown steady_kind {other:?}")),
-    };
-    Steady::new(coin, kind).map_err(|e| format!("the scene's steady motion cannot be built: {e}"))
+    Steady::new(coin, steady.kind)
+        .map_err(|e| format!("the scene's steady motion cannot be built: {e}"))
 }
 
 /// Streaming least-squares circle fit (Kåsa), in coordinates shifted to the first point.
