@@ -37,7 +37,7 @@ pub mod defaults {
     /// Display thickness, a fraction of the radius (a 500-yen coin is 1.8 mm thick for 13.25 mm radius).
     pub const THICKNESS: f64 = 0.05;
     /// Steady branch when none is given.
-    pub const BRANCH: &str = "+";
+    pub const BRANCH: crate::model::Branch = crate::model::Branch::Plus;
 }
 
 /// Largest number of samples a scene may ask for (duration × rate): 10¹¹, far beyond any disk.
