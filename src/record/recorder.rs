@@ -290,9 +290,31 @@ impl<W: Write + Seek> Sampler<W> {
     fn sample(&mut self, t: f64, y: &[f64; STATE_LEN], last: bool) -> Result<(), SampleError> {
         let ns = log_time(t)?;
         let s = State::from_array(y);
-        let coin = self.coin;
         self.buffer.clear();
         self.staged_len = 0;
+        self.stage_kinematics(t, &s)?;
+        let (total, invariants) = self.stage_dynamics(t, &s)?;
+        if let Some((foxglove, batch)) = &mut self.foxglove {
+            batch.clear();
+            foxglove.sample(t, ns, &s, last, batch)?;
+        }
+        for &(channel, start, end) in &self.staged[..self.staged_len] {
+            self.out.write(channel, ns, &self.buffer[start..end])?;
+        }
+        if let Some((_, batch)) = &self.foxglove {
+            for (channel, data) in batch.iter() {
+                self.out.write(channel, ns, data)?;
+            }
+        }
+        self.track(t, &s, total, invariants);
+        self.samples += 1;
+        Ok(())
+    }
+
+    /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
+    #[inline]
+    fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
+        let coin = self.coin;
         if self.on(Channel::Omega) {
             let m = AngularVelocity {
                 t,
@@ -312,7 +334,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Angles, |b| m.write_json(b))?;
         }
         if self.on(Channel::Quaternion) {
-            let q = orientation(&s);
+            let q = orientation(s);
             let m = QuaternionMessage {
                 t,
                 x: q.x,
@@ -323,7 +345,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Quaternion, |b| m.write_json(b))?;
         }
         if self.on(Channel::Position) {
-            let c = centre(&coin, &s);
+            let c = centre(&coin, s);
             let m = Position {
                 t,
                 x: c.x,
@@ -333,7 +355,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Position, |b| m.write_json(b))?;
         }
         if self.on(Channel::Contact) {
-            let c = contact_point(&coin, &s);
+            let c = contact_point(&coin, s);
             let m = Position {
                 t,
                 x: c.x,
@@ -342,8 +364,20 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Contact, |b| m.write_json(b))?;
         }
+        Ok(())
+    }
+
+    /// Stages the messages that need the equations or the integrals: reaction, energy, C1 and C2. Returns
+    /// E and (C1, C2) when computed, for the summary's drift.
+    #[inline]
+    fn stage_dynamics(
+        &mut self,
+        t: f64,
+        s: &State,
+    ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
+        let coin = self.coin;
         if self.on(Channel::Reaction) {
-            let r = reaction(&coin, &s);
+            let r = reaction(&coin, s);
             let m = ReactionMessage {
                 t,
                 x: r.force.x,
@@ -355,7 +389,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Reaction, |b| m.write_json(b))?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
-        let e = energy(&coin, &s);
+        let e = energy(&coin, s);
         if self.on(Channel::Energy) {
             let m = EnergyMessage {
                 t,
@@ -365,7 +399,7 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Energy, |b| m.write_json(b))?;
         }
-        let invariants = self.chaplygin.as_ref().map(|c| c.of_state(&s));
+        let invariants = self.chaplygin.as_ref().map(|c| c.of_state(s));
         if let Some(c) = invariants {
             let m = InvariantsMessage {
                 t,
@@ -374,21 +408,7 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Invariants, |b| m.write_json(b))?;
         }
-        if let Some((foxglove, batch)) = &mut self.foxglove {
-            batch.clear();
-            foxglove.sample(t, ns, &s, last, batch)?;
-        }
-        for &(channel, start, end) in &self.staged[..self.staged_len] {
-            self.out.write(channel, ns, &self.buffer[start..end])?;
-        }
-        if let Some((_, batch)) = &self.foxglove {
-            for (channel, data) in batch.iter() {
-                self.out.write(channel, ns, data)?;
-            }
-        }
-        self.track(t, &s, e.total, invariants.map(|c| (c.c1, c.c2)));
-        self.samples += 1;
-        Ok(())
+        Ok((e.total, invariants.map(|c| (c.c1, c.c2))))
     }
 
     #[inline]
