@@ -177,52 +177,17 @@ impl SteadyCheck {
             (self.omega.value / omega_scale, tol.residual, "omega"),
         ];
         let mut notes = Vec::new();
-        // The metadata's steady values against those recomputed from the scene.
-        let meta = [
-            (ctx.run.phi_dot, Some(steady.phi_dot), omega_scale),
-            (ctx.run.psi_dot, Some(steady.psi_dot), omega_scale),
-            (ctx.run.r_g, steady.r_g, a),
-            (ctx.run.r_c, steady.r_c, a),
-        ];
-        let meta_dev = meta
-            .iter()
-            .map(|(m, s, scale)| match (m, s) {
-                (Some(m), Some(s)) => (m - s).abs() / scale,
-                (None, None) => 0.0,
-                _ => f64::INFINITY,
-            })
-            .fold(0.0, f64::max);
+        let meta_dev = metadata_deviation(ctx, steady, omega_scale);
         measures.push((meta_dev, tol.residual, "metadata"));
         let arc = self.phi_range.map_or(0.0, |(lo, hi)| hi - lo);
-        let mut radii = |fit: &CircleFit, expected: Option<f64>, name: &'static str| match expected
-        {
-            None => notes.push(format!("{name}: straight rolling, no circle")),
-            Some(0.0) => {
-                measures.push((fit.max_offset / a, tol.residual, name));
-                notes.push(format!(
-                    "{name}: stays within {} of its start",
-                    fmt_num(fit.max_offset)
-                ));
-            }
-            Some(_) if fit.n < 3.0 => notes.push(format!("{name}: not stored")),
-            Some(_) if arc < MIN_ARC => notes.push(format!(
-                "{name}: the run turns only {} rad, too little to fit a circle",
-                fmt_num(arc)
-            )),
-            Some(r) => match fit.radius() {
-                Some(fitted) => {
-                    measures.push(((fitted - r).abs() / r.max(a), tol.residual, name));
-                    notes.push(format!(
-                        "{name}: fitted {} vs {}",
-                        fmt_num(fitted),
-                        fmt_num(r)
-                    ));
-                }
-                None => notes.push(format!("{name}: the circle fit is singular")),
-            },
-        };
-        radii(&self.centre, steady.r_g, "R_G");
-        radii(&self.contact, steady.r_c, "R_C");
+        for (fit, expected, name) in [
+            (&self.centre, steady.r_g, "R_G"),
+            (&self.contact, steady.r_c, "R_C"),
+        ] {
+            let (measure, note) = radius_measure(fit, expected, arc, a);
+            measures.extend(measure.map(|m| (m, tol.residual, name)));
+            notes.push(format!("{name}: {note}"));
+        }
         let Some((value, tolerance, which)) = worst(&measures) else {
             return CheckResult::skip(CheckId::Steady, "nothing measured");
         };
@@ -244,5 +209,58 @@ impl SteadyCheck {
                 notes.join(", "),
             ),
         )
+    }
+}
+
+/// The largest deviation of the metadata's steady values (φ̇, ψ̇, R_G, R_C) from those recomputed from
+/// the scene, rates relative to `omega_scale` and radii to a; infinite when one is stored and the other
+/// is not.
+fn metadata_deviation(ctx: &Context, steady: &Steady, omega_scale: f64) -> f64 {
+    let a = ctx.coin.params().radius();
+    let pairs = [
+        (ctx.run.phi_dot, Some(steady.phi_dot), omega_scale),
+        (ctx.run.psi_dot, Some(steady.psi_dot), omega_scale),
+        (ctx.run.r_g, steady.r_g, a),
+        (ctx.run.r_c, steady.r_c, a),
+    ];
+    pairs
+        .iter()
+        .map(|(m, s, scale)| match (m, s) {
+            (Some(m), Some(s)) => (m - s).abs() / scale,
+            (None, None) => 0.0,
+            _ => f64::INFINITY,
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How well a traced circle fits the expected radius: the relative misfit (if one can be measured) and a
+/// note saying what was found. A radius of 0 means the point stays put; `None` means straight rolling.
+fn radius_measure(
+    fit: &CircleFit,
+    expected: Option<f64>,
+    arc: f64,
+    a: f64,
+) -> (Option<f64>, String) {
+    match expected {
+        None => (None, "straight rolling, no circle".into()),
+        Some(0.0) => (
+            Some(fit.max_offset / a),
+            format!("stays within {} of its start", fmt_num(fit.max_offset)),
+        ),
+        Some(_) if fit.n < 3.0 => (None, "not stored".into()),
+        Some(_) if arc < MIN_ARC => (
+            None,
+            format!(
+                "the run turns only {} rad, too little to fit a circle",
+                fmt_num(arc)
+            ),
+        ),
+        Some(r) => match fit.radius() {
+            Some(fitted) => (
+                Some((fitted - r).abs() / r.max(a)),
+                format!("fitted {} vs {}", fmt_num(fitted), fmt_num(r)),
+            ),
+            None => (None, "the circle fit is singular".into()),
+        },
     }
 }
