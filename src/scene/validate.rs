@@ -297,16 +297,50 @@ fn check_initial(
     let in_lean_range = |theta: f64| flat_margin.is_none_or(|m| theta.abs() < FRAC_PI_2 - m);
     let margin_text = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
     let coin = Coin::new(*params);
-    let base: Option<(State, InitialSpec)> = match (&initial.steady, initial.theta, &initial.omega)
-    {
+    let base = initial_base(initial, &coin, margin_text, &in_lean_range, problems);
+    let perturbation = initial
+        .perturbation
+        .as_ref()
+        .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
+    let (mut state, spec) = base?;
+    let perturbation = perturbation?;
+    state.phi += offsets[0];
+    state.psi += offsets[1];
+    state.x += offsets[2];
+    state.z += offsets[3];
+    let kicked = perturbed(&state, &perturbation);
+    if perturbation[0] != 0.0 && !in_lean_range(kicked.theta) {
+        problems.push(
+            "initial.perturbation.theta",
+            number(perturbation[0]),
+            format!(
+                "takes theta to {}, which {}",
+                number(kicked.theta),
+                lean_range(margin_text)
+            ),
+        );
+    }
+    (problems.list.len() == before).then_some((state, spec, perturbation))
+}
+
+/// The state before offsets and perturbation: an explicit (θ, ω) or a solved steady motion.
+fn initial_base(
+    initial: &InitialFile,
+    coin: &Coin,
+    margin_text: f64,
+    in_lean_range: &dyn Fn(f64) -> bool,
+    problems: &mut Problems,
+) -> Option<(State, InitialSpec)> {
+    const EITHER: &str = "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion";
+    match (&initial.steady, initial.theta, &initial.omega) {
         (Some(steady), theta, omega) => {
             if let Some(t) = theta {
-                problems.push("initial.theta", number(t), "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion");
+                problems.push("initial.theta", number(t), EITHER);
             }
             if let Some(o) = omega {
-                problems.push("initial.omega", numbers(o), "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion");
+                problems.push("initial.omega", numbers(o), EITHER);
             }
-            check_steady(steady, &coin, margin_text, &in_lean_range, problems)
+            check_steady(steady, coin, margin_text, in_lean_range, problems)
                 .map(|s| (s.state, InitialSpec::Steady(s)))
         }
         (None, Some(theta), Some(omega)) => {
@@ -344,30 +378,7 @@ fn check_initial(
             );
             None
         }
-    };
-    let perturbation = initial
-        .perturbation
-        .as_ref()
-        .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
-    let (mut state, spec) = base?;
-    let perturbation = perturbation?;
-    state.phi += offsets[0];
-    state.psi += offsets[1];
-    state.x += offsets[2];
-    state.z += offsets[3];
-    let kicked = perturbed(&state, &perturbation);
-    if perturbation[0] != 0.0 && !in_lean_range(kicked.theta) {
-        problems.push(
-            "initial.perturbation.theta",
-            number(perturbation[0]),
-            format!(
-                "takes theta to {}, which {}",
-                number(kicked.theta),
-                lean_range(margin_text)
-            ),
-        );
     }
-    (problems.list.len() == before).then_some((state, spec, perturbation))
 }
 
 /// `base` with the perturbation (θ, ω_X, ω_Y, ω_Z) added.
