@@ -1,15 +1,16 @@
 //! coin-log: a coin rolling without slipping on a horizontal table, simulated to many digits and recorded
 //! as MCAP datasets for Foxglove.
 //!
-//! The physics is that of `shared/physics/NOTES.md` (cited as "NOTES §n" and "eq (n)"): a thin axisymmetric
-//! body in rim contact with a flat table, no slip, no dissipation. Dependencies point one way:
-//! [`model`] → [`integrate`] → scene → record / verify → the `coin-log` binary.
+//! The physics is that of `docs/physics.md` (cited as "physics §n" and "eq (n)"): a thin axisymmetric body in
+//! rim contact with a flat table, no slip. The file format is `docs/format.md`. Dependencies point one way
+//! (docs/architecture.md): [`model`] → [`integrate`] → [`simulation`] → [`format`] → [`scene`] →
+//! [`record`] / [`verify`] → [`bench`] → the `coin-log` binary.
 
 pub mod bench;
+pub mod format;
 pub mod integrate;
 pub mod model;
 pub mod record;
 pub mod scene;
 pub mod simulation;
-pub mod units;
 pub mod verify;

@@ -22,18 +22,6 @@ pub enum PhysicalEvent {
     Slip,
 }
 
-impl PhysicalEvent {
-    /// The contract's termination name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::FlatLanding => "flat-landing",
-            Self::LiftOff => "lift-off",
-            Self::Slip => "slip",
-        }
-    }
-}
-
 /// Event functions of the coin: g_flat = π/2 − flat_margin − |θ|, g_lift = N / (Mg),
 /// g_slip = (μN − F) / (Mg) (only when μ is given). Each ends the run when it crosses from > 0 to ≤ 0.
 #[derive(Debug, Clone, Copy)]

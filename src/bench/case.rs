@@ -3,8 +3,9 @@
 
 use super::BenchError;
 use crate::integrate::{
-    run_method, Flow, Method, MethodConfig, RunOutcome, RunSettings, StepError, Termination,
+    run_method, Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination,
 };
+use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::invariants::Chaplygin;
 use crate::model::{energy, Coin, State, Steady, STATE_LEN};
 use crate::scene::defaults;
@@ -135,25 +136,10 @@ impl Trajectory {
     }
 }
 
-/// The contract's name of a termination.
+/// The format's name of a termination.
 #[must_use]
 pub fn termination_name(termination: &Termination) -> String {
-    match termination {
-        Termination::Completed => "completed".to_string(),
-        Termination::Event { index, .. } => CoinEvents::event(*index).name().to_string(),
-        Termination::Stopped { .. } => "interrupted".to_string(),
-        Termination::Failed(e) => step_error_name(e).to_string(),
-    }
-}
-
-#[allow(unreachable_patterns)] // StepError may grow variants in the integrators' branch
-fn step_error_name(e: &StepError) -> &'static str {
-    match e {
-        StepError::NonFinite { .. } => "non-finite",
-        StepError::StepSizeUnderflow { .. } => "step-size-underflow",
-        StepError::NewtonFailure { .. } => "newton-failure",
-        _ => "failed",
-    }
+    crate::format::Termination::of_run(termination).to_string()
 }
 
 /// Runs `config` on `case`, storing every sample in `out` (cleared first).
@@ -375,43 +361,29 @@ pub fn state_error(case: &BenchCase, run: &Trajectory, reference: &Reference) ->
     worst
 }
 
-/// Energy drift (CONTRACT, verify): max|E − E₀| / max(|E₀|, Mga) over the samples.
+/// Energy drift ([`EnergyDrift`]) over the samples.
 #[must_use]
 pub fn energy_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> f64 {
     let Some(first) = states.first() else {
         return 0.0;
     };
-    let e0 = energy(coin, &State::from_array(first)).total;
-    let scale = e0.abs().max(coin.params().energy_scale());
-    let mut worst = 0.0_f64;
+    let mut drift = EnergyDrift::new(coin.params(), energy(coin, &State::from_array(first)).total);
     for y in states {
-        let d = (energy(coin, &State::from_array(y)).total - e0).abs() / scale;
-        if d.is_nan() {
-            return f64::INFINITY;
-        }
-        worst = worst.max(d);
+        drift.observe(0.0, energy(coin, &State::from_array(y)).total);
     }
-    worst
+    drift.value()
 }
 
-/// Invariant drift (CONTRACT, verify): max|C − C₀| / (|C1₀| + |C2₀|) over the samples and both
-/// Chaplygin–Appell integrals (NOTES §6); `None` when they cannot be built for the body or vanish.
+/// Invariant drift ([`InvariantDrift`]) over the samples and both Chaplygin–Appell integrals (physics §6);
+/// `None` when they cannot be evaluated for the body.
 #[must_use]
 pub fn invariant_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> Option<f64> {
     let chaplygin = Chaplygin::new(coin.params()).ok()?;
     let first = chaplygin.of_state(&State::from_array(states.first()?));
-    let scale = first.c1.abs() + first.c2.abs();
-    if scale == 0.0 || !scale.is_finite() {
-        return None;
-    }
-    let mut worst = 0.0_f64;
+    let mut drift = InvariantDrift::new(coin.params(), first.c1, first.c2);
     for y in states {
         let c = chaplygin.of_state(&State::from_array(y));
-        let d = (c.c1 - first.c1).abs().max((c.c2 - first.c2).abs()) / scale;
-        if d.is_nan() {
-            return Some(f64::INFINITY);
-        }
-        worst = worst.max(d);
+        drift.observe(0.0, c.c1, c.c2);
     }
-    Some(worst)
+    Some(drift.value())
 }

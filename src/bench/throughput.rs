@@ -20,9 +20,10 @@
 use super::precision::rtol_for;
 use super::presets::bench_case;
 use super::{reference_trajectory, run_sampled, state_error, BenchError, Trajectory};
+use crate::format::Channel;
 use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings};
 use crate::record::writer::{DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
-use crate::record::{Channel, ChunkCompression, ChunkCompressor, COMPRESSION_THREADS};
+use crate::record::{ChunkCompression, ChunkCompressor, COMPRESSION_THREADS};
 use crate::verify::reader::{self, Visitor};
 use crate::verify::wire::MessageHeader;
 use std::collections::BTreeMap;

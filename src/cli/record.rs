@@ -5,7 +5,8 @@
 use super::Outcome;
 use anyhow::{anyhow, bail, Context};
 use coin_log::bench::throughput::peak_rss_bytes;
-use coin_log::record::{self, Compression, RecordOptions, RecordSummary, Termination};
+use coin_log::format::Termination;
+use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
 use coin_log::scene::{self, presets, FlagOverrides, Scene, SceneFile};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{BufWriter, IsTerminal};
@@ -225,10 +226,8 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     }
 
     print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
-    Ok(match &summary.termination {
-        Termination::Completed | Termination::Event(_) => Outcome::Success,
-        Termination::Interrupted => Outcome::Interrupted,
-        Termination::Failed(f) => {
+    Ok(match &summary.failure {
+        Some(f) => {
             eprintln!(
                 "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
                 summary.termination_time,
@@ -236,6 +235,8 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
             );
             Outcome::Failure
         }
+        None if summary.termination == Termination::Interrupted => Outcome::Interrupted,
+        None => Outcome::Success,
     })
 }
 

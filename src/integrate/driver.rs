@@ -101,7 +101,7 @@ pub fn run<const N: usize, S, M, E, O>(
     y0: &[f64; N],
     settings: &RunSettings,
     events: &E,
-    mut observe: O,
+    observe: O,
 ) -> RunOutcome
 where
     S: OdeSystem<N>,
@@ -109,110 +109,173 @@ where
     E: EventFunctions<N>,
     O: FnMut(f64, &[f64; N]) -> Flow,
 {
-    let n_events = events.count().min(MAX_EVENTS);
-    let mut g_old = [0.0; MAX_EVENTS];
-    let mut g_new = [0.0; MAX_EVENTS];
-    let t0 = settings.t0;
-    let outcome = |termination, stepper: &M, t_last| RunOutcome {
-        termination,
-        stats: stepper.stats(),
-        t_last,
+    let mut run = Run {
+        sys,
+        stepper,
+        settings,
+        events,
+        observe,
+        n_events: events.count().min(MAX_EVENTS),
+        g_old: [0.0; MAX_EVENTS],
+        g_new: [0.0; MAX_EVENTS],
+        k: 1,
+        t_last: settings.t0,
+        buffer: [0.0; N],
+        dense_ready: false,
     };
+    let termination = run.start(y0).err().unwrap_or_else(|| run.steps());
+    RunOutcome {
+        termination,
+        stats: run.stepper.stats(),
+        t_last: run.t_last,
+    }
+}
 
-    if let Err(e) = stepper.init(sys, t0, y0, settings.t_end) {
-        return outcome(Termination::Failed(e), stepper, t0);
-    }
-    let flow = observe(t0, y0);
-    events.evaluate(t0, y0, &mut g_old[..n_events]);
-    if let Some(index) = g_old[..n_events].iter().position(|&g| g <= 0.0) {
-        return outcome(Termination::Event { index, t: t0 }, stepper, t0);
-    }
-    if flow == Flow::Stop {
-        return outcome(Termination::Stopped { t: t0 }, stepper, t0);
-    }
+/// The state of one [`run`] between its stages.
+struct Run<'a, const N: usize, S, M, E, O> {
+    sys: &'a S,
+    stepper: &'a mut M,
+    settings: &'a RunSettings,
+    events: &'a E,
+    observe: O,
+    n_events: usize,
+    /// Event functions at the start and at the end of the current step.
+    g_old: [f64; MAX_EVENTS],
+    g_new: [f64; MAX_EVENTS],
+    /// Number of the next grid sample.
+    k: u64,
+    /// Time of the last sample emitted.
+    t_last: f64,
+    buffer: [f64; N],
+    /// Whether the dense output of the current step is ready.
+    dense_ready: bool,
+}
 
-    // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly).
-    let grid_slack = 1e-9 * settings.sample_interval;
-    let mut k: u64 = 1;
-    let mut t_last = t0;
-    let mut buffer = [0.0; N];
-    loop {
-        if let Err(e) = stepper.step(sys, settings.t_end) {
-            return outcome(Termination::Failed(e), stepper, t_last);
+impl<const N: usize, S, M, E, O> Run<'_, N, S, M, E, O>
+where
+    S: OdeSystem<N>,
+    M: Stepper<N>,
+    E: EventFunctions<N>,
+    O: FnMut(f64, &[f64; N]) -> Flow,
+{
+    /// Initialises the stepper and emits the first sample; `Err` holds the termination when the run ends
+    /// right there (failure, an event already true at t0, or a stop).
+    fn start(&mut self, y0: &[f64; N]) -> Result<(), Termination> {
+        let t0 = self.settings.t0;
+        self.stepper
+            .init(self.sys, t0, y0, self.settings.t_end)
+            .map_err(Termination::Failed)?;
+        let flow = (self.observe)(t0, y0);
+        let n = self.n_events;
+        self.events.evaluate(t0, y0, &mut self.g_old[..n]);
+        if let Some(index) = self.g_old[..n].iter().position(|&g| g <= 0.0) {
+            return Err(Termination::Event { index, t: t0 });
         }
-        let t_new = stepper.t();
-        let reached_end = t_new >= settings.t_end;
-        let mut dense_ready = false;
+        if flow == Flow::Stop {
+            return Err(Termination::Stopped { t: t0 });
+        }
+        Ok(())
+    }
 
-        // Event check at the end of the step; locate the earliest crossing on the dense output.
-        events.evaluate(t_new, stepper.y(), &mut g_new[..n_events]);
-        let mut event: Option<(usize, f64)> = None;
-        for i in 0..n_events {
-            if g_old[i] > 0.0 && g_new[i] <= 0.0 {
-                if !dense_ready {
-                    stepper.prepare_interpolation(sys);
-                    dense_ready = true;
+    /// Steps until the run ends; returns how it ended.
+    fn steps(&mut self) -> Termination {
+        loop {
+            if let Err(e) = self.stepper.step(self.sys, self.settings.t_end) {
+                return Termination::Failed(e);
+            }
+            self.dense_ready = false;
+            let t_new = self.stepper.t();
+            let event = self.event_in_step(t_new);
+            if let Some(end) = self.samples_up_to(t_new, event) {
+                return end;
+            }
+            if let Some((index, t)) = event {
+                self.sample_event(t);
+                return Termination::Event { index, t };
+            }
+            if t_new >= self.settings.t_end {
+                // Unreachable in practice (the grid loop emits t_end); kept so t_end is always sampled.
+                if self.t_last < self.settings.t_end {
+                    let _ = (self.observe)(self.settings.t_end, self.stepper.y());
+                    self.t_last = self.settings.t_end;
                 }
-                let t_root = locate(stepper, events, i, n_events, &mut buffer);
+                return Termination::Completed;
+            }
+            let n = self.n_events;
+            self.g_old[..n].copy_from_slice(&self.g_new[..n]);
+        }
+    }
+
+    fn prepare_dense(&mut self) {
+        if !self.dense_ready {
+            self.stepper.prepare_interpolation(self.sys);
+            self.dense_ready = true;
+        }
+    }
+
+    /// The earliest event crossing in the last step, located on the dense output: (index, time).
+    fn event_in_step(&mut self, t_new: f64) -> Option<(usize, f64)> {
+        let n = self.n_events;
+        self.events
+            .evaluate(t_new, self.stepper.y(), &mut self.g_new[..n]);
+        let mut event: Option<(usize, f64)> = None;
+        for i in 0..n {
+            if self.g_old[i] > 0.0 && self.g_new[i] <= 0.0 {
+                self.prepare_dense();
+                let t_root = locate(&*self.stepper, self.events, i, n, &mut self.buffer);
                 if event.is_none_or(|(_, t)| t_root < t) {
                     event = Some((i, t_root));
                 }
             }
         }
-        let t_stop = event.map_or(t_new, |(_, t)| t);
+        event
+    }
 
-        // Samples on the grid up to the step's end (or strictly before the event).
+    /// Emits the grid samples up to the step's end, or strictly before the event; `Some` when the run
+    /// ends on one of them (t_end reached, or the observer stopped).
+    fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<Termination> {
+        // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly).
+        let grid_slack = 1e-9 * self.settings.sample_interval;
+        let t_stop = event.map_or(t_new, |(_, t)| t);
         loop {
-            let mut t_k = sample_time(settings, k);
-            if t_k > settings.t_end - grid_slack {
-                t_k = settings.t_end;
+            let mut t_k = sample_time(self.settings, self.k);
+            if t_k > self.settings.t_end - grid_slack {
+                t_k = self.settings.t_end;
             }
             // A grid sample closer than EVENT_SAMPLE_GAP before the event gives way to the event's own
             // sample, so sample times stay apart by more than a nanosecond of log time.
             if t_k > t_stop || (event.is_some() && t_k > t_stop - EVENT_SAMPLE_GAP) {
-                break;
+                return None;
             }
             #[allow(clippy::float_cmp)] // exact: a grid time that is the step's end uses y itself
             let flow = if t_k == t_new {
-                observe(t_k, stepper.y())
+                (self.observe)(t_k, self.stepper.y())
             } else {
-                if !dense_ready {
-                    stepper.prepare_interpolation(sys);
-                    dense_ready = true;
-                }
-                stepper.interpolate(t_k, &mut buffer);
-                observe(t_k, &buffer)
+                self.prepare_dense();
+                self.stepper.interpolate(t_k, &mut self.buffer);
+                (self.observe)(t_k, &self.buffer)
             };
-            t_last = t_k;
-            k += 1;
-            if t_k >= settings.t_end {
-                return outcome(Termination::Completed, stepper, t_last);
+            self.t_last = t_k;
+            self.k += 1;
+            if t_k >= self.settings.t_end {
+                return Some(Termination::Completed);
             }
             if flow == Flow::Stop {
-                return outcome(Termination::Stopped { t: t_k }, stepper, t_last);
+                return Some(Termination::Stopped { t: t_k });
             }
         }
-        if let Some((index, t)) = event {
-            // The last sample is the state at the event, unless a sample already stands within
-            // EVENT_SAMPLE_GAP before it (a grid point ending the previous step): that one is the event's
-            // sample to within the log time's nanosecond, and a second would repeat its log time.
-            if t - t_last >= EVENT_SAMPLE_GAP {
-                // (Locating the event prepared the dense output.)
-                stepper.interpolate(t, &mut buffer);
-                let _ = observe(t, &buffer);
-                t_last = t;
-            }
-            return outcome(Termination::Event { index, t }, stepper, t_last);
+    }
+
+    /// The last sample is the state at the event, unless a sample already stands within
+    /// EVENT_SAMPLE_GAP before it (a grid point ending the previous step): that one is the event's sample
+    /// to within the log time's nanosecond, and a second would repeat its log time.
+    fn sample_event(&mut self, t: f64) {
+        if t - self.t_last >= EVENT_SAMPLE_GAP {
+            // (Locating the event prepared the dense output.)
+            self.stepper.interpolate(t, &mut self.buffer);
+            let _ = (self.observe)(t, &self.buffer);
+            self.t_last = t;
         }
-        if reached_end {
-            // Unreachable in practice (the grid loop emits t_end); kept so t_end is always sampled.
-            if t_last < settings.t_end {
-                let _ = observe(settings.t_end, stepper.y());
-                t_last = settings.t_end;
-            }
-            return outcome(Termination::Completed, stepper, t_last);
-        }
-        g_old[..n_events].copy_from_slice(&g_new[..n_events]);
     }
 }
 

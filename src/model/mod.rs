@@ -2,6 +2,7 @@
 //! Pure functions; no I/O and no knowledge of integrators or files.
 
 mod derived;
+pub mod drift;
 mod equations;
 pub mod invariants;
 mod params;
@@ -19,4 +20,7 @@ pub use stability::{
     centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
 };
 pub use state::{State, StateRate, STATE_LEN};
-pub use steady::{steady_omega_y, Branch, Steady, SteadyError, SteadyKind};
+pub use steady::{
+    steady_omega_y, Branch, Steady, SteadyError, SteadyFamily, SteadyKind, UnknownBranch,
+    UnknownSteadyFamily,
+};

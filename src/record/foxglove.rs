@@ -35,10 +35,10 @@
 //!   than [`TRACK_MIN_SPACING`]·a to the previous kept point are skipped (a coin spinning in place adds
 //!   none); an update with no new point carries no track entity.
 //!
-//! All timestamps `{sec, nsec}` are the log time of the sample ([`crate::units::log_time`]).
+//! All timestamps `{sec, nsec}` are the log time of the sample ([`crate::format::log_time`]).
 
-use super::channels::Channel;
-use super::messages::{push_number, NonFiniteField};
+use crate::format::messages::{push_number, NonFiniteField};
+use crate::format::Channel;
 use crate::model::{contact_point, orientation, Coin, Quaternion, State};
 use std::ops::Range;
 
@@ -544,9 +544,9 @@ impl<'a> Writer<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::format::log_time;
     use crate::model::{centre, CoinParams};
     use crate::record::schema_bytes;
-    use crate::units::log_time;
     use serde_json::Value;
 
     fn unit_coin() -> Coin {

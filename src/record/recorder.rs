@@ -1,5 +1,5 @@
-//! Scene → MCAP: integrates a [`Scene`] and streams its samples into an MCAP writer (issue 5, CONTRACT:
-//! Channels, Metadata records).
+//! Scene → MCAP: integrates a [`Scene`] and streams its samples into an MCAP writer (format.md: Channels,
+//! Metadata).
 //!
 //! The file is chunked (zstd by default), indexed, with statistics, summary offsets and CRCs; the `coin-log`
 //! metadata record comes before the first message and `coin-log.result` after the last. It is written by
@@ -7,29 +7,29 @@
 //! integrates. Nothing in it depends on the machine: the bytes do not depend on the worker count or on
 //! timing, there are no timestamps, and channels are registered in the order of their first message.
 //!
-//! Hot path (issue 9): per sample only the requested quantities are computed; each message is formatted
+//! Hot path: per sample only the requested quantities are computed; each message is formatted
 //! into one reused buffer and written with a precomputed channel id. Samples are written one sample late
 //! so that the last one can be flagged as last (the 3D scene then shows the final state).
 
-use super::channels::{schema_bytes, Channel, MESSAGE_ENCODING, SCHEMA_ENCODING};
 use super::foxglove::{Foxglove3d, FoxgloveBatch};
-use super::messages::{
+use super::summary::{Failure, RecordSummary};
+use super::writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
+use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField, Position,
     QuaternionMessage, ReactionMessage,
 };
-use super::metadata::{
-    ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+use crate::format::{
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError,
+    FORMAT_VERSION, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use super::summary::{Failure, RecordSummary, Termination};
-use super::writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
-use crate::integrate::{run_method, Flow, RunSettings, Termination as RunEnd};
+use crate::integrate::{self, run_method, Flow, RunOutcome, RunSettings};
+use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{
     centre, contact_point, energy, orientation, reaction, Chaplygin, Coin, InvariantsError, State,
     STATE_LEN,
 };
 use crate::scene::Scene;
 use crate::simulation::CoinEvents;
-use crate::units::{log_time, TimeError};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::io::{Seek, Write};
@@ -145,12 +145,12 @@ pub fn run_metadata(scene: &Scene) -> RunMetadata {
         inertia_z: p.inertia_z(),
         friction: scene.friction,
         time_unit: p.time_unit(),
-        integrator: scene.run.method.method.name().to_string(),
+        integrator: scene.run.method.method,
         rtol: scene.run.method.rtol,
         atol: scene.run.method.atol,
         step: scene.run.method.step,
         rate: scene.run.rate,
-        steady_kind: steady.map_or("none", |s| s.kind.name()).to_string(),
+        steady_kind: steady.map(|s| s.kind.family()),
         phi_dot: steady.map(|s| s.phi_dot),
         psi_dot: steady.map(|s| s.psi_dot),
         r_g: steady.and_then(|s| s.r_g),
@@ -221,17 +221,31 @@ impl<W: Write + Seek> Output<W> {
     }
 }
 
-/// Running maxima for the summary.
+/// Running measures for the summary: energy and invariant drift, distance from the steady motion.
 struct Drift {
-    energy0: f64,
-    energy_scale: f64,
-    energy: f64,
-    /// (C1₀, C2₀), the scale |C1₀| + |C2₀| (1 when both are 0) and max |C − C₀| / scale.
-    invariants0: Option<(f64, f64, f64)>,
-    invariants: f64,
+    energy: EnergyDrift,
+    /// Set at the first sample that has C1, C2.
+    invariants: Option<InvariantDrift>,
+    /// (θ*, ω_X*, ω_Y*, ω_Z*) of an unperturbed steady scene.
     steady: Option<[f64; 4]>,
     time_unit: f64,
     steady_residual: f64,
+}
+
+impl Drift {
+    fn new(scene: &Scene, coin: &Coin) -> Self {
+        let params = scene.params;
+        Self {
+            energy: EnergyDrift::new(&params, energy(coin, &scene.initial).total),
+            invariants: None,
+            steady: scene.unperturbed_steady().map(|s| {
+                let s = &s.state;
+                [s.theta, s.omega_x, s.omega_y, s.omega_z]
+            }),
+            time_unit: params.time_unit(),
+            steady_residual: 0.0,
+        }
+    }
 }
 
 /// Everything a sample needs, built once.
@@ -276,9 +290,31 @@ impl<W: Write + Seek> Sampler<W> {
     fn sample(&mut self, t: f64, y: &[f64; STATE_LEN], last: bool) -> Result<(), SampleError> {
         let ns = log_time(t)?;
         let s = State::from_array(y);
-        let coin = self.coin;
         self.buffer.clear();
         self.staged_len = 0;
+        self.stage_kinematics(t, &s)?;
+        let (total, invariants) = self.stage_dynamics(t, &s)?;
+        if let Some((foxglove, batch)) = &mut self.foxglove {
+            batch.clear();
+            foxglove.sample(t, ns, &s, last, batch)?;
+        }
+        for &(channel, start, end) in &self.staged[..self.staged_len] {
+            self.out.write(channel, ns, &self.buffer[start..end])?;
+        }
+        if let Some((_, batch)) = &self.foxglove {
+            for (channel, data) in batch.iter() {
+                self.out.write(channel, ns, data)?;
+            }
+        }
+        self.track(t, &s, total, invariants);
+        self.samples += 1;
+        Ok(())
+    }
+
+    /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
+    #[inline]
+    fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
+        let coin = self.coin;
         if self.on(Channel::Omega) {
             let m = AngularVelocity {
                 t,
@@ -298,7 +334,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Angles, |b| m.write_json(b))?;
         }
         if self.on(Channel::Quaternion) {
-            let q = orientation(&s);
+            let q = orientation(s);
             let m = QuaternionMessage {
                 t,
                 x: q.x,
@@ -309,7 +345,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Quaternion, |b| m.write_json(b))?;
         }
         if self.on(Channel::Position) {
-            let c = centre(&coin, &s);
+            let c = centre(&coin, s);
             let m = Position {
                 t,
                 x: c.x,
@@ -319,7 +355,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Position, |b| m.write_json(b))?;
         }
         if self.on(Channel::Contact) {
-            let c = contact_point(&coin, &s);
+            let c = contact_point(&coin, s);
             let m = Position {
                 t,
                 x: c.x,
@@ -328,8 +364,20 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Contact, |b| m.write_json(b))?;
         }
+        Ok(())
+    }
+
+    /// Stages the messages that need the equations or the integrals: reaction, energy, C1 and C2. Returns
+    /// E and (C1, C2) when computed, for the summary's drift.
+    #[inline]
+    fn stage_dynamics(
+        &mut self,
+        t: f64,
+        s: &State,
+    ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
+        let coin = self.coin;
         if self.on(Channel::Reaction) {
-            let r = reaction(&coin, &s);
+            let r = reaction(&coin, s);
             let m = ReactionMessage {
                 t,
                 x: r.force.x,
@@ -341,7 +389,7 @@ impl<W: Write + Seek> Sampler<W> {
             self.stage(Channel::Reaction, |b| m.write_json(b))?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
-        let e = energy(&coin, &s);
+        let e = energy(&coin, s);
         if self.on(Channel::Energy) {
             let m = EnergyMessage {
                 t,
@@ -351,7 +399,7 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Energy, |b| m.write_json(b))?;
         }
-        let invariants = self.chaplygin.as_ref().map(|c| c.of_state(&s));
+        let invariants = self.chaplygin.as_ref().map(|c| c.of_state(s));
         if let Some(c) = invariants {
             let m = InvariantsMessage {
                 t,
@@ -360,41 +408,19 @@ impl<W: Write + Seek> Sampler<W> {
             };
             self.stage(Channel::Invariants, |b| m.write_json(b))?;
         }
-        if let Some((foxglove, batch)) = &mut self.foxglove {
-            batch.clear();
-            foxglove.sample(t, ns, &s, last, batch)?;
-        }
-        for &(channel, start, end) in &self.staged[..self.staged_len] {
-            self.out.write(channel, ns, &self.buffer[start..end])?;
-        }
-        if let Some((_, batch)) = &self.foxglove {
-            for (channel, data) in batch.iter() {
-                self.out.write(channel, ns, data)?;
-            }
-        }
-        self.track(&s, e.total);
-        if let Some(c) = invariants {
-            self.track_invariants(c.c1, c.c2);
-        }
-        self.samples += 1;
-        Ok(())
+        Ok((e.total, invariants.map(|c| (c.c1, c.c2))))
     }
 
     #[inline]
-    fn track_invariants(&mut self, c1: f64, c2: f64) {
+    fn track(&mut self, t: f64, s: &State, total: f64, invariants: Option<(f64, f64)>) {
         let d = &mut self.drift;
-        let (c10, c20, scale) = *d.invariants0.get_or_insert_with(|| {
-            let scale = c1.abs() + c2.abs();
-            (c1, c2, if scale > 0.0 { scale } else { 1.0 })
-        });
-        let deviation = (c1 - c10).abs().max((c2 - c20).abs()) / scale;
-        d.invariants = d.invariants.max(deviation);
-    }
-
-    #[inline]
-    fn track(&mut self, s: &State, total: f64) {
-        let d = &mut self.drift;
-        d.energy = d.energy.max((total - d.energy0).abs() / d.energy_scale);
+        d.energy.observe(t, total);
+        if let Some((c1, c2)) = invariants {
+            let params = self.coin.params();
+            d.invariants
+                .get_or_insert_with(|| InvariantDrift::new(params, c1, c2))
+                .observe(t, c1, c2);
+        }
         if let Some([theta, wx, wy, wz]) = d.steady {
             let dw = (s.omega_x - wx)
                 .abs()
@@ -419,71 +445,52 @@ pub fn record<W: Write + Seek>(
     options: &RecordOptions,
     writer: W,
     stop: &AtomicBool,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
-    let coin = scene.coin();
-    let params = scene.params;
-    let mut on = [false; Channel::ALL.len()];
-    for c in &scene.channels {
-        on[*c as usize] = true;
+    let mut sampler = Sampler::start(scene, options, writer)?;
+    let (outcome, error) = integrate_into(scene, &mut sampler, stop, progress);
+    let (termination, termination_time, failure) = match error {
+        Some(SampleError::Write(e)) => return Err(e.into()),
+        Some(SampleError::Failure(f)) => (f.termination(), outcome.t_last, Some(f)),
+        None => ending(&outcome.termination, outcome.t_last),
+    };
+    sampler.finish(outcome.stats, termination, termination_time, failure)
+}
+
+/// How the integration ended, as the file records it: termination, its time, and the failure if any.
+fn ending(end: &integrate::Termination, t_last: f64) -> (Termination, f64, Option<Failure>) {
+    let termination = Termination::of_run(end);
+    match end {
+        integrate::Termination::Completed => (termination, t_last, None),
+        integrate::Termination::Event { t, .. } | integrate::Termination::Stopped { t } => {
+            (termination, *t, None)
+        }
+        integrate::Termination::Failed(e) => {
+            let t = match e {
+                integrate::StepError::NonFinite { t }
+                | integrate::StepError::StepSizeUnderflow { t, .. }
+                | integrate::StepError::NewtonFailure { t, .. } => *t,
+            };
+            (termination, t, Some(Failure::Step(e.clone())))
+        }
     }
-    // Before the first byte: a body whose C1, C2 cannot be evaluated leaves no half-written file.
-    let chaplygin = if on[Channel::Invariants as usize] {
-        Some(Chaplygin::new(&params)?)
-    } else {
-        None
-    };
-    let mut writer = McapWriter::new(writer, &write_options(options))?;
-    writer.write_metadata(RUN_METADATA_NAME, &run_metadata(scene).to_map())?;
+}
 
-    let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
-    let foxglove = (tf || scene_on).then(|| {
-        (
-            Foxglove3d::new(&coin, scene.thickness, tf, scene_on),
-            FoxgloveBatch::default(),
-        )
-    });
-    let energy0 = energy(&coin, &scene.initial).total;
-
-    let mut sampler = Sampler {
-        out: Output {
-            writer,
-            ids: [None; Channel::ALL.len()],
-            sequence: [0; Channel::ALL.len()],
-            messages: 0,
-        },
-        coin,
-        on,
-        buffer: Vec::with_capacity(1024),
-        staged: [(Channel::Omega, 0, 0); Channel::ALL.len()],
-        staged_len: 0,
-        foxglove,
-        chaplygin,
-        samples: 0,
-        drift: Drift {
-            energy0,
-            energy_scale: energy0.abs().max(params.energy_scale()),
-            energy: 0.0,
-            invariants0: None,
-            invariants: 0.0,
-            steady: scene.unperturbed_steady().map(|s| {
-                [
-                    s.state.theta,
-                    s.state.omega_x,
-                    s.state.omega_y,
-                    s.state.omega_z,
-                ]
-            }),
-            time_unit: params.time_unit(),
-            steady_residual: 0.0,
-        },
-    };
-
+/// Runs the scene's integrator, writing each sample one sample late (so that the last one can be flagged
+/// as last), reporting progress and honouring `stop`. Returns the integrator's outcome and the error that
+/// stopped writing, if one did.
+fn integrate_into<W: Write + Seek>(
+    scene: &Scene,
+    sampler: &mut Sampler<W>,
+    stop: &AtomicBool,
+    mut progress: impl FnMut(f64),
+) -> (RunOutcome, Option<SampleError>) {
     let settings = RunSettings {
         t0: 0.0,
         t_end: scene.run.duration,
         sample_interval: scene.run.sample_interval(),
     };
+    let coin = sampler.coin;
     let events = CoinEvents::new(coin, scene.run.flat_margin, scene.friction);
     let mut pending: Option<(f64, [f64; STATE_LEN])> = None;
     let mut error: Option<SampleError> = None;
@@ -514,57 +521,93 @@ pub fn record<W: Write + Seek>(
     );
     if error.is_none() {
         if let Some((t, y)) = pending {
-            if let Err(e) = sampler.sample(t, &y, true) {
-                error = Some(e);
-            }
+            error = sampler.sample(t, &y, true).err();
         }
     }
-    let (termination, termination_time) = match (error, outcome.termination) {
-        (Some(SampleError::Write(e)), _) => return Err(e.into()),
-        (Some(SampleError::Failure(f)), _) => (Termination::Failed(f), outcome.t_last),
-        (None, RunEnd::Completed) => (Termination::Completed, outcome.t_last),
-        (None, RunEnd::Event { index, t }) => (Termination::Event(CoinEvents::event(index)), t),
-        (None, RunEnd::Stopped { t }) => (Termination::Interrupted, t),
-        (None, RunEnd::Failed(e)) => {
-            let t = match e {
-                crate::integrate::StepError::NonFinite { t }
-                | crate::integrate::StepError::StepSizeUnderflow { t, .. }
-                | crate::integrate::StepError::NewtonFailure { t, .. } => t,
-            };
-            (Termination::Failed(Failure::Step(e)), t)
-        }
-    };
-    progress(termination_time);
+    progress(outcome.t_last);
+    (outcome, error)
+}
 
-    let Sampler {
-        out: mut output,
-        drift,
-        samples,
-        ..
-    } = sampler;
-    let stats = outcome.stats;
-    output.writer.write_metadata(
-        RESULT_METADATA_NAME,
-        &ResultMetadata {
-            steps: stats.steps,
-            rhs_evaluations: stats.rhs_evaluations,
-            rejected_steps: stats.rejected_steps,
-            termination: termination.name().to_string(),
-            termination_time,
+impl<W: Write + Seek> Sampler<W> {
+    /// Opens the file: writer, `coin-log` metadata, and what each sample will compute. A body whose C1, C2
+    /// cannot be evaluated fails here, before the first byte, so no half-written file is left.
+    fn start(scene: &Scene, options: &RecordOptions, writer: W) -> Result<Self, RecordError> {
+        let coin = scene.coin();
+        let mut on = [false; Channel::ALL.len()];
+        for c in &scene.channels {
+            on[*c as usize] = true;
         }
-        .to_map(),
-    )?;
-    let (mut inner, bytes) = output.writer.finish()?;
-    inner.flush()?;
-    Ok(RecordSummary {
-        samples,
-        messages: output.messages,
-        bytes,
-        stats,
-        termination,
-        termination_time,
-        energy_drift: drift.energy,
-        invariant_drift: drift.invariants0.map(|_| drift.invariants),
-        steady_residual: drift.steady.map(|_| drift.steady_residual),
-    })
+        let chaplygin = if on[Channel::Invariants as usize] {
+            Some(Chaplygin::new(&scene.params)?)
+        } else {
+            None
+        };
+        let mut writer = McapWriter::new(writer, &write_options(options))?;
+        writer.write_metadata(RUN_METADATA_NAME, &run_metadata(scene).to_map())?;
+        let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
+        let foxglove = (tf || scene_on).then(|| {
+            (
+                Foxglove3d::new(&coin, scene.thickness, tf, scene_on),
+                FoxgloveBatch::default(),
+            )
+        });
+        Ok(Self {
+            out: Output {
+                writer,
+                ids: [None; Channel::ALL.len()],
+                sequence: [0; Channel::ALL.len()],
+                messages: 0,
+            },
+            coin,
+            on,
+            buffer: Vec::with_capacity(1024),
+            staged: [(Channel::Omega, 0, 0); Channel::ALL.len()],
+            staged_len: 0,
+            foxglove,
+            chaplygin,
+            samples: 0,
+            drift: Drift::new(scene, &coin),
+        })
+    }
+
+    /// Closes the file: `coin-log.result` metadata, summary section, flush; returns the summary.
+    fn finish(
+        self,
+        stats: integrate::Stats,
+        termination: Termination,
+        termination_time: f64,
+        failure: Option<Failure>,
+    ) -> Result<RecordSummary, RecordError> {
+        let Self {
+            mut out,
+            drift,
+            samples,
+            ..
+        } = self;
+        out.writer.write_metadata(
+            RESULT_METADATA_NAME,
+            &ResultMetadata {
+                steps: stats.steps,
+                rhs_evaluations: stats.rhs_evaluations,
+                rejected_steps: stats.rejected_steps,
+                termination,
+                termination_time,
+            }
+            .to_map(),
+        )?;
+        let (mut inner, bytes) = out.writer.finish()?;
+        inner.flush()?;
+        Ok(RecordSummary {
+            samples,
+            messages: out.messages,
+            bytes,
+            stats,
+            termination,
+            termination_time,
+            failure,
+            energy_drift: drift.energy.value(),
+            invariant_drift: drift.invariants.map(|d| d.value()),
+            steady_residual: drift.steady.map(|_| drift.steady_residual),
+        })
+    }
 }

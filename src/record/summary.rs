@@ -1,9 +1,8 @@
-//! How a recording ended and what it cost: the numbers of the end-of-run table (issue 5: Summary).
+//! How a recording ended and what it cost: the numbers of the end-of-run summary.
 
+use crate::format::messages::NonFiniteField;
+use crate::format::{Termination, TimeError};
 use crate::integrate::{Stats, StepError};
-use crate::record::messages::NonFiniteField;
-use crate::simulation::PhysicalEvent;
-use crate::units::TimeError;
 use std::fmt;
 
 /// A numerical failure that ended a run early; the file holds the samples up to it.
@@ -18,15 +17,12 @@ pub enum Failure {
 }
 
 impl Failure {
-    /// The contract's termination name (`step-size-underflow`, `non-finite`, ...).
+    /// The termination this failure is recorded as.
     #[must_use]
-    pub fn name(&self) -> &'static str {
+    pub fn termination(&self) -> Termination {
         match self {
-            Self::Step(StepError::StepSizeUnderflow { .. }) => "step-size-underflow",
-            Self::Step(StepError::NewtonFailure { .. }) => "newton-failure",
-            Self::Step(StepError::NonFinite { .. }) | Self::Message(_) | Self::Time(_) => {
-                "non-finite"
-            }
+            Self::Step(e) => Termination::of_step_error(e),
+            Self::Message(_) | Self::Time(_) => Termination::NonFinite,
         }
     }
 }
@@ -37,33 +33,6 @@ impl fmt::Display for Failure {
             Self::Step(e) => e.fmt(f),
             Self::Message(e) => e.fmt(f),
             Self::Time(e) => e.fmt(f),
-        }
-    }
-}
-
-/// Why a recording stopped (the `termination` of `coin-log.result`).
-#[derive(Debug, Clone, PartialEq)]
-pub enum Termination {
-    /// The duration was reached.
-    Completed,
-    /// A physical event ended the model's validity (flat landing, lift-off, slip); a normal end.
-    Event(PhysicalEvent),
-    /// The stop flag was raised (SIGINT).
-    Interrupted,
-    /// A numerical failure.
-    Failed(Failure),
-}
-
-impl Termination {
-    /// The contract's name: completed | flat-landing | lift-off | slip | interrupted |
-    /// step-size-underflow | non-finite (| newton-failure).
-    #[must_use]
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Completed => "completed",
-            Self::Event(e) => e.name(),
-            Self::Interrupted => "interrupted",
-            Self::Failed(f) => f.name(),
         }
     }
 }
@@ -83,9 +52,12 @@ pub struct RecordSummary {
     pub termination: Termination,
     /// When it ended (the last sample's time, or the failure's).
     pub termination_time: f64,
-    /// max |E − E₀| / max(|E₀|, M g a) over the samples (CONTRACT: verify).
+    /// The numerical failure that ended the run, when one did (its detail for the user).
+    pub failure: Option<Failure>,
+    /// Energy drift over the samples ([`EnergyDrift`](crate::model::drift::EnergyDrift)).
     pub energy_drift: f64,
-    /// max |C − C₀| / (|C1₀| + |C2₀|) over the samples, when C1, C2 were computed.
+    /// Invariant drift over the samples, when C1, C2 were computed
+    /// ([`InvariantDrift`](crate::model::drift::InvariantDrift)).
     pub invariant_drift: Option<f64>,
     /// For an unperturbed steady scene: max over the samples of |θ − θ*| and |ω − ω*|·√(a/g)
     /// (dimensionless), the distance from the steady motion.

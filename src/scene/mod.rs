@@ -15,9 +15,9 @@ pub use file::{
 };
 pub use overrides::{apply_set, FlagOverrides};
 
+use crate::format::Channel;
 use crate::integrate::MethodConfig;
 use crate::model::{Coin, CoinParams, Inertia, State, Steady};
-use crate::record::Channel;
 use std::fmt;
 
 /// Defaults of the optional scene keys (CONTRACT: Scene files).
@@ -37,7 +37,7 @@ pub mod defaults {
     /// Display thickness, a fraction of the radius (a 500-yen coin is 1.8 mm thick for 13.25 mm radius).
     pub const THICKNESS: f64 = 0.05;
     /// Steady branch when none is given.
-    pub const BRANCH: &str = "+";
+    pub const BRANCH: crate::model::Branch = crate::model::Branch::Plus;
 }
 
 /// Largest number of samples a scene may ask for (duration × rate): 10¹¹, far beyond any disk.

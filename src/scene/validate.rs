@@ -5,9 +5,9 @@ use super::file::{
     BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
 };
 use super::{defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, MAX_SAMPLES};
+use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
-use crate::model::{Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind};
-use crate::record::Channel;
+use crate::model::{Branch, Coin, CoinParams, Inertia, State, Steady, SteadyFamily, SteadyKind};
 use std::f64::consts::FRAC_PI_2;
 
 /// Collects problems, naming the flag that set a key when one did.
@@ -297,16 +297,50 @@ fn check_initial(
     let in_lean_range = |theta: f64| flat_margin.is_none_or(|m| theta.abs() < FRAC_PI_2 - m);
     let margin_text = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
     let coin = Coin::new(*params);
-    let base: Option<(State, InitialSpec)> = match (&initial.steady, initial.theta, &initial.omega)
-    {
+    let base = initial_base(initial, &coin, margin_text, &in_lean_range, problems);
+    let perturbation = initial
+        .perturbation
+        .as_ref()
+        .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
+    let (mut state, spec) = base?;
+    let perturbation = perturbation?;
+    state.phi += offsets[0];
+    state.psi += offsets[1];
+    state.x += offsets[2];
+    state.z += offsets[3];
+    let kicked = perturbed(&state, &perturbation);
+    if perturbation[0] != 0.0 && !in_lean_range(kicked.theta) {
+        problems.push(
+            "initial.perturbation.theta",
+            number(perturbation[0]),
+            format!(
+                "takes theta to {}, which {}",
+                number(kicked.theta),
+                lean_range(margin_text)
+            ),
+        );
+    }
+    (problems.list.len() == before).then_some((state, spec, perturbation))
+}
+
+/// The state before offsets and perturbation: an explicit (θ, ω) or a solved steady motion.
+fn initial_base(
+    initial: &InitialFile,
+    coin: &Coin,
+    margin_text: f64,
+    in_lean_range: &dyn Fn(f64) -> bool,
+    problems: &mut Problems,
+) -> Option<(State, InitialSpec)> {
+    const EITHER: &str = "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion";
+    match (&initial.steady, initial.theta, &initial.omega) {
         (Some(steady), theta, omega) => {
             if let Some(t) = theta {
-                problems.push("initial.theta", number(t), "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion");
+                problems.push("initial.theta", number(t), EITHER);
             }
             if let Some(o) = omega {
-                problems.push("initial.omega", numbers(o), "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion");
+                problems.push("initial.omega", numbers(o), EITHER);
             }
-            check_steady(steady, &coin, margin_text, &in_lean_range, problems)
+            check_steady(steady, coin, margin_text, in_lean_range, problems)
                 .map(|s| (s.state, InitialSpec::Steady(s)))
         }
         (None, Some(theta), Some(omega)) => {
@@ -344,30 +378,7 @@ fn check_initial(
             );
             None
         }
-    };
-    let perturbation = initial
-        .perturbation
-        .as_ref()
-        .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
-    let (mut state, spec) = base?;
-    let perturbation = perturbation?;
-    state.phi += offsets[0];
-    state.psi += offsets[1];
-    state.x += offsets[2];
-    state.z += offsets[3];
-    let kicked = perturbed(&state, &perturbation);
-    if perturbation[0] != 0.0 && !in_lean_range(kicked.theta) {
-        problems.push(
-            "initial.perturbation.theta",
-            number(perturbation[0]),
-            format!(
-                "takes theta to {}, which {}",
-                number(kicked.theta),
-                lean_range(margin_text)
-            ),
-        );
     }
-    (problems.list.len() == before).then_some((state, spec, perturbation))
 }
 
 /// `base` with the perturbation (θ, ω_X, ω_Y, ω_Z) added.
@@ -392,17 +403,17 @@ fn check_perturbation(p: &PerturbationFile, problems: &mut Problems) -> Option<[
     theta_ok.then_some([theta, wx, wy, wz])
 }
 
-/// The keys each steady kind takes.
-fn steady_keys(kind: &str) -> Option<&'static [&'static str]> {
-    Some(match kind {
-        "straight" => &["omega_z"],
-        "centre-fixed" => &["theta", "branch"],
-        "circle" => &["theta", "omega_z", "branch"],
-        "spin-upright" => &["omega_y"],
-        _ => return None,
-    })
+/// The keys of `initial.steady` each steady family takes (besides `kind`).
+fn steady_keys(family: SteadyFamily) -> &'static [&'static str] {
+    match family {
+        SteadyFamily::Straight => &["omega_z"],
+        SteadyFamily::CentreFixed => &["theta", "branch"],
+        SteadyFamily::Circle => &["theta", "omega_z", "branch"],
+        SteadyFamily::SpinUpright => &["omega_y"],
+    }
 }
 
+/// `initial.steady` → a steady motion: the family, the keys it takes, their values, then the solve.
 fn check_steady(
     steady: &SteadyFile,
     coin: &Coin,
@@ -411,35 +422,60 @@ fn check_steady(
     problems: &mut Problems,
 ) -> Option<Steady> {
     let before = problems.list.len();
-    let Some(allowed) = steady_keys(&steady.kind) else {
-        problems.push(
-            "initial.steady.kind",
-            quoted(&steady.kind),
-            "is not a steady motion: use \"straight\", \"centre-fixed\", \"circle\" or \"spin-upright\"",
-        );
-        return None;
+    let family = match steady.kind.parse::<SteadyFamily>() {
+        Ok(f) => f,
+        Err(_) => {
+            problems.push(
+                "initial.steady.kind",
+                quoted(&steady.kind),
+                "is not a steady motion: use \"straight\", \"centre-fixed\", \"circle\" or \"spin-upright\"",
+            );
+            return None;
+        }
     };
+    check_steady_keys(steady, family, problems);
+    let kind = steady_kind(steady, family, margin, in_lean_range, problems);
+    if problems.list.len() != before {
+        return None;
+    }
+    solve_steady(coin, kind, family, problems)
+}
+
+/// Reports the keys given that `family` does not take.
+fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut Problems) {
+    let allowed = steady_keys(family);
     let given = [
         ("theta", steady.theta.map(number)),
         ("omega_y", steady.omega_y.map(number)),
         ("omega_z", steady.omega_z.map(number)),
         ("branch", steady.branch.as_deref().map(quoted)),
     ];
-    for (name, value) in &given {
+    for (name, value) in given {
         if let Some(v) = value {
-            if !allowed.contains(name) {
+            if !allowed.contains(&name) {
                 problems.push(
                     &format!("initial.steady.{name}"),
-                    v.clone(),
+                    v,
                     format!(
-                        "does not apply to a \"{}\" steady motion, which takes: kind, {}",
-                        steady.kind,
+                        "does not apply to a \"{family}\" steady motion, which takes: kind, {}",
                         allowed.join(", ")
                     ),
                 );
             }
         }
     }
+}
+
+/// The steady motion's parameters from the keys `family` takes; missing or bad ones are reported (their
+/// value is then a placeholder that is never used).
+fn steady_kind(
+    steady: &SteadyFile,
+    family: SteadyFamily,
+    margin: f64,
+    in_lean_range: &dyn Fn(f64) -> bool,
+    problems: &mut Problems,
+) -> SteadyKind {
+    let allowed = steady_keys(family);
     let mut required = |name: &str, value: Option<f64>| -> f64 {
         let key = format!("initial.steady.{name}");
         match value {
@@ -448,46 +484,32 @@ fn check_steady(
                 v
             }
             None => {
-                if allowed.contains(&name) {
-                    problems.missing(
-                        &key,
-                        format!(
-                            "is missing: a \"{}\" steady motion needs {}",
-                            steady.kind,
-                            allowed.join(", ")
-                        ),
-                    );
-                }
+                problems.missing(
+                    &key,
+                    format!(
+                        "is missing: a \"{family}\" steady motion needs {}",
+                        allowed.join(", ")
+                    ),
+                );
                 0.0
             }
         }
     };
-    let kind = match steady.kind.as_str() {
-        "straight" => SteadyKind::Straight {
+    match family {
+        SteadyFamily::Straight => SteadyKind::Straight {
             omega_z: required("omega_z", steady.omega_z),
         },
-        "spin-upright" => SteadyKind::SpinUpright {
+        SteadyFamily::SpinUpright => SteadyKind::SpinUpright {
             omega_y: required("omega_y", steady.omega_y),
         },
-        kind => {
+        SteadyFamily::CentreFixed | SteadyFamily::Circle => {
             let theta = required("theta", steady.theta);
-            let omega_z = if kind == "circle" {
+            let omega_z = if family == SteadyFamily::Circle {
                 required("omega_z", steady.omega_z)
             } else {
                 0.0
             };
-            let branch = match steady.branch.as_deref().unwrap_or(defaults::BRANCH) {
-                "+" => Branch::Plus,
-                "-" => Branch::Minus,
-                other => {
-                    problems.push(
-                        "initial.steady.branch",
-                        quoted(other),
-                        "is not a branch: use \"+\" or \"-\"",
-                    );
-                    Branch::Plus
-                }
-            };
+            let branch = steady_branch(steady, problems);
             if theta.is_finite()
                 && (theta == 0.0 || !in_lean_range(theta))
                 && steady.theta.is_some()
@@ -500,7 +522,7 @@ fn check_steady(
                     ),
                 );
             }
-            if kind == "circle" {
+            if family == SteadyFamily::Circle {
                 SteadyKind::Circle {
                     theta,
                     omega_z,
@@ -510,16 +532,37 @@ fn check_steady(
                 SteadyKind::CentreFixed { theta, branch }
             }
         }
-    };
-    if problems.list.len() != before {
-        return None;
     }
+}
+
+/// `initial.steady.branch` (default `+`).
+fn steady_branch(steady: &SteadyFile, problems: &mut Problems) -> Branch {
+    match steady.branch.as_deref() {
+        None => defaults::BRANCH,
+        Some(name) => name.parse().unwrap_or_else(|_| {
+            problems.push(
+                "initial.steady.branch",
+                quoted(name),
+                "is not a branch: use \"+\" or \"-\"",
+            );
+            defaults::BRANCH
+        }),
+    }
+}
+
+/// Solves the steady motion; a motion without a finite solution is reported.
+fn solve_steady(
+    coin: &Coin,
+    kind: SteadyKind,
+    family: SteadyFamily,
+    problems: &mut Problems,
+) -> Option<Steady> {
     match Steady::new(coin, kind) {
         Ok(s) if s.state.is_finite() => Some(s),
         Ok(s) => {
             problems.push(
                 "initial.steady",
-                format!("{{ kind = \"{}\" }}", steady.kind),
+                format!("{{ kind = \"{family}\" }}"),
                 format!(
                     "has no finite solution here (ω_Y = {})",
                     number(s.state.omega_y)
@@ -530,7 +573,7 @@ fn check_steady(
         Err(e) => {
             problems.push(
                 "initial.steady",
-                format!("{{ kind = \"{}\" }}", steady.kind),
+                format!("{{ kind = \"{family}\" }}"),
                 format!("cannot be built: {e}"),
             );
             None
@@ -547,7 +590,7 @@ fn check_run(
     let before = problems.list.len();
     let duration = match run.duration {
         Some(d) => {
-            if problems.positive("run.duration", d) && crate::units::log_time(d).is_err() {
+            if problems.positive("run.duration", d) && crate::format::log_time(d).is_err() {
                 problems.push(
                     "run.duration",
                     number(d),
@@ -644,7 +687,7 @@ fn check_channels(record: Option<&RecordFile>, problems: &mut Problems) -> Optio
             Err(_) => problems.push(
                 "record.channels",
                 quoted(name),
-                "is not a channel: use omega, angles, quaternion, position, contact, reaction, energy, invariants, tf, scene",
+                format!("is not a channel: use {}", Channel::names()),
             ),
         }
     }
@@ -652,7 +695,7 @@ fn check_channels(record: Option<&RecordFile>, problems: &mut Problems) -> Optio
         problems.push(
             "record.channels",
             "[]".into(),
-            "is empty: list at least one channel (omega, angles, quaternion, position, contact, reaction, energy, invariants, tf, scene)",
+            format!("is empty: list at least one channel ({})", Channel::names()),
         );
     }
     channels.sort();
@@ -729,7 +772,7 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
 }
 
 fn steady_file(kind: &SteadyKind) -> SteadyFile {
-    let branch = |b: &Branch| Some(if *b == Branch::Plus { "+" } else { "-" }.to_string());
+    let branch = |b: &Branch| Some(b.to_string());
     let name = kind.name().to_string();
     match kind {
         SteadyKind::Straight { omega_z } => SteadyFile {

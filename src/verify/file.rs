@@ -14,17 +14,16 @@ use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::wire::MessageHeader;
 use super::Options;
-use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, CoinParams, Inertia};
-use crate::record::messages::{
+use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage,
 };
-use crate::record::{
-    schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
+use crate::format::{
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
     RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use crate::units::log_time;
+use crate::model::invariants::Chaplygin;
+use crate::model::{Coin, CoinParams, Inertia};
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -60,7 +59,8 @@ impl Checks {
     fn observe(&mut self, s: &Sample, ctx: &Context) {
         self.stats.observe(s);
         self.energy.observe(s, ctx);
-        self.invariants.observe(s, invariants_of(ctx));
+        self.invariants
+            .observe(s, ctx.coin.params(), invariants_of(ctx));
         self.steady.observe(s, ctx);
         self.constraint.observe(s, ctx.coin.params().radius());
         self.consistency.observe(s, ctx);
@@ -465,15 +465,8 @@ fn verdict(
             ReadErrorKind::Truncated | ReadErrorKind::Corrupt => problem = Some(e.detail.clone()),
         }
     }
-    let Some(mut ctx) = judge.ctx.take() else {
-        let why = judge.run_error.take().unwrap_or_else(|| {
-            let by = if judge.library.is_empty() {
-                String::new()
-            } else {
-                format!(" (written by `{}`)", judge.library)
-            };
-            format!("not a coin-log file: it has no `coin-log` metadata record before its first message{by}")
-        });
+    let Some(ctx) = judge.ctx.take() else {
+        let why = judge.not_coin_log();
         return unusable(
             &shown,
             problem.map_or(why.clone(), |p| format!("{why}; {p}")),
@@ -481,46 +474,16 @@ fn verdict(
     };
     let checks = &mut judge.checks;
     judge.assembler.finish(&mut |s| checks.observe(s, &ctx));
-    if let Some(e) = &judge.result_error {
-        judge
-            .problems
-            .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
-    }
-    if ctx.result.is_none() && error.is_none() {
-        judge.problems.push_with(|| {
-            "no `coin-log.result` metadata record (the run did not finish writing)".into()
-        });
-    }
-    let mut problems = structure.problems.clone();
-    problems.extend(&judge.problems);
-    if let Some(p) = &problem {
-        problems.push_with(|| p.clone());
-    }
-    let stats = judge.checks.stats;
-    let run = &ctx.run;
-    let tol = Tolerances::derive(
-        &RunAccuracy {
-            integrator: &run.integrator,
-            rtol: run.rtol,
-            atol: run.atol,
-            step: run.step,
-            radius: run.radius,
-            time_unit: ctx.coin.params().time_unit(),
-            span: stats.span(),
-            max_omega: stats.max_omega,
-        },
-        options.energy_tol,
-        options.residual_tol,
-    );
+    let problems = judge.all_problems(&structure, &ctx, error.is_none(), problem.as_ref());
+    let tol = tolerances(&ctx, &judge.checks.stats, options);
     let read = format!(
         "{} messages in {} chunks, {} samples",
-        structure.messages, structure.chunks, stats.samples
+        structure.messages, structure.chunks, judge.checks.stats.samples
     );
-    ctx.result = ctx.result.take();
     let c = &judge.checks;
     let mut results = vec![
         integrity::finish(&problems, &read, &judge.notes),
-        c.energy.finish(&ctx, &tol),
+        c.energy.finish(&tol),
         c.invariants
             .finish(&tol, ctx.chaplygin.as_ref().err().map(String::as_str)),
         c.steady.finish(&ctx, &tol),
@@ -541,6 +504,64 @@ fn verdict(
         checks: results,
         problem,
     }
+}
+
+impl Judge {
+    /// Why a file without a usable `coin-log` metadata record is not judged.
+    fn not_coin_log(&mut self) -> String {
+        self.run_error.take().unwrap_or_else(|| {
+            let by = if self.library.is_empty() {
+                String::new()
+            } else {
+                format!(" (written by `{}`)", self.library)
+            };
+            format!("not a coin-log file: it has no `coin-log` metadata record before its first message{by}")
+        })
+    }
+
+    /// Every integrity problem: the reader's, the judge's, the result record's, and the read error's.
+    fn all_problems(
+        &mut self,
+        structure: &reader::Structure,
+        ctx: &Context,
+        read_whole: bool,
+        read_problem: Option<&String>,
+    ) -> Problems {
+        if let Some(e) = &self.result_error {
+            self.problems
+                .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
+        }
+        if ctx.result.is_none() && read_whole {
+            self.problems.push_with(|| {
+                "no `coin-log.result` metadata record (the run did not finish writing)".into()
+            });
+        }
+        let mut problems = structure.problems.clone();
+        problems.extend(&self.problems);
+        if let Some(p) = read_problem {
+            problems.push_with(|| p.clone());
+        }
+        problems
+    }
+}
+
+/// The tolerances of this file: derived from its recorded settings and span, or the flags'.
+fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances {
+    let run = &ctx.run;
+    Tolerances::derive(
+        &RunAccuracy {
+            integrator: run.integrator,
+            rtol: run.rtol,
+            atol: run.atol,
+            step: run.step,
+            radius: run.radius,
+            time_unit: ctx.coin.params().time_unit(),
+            span: stats.span(),
+            max_omega: stats.max_omega,
+        },
+        options.energy_tol,
+        options.residual_tol,
+    )
 }
 
 /// CONTRACT: a file in which integrity, energy and at least one of constraint / steady could not run

@@ -4,11 +4,11 @@
 //! a file whose channels are far apart in time still verifies in bounded memory (samples are then judged
 //! with the channels that had arrived).
 
-use crate::model::State;
-use crate::record::messages::{
+use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage,
 };
+use crate::model::State;
 use std::collections::VecDeque;
 
 /// Most samples waiting for their other channels.

@@ -53,9 +53,9 @@ pub struct Tolerances {
 
 /// How the log was integrated, as far as the tolerances need it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RunAccuracy<'a> {
-    /// Integrator name (`metadata.integrator`).
-    pub integrator: &'a str,
+pub struct RunAccuracy {
+    /// The integrator (`metadata.integrator`).
+    pub integrator: Method,
     /// rtol.
     pub rtol: f64,
     /// atol.
@@ -72,11 +72,9 @@ pub struct RunAccuracy<'a> {
     pub max_omega: f64,
 }
 
-/// Order of a fixed-step method, `None` for adaptive ones and unknown names (treated as adaptive: rtol and
-/// atol then carry the accuracy).
+/// Order of a fixed-step method, `None` for adaptive ones (rtol and atol then carry the accuracy).
 #[must_use]
-pub fn fixed_step_order(integrator: &str) -> Option<i32> {
-    let method: Method = integrator.parse().ok()?;
+pub fn fixed_step_order(method: Method) -> Option<i32> {
     if method.is_adaptive() {
         None
     } else {
@@ -87,7 +85,7 @@ pub fn fixed_step_order(integrator: &str) -> Option<i32> {
 impl Tolerances {
     /// The default tolerances of the module doc, overridden by `energy` / `residual` when given.
     #[must_use]
-    pub fn derive(run: &RunAccuracy<'_>, energy: Option<f64>, residual: Option<f64>) -> Self {
+    pub fn derive(run: &RunAccuracy, energy: Option<f64>, residual: Option<f64>) -> Self {
         let mut epsilon = run.rtol.max(run.atol / run.radius);
         if let Some(p) = fixed_step_order(run.integrator) {
             let omega = run.max_omega.max(1.0 / run.time_unit);
@@ -123,9 +121,9 @@ impl Tolerances {
 mod tests {
     use super::*;
 
-    fn run(integrator: &str, rtol: f64, span: f64) -> RunAccuracy<'_> {
+    fn run(integrator: &str, rtol: f64, span: f64) -> RunAccuracy {
         RunAccuracy {
-            integrator,
+            integrator: integrator.parse().unwrap(),
             rtol,
             atol: 1e-12,
             step: 1e-3,

@@ -3,6 +3,7 @@
 //! the recomputed total, kinetic and potential parts, in the same units.
 
 use super::{fmt_num, worst, Context, Max};
+use crate::model::drift::EnergyDrift;
 use crate::model::energy;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
@@ -11,8 +12,7 @@ use crate::verify::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
 /// Running state of the energy check.
 #[derive(Debug, Default, Clone)]
 pub struct EnergyCheck {
-    e0: Option<f64>,
-    drift: Max,
+    drift: Option<EnergyDrift>,
     agreement: Max,
     samples: u64,
     stored: u64,
@@ -23,9 +23,10 @@ impl EnergyCheck {
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Some(state) = s.state() else { return };
         let e = energy(&ctx.coin, &state);
-        let e0 = *self.e0.get_or_insert(e.total);
+        self.drift
+            .get_or_insert_with(|| EnergyDrift::new(ctx.coin.params(), e.total))
+            .observe(s.t, e.total);
         self.samples += 1;
-        self.drift.offer((e.total - e0).abs(), s.t);
         if let Some(m) = s.energy {
             self.stored += 1;
             let d = (m.total - e.total)
@@ -38,16 +39,15 @@ impl EnergyCheck {
 
     /// The result.
     #[must_use]
-    pub fn finish(&self, ctx: &Context, tol: &Tolerances) -> CheckResult {
-        let Some(e0) = self.e0 else {
+    pub fn finish(&self, tol: &Tolerances) -> CheckResult {
+        let Some(energy_drift) = self.drift else {
             return CheckResult::skip(
                 CheckId::Energy,
                 "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed",
             );
         };
-        let scale = e0.abs().max(ctx.coin.params().energy_scale());
-        let drift = self.drift.value / scale;
-        let agreement = self.agreement.value / scale;
+        let drift = energy_drift.value();
+        let agreement = self.agreement.value / energy_drift.scale();
         let mut measures = vec![(drift, tol.energy, "drift")];
         if self.stored > 0 {
             measures.push((agreement, RECOMPUTE_TOLERANCE, "agreement"));
@@ -73,7 +73,7 @@ impl EnergyCheck {
                 "{which} is the worst measure: drift max|E - E0|/max(|E0|, Mga) = {} over {} samples (worst at t = {}, tolerance {}){stored}",
                 fmt_num(drift),
                 self.samples,
-                fmt_num(self.drift.t),
+                fmt_num(energy_drift.worst_time()),
                 fmt_num(tol.energy),
             ),
         )

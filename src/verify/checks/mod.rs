@@ -10,9 +10,9 @@ pub mod steady;
 pub mod validity;
 
 use super::samples::Sample;
+use crate::format::{ResultMetadata, RunMetadata};
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, Steady};
-use crate::record::{ResultMetadata, RunMetadata};
 
 /// What the checks know about the run besides its samples: the file's metadata.
 #[derive(Debug, Clone)]

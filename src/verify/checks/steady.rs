@@ -3,8 +3,9 @@
 //! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
 
 use super::{fmt_num, norm3, worst, Context, Max};
-use crate::model::{Branch, Coin, Steady, SteadyKind};
-use crate::record::RunMetadata;
+use crate::format::RunMetadata;
+use crate::model::{Coin, Steady};
+use crate::scene::{self, Scene};
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
@@ -12,67 +13,30 @@ use crate::verify::tolerances::Tolerances;
 /// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
 const MIN_ARC: f64 = 0.5;
 
-/// The steady motion a log's scene asks for, or why the check does not apply.
+/// The steady motion a log's scene asks for, or why the check does not apply. The stored scene is read by
+/// the same typed parser and validation as `record` uses; the motion is rebuilt for the metadata's body.
 ///
 /// # Errors
 /// A sentence saying why there is no steady motion to compare with.
 pub fn plan(coin: &Coin, run: &RunMetadata) -> Result<Steady, String> {
-    if run.steady_kind == "none" {
+    let Some(family) = run.steady_kind else {
         return Err("not a steady scene (steady_kind = none)".into());
+    };
+    let file = scene::parse_with_sets(&run.scene, &[])
+        .map_err(|e| format!("the metadata's scene does not parse: {e}"))?;
+    let scene =
+        Scene::from_file(&file).map_err(|e| format!("the metadata's scene is not valid: {e}"))?;
+    let steady = scene.unperturbed_steady().ok_or(
+        "the scene perturbs its steady motion (or has none), so it is not expected to stay steady",
+    )?;
+    if steady.kind.family() != family {
+        return Err(format!(
+            "the metadata says steady_kind = {family}, but its scene's steady motion is {}",
+            steady.kind.family()
+        ));
     }
-    let scene: toml::Table = run
-        .scene
-        .parse()
-        .map_err(|e| format!("the metadata's scene TOML does not parse: {e}"))?;
-    let initial = scene
-        .get("initial")
-        .and_then(toml::Value::as_table)
-        .ok_or("the metadata's scene has no [initial] table")?;
-    if initial.contains_key("perturbation") {
-        return Err(
-            "the scene perturbs its steady motion, so it is not expected to stay steady".into(),
-        );
-    }
-    let steady = initial
-        .get("steady")
-        .and_then(toml::Value::as_table)
-        .ok_or("steady_kind is set but the scene has no initial.steady table")?;
-    let number = |key: &str| -> Result<f64, String> {
-        let v = steady
-            .get(key)
-            .ok_or_else(|| format!("initial.steady has no `{key}`"))?;
-        v.as_float()
-            .or_else(|| v.as_integer().map(|i| i as f64))
-            .ok_or_else(|| format!("initial.steady.{key} = {v} is not a number"))
-    };
-    let branch = match steady.get("branch").and_then(toml::Value::as_str) {
-        None | Some("+") => Branch::Plus,
-        Some("-") => Branch::Minus,
-        Some(other) => {
-            return Err(format!(
-                "initial.steady.branch = {other:?} is not \"+\" or \"-\""
-            ))
-        }
-    };
-    let kind = match run.steady_kind.as_str() {
-        "straight" => SteadyKind::Straight {
-            omega_z: number("omega_z")?,
-        },
-        "centre-fixed" => SteadyKind::CentreFixed {
-            theta: number("theta")?,
-            branch,
-        },
-        "circle" => SteadyKind::Circle {
-            theta: number("theta")?,
-            omega_z: number("omega_z")?,
-            branch,
-        },
-        "spin-upright" => SteadyKind::SpinUpright {
-            omega_y: number("omega_y")?,
-        },
-        other => return Err(format!("unknown steady_kind {other:?}")),
-    };
-    Steady::new(coin, kind).map_err(|e| format!("the scene's steady motion cannot be built: {e}"))
+    Steady::new(coin, steady.kind)
+        .map_err(|e| format!("the scene's steady motion cannot be built: {e}"))
 }
 
 /// Streaming least-squares circle fit (Kåsa), in coordinates shifted to the first point.
@@ -213,52 +177,17 @@ impl SteadyCheck {
             (self.omega.value / omega_scale, tol.residual, "omega"),
         ];
         let mut notes = Vec::new();
-        // The metadata's steady values against those recomputed from the scene.
-        let meta = [
-            (ctx.run.phi_dot, Some(steady.phi_dot), omega_scale),
-            (ctx.run.psi_dot, Some(steady.psi_dot), omega_scale),
-            (ctx.run.r_g, steady.r_g, a),
-            (ctx.run.r_c, steady.r_c, a),
-        ];
-        let meta_dev = meta
-            .iter()
-            .map(|(m, s, scale)| match (m, s) {
-                (Some(m), Some(s)) => (m - s).abs() / scale,
-                (None, None) => 0.0,
-                _ => f64::INFINITY,
-            })
-            .fold(0.0, f64::max);
+        let meta_dev = metadata_deviation(ctx, steady, omega_scale);
         measures.push((meta_dev, tol.residual, "metadata"));
         let arc = self.phi_range.map_or(0.0, |(lo, hi)| hi - lo);
-        let mut radii = |fit: &CircleFit, expected: Option<f64>, name: &'static str| match expected
-        {
-            None => notes.push(format!("{name}: straight rolling, no circle")),
-            Some(0.0) => {
-                measures.push((fit.max_offset / a, tol.residual, name));
-                notes.push(format!(
-                    "{name}: stays within {} of its start",
-                    fmt_num(fit.max_offset)
-                ));
-            }
-            Some(_) if fit.n < 3.0 => notes.push(format!("{name}: not stored")),
-            Some(_) if arc < MIN_ARC => notes.push(format!(
-                "{name}: the run turns only {} rad, too little to fit a circle",
-                fmt_num(arc)
-            )),
-            Some(r) => match fit.radius() {
-                Some(fitted) => {
-                    measures.push(((fitted - r).abs() / r.max(a), tol.residual, name));
-                    notes.push(format!(
-                        "{name}: fitted {} vs {}",
-                        fmt_num(fitted),
-                        fmt_num(r)
-                    ));
-                }
-                None => notes.push(format!("{name}: the circle fit is singular")),
-            },
-        };
-        radii(&self.centre, steady.r_g, "R_G");
-        radii(&self.contact, steady.r_c, "R_C");
+        for (fit, expected, name) in [
+            (&self.centre, steady.r_g, "R_G"),
+            (&self.contact, steady.r_c, "R_C"),
+        ] {
+            let (measure, note) = radius_measure(fit, expected, arc, a);
+            measures.extend(measure.map(|m| (m, tol.residual, name)));
+            notes.push(format!("{name}: {note}"));
+        }
         let Some((value, tolerance, which)) = worst(&measures) else {
             return CheckResult::skip(CheckId::Steady, "nothing measured");
         };
@@ -280,5 +209,58 @@ impl SteadyCheck {
                 notes.join(", "),
             ),
         )
+    }
+}
+
+/// The largest deviation of the metadata's steady values (φ̇, ψ̇, R_G, R_C) from those recomputed from
+/// the scene, rates relative to `omega_scale` and radii to a; infinite when one is stored and the other
+/// is not.
+fn metadata_deviation(ctx: &Context, steady: &Steady, omega_scale: f64) -> f64 {
+    let a = ctx.coin.params().radius();
+    let pairs = [
+        (ctx.run.phi_dot, Some(steady.phi_dot), omega_scale),
+        (ctx.run.psi_dot, Some(steady.psi_dot), omega_scale),
+        (ctx.run.r_g, steady.r_g, a),
+        (ctx.run.r_c, steady.r_c, a),
+    ];
+    pairs
+        .iter()
+        .map(|(m, s, scale)| match (m, s) {
+            (Some(m), Some(s)) => (m - s).abs() / scale,
+            (None, None) => 0.0,
+            _ => f64::INFINITY,
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How well a traced circle fits the expected radius: the relative misfit (if one can be measured) and a
+/// note saying what was found. A radius of 0 means the point stays put; `None` means straight rolling.
+fn radius_measure(
+    fit: &CircleFit,
+    expected: Option<f64>,
+    arc: f64,
+    a: f64,
+) -> (Option<f64>, String) {
+    match expected {
+        None => (None, "straight rolling, no circle".into()),
+        Some(0.0) => (
+            Some(fit.max_offset / a),
+            format!("stays within {} of its start", fmt_num(fit.max_offset)),
+        ),
+        Some(_) if fit.n < 3.0 => (None, "not stored".into()),
+        Some(_) if arc < MIN_ARC => (
+            None,
+            format!(
+                "the run turns only {} rad, too little to fit a circle",
+                fmt_num(arc)
+            ),
+        ),
+        Some(r) => match fit.radius() {
+            Some(fitted) => (
+                Some((fitted - r).abs() / r.max(a)),
+                format!("fitted {} vs {}", fmt_num(fitted), fmt_num(r)),
+            ),
+            None => (None, "the circle fit is singular".into()),
+        },
     }
 }

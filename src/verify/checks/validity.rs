@@ -3,6 +3,7 @@
 //! at the event, is where the inequality becomes an equality.
 
 use super::{fmt_num, Context, Max};
+use crate::format::Termination;
 use crate::model::reaction;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
@@ -79,11 +80,11 @@ impl ValidityCheck {
         let mut judged_to = None;
         if let Some(last) = this.held.take() {
             let event = ctx.result.as_ref().filter(|r| {
-                matches!(r.termination.as_str(), "lift-off" | "slip")
+                matches!(r.termination, Termination::LiftOff | Termination::Slip)
                     && last.t >= r.termination_time
             });
             match event {
-                Some(r) => judged_to = Some(r.termination.clone()),
+                Some(r) => judged_to = Some(r.termination),
                 None => this.fold(last),
             }
         }

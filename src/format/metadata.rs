@@ -1,8 +1,13 @@
-//! The two metadata records of the contract (CONTRACT: Metadata records): `coin-log`, written before the
-//! first message, and `coin-log.result`, written when the run finishes. Numbers are shortest round-trip
-//! strings; optional values are empty strings. Nothing machine- or clock-dependent goes in.
+//! The two metadata records (format.md, Metadata): `coin-log`, written before the first message, and
+//! `coin-log.result`, written when the run finishes. Numbers are shortest round-trip strings; optional values
+//! are empty strings; names (integrator, steady kind, termination) are typed here and written by their
+//! `Display`, read by their `FromStr`. Nothing machine- or clock-dependent goes in.
 
+use super::Termination;
+use crate::integrate::Method;
+use crate::model::SteadyFamily;
 use std::collections::BTreeMap;
+use std::str::FromStr;
 
 /// Name of the metadata record written before the first message.
 pub const RUN_METADATA_NAME: &str = "coin-log";
@@ -23,7 +28,7 @@ pub enum MetadataError {
         key: &'static str,
     },
     /// A value does not parse.
-    #[error("metadata `{record}`: `{key}` = {value:?} is not {expected}")]
+    #[error("metadata `{record}`: `{key}` = {value:?}: {reason}")]
     Invalid {
         /// Record name.
         record: &'static str,
@@ -31,8 +36,8 @@ pub enum MetadataError {
         key: &'static str,
         /// Value found.
         value: String,
-        /// What was expected.
-        expected: &'static str,
+        /// Why it does not parse, and what would.
+        reason: String,
     },
 }
 
@@ -69,8 +74,8 @@ pub struct RunMetadata {
     pub friction: Option<f64>,
     /// √(a/g).
     pub time_unit: f64,
-    /// Integrator name.
-    pub integrator: String,
+    /// The integrator.
+    pub integrator: Method,
     /// rtol.
     pub rtol: f64,
     /// atol.
@@ -79,8 +84,9 @@ pub struct RunMetadata {
     pub step: f64,
     /// Samples per time unit.
     pub rate: f64,
-    /// `straight` | `centre-fixed` | `circle` | `spin-upright` | `none`.
-    pub steady_kind: String,
+    /// The steady motion the whole run should stay on (`none` when the scene is not an unperturbed steady
+    /// motion).
+    pub steady_kind: Option<SteadyFamily>,
     /// Steady φ̇.
     pub phi_dot: Option<f64>,
     /// Steady ψ̇.
@@ -100,9 +106,8 @@ pub struct ResultMetadata {
     pub rhs_evaluations: u64,
     /// Rejected steps.
     pub rejected_steps: u64,
-    /// completed | flat-landing | lift-off | slip | interrupted | step-size-underflow | non-finite
-    /// (and newton-failure for the implicit method).
-    pub termination: String,
+    /// How the run ended.
+    pub termination: Termination,
     /// Time the run ended.
     pub termination_time: f64,
 }
@@ -127,9 +132,30 @@ fn get_f64(
         record,
         key,
         value: value.to_string(),
-        expected: "a number",
+        reason: "not a number".into(),
     })
 }
+
+/// A typed name: the value's `FromStr` error says what is wrong and what is allowed.
+fn get_parsed<T: FromStr>(
+    map: &BTreeMap<String, String>,
+    record: &'static str,
+    key: &'static str,
+) -> Result<T, MetadataError>
+where
+    T::Err: std::fmt::Display,
+{
+    let value = get(map, record, key)?;
+    value.parse::<T>().map_err(|e| MetadataError::Invalid {
+        record,
+        key,
+        value: value.to_string(),
+        reason: e.to_string(),
+    })
+}
+
+/// The `steady_kind` value of no steady motion.
+const NO_STEADY: &str = "none";
 
 fn get_optional_f64(
     map: &BTreeMap<String, String>,
@@ -152,7 +178,7 @@ fn get_u64(
         record,
         key,
         value: value.to_string(),
-        expected: "a non-negative integer",
+        reason: "not a non-negative integer".into(),
     })
 }
 
@@ -171,12 +197,16 @@ impl RunMetadata {
             ("inertia_z", number_string(self.inertia_z)),
             ("friction", optional_string(self.friction)),
             ("time_unit", number_string(self.time_unit)),
-            ("integrator", self.integrator.clone()),
+            ("integrator", self.integrator.to_string()),
             ("rtol", number_string(self.rtol)),
             ("atol", number_string(self.atol)),
             ("step", number_string(self.step)),
             ("rate", number_string(self.rate)),
-            ("steady_kind", self.steady_kind.clone()),
+            (
+                "steady_kind",
+                self.steady_kind
+                    .map_or_else(|| NO_STEADY.to_string(), |k| k.to_string()),
+            ),
             ("phi_dot", optional_string(self.phi_dot)),
             ("psi_dot", optional_string(self.psi_dot)),
             ("r_g", optional_string(self.r_g)),
@@ -205,12 +235,15 @@ impl RunMetadata {
             inertia_z: get_f64(map, r, "inertia_z")?,
             friction: get_optional_f64(map, r, "friction")?,
             time_unit: get_f64(map, r, "time_unit")?,
-            integrator: get(map, r, "integrator")?.to_string(),
+            integrator: get_parsed(map, r, "integrator")?,
             rtol: get_f64(map, r, "rtol")?,
             atol: get_f64(map, r, "atol")?,
             step: get_f64(map, r, "step")?,
             rate: get_f64(map, r, "rate")?,
-            steady_kind: get(map, r, "steady_kind")?.to_string(),
+            steady_kind: match get(map, r, "steady_kind")? {
+                NO_STEADY => None,
+                _ => Some(get_parsed(map, r, "steady_kind")?),
+            },
             phi_dot: get_optional_f64(map, r, "phi_dot")?,
             psi_dot: get_optional_f64(map, r, "psi_dot")?,
             r_g: get_optional_f64(map, r, "r_g")?,
@@ -227,7 +260,7 @@ impl ResultMetadata {
             ("steps", self.steps.to_string()),
             ("rhs_evaluations", self.rhs_evaluations.to_string()),
             ("rejected_steps", self.rejected_steps.to_string()),
-            ("termination", self.termination.clone()),
+            ("termination", self.termination.to_string()),
             ("termination_time", number_string(self.termination_time)),
         ];
         entries
@@ -246,7 +279,7 @@ impl ResultMetadata {
             steps: get_u64(map, r, "steps")?,
             rhs_evaluations: get_u64(map, r, "rhs_evaluations")?,
             rejected_steps: get_u64(map, r, "rejected_steps")?,
-            termination: get(map, r, "termination")?.to_string(),
+            termination: get_parsed(map, r, "termination")?,
             termination_time: get_f64(map, r, "termination_time")?,
         })
     }

@@ -1,4 +1,4 @@
-//! The channels of the data contract (CONTRACT: Channels): name, topic, schema name and schema bytes.
+//! The channels of the format (format.md: Channels and fields): name, topic, schema name and schema bytes.
 //! The schema bytes are the files in `schemas/`, embedded at build time, so a log's schema is the file.
 
 use std::fmt;
@@ -99,6 +99,12 @@ impl Channel {
         }
     }
 
+    /// Every channel's name, comma-separated, for messages.
+    #[must_use]
+    pub fn names() -> String {
+        Self::ALL.map(Self::name).join(", ")
+    }
+
     /// The channel with this topic.
     #[must_use]
     pub fn from_topic(topic: &str) -> Option<Self> {
@@ -131,7 +137,7 @@ impl fmt::Display for Channel {
 
 /// An unknown channel name, with the list of valid ones.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown channel `{0}`; valid channels: omega, angles, quaternion, position, contact, reaction, energy, invariants, tf, scene")]
+#[error("unknown channel `{name}`; valid channels: {valid}", name = .0, valid = Channel::names())]
 pub struct UnknownChannel(pub String);
 
 impl FromStr for Channel {

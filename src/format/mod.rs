@@ -1,0 +1,23 @@
+//! The file format, typed: everything a coin-log MCAP file contains that `scene`, `record` and `verify` must
+//! agree on (docs/format.md). The channels with their topics, schema names and schema bytes
+//! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`]); the two metadata
+//! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
+//! simulation time to log time ([`log_time`]).
+//!
+//! It knows the physics' vocabulary (integrator [`Method`](crate::integrate::Method), steady
+//! [`SteadyFamily`](crate::model::SteadyFamily), [`Branch`](crate::model::Branch), physical events) but
+//! nothing about scenes, the recorder or the checks, which all import it.
+
+pub mod channels;
+pub mod messages;
+pub mod metadata;
+mod termination;
+mod time;
+
+pub use channels::{schema_bytes, Channel, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING};
+pub use metadata::{
+    MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
+    RUN_METADATA_NAME,
+};
+pub use termination::{Termination, UnknownTermination};
+pub use time::{log_time, TimeError};
