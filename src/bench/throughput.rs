@@ -21,10 +21,10 @@ use super::precision::rtol_for;
 use super::presets::bench_case;
 use super::{reference_trajectory, run_sampled, state_error, BenchError, Trajectory};
 use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings};
-use crate::record::writer::{DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
-use crate::record::{Channel, ChunkCompression, ChunkCompressor, COMPRESSION_THREADS};
-use crate::verify::reader::{self, Visitor};
-use crate::verify::wire::MessageHeader;
+use crate::mcap_io::{
+    self, ChunkCompression, ChunkCompressor, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
+};
+use crate::record::{Channel, COMPRESSION_THREADS};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::hint::black_box;
@@ -434,7 +434,7 @@ pub fn compression_bound(path: &Path) -> Result<Bound, ThroughputError> {
         bound: Bound::default(),
         error: None,
     };
-    let (_, error) = reader::read(path, &mut visitor);
+    let (_, error) = mcap_io::read(path, &mut visitor);
     visitor.flush();
     if let Some(e) = visitor.error {
         return Err(ThroughputError::Compress(e));

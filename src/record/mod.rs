@@ -1,5 +1,5 @@
 //! Writing MCAP logs (CONTRACT: Channels, Metadata records): the contract's data types and the recorder
-//! that integrates a scene straight into a file.
+//! that integrates a scene straight into a file through [`crate::mcap_io::McapWriter`].
 
 pub mod channels;
 pub mod foxglove;
@@ -7,7 +7,6 @@ pub mod messages;
 pub mod metadata;
 pub mod recorder;
 pub mod summary;
-pub mod writer;
 
 pub use channels::{schema_bytes, Channel, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING};
 pub use foxglove::{Foxglove3d, FoxgloveBatch};
@@ -19,4 +18,3 @@ pub use recorder::{
     COMPRESSION_THREADS,
 };
 pub use summary::{Failure, RecordSummary, Termination};
-pub use writer::{ChunkCompression, ChunkCompressor, McapWriter, WriteError, WriterOptions};

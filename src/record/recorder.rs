@@ -21,8 +21,8 @@ use super::metadata::{
     ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use super::summary::{Failure, RecordSummary, Termination};
-use super::writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::integrate::{run_method, Flow, RunSettings, Termination as RunEnd};
+use crate::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::model::{
     centre, contact_point, energy, orientation, reaction, Chaplygin, Coin, InvariantsError, State,
     STATE_LEN,
@@ -46,7 +46,7 @@ const PROGRESS_INTERVAL: u64 = 4096;
 /// Chunk compression (`--compression`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Compression {
-    /// zstd at [`super::writer::ZSTD_LEVEL`] (the default).
+    /// zstd at [`crate::mcap_io::ZSTD_LEVEL`] (the default).
     #[default]
     Zstd,
     /// lz4.

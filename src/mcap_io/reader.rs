@@ -1,4 +1,4 @@
-//! The streaming MCAP reader of `verify`: one pass over the file in memory bounded by the largest record
+//! The streaming MCAP reader: one pass over the file in memory bounded by the largest record
 //! (never by the file's length).
 //!
 //! Reading is a two-thread pipeline (the private `prefetch` module): a worker runs the mcap crate's sans-io
@@ -39,7 +39,7 @@ pub trait Visitor {
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>);
     /// The header record's library string.
     fn library(&mut self, library: &str);
-    /// A message; `Break` stops reading (e.g. the file is not a coin-log file).
+    /// A message; `Break` stops reading (e.g. the file is not one the caller understands).
     fn message(&mut self, header: &MessageHeader, data: &[u8]) -> ControlFlow<()>;
 }
 
@@ -82,7 +82,7 @@ pub struct Structure {
     pub messages: u64,
     /// Chunks read.
     pub chunks: u64,
-    /// Structural problems (indexes, statistics, summary), for the `integrity` check.
+    /// Structural problems (indexes, statistics, summary).
     pub problems: Problems,
     /// Whether a summary section, statistics and chunk indexes were present.
     pub has_summary: bool,

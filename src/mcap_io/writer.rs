@@ -7,35 +7,7 @@
 //! threads), and it cannot hand a finished chunk away and go on. Profiling showed that this, not the
 //! simulation and JSON formatting (~0.25 µs per message), bounded the recorder.
 //!
-//! # Pipeline
-//! - The calling thread appends Message records to a plain `Vec<u8>` (the chunk's uncompressed records),
-//!   noting per channel (`log_time`, offset in the chunk) for the message indexes, and the chunk's time
-//!   bounds.
-//! - When the chunk reaches [`WriterOptions::chunk_size`] bytes it goes to a compression worker over a
-//!   `std::sync::mpsc` channel. The worker computes its CRC-32 and compresses it in one call (zstd's bulk
-//!   API at [`ZSTD_LEVEL`], single-threaded; an lz4 frame as the `mcap` crate writes one; or nothing),
-//!   and sends both buffers back; they are reused, so the steady state allocates nothing per chunk
-//!   (lz4's encoder context excepted).
-//! - The calling thread writes finished chunks, in order, each followed by its MessageIndex records, as
-//!   their results come back. The file never leaves the calling thread: a borrowed `&mut Cursor` or
-//!   `BufWriter<&mut File>` works (nothing needs to be `Send + 'static`), and an I/O error surfaces from
-//!   the call that met it. A compression error or a lost worker surfaces from the next call that
-//!   collects a chunk ([`McapWriter::write_message`], [`McapWriter::write_metadata`] or
-//!   [`McapWriter::finish`]); after any error every call fails and the file is unusable.
-//! - At most [`IN_FLIGHT_PER_WORKER`] chunks per worker are in flight (the calling thread waits for the
-//!   oldest beyond that), so memory is bounded whatever the length of the run.
-//!
-//! # Determinism
-//! Chunk boundaries depend only on the bytes written; each chunk is compressed independently with fixed
-//! parameters by one thread; chunks are written in the order they were filled. Neither the worker count
-//! nor timing changes a byte.
-//!
-//! # Layout ([MCAP spec](https://mcap.dev/spec))
-//! Magic; Header (profile, library); the data section: chunks (Schema and Channel records inside the
-//! chunk that holds the channel's first message, before it), each followed by its MessageIndex records,
-//! and Metadata records between chunks (the open chunk is written first); DataEnd with the CRC-32 of
-//! everything before it; the summary section: Schemas, Channels, Statistics, ChunkIndexes,
-//! MetadataIndexes, each group listed by a SummaryOffset record; Footer with the summary CRC; magic.
+//! [`McapWriter`]'s doc describes the pipeline, why the bytes are deterministic, and the file's layout.
 
 use std::collections::{BTreeMap, VecDeque};
 use std::io::{self, BufWriter, Write};
@@ -45,7 +17,7 @@ use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
 use std::thread::JoinHandle;
 
 /// The 8 bytes at both ends of an MCAP file.
-pub const MAGIC: [u8; 8] = [0x89, b'M', b'C', b'A', b'P', b'0', b'\r', b'\n'];
+const MAGIC: [u8; 8] = [0x89, b'M', b'C', b'A', b'P', b'0', b'\r', b'\n'];
 
 /// Record opcodes (MCAP spec, "Records").
 mod op {
@@ -78,7 +50,7 @@ const LZ4_LEVEL: u32 = 0;
 
 /// Chunks a worker may hold (one being compressed, one queued) before the calling thread waits: enough
 /// to keep the worker busy, few enough that memory stays a few chunk sizes.
-pub const IN_FLIGHT_PER_WORKER: usize = 2;
+const IN_FLIGHT_PER_WORKER: usize = 2;
 
 /// Buffer between the writer and the output, so that small records (indexes, headers) are not one
 /// system call each.
@@ -397,7 +369,37 @@ impl<W: Write> Output<W> {
     }
 }
 
-/// A chunked, indexed MCAP writer whose chunks are compressed on worker threads (see the module doc).
+/// A chunked, indexed MCAP writer whose chunks are compressed on worker threads.
+///
+/// # Pipeline
+/// - The calling thread appends Message records to a plain `Vec<u8>` (the chunk's uncompressed records),
+///   noting per channel (`log_time`, offset in the chunk) for the message indexes, and the chunk's time
+///   bounds.
+/// - When the chunk reaches [`WriterOptions::chunk_size`] bytes it goes to a compression worker over a
+///   `std::sync::mpsc` channel. The worker computes its CRC-32 and compresses it in one call (zstd's bulk
+///   API at [`ZSTD_LEVEL`], single-threaded; an lz4 frame as the `mcap` crate writes one; or nothing),
+///   and sends both buffers back; they are reused, so the steady state allocates nothing per chunk
+///   (lz4's encoder context excepted).
+/// - The calling thread writes finished chunks, in order, each followed by its MessageIndex records, as
+///   their results come back. The file never leaves the calling thread: a borrowed `&mut Cursor` or
+///   `BufWriter<&mut File>` works (nothing needs to be `Send + 'static`), and an I/O error surfaces from
+///   the call that met it. A compression error or a lost worker surfaces from the next call that
+///   collects a chunk ([`write_message`](Self::write_message), [`write_metadata`](Self::write_metadata) or
+///   [`finish`](Self::finish)); after any error every call fails and the file is unusable.
+/// - At most two chunks per worker (one being compressed, one queued) are in flight: the calling thread
+///   waits for the oldest beyond that, so memory is bounded whatever the length of the run.
+///
+/// # Determinism
+/// Chunk boundaries depend only on the bytes written; each chunk is compressed independently with fixed
+/// parameters by one thread; chunks are written in the order they were filled. Neither the worker count
+/// nor timing changes a byte.
+///
+/// # Layout ([MCAP spec](https://mcap.dev/spec))
+/// Magic; Header (profile, library); the data section: chunks (Schema and Channel records inside the
+/// chunk that holds the channel's first message, before it), each followed by its MessageIndex records,
+/// and Metadata records between chunks (the open chunk is written first); DataEnd with the CRC-32 of
+/// everything before it; the summary section: Schemas, Channels, Statistics, ChunkIndexes,
+/// MetadataIndexes, each group listed by a SummaryOffset record; Footer with the summary CRC; magic.
 ///
 /// Call [`finish`](Self::finish) to complete the file; dropping the writer without it stops the workers
 /// and leaves an incomplete file.
