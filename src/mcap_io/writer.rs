@@ -816,65 +816,56 @@ impl<W: Write> McapWriter<W> {
         // The summary CRC starts at the summary's first byte, after DataEnd.
         self.out.crc = crc32fast::Hasher::new();
         let summary_start = self.out.position;
-        let mut groups: Vec<(u8, u64, u64)> = Vec::new();
-        let mut group = |out: &mut Output<W>, opcode: u8, bytes: &[u8]| -> io::Result<()> {
-            if !bytes.is_empty() {
-                groups.push((opcode, out.position, bytes.len() as u64));
-                out.write_all(bytes)?;
-            }
-            Ok(())
-        };
+        let groups = self.write_summary_groups()?;
+        self.write_footer(summary_start, &groups)
+    }
 
-        b.clear();
+    /// The summary's groups, in the order of the layout; returns (opcode, start, length) of each group
+    /// written (an empty group is left out).
+    fn write_summary_groups(&mut self) -> Result<Vec<(u8, u64, u64)>, WriteError> {
+        let mut groups = Vec::new();
+        let mut b = Vec::new();
         for (i, schema) in self.schemas.iter().enumerate() {
             encode_schema(&mut b, id_of(i), schema)?;
         }
-        group(&mut self.out, op::SCHEMA, &b)?;
-
-        b.clear();
+        self.write_group(op::SCHEMA, &mut b, &mut groups)?;
         for (i, channel) in self.channels.iter().enumerate() {
             encode_channel(&mut b, id_of(i), channel)?;
         }
-        group(&mut self.out, op::CHANNEL, &b)?;
-
-        b.clear();
+        self.write_group(op::CHANNEL, &mut b, &mut groups)?;
         self.encode_statistics(&mut b)?;
-        group(&mut self.out, op::STATISTICS, &b)?;
+        self.write_group(op::STATISTICS, &mut b, &mut groups)?;
+        self.encode_chunk_indexes(&mut b)?;
+        self.write_group(op::CHUNK_INDEX, &mut b, &mut groups)?;
+        self.encode_metadata_indexes(&mut b)?;
+        self.write_group(op::METADATA_INDEX, &mut b, &mut groups)?;
+        Ok(groups)
+    }
 
-        b.clear();
-        for index in &self.chunk_indexes {
-            let at = begin_record(&mut b, op::CHUNK_INDEX);
-            put_u64(&mut b, index.bounds.0);
-            put_u64(&mut b, index.bounds.1);
-            put_u64(&mut b, index.chunk_start);
-            put_u64(&mut b, index.chunk_length);
-            let offsets = &self.index_offsets[index.offsets.clone()];
-            put_u32(&mut b, len32("message index offsets", offsets.len() * 10)?);
-            for &(channel_id, offset) in offsets {
-                put_u16(&mut b, channel_id);
-                put_u64(&mut b, offset);
-            }
-            put_u64(&mut b, index.message_index_length);
-            put_str(&mut b, self.compression.mcap_name())?;
-            put_u64(&mut b, index.compressed_size);
-            put_u64(&mut b, index.uncompressed_size);
-            end_record(&mut b, at);
+    /// Writes the records of one summary group (if any), notes where they went, and empties `records`.
+    fn write_group(
+        &mut self,
+        opcode: u8,
+        records: &mut Vec<u8>,
+        groups: &mut Vec<(u8, u64, u64)>,
+    ) -> io::Result<()> {
+        if !records.is_empty() {
+            groups.push((opcode, self.out.position, records.len() as u64));
+            self.out.write_all(records)?;
         }
-        group(&mut self.out, op::CHUNK_INDEX, &b)?;
+        records.clear();
+        Ok(())
+    }
 
-        b.clear();
-        for index in &self.metadata_indexes {
-            let at = begin_record(&mut b, op::METADATA_INDEX);
-            put_u64(&mut b, index.offset);
-            put_u64(&mut b, index.length);
-            put_str(&mut b, &index.name)?;
-            end_record(&mut b, at);
-        }
-        group(&mut self.out, op::METADATA_INDEX, &b)?;
-
+    /// The SummaryOffset records of `groups`, the footer and the closing magic.
+    fn write_footer(
+        &mut self,
+        summary_start: u64,
+        groups: &[(u8, u64, u64)],
+    ) -> Result<(), WriteError> {
         let summary_offset_start = self.out.position;
-        b.clear();
-        for &(opcode, start, length) in &groups {
+        let mut b = Vec::new();
+        for &(opcode, start, length) in groups {
             let at = begin_record(&mut b, op::SUMMARY_OFFSET);
             b.push(opcode);
             put_u64(&mut b, start);
@@ -892,6 +883,39 @@ impl<W: Write> McapWriter<W> {
         put_u32(&mut b, summary_crc);
         b.extend_from_slice(&MAGIC);
         self.out.write_all(&b)?;
+        Ok(())
+    }
+
+    fn encode_chunk_indexes(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
+        for index in &self.chunk_indexes {
+            let at = begin_record(b, op::CHUNK_INDEX);
+            put_u64(b, index.bounds.0);
+            put_u64(b, index.bounds.1);
+            put_u64(b, index.chunk_start);
+            put_u64(b, index.chunk_length);
+            let offsets = &self.index_offsets[index.offsets.clone()];
+            put_u32(b, len32("message index offsets", offsets.len() * 10)?);
+            for &(channel_id, offset) in offsets {
+                put_u16(b, channel_id);
+                put_u64(b, offset);
+            }
+            put_u64(b, index.message_index_length);
+            put_str(b, self.compression.mcap_name())?;
+            put_u64(b, index.compressed_size);
+            put_u64(b, index.uncompressed_size);
+            end_record(b, at);
+        }
+        Ok(())
+    }
+
+    fn encode_metadata_indexes(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
+        for index in &self.metadata_indexes {
+            let at = begin_record(b, op::METADATA_INDEX);
+            put_u64(b, index.offset);
+            put_u64(b, index.length);
+            put_str(b, &index.name)?;
+            end_record(b, at);
+        }
         Ok(())
     }
 
