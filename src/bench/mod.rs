@@ -2,7 +2,8 @@
 //! scene ([`precision`]), a fixed suite of hard cases ([`stability`]), and their output as tables, CSV
 //! ([`table`]) and SVG work-precision diagrams ([`plot`]).
 //!
-//! The library returns rows; only the `coin-log bench` command prints them or writes files.
+//! The library returns rows; only the `coin-log bench` command prints them, writes files, or starts
+//! processes (the throughput bench's record and verify runs, [`throughput`]).
 //! The physics of the hard cases is NOTES §5 and §7.
 
 mod case;

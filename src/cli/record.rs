@@ -2,9 +2,9 @@
 //! file into place without clobbering, print the summary. The library does the work; this file does paths,
 //! signals, the progress bar, printing and exit codes.
 
+use super::rss::peak_rss_bytes;
 use super::Outcome;
 use anyhow::{anyhow, bail, Context};
-use coin_log::bench::throughput::peak_rss_bytes;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary, Termination};
 use coin_log::scene::{self, presets, FlagOverrides, Scene, SceneFile};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
