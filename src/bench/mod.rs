@@ -16,9 +16,9 @@ pub mod throughput;
 pub mod table;
 
 pub use case::{
-    analytic_steady_state, default_config, energy_drift, invariant_drift, method_by_name,
-    nominal_order, reference_trajectory, run_sampled, state_difference, state_error, BenchCase,
-    Reference, ReferenceKind, Trajectory, DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
+    analytic_steady_state, default_config, energy_drift, invariant_drift, reference_trajectory,
+    run_sampled, state_difference, state_error, BenchCase, Reference, ReferenceKind, Trajectory,
+    DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
 };
 
 use thiserror::Error;

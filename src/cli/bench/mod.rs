@@ -8,9 +8,9 @@ use anyhow::Context;
 use coin_log::bench::plot::work_precision_svg;
 use coin_log::bench::precision::{precision_bench, PrecisionOptions};
 use coin_log::bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
+use coin_log::bench::stability;
 use coin_log::bench::table::{precision_csv, precision_table, stability_csv, stability_table};
 use coin_log::bench::BenchCase;
-use coin_log::bench::{nominal_order, stability};
 use coin_log::integrate::Method;
 use coin_log::scene::presets;
 use std::fs;
@@ -119,7 +119,7 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         println!("scene {} — reference: {}", report.scene, report.reference);
         print!("{}", precision_table(&report.rows));
         for s in &report.slopes {
-            let expected = nominal_order(s.integrator);
+            let expected = s.integrator.order();
             println!(
                 "  {:>8}: slope {} (vs time), {} (vs RHS evaluations), order -{expected}, {} points",
                 s.integrator.name(),
