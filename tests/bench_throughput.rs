@@ -1,4 +1,4 @@
-//! `bench throughput` (issue 9). The library part: the workload recorded in-process is byte for byte the
+//! `bench throughput`. The library part: the workload recorded in-process is byte for byte the
 //! file the command's child `coin-log record` writes, its compression bound counts every message, and the
 //! rows follow from the runs (medians, rates, ratio, missing peak RSS). The command on a tiny workload
 //! prints sane rows, and `record --json` / `verify --json` carry `peak_rss_bytes`. No timing assertions:

@@ -36,13 +36,15 @@ mod op {
     pub const DATA_END: u8 = 0x0F;
 }
 
-/// Uncompressed bytes per chunk: the `mcap` crate's default, large enough for good compression and few
-/// index records, small enough that a reader seeking to a time decompresses little.
+/// The default of [`WriterOptions::chunk_size`] \[bytes of uncompressed records\]: the `mcap` crate's
+/// default, large enough for good compression and few index records, small enough that a reader seeking
+/// to a time decompresses little.
 pub const DEFAULT_CHUNK_SIZE: usize = 1 << 20;
 
-/// zstd level. Level 1 is both faster and smaller than the default level 3 on coin-log's JSON chunks
-/// (measured on the seven-channel wobble run: 3.9× vs 3.5× smaller, about 1.3× faster; the
-/// shortest round-trip digits leave little for level 3's longer matches to find).
+/// The zstd level of [`ChunkCompression::Zstd`] chunks (fixed: the writer has no other). Level 1 is both
+/// faster and smaller than zstd's default level 3 on coin-log's JSON chunks (measured on the seven-channel
+/// wobble run: 3.9× vs 3.5× smaller, about 1.3× faster; the shortest round-trip digits leave little for
+/// level 3's longer matches to find).
 pub const ZSTD_LEVEL: i32 = 1;
 
 /// lz4 level: 0 is lz4's fast default, as in the `mcap` crate.
