@@ -1,12 +1,12 @@
 //! The compression bound of issue 9: the time one thread takes to zstd-compress the bytes of a recording,
-//! chunk by chunk as `record::writer` does, and the JSON payloads alone in pieces of the same size.
+//! chunk by chunk as `mcap_io::McapWriter` does, and the JSON payloads alone in pieces of the same size.
 //!
 //! `cargo run --release --example compression_bound -- FILE.mcap [LEVEL...]`. Prints the median of 5 passes
 //! (seconds, MB/s, messages/s, compressed size) for the writer's own `ChunkCompressor` (zstd at its level,
 //! lz4, none: what a recording costs to compress), then for each zstd LEVEL given.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use coin_log::record::writer::{ChunkCompression, ChunkCompressor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
+use coin_log::mcap_io::{ChunkCompression, ChunkCompressor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
 use mcap::records::Record;
 use std::io::Read;
 use std::time::Instant;
@@ -21,33 +21,8 @@ fn main() {
     let levels: Vec<i32> = args.map(|a| a.parse().expect("a zstd level")).collect();
     let bytes = std::fs::read(&path).unwrap();
 
-    // The uncompressed records of every chunk, as the writer handed them to its worker.
-    let mut chunks = Vec::new();
-    for record in mcap::read::LinearReader::new(&bytes).unwrap() {
-        if let Record::Chunk { header, data } = record.unwrap() {
-            let size = usize::try_from(header.uncompressed_size).unwrap();
-            let records = match header.compression.as_str() {
-                "zstd" => zstd::bulk::decompress(&data, size).unwrap(),
-                "lz4" => {
-                    let mut out = Vec::with_capacity(size);
-                    lz4::Decoder::new(&*data)
-                        .unwrap()
-                        .read_to_end(&mut out)
-                        .unwrap();
-                    out
-                }
-                _ => data.into_owned(),
-            };
-            chunks.push(records);
-        }
-    }
-    // The JSON payloads alone, back to back, cut into pieces of the chunk size.
-    let mut payloads = Vec::new();
-    let mut messages = 0_u64;
-    for message in mcap::MessageStream::new(&bytes).unwrap() {
-        payloads.extend_from_slice(&message.unwrap().data);
-        messages += 1;
-    }
+    let chunks = chunk_records(&bytes);
+    let (payloads, messages) = payloads(&bytes);
     let pieces: Vec<&[u8]> = payloads.chunks(DEFAULT_CHUNK_SIZE).collect();
     let chunk_refs: Vec<&[u8]> = chunks.iter().map(Vec::as_slice).collect();
     let records_len: usize = chunks.iter().map(Vec::len).sum();
@@ -70,16 +45,7 @@ fn main() {
         ChunkCompression::Lz4,
         ChunkCompression::None,
     ] {
-        let mut compressor = ChunkCompressor::new(compression);
-        let (seconds, compressed) = median_pass(&chunk_refs, |piece, out| {
-            compressor.compress(piece, out).unwrap();
-            crc32fast::hash(piece);
-            if out.is_empty() {
-                piece.len() // stored as is
-            } else {
-                out.len()
-            }
-        });
+        let (seconds, compressed) = writer_pass(compression, &chunk_refs);
         let name = match compression {
             ChunkCompression::Zstd => format!("zstd level {ZSTD_LEVEL}"),
             other => format!("{other:?}").to_lowercase(),
@@ -109,6 +75,55 @@ fn main() {
             );
         }
     }
+}
+
+/// The uncompressed records of every chunk, as the writer handed them to its worker.
+fn chunk_records(bytes: &[u8]) -> Vec<Vec<u8>> {
+    let mut chunks = Vec::new();
+    for record in mcap::read::LinearReader::new(bytes).unwrap() {
+        if let Record::Chunk { header, data } = record.unwrap() {
+            let size = usize::try_from(header.uncompressed_size).unwrap();
+            let records = match header.compression.as_str() {
+                "zstd" => zstd::bulk::decompress(&data, size).unwrap(),
+                "lz4" => {
+                    let mut out = Vec::with_capacity(size);
+                    lz4::Decoder::new(&*data)
+                        .unwrap()
+                        .read_to_end(&mut out)
+                        .unwrap();
+                    out
+                }
+                _ => data.into_owned(),
+            };
+            chunks.push(records);
+        }
+    }
+    chunks
+}
+
+/// The JSON payloads alone, back to back, and how many messages they are.
+fn payloads(bytes: &[u8]) -> (Vec<u8>, u64) {
+    let mut payloads = Vec::new();
+    let mut messages = 0_u64;
+    for message in mcap::MessageStream::new(bytes).unwrap() {
+        payloads.extend_from_slice(&message.unwrap().data);
+        messages += 1;
+    }
+    (payloads, messages)
+}
+
+/// The writer's own compressor (and CRC) over the chunk records: median seconds and compressed size.
+fn writer_pass(compression: ChunkCompression, chunks: &[&[u8]]) -> (f64, usize) {
+    let mut compressor = ChunkCompressor::new(compression);
+    median_pass(chunks, |piece, out| {
+        compressor.compress(piece, out).unwrap();
+        crc32fast::hash(piece);
+        if out.is_empty() {
+            piece.len() // stored as is
+        } else {
+            out.len()
+        }
+    })
 }
 
 /// Median seconds of `PASSES` single-threaded passes of `compress` over `input`, and the compressed size.

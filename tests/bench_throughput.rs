@@ -1,6 +1,8 @@
-//! `bench throughput` (issue 9) on a tiny workload: the library's rows are sane (counts agree, times
-//! positive, the bound ratio finite), and `record --json` / `verify --json` carry `peak_rss_bytes`. No
-//! timing assertions: the numbers depend on the machine.
+//! `bench throughput`. The library part: the workload recorded in-process is byte for byte the
+//! file the command's child `coin-log record` writes, its compression bound counts every message, and the
+//! rows follow from the runs (medians, rates, ratio, missing peak RSS). The command on a tiny workload
+//! prints sane rows, and `record --json` / `verify --json` carry `peak_rss_bytes`. No timing assertions:
+//! the numbers depend on the machine.
 #![allow(
     clippy::unwrap_used,
     clippy::cast_possible_truncation,
@@ -8,63 +10,196 @@
 )]
 
 use coin_log::bench::throughput::{
-    self, compression_bound, record_run, recording_path, ThroughputOptions,
+    self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, RecordRun,
+    ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
 };
+use coin_log::record::{self, Compression, RecordOptions};
+use std::io::Cursor;
 use std::path::PathBuf;
 use std::process::Command;
+use std::sync::atomic::AtomicBool;
 
 fn exe() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_coin-log"))
 }
 
-fn value(rows: &[throughput::ThroughputRow], workload_starts: &str, quantity: &str) -> f64 {
+fn row<'a>(rows: &'a [ThroughputRow], workload_starts: &str, quantity: &str) -> &'a ThroughputRow {
     rows.iter()
         .find(|r| r.workload.starts_with(workload_starts) && r.quantity == quantity)
         .unwrap_or_else(|| panic!("no row {workload_starts} / {quantity}: {rows:#?}"))
-        .value
+}
+
+/// The fields of one CSV line (quoted fields may hold commas and doubled quotes).
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
+}
+
+/// Relative difference, for values computed from exact inputs.
+fn close(measured: f64, expected: f64) -> bool {
+    (measured - expected).abs() <= 1e-15 * expected.abs()
 }
 
 #[test]
-fn the_throughput_bench_returns_sane_rows_on_a_tiny_workload() {
+fn the_throughput_command_records_the_library_workload_and_prints_sane_rows() {
     let dir = tempfile::tempdir().unwrap();
-    let options = ThroughputOptions {
-        exe: exe(),
-        dir: dir.path().to_path_buf(),
-        durations: vec![0.5, 1.0],
-        repeats: 1,
-    };
-    let report = throughput::run(&options).unwrap();
-    print!("{}", throughput::table(&report));
-    assert!(report.cores >= 1);
-    for r in &report.rows {
+    let out = Command::new(exe())
+        .args([
+            "bench",
+            "throughput",
+            "--durations",
+            "0.5,1",
+            "--repeats",
+            "1",
+        ])
+        .arg("--out")
+        .arg(dir.path())
+        .arg("--keep")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    print!("{stdout}");
+    assert!(
+        out.status.success(),
+        "bench throughput: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("throughput.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(CSV_HEADER));
+    // Nine rows per duration (record 5, bound 2, verify 2), then dop853 and one RHS evaluation.
+    let rows: Vec<Vec<String>> = lines.map(csv_fields).collect();
+    assert_eq!(rows.len(), 2 * 9 + 2, "{csv}");
+    for fields in &rows {
+        let value: f64 = fields[2].parse().unwrap();
+        println!("{} / {}: {value}", fields[0], fields[1]);
         assert!(
-            r.value.is_finite() && r.value > 0.0,
-            "{} / {}: {} (expected finite and > 0)",
-            r.workload,
-            r.quantity,
-            r.value
+            value.is_finite() && value > 0.0,
+            "{fields:?}: expected finite and > 0"
         );
     }
+
     for duration in [0.5, 1.0] {
         let path = recording_path(dir.path(), duration);
-        let recorded = record_run(&exe(), &path, duration).unwrap();
+        let kept = std::fs::read(&path).unwrap();
+        let scene = workload_scene(duration).unwrap();
+        let mut recorded = Cursor::new(Vec::new());
+        let options = RecordOptions {
+            compression: Compression::Zstd,
+        };
+        let summary = record::record(
+            &scene,
+            &options,
+            &mut recorded,
+            &AtomicBool::new(false),
+            |_| {},
+        )
+        .unwrap();
+        assert!(
+            recorded.get_ref() == &kept,
+            "duration {duration}: the in-process workload ({} bytes) differs from the command's \
+             recording ({} bytes)",
+            recorded.get_ref().len(),
+            kept.len()
+        );
         let bound = compression_bound(&path).unwrap();
         // 7 channels at 1 kHz, samples at 0, 1 ms, ..., duration.
         let expected = 7 * (1000.0 * duration) as u64 + 7;
         println!(
-            "duration {duration}: record {} messages, read back {}, expected {expected}",
-            recorded.messages, bound.messages
+            "duration {duration}: recorded {} messages, read back {}, expected {expected}",
+            summary.messages, bound.messages
         );
-        assert_eq!(recorded.messages, expected);
-        assert_eq!(bound.messages, recorded.messages);
+        assert_eq!(summary.messages, expected);
+        assert_eq!(bound.messages, expected);
         assert!(bound.json_bytes > bound.compressed_bytes && bound.compressed_bytes > 0);
         assert!(bound.seconds > 0.0);
     }
-    let ratio = value(&report.rows, "zstd bound 1", "record time / bound");
-    assert!(ratio.is_finite() && ratio > 0.0, "ratio {ratio}");
+}
+
+#[test]
+fn the_rows_are_medians_and_rates_of_the_runs() {
+    const MIB: u64 = 1 << 20;
+    let messages = 7007;
+    let record = |seconds, peak_rss| RecordRun {
+        messages,
+        bytes: 100_000,
+        seconds,
+        peak_rss,
+    };
+    let bound = |seconds| Bound {
+        messages,
+        json_bytes: 400_000,
+        compressed_bytes: 100_000,
+        seconds,
+    };
+    let verify = |seconds| VerifyRun {
+        seconds,
+        peak_rss: None,
+    };
+    let runs = DurationRuns {
+        records: vec![
+            record(3.0, Some(10 * MIB)),
+            record(1.0, None),
+            record(2.0, Some(12 * MIB)),
+        ],
+        bounds: vec![bound(0.5), bound(1.5), bound(1.0)],
+        verifies: vec![verify(1.0), verify(1.0), verify(4.0)],
+        ..DurationRuns::new(0.5)
+    };
+    let rows = runs.rows().unwrap();
+    let report = ThroughputReport::new(rows.clone());
+    print!("{}", throughput::table(&report));
+    assert_eq!(rows.len(), 9);
+    // Medians: record 2 s, bound 1 s, verify 1 s; peak RSS of the two reported, 11 MiB.
+    let checks = [
+        ("record wobble 0.5", "messages/s", 7007.0 / 2.0),
+        ("record wobble 0.5", "JSON MB/s", 400_000.0 / 2.0 / 1e6),
+        ("record wobble 0.5", "file size", 100_000.0),
+        ("record wobble 0.5", "peak RSS", 11.0 * 1_048_576.0),
+        ("zstd bound 0.5", "compression time", 1.0),
+        ("zstd bound 0.5", "record time / bound", 2.0),
+        ("verify 0.5", "messages/s", 7007.0),
+    ];
+    for (workload, quantity, expected) in checks {
+        let r = row(&rows, workload, quantity);
+        println!("{workload} / {quantity}: {} (expected {expected})", r.value);
+        assert!(close(r.value, expected), "{r:?}: expected {expected}");
+    }
+    assert_eq!(
+        row(&rows, "zstd bound", "record time / bound").met(),
+        Some(true),
+        "a ratio of exactly 2 meets the target ≤ 2"
+    );
+    let unreported = row(&rows, "verify", "peak RSS");
+    assert!(
+        unreported.value.is_nan(),
+        "{unreported:?}: no peak RSS was reported"
+    );
     let csv = throughput::csv(&report);
-    assert!(csv.starts_with(throughput::CSV_HEADER));
-    assert_eq!(csv.lines().count(), report.rows.len() + 1);
+    assert!(csv.starts_with(CSV_HEADER));
+    assert_eq!(csv.lines().count(), rows.len() + 1);
+
+    let empty = DurationRuns {
+        verifies: Vec::new(),
+        ..runs
+    };
+    assert!(matches!(
+        empty.rows(),
+        Err(ThroughputError::NoRuns { duration }) if close(duration, 0.5)
+    ));
 }
 
 fn run(args: &[&str]) -> serde_json::Value {

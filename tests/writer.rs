@@ -1,11 +1,11 @@
-//! `record::writer::McapWriter` (issue 9): files read back through the `mcap` crate's linear and indexed
+//! `mcap_io::McapWriter` (issue 9): files read back through the `mcap` crate's linear and indexed
 //! paths for every compression, with many chunks; statistics, indexes and CRCs are right (and a flipped
 //! byte is caught); the bytes do not depend on the worker count; a failing output is an error, never a
 //! panic or a hang.
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use coin_log::record::writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
+use coin_log::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::{McapError, MessageStream, Summary};

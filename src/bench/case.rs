@@ -21,8 +21,6 @@ pub const DEFAULT_FLAT_MARGIN: f64 = defaults::FLAT_MARGIN;
 const REFERENCE_ATOL: f64 = 1e-16;
 /// See [`REFERENCE_ATOL`].
 const REFERENCE_RTOL: f64 = 1e-14;
-/// If dop853 is not available, rk4 at this step (natural units) stands in as the numerical reference.
-const FALLBACK_REFERENCE_STEP: f64 = 2.5e-4;
 
 /// One benchmark scene: the body, where it starts, how long it runs and what ends it.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,19 +64,6 @@ impl BenchCase {
     pub fn events(&self) -> CoinEvents {
         CoinEvents::new(self.coin, self.flat_margin, self.friction)
     }
-}
-
-/// A method looked up by its contract name (`rk4`, `dopri5`, `dop853`, `gauss4`); `None` if this build
-/// does not have it.
-#[must_use]
-pub fn method_by_name(name: &str) -> Option<Method> {
-    name.parse().ok()
-}
-
-/// The classical order of a method: the slope its work-precision line should have.
-#[must_use]
-pub fn nominal_order(method: Method) -> u32 {
-    method.order()
 }
 
 /// The contract's default settings of a method, the step scaled to the case's time unit.
@@ -269,7 +254,7 @@ pub fn analytic_steady_state(coin: &Coin, steady: &Steady, start: &State, t: f64
 }
 
 /// The reference of a case: analytic when the case is an unperturbed steady motion, otherwise dop853 at
-/// atol 1e-16, rtol 1e-14 (rk4 at a small step in a build without dop853).
+/// atol 1e-16, rtol 1e-14.
 ///
 /// # Errors
 /// [`BenchError::ReferenceFailed`] when the numerical reference does not reach the end of the case.
@@ -291,17 +276,11 @@ pub fn reference_trajectory_with(
             start: case.initial,
         });
     }
-    let config = match method_by_name("dop853") {
-        Some(method) => MethodConfig {
-            method,
-            rtol: REFERENCE_RTOL,
-            atol: REFERENCE_ATOL,
-            step: 0.0,
-        },
-        None => MethodConfig {
-            step: FALLBACK_REFERENCE_STEP * case.time_unit(),
-            ..default_config(Method::Rk4, case.time_unit())
-        },
+    let config = MethodConfig {
+        method: Method::Dop853,
+        rtol: REFERENCE_RTOL,
+        atol: REFERENCE_ATOL,
+        step: 0.0,
     };
     let mut trajectory = Trajectory::default();
     run_sampled_with(&config, case, settings, &mut trajectory);

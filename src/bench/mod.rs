@@ -2,7 +2,8 @@
 //! scene ([`precision`]), a fixed suite of hard cases ([`stability`]), and their output as tables, CSV
 //! ([`table`]) and SVG work-precision diagrams ([`plot`]).
 //!
-//! The library returns rows; only the `coin-log bench` command prints them or writes files.
+//! The library returns rows; only the `coin-log bench` command prints them, writes files, or starts
+//! processes (the throughput bench's record and verify runs, [`throughput`]).
 //! The physics of the hard cases is NOTES §5 and §7.
 
 mod case;
@@ -15,9 +16,9 @@ pub mod throughput;
 pub mod table;
 
 pub use case::{
-    analytic_steady_state, default_config, energy_drift, invariant_drift, method_by_name,
-    nominal_order, reference_trajectory, run_sampled, state_difference, state_error, BenchCase,
-    Reference, ReferenceKind, Trajectory, DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
+    analytic_steady_state, default_config, energy_drift, invariant_drift, reference_trajectory,
+    run_sampled, state_difference, state_error, BenchCase, Reference, ReferenceKind, Trajectory,
+    DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
 };
 
 use thiserror::Error;

@@ -7,8 +7,7 @@
 
 use super::case::{run_sampled, termination_name, Reference, ReferenceKind, Trajectory};
 use super::{
-    energy_drift, invariant_drift, nominal_order, reference_trajectory, state_error, BenchCase,
-    BenchError,
+    energy_drift, invariant_drift, reference_trajectory, state_error, BenchCase, BenchError,
 };
 use crate::integrate::{Method, MethodConfig};
 use std::time::Instant;
@@ -272,7 +271,7 @@ pub fn fixed_steps(
     points: usize,
 ) -> Vec<f64> {
     let interval = case.settings().sample_interval;
-    let order = f64::from(nominal_order(method));
+    let order = f64::from(method.order());
     let mut buffer = Trajectory::default();
     let mut pilot = interval;
     let mut pilot_error = f64::INFINITY;

@@ -16,8 +16,8 @@
 
 use super::case::{reference_trajectory_with, run_sampled_with, termination_name, Trajectory};
 use super::{
-    default_config, energy_drift, method_by_name, reference_trajectory, state_error, BenchCase,
-    BenchError, DEFAULT_FLAT_MARGIN,
+    default_config, energy_drift, reference_trajectory, state_error, BenchCase, BenchError,
+    DEFAULT_FLAT_MARGIN,
 };
 use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
 use crate::model::{
@@ -898,12 +898,6 @@ pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError
     rows.extend(long_horizon(options.long_horizon));
     rows.extend(scale_invariance(options.scale_horizon)?);
     Ok(rows)
-}
-
-/// Whether `method` is in this build (the suite's tests name dop853 and gauss4).
-#[must_use]
-pub fn available(name: &str) -> bool {
-    method_by_name(name).is_some()
 }
 
 #[cfg(test)]

@@ -4,34 +4,38 @@
 //!
 //! Workloads, each repeated and reported as the median:
 //! - **record**: `coin-log record wobble` with the seven channels omega, angles, quaternion, position,
-//!   contact, reaction, energy at 1 kHz with zstd, in a child process of the `coin-log` binary (its
-//!   `--json` summary gives the wall time and the peak RSS);
+//!   contact, reaction, energy at 1 kHz with zstd ([`workload_scene`]); its `--json` summary gives the
+//!   wall time and the peak RSS ([`RecordRun`]);
 //! - **compression bound**: the time to zstd-compress the same JSON message bytes (read back from that
 //!   file) in chunks of the recorder's size with the recorder's own [`ChunkCompressor`], on one thread
-//!   as each compression worker does; the ratio record time / bound says how close recording is to what
-//!   compression alone costs;
-//! - **verify**: `coin-log verify --json` of that file in its own child process (every check on);
+//!   as each compression worker does ([`compression_bound`]); the ratio record time / bound says how close
+//!   recording is to what compression alone costs;
+//! - **verify**: `coin-log verify --json` of that file, every check on ([`VerifyRun`]);
 //! - **integration**: dop853 on `wobble` (30 time units) at the loosest tolerance whose state error against
-//!   the dop853 reference (atol 1e-16) is ≤ 1e-10, and one RHS evaluation (`Coin::derivative`).
+//!   the dop853 reference (atol 1e-16) is ≤ 1e-10, and one RHS evaluation (`Coin::derivative`)
+//!   ([`integration_cost`]).
 //!
 //! Record and verify run at two durations, so that their peak RSS shows whether memory grows with the
-//! length of the run. The library returns rows; `coin-log bench throughput` prints them.
+//! length of the run. Each runs in its own process so that its peak RSS is its own: the `coin-log bench
+//! throughput` command starts them and fills in [`RecordRun`] and [`VerifyRun`]; this module defines the
+//! workloads, measures what runs in-process (the bound, the integration), turns the runs into rows
+//! ([`DurationRuns::rows`]) and formats them ([`table`], [`csv`]).
 
 use super::precision::rtol_for;
 use super::presets::bench_case;
-use super::{reference_trajectory, run_sampled, state_error, BenchError, Trajectory};
+use super::{reference_trajectory, run_sampled, state_error, BenchCase, BenchError, Trajectory};
 use crate::format::Channel;
-use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings};
-use crate::record::writer::{DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
-use crate::record::{ChunkCompression, ChunkCompressor, COMPRESSION_THREADS};
-use crate::verify::reader::{self, Visitor};
-use crate::verify::wire::MessageHeader;
+use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Stats};
+use crate::mcap_io::{
+    self, ChunkCompression, ChunkCompressor, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
+};
+use crate::record::COMPRESSION_THREADS;
+use crate::scene::{self, presets, FlagOverrides, Scene};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::hint::black_box;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 /// The scene of the record and verify workloads.
@@ -75,19 +79,6 @@ pub mod targets {
     pub const INTEGRATION_SECONDS: f64 = 0.5e-3;
     /// One RHS evaluation \[s\].
     pub const RHS_SECONDS: f64 = 50e-9;
-}
-
-/// What the bench runs.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ThroughputOptions {
-    /// The `coin-log` binary run as a child process for record and verify.
-    pub exe: PathBuf,
-    /// Folder for the recordings (one file per duration, replaced on each repeat).
-    pub dir: PathBuf,
-    /// Durations of the record and verify workloads \[time units\], shortest first.
-    pub durations: Vec<f64>,
-    /// Timed repeats; the median is reported.
-    pub repeats: usize,
 }
 
 /// A target and which side of it is good.
@@ -157,23 +148,26 @@ pub struct ThroughputReport {
     pub rows: Vec<ThroughputRow>,
 }
 
-/// Why the throughput bench could not run.
+impl ThroughputReport {
+    /// The report of `rows`, with the cores available to this process.
+    #[must_use]
+    pub fn new(rows: Vec<ThroughputRow>) -> Self {
+        Self {
+            cores: std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+            rows,
+        }
+    }
+}
+
+/// Why a part of the throughput bench could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum ThroughputError {
-    /// A child process could not be started.
-    #[error("cannot run `{command}`: {source}")]
-    Spawn {
-        /// The command line.
-        command: String,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// A child process failed or printed something unexpected.
-    #[error("`{command}` {reason}")]
-    Child {
-        /// The command line.
-        command: String,
-        /// What went wrong, with its stderr.
+    /// The workload's scene does not resolve (a bug: the built-in scene and these settings are valid).
+    #[error("the record workload at duration {duration}: {reason}")]
+    Workload {
+        /// Its duration \[time units\].
+        duration: f64,
+        /// What is wrong.
         reason: String,
     },
     /// The recording could not be read back for the compression bound.
@@ -187,6 +181,12 @@ pub enum ThroughputError {
     /// zstd failed.
     #[error("zstd compression failed: {0}")]
     Compress(std::io::Error),
+    /// Rows were asked of a duration without a record, bound and verify run.
+    #[error("no record, bound and verify runs at duration {duration}")]
+    NoRuns {
+        /// The duration \[time units\].
+        duration: f64,
+    },
     /// The integration workload could not be set up.
     #[error(transparent)]
     Bench(#[from] BenchError),
@@ -196,20 +196,6 @@ pub enum ThroughputError {
         /// The smallest error reached.
         best: f64,
     },
-}
-
-/// This process's peak resident set size (`VmHWM` of `/proc/self/status`) \[bytes\]; `None` where the
-/// system does not report it.
-#[must_use]
-pub fn peak_rss_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let mut words = line.split_whitespace().skip(1);
-    let value: u64 = words.next()?.parse().ok()?;
-    match words.next() {
-        Some("kB") => value.checked_mul(1024),
-        _ => None,
-    }
 }
 
 /// The median of `values` (the mean of the middle two for an even count); NaN when empty.
@@ -238,35 +224,21 @@ pub fn channel_list() -> String {
         .join(",")
 }
 
-/// Runs a child `coin-log` and returns its parsed JSON stdout and wall time; `allowed` exit codes pass.
-fn child_json(exe: &Path, args: &[String]) -> Result<(serde_json::Value, f64), ThroughputError> {
-    let command = format!("{} {}", exe.display(), args.join(" "));
-    let start = Instant::now();
-    let output =
-        Command::new(exe)
-            .args(args)
-            .output()
-            .map_err(|source| ThroughputError::Spawn {
-                command: command.clone(),
-                source,
-            })?;
-    let wall = start.elapsed().as_secs_f64();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if !output.status.success() {
-        return Err(ThroughputError::Child {
-            command,
-            reason: format!("exited with {}: {stderr}", output.status),
-        });
-    }
-    let json = serde_json::from_slice(&output.stdout).map_err(|e| ThroughputError::Child {
-        command: command.clone(),
-        reason: format!("printed no JSON ({e}): {stderr}"),
-    })?;
-    Ok((json, wall))
-}
-
-fn field_f64(json: &serde_json::Value, key: &str) -> Option<f64> {
-    json.get(key).and_then(serde_json::Value::as_f64)
+/// The record workload of `duration` time units as a scene: [`SCENE`] with [`CHANNELS`] at [`RATE`],
+/// the scene `coin-log record` resolves from the workload's flags.
+///
+/// # Errors
+/// [`ThroughputError::Workload`] if the scene does not validate (e.g. a duration that is not positive).
+pub fn workload_scene(duration: f64) -> Result<Scene, ThroughputError> {
+    let invalid = |reason: String| ThroughputError::Workload { duration, reason };
+    let file = presets::preset(SCENE).ok_or_else(|| invalid(format!("no built-in `{SCENE}`")))?;
+    let flags = FlagOverrides {
+        duration: Some(duration),
+        rate: Some(RATE),
+        channels: Some(CHANNELS.iter().map(|c| c.name().to_string()).collect()),
+        ..FlagOverrides::default()
+    };
+    scene::resolve(&file, &flags).map_err(|e| invalid(e.to_string()))
 }
 
 /// One record run, as its `--json` summary reports it.
@@ -282,85 +254,13 @@ pub struct RecordRun {
     pub peak_rss: Option<u64>,
 }
 
-/// Records the workload for `duration` time units into `path` in a child process.
-///
-/// # Errors
-/// [`ThroughputError`] if the child cannot run, fails, or reports nonsense.
-pub fn record_run(exe: &Path, path: &Path, duration: f64) -> Result<RecordRun, ThroughputError> {
-    let args: Vec<String> = [
-        "record",
-        SCENE,
-        "--duration",
-        &duration.to_string(),
-        "--rate",
-        &RATE.to_string(),
-        "--channels",
-        &channel_list(),
-        "--compression",
-        "zstd",
-        "-o",
-        &path.display().to_string(),
-        "--overwrite",
-        "--json",
-    ]
-    .iter()
-    .map(ToString::to_string)
-    .collect();
-    let (json, _) = child_json(exe, &args)?;
-    let bad = |what: &str| ThroughputError::Child {
-        command: format!("{} record", exe.display()),
-        reason: format!("printed a summary without `{what}`: {json}"),
-    };
-    let termination = json.get("termination").and_then(serde_json::Value::as_str);
-    if termination != Some("completed") {
-        return Err(ThroughputError::Child {
-            command: format!("{} record", exe.display()),
-            reason: format!("ended with termination {termination:?}, not completed"),
-        });
-    }
-    Ok(RecordRun {
-        messages: json
-            .get("messages")
-            .and_then(serde_json::Value::as_u64)
-            .ok_or_else(|| bad("messages"))?,
-        bytes: json
-            .get("bytes")
-            .and_then(serde_json::Value::as_u64)
-            .ok_or_else(|| bad("bytes"))?,
-        seconds: field_f64(&json, "wall_time_s").ok_or_else(|| bad("wall_time_s"))?,
-        peak_rss: json
-            .get("peak_rss_bytes")
-            .and_then(serde_json::Value::as_u64),
-    })
-}
-
 /// One verify run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VerifyRun {
-    /// Wall time of the child process \[s\].
+    /// Wall time of the verify process \[s\].
     pub seconds: f64,
     /// Its peak RSS \[bytes\], if reported.
     pub peak_rss: Option<u64>,
-}
-
-/// Verifies `path` in a child process; the file must pass (exit 0).
-///
-/// # Errors
-/// [`ThroughputError`] if the child cannot run or the file does not pass.
-pub fn verify_run(exe: &Path, path: &Path) -> Result<VerifyRun, ThroughputError> {
-    let args = vec![
-        "verify".to_string(),
-        path.display().to_string(),
-        "--json".to_string(),
-    ];
-    let (json, seconds) = child_json(exe, &args)?;
-    let file = json.get("files").and_then(|f| f.get(0));
-    Ok(VerifyRun {
-        seconds,
-        peak_rss: file
-            .and_then(|f| f.get("peak_rss_bytes"))
-            .and_then(serde_json::Value::as_u64),
-    })
 }
 
 /// The compression bound of one file: its JSON message bytes and the time zstd takes on them.
@@ -435,7 +335,7 @@ pub fn compression_bound(path: &Path) -> Result<Bound, ThroughputError> {
         bound: Bound::default(),
         error: None,
     };
-    let (_, error) = reader::read(path, &mut visitor);
+    let (_, error) = mcap_io::read(path, &mut visitor);
     visitor.flush();
     if let Some(e) = visitor.error {
         return Err(ThroughputError::Compress(e));
@@ -465,150 +365,196 @@ fn as_f64(x: u64) -> f64 {
     x as f64
 }
 
-/// Record, bound and verify at one duration: `repeats` runs each, medians.
-///
-/// # Errors
-/// [`ThroughputError`] from any run.
-#[allow(clippy::cast_precision_loss)]
-pub fn record_and_verify(
-    options: &ThroughputOptions,
-    duration: f64,
-) -> Result<Vec<ThroughputRow>, ThroughputError> {
-    let path = recording_path(&options.dir, duration);
-    let (mut records, mut bounds, mut verifies) = (Vec::new(), Vec::new(), Vec::new());
-    for _ in 0..options.repeats.max(1) {
-        records.push(record_run(&options.exe, &path, duration)?);
-        bounds.push(compression_bound(&path)?);
-        verifies.push(verify_run(&options.exe, &path)?);
+fn row(
+    workload: &str,
+    quantity: &str,
+    value: f64,
+    unit: &str,
+    target: Option<Target>,
+    note: &str,
+) -> ThroughputRow {
+    ThroughputRow {
+        workload: workload.to_string(),
+        quantity: quantity.to_string(),
+        value,
+        unit: unit.to_string(),
+        target,
+        note: note.to_string(),
     }
-    let last = records[records.len() - 1];
-    let bound = bounds[bounds.len() - 1];
-    let messages = last.messages;
-    let record_s = median(&records.iter().map(|r| r.seconds).collect::<Vec<_>>());
-    let bound_s = median(&bounds.iter().map(|b| b.seconds).collect::<Vec<_>>());
-    let verify_s = median(&verifies.iter().map(|v| v.seconds).collect::<Vec<_>>());
-    let peak = |runs: &mut dyn Iterator<Item = Option<u64>>| {
-        let v: Vec<f64> = runs.flatten().map(as_f64).collect();
-        if v.is_empty() {
-            f64::NAN
-        } else {
-            median(&v)
-        }
-    };
-    let record_rss = peak(&mut records.iter().map(|r| r.peak_rss));
-    let verify_rss = peak(&mut verifies.iter().map(|v| v.peak_rss));
-    let workload = format!("record {SCENE} {duration} u @ 1 kHz, 7 channels, zstd");
-    let counts = format!("{messages} messages, {} JSON bytes", bound.json_bytes);
-    let row = |workload: &str, quantity: &str, value: f64, unit: &str, target, note: &str| {
-        ThroughputRow {
-            workload: workload.to_string(),
-            quantity: quantity.to_string(),
-            value,
-            unit: unit.to_string(),
-            target,
-            note: note.to_string(),
-        }
-    };
-    let bound_workload = format!(
-        "zstd bound {duration} u (level {ZSTD_LEVEL}, {} KiB chunks, 1 thread; recorder: {COMPRESSION_THREADS} worker(s))",
-        CHUNK_SIZE >> 10
-    );
-    let verify_workload = format!("verify {duration} u, every check");
-    Ok(vec![
-        row(
-            &workload,
-            "messages/s",
-            rate(messages, record_s),
-            "1/s",
-            Some(Target::AtLeast(targets::RECORD_MESSAGES_PER_SECOND)),
-            &format!("{counts}, {record_s:.3} s"),
-        ),
-        row(
-            &workload,
-            "JSON MB/s",
-            as_f64(bound.json_bytes) / record_s / 1e6,
-            "MB/s",
-            None,
-            "uncompressed message bytes per second",
-        ),
-        row(
-            &workload,
-            "file MB/s",
-            as_f64(last.bytes) / record_s / 1e6,
-            "MB/s",
-            None,
-            "file bytes per second",
-        ),
-        row(
-            &workload,
-            "file size",
-            as_f64(last.bytes),
-            "B",
-            None,
-            &format!(
-                "{:.1} B/message, JSON/file {:.2}",
-                as_f64(last.bytes) / as_f64(messages),
-                as_f64(bound.json_bytes) / as_f64(last.bytes)
-            ),
-        ),
-        row(
-            &workload,
-            "peak RSS",
-            record_rss,
-            "B",
-            Some(Target::Below(targets::PEAK_RSS_BYTES)),
-            "VmHWM of the record process",
-        ),
-        row(
-            &bound_workload,
-            "compression time",
-            bound_s,
-            "s",
-            None,
-            &format!(
-                "{:.0} MB/s, ratio {:.2}",
-                as_f64(bound.json_bytes) / bound_s / 1e6,
-                as_f64(bound.json_bytes) / as_f64(bound.compressed_bytes)
-            ),
-        ),
-        row(
-            &bound_workload,
-            "record time / bound",
-            record_s / bound_s,
-            "",
-            Some(Target::AtMost(targets::BOUND_RATIO)),
-            "",
-        ),
-        row(
-            &verify_workload,
-            "messages/s",
-            rate(messages, verify_s),
-            "1/s",
-            Some(Target::AtLeast(targets::VERIFY_MESSAGES_PER_SECOND)),
-            &format!("{verify_s:.3} s wall of the verify process"),
-        ),
-        row(
-            &verify_workload,
-            "peak RSS",
-            verify_rss,
-            "B",
-            Some(Target::Below(targets::PEAK_RSS_BYTES)),
-            "VmHWM of the verify process",
-        ),
-    ])
 }
 
-/// dop853 on `wobble` at the loosest tolerance meeting [`INTEGRATION_ERROR`], timed over
-/// [`INTEGRATION_RUNS`] runs per repeat, and one RHS evaluation.
-///
-/// # Errors
-/// [`ThroughputError`] if the reference cannot be built or no tolerance is accurate enough.
-pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, ThroughputError> {
-    let case = bench_case(SCENE)?;
-    let reference = reference_trajectory(&case)?;
+/// The median of the peak RSS values reported \[bytes\]; NaN when none was.
+fn median_peak(peaks: impl Iterator<Item = Option<u64>>) -> f64 {
+    let v: Vec<f64> = peaks.flatten().map(as_f64).collect();
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        median(&v)
+    }
+}
+
+/// What the repeats of the record, bound and verify workloads measured at one duration.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct DurationRuns {
+    /// The workloads' duration \[time units\].
+    pub duration: f64,
+    /// The record runs, one per repeat.
+    pub records: Vec<RecordRun>,
+    /// The compression bounds of their recordings.
+    pub bounds: Vec<Bound>,
+    /// The verify runs of their recordings.
+    pub verifies: Vec<VerifyRun>,
+}
+
+impl DurationRuns {
+    /// No runs yet at `duration`.
+    #[must_use]
+    pub fn new(duration: f64) -> Self {
+        Self {
+            duration,
+            ..Self::default()
+        }
+    }
+
+    /// The rows of the record, bound and verify workloads: medians over the repeats; counts and sizes of
+    /// the last repeat (every repeat writes the same file).
+    ///
+    /// # Errors
+    /// [`ThroughputError::NoRuns`] when any of the three lists is empty.
+    pub fn rows(&self) -> Result<Vec<ThroughputRow>, ThroughputError> {
+        let (Some(record), Some(bound), false) = (
+            self.records.last(),
+            self.bounds.last(),
+            self.verifies.is_empty(),
+        ) else {
+            return Err(ThroughputError::NoRuns {
+                duration: self.duration,
+            });
+        };
+        let record_s = median(&self.records.iter().map(|r| r.seconds).collect::<Vec<_>>());
+        let bound_s = median(&self.bounds.iter().map(|b| b.seconds).collect::<Vec<_>>());
+        let mut rows = self.record_rows(record, bound, record_s);
+        rows.extend(self.bound_rows(bound, bound_s, record_s));
+        rows.extend(self.verify_rows(record.messages));
+        Ok(rows)
+    }
+
+    /// Messages/s, MB/s, file size and peak RSS of the record workload.
+    fn record_rows(&self, last: &RecordRun, bound: &Bound, record_s: f64) -> Vec<ThroughputRow> {
+        let duration = self.duration;
+        let messages = last.messages;
+        let workload = format!("record {SCENE} {duration} u @ 1 kHz, 7 channels, zstd");
+        let counts = format!("{messages} messages, {} JSON bytes", bound.json_bytes);
+        vec![
+            row(
+                &workload,
+                "messages/s",
+                rate(messages, record_s),
+                "1/s",
+                Some(Target::AtLeast(targets::RECORD_MESSAGES_PER_SECOND)),
+                &format!("{counts}, {record_s:.3} s"),
+            ),
+            row(
+                &workload,
+                "JSON MB/s",
+                as_f64(bound.json_bytes) / record_s / 1e6,
+                "MB/s",
+                None,
+                "uncompressed message bytes per second",
+            ),
+            row(
+                &workload,
+                "file MB/s",
+                as_f64(last.bytes) / record_s / 1e6,
+                "MB/s",
+                None,
+                "file bytes per second",
+            ),
+            row(
+                &workload,
+                "file size",
+                as_f64(last.bytes),
+                "B",
+                None,
+                &format!(
+                    "{:.1} B/message, JSON/file {:.2}",
+                    as_f64(last.bytes) / as_f64(messages),
+                    as_f64(bound.json_bytes) / as_f64(last.bytes)
+                ),
+            ),
+            row(
+                &workload,
+                "peak RSS",
+                median_peak(self.records.iter().map(|r| r.peak_rss)),
+                "B",
+                Some(Target::Below(targets::PEAK_RSS_BYTES)),
+                "VmHWM of the record process",
+            ),
+        ]
+    }
+
+    /// The compression bound and the record time against it.
+    fn bound_rows(&self, bound: &Bound, bound_s: f64, record_s: f64) -> Vec<ThroughputRow> {
+        let workload = format!(
+            "zstd bound {} u (level {ZSTD_LEVEL}, {} KiB chunks, 1 thread; recorder: {COMPRESSION_THREADS} worker(s))",
+            self.duration,
+            CHUNK_SIZE >> 10
+        );
+        vec![
+            row(
+                &workload,
+                "compression time",
+                bound_s,
+                "s",
+                None,
+                &format!(
+                    "{:.0} MB/s, ratio {:.2}",
+                    as_f64(bound.json_bytes) / bound_s / 1e6,
+                    as_f64(bound.json_bytes) / as_f64(bound.compressed_bytes)
+                ),
+            ),
+            row(
+                &workload,
+                "record time / bound",
+                record_s / bound_s,
+                "",
+                Some(Target::AtMost(targets::BOUND_RATIO)),
+                "",
+            ),
+        ]
+    }
+
+    /// Messages/s and peak RSS of the verify workload.
+    fn verify_rows(&self, messages: u64) -> Vec<ThroughputRow> {
+        let verify_s = median(&self.verifies.iter().map(|v| v.seconds).collect::<Vec<_>>());
+        let workload = format!("verify {} u, every check", self.duration);
+        vec![
+            row(
+                &workload,
+                "messages/s",
+                rate(messages, verify_s),
+                "1/s",
+                Some(Target::AtLeast(targets::VERIFY_MESSAGES_PER_SECOND)),
+                &format!("{verify_s:.3} s wall of the verify process"),
+            ),
+            row(
+                &workload,
+                "peak RSS",
+                median_peak(self.verifies.iter().map(|v| v.peak_rss)),
+                "B",
+                Some(Target::Below(targets::PEAK_RSS_BYTES)),
+                "VmHWM of the verify process",
+            ),
+        ]
+    }
+}
+
+/// The loosest dop853 setting in [`INTEGRATION_ATOLS`] whose state error on `case` is at most
+/// [`INTEGRATION_ERROR`], with that error.
+fn accurate_dop853(case: &BenchCase) -> Result<(MethodConfig, f64), ThroughputError> {
+    let reference = reference_trajectory(case)?;
     let mut run = Trajectory::default();
     let mut best = f64::INFINITY;
-    let mut chosen = None;
     for atol in INTEGRATION_ATOLS {
         let config = MethodConfig {
             method: Method::Dop853,
@@ -616,15 +562,19 @@ pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, Throughput
             atol,
             step: 0.0,
         };
-        run_sampled(&config, &case, &mut run);
-        let error = state_error(&case, &run, &reference);
+        run_sampled(&config, case, &mut run);
+        let error = state_error(case, &run, &reference);
         best = best.min(error);
         if run.completed() && error <= INTEGRATION_ERROR {
-            chosen = Some((config, error));
-            break;
+            return Ok((config, error));
         }
     }
-    let (config, error) = chosen.ok_or(ThroughputError::Accuracy { best })?;
+    Err(ThroughputError::Accuracy { best })
+}
+
+/// Wall time of one run of `config` on `case` (no sampling) over [`INTEGRATION_RUNS`] runs per repeat,
+/// and the last run's counters.
+fn time_integration(config: &MethodConfig, case: &BenchCase, repeats: usize) -> (Vec<f64>, Stats) {
     let settings = RunSettings {
         t0: 0.0,
         t_end: case.duration,
@@ -638,7 +588,7 @@ pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, Throughput
         let start = Instant::now();
         for _ in 0..INTEGRATION_RUNS {
             let outcome = run_method(
-                &config,
+                config,
                 &case.coin,
                 black_box(&y0),
                 &settings,
@@ -652,6 +602,12 @@ pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, Throughput
         }
         per_run.push(start.elapsed().as_secs_f64() / f64::from(INTEGRATION_RUNS));
     }
+    (per_run, stats.unwrap_or_default())
+}
+
+/// Time per RHS evaluation at the case's initial state, one value per repeat.
+fn time_rhs(case: &BenchCase, repeats: usize) -> Vec<f64> {
+    let y0 = case.initial.to_array();
     let mut per_rhs = Vec::new();
     let mut dy = [0.0; crate::model::STATE_LEN];
     for _ in 0..repeats.max(1) {
@@ -661,7 +617,19 @@ pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, Throughput
         }
         per_rhs.push(start.elapsed().as_secs_f64() / f64::from(RHS_EVALUATIONS));
     }
-    let stats = stats.unwrap_or_default();
+    per_rhs
+}
+
+/// dop853 on `wobble` at the loosest tolerance meeting [`INTEGRATION_ERROR`], timed over
+/// [`INTEGRATION_RUNS`] runs per repeat, and one RHS evaluation.
+///
+/// # Errors
+/// [`ThroughputError`] if the reference cannot be built or no tolerance is accurate enough.
+pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, ThroughputError> {
+    let case = bench_case(SCENE)?;
+    let (config, error) = accurate_dop853(&case)?;
+    let (per_run, stats) = time_integration(&config, &case, repeats);
+    let per_rhs = time_rhs(&case, repeats);
     Ok(vec![
         ThroughputRow {
             workload: format!(
@@ -686,22 +654,6 @@ pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, Throughput
             note: format!("{RHS_EVALUATIONS} evaluations per repeat"),
         },
     ])
-}
-
-/// The whole bench: record, bound and verify at every duration, then the integration cost.
-///
-/// # Errors
-/// [`ThroughputError`] from any workload.
-pub fn run(options: &ThroughputOptions) -> Result<ThroughputReport, ThroughputError> {
-    let mut rows = Vec::new();
-    for &duration in &options.durations {
-        rows.extend(record_and_verify(options, duration)?);
-    }
-    rows.extend(integration_cost(options.repeats)?);
-    Ok(ThroughputReport {
-        cores: std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
-        rows,
-    })
 }
 
 /// The CSV header of `bench throughput`.
@@ -802,13 +754,5 @@ mod tests {
         assert!(Target::AtLeast(2.0).met(2.0));
         assert!(!Target::Below(2.0).met(2.0));
         assert!(Target::AtMost(2.0).met(2.0));
-    }
-
-    #[test]
-    fn peak_rss_is_reported_on_linux() {
-        if cfg!(target_os = "linux") {
-            let rss = peak_rss_bytes().unwrap_or(0);
-            assert!(rss > 1 << 20, "VmHWM {rss} B");
-        }
     }
 }

@@ -2,6 +2,7 @@
 
 mod bench;
 mod record;
+mod rss;
 mod scenes;
 mod verify;
 

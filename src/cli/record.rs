@@ -2,9 +2,9 @@
 //! file into place without clobbering, print the summary. The library does the work; this file does paths,
 //! signals, the progress bar, printing and exit codes.
 
+use super::rss::peak_rss_bytes;
 use super::Outcome;
 use anyhow::{anyhow, bail, Context};
-use coin_log::bench::throughput::peak_rss_bytes;
 use coin_log::format::Termination;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
 use coin_log::scene::{self, presets, FlagOverrides, Scene, SceneFile};
@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tempfile::NamedTempFile;
 
 /// Runs shorter than this show no progress bar.
 const PROGRESS_DELAY: Duration = Duration::from_secs(1);
@@ -131,9 +132,20 @@ fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
     })
 }
 
-/// Runs `coin-log record`.
+/// Runs `coin-log record`: load → resolve → prepare the output → record → persist → summary and exit code.
 pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     let source = load_source(&args.scene, &args.set)?;
+    let scene = resolve(&args, &source)?;
+    let target = output_path(&args, &source)?;
+    let mut temp = temp_file_beside(&target)?;
+    let (summary, wall) = record_into(&args, &scene, &target, &mut temp)?;
+    persist(temp, &target, args.overwrite)?;
+    print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
+    Ok(outcome(&summary, &target))
+}
+
+/// The scene with the command-line flags applied and validated.
+fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
     let flags = FlagOverrides {
         duration: args.duration,
         rate: args.rate,
@@ -143,9 +155,12 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
         step: args.step,
         channels: args.channels.clone(),
     };
-    let scene = scene::resolve(&source.file, &flags)
-        .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
+    scene::resolve(&source.file, &flags).map_err(|e| anyhow!("scene `{}`: {e}", source.label))
+}
 
+/// Where the recording goes (`-o`, or the scene's stem in the current folder): never a folder, and an
+/// existing file only with `--overwrite`.
+fn output_path(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<PathBuf> {
     let target = args
         .output
         .clone()
@@ -163,11 +178,16 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
             target.display()
         );
     }
+    Ok(target)
+}
+
+/// A temporary file in the target's folder, so that the finished recording is moved, not copied.
+fn temp_file_beside(target: &Path) -> anyhow::Result<NamedTempFile> {
     let folder = match target.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut temp = tempfile::Builder::new()
+    tempfile::Builder::new()
         .prefix(".coin-log-")
         .suffix(".mcap.tmp")
         .tempfile_in(&folder)
@@ -177,8 +197,17 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
                 folder.display(),
                 target.display()
             )
-        })?;
+        })
+}
 
+/// Records the scene into `temp` with Ctrl-C finishing the file early and a progress bar on long runs;
+/// returns the summary and the wall time, the file synced to disk and readable.
+fn record_into(
+    args: &RecordArgs,
+    scene: &Scene,
+    target: &Path,
+    temp: &mut NamedTempFile,
+) -> anyhow::Result<(RecordSummary, Duration)> {
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = Arc::clone(&stop);
@@ -193,7 +222,7 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let duration = scene.run.duration;
     let result = record::record(
-        &scene,
+        scene,
         &options,
         BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut()),
         &stop,
@@ -206,16 +235,21 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
         .with_context(|| format!("writing `{}`", target.display()))?;
     let wall = started.elapsed();
     make_readable(temp.as_file());
+    Ok((summary, wall))
+}
 
-    if args.overwrite {
-        temp.persist(&target).map_err(|e| {
+/// Moves the finished recording into place; without `--overwrite` a file that appeared meanwhile is left
+/// alone and the recording kept under its temporary name.
+fn persist(temp: NamedTempFile, target: &Path, overwrite: bool) -> anyhow::Result<()> {
+    if overwrite {
+        temp.persist(target).map_err(|e| {
             anyhow!(
                 "cannot move the recording to `{}`: {}",
                 target.display(),
                 e.error
             )
         })?;
-    } else if let Err(e) = temp.persist_noclobber(&target) {
+    } else if let Err(e) = temp.persist_noclobber(target) {
         // The target appeared while we were recording: keep our file rather than lose it.
         let kept = e.file.keep().map(|(_, p)| p);
         let kept = kept.map_or_else(|_| "(lost)".to_string(), |p| p.display().to_string());
@@ -224,9 +258,12 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
             target.display()
         );
     }
+    Ok(())
+}
 
-    print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
-    Ok(match &summary.failure {
+/// The exit code of a finished recording; a numerical failure says where the samples stop.
+fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
+    match &summary.failure {
         Some(f) => {
             eprintln!(
                 "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
@@ -237,7 +274,7 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
         }
         None if summary.termination == Termination::Interrupted => Outcome::Interrupted,
         None => Outcome::Success,
-    })
+    }
 }
 
 /// A bar that stays hidden for the first second and when stderr is not a terminal.

@@ -1,8 +1,8 @@
 //! `coin-log verify`: prints each file's checks as a table (or the contract's JSON) and maps the worst
 //! verdict to the exit code.
 
+use super::rss::peak_rss_bytes;
 use super::Outcome;
-use coin_log::bench::throughput::peak_rss_bytes;
 use coin_log::verify::{self, FileReport, Options, Report};
 use std::path::PathBuf;
 

@@ -16,9 +16,9 @@ const MAX_TIME: f64 = 1.8e10;
 /// log_time = round(t·10⁹) ns, checked: t finite, ≥ 0, and small enough for a u64.
 ///
 /// ```
-/// assert_eq!(coin_log::units::log_time(1.5).unwrap(), 1_500_000_000);
-/// assert_eq!(coin_log::units::log_time(0.01).unwrap(), 10_000_000);
-/// assert!(coin_log::units::log_time(-1.0).is_err());
+/// assert_eq!(coin_log::format::log_time(1.5).unwrap(), 1_500_000_000);
+/// assert_eq!(coin_log::format::log_time(0.01).unwrap(), 10_000_000);
+/// assert!(coin_log::format::log_time(-1.0).is_err());
 /// ```
 ///
 /// # Errors

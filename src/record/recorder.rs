@@ -13,7 +13,6 @@
 
 use super::foxglove::{Foxglove3d, FoxgloveBatch};
 use super::summary::{Failure, RecordSummary};
-use super::writer::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField, Position,
     QuaternionMessage, ReactionMessage,
@@ -23,6 +22,7 @@ use crate::format::{
     FORMAT_VERSION, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use crate::integrate::{self, run_method, Flow, RunOutcome, RunSettings};
+use crate::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{
     centre, contact_point, energy, orientation, reaction, Chaplygin, Coin, InvariantsError, State,
@@ -46,7 +46,7 @@ const PROGRESS_INTERVAL: u64 = 4096;
 /// Chunk compression (`--compression`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Compression {
-    /// zstd at [`super::writer::ZSTD_LEVEL`] (the default).
+    /// zstd at [`crate::mcap_io::ZSTD_LEVEL`] (the default).
     #[default]
     Zstd,
     /// lz4.

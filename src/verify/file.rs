@@ -7,12 +7,9 @@ use super::checks::{
     RunStats,
 };
 use super::json;
-use super::problems::Problems;
-use super::reader::{self, ReadErrorKind, Visitor};
 use super::report::{CheckId, CheckResult, FileReport, Status};
 use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
-use super::wire::MessageHeader;
 use super::Options;
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
@@ -22,6 +19,7 @@ use crate::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
     RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
+use crate::mcap_io::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Inertia};
 use std::collections::BTreeMap;
@@ -437,22 +435,22 @@ fn unusable(path: &str, problem: String) -> FileReport {
 /// Judges one file (see [`super::verify_file`]).
 pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     let mut judge = Judge::default();
-    let (structure, error) = reader::read(path, &mut judge);
+    let (structure, error) = mcap_io::read(path, &mut judge);
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 
 /// Judges an MCAP held in memory (see [`super::verify_bytes`]).
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();
-    let (structure, error) = reader::read_from(bytes, bytes.len() as u64, &mut judge);
+    let (structure, error) = mcap_io::read_from(bytes, bytes.len() as u64, &mut judge);
     verdict(name.to_string(), judge, structure, error, options)
 }
 
 fn verdict(
     shown: String,
     mut judge: Judge,
-    structure: reader::Structure,
-    error: Option<reader::ReadError>,
+    structure: mcap_io::Structure,
+    error: Option<mcap_io::ReadError>,
     options: &Options,
 ) -> FileReport {
     let mut problem = None;
@@ -522,7 +520,7 @@ impl Judge {
     /// Every integrity problem: the reader's, the judge's, the result record's, and the read error's.
     fn all_problems(
         &mut self,
-        structure: &reader::Structure,
+        structure: &mcap_io::Structure,
         ctx: &Context,
         read_whole: bool,
         read_problem: Option<&String>,

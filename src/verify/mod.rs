@@ -1,21 +1,17 @@
 //! `coin-log verify`: judge a stored log from the file alone (CONTRACT: verify).
 //!
 //! The parameters come from the file's `coin-log` metadata; the physics is recomputed from the stored
-//! channels, never re-simulated. The file is read once, as a stream ([`reader`]), in memory bounded by its
-//! largest record: messages are parsed into their strict types, grouped by log time into samples
-//! ([`samples`]), and each check keeps running maxima and a short window ([`checks`]). Tolerances follow
-//! from the recorded integrator settings ([`tolerances`]).
+//! channels, never re-simulated. The file is read once, as a stream ([`crate::mcap_io::read`]), in memory
+//! bounded by its largest record: messages are parsed into their strict types, grouped by log time into
+//! samples ([`samples`]), and each check keeps running maxima and a short window ([`checks`]). Tolerances
+//! follow from the recorded integrator settings ([`tolerances`]).
 
 pub mod checks;
 mod file;
 mod json;
-mod prefetch;
-pub mod problems;
-pub mod reader;
 pub mod report;
 pub mod samples;
 pub mod tolerances;
-pub mod wire;
 
 pub use report::{CheckId, CheckResult, FileReport, Report, Status};
 pub use tolerances::Tolerances;

@@ -1,4 +1,4 @@
-//! The streaming MCAP reader of `verify`: one pass over the file in memory bounded by the largest record
+//! The streaming MCAP reader: one pass over the file in memory bounded by the largest record
 //! (never by the file's length).
 //!
 //! Reading is a two-thread pipeline (the private `prefetch` module): a worker runs the mcap crate's sans-io
@@ -39,7 +39,7 @@ pub trait Visitor {
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>);
     /// The header record's library string.
     fn library(&mut self, library: &str);
-    /// A message; `Break` stops reading (e.g. the file is not a coin-log file).
+    /// A message; `Break` stops reading (e.g. the file is not one the caller understands).
     fn message(&mut self, header: &MessageHeader, data: &[u8]) -> ControlFlow<()>;
 }
 
@@ -82,7 +82,7 @@ pub struct Structure {
     pub messages: u64,
     /// Chunks read.
     pub chunks: u64,
-    /// Structural problems (indexes, statistics, summary), for the `integrity` check.
+    /// Structural problems (indexes, statistics, summary).
     pub problems: Problems,
     /// Whether a summary section, statistics and chunk indexes were present.
     pub has_summary: bool,
@@ -603,6 +603,7 @@ impl Book {
         Ok(())
     }
 
+    /// A record outside the chunk bookkeeping: definitions, metadata and the summary's records.
     fn record(
         &mut self,
         opcode: u8,
@@ -610,121 +611,173 @@ impl Book {
         at: u64,
         visitor: &mut impl Visitor,
     ) -> Result<(), ReadError> {
-        let mut c = Cursor::new(data);
         match opcode {
-            op::MESSAGE => self.message(data, at, None, visitor)?,
-            op::SCHEMA => {
-                let err = |e| wire_error("schema", at, e);
-                let id = c.u16("id").map_err(err)?;
-                let name = c.string("name").map_err(err)?.unwrap_or("");
-                let encoding = c.string("encoding").map_err(err)?.unwrap_or("");
-                let body = c.bytes("data").map_err(err)?;
-                match definition(&mut self.schemas, id, data) {
-                    Definition::New => visitor.schema(id, name, encoding, body),
-                    Definition::Repeated => {}
-                    Definition::Different => {
-                        self.problem(|| format!("schema {id} `{name}` at byte {at} differs from its earlier definition"));
-                    }
-                }
+            op::MESSAGE => self.message(data, at, None, visitor),
+            op::SCHEMA => self.schema(data, at, visitor),
+            op::CHANNEL => self.channel(data, at, visitor),
+            op::METADATA => self.metadata(data, at, visitor),
+            op::ATTACHMENT => {
+                self.attachment_count += 1;
+                Ok(())
             }
-            op::CHANNEL => {
-                let err = |e| wire_error("channel", at, e);
-                let id = c.u16("id").map_err(err)?;
-                let schema_id = c.u16("schema_id").map_err(err)?;
-                let topic = c.string("topic").map_err(err)?.unwrap_or("");
-                let encoding = c.string("message_encoding").map_err(err)?.unwrap_or("");
-                match definition(&mut self.channels, id, data) {
-                    Definition::New => visitor.channel(id, schema_id, topic, encoding),
-                    Definition::Repeated => {}
-                    Definition::Different => {
-                        self.problem(|| format!("channel {id} `{topic}` at byte {at} differs from its earlier definition"));
-                    }
-                }
-            }
-            op::METADATA => {
-                let err = |e| wire_error("metadata", at, e);
-                let name = c.string("name").map_err(err)?.unwrap_or("").to_string();
-                let mut entries = BTreeMap::new();
-                wire::for_each_entry(&mut c, "metadata", |e| {
-                    let k = e.string("key")?.unwrap_or("");
-                    let v = e.string("value")?.unwrap_or("");
-                    entries.insert(k.to_string(), v.to_string());
-                    Ok(())
-                })
-                .map_err(err)?;
-                self.metadata_count += 1;
-                if self.metadata.len() < MAX_REMEMBERED {
-                    self.metadata
-                        .push((at, RECORD_PREFIX + data.len() as u64, name.clone()));
-                }
-                visitor.metadata(&name, &entries);
-            }
-            op::ATTACHMENT => self.attachment_count += 1,
-            op::CHUNK_INDEX => {
-                let err = |e| wire_error("chunk index", at, e);
-                let mut d = Digest::default();
-                let start_time = c.u64("message_start_time").map_err(err)?;
-                let end_time = c.u64("message_end_time").map_err(err)?;
-                let start = c.u64("chunk_start_offset").map_err(err)?;
-                let length = c.u64("chunk_length").map_err(err)?;
-                let mut offsets = Vec::new();
-                wire::for_each_entry(&mut c, "message_index_offsets", |e| {
-                    offsets.push((e.u16("channel_id")?, e.u64("offset")?));
-                    Ok(())
-                })
-                .map_err(err)?;
-                offsets.sort_unstable();
-                let index_length = c.u64("message_index_length").map_err(err)?;
-                let compression = c.bytes("compression").map_err(err)?;
-                let compressed = c.u64("compressed_size").map_err(err)?;
-                let uncompressed = c.u64("uncompressed_size").map_err(err)?;
-                let mut comp = Digest::default();
-                comp.push_bytes(compression);
-                for v in [
-                    start,
-                    length,
-                    start_time,
-                    end_time,
-                    comp.0,
-                    compressed,
-                    uncompressed,
-                ] {
-                    d.push(v);
-                }
-                for (ch, o) in offsets {
-                    d.push(u64::from(ch));
-                    d.push(o);
-                }
-                d.push(index_length);
-                self.chunk_index_digest.push(d.0);
-                self.chunk_indexes += 1;
-            }
-            op::METADATA_INDEX => {
-                let err = |e| wire_error("metadata index", at, e);
-                let offset = c.u64("offset").map_err(err)?;
-                let length = c.u64("length").map_err(err)?;
-                let name = c.string("name").map_err(err)?.unwrap_or("").to_string();
-                if self.metadata_indexes.len() < MAX_REMEMBERED {
-                    self.metadata_indexes.push((offset, length, name));
-                }
-            }
+            op::CHUNK_INDEX => self.chunk_index(data, at),
+            op::METADATA_INDEX => self.metadata_index(data, at),
             op::STATISTICS => {
                 self.statistics += 1;
-                self.check_statistics(&mut c)
-                    .map_err(|e| wire_error("statistics", at, e))?;
+                self.check_statistics(&mut Cursor::new(data))
+                    .map_err(|e| wire_error("statistics", at, e))
             }
-            op::SUMMARY_OFFSET => {
-                let err = |e| wire_error("summary offset", at, e);
-                let entry = (
-                    c.u8("group_opcode").map_err(err)?,
-                    c.u64("group_start").map_err(err)?,
-                    c.u64("group_length").map_err(err)?,
-                );
-                if self.summary_offsets.len() < MAX_REMEMBERED {
-                    self.summary_offsets.push(entry);
-                }
+            op::SUMMARY_OFFSET => self.summary_offset(data, at),
+            _ => Ok(()),
+        }
+    }
+
+    /// A schema record: passed on at its first definition, compared with it afterwards.
+    fn schema(
+        &mut self,
+        data: &[u8],
+        at: u64,
+        visitor: &mut impl Visitor,
+    ) -> Result<(), ReadError> {
+        let mut c = Cursor::new(data);
+        let err = |e| wire_error("schema", at, e);
+        let id = c.u16("id").map_err(err)?;
+        let name = c.string("name").map_err(err)?.unwrap_or("");
+        let encoding = c.string("encoding").map_err(err)?.unwrap_or("");
+        let body = c.bytes("data").map_err(err)?;
+        match definition(&mut self.schemas, id, data) {
+            Definition::New => visitor.schema(id, name, encoding, body),
+            Definition::Repeated => {}
+            Definition::Different => {
+                self.problem(|| {
+                    format!("schema {id} `{name}` at byte {at} differs from its earlier definition")
+                });
             }
-            _ => {}
+        }
+        Ok(())
+    }
+
+    /// A channel record: passed on at its first definition, compared with it afterwards.
+    fn channel(
+        &mut self,
+        data: &[u8],
+        at: u64,
+        visitor: &mut impl Visitor,
+    ) -> Result<(), ReadError> {
+        let mut c = Cursor::new(data);
+        let err = |e| wire_error("channel", at, e);
+        let id = c.u16("id").map_err(err)?;
+        let schema_id = c.u16("schema_id").map_err(err)?;
+        let topic = c.string("topic").map_err(err)?.unwrap_or("");
+        let encoding = c.string("message_encoding").map_err(err)?.unwrap_or("");
+        match definition(&mut self.channels, id, data) {
+            Definition::New => visitor.channel(id, schema_id, topic, encoding),
+            Definition::Repeated => {}
+            Definition::Different => {
+                self.problem(|| {
+                    format!(
+                        "channel {id} `{topic}` at byte {at} differs from its earlier definition"
+                    )
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// A metadata record: passed on, and remembered (up to [`MAX_REMEMBERED`]) for the metadata indexes.
+    fn metadata(
+        &mut self,
+        data: &[u8],
+        at: u64,
+        visitor: &mut impl Visitor,
+    ) -> Result<(), ReadError> {
+        let mut c = Cursor::new(data);
+        let err = |e| wire_error("metadata", at, e);
+        let name = c.string("name").map_err(err)?.unwrap_or("").to_string();
+        let mut entries = BTreeMap::new();
+        wire::for_each_entry(&mut c, "metadata", |e| {
+            let k = e.string("key")?.unwrap_or("");
+            let v = e.string("value")?.unwrap_or("");
+            entries.insert(k.to_string(), v.to_string());
+            Ok(())
+        })
+        .map_err(err)?;
+        self.metadata_count += 1;
+        if self.metadata.len() < MAX_REMEMBERED {
+            self.metadata
+                .push((at, RECORD_PREFIX + data.len() as u64, name.clone()));
+        }
+        visitor.metadata(&name, &entries);
+        Ok(())
+    }
+
+    /// A chunk index record: folded into the digest that must match the chunks' own.
+    fn chunk_index(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
+        let mut c = Cursor::new(data);
+        let err = |e| wire_error("chunk index", at, e);
+        let mut d = Digest::default();
+        let start_time = c.u64("message_start_time").map_err(err)?;
+        let end_time = c.u64("message_end_time").map_err(err)?;
+        let start = c.u64("chunk_start_offset").map_err(err)?;
+        let length = c.u64("chunk_length").map_err(err)?;
+        let mut offsets = Vec::new();
+        wire::for_each_entry(&mut c, "message_index_offsets", |e| {
+            offsets.push((e.u16("channel_id")?, e.u64("offset")?));
+            Ok(())
+        })
+        .map_err(err)?;
+        offsets.sort_unstable();
+        let index_length = c.u64("message_index_length").map_err(err)?;
+        let compression = c.bytes("compression").map_err(err)?;
+        let compressed = c.u64("compressed_size").map_err(err)?;
+        let uncompressed = c.u64("uncompressed_size").map_err(err)?;
+        let mut comp = Digest::default();
+        comp.push_bytes(compression);
+        for v in [
+            start,
+            length,
+            start_time,
+            end_time,
+            comp.0,
+            compressed,
+            uncompressed,
+        ] {
+            d.push(v);
+        }
+        for (ch, o) in offsets {
+            d.push(u64::from(ch));
+            d.push(o);
+        }
+        d.push(index_length);
+        self.chunk_index_digest.push(d.0);
+        self.chunk_indexes += 1;
+        Ok(())
+    }
+
+    /// A metadata index record, remembered (up to [`MAX_REMEMBERED`]) to compare with the records.
+    fn metadata_index(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
+        let mut c = Cursor::new(data);
+        let err = |e| wire_error("metadata index", at, e);
+        let offset = c.u64("offset").map_err(err)?;
+        let length = c.u64("length").map_err(err)?;
+        let name = c.string("name").map_err(err)?.unwrap_or("").to_string();
+        if self.metadata_indexes.len() < MAX_REMEMBERED {
+            self.metadata_indexes.push((offset, length, name));
+        }
+        Ok(())
+    }
+
+    /// A summary offset record, remembered (up to [`MAX_REMEMBERED`]) to compare with the summary's groups.
+    fn summary_offset(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
+        let mut c = Cursor::new(data);
+        let err = |e| wire_error("summary offset", at, e);
+        let entry = (
+            c.u8("group_opcode").map_err(err)?,
+            c.u64("group_start").map_err(err)?,
+            c.u64("group_length").map_err(err)?,
+        );
+        if self.summary_offsets.len() < MAX_REMEMBERED {
+            self.summary_offsets.push(entry);
         }
         Ok(())
     }

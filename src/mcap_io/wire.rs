@@ -2,19 +2,19 @@
 //!
 //! The mcap crate's record parsers trust length prefixes inside a record (a string may claim 4 GB and the
 //! parser reserves it before reading); these read only what the record holds and borrow from it, so a
-//! crafted record can never make `verify` allocate more than the record's own bytes.
+//! crafted record can never make the reader allocate more than the record's own bytes.
 
 use std::fmt;
 
 /// A record body that ends before a field it declares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct WireError {
+pub(crate) struct WireError {
     /// The field being read.
-    pub field: &'static str,
+    pub(crate) field: &'static str,
     /// Bytes it needed.
-    pub needed: u64,
+    pub(crate) needed: u64,
     /// Bytes left in the record.
-    pub available: u64,
+    pub(crate) available: u64,
 }
 
 impl fmt::Display for WireError {
@@ -29,20 +29,20 @@ impl fmt::Display for WireError {
 
 /// A cursor over one record body.
 #[derive(Debug, Clone)]
-pub struct Cursor<'a> {
+pub(crate) struct Cursor<'a> {
     data: &'a [u8],
 }
 
 impl<'a> Cursor<'a> {
     /// A cursor at the start of `data`.
     #[must_use]
-    pub fn new(data: &'a [u8]) -> Self {
+    pub(crate) fn new(data: &'a [u8]) -> Self {
         Self { data }
     }
 
     /// Bytes not read yet.
     #[must_use]
-    pub fn rest(&self) -> &'a [u8] {
+    pub(crate) fn rest(&self) -> &'a [u8] {
         self.data
     }
 
@@ -50,7 +50,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] if fewer are left.
-    pub fn take(&mut self, n: u64, field: &'static str) -> Result<&'a [u8], WireError> {
+    pub(crate) fn take(&mut self, n: u64, field: &'static str) -> Result<&'a [u8], WireError> {
         let err = WireError {
             field,
             needed: n,
@@ -76,7 +76,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] at the end of the record.
-    pub fn u8(&mut self, field: &'static str) -> Result<u8, WireError> {
+    pub(crate) fn u8(&mut self, field: &'static str) -> Result<u8, WireError> {
         Ok(self.array::<1>(field)?[0])
     }
 
@@ -84,7 +84,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] at the end of the record.
-    pub fn u16(&mut self, field: &'static str) -> Result<u16, WireError> {
+    pub(crate) fn u16(&mut self, field: &'static str) -> Result<u16, WireError> {
         Ok(u16::from_le_bytes(self.array(field)?))
     }
 
@@ -92,7 +92,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] at the end of the record.
-    pub fn u32(&mut self, field: &'static str) -> Result<u32, WireError> {
+    pub(crate) fn u32(&mut self, field: &'static str) -> Result<u32, WireError> {
         Ok(u32::from_le_bytes(self.array(field)?))
     }
 
@@ -100,7 +100,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] at the end of the record.
-    pub fn u64(&mut self, field: &'static str) -> Result<u64, WireError> {
+    pub(crate) fn u64(&mut self, field: &'static str) -> Result<u64, WireError> {
         Ok(u64::from_le_bytes(self.array(field)?))
     }
 
@@ -108,7 +108,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] if the prefix claims more than the record holds.
-    pub fn bytes(&mut self, field: &'static str) -> Result<&'a [u8], WireError> {
+    pub(crate) fn bytes(&mut self, field: &'static str) -> Result<&'a [u8], WireError> {
         let len = self.u32(field)?;
         self.take(u64::from(len), field)
     }
@@ -117,7 +117,7 @@ impl<'a> Cursor<'a> {
     ///
     /// # Errors
     /// [`WireError`] if the prefix claims more than the record holds.
-    pub fn string(&mut self, field: &'static str) -> Result<Option<&'a str>, WireError> {
+    pub(crate) fn string(&mut self, field: &'static str) -> Result<Option<&'a str>, WireError> {
         Ok(std::str::from_utf8(self.bytes(field)?).ok())
     }
 }
@@ -139,7 +139,7 @@ pub struct MessageHeader {
 ///
 /// # Errors
 /// [`WireError`] if the record is shorter than a message header.
-pub fn message(body: &[u8]) -> Result<(MessageHeader, &[u8]), WireError> {
+pub(crate) fn message(body: &[u8]) -> Result<(MessageHeader, &[u8]), WireError> {
     let mut c = Cursor::new(body);
     let header = MessageHeader {
         channel_id: c.u16("channel_id")?,
@@ -152,26 +152,26 @@ pub fn message(body: &[u8]) -> Result<(MessageHeader, &[u8]), WireError> {
 
 /// The header of a chunk record.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ChunkHeader<'a> {
+pub(crate) struct ChunkHeader<'a> {
     /// Earliest message log time.
-    pub message_start_time: u64,
+    pub(crate) message_start_time: u64,
     /// Latest message log time.
-    pub message_end_time: u64,
+    pub(crate) message_end_time: u64,
     /// Size of the records once decompressed.
-    pub uncompressed_size: u64,
+    pub(crate) uncompressed_size: u64,
     /// CRC-32 of the decompressed records (0: none).
-    pub uncompressed_crc: u32,
+    pub(crate) uncompressed_crc: u32,
     /// Compression name ("" for none).
-    pub compression: &'a [u8],
+    pub(crate) compression: &'a [u8],
     /// Size of the compressed records.
-    pub compressed_size: u64,
+    pub(crate) compressed_size: u64,
 }
 
 /// Parses a chunk header and checks that the compressed records fit in the record.
 ///
 /// # Errors
 /// [`WireError`] if a field or the compressed records run past the record.
-pub fn chunk_header(body: &[u8]) -> Result<ChunkHeader<'_>, WireError> {
+pub(crate) fn chunk_header(body: &[u8]) -> Result<ChunkHeader<'_>, WireError> {
     let mut c = Cursor::new(body);
     let header = ChunkHeader {
         message_start_time: c.u64("message_start_time")?,
@@ -189,7 +189,7 @@ pub fn chunk_header(body: &[u8]) -> Result<ChunkHeader<'_>, WireError> {
 ///
 /// # Errors
 /// [`WireError`] if the prefix or an entry runs past the record.
-pub fn for_each_entry<'a>(
+pub(crate) fn for_each_entry<'a>(
     c: &mut Cursor<'a>,
     field: &'static str,
     mut read: impl FnMut(&mut Cursor<'a>) -> Result<(), WireError>,

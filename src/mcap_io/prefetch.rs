@@ -1,6 +1,6 @@
-//! The reading half of `verify`'s pipeline (issue 9): a worker thread reads the file, checks the data and
+//! The reading half of the reader's pipeline: a worker thread reads the file, checks the data and
 //! summary CRCs, decompresses each chunk and checks its CRC, and hands the records over in batches through
-//! a bounded channel, while the calling thread parses messages and runs the checks.
+//! a bounded channel, while the calling thread walks the records and runs the visitor.
 //!
 //! A batch holds copies of whole records back to back and a list of [`Event`]s pointing into them, in file
 //! order; errors travel as events in their place, so the consumer sees exactly the sequence a
@@ -22,13 +22,13 @@ const READ_BLOCK: usize = 1 << 18;
 /// Smallest record-length limit inside chunks (a chunk's records may decompress beyond the file's size).
 const MIN_CHUNK_RECORD_LIMIT: usize = 1 << 24;
 /// A batch is handed over once it holds this many bytes (about one decompressed chunk).
-pub const BATCH_BYTES: usize = 1 << 20;
+pub(crate) const BATCH_BYTES: usize = 1 << 20;
 /// Batches in flight between the threads: enough to keep both busy, few enough to bound memory.
-pub const QUEUE: usize = 4;
+pub(crate) const QUEUE: usize = 4;
 
 /// One step of the read, in file order.
 #[derive(Debug)]
-pub enum Event {
+pub(crate) enum Event {
     /// A top-level record (chunks included, whole and compressed) and its bytes in the batch.
     Outer {
         /// Record opcode.
@@ -55,11 +55,11 @@ pub enum Event {
 
 /// Records and the events that point into them.
 #[derive(Debug, Default)]
-pub struct Batch {
+pub(crate) struct Batch {
     /// Record bodies back to back.
-    pub bytes: Vec<u8>,
+    pub(crate) bytes: Vec<u8>,
     /// What happened, in order.
-    pub events: Vec<Event>,
+    pub(crate) events: Vec<Event>,
 }
 
 impl Batch {
@@ -75,11 +75,11 @@ impl Batch {
 }
 
 /// The worker's end: where batches go and where spent ones come back.
-pub struct Producer {
+pub(crate) struct Producer {
     /// Filled batches, to the consumer.
-    pub to_consumer: SyncSender<Batch>,
+    pub(crate) to_consumer: SyncSender<Batch>,
     /// Spent batches, from the consumer.
-    pub recycled: Receiver<Batch>,
+    pub(crate) recycled: Receiver<Batch>,
 }
 
 impl Producer {
@@ -106,7 +106,7 @@ impl Producer {
 
 /// Reads an MCAP stream of `file_len` bytes from `source` and sends its records to the consumer, ending
 /// after the last record, the first error, or when the consumer hangs up.
-pub fn produce(mut source: impl Read, file_len: u64, producer: &Producer) {
+pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer) {
     let limit = usize::try_from(file_len).unwrap_or(usize::MAX);
     let mut outer = LinearReader::new_with_options(
         LinearReaderOptions::default()

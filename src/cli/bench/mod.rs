@@ -1,15 +1,16 @@
 //! `coin-log bench`: accuracy against cost of every integrator, the hard-case suite (issue 8), and throughput
 //! and memory of record and verify (issue 9).
 
+mod throughput;
+
 use super::Outcome;
 use anyhow::Context;
 use coin_log::bench::plot::work_precision_svg;
 use coin_log::bench::precision::{precision_bench, PrecisionOptions};
 use coin_log::bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
+use coin_log::bench::stability;
 use coin_log::bench::table::{precision_csv, precision_table, stability_csv, stability_table};
-use coin_log::bench::throughput::{self, ThroughputOptions};
 use coin_log::bench::BenchCase;
-use coin_log::bench::{nominal_order, stability};
 use coin_log::integrate::Method;
 use coin_log::scene::presets;
 use std::fs;
@@ -42,7 +43,7 @@ enum BenchCommand {
     /// same JSON bytes (the bound); verifies the file in a child `coin-log verify`; reports messages/s,
     /// MB/s, file size and peak RSS at two durations (100 and 1000 time units; 1000 and 10000 with
     /// --long), then dop853 on wobble and one RHS evaluation. Medians of --repeats runs.
-    Throughput(ThroughputArgs),
+    Throughput(throughput::ThroughputArgs),
 }
 
 /// Arguments of `coin-log bench precision`.
@@ -66,32 +67,11 @@ struct StabilityArgs {
     out: PathBuf,
 }
 
-/// Arguments of `coin-log bench throughput`.
-#[derive(Debug, clap::Args)]
-struct ThroughputArgs {
-    /// Folder for `throughput.csv` and the recordings (created if missing; the recordings are deleted
-    /// afterwards unless --keep).
-    #[arg(long, default_value = "bench-results")]
-    out: PathBuf,
-    /// Timed repeats of every workload; the median is reported.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
-    repeats: u32,
-    /// Measure at 1000 and 10000 time units (7 and 70 million messages) instead of 100 and 1000.
-    #[arg(long, conflicts_with = "durations")]
-    long: bool,
-    /// Durations of the record and verify workloads, comma-separated [time units].
-    #[arg(long, value_delimiter = ',', value_name = "T,...")]
-    durations: Option<Vec<f64>>,
-    /// Keep the recordings in the output folder.
-    #[arg(long)]
-    keep: bool,
-}
-
 pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
     match args.command {
         BenchCommand::Precision(a) => precision(&a),
         BenchCommand::Stability(a) => stability_suite(&a),
-        BenchCommand::Throughput(a) => throughput_bench(&a),
+        BenchCommand::Throughput(a) => throughput::run(&a),
     }
 }
 
@@ -139,7 +119,7 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         println!("scene {} — reference: {}", report.scene, report.reference);
         print!("{}", precision_table(&report.rows));
         for s in &report.slopes {
-            let expected = nominal_order(s.integrator);
+            let expected = s.integrator.order();
             println!(
                 "  {:>8}: slope {} (vs time), {} (vs RHS evaluations), order -{expected}, {} points",
                 s.integrator.name(),
@@ -165,37 +145,6 @@ fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     print!("{}", stability_table(&rows));
     let csv_path = args.out.join("stability.csv");
     write(&csv_path, &stability_csv(&rows))?;
-    println!("CSV: {}", csv_path.display());
-    Ok(Outcome::Success)
-}
-
-fn throughput_bench(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
-    let durations = match (&args.durations, args.long) {
-        (Some(d), _) => d.clone(),
-        (None, true) => vec![1000.0, 10_000.0],
-        (None, false) => vec![100.0, 1000.0],
-    };
-    if let Some(bad) = durations.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
-        anyhow::bail!("--durations: `{bad}` is not a positive duration");
-    }
-    create_dir(&args.out)?;
-    let options = ThroughputOptions {
-        exe: std::env::current_exe().context("locating the coin-log binary")?,
-        dir: args.out.clone(),
-        durations,
-        repeats: args.repeats as usize,
-    };
-    let result = throughput::run(&options);
-    if !args.keep {
-        for d in &options.durations {
-            let _ = fs::remove_file(throughput::recording_path(&options.dir, *d));
-        }
-    }
-    let report = result?;
-    println!("cores available: {}", report.cores);
-    print!("{}", throughput::table(&report));
-    let csv_path = args.out.join("throughput.csv");
-    write(&csv_path, &throughput::csv(&report))?;
     println!("CSV: {}", csv_path.display());
     Ok(Outcome::Success)
 }

@@ -7,35 +7,7 @@
 //! threads), and it cannot hand a finished chunk away and go on. Profiling showed that this, not the
 //! simulation and JSON formatting (~0.25 µs per message), bounded the recorder.
 //!
-//! # Pipeline
-//! - The calling thread appends Message records to a plain `Vec<u8>` (the chunk's uncompressed records),
-//!   noting per channel (`log_time`, offset in the chunk) for the message indexes, and the chunk's time
-//!   bounds.
-//! - When the chunk reaches [`WriterOptions::chunk_size`] bytes it goes to a compression worker over a
-//!   `std::sync::mpsc` channel. The worker computes its CRC-32 and compresses it in one call (zstd's bulk
-//!   API at [`ZSTD_LEVEL`], single-threaded; an lz4 frame as the `mcap` crate writes one; or nothing),
-//!   and sends both buffers back; they are reused, so the steady state allocates nothing per chunk
-//!   (lz4's encoder context excepted).
-//! - The calling thread writes finished chunks, in order, each followed by its MessageIndex records, as
-//!   their results come back. The file never leaves the calling thread: a borrowed `&mut Cursor` or
-//!   `BufWriter<&mut File>` works (nothing needs to be `Send + 'static`), and an I/O error surfaces from
-//!   the call that met it. A compression error or a lost worker surfaces from the next call that
-//!   collects a chunk ([`McapWriter::write_message`], [`McapWriter::write_metadata`] or
-//!   [`McapWriter::finish`]); after any error every call fails and the file is unusable.
-//! - At most [`IN_FLIGHT_PER_WORKER`] chunks per worker are in flight (the calling thread waits for the
-//!   oldest beyond that), so memory is bounded whatever the length of the run.
-//!
-//! # Determinism
-//! Chunk boundaries depend only on the bytes written; each chunk is compressed independently with fixed
-//! parameters by one thread; chunks are written in the order they were filled. Neither the worker count
-//! nor timing changes a byte.
-//!
-//! # Layout ([MCAP spec](https://mcap.dev/spec))
-//! Magic; Header (profile, library); the data section: chunks (Schema and Channel records inside the
-//! chunk that holds the channel's first message, before it), each followed by its MessageIndex records,
-//! and Metadata records between chunks (the open chunk is written first); DataEnd with the CRC-32 of
-//! everything before it; the summary section: Schemas, Channels, Statistics, ChunkIndexes,
-//! MetadataIndexes, each group listed by a SummaryOffset record; Footer with the summary CRC; magic.
+//! [`McapWriter`]'s doc describes the pipeline, why the bytes are deterministic, and the file's layout.
 
 use std::collections::{BTreeMap, VecDeque};
 use std::io::{self, BufWriter, Write};
@@ -45,7 +17,7 @@ use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
 use std::thread::JoinHandle;
 
 /// The 8 bytes at both ends of an MCAP file.
-pub const MAGIC: [u8; 8] = [0x89, b'M', b'C', b'A', b'P', b'0', b'\r', b'\n'];
+const MAGIC: [u8; 8] = [0x89, b'M', b'C', b'A', b'P', b'0', b'\r', b'\n'];
 
 /// Record opcodes (MCAP spec, "Records").
 mod op {
@@ -64,13 +36,15 @@ mod op {
     pub const DATA_END: u8 = 0x0F;
 }
 
-/// Uncompressed bytes per chunk: the `mcap` crate's default, large enough for good compression and few
-/// index records, small enough that a reader seeking to a time decompresses little.
+/// The default of [`WriterOptions::chunk_size`] \[bytes of uncompressed records\]: the `mcap` crate's
+/// default, large enough for good compression and few index records, small enough that a reader seeking
+/// to a time decompresses little.
 pub const DEFAULT_CHUNK_SIZE: usize = 1 << 20;
 
-/// zstd level. Level 1 is both faster and smaller than the default level 3 on coin-log's JSON chunks
-/// (measured on the seven-channel wobble run: 3.9× vs 3.5× smaller, about 1.3× faster; the
-/// shortest round-trip digits leave little for level 3's longer matches to find).
+/// The zstd level of [`ChunkCompression::Zstd`] chunks (fixed: the writer has no other). Level 1 is both
+/// faster and smaller than zstd's default level 3 on coin-log's JSON chunks (measured on the seven-channel
+/// wobble run: 3.9× vs 3.5× smaller, about 1.3× faster; the shortest round-trip digits leave little for
+/// level 3's longer matches to find).
 pub const ZSTD_LEVEL: i32 = 1;
 
 /// lz4 level: 0 is lz4's fast default, as in the `mcap` crate.
@@ -78,7 +52,7 @@ const LZ4_LEVEL: u32 = 0;
 
 /// Chunks a worker may hold (one being compressed, one queued) before the calling thread waits: enough
 /// to keep the worker busy, few enough that memory stays a few chunk sizes.
-pub const IN_FLIGHT_PER_WORKER: usize = 2;
+const IN_FLIGHT_PER_WORKER: usize = 2;
 
 /// Buffer between the writer and the output, so that small records (indexes, headers) are not one
 /// system call each.
@@ -397,7 +371,37 @@ impl<W: Write> Output<W> {
     }
 }
 
-/// A chunked, indexed MCAP writer whose chunks are compressed on worker threads (see the module doc).
+/// A chunked, indexed MCAP writer whose chunks are compressed on worker threads.
+///
+/// # Pipeline
+/// - The calling thread appends Message records to a plain `Vec<u8>` (the chunk's uncompressed records),
+///   noting per channel (`log_time`, offset in the chunk) for the message indexes, and the chunk's time
+///   bounds.
+/// - When the chunk reaches [`WriterOptions::chunk_size`] bytes it goes to a compression worker over a
+///   `std::sync::mpsc` channel. The worker computes its CRC-32 and compresses it in one call (zstd's bulk
+///   API at [`ZSTD_LEVEL`], single-threaded; an lz4 frame as the `mcap` crate writes one; or nothing),
+///   and sends both buffers back; they are reused, so the steady state allocates nothing per chunk
+///   (lz4's encoder context excepted).
+/// - The calling thread writes finished chunks, in order, each followed by its MessageIndex records, as
+///   their results come back. The file never leaves the calling thread: a borrowed `&mut Cursor` or
+///   `BufWriter<&mut File>` works (nothing needs to be `Send + 'static`), and an I/O error surfaces from
+///   the call that met it. A compression error or a lost worker surfaces from the next call that
+///   collects a chunk ([`write_message`](Self::write_message), [`write_metadata`](Self::write_metadata) or
+///   [`finish`](Self::finish)); after any error every call fails and the file is unusable.
+/// - At most two chunks per worker (one being compressed, one queued) are in flight: the calling thread
+///   waits for the oldest beyond that, so memory is bounded whatever the length of the run.
+///
+/// # Determinism
+/// Chunk boundaries depend only on the bytes written; each chunk is compressed independently with fixed
+/// parameters by one thread; chunks are written in the order they were filled. Neither the worker count
+/// nor timing changes a byte.
+///
+/// # Layout ([MCAP spec](https://mcap.dev/spec))
+/// Magic; Header (profile, library); the data section: chunks (Schema and Channel records inside the
+/// chunk that holds the channel's first message, before it), each followed by its MessageIndex records,
+/// and Metadata records between chunks (the open chunk is written first); DataEnd with the CRC-32 of
+/// everything before it; the summary section: Schemas, Channels, Statistics, ChunkIndexes,
+/// MetadataIndexes, each group listed by a SummaryOffset record; Footer with the summary CRC; magic.
 ///
 /// Call [`finish`](Self::finish) to complete the file; dropping the writer without it stops the workers
 /// and leaves an incomplete file.
@@ -814,65 +818,56 @@ impl<W: Write> McapWriter<W> {
         // The summary CRC starts at the summary's first byte, after DataEnd.
         self.out.crc = crc32fast::Hasher::new();
         let summary_start = self.out.position;
-        let mut groups: Vec<(u8, u64, u64)> = Vec::new();
-        let mut group = |out: &mut Output<W>, opcode: u8, bytes: &[u8]| -> io::Result<()> {
-            if !bytes.is_empty() {
-                groups.push((opcode, out.position, bytes.len() as u64));
-                out.write_all(bytes)?;
-            }
-            Ok(())
-        };
+        let groups = self.write_summary_groups()?;
+        self.write_footer(summary_start, &groups)
+    }
 
-        b.clear();
+    /// The summary's groups, in the order of the layout; returns (opcode, start, length) of each group
+    /// written (an empty group is left out).
+    fn write_summary_groups(&mut self) -> Result<Vec<(u8, u64, u64)>, WriteError> {
+        let mut groups = Vec::new();
+        let mut b = Vec::new();
         for (i, schema) in self.schemas.iter().enumerate() {
             encode_schema(&mut b, id_of(i), schema)?;
         }
-        group(&mut self.out, op::SCHEMA, &b)?;
-
-        b.clear();
+        self.write_group(op::SCHEMA, &mut b, &mut groups)?;
         for (i, channel) in self.channels.iter().enumerate() {
             encode_channel(&mut b, id_of(i), channel)?;
         }
-        group(&mut self.out, op::CHANNEL, &b)?;
-
-        b.clear();
+        self.write_group(op::CHANNEL, &mut b, &mut groups)?;
         self.encode_statistics(&mut b)?;
-        group(&mut self.out, op::STATISTICS, &b)?;
+        self.write_group(op::STATISTICS, &mut b, &mut groups)?;
+        self.encode_chunk_indexes(&mut b)?;
+        self.write_group(op::CHUNK_INDEX, &mut b, &mut groups)?;
+        self.encode_metadata_indexes(&mut b)?;
+        self.write_group(op::METADATA_INDEX, &mut b, &mut groups)?;
+        Ok(groups)
+    }
 
-        b.clear();
-        for index in &self.chunk_indexes {
-            let at = begin_record(&mut b, op::CHUNK_INDEX);
-            put_u64(&mut b, index.bounds.0);
-            put_u64(&mut b, index.bounds.1);
-            put_u64(&mut b, index.chunk_start);
-            put_u64(&mut b, index.chunk_length);
-            let offsets = &self.index_offsets[index.offsets.clone()];
-            put_u32(&mut b, len32("message index offsets", offsets.len() * 10)?);
-            for &(channel_id, offset) in offsets {
-                put_u16(&mut b, channel_id);
-                put_u64(&mut b, offset);
-            }
-            put_u64(&mut b, index.message_index_length);
-            put_str(&mut b, self.compression.mcap_name())?;
-            put_u64(&mut b, index.compressed_size);
-            put_u64(&mut b, index.uncompressed_size);
-            end_record(&mut b, at);
+    /// Writes the records of one summary group (if any), notes where they went, and empties `records`.
+    fn write_group(
+        &mut self,
+        opcode: u8,
+        records: &mut Vec<u8>,
+        groups: &mut Vec<(u8, u64, u64)>,
+    ) -> io::Result<()> {
+        if !records.is_empty() {
+            groups.push((opcode, self.out.position, records.len() as u64));
+            self.out.write_all(records)?;
         }
-        group(&mut self.out, op::CHUNK_INDEX, &b)?;
+        records.clear();
+        Ok(())
+    }
 
-        b.clear();
-        for index in &self.metadata_indexes {
-            let at = begin_record(&mut b, op::METADATA_INDEX);
-            put_u64(&mut b, index.offset);
-            put_u64(&mut b, index.length);
-            put_str(&mut b, &index.name)?;
-            end_record(&mut b, at);
-        }
-        group(&mut self.out, op::METADATA_INDEX, &b)?;
-
+    /// The SummaryOffset records of `groups`, the footer and the closing magic.
+    fn write_footer(
+        &mut self,
+        summary_start: u64,
+        groups: &[(u8, u64, u64)],
+    ) -> Result<(), WriteError> {
         let summary_offset_start = self.out.position;
-        b.clear();
-        for &(opcode, start, length) in &groups {
+        let mut b = Vec::new();
+        for &(opcode, start, length) in groups {
             let at = begin_record(&mut b, op::SUMMARY_OFFSET);
             b.push(opcode);
             put_u64(&mut b, start);
@@ -890,6 +885,39 @@ impl<W: Write> McapWriter<W> {
         put_u32(&mut b, summary_crc);
         b.extend_from_slice(&MAGIC);
         self.out.write_all(&b)?;
+        Ok(())
+    }
+
+    fn encode_chunk_indexes(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
+        for index in &self.chunk_indexes {
+            let at = begin_record(b, op::CHUNK_INDEX);
+            put_u64(b, index.bounds.0);
+            put_u64(b, index.bounds.1);
+            put_u64(b, index.chunk_start);
+            put_u64(b, index.chunk_length);
+            let offsets = &self.index_offsets[index.offsets.clone()];
+            put_u32(b, len32("message index offsets", offsets.len() * 10)?);
+            for &(channel_id, offset) in offsets {
+                put_u16(b, channel_id);
+                put_u64(b, offset);
+            }
+            put_u64(b, index.message_index_length);
+            put_str(b, self.compression.mcap_name())?;
+            put_u64(b, index.compressed_size);
+            put_u64(b, index.uncompressed_size);
+            end_record(b, at);
+        }
+        Ok(())
+    }
+
+    fn encode_metadata_indexes(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
+        for index in &self.metadata_indexes {
+            let at = begin_record(b, op::METADATA_INDEX);
+            put_u64(b, index.offset);
+            put_u64(b, index.length);
+            put_str(b, &index.name)?;
+            end_record(b, at);
+        }
         Ok(())
     }
 

@@ -1,0 +1,177 @@
+//! `coin-log bench throughput`: runs the record and verify workloads of
+//! [`coin_log::bench::throughput`] in child processes of this binary (each in its own process, so that its
+//! peak RSS is its own), reads their `--json` summaries, and has the library measure the compression
+//! bound and the integration cost, turn the runs into rows and format them.
+
+use super::{create_dir, write};
+use crate::cli::Outcome;
+use anyhow::{anyhow, bail, Context};
+use coin_log::bench::throughput::{
+    self, channel_list, compression_bound, recording_path, DurationRuns, RecordRun,
+    ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
+};
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// Arguments of `coin-log bench throughput`.
+#[derive(Debug, clap::Args)]
+pub struct ThroughputArgs {
+    /// Folder for `throughput.csv` and the recordings (created if missing; the recordings are deleted
+    /// afterwards unless --keep).
+    #[arg(long, default_value = "bench-results")]
+    out: PathBuf,
+    /// Timed repeats of every workload; the median is reported.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
+    repeats: u32,
+    /// Measure at 1000 and 10000 time units (7 and 70 million messages) instead of 100 and 1000.
+    #[arg(long, conflicts_with = "durations")]
+    long: bool,
+    /// Durations of the record and verify workloads, comma-separated [time units].
+    #[arg(long, value_delimiter = ',', value_name = "T,...")]
+    durations: Option<Vec<f64>>,
+    /// Keep the recordings in the output folder.
+    #[arg(long)]
+    keep: bool,
+}
+
+/// Runs `coin-log bench throughput`: measure, clean up, print the table, write the CSV.
+pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
+    let durations = durations(args)?;
+    create_dir(&args.out)?;
+    let exe = std::env::current_exe().context("locating the coin-log binary")?;
+    let result = measure(&exe, &args.out, &durations, args.repeats as usize);
+    if !args.keep {
+        for d in &durations {
+            let _ = fs::remove_file(recording_path(&args.out, *d));
+        }
+    }
+    let report = result?;
+    println!("cores available: {}", report.cores);
+    print!("{}", throughput::table(&report));
+    let csv_path = args.out.join("throughput.csv");
+    write(&csv_path, &throughput::csv(&report))?;
+    println!("CSV: {}", csv_path.display());
+    Ok(Outcome::Success)
+}
+
+/// The durations asked for, each positive and finite.
+fn durations(args: &ThroughputArgs) -> anyhow::Result<Vec<f64>> {
+    let durations = match (&args.durations, args.long) {
+        (Some(d), _) => d.clone(),
+        (None, true) => vec![1000.0, 10_000.0],
+        (None, false) => vec![100.0, 1000.0],
+    };
+    if let Some(bad) = durations.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
+        bail!("--durations: `{bad}` is not a positive duration");
+    }
+    Ok(durations)
+}
+
+/// Record, bound and verify at every duration, then the integration cost.
+fn measure(
+    exe: &Path,
+    dir: &Path,
+    durations: &[f64],
+    repeats: usize,
+) -> anyhow::Result<ThroughputReport> {
+    let mut rows = Vec::new();
+    for &duration in durations {
+        rows.extend(record_and_verify(exe, dir, duration, repeats)?);
+    }
+    rows.extend(throughput::integration_cost(repeats)?);
+    Ok(ThroughputReport::new(rows))
+}
+
+/// Record, bound and verify at one duration: `repeats` runs each, as rows of medians.
+fn record_and_verify(
+    exe: &Path,
+    dir: &Path,
+    duration: f64,
+    repeats: usize,
+) -> anyhow::Result<Vec<ThroughputRow>> {
+    let path = recording_path(dir, duration);
+    let mut runs = DurationRuns::new(duration);
+    for _ in 0..repeats.max(1) {
+        runs.records.push(record_run(exe, &path, duration)?);
+        runs.bounds.push(compression_bound(&path)?);
+        runs.verifies.push(verify_run(exe, &path)?);
+    }
+    Ok(runs.rows()?)
+}
+
+/// Runs a child `coin-log` and returns its parsed JSON stdout and wall time; it must exit 0.
+fn child_json(exe: &Path, args: &[String]) -> anyhow::Result<(serde_json::Value, f64)> {
+    let command = format!("{} {}", exe.display(), args.join(" "));
+    let start = Instant::now();
+    let output = Command::new(exe)
+        .args(args)
+        .output()
+        .map_err(|e| anyhow!("cannot run `{command}`: {e}"))?;
+    let wall = start.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if !output.status.success() {
+        bail!("`{command}` exited with {}: {stderr}", output.status);
+    }
+    let json = serde_json::from_slice(&output.stdout)
+        .map_err(|e| anyhow!("`{command}` printed no JSON ({e}): {stderr}"))?;
+    Ok((json, wall))
+}
+
+/// Records the workload for `duration` time units into `path` in a child process.
+fn record_run(exe: &Path, path: &Path, duration: f64) -> anyhow::Result<RecordRun> {
+    let args: Vec<String> = [
+        "record",
+        SCENE,
+        "--duration",
+        &duration.to_string(),
+        "--rate",
+        &RATE.to_string(),
+        "--channels",
+        &channel_list(),
+        "--compression",
+        "zstd",
+        "-o",
+        &path.display().to_string(),
+        "--overwrite",
+        "--json",
+    ]
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    let (json, _) = child_json(exe, &args)?;
+    let command = format!("{} record", exe.display());
+    let termination = json.get("termination").and_then(serde_json::Value::as_str);
+    if termination != Some("completed") {
+        bail!("`{command}` ended with termination {termination:?}, not completed");
+    }
+    let bad = |what: &str| anyhow!("`{command}` printed a summary without `{what}`: {json}");
+    let u64_field = |key: &str| json.get(key).and_then(serde_json::Value::as_u64);
+    Ok(RecordRun {
+        messages: u64_field("messages").ok_or_else(|| bad("messages"))?,
+        bytes: u64_field("bytes").ok_or_else(|| bad("bytes"))?,
+        seconds: json
+            .get("wall_time_s")
+            .and_then(serde_json::Value::as_f64)
+            .ok_or_else(|| bad("wall_time_s"))?,
+        peak_rss: u64_field("peak_rss_bytes"),
+    })
+}
+
+/// Verifies `path` in a child process; the file must pass (exit 0).
+fn verify_run(exe: &Path, path: &Path) -> anyhow::Result<VerifyRun> {
+    let args = vec![
+        "verify".to_string(),
+        path.display().to_string(),
+        "--json".to_string(),
+    ];
+    let (json, seconds) = child_json(exe, &args)?;
+    let file = json.get("files").and_then(|f| f.get(0));
+    Ok(VerifyRun {
+        seconds,
+        peak_rss: file
+            .and_then(|f| f.get("peak_rss_bytes"))
+            .and_then(serde_json::Value::as_u64),
+    })
+}

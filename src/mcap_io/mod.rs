@@ -1,0 +1,32 @@
+//! MCAP files (<https://mcap.dev/spec>) read and written as records, in bounded memory. This module
+//! knows MCAP, not what the messages mean: `record` and `verify` (and any later command that reads files)
+//! put the coin-log contract on top of it. It depends on nothing else in the crate.
+//!
+//! **Writing**: [`McapWriter`] writes a chunked, indexed file with statistics, summary offsets and CRCs,
+//! compressing whole chunks on worker threads ([`WriterOptions`], [`ChunkCompression`]). The same bytes go
+//! out whatever the worker count or timing. [`ChunkCompressor`] is the code its workers compress a chunk
+//! with, public so that a benchmark can time compression alone; [`DEFAULT_CHUNK_SIZE`] and [`ZSTD_LEVEL`]
+//! are the writer's defaults.
+//!
+//! **Reading**: [`read`] (a path) and [`read_from`] (any reader of known length) walk a file once, in
+//! file order, passing its schemas, channels, metadata and messages to a [`Visitor`]. Memory is bounded by
+//! the largest record, never by the length of the file; every claimed length is checked against the file
+//! size before anything is allocated for it. A worker thread reads and decompresses ahead and checks the
+//! data, summary and chunk CRCs. Along the way the reader checks the file's structure (message indexes,
+//! chunk indexes, statistics, metadata indexes, summary offsets, footer) and returns what it found as a
+//! [`Structure`]; a file that cannot be read to its end is a [`ReadError`] whose [`ReadErrorKind`] says
+//! why.
+
+mod prefetch;
+mod problems;
+mod reader;
+mod wire;
+mod writer;
+
+pub use problems::Problems;
+pub use reader::{read, read_from, ReadError, ReadErrorKind, Structure, Visitor};
+pub use wire::MessageHeader;
+pub use writer::{
+    ChunkCompression, ChunkCompressor, McapWriter, WriteError, WriterOptions, DEFAULT_CHUNK_SIZE,
+    ZSTD_LEVEL,
+};
