@@ -4,9 +4,10 @@ use super::equations::Coin;
 use super::state::State;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-/// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (NOTES §1), acting on the coin lying in the x–y plane
-/// with normal +z (world frame, y up). Computed from the unwrapped angles, so it is continuous in time and
-/// not forced to w ≥ 0. Its components (i, j, k, w) are Foxglove's (x, y, z, w).
+/// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (NOTES §1: spin ψ about z, then lean θ about x, then
+/// heading φ about y; rotation matrix eq (7)), a dimensionless unit quaternion acting on the coin lying in
+/// the x–y plane with normal +z (world frame, y up). Computed from the unwrapped angles, so it is continuous in time and not
+/// forced to w ≥ 0. Its components (i, j, k, w) are Foxglove's (x, y, z, w).
 ///
 /// ```
 /// use coin_log::model::{orientation, State};
