@@ -150,7 +150,7 @@ proptest! {
         let s = scaled(&p, &u);
         let q = orientation(&s);
         within("|q| - 1", q.norm() - 1.0, 1.0)?;
-        let n = q.rotate([0.0, 0.0, 1.0]);
+        let n: V3 = q.transform_vector(&nalgebra::Vector3::z()).into();
         let (st, ct) = s.theta.sin_cos();
         let (sp, cp) = s.phi.sin_cos();
         within("|q e_z - e_Z|", max_diff(&n, &[ct * sp, -st, ct * cp]), 1.0)?;

@@ -82,7 +82,7 @@ fn disagreement<S: OdeSystem<STATE_LEN>>(
         let d = [
             max_diff(&[c.x, c.y, c.z], &NewtonEuler::centre(yn)) / a,
             max_diff(&[cp.x, cp.y, cp.z], &ne.contact_point(yn)) / a,
-            quat_distance([q.w, q.x, q.y, q.z], NewtonEuler::quaternion(yn)),
+            quat_distance([q.w, q.i, q.j, q.k], NewtonEuler::quaternion(yn)),
             max_diff(&omega, &NewtonEuler::omega(yn)) / w,
         ];
         for (wk, dk) in worst.iter_mut().zip(d) {

@@ -14,6 +14,7 @@
 
 use super::fixed::FixedSteps;
 use super::{OdeSystem, Stats, StepError, Stepper};
+use nalgebra::{DMatrix, DVector, Dyn, SMatrix, LU};
 
 /// √3/6, the half-distance of the Gauss nodes from 1/2.
 const SQRT3_6: f64 = 0.288_675_134_594_812_882_254_574_390_250_978_7;
@@ -52,15 +53,15 @@ pub struct Gauss4<const N: usize> {
     z_last: [[f64; N]; 2],
     /// Step of `z_last` (0 when there is none).
     h_z_last: f64,
-    /// Jacobian, row-major N×N.
-    jacobian: Vec<f64>,
+    /// Jacobian J ≈ ∂f/∂y.
+    jacobian: SMatrix<f64, N, N>,
     jacobian_stale: bool,
-    /// LU factors of I − h·(A ⊗ J), row-major 2N×2N, with row pivots; built for step `h_lu`.
-    lu: Vec<f64>,
-    pivots: Vec<usize>,
+    /// LU factors (partial pivoting) of I − h·(A ⊗ J), built for step `h_lu`. 2N×2N is a run-time size:
+    /// a fixed-size `SMatrix` of 2N rows cannot be named for a generic `N` on stable Rust.
+    lu: Option<LU<f64, Dyn, Dyn>>,
     h_lu: f64,
     /// Newton right-hand side / correction, length 2N.
-    work: Vec<f64>,
+    work: DVector<f64>,
     stats: Stats,
 }
 
@@ -72,12 +73,11 @@ impl<const N: usize> Gauss4<N> {
             steps: FixedSteps::new(h),
             z_last: [[0.0; N]; 2],
             h_z_last: 0.0,
-            jacobian: vec![0.0; N * N],
+            jacobian: SMatrix::zeros(),
             jacobian_stale: true,
-            lu: vec![0.0; 4 * N * N],
-            pivots: vec![0; 2 * N],
+            lu: None,
             h_lu: 0.0,
-            work: vec![0.0; 2 * N],
+            work: DVector::zeros(2 * N),
             stats: Stats::default(),
         }
     }
@@ -92,7 +92,7 @@ impl<const N: usize> Gauss4<N> {
             let delta = y[j] - self.steps.y[j]; // the increment actually representable
             sys.rhs(self.steps.t, &y, &mut f);
             for i in 0..N {
-                self.jacobian[i * N + j] = (f[i] - self.steps.f[i]) / delta;
+                self.jacobian[(i, j)] = (f[i] - self.steps.f[i]) / delta;
             }
             y[j] = self.steps.y[j];
         }
@@ -101,70 +101,27 @@ impl<const N: usize> Gauss4<N> {
         self.h_lu = 0.0;
     }
 
-    /// LU factors (partial pivoting) of I − h·(A ⊗ J). Returns false if the matrix is singular.
+    /// LU factors (partial pivoting) of I − h·(A ⊗ J). Returns false if the matrix is singular or the
+    /// factors are not finite.
     fn factor(&mut self, h: f64) -> bool {
-        let m = 2 * N;
-        for a in 0..2 {
-            for i in 0..N {
-                let r = a * N + i;
-                for b in 0..2 {
-                    for j in 0..N {
-                        let c = b * N + j;
-                        let identity = if r == c { 1.0 } else { 0.0 };
-                        self.lu[r * m + c] = identity - h * A[a][b] * self.jacobian[i * N + j];
-                    }
-                }
-            }
+        self.lu = None;
+        self.h_lu = 0.0;
+        // Row (a, i) and column (b, j) of the Kronecker product: stage a, b and component i, j.
+        let matrix = DMatrix::from_fn(2 * N, 2 * N, |r, c| {
+            let (a, i, b, j) = (r / N, r % N, c / N, c % N);
+            let identity = if r == c { 1.0 } else { 0.0 };
+            identity - h * A[a][b] * self.jacobian[(i, j)]
+        });
+        if !matrix.iter().all(|v| v.is_finite()) {
+            return false;
         }
-        for col in 0..m {
-            let mut pivot = col;
-            for r in col + 1..m {
-                if self.lu[r * m + col].abs() > self.lu[pivot * m + col].abs() {
-                    pivot = r;
-                }
-            }
-            self.pivots[col] = pivot;
-            if self.lu[pivot * m + col] == 0.0 || !self.lu[pivot * m + col].is_finite() {
-                return false;
-            }
-            if pivot != col {
-                for c in 0..m {
-                    self.lu.swap(col * m + c, pivot * m + c);
-                }
-            }
-            let diagonal = self.lu[col * m + col];
-            for r in col + 1..m {
-                let factor = self.lu[r * m + col] / diagonal;
-                self.lu[r * m + col] = factor;
-                for c in col + 1..m {
-                    self.lu[r * m + c] -= factor * self.lu[col * m + c];
-                }
-            }
+        let lu = matrix.lu();
+        if !lu.u().diagonal().iter().all(|&d| d != 0.0 && d.is_finite()) {
+            return false;
         }
+        self.lu = Some(lu);
         self.h_lu = h;
         true
-    }
-
-    /// Solves (LU) x = `work` in place.
-    fn solve(&mut self) {
-        let m = 2 * N;
-        for col in 0..m {
-            self.work.swap(col, self.pivots[col]);
-        }
-        for r in 0..m {
-            let mut sum = self.work[r];
-            for c in 0..r {
-                sum -= self.lu[r * m + c] * self.work[c];
-            }
-            self.work[r] = sum;
-        }
-        for r in (0..m).rev() {
-            let mut sum = self.work[r];
-            for c in r + 1..m {
-                sum -= self.lu[r * m + c] * self.work[c];
-            }
-            self.work[r] = sum / self.lu[r * m + r];
-        }
     }
 
     /// Starting guess for the stage increments: the previous step's collocation polynomial
@@ -222,7 +179,14 @@ impl<const N: usize> Gauss4<N> {
             if !self.work.iter().all(|v| v.is_finite()) {
                 return Err((iteration, f64::NAN));
             }
-            self.solve();
+            // `factor` succeeded before every Newton solve, so the factors exist and are invertible.
+            let solved = self
+                .lu
+                .as_ref()
+                .is_some_and(|lu| lu.solve_mut(&mut self.work));
+            if !solved {
+                return Err((iteration, f64::INFINITY));
+            }
             let mut norm = 0.0_f64;
             for a in 0..2 {
                 for i in 0..N {

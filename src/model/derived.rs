@@ -2,125 +2,49 @@
 
 use super::equations::Coin;
 use super::state::State;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-/// A point or vector in the world frame (y up, NOTES §1).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Vec3 {
-    /// x component.
-    pub x: f64,
-    /// y component (up).
-    pub y: f64,
-    /// z component.
-    pub z: f64,
-}
-
-/// A unit quaternion, components named like Foxglove's (`w` the scalar part).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quaternion {
-    /// Vector part, x.
-    pub x: f64,
-    /// Vector part, y.
-    pub y: f64,
-    /// Vector part, z.
-    pub z: f64,
-    /// Scalar part.
-    pub w: f64,
-}
-
-impl Quaternion {
-    /// Rotation by `angle` about a unit `axis`.
-    #[must_use]
-    pub fn from_axis_angle(axis: [f64; 3], angle: f64) -> Self {
-        let (s, c) = (0.5 * angle).sin_cos();
-        Self {
-            x: s * axis[0],
-            y: s * axis[1],
-            z: s * axis[2],
-            w: c,
-        }
-    }
-
-    /// Hamilton product `self · other` (apply `other` first, then `self`).
-    #[must_use]
-    pub fn mul(&self, o: &Self) -> Self {
-        Self {
-            w: self.w * o.w - self.x * o.x - self.y * o.y - self.z * o.z,
-            x: self.w * o.x + self.x * o.w + self.y * o.z - self.z * o.y,
-            y: self.w * o.y - self.x * o.z + self.y * o.w + self.z * o.x,
-            z: self.w * o.z + self.x * o.y - self.y * o.x + self.z * o.w,
-        }
-    }
-
-    /// Rotates a vector: q v q*.
-    #[must_use]
-    pub fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
-        let p = Self {
-            x: v[0],
-            y: v[1],
-            z: v[2],
-            w: 0.0,
-        };
-        let conj = Self {
-            x: -self.x,
-            y: -self.y,
-            z: -self.z,
-            w: self.w,
-        };
-        let r = self.mul(&p).mul(&conj);
-        [r.x, r.y, r.z]
-    }
-
-    /// Euclidean norm (1 for a rotation).
-    #[must_use]
-    pub fn norm(&self) -> f64 {
-        (self.x * self.x + self.y * self.y + self.z * self.z + self.w * self.w).sqrt()
-    }
-}
-
-/// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (NOTES §1), acting on the coin lying in the x–y plane
-/// with normal +z. Computed from the unwrapped angles, so it is continuous in time and not forced to w ≥ 0.
+/// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (NOTES §1: spin ψ about z, then lean θ about x, then
+/// heading φ about y; rotation matrix eq (7)), a dimensionless unit quaternion acting on the coin lying in
+/// the x–y plane with normal +z (world frame, y up). Computed from the unwrapped angles, so it is continuous in time and not
+/// forced to w ≥ 0. Its components (i, j, k, w) are Foxglove's (x, y, z, w).
 ///
 /// ```
 /// use coin_log::model::{orientation, State};
 /// let q = orientation(&State::default());
-/// assert_eq!((q.x, q.y, q.z, q.w), (0.0, 0.0, 0.0, 1.0));
+/// assert_eq!((q.i, q.j, q.k, q.w), (0.0, 0.0, 0.0, 1.0));
 /// ```
 #[must_use]
-pub fn orientation(s: &State) -> Quaternion {
+pub fn orientation(s: &State) -> UnitQuaternion<f64> {
     let (sp, cp) = (0.5 * s.phi).sin_cos();
     let (st, ct) = (0.5 * s.theta).sin_cos();
     let (ss, cs) = (0.5 * s.psi).sin_cos();
     // q(e_y, φ)·q(e_x, θ) = (cp ct, cp st, sp ct, −sp st) [w, x, y, z], then · q(e_z, ψ), expanded by hand.
     let (w1, x1, y1, z1) = (cp * ct, cp * st, sp * ct, -sp * st);
-    Quaternion {
-        w: w1 * cs - z1 * ss,
-        x: x1 * cs + y1 * ss,
-        y: y1 * cs - x1 * ss,
-        z: w1 * ss + z1 * cs,
-    }
+    let w = w1 * cs - z1 * ss;
+    let x = x1 * cs + y1 * ss;
+    let y = y1 * cs - x1 * ss;
+    let z = w1 * ss + z1 * cs;
+    // Wrapped as it is, not renormalised and not built as a product of `from_axis_angle` factors: the
+    // recorded components must keep these exact floating-point operations (the committed datasets are
+    // compared byte for byte), and a product of unit quaternions is unit to round-off anyway.
+    UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z))
 }
 
-/// Centre of the coin in the world frame: (x, a cos θ, z) (NOTES §1).
+/// Centre of the coin in the world frame: (x, a cos θ, z) \[length\] (NOTES §1).
 #[must_use]
-pub fn centre(coin: &Coin, s: &State) -> Vec3 {
-    Vec3 {
-        x: s.x,
-        y: coin.params().radius() * s.theta.cos(),
-        z: s.z,
-    }
+pub fn centre(coin: &Coin, s: &State) -> Vector3<f64> {
+    Vector3::new(s.x, coin.params().radius() * s.theta.cos(), s.z)
 }
 
-/// Contact point on the table: x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y = 0 (NOTES §3).
+/// Contact point on the table: x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y = 0 \[length\]
+/// (NOTES §3).
 #[must_use]
-pub fn contact_point(coin: &Coin, s: &State) -> Vec3 {
+pub fn contact_point(coin: &Coin, s: &State) -> Vector3<f64> {
     let a = coin.params().radius();
     let st = s.theta.sin();
     let (sp, cp) = s.phi.sin_cos();
-    Vec3 {
-        x: s.x - a * st * sp,
-        y: 0.0,
-        z: s.z - a * st * cp,
-    }
+    Vector3::new(s.x - a * st * sp, 0.0, s.z - a * st * cp)
 }
 
 /// Energy split into its parts [mass·length²/time²].
@@ -163,8 +87,8 @@ pub fn energy(coin: &Coin, s: &State) -> Energy {
 /// The table's reaction on the coin (NOTES §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reaction {
-    /// R = M dv/dt + Mg e_y, world components \[force\].
-    pub force: Vec3,
+    /// R = M dv/dt + Mg e_y, world components (y up) \[force\].
+    pub force: Vector3<f64>,
     /// Friction magnitude F = √(R_x² + R_z²) (NOTES §3, corrected; §8 item 4).
     pub friction: f64,
     /// Normal force N = R_y.
@@ -197,11 +121,7 @@ pub fn reaction(coin: &Coin, s: &State) -> Reaction {
     let ry = ma * (-radial * ct - tangential * st) + p.mass() * p.gravity();
     let rz = ma * (along_z * sp - radial * st * cp + tangential * ct * cp);
     Reaction {
-        force: Vec3 {
-            x: rx,
-            y: ry,
-            z: rz,
-        },
+        force: Vector3::new(rx, ry, rz),
         friction: rx.hypot(rz),
         normal: ry,
     }

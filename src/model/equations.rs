@@ -103,6 +103,12 @@ impl Coin {
     /// Writes into a caller-owned buffer; no allocation.
     #[inline]
     pub fn derivative(&self, y: &[f64; STATE_LEN], dydt: &mut StateRate) {
+        // Plain arrays rather than nalgebra's SVector: this is the hot path of every integrator, and the
+        // integrators' interface (`OdeSystem`) is `[f64; N]`. Measured with `cargo bench --bench rhs`
+        // (criterion; the same body on `SVector<f64, 8>` in and out, side by side in one run, three rounds,
+        // on a loaded 2-core machine): fastest samples 27.4–27.9 ns per evaluation with arrays against
+        // 27.5–28.1 ns with SVector, medians 54–102 ns against 60–88 ns (load-dominated). nalgebra would
+        // cost nothing measurable here; the arrays stay because they are the interface of every stepper.
         let [theta, phi, _psi, wx, wy, wz, _x, _z] = *y;
         let (sin_t, cos_t) = theta.sin_cos();
         let (sin_p, cos_p) = phi.sin_cos();

@@ -10,9 +10,7 @@ mod stability;
 mod state;
 mod steady;
 
-pub use derived::{
-    centre, contact_point, energy, orientation, reaction, Energy, Quaternion, Reaction, Vec3,
-};
+pub use derived::{centre, contact_point, energy, orientation, reaction, Energy, Reaction};
 pub use equations::{AngularAcceleration, Coin};
 pub use invariants::{Chaplygin, Invariants, InvariantsError, LegendreBasis};
 pub use params::{CoinParams, Inertia, ParamError};

@@ -39,7 +39,8 @@
 
 use crate::format::messages::{push_number, NonFiniteField};
 use crate::format::Channel;
-use crate::model::{contact_point, orientation, Coin, Quaternion, State};
+use crate::model::{contact_point, orientation, Coin, State};
+use nalgebra::{Quaternion, UnitQuaternion};
 use std::ops::Range;
 
 /// Display rate of `/scene`, in updates per time unit of simulation time (≈ 30 Hz in Foxglove).
@@ -48,13 +49,14 @@ pub const SCENE_RATE: f64 = 30.0;
 /// Skipped contact points: closer than this to the last kept one, in units of the radius a.
 pub const TRACK_MIN_SPACING: f64 = 1e-3;
 
-/// Rotation `world` ← `table`: +90° about x (note's y up → Foxglove's z up), w last.
-pub const TABLE_ROTATION: Quaternion = Quaternion {
-    x: std::f64::consts::FRAC_1_SQRT_2,
-    y: 0.0,
-    z: 0.0,
-    w: std::f64::consts::FRAC_1_SQRT_2,
-};
+/// Rotation `world` ← `table`: +90° about x (note's y up → Foxglove's z up), q_T = (cos 45°; sin 45°, 0, 0).
+/// Unit to round-off (2·(1/√2)² = 1 ± 1 ulp), so it is wrapped as it is.
+pub const TABLE_ROTATION: UnitQuaternion<f64> = UnitQuaternion::new_unchecked(Quaternion::new(
+    std::f64::consts::FRAC_1_SQRT_2,
+    std::f64::consts::FRAC_1_SQRT_2,
+    0.0,
+    0.0,
+));
 
 /// Root frame (z up).
 pub const WORLD_FRAME: &str = "world";
@@ -499,13 +501,14 @@ impl<'a> Writer<'a> {
         Ok(())
     }
 
-    fn quaternion(&mut self, q: &Quaternion) -> Result<(), NonFiniteField> {
+    /// Foxglove's `{x, y, z, w}` are the quaternion's (i, j, k, w).
+    fn quaternion(&mut self, q: &UnitQuaternion<f64>) -> Result<(), NonFiniteField> {
         self.raw(b"{\"x\":");
-        self.num("rotation.x", q.x)?;
+        self.num("rotation.x", q.i)?;
         self.raw(b",\"y\":");
-        self.num("rotation.y", q.y)?;
+        self.num("rotation.y", q.j)?;
         self.raw(b",\"z\":");
-        self.num("rotation.z", q.z)?;
+        self.num("rotation.z", q.k)?;
         self.raw(b",\"w\":");
         self.num("rotation.w", q.w)?;
         self.raw(b"}");
@@ -545,8 +548,10 @@ impl<'a> Writer<'a> {
 mod tests {
     use super::*;
     use crate::format::log_time;
+    use crate::format::log_time;
     use crate::model::{centre, CoinParams};
     use crate::record::schema_bytes;
+    use nalgebra::Vector3;
     use serde_json::Value;
 
     fn unit_coin() -> Coin {
@@ -713,7 +718,7 @@ mod tests {
             ([0.0, 0.0, 1.0], [0.0, -1.0, 0.0]),
         ];
         for (from, to) in cases {
-            let r = q.rotate(from);
+            let r = q.transform_vector(&Vector3::from(from));
             for i in 0..3 {
                 assert!(
                     (r[i] - to[i]).abs() < 1e-15,
@@ -744,16 +749,16 @@ mod tests {
             let v: Value = serde_json::from_slice(bytes).unwrap();
             let tr = &v["translation"];
             let r = &v["rotation"];
-            let q = Quaternion {
-                x: r["x"].as_f64().unwrap(),
-                y: r["y"].as_f64().unwrap(),
-                z: r["z"].as_f64().unwrap(),
-                w: r["w"].as_f64().unwrap(),
-            };
+            let q = UnitQuaternion::new_unchecked(Quaternion::new(
+                r["w"].as_f64().unwrap(),
+                r["x"].as_f64().unwrap(),
+                r["y"].as_f64().unwrap(),
+                r["z"].as_f64().unwrap(),
+            ));
             // q = q_lean · q(e_z, ψ), so the coin-frame vector that q takes to −a e_Y is the rotation of
             // (0, −1, 0) by −ψ about z: (−sin ψ, −cos ψ, 0).
             let (sp, cp) = s.psi.sin_cos();
-            let rim = q.rotate([-sp, -cp, 0.0]);
+            let rim = q.transform_vector(&Vector3::new(-sp, -cp, 0.0));
             let c = contact_point(&coin, &s);
             let g = centre(&coin, &s);
             let got = [

@@ -337,9 +337,9 @@ impl<W: Write + Seek> Sampler<W> {
             let q = orientation(s);
             let m = QuaternionMessage {
                 t,
-                x: q.x,
-                y: q.y,
-                z: q.z,
+                x: q.i,
+                y: q.j,
+                z: q.k,
                 w: q.w,
             };
             self.stage(Channel::Quaternion, |b| m.write_json(b))?;

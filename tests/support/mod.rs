@@ -61,9 +61,9 @@ pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &
             let q = orientation(s);
             QuaternionMessage {
                 t,
-                x: q.x,
-                y: q.y,
-                z: q.z,
+                x: q.i,
+                y: q.j,
+                z: q.k,
                 w: q.w,
             }
             .write_json(&mut buf)

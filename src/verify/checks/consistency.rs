@@ -9,6 +9,7 @@ use crate::model::{orientation, reaction};
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
+use nalgebra::Quaternion;
 
 /// Running state of the consistency check.
 #[derive(Debug, Default, Clone)]
@@ -35,16 +36,11 @@ impl ConsistencyCheck {
                 ..Default::default()
             };
             let e = orientation(&state);
-            let diff = |sign: f64| {
-                (q.x - sign * e.x)
-                    .abs()
-                    .max((q.y - sign * e.y).abs())
-                    .max((q.z - sign * e.z).abs())
-                    .max((q.w - sign * e.w).abs())
-            };
+            let stored = Quaternion::new(q.w, q.x, q.y, q.z);
+            // Largest component difference, to q or to −q (the same rotation).
+            let diff = |sign: f64| (stored.coords - e.coords * sign).amax();
             self.quaternion.offer(diff(1.0).min(diff(-1.0)), s.t);
-            let n = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
-            self.norm.offer((n - 1.0).abs(), s.t);
+            self.norm.offer((stored.norm() - 1.0).abs(), s.t);
         }
         if let (Some(pos), Some(ang)) = (s.position, s.angles) {
             self.counts[1] += 1;

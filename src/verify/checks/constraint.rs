@@ -9,10 +9,11 @@
 //! where 4 (hΩ)⁸/630 exceeds a tenth of the tolerance are not resolved by the sampling and are left out (and
 //! counted); if none is resolved the check is skipped and says so.
 
-use super::{fmt_num, norm3, Max};
+use super::{fmt_num, Max};
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
+use nalgebra::Vector3;
 
 /// Central difference weights for f′(0)·h at offsets 1..4 (antisymmetric), 8th order.
 const WEIGHTS: [f64; 4] = [4.0 / 5.0, -1.0 / 5.0, 4.0 / 105.0, -1.0 / 280.0];
@@ -30,8 +31,10 @@ const DECADES: usize = 40;
 #[derive(Debug, Clone, Copy, Default)]
 struct Entry {
     t: f64,
-    position: [f64; 3],
-    velocity: [f64; 3],
+    /// Stored centre \[length\].
+    position: Vector3<f64>,
+    /// Centre velocity from the rolling constraint \[length/time\].
+    velocity: Vector3<f64>,
     rate: f64,
 }
 
@@ -77,16 +80,16 @@ impl ConstraintCheck {
         self.samples += 1;
         let (st, ct) = ang.theta.sin_cos();
         let (sp, cp) = ang.phi.sin_cos();
-        let velocity = [
+        let velocity = Vector3::new(
             a * (-w.z * cp + w.x * ct * sp),
             -a * w.x * st,
             a * (w.z * sp + w.x * ct * cp),
-        ];
-        let omega = norm3(w.x, w.y, w.z);
+        );
+        let omega = Vector3::new(w.x, w.y, w.z).norm();
         self.max_omega = self.max_omega.max(omega);
         let entry = Entry {
             t: s.t,
-            position: [p.x, p.y, p.z],
+            position: Vector3::new(p.x, p.y, p.z),
             velocity,
             rate: omega.max((w.y / ct).abs()),
         };
@@ -114,15 +117,11 @@ impl ConstraintCheck {
         }
         self.min_h = self.min_h.min(h);
         let centre = &win[WINDOW / 2];
-        let mut residual = [0.0; 3];
-        for (k, r) in residual.iter_mut().enumerate() {
-            let mut d = 0.0;
-            for (j, c) in WEIGHTS.iter().enumerate() {
-                d +=
-                    c * (win[WINDOW / 2 + j + 1].position[k] - win[WINDOW / 2 - j - 1].position[k]);
-            }
-            *r = d / h - centre.velocity[k];
+        let mut d = Vector3::zeros();
+        for (j, c) in WEIGHTS.iter().enumerate() {
+            d += (win[WINDOW / 2 + j + 1].position - win[WINDOW / 2 - j - 1].position) * *c;
         }
+        let residual = d / h - centre.velocity;
         let rate = win.iter().map(|e| e.rate).fold(0.0, f64::max);
         let truncation = TRUNCATION_SAFETY * (h * rate).powi(8) / 630.0;
         let decade = if truncation > 0.0 {
@@ -132,9 +131,7 @@ impl ConstraintCheck {
         };
         let bucket = &mut self.buckets[decade];
         bucket.windows += 1;
-        bucket
-            .residual
-            .offer(norm3(residual[0], residual[1], residual[2]), centre.t);
+        bucket.residual.offer(residual.norm(), centre.t);
     }
 
     /// The result.

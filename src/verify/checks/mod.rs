@@ -13,6 +13,7 @@ use super::samples::Sample;
 use crate::format::{ResultMetadata, RunMetadata};
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, Steady};
+use nalgebra::Vector3;
 
 /// What the checks know about the run besides its samples: the file's metadata.
 #[derive(Debug, Clone)]
@@ -49,7 +50,7 @@ impl RunStats {
         self.last_t = s.t;
         self.samples += 1;
         if let Some(w) = s.omega {
-            self.max_omega = self.max_omega.max(norm3(w.x, w.y, w.z));
+            self.max_omega = self.max_omega.max(Vector3::new(w.x, w.y, w.z).norm());
         }
     }
 
@@ -58,12 +59,6 @@ impl RunStats {
     pub fn span(&self) -> f64 {
         self.first_t.map_or(0.0, |t0| self.last_t - t0)
     }
-}
-
-/// Euclidean norm of three components.
-#[must_use]
-pub fn norm3(x: f64, y: f64, z: f64) -> f64 {
-    (x * x + y * y + z * z).sqrt()
 }
 
 /// The worst of several (value, tolerance, label) measures: the one with the largest value/tolerance.

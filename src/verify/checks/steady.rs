@@ -2,13 +2,14 @@
 //! must vanish, θ and ω must equal the steady values, and the circles traced by the stored centre and
 //! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
 
-use super::{fmt_num, norm3, worst, Context, Max};
+use super::{fmt_num, worst, Context, Max};
 use crate::format::RunMetadata;
 use crate::model::{Coin, Steady};
 use crate::scene::{self, Scene};
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
+use nalgebra::{Matrix3, Vector3};
 
 /// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
 const MIN_ARC: f64 = 0.5;
@@ -73,36 +74,28 @@ impl CircleFit {
         self.max_offset = self.max_offset.max(u.hypot(v));
     }
 
-    /// The fitted radius, if the system is solvable.
+    /// The fitted radius, if the system is solvable. The circle u² + v² + D u + E v + F = 0 that minimises
+    /// Σ(u² + v² + D u + E v + F)² solves the normal equations
+    /// [Σu² Σuv Σu; Σuv Σv² Σv; Σu Σv n]·(D, E, F) = −(Σu³ + Σuv², Σu²v + Σv³, Σu² + Σv²),
+    /// and its radius is √((D² + E²)/4 − F). `None` when the matrix is singular (collinear points), the
+    /// solution is not finite, or the radius² comes out negative.
     fn radius(&self) -> Option<f64> {
-        let m = [
-            [self.suu, self.suv, self.su],
-            [self.suv, self.svv, self.sv],
-            [self.su, self.sv, self.n],
-        ];
-        let r = [
-            -(self.suuu + self.suvv),
-            -(self.suuv + self.svvv),
-            -(self.suu + self.svv),
-        ];
-        let det = |m: &[[f64; 3]; 3]| {
-            m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-        };
-        let d = det(&m);
-        if d == 0.0 || !d.is_finite() {
-            return None;
-        }
-        let mut sol = [0.0; 3];
-        for (k, s) in sol.iter_mut().enumerate() {
-            let mut mk = m;
-            for (row, rk) in mk.iter_mut().zip(r) {
-                row[k] = rk;
-            }
-            *s = det(&mk) / d;
-        }
-        let [dd, ee, ff] = sol;
+        #[rustfmt::skip]
+        let m = Matrix3::new(
+            self.suu, self.suv, self.su,
+            self.suv, self.svv, self.sv,
+            self.su, self.sv, self.n,
+        );
+        let r = -Vector3::new(
+            self.suuu + self.suvv,
+            self.suuv + self.svvv,
+            self.suu + self.svv,
+        );
+        let sol = m
+            .lu()
+            .solve(&r)
+            .filter(|s| s.iter().all(|v| v.is_finite()))?;
+        let (dd, ee, ff) = (sol.x, sol.y, sol.z);
         let r2 = 0.25 * (dd * dd + ee * ee) - ff;
         (r2 >= 0.0).then(|| r2.sqrt())
     }
@@ -141,7 +134,7 @@ impl SteadyCheck {
                 .max((w.z - e.omega_z).abs()),
             s.t,
         );
-        self.max_omega = self.max_omega.max(norm3(w.x, w.y, w.z));
+        self.max_omega = self.max_omega.max(Vector3::new(w.x, w.y, w.z).norm());
         let (lo, hi) = self.phi_range.get_or_insert((a.phi, a.phi));
         *lo = lo.min(a.phi);
         *hi = hi.max(a.phi);
@@ -262,5 +255,42 @@ fn radius_measure(
             ),
             None => (None, "the circle fit is singular".into()),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fit(points: impl IntoIterator<Item = (f64, f64)>) -> CircleFit {
+        let mut f = CircleFit::default();
+        for (x, z) in points {
+            f.add(x, z);
+        }
+        f
+    }
+
+    #[test]
+    fn the_circle_fit_recovers_the_radius_of_points_on_an_arc() {
+        // 50 points over 1 rad of a circle of radius 3.7 centred at (12, −5): the normal equations hold
+        // exactly for the true circle, so the fit is exact up to round-off of the sums.
+        let (r, cx, cz) = (3.7, 12.0, -5.0);
+        let f = fit((0..50).map(|k| {
+            let a = 0.3 + f64::from(k) * 0.02;
+            (cx + r * a.cos(), cz + r * a.sin())
+        }));
+        let got = f.radius().unwrap();
+        println!("fitted radius {got}, expected {r}, tolerance 1e-9 relative");
+        assert!((got - r).abs() <= 1e-9 * r);
+    }
+
+    #[test]
+    fn collinear_or_too_few_points_have_no_circle() {
+        // Negative controls: the matrix of the normal equations is singular (exactly, in these sums).
+        let line = fit((0..20).map(|k| (f64::from(k), 2.0 * f64::from(k))));
+        assert_eq!(line.radius(), None);
+        let two = fit([(0.0, 0.0), (1.0, 1.0)]);
+        assert_eq!(two.radius(), None);
+        assert_eq!(CircleFit::default().radius(), None);
     }
 }
