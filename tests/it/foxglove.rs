@@ -6,11 +6,9 @@
 // Helpers outside #[test] functions panic on any failure by design.
 #![allow(clippy::unwrap_used)]
 
-mod support;
-
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
-use support::{read_messages, record_circle, repo, Damage};
+use crate::support::writers::{read_messages, record_circle, repo, Damage};
 
 /// (topic, log time, message) of every message of a file.
 type Messages = Vec<(String, u64, Value)>;

@@ -19,7 +19,7 @@ use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-use crate::support::{add_channel, message_json, tool_schema, write_message, COIN_CHANNELS};
+use crate::support::writers::{add_channel, message_json, tool_schema, write_message, COIN_CHANNELS};
 
 /// What to record.
 #[derive(Debug, Clone)]

@@ -20,7 +20,7 @@
 //! Only the velocity-level and position-level constraints' second derivatives are imposed, so they drift
 //! with the integrator's truncation error; with rk4 at h = 1e-3 that drift is far below the tolerances.
 
-use super::{
+use super::vectors::{
     add, column, cross, dot, lean_frame_from_normal, norm, quat_matrix, quat_mul,
     quaternion_from_angles, scale, sub, world_omega, Quat, V3,
 };

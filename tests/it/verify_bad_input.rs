@@ -4,10 +4,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-mod common_verify;
-mod support;
-
-use common_verify::*;
+use crate::support::verify_files::*;
 use std::path::Path;
 
 /// The top-level records of an MCAP file: (opcode, offset, body length).

@@ -3,9 +3,6 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common_record;
-mod support;
-
 use coin_log::integrate::{run_method, Flow, RunSettings};
 use coin_log::model::{Chaplygin, State, STATE_LEN};
 use coin_log::record::{
@@ -16,10 +13,10 @@ use coin_log::record::{
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log::simulation::CoinEvents;
 use coin_log::units::log_time;
-use common_record::{read_back, schema_file, validate_flat, ReadBack};
+use crate::support::record::{read_back, schema_file, validate_flat, ReadBack};
 use std::io::{Cursor, Seek, SeekFrom, Write};
 use std::sync::atomic::AtomicBool;
-use support::{message_json, COIN_CHANNELS};
+use crate::support::writers::{message_json, COIN_CHANNELS};
 
 /// Longest duration used here, so that every built-in scene is exercised quickly.
 const TEST_DURATION: f64 = 4.0;

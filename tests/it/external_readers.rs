@@ -6,11 +6,9 @@
 //!
 //! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
 
-mod support;
-
 use std::path::PathBuf;
 use std::process::Command;
-use support::{record_circle, repo, Damage};
+use crate::support::writers::{record_circle, repo, Damage};
 
 fn python() -> PathBuf {
     let p = repo().join(".venv/bin/python");

@@ -2,11 +2,8 @@
 //! check, by id, with the measured number in the report.
 #![allow(clippy::unwrap_used)]
 
-mod common_verify;
-mod support;
-
 use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status};
-use common_verify::*;
+use crate::support::verify_files::*;
 
 fn show(r: &FileReport) -> String {
     r.checks

@@ -3,10 +3,8 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common_record;
-
 use coin_log::record::{ResultMetadata, RESULT_METADATA_NAME};
-use common_record::{coin_log, listing, read_back};
+use crate::support::record::{coin_log, listing, read_back};
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
