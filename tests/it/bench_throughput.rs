@@ -7,15 +7,11 @@
     clippy::cast_sign_loss
 )]
 
+use crate::support::record::{coin_log, exe};
+use crate::support::repo;
 use coin_log::bench::throughput::{
     self, compression_bound, record_run, recording_path, ThroughputOptions,
 };
-use std::path::PathBuf;
-use std::process::Command;
-
-fn exe() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_coin-log"))
-}
 
 fn value(rows: &[throughput::ThroughputRow], workload_starts: &str, quantity: &str) -> f64 {
     rows.iter()
@@ -68,7 +64,7 @@ fn the_throughput_bench_returns_sane_rows_on_a_tiny_workload() {
 }
 
 fn run(args: &[&str]) -> serde_json::Value {
-    let out = Command::new(exe()).args(args).output().unwrap();
+    let out = coin_log(&repo(), args);
     assert!(
         out.status.success(),
         "coin-log {args:?}: {}",

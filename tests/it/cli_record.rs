@@ -3,9 +3,9 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::record::{coin_log, exe, listing, read_back};
+use crate::support::repo;
 use coin_log::record::{ResultMetadata, RESULT_METADATA_NAME};
-use crate::support::record::{coin_log, listing, read_back};
-use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -353,8 +353,7 @@ fn the_scenes_command_lists_and_shows_every_built_in() {
         let out = coin_log(dir.path(), &["scenes", "--show", name]);
         assert_eq!(code(&out), 0);
         let shown = String::from_utf8(out.stdout).unwrap();
-        let file =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("datasets/scenes/{name}.toml"));
+        let file = repo().join(format!("datasets/scenes/{name}.toml"));
         assert_eq!(
             shown,
             std::fs::read_to_string(file).unwrap(),
@@ -369,7 +368,7 @@ fn the_scenes_command_lists_and_shows_every_built_in() {
 #[test]
 fn ctrl_c_finishes_the_file_marked_interrupted() {
     let dir = tempfile::tempdir().unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_coin-log"))
+    let mut child = Command::new(exe())
         .args([
             "record",
             "long-horizon",

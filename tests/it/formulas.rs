@@ -5,11 +5,11 @@
 
 use crate::support::{physics, vectors};
 
+use crate::support::physics::{rate_unit, wobbling};
+use crate::support::vectors::V3;
 use coin_log::model::{
     centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State,
 };
-use crate::support::physics::{rate_unit, wobbling};
-use crate::support::vectors::V3;
 
 /// Eighth-order central difference weights for the first derivative (offsets −4..4, times 1/H).
 const FD1: [f64; 9] = [

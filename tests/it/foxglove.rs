@@ -6,9 +6,11 @@
 // Helpers outside #[test] functions panic on any failure by design.
 #![allow(clippy::unwrap_used)]
 
+use crate::support::record::read_messages;
+use crate::support::writers::{record_circle, Damage};
+use crate::support::{dataset_files, repo};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
-use crate::support::writers::{read_messages, record_circle, repo, Damage};
 
 /// (topic, log time, message) of every message of a file.
 type Messages = Vec<(String, u64, Value)>;
@@ -27,13 +29,7 @@ fn recording(duration: f64) -> Vec<(String, u64, Value)> {
 
 /// The committed recordings (made by `coin-log record`), read back, with their names.
 fn datasets() -> Vec<(String, Messages)> {
-    let mut files: Vec<_> = std::fs::read_dir(repo().join("datasets"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
-        .collect();
-    files.sort();
-    files
+    dataset_files()
         .into_iter()
         .map(|p| (p.display().to_string(), read_messages(&p)))
         .collect()

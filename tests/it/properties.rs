@@ -10,13 +10,13 @@
 
 use crate::support::{physics, vectors};
 
+use crate::support::newton_euler::NewtonEuler;
+use crate::support::physics::rate_unit;
+use crate::support::vectors::{add, cross, max_diff, norm, scale, V3};
 use coin_log::model::{
     centre, contact_point, orientation, reaction, Branch, Coin, CoinParams, Inertia, State, Steady,
     SteadyKind, STATE_LEN,
 };
-use crate::support::newton_euler::NewtonEuler;
-use crate::support::physics::rate_unit;
-use crate::support::vectors::{add, cross, max_diff, norm, scale, V3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 

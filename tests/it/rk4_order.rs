@@ -5,8 +5,8 @@
 
 use crate::support::physics;
 
-use coin_log::model::{Coin, CoinParams};
 use crate::support::physics::{rate_unit, wobbling};
+use coin_log::model::{Coin, CoinParams};
 
 /// Error floor below which a ratio is not trusted: 1e3 × machine epsilon (issue 3).
 const FLOOR: f64 = 1e3 * f64::EPSILON;

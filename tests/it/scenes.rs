@@ -3,14 +3,14 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::repo;
 use coin_log::model::{Branch, SteadyKind};
 use coin_log::scene::{
     self, presets, FlagOverrides, InitialSpec, Problem, Scene, SceneError, SceneFile,
 };
-use std::path::Path;
 
 fn scene_dir() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/scenes")
+    repo().join("datasets/scenes")
 }
 
 /// The problems of an invalid scene text (with `--set` edits and flags).

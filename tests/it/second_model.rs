@@ -5,13 +5,13 @@
 
 use crate::support::physics;
 
+use crate::support::newton_euler::{NewtonEuler, NE_LEN};
+use crate::support::physics::{rate_unit, wobbling};
+use crate::support::vectors::{max_diff, quat_distance, world_omega};
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Termination,
 };
 use coin_log::model::{centre, contact_point, orientation, Coin, CoinParams, State, STATE_LEN};
-use crate::support::newton_euler::{NewtonEuler, NE_LEN};
-use crate::support::physics::{rate_unit, wobbling};
-use crate::support::vectors::{max_diff, quat_distance, world_omega};
 
 /// Duration of the comparison [time units of the parameters].
 const DURATION: f64 = 20.0;
@@ -151,7 +151,11 @@ fn the_angle_model_and_a_newton_euler_model_agree_for_a_scaled_thin_disk() {
 /// The contact force the Newton–Euler model solves for is the reaction of NOTES §3.
 #[test]
 fn the_newton_euler_contact_force_equals_the_reaction_of_notes_section_3() {
-    for p in [physics::unit_disk(), physics::unit_hoop(), physics::general()] {
+    for p in [
+        physics::unit_disk(),
+        physics::unit_hoop(),
+        physics::general(),
+    ] {
         let coin = Coin::new(p);
         let ne = NewtonEuler::from_params(&p);
         let s = wobbling(&p);

@@ -10,11 +10,11 @@
 
 use crate::support::physics;
 
+use crate::support::physics::rate_unit;
 use coin_log::model::{
     centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
     Branch, Coin, CoinParams, State, Steady, SteadyKind,
 };
-use crate::support::physics::rate_unit;
 
 /// Relative accuracy required of measured rates and frequencies (issue 3).
 const RATE: f64 = 1e-3;

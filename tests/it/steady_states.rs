@@ -10,10 +10,10 @@
 
 use crate::support::{physics, vectors};
 
+use crate::support::physics::rate_unit;
 use coin_log::model::{
     centre, contact_point, reaction, Branch, Coin, CoinParams, State, Steady, SteadyKind,
 };
-use crate::support::physics::rate_unit;
 
 /// Natural time units of the run.
 const DURATION: f64 = 20.0;
