@@ -124,9 +124,6 @@ impl NewtonEuler {
     pub fn centre(y: &[f64; NE_LEN]) -> V3 {
         [y[7], y[8], y[9]]
     }
-    pub fn velocity(y: &[f64; NE_LEN]) -> V3 {
-        [y[10], y[11], y[12]]
-    }
     /// ρ = −a e_Y from the state's orientation.
     pub fn rho(&self, y: &[f64; NE_LEN]) -> V3 {
         let [_, e_y_lean, _] = lean_frame_from_normal(column(&quat_matrix(Self::quaternion(y)), 2));

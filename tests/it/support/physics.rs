@@ -1,10 +1,9 @@
 //! Helpers of the model tests: parameter sets, a generic wobbling state, fixed-step rk4 trajectories,
 //! zero crossings of a sampled signal, and the reporting check that prints measured vs expected vs
 //! tolerance.
-#![allow(dead_code)]
 // Test helpers are not #[test] functions, so clippy.toml's allow-unwrap-in-tests does not reach them; a
 // failed unwrap here is a failed test, which is what we want.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used)]
 
 use coin_log::integrate::{OdeSystem, Rk4, Stepper};
 use coin_log::model::{CoinParams, Inertia, State};

@@ -1,6 +1,7 @@
 //! Reading a recording back, a validator for our flat JSON schemas, and running the binary.
-// Test helpers: a failed read is a failed test, so they panic with a message.
-#![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
+// Test helpers are not #[test] functions, so clippy.toml's allow-unwrap-in-tests and allow-expect-in-tests
+// do not reach them; a failed unwrap or expect here is a failed test, which is what we want.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use super::repo;
 use std::collections::BTreeMap;

@@ -1,6 +1,5 @@
 //! Small vector and quaternion algebra written here (not the library's), and the angle → quaternion and
 //! lean-frame constructions of NOTES §1 done independently of the library.
-#![allow(dead_code)]
 
 /// A world-frame vector (y up, NOTES §1).
 pub type V3 = [f64; 3];

@@ -2,8 +2,9 @@
 //! the recorder (so tests that check the recorder do not compare it with itself, and files the recorder
 //! cannot make: odd channel sets, small or uncompressed chunks, Foxglove output with a defect), and a
 //! recording rewritten with one message or schema changed (negative controls).
-// Test helpers panic on any setup failure by design.
-#![allow(dead_code, clippy::unwrap_used)]
+// Test helpers are not #[test] functions, so clippy.toml's allow-unwrap-in-tests does not reach them; a
+// failed unwrap here is a failed test, which is what we want.
+#![allow(clippy::unwrap_used)]
 
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
 use coin_log::model::{
