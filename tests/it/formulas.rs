@@ -3,10 +3,8 @@
 //! F = √(R_x² + R_z²) and its closed form; N = Mg − Ma(ω_X² cos θ + ω̇_X sin θ); the quaternion equal to the
 //! rotation of eq (7); the contact point's speed a|ψ̇|.
 
-use crate::support::{physics, vectors};
-
-use crate::support::physics::{rate_unit, wobbling};
-use crate::support::vectors::V3;
+use crate::support::physics::{self, rate_unit, wobbling};
+use crate::support::vectors::{self, V3};
 use coin_log::model::{
     centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State,
 };

@@ -8,11 +8,9 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
-use crate::support::{physics, vectors};
-
 use crate::support::newton_euler::NewtonEuler;
-use crate::support::physics::rate_unit;
-use crate::support::vectors::{add, cross, max_diff, norm, scale, V3};
+use crate::support::physics::{self, rate_unit};
+use crate::support::vectors::{self, add, cross, max_diff, norm, scale, V3};
 use coin_log::model::{
     centre, contact_point, orientation, reaction, Branch, Coin, CoinParams, Inertia, State, Steady,
     SteadyKind, STATE_LEN,

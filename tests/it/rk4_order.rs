@@ -3,9 +3,7 @@
 //! 16⁴ ≈ 7e4 times smaller), halves the step repeatedly; log₂ of successive error ratios must be 4 ± 0.15 wherever
 //! both errors stay above 1e3 × machine epsilon (below that, round-off dominates the ratio).
 
-use crate::support::physics;
-
-use crate::support::physics::{rate_unit, wobbling};
+use crate::support::physics::{self, rate_unit, wobbling};
 use coin_log::model::{Coin, CoinParams};
 
 /// Error floor below which a ratio is not trusted: 1e3 × machine epsilon (issue 3).

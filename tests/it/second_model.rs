@@ -3,10 +3,8 @@
 //! the same motion. A wrong sign or factor in either shows up as a disagreement of order 1, far above the
 //! 1e-9 tolerance; the negative control at the end proves it by flipping one sign.
 
-use crate::support::physics;
-
 use crate::support::newton_euler::{NewtonEuler, NE_LEN};
-use crate::support::physics::{rate_unit, wobbling};
+use crate::support::physics::{self, rate_unit, wobbling};
 use crate::support::vectors::{max_diff, quat_distance, world_omega};
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Termination,

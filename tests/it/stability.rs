@@ -8,9 +8,7 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
-use crate::support::physics;
-
-use crate::support::physics::rate_unit;
+use crate::support::physics::{self, rate_unit};
 use coin_log::model::{
     centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
     Branch, Coin, CoinParams, State, Steady, SteadyKind,

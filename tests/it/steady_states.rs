@@ -8,9 +8,8 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
-use crate::support::{physics, vectors};
-
-use crate::support::physics::rate_unit;
+use crate::support::physics::{self, rate_unit};
+use crate::support::vectors;
 use coin_log::model::{
     centre, contact_point, reaction, Branch, Coin, CoinParams, State, Steady, SteadyKind,
 };
