@@ -1,4 +1,10 @@
 //! The integration tests, as one test binary: one module per area, sharing the helpers of [`support`].
+//! One binary links the library and its dependencies once, where a file per test under `tests/` would
+//! link them once per file: add new tests as a module here. Run one area with
+//! `cargo test --release --test it verify::` (any module path as the filter).
+//!
+//! proptest keeps the failing cases of a property test in `tests/proptest-regressions/<module>.txt` (the
+//! folder beside the one holding this `main.rs`); commit such a file when it appears.
 
 mod support;
 
