@@ -548,9 +548,8 @@ impl<'a> Writer<'a> {
 mod tests {
     use super::*;
     use crate::format::log_time;
-    use crate::format::log_time;
+    use crate::format::schema_bytes;
     use crate::model::{centre, CoinParams};
-    use crate::record::schema_bytes;
     use nalgebra::Vector3;
     use serde_json::Value;
 

@@ -97,7 +97,7 @@ fn check_event(config: &MethodConfig, theta0: f64, expected: PhysicalEvent, thet
     println!(
         "{} θ₀ = {theta0}: {} at t = {:.15} (quadrature {t_expected:.15}, |Δt| = {error:.2e}, tolerance {TIME_TOLERANCE:.0e}); θ there {:.12} (expected {theta_event:.12})",
         config.method,
-        ended.event.name(),
+        coin_log::format::Termination::from(ended.event),
         ended.t,
         ended.last_sample.1[0]
     );
@@ -291,7 +291,7 @@ fn an_event_just_after_a_grid_sample_never_repeats_a_nanosecond_of_log_time() {
         };
         let mut times = Vec::new();
         let outcome = run_method(&config, &Clock, &[0.0], &settings, &Reaches(at), |t, _| {
-            times.push(coin_log::units::log_time(t).unwrap());
+            times.push(coin_log::format::log_time(t).unwrap());
             Flow::Continue
         });
         let Termination::Event { t, .. } = outcome.termination else {

@@ -8,13 +8,11 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
+use crate::support::physics::{self, rate_unit};
 use coin_log::model::{
     centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
     Branch, Coin, CoinParams, State, Steady, SteadyKind,
 };
-use common::rate_unit;
 
 /// Relative accuracy required of measured rates and frequencies (issue 3).
 const RATE: f64 = 1e-3;
@@ -25,7 +23,7 @@ fn series(p: &CoinParams, start: &State, duration: f64) -> Vec<(f64, f64, f64)> 
     let h = 1e-3 * p.time_unit();
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let steps = (duration / 1e-3).round() as usize;
-    common::rk4_trajectory(&coin, &start.to_array(), h, steps, 1)
+    physics::rk4_trajectory(&coin, &start.to_array(), h, steps, 1)
         .iter()
         .map(|(t, y)| (*t, y[0], y[3]))
         .collect()
@@ -33,7 +31,7 @@ fn series(p: &CoinParams, start: &State, duration: f64) -> Vec<(f64, f64, f64)> 
 
 /// Angular frequency of an oscillating signal from the spacing of its zero crossings.
 fn frequency(samples: &[(f64, f64)]) -> f64 {
-    let zeros = common::zero_crossings(samples);
+    let zeros = physics::zero_crossings(samples);
     assert!(zeros.len() >= 4, "only {} zero crossings", zeros.len());
     #[allow(clippy::cast_precision_loss)]
     let half_periods = (zeros.len() - 1) as f64;
@@ -76,8 +74,8 @@ fn straight(p: &CoinParams, omega_z: f64) -> State {
 #[test]
 fn slow_straight_rolling_is_unstable_with_the_growth_rate_of_notes_section_5() {
     for (label, p, omega_z) in [
-        ("unit disk, w_Z0 = 0.4", common::unit_disk(), 0.4),
-        ("general, w_Z0 = w_c / 2", common::general(), 0.0),
+        ("unit disk, w_Z0 = 0.4", physics::unit_disk(), 0.4),
+        ("general, w_Z0 = w_c / 2", physics::general(), 0.0),
     ] {
         let coin = Coin::new(p);
         let omega_z = if omega_z == 0.0 {
@@ -89,7 +87,7 @@ fn slow_straight_rolling_is_unstable_with_the_growth_rate_of_notes_section_5() {
         let tu = p.time_unit();
         let measured = growth_rate(&samples, 8.0 * tu, 18.0 * tu);
         let lambda2 = straight_lambda_squared(&coin, omega_z);
-        common::check_relative(
+        physics::check_relative(
             &format!("{label}: growth rate of the tilt"),
             measured,
             lambda2.sqrt(),
@@ -97,7 +95,7 @@ fn slow_straight_rolling_is_unstable_with_the_growth_rate_of_notes_section_5() {
         );
         if label.starts_with("unit") {
             // Thin disk, unit scales: λ² = 4/5 (1 − 3 ω_Z0²) (NOTES §5).
-            common::check_relative(
+            physics::check_relative(
                 "unit disk: lambda^2 formula",
                 lambda2,
                 0.8 * (1.0 - 3.0 * 0.16),
@@ -110,8 +108,8 @@ fn slow_straight_rolling_is_unstable_with_the_growth_rate_of_notes_section_5() {
 #[test]
 fn fast_straight_rolling_oscillates_at_the_frequency_of_notes_section_5() {
     for (label, p, omega_z) in [
-        ("unit disk, w_Z0 = 1", common::unit_disk(), 1.0),
-        ("general, w_Z0 = 2 w_c", common::general(), 0.0),
+        ("unit disk, w_Z0 = 1", physics::unit_disk(), 1.0),
+        ("general, w_Z0 = 2 w_c", physics::general(), 0.0),
     ] {
         let coin = Coin::new(p);
         let omega_z = if omega_z == 0.0 {
@@ -123,14 +121,14 @@ fn fast_straight_rolling_oscillates_at_the_frequency_of_notes_section_5() {
         let wx: Vec<(f64, f64)> = samples.iter().map(|(t, _, w)| (*t, *w)).collect();
         let measured = frequency(&wx);
         let expected = (-straight_lambda_squared(&coin, omega_z)).sqrt();
-        common::check_relative(
+        physics::check_relative(
             &format!("{label}: tilt oscillation frequency"),
             measured,
             expected,
             RATE,
         );
         if label.starts_with("unit") {
-            common::check_relative(
+            physics::check_relative(
                 "unit disk, w_Z0 = 1: frequency vs NOTES 1.26491",
                 measured,
                 1.26491,
@@ -146,13 +144,13 @@ fn fast_straight_rolling_oscillates_at_the_frequency_of_notes_section_5() {
 #[test]
 fn at_the_critical_spin_a_tilt_grows_quadratically_and_a_kick_linearly() {
     for (label, p) in [
-        ("unit disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         let coin = Coin::new(p);
         let omega_c = critical_spin(&coin);
         if label == "unit disk" {
-            common::check_relative(
+            physics::check_relative(
                 "unit disk: w_c = 1/sqrt(3)",
                 omega_c,
                 1.0 / 3.0_f64.sqrt(),
@@ -170,20 +168,20 @@ fn at_the_critical_spin_a_tilt_grows_quadratically_and_a_kick_linearly() {
         let c = num / den;
         let expected =
             p.mass() * p.gravity() * p.radius() / (2.0 * (p.inertia_x() + p.ma2())) * tu * tu;
-        common::check_relative(
+        physics::check_relative(
             &format!("{label}: t^2 coefficient of delta theta / delta theta0"),
             c,
             expected,
             RATE,
         );
         if label == "unit disk" {
-            common::check_relative("unit disk: t^2 coefficient vs NOTES 2/5", c, 0.4, RATE);
+            physics::check_relative("unit disk: t^2 coefficient vs NOTES 2/5", c, 0.4, RATE);
         }
         let shape = samples
             .iter()
             .map(|(t, th, _)| (th / delta - 1.0 - c * (t / tu).powi(2)).abs())
             .fold(0.0, f64::max);
-        common::check(
+        physics::check(
             &format!("{label}: max |delta theta/delta theta0 - (1 + c t^2)|"),
             shape,
             0.0,
@@ -200,7 +198,7 @@ fn at_the_critical_spin_a_tilt_grows_quadratically_and_a_kick_linearly() {
         let (num, den) = samples.iter().fold((0.0, 0.0), |(n, d), (t, th, _)| {
             (n + t * th / kick, d + t * t)
         });
-        common::check_relative(
+        physics::check_relative(
             &format!("{label}: kick response delta theta / (delta omega t)"),
             num / den,
             1.0,
@@ -214,8 +212,8 @@ fn at_the_critical_spin_a_tilt_grows_quadratically_and_a_kick_linearly() {
 #[test]
 fn a_coin_spinning_upright_nutates_at_the_frequency_of_notes_section_5() {
     for (label, p) in [
-        ("unit disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         let coin = Coin::new(p);
         for omega_natural in [1.5, 3.0] {
@@ -228,13 +226,13 @@ fn a_coin_spinning_upright_nutates_at_the_frequency_of_notes_section_5() {
             let measured = frequency(&wx);
             let sigma2 =
                 omega * omega - p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
-            common::check_relative(
+            physics::check_relative(
                 &format!("{label}, Omega = {omega_natural} sqrt(g/a): nutation frequency"),
                 measured,
                 sigma2.sqrt(),
                 RATE,
             );
-            common::check_relative(
+            physics::check_relative(
                 "library sigma^2 vs formula",
                 spin_upright_sigma_squared(&coin, omega),
                 sigma2,
@@ -242,8 +240,8 @@ fn a_coin_spinning_upright_nutates_at_the_frequency_of_notes_section_5() {
             );
         }
     }
-    let coin = Coin::new(common::unit_disk());
-    common::check_relative(
+    let coin = Coin::new(physics::unit_disk());
+    physics::check_relative(
         "unit disk: sigma^2 = Omega^2 - 4/5 at Omega = 2",
         spin_upright_sigma_squared(&coin, 2.0),
         4.0 - 0.8,
@@ -256,8 +254,8 @@ fn a_coin_spinning_upright_nutates_at_the_frequency_of_notes_section_5() {
 #[test]
 fn a_coin_rolling_round_its_fixed_centre_nutates_at_the_frequency_of_notes_section_5() {
     for (label, p) in [
-        ("unit disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         let coin = Coin::new(p);
         for theta0 in [0.3, 0.8, -1.2] {
@@ -276,13 +274,13 @@ fn a_coin_rolling_round_its_fixed_centre_nutates_at_the_frequency_of_notes_secti
             let mga = p.mass() * p.gravity() * p.radius();
             let sigma2 =
                 mga * (p.ma2() * c / p.inertia_x() + 3.0 * s * s / c) / (p.inertia_x() + p.ma2());
-            common::check_relative(
+            physics::check_relative(
                 &format!("{label}, theta0 = {theta0}: nutation frequency"),
                 measured,
                 sigma2.sqrt(),
                 RATE,
             );
-            common::check_relative(
+            physics::check_relative(
                 "library sigma^2 vs formula",
                 centre_fixed_sigma_squared(&coin, theta0),
                 sigma2,
@@ -291,14 +289,14 @@ fn a_coin_rolling_round_its_fixed_centre_nutates_at_the_frequency_of_notes_secti
             if label == "unit disk" {
                 let alpha = std::f64::consts::FRAC_PI_2 - theta0.abs();
                 let phi_dot = 2.0 / c.sqrt();
-                common::check_relative(
+                physics::check_relative(
                     "unit disk: phi dot = 2/sqrt(cos theta0)",
                     steady.phi_dot,
                     phi_dot,
                     1e-15,
                 );
                 let thin = phi_dot * phi_dot * (3.0 + alpha.sin().powi(2)) / 5.0;
-                common::check_relative(
+                physics::check_relative(
                     "unit disk: sigma^2 vs phi dot^2 (3 + sin^2 alpha)/5",
                     sigma2,
                     thin,

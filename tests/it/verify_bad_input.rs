@@ -4,10 +4,8 @@
 
 #![allow(clippy::unwrap_used)]
 
-mod common_verify;
-mod support;
-
-use common_verify::*;
+use crate::support::record::coin_log_text;
+use crate::support::writers::{recorded, rewrite, wobble, Spec};
 use std::path::Path;
 
 /// The top-level records of an MCAP file: (opcode, offset, body length).
@@ -40,7 +38,7 @@ fn crc32(data: &[u8]) -> u32 {
 }
 
 fn verify(path: &Path) -> (i32, String, String) {
-    coin_log(&["verify", path.to_str().unwrap()])
+    coin_log_text(&["verify", path.to_str().unwrap()])
 }
 
 fn small_chunks(compression: Option<mcap::Compression>) -> Spec {
@@ -170,7 +168,7 @@ fn a_truncated_file_is_judged_on_its_readable_messages_and_is_unusable() {
         .iter()
         .find(|(_, at, len)| *at < cut && at + 9 + len > cut)
         .unwrap();
-    let (code, out, err) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    let (code, out, err) = coin_log_text(&["verify", "--json", path.to_str().unwrap()]);
     println!("{err}");
     assert_eq!(code, 2);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
@@ -326,7 +324,7 @@ fn non_monotonic_log_times_fail_integrity() {
             *e.log_time = 90_000_000;
         }
     });
-    let (code, out, err) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    let (code, out, err) = coin_log_text(&["verify", "--json", path.to_str().unwrap()]);
     assert_eq!(code, 1, "{out}{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let integrity = &v["files"][0]["checks"][0];
@@ -370,9 +368,10 @@ fn several_files_exit_with_the_worst_code() {
     let (dir, good) = recorded(&wobble(), "good.mcap");
     let empty = dir.path().join("empty.mcap");
     std::fs::write(&empty, b"").unwrap();
-    let (code, out, _) = coin_log(&["verify", good.to_str().unwrap(), empty.to_str().unwrap()]);
+    let (code, out, _) =
+        coin_log_text(&["verify", good.to_str().unwrap(), empty.to_str().unwrap()]);
     println!("{out}");
     assert_eq!(code, 2);
-    let (code, _, _) = coin_log(&["verify", good.to_str().unwrap()]);
+    let (code, _, _) = coin_log_text(&["verify", good.to_str().unwrap()]);
     assert_eq!(code, 0);
 }

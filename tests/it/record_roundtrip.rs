@@ -3,23 +3,22 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common_record;
-mod support;
-
+use crate::support::record::{read_back, schema_file, validate_flat, ReadBack};
+use crate::support::writers::{message_json, COIN_CHANNELS};
+use crate::support::FailingWriter;
+use coin_log::format::{
+    log_time, Channel, ResultMetadata, RunMetadata, Termination, RESULT_METADATA_NAME,
+    RUN_METADATA_NAME,
+};
 use coin_log::integrate::{run_method, Flow, RunSettings};
 use coin_log::model::{Chaplygin, State, STATE_LEN};
 use coin_log::record::{
-    self, run_metadata, Channel, Compression, Foxglove3d, FoxgloveBatch, RecordOptions,
-    RecordSummary, ResultMetadata, RunMetadata, Termination, RESULT_METADATA_NAME,
-    RUN_METADATA_NAME,
+    self, run_metadata, Compression, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
 };
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log::simulation::CoinEvents;
-use coin_log::units::log_time;
-use common_record::{read_back, schema_file, validate_flat, ReadBack};
-use std::io::{Cursor, Seek, SeekFrom, Write};
+use std::io::Cursor;
 use std::sync::atomic::AtomicBool;
-use support::{message_json, COIN_CHANNELS};
 
 /// Longest duration used here, so that every built-in scene is exercised quickly.
 const TEST_DURATION: f64 = 4.0;
@@ -47,7 +46,7 @@ fn record_to_memory(scene: &Scene, options: &RecordOptions) -> (Vec<u8>, RecordS
 }
 
 /// The messages the recorder should write, computed here from the model and the message types
-/// (`support::message_json`, which shares no code with the recorder).
+/// (`support::writers::message_json`, which shares no code with the recorder).
 fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
     let coin = scene.coin();
     let settings = RunSettings {
@@ -247,7 +246,7 @@ fn check_recording(name: &str, scene: &Scene, bytes: &[u8], summary: &RecordSumm
         .get(RESULT_METADATA_NAME)
         .expect("coin-log.result metadata");
     let result = ResultMetadata::from_map(result_map).expect("coin-log.result parses");
-    assert_eq!(result.termination, summary.termination.name());
+    assert_eq!(result.termination, summary.termination);
     assert_eq!(
         result.termination_time.to_bits(),
         summary.termination_time.to_bits()
@@ -380,43 +379,13 @@ fn a_message_with_a_missing_or_an_extra_field_fails_validation() {
     assert!(validate_flat(&schema, string).is_err());
 }
 
-/// A writer that fails once `limit` bytes would be exceeded, like a full disk.
-struct FailingWriter {
-    inner: Cursor<Vec<u8>>,
-    limit: u64,
-}
-
-impl Write for FailingWriter {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        if self.inner.position() + buf.len() as u64 > self.limit {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::StorageFull,
-                "no space left on device (test)",
-            ));
-        }
-        self.inner.write(buf)
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
-impl Seek for FailingWriter {
-    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
-        self.inner.seek(pos)
-    }
-}
-
 #[test]
 fn a_write_failure_at_any_point_is_an_error_not_a_file() {
     let scene = preset_scene("wobble", FlagOverrides::default());
     let (full, _) = record_to_memory(&scene, &RecordOptions::default());
     let size = full.len() as u64;
     for limit in [0, 10, 100, 1_000, 100_000, size / 2, size - 100, size - 1] {
-        let writer = FailingWriter {
-            inner: Cursor::new(Vec::new()),
-            limit,
-        };
+        let writer = FailingWriter::new(limit);
         let result = record::record(
             &scene,
             &RecordOptions::default(),
@@ -441,10 +410,7 @@ fn a_write_failure_at_any_point_is_an_error_not_a_file() {
             Ok(s) => panic!("a writer failing after {limit} of {size} bytes gave a summary: {s:?}"),
         }
     }
-    let writer = FailingWriter {
-        inner: Cursor::new(Vec::new()),
-        limit: size,
-    };
+    let writer = FailingWriter::new(size);
     assert!(record::record(
         &scene,
         &RecordOptions::default(),
@@ -474,7 +440,7 @@ fn a_raised_stop_flag_finishes_the_file_marked_interrupted() {
         summary.samples, result.termination, result.termination_time
     );
     assert_eq!(summary.termination, Termination::Interrupted);
-    assert_eq!(result.termination, "interrupted");
+    assert_eq!(result.termination, Termination::Interrupted);
     assert_eq!(summary.samples, 1);
     assert_eq!(file.on_topic("/coin/omega").len(), 1);
 }

@@ -3,12 +3,11 @@
 //! F = √(R_x² + R_z²) and its closed form; N = Mg − Ma(ω_X² cos θ + ω̇_X sin θ); the quaternion equal to the
 //! rotation of eq (7); the contact point's speed a|ψ̇|.
 
-mod common;
-
+use crate::support::physics::{self, rate_unit, wobbling};
+use crate::support::vectors::{self, V3};
 use coin_log::model::{
     centre, contact_point, energy, orientation, reaction, Coin, CoinParams, State,
 };
-use common::{rate_unit, wobbling, V3};
 
 /// Eighth-order central difference weights for the first derivative (offsets −4..4, times 1/H).
 const FD1: [f64; 9] = [
@@ -41,9 +40,9 @@ fn fd(weights: &[f64; 9], values: &[f64], i: usize, scale: f64) -> f64 {
 
 fn cases() -> [(&'static str, CoinParams); 3] {
     [
-        ("unit thin disk", common::unit_disk()),
-        ("unit hoop", common::unit_hoop()),
-        ("general", common::general()),
+        ("unit thin disk", physics::unit_disk()),
+        ("unit hoop", physics::unit_hoop()),
+        ("general", physics::general()),
     ]
 }
 
@@ -53,7 +52,7 @@ fn trajectory(p: &CoinParams, spacing: f64) -> (f64, Vec<State>) {
     let big_h = spacing * p.time_unit();
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let samples = (20.0 / spacing).round() as usize;
-    let traj = common::rk4_trajectory(
+    let traj = physics::rk4_trajectory(
         &coin,
         &wobbling(p).to_array(),
         big_h / 10.0,
@@ -78,7 +77,7 @@ fn energy_is_constant_along_wobbling_trajectories() {
             .iter()
             .map(|s| (energy(&coin, s).total - e0).abs())
             .fold(0.0, f64::max);
-        common::check(
+        physics::check(
             &format!("{label}: max |E(t) - E(0)| / (M g a) over 20 time units"),
             drift / p.energy_scale(),
             0.0,
@@ -86,7 +85,7 @@ fn energy_is_constant_along_wobbling_trajectories() {
         );
         // The parts add up, and the potential is M g a cos θ.
         let e = energy(&coin, &states[500]);
-        common::check(
+        physics::check(
             &format!("{label}: kinetic + potential - total"),
             e.kinetic + e.potential - e.total,
             0.0,
@@ -120,7 +119,7 @@ fn the_reaction_equals_mass_times_the_differenced_centre_acceleration_plus_weigh
             let acc: V3 = [0, 1, 2].map(|k| fd(&FD2, &pos[k], i, 1.0 / (big_h * big_h)));
             let expected = [m * acc[0], m * acc[1] + m * g, m * acc[2]];
             let r = reaction(&coin, s);
-            worst_r = worst_r.max(common::max_diff(
+            worst_r = worst_r.max(vectors::max_diff(
                 &[r.force.x, r.force.y, r.force.z],
                 &expected,
             ));
@@ -138,25 +137,25 @@ fn the_reaction_equals_mass_times_the_differenced_centre_acceleration_plus_weigh
             worst_closed = worst_closed.max((r.friction - closed).abs());
         }
         let weight = m * g;
-        common::check(
+        physics::check(
             &format!("{label}: max |R - (M dv/dt + M g e_y)| / (M g)"),
             worst_r / weight,
             0.0,
             1e-8,
         );
-        common::check(
+        physics::check(
             &format!("{label}: max |N - (Mg - Ma(wX^2 cos + wX' sin))| / (M g)"),
             worst_n / weight,
             0.0,
             1e-9,
         );
-        common::check(
+        physics::check(
             &format!("{label}: max |F - hypot(R_x, R_z)| / (M g)"),
             worst_f / weight,
             0.0,
             1e-15,
         );
-        common::check(
+        physics::check(
             &format!("{label}: max |F - closed form of NOTES 3| / (M g)"),
             worst_closed / weight,
             0.0,
@@ -181,12 +180,12 @@ fn the_differenced_centre_velocity_is_the_no_slip_velocity() {
         for i in (4..states.len() - 4).step_by(25) {
             let s = &states[i];
             let v: V3 = [0, 1, 2].map(|k| fd(&FD1, &pos[k], i, 1.0 / big_h));
-            let [_, e_y_lean, _] = common::lean_frame(s.theta, s.phi);
-            let omega = common::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
-            let no_slip = common::scale(-1.0, common::cross(omega, common::scale(-a, e_y_lean)));
-            worst = worst.max(common::max_diff(&v, &no_slip));
+            let [_, e_y_lean, _] = vectors::lean_frame(s.theta, s.phi);
+            let omega = vectors::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
+            let no_slip = vectors::scale(-1.0, vectors::cross(omega, vectors::scale(-a, e_y_lean)));
+            worst = worst.max(vectors::max_diff(&v, &no_slip));
         }
-        common::check(
+        physics::check(
             &format!("{label}: max |dr_G/dt (differenced) + omega x rho| / (a sqrt(g/a))"),
             worst / (a * rate_unit(&p)),
             0.0,
@@ -211,7 +210,7 @@ fn the_contact_point_moves_at_speed_a_times_the_spin_rate() {
             let expected = p.radius() * fd(&FD1, &psi, i, 1.0 / big_h).abs();
             worst = worst.max((speed - expected).abs());
         }
-        common::check(
+        physics::check(
             &format!("{label}: max |contact speed - a |psi dot|| / (a sqrt(g/a))"),
             worst / (p.radius() * rate_unit(&p)),
             0.0,
@@ -220,11 +219,11 @@ fn the_contact_point_moves_at_speed_a_times_the_spin_rate() {
         // The contact point is on the table and a below the centre along −e_Y.
         let s = &states[777];
         let (c, cp) = (centre(&coin, s), contact_point(&coin, s));
-        let [_, e_y_lean, _] = common::lean_frame(s.theta, s.phi);
-        let expected = common::sub([c.x, c.y, c.z], common::scale(p.radius(), e_y_lean));
-        common::check(
+        let [_, e_y_lean, _] = vectors::lean_frame(s.theta, s.phi);
+        let expected = vectors::sub([c.x, c.y, c.z], vectors::scale(p.radius(), e_y_lean));
+        physics::check(
             &format!("{label}: |contact point - (centre - a e_Y)| / a"),
-            common::max_diff(&[cp.x, cp.y, cp.z], &expected) / p.radius(),
+            vectors::max_diff(&[cp.x, cp.y, cp.z], &expected) / p.radius(),
             0.0,
             4e-15, // a few ulps of the coordinates
         );
@@ -257,8 +256,8 @@ fn the_quaternion_is_the_rotation_of_eq_7_followed_by_the_spin() {
                     ..State::default()
                 });
                 let expected = [
-                    common::add(common::scale(cs, e_x), common::scale(ss, e_y)),
-                    common::add(common::scale(-ss, e_x), common::scale(cs, e_y)),
+                    vectors::add(vectors::scale(cs, e_x), vectors::scale(ss, e_y)),
+                    vectors::add(vectors::scale(-ss, e_x), vectors::scale(cs, e_y)),
                     e_z,
                 ];
                 for (axis, want) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
@@ -266,26 +265,26 @@ fn the_quaternion_is_the_rotation_of_eq_7_followed_by_the_spin() {
                     .zip(expected)
                 {
                     let rotated = q.transform_vector(&nalgebra::Vector3::from(*axis));
-                    worst = worst.max(common::max_diff(rotated.as_slice(), &want));
+                    worst = worst.max(vectors::max_diff(rotated.as_slice(), &want));
                 }
                 worst_norm = worst_norm.max((q.norm() - 1.0).abs());
             }
         }
     }
-    common::check(
+    physics::check(
         "max |q e_i - eq (7) axes| over 252 angle triples",
         worst,
         0.0,
         1e-14,
     );
-    common::check("max ||q| - 1|", worst_norm, 0.0, 1e-15);
+    physics::check("max ||q| - 1|", worst_norm, 0.0, 1e-15);
 }
 
 /// A wrong formula is caught: the note's uncorrected F (R_y in place of R_z, §8 item 4) differs from
 /// √(R_x² + R_z²) by a large margin on a wobbling motion (negative control for the F check).
 #[test]
 fn the_uncorrected_friction_formula_of_the_note_is_rejected() {
-    let p = common::unit_disk();
+    let p = physics::unit_disk();
     let coin = Coin::new(p);
     let s = wobbling(&p);
     let r = reaction(&coin, &s);

@@ -9,19 +9,16 @@
     clippy::cast_sign_loss
 )]
 
+use crate::support::record::{coin_log, exe};
+use crate::support::repo;
 use coin_log::bench::throughput::{
     self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, RecordRun,
     ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
 };
 use coin_log::record::{self, Compression, RecordOptions};
 use std::io::Cursor;
-use std::path::PathBuf;
 use std::process::Command;
 use std::sync::atomic::AtomicBool;
-
-fn exe() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_coin-log"))
-}
 
 fn row<'a>(rows: &'a [ThroughputRow], workload_starts: &str, quantity: &str) -> &'a ThroughputRow {
     rows.iter()
@@ -203,7 +200,7 @@ fn the_rows_are_medians_and_rates_of_the_runs() {
 }
 
 fn run(args: &[&str]) -> serde_json::Value {
-    let out = Command::new(exe()).args(args).output().unwrap();
+    let out = coin_log(&repo(), args);
     assert!(
         out.status.success(),
         "coin-log {args:?}: {}",

@@ -1,16 +1,15 @@
 //! The library's angle model (eqs (14)–(19)) against an independent world-frame Newton–Euler model
-//! (`common::newton_euler`): both are integrated from the same physical state with rk4 and must describe
+//! (`support::newton_euler`): both are integrated from the same physical state with rk4 and must describe
 //! the same motion. A wrong sign or factor in either shows up as a disagreement of order 1, far above the
 //! 1e-9 tolerance; the negative control at the end proves it by flipping one sign.
 
-mod common;
-
+use crate::support::newton_euler::{NewtonEuler, NE_LEN};
+use crate::support::physics::{self, rate_unit, wobbling};
+use crate::support::vectors::{max_diff, quat_distance, world_omega};
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Termination,
 };
 use coin_log::model::{centre, contact_point, orientation, Coin, CoinParams, State, STATE_LEN};
-use common::newton_euler::{NewtonEuler, NE_LEN};
-use common::{max_diff, quat_distance, rate_unit, wobbling, world_omega};
 
 /// Duration of the comparison [time units of the parameters].
 const DURATION: f64 = 20.0;
@@ -38,7 +37,7 @@ fn disagreement<S: OdeSystem<STATE_LEN>>(
     let step = DURATION / steps as f64;
     let every = steps / 200;
     let a_traj = match method {
-        None => common::rk4_trajectory(angle_model, &start.to_array(), step, steps, every),
+        None => physics::rk4_trajectory(angle_model, &start.to_array(), step, steps, every),
         Some(config) => {
             let mut out = Vec::new();
             #[allow(clippy::cast_precision_loss)]
@@ -67,7 +66,7 @@ fn disagreement<S: OdeSystem<STATE_LEN>>(
         }
     };
     let n_traj =
-        common::rk4_trajectory::<NE_LEN, _>(&ne, &ne.state_from(&start), step, steps, every);
+        physics::rk4_trajectory::<NE_LEN, _>(&ne, &ne.state_from(&start), step, steps, every);
     assert_eq!(a_traj.len(), n_traj.len());
     let (a, w) = (p.radius(), rate_unit(p));
     let mut worst = [0.0_f64; 4];
@@ -114,7 +113,7 @@ fn models_agree_with(label: &str, p: &CoinParams, method: Option<MethodConfig>) 
     .iter()
     .zip(worst)
     {
-        common::check(
+        physics::check(
             &format!("{label}: max |angle model - Newton-Euler| of {what}"),
             d,
             0.0,
@@ -125,19 +124,19 @@ fn models_agree_with(label: &str, p: &CoinParams, method: Option<MethodConfig>) 
 
 #[test]
 fn the_angle_model_and_a_newton_euler_model_agree_for_the_thin_disk() {
-    models_agree("unit thin disk", &common::unit_disk());
+    models_agree("unit thin disk", &physics::unit_disk());
 }
 
 #[test]
 fn the_angle_model_and_a_newton_euler_model_agree_for_the_hoop() {
-    models_agree("unit hoop", &common::unit_hoop());
+    models_agree("unit hoop", &physics::unit_hoop());
 }
 
 #[test]
 fn the_angle_model_and_a_newton_euler_model_agree_for_general_parameters() {
     models_agree(
         "M = 0.5, a = 2, g = 9.81, I_X = 0.35, I_Z = 0.6",
-        &common::general(),
+        &physics::general(),
     );
 }
 
@@ -150,7 +149,11 @@ fn the_angle_model_and_a_newton_euler_model_agree_for_a_scaled_thin_disk() {
 /// The contact force the Newton–Euler model solves for is the reaction of NOTES §3.
 #[test]
 fn the_newton_euler_contact_force_equals_the_reaction_of_notes_section_3() {
-    for p in [common::unit_disk(), common::unit_hoop(), common::general()] {
+    for p in [
+        physics::unit_disk(),
+        physics::unit_hoop(),
+        physics::general(),
+    ] {
         let coin = Coin::new(p);
         let ne = NewtonEuler::from_params(&p);
         let s = wobbling(&p);
@@ -158,7 +161,7 @@ fn the_newton_euler_contact_force_equals_the_reaction_of_notes_section_3() {
         let r = coin_log::model::reaction(&coin, &s).force;
         let weight = p.mass() * p.gravity();
         // Two algebraically different round-off paths: 1e-13 of the weight.
-        common::check(
+        physics::check(
             "max |R_library - R_Newton-Euler| / (M g)",
             max_diff(&[r.x, r.y, r.z], &r_ne) / weight,
             0.0,
@@ -198,8 +201,8 @@ impl OdeSystem<STATE_LEN> for FlippedCoin {
 #[test]
 fn a_flipped_sign_in_eq_14_makes_the_two_models_disagree_by_orders_of_magnitude() {
     for (label, p) in [
-        ("unit thin disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit thin disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         let worst = disagreement(&FlippedCoin { params: p }, &p, None);
         let biggest = worst.iter().copied().fold(0.0, f64::max);

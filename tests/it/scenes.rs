@@ -3,14 +3,14 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::repo;
 use coin_log::model::{Branch, SteadyKind};
 use coin_log::scene::{
     self, presets, FlagOverrides, InitialSpec, Problem, Scene, SceneError, SceneFile,
 };
-use std::path::Path;
 
 fn scene_dir() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/scenes")
+    repo().join("datasets/scenes")
 }
 
 /// The problems of an invalid scene text (with `--set` edits and flags).
@@ -99,7 +99,7 @@ fn defaults_are_those_of_the_contract() {
     assert_eq!(s.run.method.step, 1e-3);
     assert_eq!(s.run.flat_margin, 1e-4);
     assert_eq!(s.thickness, 0.05);
-    assert_eq!(s.channels, coin_log::record::Channel::ALL.to_vec());
+    assert_eq!(s.channels, coin_log::format::Channel::ALL.to_vec());
     assert_eq!(scene::defaults::INTEGRATOR, "dop853");
     assert_eq!(
         scene::defaults::INTEGRATOR,

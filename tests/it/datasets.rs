@@ -7,13 +7,10 @@
 // Helpers outside #[test] functions panic on any failure by design.
 #![allow(clippy::unwrap_used)]
 
+use crate::support::record::coin_log;
+use crate::support::repo;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
-use std::process::Command;
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// (output path as written, arguments after `coin-log`) of each `coin-log record` line of the README.
 fn commands() -> Vec<(String, Vec<String>)> {
@@ -92,10 +89,7 @@ fn re_recording_each_dataset_gives_the_committed_bytes() {
                 }
             })
             .collect();
-        let run = Command::new(env!("CARGO_BIN_EXE_coin-log"))
-            .args(&args)
-            .output()
-            .unwrap();
+        let run = coin_log(&repo(), &args);
         assert!(
             run.status.success(),
             "coin-log {} failed:\n{}",

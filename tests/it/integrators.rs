@@ -2,6 +2,7 @@
 //! of convergence, energy conservation on the wobbling coin, bounded energy error of the symmetric
 //! method (with rk4 as the drifting control), dense output and behaviour at a finite-time blow-up.
 
+use crate::support::vectors::max_diff;
 use coin_log::bench::stability::wobble_state;
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Stats, StepError,
@@ -91,13 +92,6 @@ fn final_state<const N: usize, S: OdeSystem<N>>(
     (last, outcome.stats)
 }
 
-fn max_difference<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
-}
-
 /// Least-squares slope of ys against xs.
 fn slope(xs: &[f64], ys: &[f64]) -> f64 {
     #[allow(clippy::cast_precision_loss)]
@@ -126,7 +120,7 @@ fn fixed_step_order<const N: usize, S: OdeSystem<N>>(
     let mut h = h0;
     for _ in 0..8 {
         let (y, stats) = final_state(&config(method, h), sys, y0, t_end);
-        let error = max_difference(&y, exact);
+        let error = max_diff(&y, exact);
         #[allow(clippy::cast_precision_loss)]
         let floor = ROUND_OFF_MARGIN * EPS * (stats.steps as f64).sqrt();
         println!("  {method} h = {h:.3e}: error {error:.3e} (round-off floor {floor:.1e})");
@@ -158,7 +152,7 @@ fn max_sampled_error<const N: usize, S: OdeSystem<N>>(
     };
     let mut error = 0.0_f64;
     let outcome = run_method(config, sys, &exact(0.0), &settings, &NoEvents, |t, y| {
-        error = error.max(max_difference(y, &exact(t)));
+        error = error.max(max_diff(y, &exact(t)));
         Flow::Continue
     });
     assert_eq!(outcome.termination, Termination::Completed);
@@ -324,10 +318,7 @@ fn every_method_shows_its_order_on_the_wobbling_coin() {
             .iter()
             .map(|&h| final_state(&config(method, h), &coin, &y0, t_end).0)
             .collect();
-        let (d1, d2) = (
-            max_difference(&ends[0], &ends[1]),
-            max_difference(&ends[1], &ends[2]),
-        );
+        let (d1, d2) = (max_diff(&ends[0], &ends[1]), max_diff(&ends[1], &ends[2]));
         println!("  {method} h = {h}: |y_h − y_h/2| = {d1:.3e}, |y_h/2 − y_h/4| = {d2:.3e}");
         check_order(method, "coin", (d1 / d2).log2(), 4.0, 0.15);
     }
@@ -349,7 +340,7 @@ fn every_method_shows_its_order_on_the_wobbling_coin() {
             let error = samples
                 .iter()
                 .zip(&reference)
-                .map(|((_, y), (_, r))| max_difference(y, r))
+                .map(|((_, y), (_, r))| max_diff(y, r))
                 .fold(0.0, f64::max);
             println!(
                 "  {method} tol = {tol:.1e}: steps {} (rejected {}), max error {error:.3e}",
@@ -475,7 +466,7 @@ fn dense_output_samples_agree_with_runs_stepped_to_the_sample_times() {
         let mut worst = 0.0_f64;
         for (t, y) in samples.iter().skip(1).step_by(7) {
             let (stepped, _) = final_state(&config(method, tol), &coin, &y0, *t);
-            worst = worst.max(max_difference(y, &stepped));
+            worst = worst.max(max_diff(y, &stepped));
         }
         println!("{method} tol {tol:.0e}: dense output vs stepped-to runs max difference {worst:.3e} (bound {bound:.0e})");
         assert!(
@@ -587,7 +578,7 @@ fn adaptive_methods_stay_accurate_at_rtol_1e_14_and_atol_1e_16() {
             step: 0.0,
         };
         let (y, stats) = final_state(&tight, &Kepler, &kepler_exact(0.0), t_end);
-        let error = max_difference(&y, &exact);
+        let error = max_diff(&y, &exact);
         println!("{method} rtol 1e-14 atol 1e-16 on Kepler to t = {t_end}: error {error:.3e} (expected ≤ 1e-11), {stats:?}");
         assert!(error <= 1e-11, "{method}: error {error:.3e}");
     }

@@ -6,11 +6,10 @@
 //!
 //! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
 
-mod support;
-
+use crate::support::writers::{record_circle, Damage};
+use crate::support::{dataset_files, repo};
 use std::path::PathBuf;
 use std::process::Command;
-use support::{record_circle, repo, Damage};
 
 fn python() -> PathBuf {
     let p = repo().join(".venv/bin/python");
@@ -55,25 +54,12 @@ fn run_readers(files: &[PathBuf]) -> [(bool, String); 2] {
     })
 }
 
-fn datasets() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(repo().join("datasets"))
-        .map(|d| {
-            d.filter_map(Result::ok)
-                .map(|e| e.path())
-                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
-                .collect()
-        })
-        .unwrap_or_default();
-    files.sort();
-    files
-}
-
 #[test]
 fn both_independent_readers_accept_every_dataset_and_a_fresh_recording() {
     let dir = tempfile::tempdir().unwrap();
     let fresh = dir.path().join("fresh-circle.mcap");
     record_circle(&fresh, 3.0, Damage::None);
-    let mut files = datasets();
+    let mut files = dataset_files();
     files.push(fresh);
     let [(node_ok, node_out), (py_ok, py_out)] = run_readers(&files);
     println!("--- @mcap/core (check.mjs)\n{node_out}--- python mcap (check.py)\n{py_out}");

@@ -8,12 +8,11 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
+use crate::support::physics::{self, rate_unit};
+use crate::support::vectors;
 use coin_log::model::{
     centre, contact_point, reaction, Branch, Coin, CoinParams, State, Steady, SteadyKind,
 };
-use common::rate_unit;
 
 /// Natural time units of the run.
 const DURATION: f64 = 20.0;
@@ -37,7 +36,7 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
     let h = STEP_NATURAL * p.time_unit();
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let steps = (DURATION / STEP_NATURAL).round() as usize;
-    let traj = common::rk4_trajectory(&coin, &start.to_array(), h, steps, 10);
+    let traj = physics::rk4_trajectory(&coin, &start.to_array(), h, steps, 10);
     let centre_of_circle = steady.circle_centre(&coin, &start);
     let (mut d_theta, mut d_omega, mut d_angles, mut d_centre, mut d_contact) =
         (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
@@ -45,7 +44,7 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
         let s = State::from_array(y);
         d_theta = d_theta.max((s.theta - start.theta).abs());
         d_omega = d_omega.max(
-            common::max_diff(
+            vectors::max_diff(
                 &[s.omega_x, s.omega_y, s.omega_z],
                 &[start.omega_x, start.omega_y, start.omega_z],
             ) / w,
@@ -71,36 +70,36 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
                 let (sp, cp0) = start.phi.sin_cos();
                 let expected = [start.x - v * cp0 * t, start.z + v * sp * t];
                 let travelled = (v * t).abs().max(a);
-                d_centre = d_centre.max(common::max_diff(&[c.x, c.z], &expected) / travelled);
-                d_contact = d_contact.max(common::max_diff(&[cp.x, cp.z], &expected) / travelled);
+                d_centre = d_centre.max(vectors::max_diff(&[c.x, c.z], &expected) / travelled);
+                d_contact = d_contact.max(vectors::max_diff(&[cp.x, cp.z], &expected) / travelled);
             }
         }
     }
-    common::check(
+    physics::check(
         &format!("{label}: max |theta - theta0| [rad]"),
         d_theta,
         0.0,
         STEADY,
     );
-    common::check(
+    physics::check(
         &format!("{label}: max |omega - omega0| / sqrt(g/a)"),
         d_omega,
         0.0,
         STEADY,
     );
-    common::check(
+    physics::check(
         &format!("{label}: max |phi, psi - analytic| / angle turned"),
         d_angles,
         0.0,
         STEADY,
     );
-    common::check(
+    physics::check(
         &format!("{label}: max |centre distance - R_G| / a"),
         d_centre,
         0.0,
         STEADY,
     );
-    common::check(
+    physics::check(
         &format!("{label}: max |contact distance - R_C| / a"),
         d_contact,
         0.0,
@@ -113,13 +112,13 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
     let centripetal = p.mass() * a * (s0.omega_y * s0.omega_z).abs() / s0.theta.cos();
     // Round-off of terms of size max(Mg, centripetal force).
     let force_scale = weight.max(centripetal);
-    common::check(
+    physics::check(
         &format!("{label}: (N - M g) / max(M g, F)"),
         (r.normal - weight) / force_scale,
         0.0,
         1e-14,
     );
-    common::check(
+    physics::check(
         &format!("{label}: (F - M a |wY wZ| / cos(theta0)) / max(M g, F)"),
         (r.friction - centripetal) / force_scale,
         0.0,
@@ -135,7 +134,7 @@ fn sign_rule(label: &str, p: &CoinParams, steady: &Steady) {
     let r_g = steady.r_g.unwrap();
     let sign = (s.omega_y * s.omega_z).signum();
     let expected = a * (r_g / a + sign * s.theta.sin()).abs();
-    common::check(
+    physics::check(
         &format!("{label}: R_C / a vs |R_G/a + sgn(wY wZ) sin(theta0)| (sgn = {sign})"),
         steady.r_c.unwrap() / a,
         expected / a,
@@ -145,7 +144,7 @@ fn sign_rule(label: &str, p: &CoinParams, steady: &Steady) {
 
 #[test]
 fn straight_rolling_stays_straight() {
-    let p = common::unit_disk();
+    let p = physics::unit_disk();
     stays_steady(
         "straight, w_Z = 1",
         &p,
@@ -156,7 +155,7 @@ fn straight_rolling_stays_straight() {
         &p,
         SteadyKind::Straight { omega_z: -2.5 },
     );
-    let g = common::general();
+    let g = physics::general();
     stays_steady(
         "general, straight",
         &g,
@@ -169,8 +168,8 @@ fn straight_rolling_stays_straight() {
 #[test]
 fn the_coin_rolling_round_its_fixed_centre_stays_on_its_circle() {
     for (label, p) in [
-        ("unit disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         for branch in [Branch::Plus, Branch::Minus] {
             for theta in [0.5, -0.9] {
@@ -180,8 +179,8 @@ fn the_coin_rolling_round_its_fixed_centre_stays_on_its_circle() {
                     SteadyKind::CentreFixed { theta, branch },
                 );
                 // R_C = a |sin θ₀| and R_G = 0 (NOTES §4 item 2).
-                common::check("R_G / a", s.r_g.unwrap() / p.radius(), 0.0, 0.0);
-                common::check(
+                physics::check("R_G / a", s.r_g.unwrap() / p.radius(), 0.0, 0.0);
+                physics::check(
                     "R_C / a",
                     s.r_c.unwrap() / p.radius(),
                     f64::abs(theta.sin()),
@@ -194,7 +193,7 @@ fn the_coin_rolling_round_its_fixed_centre_stays_on_its_circle() {
 
 #[test]
 fn the_notes_circle_example_has_the_stated_radii_and_stays_on_them() {
-    let p = common::unit_disk();
+    let p = physics::unit_disk();
     let s = stays_steady(
         "circle theta 0.3, w_Z 1, +",
         &p,
@@ -204,16 +203,16 @@ fn the_notes_circle_example_has_the_stated_radii_and_stays_on_them() {
             branch: Branch::Plus,
         },
     );
-    common::check("R_G (NOTES §4 example)", s.r_g.unwrap(), 4.897855, 1e-6);
-    common::check("R_C (NOTES §4 example)", s.r_c.unwrap(), 5.193375, 1e-6);
+    physics::check("R_G (NOTES §4 example)", s.r_g.unwrap(), 4.897855, 1e-6);
+    physics::check("R_C (NOTES §4 example)", s.r_c.unwrap(), 5.193375, 1e-6);
     sign_rule("circle theta 0.3, w_Z 1, +", &p, &s);
 }
 
 #[test]
 fn circles_on_both_branches_and_every_sign_stay_steady_and_follow_the_contact_radius_sign_rule() {
     for (label, p) in [
-        ("unit disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         let w = rate_unit(&p);
         for (theta, omega_z) in [
@@ -243,8 +242,8 @@ fn circles_on_both_branches_and_every_sign_stay_steady_and_follow_the_contact_ra
 #[test]
 fn a_stably_spinning_upright_coin_stays_upright() {
     for (label, p) in [
-        ("unit disk", common::unit_disk()),
-        ("general", common::general()),
+        ("unit disk", physics::unit_disk()),
+        ("general", physics::general()),
     ] {
         // Ω² = 4 g/a is above the stability bound Mga/(I_X + Ma²) for both bodies (NOTES §5).
         let omega = 2.0 * rate_unit(&p);
@@ -253,7 +252,7 @@ fn a_stably_spinning_upright_coin_stays_upright() {
             &p,
             SteadyKind::SpinUpright { omega_y: omega },
         );
-        common::check("R_G", s.r_g.unwrap(), 0.0, 0.0);
+        physics::check("R_G", s.r_g.unwrap(), 0.0, 0.0);
     }
 }
 
@@ -262,7 +261,7 @@ fn a_stably_spinning_upright_coin_stays_upright() {
 /// eq (14) then gives ω̇_X = 0.
 #[test]
 fn the_steady_quadratic_holds_for_general_parameters() {
-    let p = common::general();
+    let p = physics::general();
     let coin = Coin::new(p);
     let w = rate_unit(&p);
     for (theta, omega_z) in [(0.3, 1.0), (-0.7, 0.2), (1.3, -3.0), (0.05, 4.0)] {
@@ -283,14 +282,14 @@ fn the_steady_quadratic_holds_for_general_parameters() {
                 -p.mass() * p.gravity() * p.radius() * theta.sin(),
             ];
             let biggest = terms.iter().map(|t| t.abs()).fold(0.0, f64::max);
-            common::check(
+            physics::check(
                 &format!("steady quadratic residual / largest term, theta {theta}, w_Z {omega_z}, {branch:?}"),
                 terms.iter().sum::<f64>() / biggest,
                 0.0,
                 1e-14,
             );
             let acc = coin.angular_acceleration(s.theta, s.omega_x, s.omega_y, s.omega_z);
-            common::check(
+            physics::check(
                 "eq (14): w_X dot (I_X + M a^2) / largest term",
                 acc.x * (p.inertia_x() + p.ma2()) / biggest,
                 0.0,

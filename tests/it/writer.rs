@@ -5,6 +5,7 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::FailingWriter;
 use coin_log::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -511,28 +512,6 @@ fn unknown_channels_and_schemas_are_refused_and_equal_registrations_share_an_id(
     assert!(summary.channels.values().any(|c| c.schema.is_none()));
 }
 
-/// An output that refuses any write past `limit` bytes, like a full disk.
-struct FailingWriter {
-    inner: Vec<u8>,
-    limit: usize,
-}
-
-impl Write for FailingWriter {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        if self.inner.len() + buf.len() > self.limit {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::StorageFull,
-                "no space left on device (test)",
-            ));
-        }
-        self.inner.extend_from_slice(buf);
-        Ok(buf.len())
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
 #[test]
 fn a_failing_output_is_an_error_from_a_write_or_from_finish_never_a_panic_or_a_hang() {
     for compression in COMPRESSIONS {
@@ -550,10 +529,7 @@ fn a_failing_output_is_an_error_from_a_write_or_from_finish_never_a_panic_or_a_h
             size - 40,
             size - 1,
         ] {
-            let out = FailingWriter {
-                inner: Vec::new(),
-                limit,
-            };
+            let out = FailingWriter::new(limit as u64);
             match write_to(out, &options, 20_000) {
                 Ok(_) => panic!(
                     "{compression:?}: an output failing after {limit} of {size} bytes gave a file"
@@ -573,13 +549,10 @@ fn a_failing_output_is_an_error_from_a_write_or_from_finish_never_a_panic_or_a_h
                 }
             }
         }
-        let out = FailingWriter {
-            inner: Vec::new(),
-            limit: size,
-        };
+        let out = FailingWriter::new(size as u64);
         let (out, _) = write_to(out, &options, 20_000).unwrap();
         assert!(
-            out.inner == full,
+            out.into_bytes() == full,
             "{compression:?}: exactly enough room gives the same file"
         );
     }
@@ -587,10 +560,7 @@ fn a_failing_output_is_an_error_from_a_write_or_from_finish_never_a_panic_or_a_h
 
 #[test]
 fn after_a_failure_every_call_fails_and_dropping_the_writer_returns() {
-    let out = FailingWriter {
-        inner: Vec::new(),
-        limit: 200_000,
-    };
+    let out = FailingWriter::new(200_000);
     let mut writer = McapWriter::new(out, &options(ChunkCompression::Zstd, 4096, 2)).unwrap();
     let s = writer.add_schema("s", "jsonschema", b"{}").unwrap();
     let c = writer

@@ -6,11 +6,11 @@
 // Helpers outside #[test] functions panic on any failure by design.
 #![allow(clippy::unwrap_used)]
 
-mod support;
-
+use crate::support::record::read_messages;
+use crate::support::writers::{record_circle, Damage};
+use crate::support::{dataset_files, repo};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
-use support::{read_messages, record_circle, repo, Damage};
 
 /// (topic, log time, message) of every message of a file.
 type Messages = Vec<(String, u64, Value)>;
@@ -29,13 +29,7 @@ fn recording(duration: f64) -> Vec<(String, u64, Value)> {
 
 /// The committed recordings (made by `coin-log record`), read back, with their names.
 fn datasets() -> Vec<(String, Messages)> {
-    let mut files: Vec<_> = std::fs::read_dir(repo().join("datasets"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
-        .collect();
-    files.sort();
-    files
+    dataset_files()
         .into_iter()
         .map(|p| (p.display().to_string(), read_messages(&p)))
         .collect()
@@ -279,10 +273,10 @@ fn the_layout_shows_the_scene_following_world_and_plots_the_main_quantities() {
     // Each plotted path ends on a numeric field of its topic's schema.
     for p in &paths {
         let (topic, field) = p.split_once('.').unwrap();
-        let channel = coin_log::record::Channel::from_topic(topic)
+        let channel = coin_log::format::Channel::from_topic(topic)
             .unwrap_or_else(|| panic!("{p}: unknown topic"));
         let schema: Value =
-            serde_json::from_slice(coin_log::record::schema_bytes(channel.schema_name()).unwrap())
+            serde_json::from_slice(coin_log::format::schema_bytes(channel.schema_name()).unwrap())
                 .unwrap();
         assert_eq!(
             schema["properties"][field]["type"],

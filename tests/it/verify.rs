@@ -2,11 +2,11 @@
 //! check, by id, with the measured number in the report.
 #![allow(clippy::unwrap_used)]
 
-mod common_verify;
-mod support;
-
+use crate::support::record::{coin_log_text, record_scene, scene_names};
+use crate::support::writers::{
+    nudge, record, recorded, rewrite, rewrite_with_schemas, steady_circle, wobble, Edit, Spec,
+};
 use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status};
-use common_verify::*;
 
 fn show(r: &FileReport) -> String {
     r.checks
@@ -147,7 +147,7 @@ fn negative_control_numbers_appear_in_the_json_output() {
             nudge(e.data, "x", 1e-4);
         }
     });
-    let (code, stdout, stderr) = coin_log(&["verify", "--json", bad.to_str().unwrap()]);
+    let (code, stdout, stderr) = coin_log_text(&["verify", "--json", bad.to_str().unwrap()]);
     assert_eq!(code, 1, "{stdout}{stderr}");
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     let checks = v["files"][0]["checks"].as_array().unwrap();
@@ -161,7 +161,7 @@ fn negative_control_numbers_appear_in_the_json_output() {
 #[test]
 fn a_log_on_which_no_physics_check_can_run_fails() {
     let spec = Spec {
-        channels: vec![coin_log::record::Channel::Energy],
+        channels: vec![coin_log::format::Channel::Energy],
         ..wobble()
     };
     let (_dir, path) = recorded(&spec, "energy-only.mcap");
@@ -179,7 +179,7 @@ fn a_log_on_which_no_physics_check_can_run_fails() {
 fn the_json_output_has_exactly_the_contract_fields() {
     let dir = tempfile::tempdir().unwrap();
     let path = record_scene(dir.path(), "wobble", &[]);
-    let (code, stdout, _) = coin_log(&["verify", "--json", path.to_str().unwrap()]);
+    let (code, stdout, _) = coin_log_text(&["verify", "--json", path.to_str().unwrap()]);
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     let keys = |v: &serde_json::Value| {
@@ -262,7 +262,7 @@ fn recordings_by_every_integrator_pass_at_default_tolerances() {
 }
 
 /// Writes a long recording for measuring `verify` by hand (not a timed test):
-/// `VERIFY_LONG=/tmp/long.mcap cargo test --release --test verify -- --ignored write_a_long_recording`,
+/// `VERIFY_LONG=/tmp/long.mcap cargo test --release --test it -- --ignored verify::write_a_long_recording`,
 /// then `/usr/bin/time -v target/release/coin-log verify /tmp/long.mcap`.
 #[test]
 #[ignore = "writes a large file for manual throughput measurement"]
@@ -295,7 +295,7 @@ fn with_other_schema(name: &str, edit: impl Fn(&mut serde_json::Value)) -> FileR
     let good = record_scene(dir.path(), "wobble", &[]);
     let other = dir.path().join("other-version.mcap");
     let schema_of = |n: &str| {
-        let ours = coin_log::record::schema_bytes(n).unwrap().to_vec();
+        let ours = coin_log::format::schema_bytes(n).unwrap().to_vec();
         if n != name {
             return ours;
         }

@@ -3,10 +3,8 @@
 //! 16⁴ ≈ 7e4 times smaller), halves the step repeatedly; log₂ of successive error ratios must be 4 ± 0.15 wherever
 //! both errors stay above 1e3 × machine epsilon (below that, round-off dominates the ratio).
 
-mod common;
-
+use crate::support::physics::{self, rate_unit, wobbling};
 use coin_log::model::{Coin, CoinParams};
-use common::{rate_unit, wobbling};
 
 /// Error floor below which a ratio is not trusted: 1e3 × machine epsilon (issue 3).
 const FLOOR: f64 = 1e3 * f64::EPSILON;
@@ -37,7 +35,7 @@ fn observed_orders(label: &str, p: &CoinParams) {
     let span = 4.0 * tu;
     let finest_steps = 40 << 6;
     #[allow(clippy::cast_precision_loss)]
-    let reference = common::rk4_final(
+    let reference = physics::rk4_final(
         &coin,
         &y0,
         span / (16 * finest_steps) as f64,
@@ -48,7 +46,7 @@ fn observed_orders(label: &str, p: &CoinParams) {
         let steps = 40usize << k; // h = 0.1 .. 0.0016 natural units (h = 0.2 is not yet asymptotic)
         #[allow(clippy::cast_precision_loss)]
         let h = span / steps as f64;
-        let e = scaled_error(p, &common::rk4_final(&coin, &y0, h, steps), &reference);
+        let e = scaled_error(p, &physics::rk4_final(&coin, &y0, h, steps), &reference);
         println!("{label}: h = {:.5} (natural units): error {e:.3e}", h / tu);
         errors.push(e);
         assert!(steps <= finest_steps);
@@ -63,7 +61,7 @@ fn observed_orders(label: &str, p: &CoinParams) {
             continue;
         }
         let order = (pair[0] / pair[1]).log2();
-        common::check(&format!("{label}: observed order"), order, 4.0, ORDER_SLACK);
+        physics::check(&format!("{label}: observed order"), order, 4.0, ORDER_SLACK);
         checked += 1;
     }
     assert!(
@@ -74,10 +72,10 @@ fn observed_orders(label: &str, p: &CoinParams) {
 
 #[test]
 fn rk4_converges_at_fourth_order_on_the_thin_disk() {
-    observed_orders("unit thin disk", &common::unit_disk());
+    observed_orders("unit thin disk", &physics::unit_disk());
 }
 
 #[test]
 fn rk4_converges_at_fourth_order_for_general_parameters() {
-    observed_orders("general", &common::general());
+    observed_orders("general", &physics::general());
 }

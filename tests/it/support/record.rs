@@ -1,10 +1,12 @@
-//! Helpers shared by the record tests: reading a recording back, a validator for our flat JSON schemas,
-//! running the binary in a temporary folder.
-// Test helpers: a failed read is a failed test, so they panic with a message.
-#![allow(dead_code, missing_docs, clippy::unwrap_used, clippy::expect_used)]
+//! Reading a recording back, a validator for our flat JSON schemas, and running the binary.
+// Test helpers are not #[test] functions, so clippy.toml's allow-unwrap-in-tests and allow-expect-in-tests
+// do not reach them; a failed unwrap or expect here is a failed test, which is what we want.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use super::repo;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// One message as read back.
@@ -85,11 +87,26 @@ pub fn read_back(bytes: &[u8]) -> ReadBack {
     }
 }
 
+/// Every message of the MCAP file at `path` as (topic, log time, JSON value), in file order; asserts that
+/// each publish time equals its log time.
+pub fn read_messages(path: &Path) -> Vec<(String, u64, serde_json::Value)> {
+    read_back(&std::fs::read(path).unwrap())
+        .messages
+        .into_iter()
+        .map(|m| {
+            assert_eq!(m.log_time, m.publish_time);
+            (
+                m.topic,
+                m.log_time,
+                serde_json::from_slice(&m.data).unwrap(),
+            )
+        })
+        .collect()
+}
+
 /// The bytes of `schemas/<name>.json`.
 pub fn schema_file(name: &str) -> Vec<u8> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("schemas")
-        .join(format!("{name}.json"));
+    let path = repo().join("schemas").join(format!("{name}.json"));
     std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -139,13 +156,49 @@ pub fn validate_flat(schema: &serde_json::Value, message: &[u8]) -> Result<(), S
     Ok(())
 }
 
+/// The `coin-log` binary cargo built for these tests.
+pub fn exe() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_coin-log"))
+}
+
 /// Runs the binary with `args` in `dir`.
-pub fn coin_log(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_coin-log"))
+pub fn coin_log<S: AsRef<OsStr>>(dir: &Path, args: &[S]) -> Output {
+    Command::new(exe())
         .args(args)
         .current_dir(dir)
         .output()
         .expect("coin-log runs")
+}
+
+/// Runs the binary with `args` in the repository root; returns the exit code (−1 if a signal ended the
+/// process), stdout and stderr as text.
+pub fn coin_log_text(args: &[&str]) -> (i32, String, String) {
+    let out = coin_log(&repo(), args);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Records built-in scene `scene` with the real recorder (`coin-log record`), plus `extra` flags.
+pub fn record_scene(dir: &Path, scene: &str, extra: &[&str]) -> PathBuf {
+    let path = dir.join(format!("{scene}.mcap"));
+    let mut args = vec!["record", scene, "-o", path.to_str().unwrap(), "--overwrite"];
+    args.extend_from_slice(extra);
+    let (code, out, err) = coin_log_text(&args);
+    assert_eq!(code, 0, "coin-log record {scene}: {out}{err}");
+    path
+}
+
+/// The built-in scene names (`coin-log scenes`).
+pub fn scene_names() -> Vec<String> {
+    let (code, out, err) = coin_log_text(&["scenes"]);
+    assert_eq!(code, 0, "{err}");
+    out.lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_string)
+        .collect()
 }
 
 /// File names in `dir`, sorted (hidden temporary files included).

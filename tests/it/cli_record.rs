@@ -3,11 +3,9 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common_record;
-
-use coin_log::record::{ResultMetadata, RESULT_METADATA_NAME};
-use common_record::{coin_log, listing, read_back};
-use std::path::Path;
+use crate::support::record::{coin_log, exe, listing, read_back};
+use crate::support::repo;
+use coin_log::format::{ResultMetadata, RESULT_METADATA_NAME};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -315,7 +313,10 @@ fn a_physical_event_ends_the_run_normally() {
     assert_eq!(summary["termination"], "flat-landing");
     let file = read_back(&std::fs::read(dir.path().join("t.mcap")).unwrap());
     let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
-    assert_eq!(result.termination, "flat-landing");
+    assert_eq!(
+        result.termination,
+        coin_log::format::Termination::FlatLanding
+    );
 }
 
 #[test]
@@ -355,8 +356,7 @@ fn the_scenes_command_lists_and_shows_every_built_in() {
         let out = coin_log(dir.path(), &["scenes", "--show", name]);
         assert_eq!(code(&out), 0);
         let shown = String::from_utf8(out.stdout).unwrap();
-        let file =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("datasets/scenes/{name}.toml"));
+        let file = repo().join(format!("datasets/scenes/{name}.toml"));
         assert_eq!(
             shown,
             std::fs::read_to_string(file).unwrap(),
@@ -371,7 +371,7 @@ fn the_scenes_command_lists_and_shows_every_built_in() {
 #[test]
 fn ctrl_c_finishes_the_file_marked_interrupted() {
     let dir = tempfile::tempdir().unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_coin-log"))
+    let mut child = Command::new(exe())
         .args([
             "record",
             "long-horizon",
@@ -432,12 +432,15 @@ fn ctrl_c_finishes_the_file_marked_interrupted() {
         result.termination_time,
         file.messages.len()
     );
-    assert_eq!(result.termination, "interrupted");
+    assert_eq!(
+        result.termination,
+        coin_log::format::Termination::Interrupted
+    );
     assert!(result.termination_time > 0.0 && result.termination_time < 100_000.0);
     let last = file.on_topic("/coin/omega").last().unwrap().log_time;
     assert_eq!(
         last,
-        coin_log::units::log_time(result.termination_time).unwrap()
+        coin_log::format::log_time(result.termination_time).unwrap()
     );
 }
 
@@ -473,7 +476,7 @@ fn a_numerical_failure_finishes_the_file_and_exits_1() {
         result.termination_time,
         file.messages.len()
     );
-    assert_eq!(result.termination, "non-finite");
+    assert_eq!(result.termination, coin_log::format::Termination::NonFinite);
     assert_eq!(
         file.on_topic("/coin/omega").len(),
         1,

@@ -8,14 +8,13 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
+use crate::support::newton_euler::NewtonEuler;
+use crate::support::physics::{self, rate_unit};
+use crate::support::vectors::{self, add, cross, max_diff, norm, scale, V3};
 use coin_log::model::{
     centre, contact_point, orientation, reaction, Branch, Coin, CoinParams, Inertia, State, Steady,
     SteadyKind, STATE_LEN,
 };
-use common::newton_euler::NewtonEuler;
-use common::{add, cross, max_diff, norm, rate_unit, scale, V3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
@@ -135,8 +134,8 @@ proptest! {
         let f = rhs(&coin, &s);
         let a = p.radius();
         let v = [f[6], -a * s.theta.sin() * f[0], f[7]];
-        let [_, e_y_lean, _] = common::lean_frame(s.theta, s.phi);
-        let omega = common::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
+        let [_, e_y_lean, _] = vectors::lean_frame(s.theta, s.phi);
+        let omega = vectors::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
         let no_slip = scale(-1.0, cross(omega, scale(-a, e_y_lean)));
         within("|v_G + omega x rho|", max_diff(&v, &no_slip), a * (norm(omega) + rate_unit(&p)))?;
     }
@@ -154,9 +153,9 @@ proptest! {
         let (st, ct) = s.theta.sin_cos();
         let (sp, cp) = s.phi.sin_cos();
         within("|q e_z - e_Z|", max_diff(&n, &[ct * sp, -st, ct * cp]), 1.0)?;
-        let [_, e_y_lean, _] = common::lean_frame_from_normal(n);
+        let [_, e_y_lean, _] = vectors::lean_frame_from_normal(n);
         let c = centre(&coin, &s);
-        let expected = common::sub([c.x, c.y, c.z], scale(p.radius(), e_y_lean));
+        let expected = vectors::sub([c.x, c.y, c.z], scale(p.radius(), e_y_lean));
         let cp_lib = contact_point(&coin, &s);
         within("|contact - (centre - a e_Y)|", max_diff(&[cp_lib.x, cp_lib.y, cp_lib.z], &expected), p.radius() * (1.0 + u[6].abs() + u[7].abs()))?;
     }
@@ -178,8 +177,8 @@ proptest! {
         within("|R_library - R_Newton-Euler|", max_diff(&[r.x, r.y, r.z], &eval.reaction), force_scale)?;
 
         let f = rhs(&coin, &s);
-        let [e_x, e_y_lean, e_z] = common::lean_frame(s.theta, s.phi);
-        let omega = common::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
+        let [e_x, e_y_lean, e_z] = vectors::lean_frame(s.theta, s.phi);
+        let omega = vectors::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
         let frame_rate: V3 = add(scale(f[0], e_x), scale(f[1], [0.0, 1.0, 0.0]));
         let omega_dot = add(
             add(add(scale(f[3], e_x), scale(f[4], e_y_lean)), scale(f[5], e_z)),
@@ -231,7 +230,7 @@ proptest! {
 /// of the order of its terms, not of round-off.
 #[test]
 fn a_flipped_sign_in_eq_14_breaks_energy_conservation() {
-    let p = common::unit_disk();
+    let p = physics::unit_disk();
     let coin = Coin::new(p);
     let s = State {
         theta: 0.4,

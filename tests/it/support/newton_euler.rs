@@ -20,8 +20,8 @@
 //! Only the velocity-level and position-level constraints' second derivatives are imposed, so they drift
 //! with the integrator's truncation error; with rk4 at h = 1e-3 that drift is far below the tolerances.
 
-use super::{
-    add, column, cross, dot, lean_frame_from_normal, norm, quat_matrix, quat_mul,
+use super::vectors::{
+    add, column, cross, dot, lean_frame_from_normal, mat_vec, norm, quat_matrix, quat_mul,
     quaternion_from_angles, scale, sub, world_omega, Quat, V3,
 };
 use coin_log::integrate::OdeSystem;
@@ -59,9 +59,6 @@ fn transpose(a: &M3) -> M3 {
         }
     }
     t
-}
-fn mat_vec(a: &M3, v: V3) -> V3 {
-    [dot(a[0], v), dot(a[1], v), dot(a[2], v)]
 }
 fn skew(v: V3) -> M3 {
     [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]]
@@ -126,9 +123,6 @@ impl NewtonEuler {
     }
     pub fn centre(y: &[f64; NE_LEN]) -> V3 {
         [y[7], y[8], y[9]]
-    }
-    pub fn velocity(y: &[f64; NE_LEN]) -> V3 {
-        [y[10], y[11], y[12]]
     }
     /// ρ = −a e_Y from the state's orientation.
     pub fn rho(&self, y: &[f64; NE_LEN]) -> V3 {

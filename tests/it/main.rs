@@ -1,0 +1,32 @@
+//! The integration tests, as one test binary: one module per area, sharing the helpers of [`support`].
+//! One binary links the library and its dependencies once, where a file per test under `tests/` would
+//! link them once per file: add new tests as a module here. Run one area with
+//! `cargo test --release --test it verify::` (any module path as the filter).
+//!
+//! proptest keeps the failing cases of a property test in `tests/proptest-regressions/<module>.txt` (the
+//! folder beside the one holding this `main.rs`); commit such a file when it appears.
+
+mod support;
+
+mod bench_precision;
+mod bench_stability;
+mod bench_throughput;
+mod cli_record;
+mod datasets;
+mod events;
+mod external_readers;
+mod formulas;
+mod foxglove;
+mod integrators;
+mod invariants;
+mod params;
+mod properties;
+mod record_roundtrip;
+mod rk4_order;
+mod scenes;
+mod second_model;
+mod stability;
+mod steady_states;
+mod verify;
+mod verify_bad_input;
+mod writer;

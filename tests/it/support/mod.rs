@@ -1,0 +1,76 @@
+//! The helpers of the integration tests: [`vectors`] and [`physics`] for the model tests, [`newton_euler`]
+//! (a second, independent model), [`writers`] (MCAP files written straight from the model, and rewritten
+//! with a defect), [`record`] (reading files back, running the binary); here the repository's paths and an
+//! output that fails like a full disk.
+
+pub mod newton_euler;
+pub mod physics;
+pub mod record;
+pub mod vectors;
+pub mod writers;
+
+use std::io::{Cursor, Seek, SeekFrom, Write};
+use std::path::PathBuf;
+
+/// The repository root (cargo also runs the tests there).
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The committed recordings, `datasets/*.mcap`, sorted.
+pub fn dataset_files() -> Vec<PathBuf> {
+    let dir = repo().join("datasets");
+    let entries = std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let mut files: Vec<PathBuf> = entries
+        .map(|e| {
+            e.unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+                .path()
+        })
+        .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// An output that refuses any write past `limit` bytes, like a full disk (seekable, for writers that go
+/// back to patch what they wrote).
+pub struct FailingWriter {
+    inner: Cursor<Vec<u8>>,
+    limit: u64,
+}
+
+impl FailingWriter {
+    /// An empty output with room for `limit` bytes.
+    pub fn new(limit: u64) -> Self {
+        Self {
+            inner: Cursor::new(Vec::new()),
+            limit,
+        }
+    }
+
+    /// The bytes written.
+    pub fn into_bytes(self) -> Vec<u8> {
+        self.inner.into_inner()
+    }
+}
+
+impl Write for FailingWriter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.inner.position() + buf.len() as u64 > self.limit {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::StorageFull,
+                "no space left on device (test)",
+            ));
+        }
+        self.inner.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl Seek for FailingWriter {
+    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
+        self.inner.seek(pos)
+    }
+}
