@@ -27,39 +27,8 @@ pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError
         scene: report.scene.clone(),
         reason: e.to_string(),
     };
-    let series: Vec<(String, Vec<(f64, f64)>)> = report
-        .slopes
-        .iter()
-        .map(|slope| {
-            let mut points: Vec<(f64, f64)> = report
-                .rows
-                .iter()
-                .filter(|r| r.integrator == slope.integrator)
-                .filter(|r| r.state_error > 0.0 && r.state_error.is_finite())
-                .filter(|r| r.wall_seconds > 0.0)
-                .map(|r| (r.wall_seconds.log10(), r.state_error.log10()))
-                .collect();
-            points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let label = match slope.time {
-                Some(s) => format!("{} (slope {s:.2})", slope.integrator),
-                None => slope.integrator.to_string(),
-            };
-            (label, points)
-        })
-        .collect();
-    let all = series.iter().flat_map(|(_, p)| p.iter());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in all {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 > x1 {
-        (x0, x1, y0, y1) = (-6.0, 0.0, -16.0, 0.0);
-    }
-    let (x0, x1) = (x0.floor() - 0.1, x1.ceil() + 0.1);
-    let (y0, y1) = (y0.floor() - 0.5, y1.ceil() + 0.5);
+    let series = series(report);
+    let (x0, x1, y0, y1) = bounds(&series);
 
     let mut svg = String::new();
     {
@@ -107,4 +76,51 @@ pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError
         root.present().map_err(|e| fail(&e))?;
     }
     Ok(svg)
+}
+
+/// One (label, points) series per integrator: (log10 wall time, log10 state error), sorted by time; the
+/// label carries the measured slope.
+fn series(report: &PrecisionReport) -> Vec<(String, Vec<(f64, f64)>)> {
+    report
+        .slopes
+        .iter()
+        .map(|slope| {
+            let mut points: Vec<(f64, f64)> = report
+                .rows
+                .iter()
+                .filter(|r| r.integrator == slope.integrator)
+                .filter(|r| r.state_error > 0.0 && r.state_error.is_finite())
+                .filter(|r| r.wall_seconds > 0.0)
+                .map(|r| (r.wall_seconds.log10(), r.state_error.log10()))
+                .collect();
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let label = match slope.time {
+                Some(s) => format!("{} (slope {s:.2})", slope.integrator),
+                None => slope.integrator.to_string(),
+            };
+            (label, points)
+        })
+        .collect()
+}
+
+/// The axes' ranges (x0, x1, y0, y1): the points' extent rounded out to whole decades (with a margin),
+/// or a default frame when there is no point.
+fn bounds(series: &[(String, Vec<(f64, f64)>)]) -> (f64, f64, f64, f64) {
+    let all = series.iter().flat_map(|(_, p)| p.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (-6.0, 0.0, -16.0, 0.0);
+    }
+    (
+        x0.floor() - 0.1,
+        x1.ceil() + 0.1,
+        y0.floor() - 0.5,
+        y1.ceil() + 0.5,
+    )
 }

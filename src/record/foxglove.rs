@@ -308,13 +308,29 @@ impl Foxglove3d {
         log_time: u64,
         track_id: Option<u64>,
     ) -> Result<(), NonFiniteField> {
-        let a = self.coin.params().radius();
-        let h = self.thickness * a;
+        let h = self.thickness * self.coin.params().radius();
         check(SCENE_UPDATE, "cylinders.size.z", h)?;
         let mut w = Writer::new(buf, SCENE_UPDATE);
         w.raw(b"{\"deletions\":[],\"entities\":[");
+        self.write_coin_entity(&mut w, log_time, h)?;
+        w.raw(b",");
+        self.write_table_entity(&mut w, log_time)?;
+        if let Some(id) = track_id {
+            w.raw(b",");
+            self.write_track_entity(&mut w, log_time, id)?;
+        }
+        w.raw(b"]}");
+        Ok(())
+    }
 
-        // The coin: cylinder with its axis along the coin frame's z, stripes on both faces.
+    /// The coin: a cylinder of thickness `h` with its axis along the coin frame's z, stripes on both faces.
+    fn write_coin_entity(
+        &self,
+        w: &mut Writer,
+        log_time: u64,
+        h: f64,
+    ) -> Result<(), NonFiniteField> {
+        let a = self.coin.params().radius();
         w.entity_head(log_time, COIN_FRAME, b"coin", None, true);
         let mark = (0.2 * h).max(1e-3 * a);
         w.raw(b"\"cubes\":[");
@@ -340,9 +356,12 @@ impl Foxglove3d {
         w.raw(COIN_COLOR);
         w.raw(b"}],\"lines\":[],");
         w.entity_tail();
+        Ok(())
+    }
 
-        // The table: a thin slab just below the plane y = 0 of the table frame.
-        w.raw(b",");
+    /// The table: a thin slab just below the plane y = 0 of the table frame.
+    fn write_table_entity(&self, w: &mut Writer, log_time: u64) -> Result<(), NonFiniteField> {
+        let a = self.coin.params().radius();
         w.entity_head(log_time, TABLE_FRAME, b"table", None, true);
         w.raw(b"\"cubes\":[{\"pose\":{\"position\":{\"x\":");
         w.num("cubes.pose.position.x", self.table_centre[0])?;
@@ -364,32 +383,37 @@ impl Foxglove3d {
         w.raw(TABLE_COLOR);
         w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[],");
         w.entity_tail();
+        Ok(())
+    }
 
-        // The new piece of the contact track.
-        if let Some(id) = track_id {
-            w.raw(b",");
-            w.entity_head(log_time, TABLE_FRAME, b"track-", Some(id), false);
-            w.raw(b"\"cubes\":[],\"spheres\":[],\"cylinders\":[],\"lines\":[{\"type\":0,\"pose\":");
-            w.raw(IDENTITY_POSE);
-            w.raw(b",\"thickness\":");
-            w.num("lines.thickness", TRACK_WIDTH * a)?;
-            w.raw(b",\"scale_invariant\":false,\"points\":[");
-            for (i, p) in self.track.iter().enumerate() {
-                if i > 0 {
-                    w.raw(b",");
-                }
-                w.raw(b"{\"x\":");
-                w.num("lines.points.x", p[0])?;
-                w.raw(b",\"y\":0,\"z\":");
-                w.num("lines.points.z", p[1])?;
-                w.raw(b"}");
+    /// The new piece of the contact track, entity `track-<id>`.
+    fn write_track_entity(
+        &self,
+        w: &mut Writer,
+        log_time: u64,
+        id: u64,
+    ) -> Result<(), NonFiniteField> {
+        let a = self.coin.params().radius();
+        w.entity_head(log_time, TABLE_FRAME, b"track-", Some(id), false);
+        w.raw(b"\"cubes\":[],\"spheres\":[],\"cylinders\":[],\"lines\":[{\"type\":0,\"pose\":");
+        w.raw(IDENTITY_POSE);
+        w.raw(b",\"thickness\":");
+        w.num("lines.thickness", TRACK_WIDTH * a)?;
+        w.raw(b",\"scale_invariant\":false,\"points\":[");
+        for (i, p) in self.track.iter().enumerate() {
+            if i > 0 {
+                w.raw(b",");
             }
-            w.raw(b"],\"color\":");
-            w.raw(TRACK_COLOR);
-            w.raw(b",\"colors\":[],\"indices\":[]}],");
-            w.entity_tail();
+            w.raw(b"{\"x\":");
+            w.num("lines.points.x", p[0])?;
+            w.raw(b",\"y\":0,\"z\":");
+            w.num("lines.points.z", p[1])?;
+            w.raw(b"}");
         }
-        w.raw(b"]}");
+        w.raw(b"],\"color\":");
+        w.raw(TRACK_COLOR);
+        w.raw(b",\"colors\":[],\"indices\":[]}],");
+        w.entity_tail();
         Ok(())
     }
 }

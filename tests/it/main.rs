@@ -8,6 +8,7 @@
 
 mod support;
 
+mod architecture;
 mod bench_precision;
 mod bench_stability;
 mod bench_throughput;
