@@ -1,4 +1,4 @@
-//! The compression bound of issue 9: the time one thread takes to zstd-compress the bytes of a recording,
+//! The compression bound: the time one thread takes to zstd-compress the bytes of a recording,
 //! chunk by chunk as `mcap_io::McapWriter` does, and the JSON payloads alone in pieces of the same size.
 //!
 //! `cargo run --release --example compression_bound -- FILE.mcap [LEVEL...]`. Prints the median of 5 passes

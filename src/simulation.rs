@@ -1,4 +1,4 @@
-//! The rolling coin as an integrable system with its physical events (NOTES §7), and the one entry point
+//! The rolling coin as an integrable system with its physical events (physics §7), and the one entry point
 //! that runs a chosen method on it. This is where the coin model meets the generic integrators.
 
 use crate::integrate::{self, EventFunctions, OdeSystem, RunOutcome, RunSettings, Stepper};
@@ -11,7 +11,7 @@ impl OdeSystem<STATE_LEN> for Coin {
     }
 }
 
-/// A physical event that ends a run because the rolling model stops being valid (NOTES §7).
+/// A physical event that ends a run because the rolling model stops being valid (physics §7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PhysicalEvent {
     /// |θ| reached π/2 − flat_margin: the coin lands flat.

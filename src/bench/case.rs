@@ -11,13 +11,13 @@ use crate::model::{energy, Coin, State, Steady, STATE_LEN};
 use crate::scene::defaults;
 use crate::simulation::CoinEvents;
 
-/// Samples per natural time unit √(a/g) at which errors are measured (issue 8: "100 per time unit").
+/// Samples per natural time unit √(a/g) at which errors are measured ("100 per time unit").
 pub const SAMPLES_PER_TIME_UNIT: f64 = 100.0;
 
 /// Flat-landing margin of the bench runs: the contract's scene default (`run.flat_margin`).
 pub const DEFAULT_FLAT_MARGIN: f64 = defaults::FLAT_MARGIN;
 
-/// Reference tolerances (issue 8): dop853 at atol 1e-16, rtol 1e-14.
+/// Reference tolerances: dop853 at atol 1e-16, rtol 1e-14.
 const REFERENCE_ATOL: f64 = 1e-16;
 /// See [`REFERENCE_ATOL`].
 const REFERENCE_RTOL: f64 = 1e-14;
@@ -217,7 +217,7 @@ impl Reference {
     }
 }
 
-/// The state at time `t` of a steady motion started from `start` (NOTES §4): θ and ω constant,
+/// The state at time `t` of a steady motion started from `start` (physics §4): θ and ω constant,
 /// φ = φ₀ + φ̇t, ψ = ψ₀ + ψ̇t, the centre on its circle about C = p₀ + r(sin φ₀, cos φ₀), r = aω_Z/φ̇:
 /// x = C_x − r sin φ, z = C_z − r cos φ (from ẋ = −aω_Z cos φ, ż = aω_Z sin φ at ω_X = 0); a straight
 /// line x = x₀ − aω_Z cos φ₀ t, z = z₀ + aω_Z sin φ₀ t when φ̇ = 0.
@@ -318,7 +318,7 @@ pub fn state_difference(coin: &Coin, y: &[f64; STATE_LEN], r: &[f64; STATE_LEN])
     worst
 }
 
-/// State error of a run (issue 8): the largest [`state_difference`] over the samples, against the
+/// State error of a run: the largest [`state_difference`] over the samples, against the
 /// reference on the same grid. Infinite when the run stopped before the reference did (or vice versa):
 /// a run that ends early is not accurate.
 #[must_use]

@@ -1,10 +1,10 @@
-//! Benchmarks of accuracy, cost and robustness (issue 8): work-precision sweeps of every integrator on a
+//! Benchmarks of accuracy, cost and robustness: work-precision sweeps of every integrator on a
 //! scene ([`precision`]), a fixed suite of hard cases ([`stability`]), and their output as tables, CSV
 //! ([`table`]) and SVG work-precision diagrams ([`plot`]).
 //!
 //! The library returns rows; only the `coin-log bench` command prints them, writes files, or starts
 //! processes (the throughput bench's record and verify runs, [`throughput`]).
-//! The physics of the hard cases is NOTES §5 and §7.
+//! The physics of the hard cases is physics §5 and §7.
 
 mod case;
 pub mod plot;

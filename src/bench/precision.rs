@@ -1,4 +1,4 @@
-//! Work-precision sweeps (issue 8, `bench precision`): for a scene and each integrator, a sweep of
+//! Work-precision sweeps (`bench precision`): for a scene and each integrator, a sweep of
 //! tolerances (adaptive methods) or steps (fixed-step methods), each point's state, energy and invariant
 //! errors against a reference, its wall time (median of repeats after a warm-up) and its work counters.
 //!
@@ -12,7 +12,7 @@ use super::{
 use crate::integrate::{Method, MethodConfig};
 use std::time::Instant;
 
-/// The adaptive sweep's rtol is 1e3·atol (issue 8) ...
+/// The adaptive sweep's rtol is 1e3·atol ...
 const RTOL_OVER_ATOL: f64 = 1e3;
 /// ... capped at 1e-3.
 const RTOL_CAP: f64 = 1e-3;
@@ -45,7 +45,7 @@ pub struct PrecisionOptions {
 }
 
 impl PrecisionOptions {
-    /// The full sweep of issue 8: atol = 1e-6, 1e-7, ..., 1e-16 and 10 fixed steps.
+    /// The full sweep: atol = 1e-6, 1e-7, ..., 1e-16 and 10 fixed steps.
     #[must_use]
     pub fn full(repeats: usize) -> Self {
         Self {
@@ -79,9 +79,9 @@ pub struct PrecisionRow {
     pub step: Option<f64>,
     /// Max dimensionless state difference to the reference over the samples ([`super::state_error`]).
     pub state_error: f64,
-    /// Energy drift, CONTRACT definition.
+    /// Energy drift, format.md definition.
     pub energy_error: f64,
-    /// C1, C2 drift, CONTRACT definition; `None` when the invariants are not available.
+    /// C1, C2 drift, format.md definition; `None` when the invariants are not available.
     pub invariant_error: Option<f64>,
     /// Median wall time of the run \[s\].
     pub wall_seconds: f64,

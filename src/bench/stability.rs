@@ -1,4 +1,4 @@
-//! The hard-case suite (issue 8, `bench stability`; NOTES §5, §7): every case run with every integrator,
+//! The hard-case suite (`bench stability`; physics §5, §7): every case run with every integrator,
 //! each reporting how the run ended, its error, energy drift and time, plus the case's own measurement
 //! against its expectation:
 //! - fast spin (ω_Z = 50, 500 on a steady circle at tilt 0.2, nudged): the largest stable fixed step of
@@ -27,7 +27,7 @@ use crate::model::{
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::time::Instant;
 
-/// Stability criterion of the fast-spin bisection (issue 8): energy drift below 1e-2.
+/// Stability criterion of the fast-spin bisection: energy drift below 1e-2.
 pub const STABLE_ENERGY_DRIFT: f64 = 1e-2;
 /// Relative width to which the largest stable step is bisected.
 const BISECTION_WIDTH: f64 = 1e-3;
@@ -52,13 +52,13 @@ const TIGHT_ATOL: f64 = 1e-14;
 /// Horizons of the suite; the bench uses [`SuiteOptions::full`], the tests [`SuiteOptions::quick`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct SuiteOptions {
-    /// Nutation periods of the fast-spin stability runs (issue 8: 100).
+    /// Nutation periods of the fast-spin stability runs (100).
     pub nutation_periods: f64,
     /// Nutation periods of the near-flat runs.
     pub near_flat_periods: f64,
     /// Horizon of the marginal-stability runs [natural time units].
     pub marginal_horizon: f64,
-    /// Horizon of the long run (issue 8: 10⁴) and the checkpoints at which its drift is reported.
+    /// Horizon of the long run (10⁴) and the checkpoints at which its drift is reported.
     pub long_horizon: f64,
     /// Horizon of the scale-invariance runs [natural time units].
     pub scale_horizon: f64,
@@ -105,7 +105,7 @@ pub struct StabilityRow {
     pub end_time: f64,
     /// Max state error against the case's reference, when it has one.
     pub max_error: Option<f64>,
-    /// Energy drift, CONTRACT definition.
+    /// Energy drift, format.md definition.
     pub energy_drift: f64,
     /// Wall time \[s\].
     pub wall_seconds: f64,
@@ -171,7 +171,7 @@ fn row_for(
 // ---------------------------------------------------------------------------------------------------------
 // Fast spin
 
-/// Nutation frequency σ of a steady motion (NOTES §5): the linearisation of eqs (14)–(17) in
+/// Nutation frequency σ of a steady motion (physics §5): the linearisation of eqs (14)–(17) in
 /// (θ, ω_X, ω_Y, ω_Z) about ω_X = 0 has eigenvalues 0, 0, ±iσ (the steady family is two-dimensional), so
 /// σ² = −tr(J²)/2 = −(∂ω̇_X/∂θ + ∂ω̇_X/∂ω_Y · ∂ω̇_Y/∂ω_X + ∂ω̇_X/∂ω_Z · ∂ω̇_Z/∂ω_X). `None` when σ² ≤ 0
 /// (an unstable steady motion).
@@ -442,7 +442,7 @@ pub fn release_time(coin: &Coin, theta0: f64, theta1: f64) -> f64 {
 }
 
 /// The lean at which a coin released at rest at θ₀ leaves the table, if it does before `theta_max`:
-/// N/(Mg) = 1 − (a/g)(θ̇² cos θ + θ̈ sin θ) with θ̇² = 2K(cos θ₀ − cos θ), θ̈ = K sin θ (NOTES §3), first
+/// N/(Mg) = 1 − (a/g)(θ̇² cos θ + θ̈ sin θ) with θ̇² = 2K(cos θ₀ − cos θ), θ̈ = K sin θ (physics §3), first
 /// zero by bisection to round-off.
 #[must_use]
 pub fn lift_off_lean(coin: &Coin, theta0: f64, theta_max: f64) -> Option<f64> {
@@ -523,7 +523,7 @@ pub fn release(theta0: f64, case_name: &str) -> Vec<StabilityRow> {
 // ---------------------------------------------------------------------------------------------------------
 // Marginal stability
 
-/// Linear theory of straight rolling at spin Ω from a tilt δθ₀ at rest (NOTES §5): with
+/// Linear theory of straight rolling at spin Ω from a tilt δθ₀ at rest (physics §5): with
 /// G = Mga/(I_X + Ma²) and λ² = [`straight_lambda_squared`], θ̈ = λ²θ + (G − λ²)θ₀, so
 /// θ(t) = θ₀(1 + G(cosh λt − 1)/λ²) (with (1 − cos σt)/σ² for λ² = −σ² < 0 and t²/2 at λ² = 0: the
 /// thin disk's δθ₀(1 + 2t²/5) at ω_c).
@@ -607,7 +607,7 @@ pub struct DriftHistory {
     pub wall_seconds: f64,
 }
 
-/// The wobbling motion of issue 4 and of the built-in `wobble` scene (θ₀ = 0.5, ω = (0.3, 0.2, 1.5), unit
+/// The wobbling motion of the built-in `wobble` scene (θ₀ = 0.5, ω = (0.3, 0.2, 1.5), unit
 /// thin disk): the long-horizon case here, and the motion of the integrator tests and benchmarks.
 #[must_use]
 pub fn wobble_state() -> State {

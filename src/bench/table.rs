@@ -3,7 +3,7 @@
 use super::precision::PrecisionRow;
 use super::stability::StabilityRow;
 
-/// The CSV header of `bench precision` (issue 8, fixed column set).
+/// The CSV header of `bench precision` (fixed column set).
 pub const PRECISION_CSV_HEADER: &str = "scene,integrator,tolerance,step,state_error,energy_error,invariant_error,wall_seconds,rhs_evaluations,steps,rejected";
 
 /// A number for CSV and tables: shortest round-trip, `inf` for infinity, empty for `None`.

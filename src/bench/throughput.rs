@@ -1,4 +1,4 @@
-//! The throughput bench (issue 9, `bench throughput`): how fast `record` and `verify` run on the real
+//! The throughput bench (`bench throughput`): how fast `record` and `verify` run on the real
 //! channel set and code paths, in how much memory, against the bound the machine sets, and what the
 //! integration itself costs.
 //!
@@ -40,7 +40,7 @@ use std::time::Instant;
 
 /// The scene of the record and verify workloads.
 pub const SCENE: &str = "wobble";
-/// The seven channels of issue 9, in the contract's order.
+/// The seven channels of the throughput workload, in the format's order.
 pub const CHANNELS: [Channel; 7] = [
     Channel::Omega,
     Channel::Angles,
@@ -56,7 +56,7 @@ pub const RATE: f64 = 1000.0;
 pub const CHUNK_SIZE: usize = DEFAULT_CHUNK_SIZE;
 /// Duration of the integration workload (the `wobble` scene's) \[time units\].
 pub const INTEGRATION_DURATION: f64 = 30.0;
-/// Largest state error of the integration workload against the reference (issue 9).
+/// Largest state error of the integration workload against the reference.
 pub const INTEGRATION_ERROR: f64 = 1e-10;
 /// atol values tried for the integration workload, loosest first (rtol = min(1e3·atol, 1e-3)).
 const INTEGRATION_ATOLS: [f64; 7] = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14];
@@ -65,7 +65,7 @@ pub const RHS_EVALUATIONS: u32 = 2_000_000;
 /// Timed integration runs per repeat (one run lasts well under a millisecond).
 pub const INTEGRATION_RUNS: u32 = 200;
 
-/// Targets of issue 9.
+/// The throughput targets.
 pub mod targets {
     /// Recording, messages per second.
     pub const RECORD_MESSAGES_PER_SECOND: f64 = 3e6;

@@ -1,4 +1,4 @@
-//! Command-line parsing and the exit-code policy (CONTRACT: exit codes). Only this module prints.
+//! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints.
 
 mod bench;
 mod record;
@@ -32,7 +32,7 @@ enum Command {
     Bench(bench::BenchArgs),
 }
 
-/// What a command ended with; the one place exit codes are decided (CONTRACT: exit codes).
+/// What a command ended with; the one place exit codes are decided (format.md: Exit codes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Outcome {
     /// 0: finished.

@@ -1,4 +1,4 @@
-//! The `coin_log.*` message types (CONTRACT: Channels). Each type deserialises strictly (unknown or missing
+//! The `coin_log.*` message types (format.md: Channels and fields). Each type deserialises strictly (unknown or missing
 //! fields rejected) for `verify`, and writes itself as compact JSON straight into a reused buffer for the
 //! recorder's hot path: shortest round-trip floats (ryu), fields in the schema's order, no allocation.
 //!
@@ -104,7 +104,7 @@ message!(
 });
 
 message!(
-    /// `/coin/quaternion`: q of NOTES §1.
+    /// `/coin/quaternion`: q of physics §1.
     QuaternionMessage, "coin_log.Quaternion", {
     /// Simulation time.
     t,
@@ -162,7 +162,7 @@ message!(
 });
 
 message!(
-    /// `/coin/invariants`: C1, C2 of NOTES §6.
+    /// `/coin/invariants`: C1, C2 of physics §6.
     InvariantsMessage, "coin_log.Invariants", {
     /// Simulation time.
     t,

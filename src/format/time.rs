@@ -1,4 +1,4 @@
-//! The one conversion from simulation time to MCAP nanoseconds (CONTRACT: log_time = round(t·10⁹)).
+//! The one conversion from simulation time to MCAP nanoseconds (format.md: log_time = round(t·10⁹)).
 
 use thiserror::Error;
 

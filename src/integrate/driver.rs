@@ -11,7 +11,7 @@ pub const MAX_EVENTS: usize = 8;
 const EVENT_TIME_TOLERANCE: f64 = 1e-13;
 
 /// Grid samples within this time before an event are dropped in favour of the sample at the event, so
-/// that no two samples round to the same nanosecond (CONTRACT: log_time = round(t·10⁹), strictly
+/// that no two samples round to the same nanosecond (format.md: log_time = round(t·10⁹), strictly
 /// increasing per channel).
 pub const EVENT_SAMPLE_GAP: f64 = 2e-9;
 

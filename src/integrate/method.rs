@@ -1,4 +1,4 @@
-//! The user-facing choice of integrator (CONTRACT: Integrators) and the one dispatch from it to a stepper.
+//! The user-facing choice of integrator (format.md: record) and the one dispatch from it to a stepper.
 
 use super::driver::{run, EventFunctions, Flow, RunOutcome, RunSettings};
 use super::{Dop853, Dopri5, Gauss4, OdeSystem, Rk4};

@@ -1,4 +1,4 @@
-//! A pipelined, deterministic, chunked MCAP writer (issue 9): the calling thread appends messages to an
+//! A pipelined, deterministic, chunked MCAP writer: the calling thread appends messages to an
 //! uncompressed chunk while earlier chunks are compressed whole on a worker thread.
 //!
 //! Written by hand because `mcap::Writer` (0.26) cannot compress a whole chunk on another thread: it

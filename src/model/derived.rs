@@ -1,10 +1,10 @@
-//! Quantities derived from a state (NOTES §1, §3): centre, contact point, quaternion, energy, reaction.
+//! Quantities derived from a state (physics §1, §3): centre, contact point, quaternion, energy, reaction.
 
 use super::equations::Coin;
 use super::state::State;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-/// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (NOTES §1: spin ψ about z, then lean θ about x, then
+/// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (physics §1: spin ψ about z, then lean θ about x, then
 /// heading φ about y; rotation matrix eq (7)), a dimensionless unit quaternion acting on the coin lying in
 /// the x–y plane with normal +z (world frame, y up). Computed from the unwrapped angles, so it is continuous in time and not
 /// forced to w ≥ 0. Its components (i, j, k, w) are Foxglove's (x, y, z, w).
@@ -31,14 +31,14 @@ pub fn orientation(s: &State) -> UnitQuaternion<f64> {
     UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z))
 }
 
-/// Centre of the coin in the world frame: (x, a cos θ, z) \[length\] (NOTES §1).
+/// Centre of the coin in the world frame: (x, a cos θ, z) \[length\] (physics §1).
 #[must_use]
 pub fn centre(coin: &Coin, s: &State) -> Vector3<f64> {
     Vector3::new(s.x, coin.params().radius() * s.theta.cos(), s.z)
 }
 
 /// Contact point on the table: x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y = 0 \[length\]
-/// (NOTES §3).
+/// (physics §3).
 #[must_use]
 pub fn contact_point(coin: &Coin, s: &State) -> Vector3<f64> {
     let a = coin.params().radius();
@@ -58,7 +58,7 @@ pub struct Energy {
     pub potential: f64,
 }
 
-/// Energy, NOTES §3: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ.
+/// Energy, physics §3: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ.
 ///
 /// ```
 /// use coin_log::model::{energy, Coin, CoinParams, State};
@@ -84,18 +84,18 @@ pub fn energy(coin: &Coin, s: &State) -> Energy {
     }
 }
 
-/// The table's reaction on the coin (NOTES §3).
+/// The table's reaction on the coin (physics §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reaction {
     /// R = M dv/dt + Mg e_y, world components (y up) \[force\].
     pub force: Vector3<f64>,
-    /// Friction magnitude F = √(R_x² + R_z²) (NOTES §3, corrected; §8 item 4).
+    /// Friction magnitude F = √(R_x² + R_z²) (physics §3, corrected; §8 item 4).
     pub friction: f64,
     /// Normal force N = R_y.
     pub normal: f64,
 }
 
-/// Reaction R of the table (NOTES §3), from the state and eqs (14)–(16):
+/// Reaction R of the table (physics §3), from the state and eqs (14)–(16):
 /// R_x = Ma(−(ω̇_Z − ω_X ω_Y) cos φ − (ω_X² − ω_Y ω_Z tan θ) sin θ sin φ + (ω̇_X + ω_Y ω_Z) cos θ sin φ),
 /// R_y = N = Ma(−(ω_X² − ω_Y ω_Z tan θ) cos θ − (ω̇_X + ω_Y ω_Z) sin θ) + Mg,
 /// R_z = Ma((ω̇_Z − ω_X ω_Y) sin φ − (ω_X² − ω_Y ω_Z tan θ) sin θ cos φ + (ω̇_X + ω_Y ω_Z) cos θ cos φ).

@@ -1,4 +1,4 @@
-//! The equations of motion of the rolling coin, eqs (14)–(19) of NOTES §2, plus ẋ and ż.
+//! The equations of motion of the rolling coin, eqs (14)–(19) of physics §2, plus ẋ and ż.
 
 use super::params::CoinParams;
 use super::state::{StateRate, STATE_LEN};
@@ -99,7 +99,7 @@ impl Coin {
     }
 
     /// The right-hand side: eqs (14)–(19) and the centre's velocity
-    /// ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ), ż = a(ω_Z sin φ + ω_X cos θ cos φ) (NOTES §2).
+    /// ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ), ż = a(ω_Z sin φ + ω_X cos θ cos φ) (physics §2).
     /// Writes into a caller-owned buffer; no allocation.
     #[inline]
     pub fn derivative(&self, y: &[f64; STATE_LEN], dydt: &mut StateRate) {

@@ -1,4 +1,4 @@
-//! Chaplygin–Appell integrals C1, C2 (NOTES §6): two conserved quantities besides the energy.
+//! Chaplygin–Appell integrals C1, C2 (physics §6): two conserved quantities besides the energy.
 //!
 //! With ω_X = θ̇, eqs (15)–(16) are linear in (ω_Y, ω_Z) with θ as the independent variable, and ω_Z solves
 //! Legendre's equation in s = sin θ,
@@ -24,7 +24,7 @@
 //! dp/ds = μ y. Two convergent expansions, glued at |s| = ½ (for μ ≤ 4; see below):
 //!
 //! * **|s| ≤ ½: Taylor series about s = 0**, a_{m+2} = (m² + m + μ)/((m + 2)(m + 1)) a_m, summed in t = s² ≤ ¼.
-//!   This is ₂F₁(A, B; ½; s²) and s ₂F₁(A + ½, B + ½; 3/2; s²) of NOTES §6, written with μ alone, so real
+//!   This is ₂F₁(A, B; ½; s²) and s ₂F₁(A + ½, B + ½; 3/2; s²) of physics §6, written with μ alone, so real
 //!   A, B (μ < ¼), complex conjugate A, B (μ > ¼) and μ = ¼ are one and the same code path.
 //! * **|s| > ½: Frobenius expansion about s = 1** in x = (1 − |s|)/2 ≤ ¼, the logarithmic case of
 //!   x(1 − x) y″ + (1 − 2x) y′ − μ y = 0 (indicial roots 0, 0):
@@ -56,7 +56,7 @@
 //!
 //! Each basis function is accurate to a few ulp of its own size (y_e, y_o, p_e, p_o are all positive on
 //! 0 < s < 1, so relative error is meaningful): against an independent integration of Legendre's equation
-//! (`tests/invariants.rs`), ≤ 3e-15 for μ ≤ 2.7 and ≤ 8e-15 up to μ = 100, over |θ| ≤ 1.5705. C1, C2 then
+//! (`tests/it/invariants.rs`), ≤ 3e-15 for μ ≤ 2.7 and ≤ 8e-15 up to μ = 100, over |θ| ≤ 1.5705. C1, C2 then
 //! carry a few ulp of the *term scale* |cos²θ y′ ω_Z| + |cos θ y ω_Y / k|, the size of what is summed.
 //! The map (ω_Y, ω_Z) → (C1, C2) has determinant −cos θ / k, so |C1| + |C2| (the contract's drift
 //! denominator) can be smaller than the term scale, by at most a factor of order 1/cos θ (and exp(2√μ|θ|)
@@ -109,7 +109,7 @@ pub enum InvariantsError {
     },
 }
 
-/// The two Chaplygin–Appell integrals of one state (NOTES §6).
+/// The two Chaplygin–Appell integrals of one state (physics §6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Invariants {
     /// C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k [rad/time].
@@ -118,7 +118,7 @@ pub struct Invariants {
     pub c2: f64,
 }
 
-/// The Legendre solutions of NOTES §6 and their derivatives at one s = sin θ.
+/// The Legendre solutions of physics §6 and their derivatives at one s = sin θ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LegendreBasis {
     /// y_e(s), the even solution with y_e(0) = 1, y_e′(0) = 0.
@@ -168,7 +168,7 @@ pub struct Chaplygin {
 }
 
 impl Chaplygin {
-    /// Precomputes the expansions of NOTES §6 for `params`.
+    /// Precomputes the expansions of physics §6 for `params`.
     ///
     /// # Errors
     /// [`InvariantsError::MuTooLarge`] if μ > [`MU_MAX`] (no real body; see there).
@@ -217,13 +217,13 @@ impl Chaplygin {
         Ok(chaplygin)
     }
 
-    /// μ = I_Z Ma² / (I_X (I_Z + Ma²)) (NOTES §6).
+    /// μ = I_Z Ma² / (I_X (I_Z + Ma²)) (physics §6).
     #[must_use]
     pub fn mu(&self) -> f64 {
         self.mu
     }
 
-    /// k = (I_Z + Ma²)/(Ma²) (NOTES §6).
+    /// k = (I_Z + Ma²)/(Ma²) (physics §6).
     #[must_use]
     pub fn k(&self) -> f64 {
         1.0 / self.inverse_k
@@ -241,9 +241,9 @@ impl Chaplygin {
         (self.centre.len(), self.edge.len())
     }
 
-    /// C1, C2 of NOTES §6 at lean θ (rad) and lean-frame ω_Y, ω_Z (rad/time).
+    /// C1, C2 of physics §6 at lean θ (rad) and lean-frame ω_Y, ω_Z (rad/time).
     ///
-    /// Meaningful for |θ| < π/2 (the rim-contact model, NOTES §7); the formula is evaluated literally with
+    /// Meaningful for |θ| < π/2 (the rim-contact model, physics §7); the formula is evaluated literally with
     /// s = sin θ, cos θ for any finite θ. A non-finite input gives NaN. No allocation.
     #[must_use]
     #[inline]

@@ -1,4 +1,4 @@
-//! The rolling coin: parameters, state, equations of motion and derived quantities (NOTES §1–§6).
+//! The rolling coin: parameters, state, equations of motion and derived quantities (physics §1–§6).
 //! Pure functions; no I/O and no knowledge of integrators or files.
 
 mod derived;

@@ -1,4 +1,4 @@
-//! Body parameters of the coin: mass M, radius a, gravity g and the axisymmetric inertia (NOTES §1–§2).
+//! Body parameters of the coin: mass M, radius a, gravity g and the axisymmetric inertia (physics §1–§2).
 
 use thiserror::Error;
 
@@ -21,9 +21,9 @@ pub enum ParamError {
 /// How the axisymmetric inertia is specified.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Inertia {
-    /// Thin uniform disk: I_X = Ma²/4, I_Z = Ma²/2 (NOTES §2).
+    /// Thin uniform disk: I_X = Ma²/4, I_Z = Ma²/2 (physics §2).
     ThinDisk,
-    /// Thin ring: I_X = Ma²/2, I_Z = Ma² (NOTES §2).
+    /// Thin ring: I_X = Ma²/2, I_Z = Ma² (physics §2).
     Hoop,
     /// Explicit moments about a diameter (`inertia_x`) and the symmetry axis (`inertia_z`), in M·length².
     Explicit {
@@ -149,12 +149,12 @@ impl CoinParams {
     pub fn ma2(&self) -> f64 {
         self.mass * self.radius * self.radius
     }
-    /// The natural time unit √(a/g) (NOTES §2).
+    /// The natural time unit √(a/g) (physics §2).
     #[must_use]
     pub fn time_unit(&self) -> f64 {
         (self.radius / self.gravity).sqrt()
     }
-    /// The energy scale M g a used to make energy drift relative (CONTRACT, verify).
+    /// The energy scale M g a used to make energy drift relative (format.md, verify).
     #[must_use]
     pub fn energy_scale(&self) -> f64 {
         self.mass * self.gravity * self.radius

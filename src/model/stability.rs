@@ -1,8 +1,8 @@
-//! Linear stability of the steady motions (NOTES §5).
+//! Linear stability of the steady motions (physics §5).
 
 use super::equations::Coin;
 
-/// λ² of straight rolling at spin ω_Z0 (NOTES §5):
+/// λ² of straight rolling at spin ω_Z0 (physics §5):
 /// λ² = (Mga − I_Z(I_Z + Ma²) ω_Z0² / I_X) / (I_X + Ma²). Positive: the tilt grows like e^{λt};
 /// negative: it oscillates at σ = √(−λ²).
 ///
@@ -20,7 +20,7 @@ pub fn straight_lambda_squared(coin: &Coin, omega_z0: f64) -> f64 {
         / (p.inertia_x() + p.ma2())
 }
 
-/// Critical spin ω_c of straight rolling: ω_c² = Mga I_X / (I_Z (I_Z + Ma²)) (NOTES §5); unstable while
+/// Critical spin ω_c of straight rolling: ω_c² = Mga I_X / (I_Z (I_Z + Ma²)) (physics §5); unstable while
 /// |ω_Z0| < ω_c. Thin disk, unit scales: 1/√3.
 #[must_use]
 pub fn critical_spin(coin: &Coin) -> f64 {
@@ -30,7 +30,7 @@ pub fn critical_spin(coin: &Coin) -> f64 {
     .sqrt()
 }
 
-/// σ² of the upright spin about the vertical diameter at rate Ω (NOTES §5): σ² = Ω² − Mga/(I_X + Ma²).
+/// σ² of the upright spin about the vertical diameter at rate Ω (physics §5): σ² = Ω² − Mga/(I_X + Ma²).
 /// Stable iff σ² > 0; σ is the small-oscillation frequency.
 #[must_use]
 pub fn spin_upright_sigma_squared(coin: &Coin, omega: f64) -> f64 {
@@ -38,7 +38,7 @@ pub fn spin_upright_sigma_squared(coin: &Coin, omega: f64) -> f64 {
     omega * omega - p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2())
 }
 
-/// σ² of the nutation about solution 2, centre at rest at lean θ₀ (NOTES §5):
+/// σ² of the nutation about solution 2, centre at rest at lean θ₀ (physics §5):
 /// σ² = Mga(Ma² cos θ₀ / I_X + 3 sin²θ₀ / cos θ₀)/(I_X + Ma²). Always positive: always stable.
 #[must_use]
 pub fn centre_fixed_sigma_squared(coin: &Coin, theta0: f64) -> f64 {

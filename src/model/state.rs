@@ -1,4 +1,4 @@
-//! The state of the rolling coin (NOTES §1): angles, lean-frame angular velocity and centre position.
+//! The state of the rolling coin (physics §1): angles, lean-frame angular velocity and centre position.
 
 /// Number of state components.
 pub const STATE_LEN: usize = 8;

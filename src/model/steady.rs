@@ -1,4 +1,4 @@
-//! Steady motions (NOTES §4) and their analytic properties.
+//! Steady motions (physics §4) and their analytic properties.
 //!
 //! In every steady motion ω_X = 0 and θ, ω_Y, ω_Z are constant; eq (14) then reduces to the steady family
 //! I_X tan θ ω_Y² + (I_Z + Ma²) ω_Z ω_Y − Mga sin θ = 0, which gives ω_Y for a chosen θ and ω_Z.
@@ -9,7 +9,7 @@ use std::fmt;
 use std::str::FromStr;
 use thiserror::Error;
 
-/// Which root of the steady family's quadratic in ω_Y (NOTES §4 item 3).
+/// Which root of the steady family's quadratic in ω_Y (physics §4.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Branch {
     /// ω_Y = (−B + √D) / (2A): for θ, ω_Z > 0 the large, outer circle of the note.
@@ -54,7 +54,7 @@ impl FromStr for Branch {
 }
 
 /// The four families of steady motion by name: the `kind` of a scene's `initial.steady` and the
-/// `steady_kind` of a recording's metadata (NOTES §4, §5).
+/// `steady_kind` of a recording's metadata (physics §4, §5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SteadyFamily {
     /// Upright, rolling straight.
@@ -112,19 +112,19 @@ impl FromStr for SteadyFamily {
 /// A steady motion to build.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SteadyKind {
-    /// Upright, rolling straight: θ = ω_X = ω_Y = 0, ω_Z constant (NOTES §4 item 1).
+    /// Upright, rolling straight: θ = ω_X = ω_Y = 0, ω_Z constant (physics §4.1).
     Straight {
         /// Spin about the normal [rad/time].
         omega_z: f64,
     },
-    /// Centre at rest, the coin rolling round it: ω_Z = 0, ω_Y² = Mga cos θ / I_X (NOTES §4 item 2).
+    /// Centre at rest, the coin rolling round it: ω_Z = 0, ω_Y² = Mga cos θ / I_X (physics §4.2).
     CentreFixed {
         /// Lean \[rad\], 0 < |θ| < π/2.
         theta: f64,
         /// Sign of ω_Y: `Plus` gives ω_Y > 0.
         branch: Branch,
     },
-    /// Circular rolling on either branch (NOTES §4 item 3).
+    /// Circular rolling on either branch (physics §4.3).
     Circle {
         /// Lean \[rad\], 0 < |θ| < π/2.
         theta: f64,
@@ -133,7 +133,7 @@ pub enum SteadyKind {
         /// Root of the steady quadratic.
         branch: Branch,
     },
-    /// Spinning upright in place about the vertical diameter: θ = 0, ω_Z = 0, ω_Y = Ω (NOTES §5).
+    /// Spinning upright in place about the vertical diameter: θ = 0, ω_Z = 0, ω_Y = Ω (physics §5).
     SpinUpright {
         /// Ω [rad/time].
         omega_y: f64,
@@ -184,7 +184,7 @@ pub enum SteadyError {
     },
 }
 
-/// A steady motion: its initial state and analytic properties (NOTES §4).
+/// A steady motion: its initial state and analytic properties (physics §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Steady {
     /// What was asked for.
@@ -201,7 +201,7 @@ pub struct Steady {
     pub r_c: Option<f64>,
 }
 
-/// ω_Y on the steady family for given θ and ω_Z (NOTES §4): the root of
+/// ω_Y on the steady family for given θ and ω_Z (physics §4): the root of
 /// I_X tan θ ω_Y² + (I_Z + Ma²) ω_Z ω_Y − Mga sin θ = 0 on `branch`, computed without cancellation.
 /// Requires tan θ ≠ 0.
 #[must_use]
@@ -253,7 +253,7 @@ impl Steady {
     /// use coin_log::model::{Branch, Coin, CoinParams, Steady, SteadyKind};
     /// let coin = Coin::new(CoinParams::unit_disk());
     /// let s = Steady::new(&coin, SteadyKind::Circle { theta: 0.3, omega_z: 1.0, branch: Branch::Plus }).unwrap();
-    /// assert!((s.r_g.unwrap() - 4.897855).abs() < 1e-6); // NOTES §4 example
+    /// assert!((s.r_g.unwrap() - 4.897855).abs() < 1e-6); // physics §4 example
     /// ```
     ///
     /// # Errors
@@ -306,7 +306,7 @@ impl Steady {
         let (r_g, r_c) = match kind {
             SteadyKind::Straight { .. } => (None, None),
             SteadyKind::SpinUpright { .. } => (Some(0.0), Some(0.0)),
-            // R_G = a|ω_Z cos θ / ω_Y|, R_C = a|ω_Z cos θ / ω_Y + sin θ| (NOTES §4 item 3; item 2 with ω_Z = 0).
+            // R_G = a|ω_Z cos θ / ω_Y|, R_C = a|ω_Z cos θ / ω_Y + sin θ| (physics §4.3; item 2 with ω_Z = 0).
             SteadyKind::CentreFixed { .. } | SteadyKind::Circle { .. } => {
                 let signed = omega_z * ct / omega_y;
                 (Some(a * signed.abs()), Some(a * (signed + st).abs()))

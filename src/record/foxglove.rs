@@ -1,17 +1,17 @@
 //! Foxglove's 3D view of the coin: `/tf` (world → table → coin) and `/scene` (the coin as a cylinder with a
-//! mark, the table, the contact track), as CONTRACT (Channels) and FOXGLOVE.md describe.
+//! mark, the table, the contact track), as format.md (Channels) and FOXGLOVE.md describe.
 //!
 //! # Frames
 //! - `world`: Foxglove's convention, z up. The root, so that the 3D panel has a fixed frame to follow.
-//! - `table`: the note's world frame (NOTES §1: the table is the z–x plane, y up). Its transform from
+//! - `table`: the note's world frame (physics §1: the table is the z–x plane, y up). Its transform from
 //!   `world` is the static rotation R = rotation by +90° about x, q_T = (sin 45°, 0, 0, cos 45°)
 //!   ([`TABLE_ROTATION`]): it takes the note's x to world x, y (up) to world z, z to world −y. It is a
 //!   proper rotation (det +1), so handedness is kept and the note's quaternion needs no change. Published
 //!   once, at the first sample (t = 0), before any scene update (Foxglove preloads `/tf`, so a transform
 //!   published once is known at every time, seeks included).
-//! - `coin`: translation = centre (x, a cos θ, z) in `table` (NOTES §1), rotation = q = q(e_y, φ) ·
+//! - `coin`: translation = centre (x, a cos θ, z) in `table` (physics §1), rotation = q = q(e_y, φ) ·
 //!   q(e_x, θ) · q(e_z, ψ) from [`orientation`]. q rotates the coin lying in the x–y plane with normal +z,
-//!   so in the `coin` frame the coin is a cylinder whose axis is z (NOTES §8 item 5).
+//!   so in the `coin` frame the coin is a cylinder whose axis is z (physics §8 item 5).
 //!   Published at **every data sample**, not at the display rate: the 3D panel interpolates between
 //!   transforms by slerp (the shortest arc), so a coin turning by more than π between two transforms
 //!   would be drawn spinning backwards; at the data rate the transform is also exactly the recorded state
@@ -29,7 +29,7 @@
 //!   contact point snapped to a 10a grid. Republished in every update rather than once: after a seek
 //!   Foxglove shows only the last `/scene` message, and a table sent once at t = 0 would vanish. Cost: a
 //!   few hundred bytes per update before compression (a constant factor, linear in duration).
-//! - `track-N` (frame `table`): a `LinePrimitive` strip of the contact points (NOTES §3) since the previous
+//! - `track-N` (frame `table`): a `LinePrimitive` strip of the contact points (physics §3) since the previous
 //!   update, starting with the last point of the previous strip so the track is continuous. Each update
 //!   adds a fresh id and never repeats older points, so the bytes are linear in duration. Points closer
 //!   than [`TRACK_MIN_SPACING`]·a to the previous kept point are skipped (a coin spinning in place adds
@@ -757,7 +757,7 @@ mod tests {
     fn the_coin_frame_puts_the_rim_point_minus_a_e_y_on_the_contact_point() {
         // Translation + rotation of /tf table → coin must carry the coin-frame point c = −a e_Y of the
         // lean frame (in the coin frame: the rim point (0, −a, 0) before spin ψ, i.e. rotated back by ψ)
-        // onto the model's contact point (NOTES §3): checks the frame against an independent formula.
+        // onto the model's contact point (physics §3): checks the frame against an independent formula.
         let coin = unit_coin();
         let mut fox = Foxglove3d::new(&coin, 0.05, true, false);
         let mut batch = FoxgloveBatch::default();

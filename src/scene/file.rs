@@ -1,4 +1,4 @@
-//! The scene file exactly as written (CONTRACT: Scene files): every table refuses unknown keys, every
+//! The scene file exactly as written (format.md: Scene files): every table refuses unknown keys, every
 //! optional key is an `Option`, names (shape, integrator, channels, steady kind) stay strings so that
 //! validation can report every bad one at once with its key, value and allowed values.
 
@@ -72,7 +72,7 @@ pub struct InitialFile {
     /// Centre z \[length\] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub z: Option<f64>,
-    /// A steady motion (NOTES §4) whose ω the solver fills in.
+    /// A steady motion (physics §4) whose ω the solver fills in.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steady: Option<SteadyFile>,
     /// A kick added to the initial state of either form.

@@ -1,4 +1,4 @@
-//! What to simulate (CONTRACT: Scene files). Two stages: [`SceneFile`] mirrors the TOML exactly (unknown keys
+//! What to simulate (format.md: Scene files). Two stages: [`SceneFile`] mirrors the TOML exactly (unknown keys
 //! refused), [`Scene`] is the validated, resolved scene (defaults filled in, steady motions solved, the step
 //! fitted to the sampling grid). Only a [`Scene`] reaches the recorder.
 //!
@@ -20,7 +20,7 @@ use crate::integrate::MethodConfig;
 use crate::model::{Coin, CoinParams, Inertia, State, Steady};
 use std::fmt;
 
-/// Defaults of the optional scene keys (CONTRACT: Scene files).
+/// Defaults of the optional scene keys (format.md: Scene files).
 pub mod defaults {
     /// Samples per time unit.
     pub const RATE: f64 = 100.0;
@@ -116,7 +116,7 @@ fn format_problems(problems: &[Problem]) -> String {
 pub enum InitialSpec {
     /// θ and ω given.
     Explicit,
-    /// Solved from a steady motion (NOTES §4).
+    /// Solved from a steady motion (physics §4).
     Steady(Steady),
 }
 

@@ -1,5 +1,5 @@
 //! Changing a scene from the command line: `--set KEY=VALUE` edits the TOML table before it is read
-//! (CONTRACT: `--set`), then the explicit flags (`--duration`, `--rate`, ...) apply on top.
+//! (format.md: `--set`), then the explicit flags (`--duration`, `--rate`, ...) apply on top.
 
 use super::file::{RecordFile, RunFile, SceneFile};
 use super::SceneError;

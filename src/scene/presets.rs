@@ -1,7 +1,7 @@
-//! The built-in scenes (issue 5), each also a file `datasets/scenes/<name>.toml` written by
+//! The built-in scenes, each also a file `datasets/scenes/<name>.toml` written by
 //! `coin-log scenes --show <name>` (a test checks that the files and these presets agree).
 //!
-//! Unless said otherwise: the unit thin disk (M = a = g = 1, NOTES §2), the default run settings and all
+//! Unless said otherwise: the unit thin disk (M = a = g = 1, physics §2), the default run settings and all
 //! channels, durations of 20–30 time units at 100 samples per unit so that recordings stay small.
 
 use super::file::{BodyFile, InitialFile, PerturbationFile, RunFile, SceneFile, SteadyFile};
@@ -29,7 +29,7 @@ pub const NAMES: [&str; 14] = [
 pub fn preset(name: &str) -> Option<SceneFile> {
     Some(match name {
         "straight" => steady(
-            "Upright coin rolling straight at ω_Z = 1, above the critical spin 1/√3: stable (NOTES §4.1, §5)",
+            "Upright coin rolling straight at ω_Z = 1, above the critical spin 1/√3: stable (physics §4.1, §5)",
             straight(1.0),
             20.0,
         ),
@@ -42,13 +42,13 @@ pub fn preset(name: &str) -> Option<SceneFile> {
                 ..steady_initial(straight(0.3))
             },
             ..steady(
-                "Straight rolling at ω_Z = 0.3 < ω_c = 1/√3 with a 1e-6 tilt: the tilt grows like e^{λt}, λ = 0.764, to about 1 rad by t = 19 (NOTES §5)",
+                "Straight rolling at ω_Z = 0.3 < ω_c = 1/√3 with a 1e-6 tilt: the tilt grows like e^{λt}, λ = 0.764, to about 1 rad by t = 19 (physics §5)",
                 straight(0.3),
                 20.0,
             )
         },
         "centre-fixed" => steady(
-            "Centre at rest, the coin leaning θ = 0.5 and rolling round it (NOTES §4.2)",
+            "Centre at rest, the coin leaning θ = 0.5 and rolling round it (physics §4.2)",
             SteadyFile {
                 kind: "centre-fixed".into(),
                 theta: Some(0.5),
@@ -57,22 +57,22 @@ pub fn preset(name: &str) -> Option<SceneFile> {
             20.0,
         ),
         "circle-plus" => steady(
-            "Steady circle θ = 0.3, ω_Z = 1 on the + branch: R_G = 4.8979, R_C = 5.1934 (NOTES §4.3 example)",
+            "Steady circle θ = 0.3, ω_Z = 1 on the + branch: R_G = 4.8979, R_C = 5.1934 (physics §4.3 example)",
             circle(0.3, 1.0, "+"),
             30.0,
         ),
         "circle-minus" => steady(
-            "Steady circle θ = 0.3, ω_Z = 1 on the − branch: a fast, tight turn (NOTES §4.3)",
+            "Steady circle θ = 0.3, ω_Z = 1 on the − branch: a fast, tight turn (physics §4.3)",
             circle(0.3, 1.0, "-"),
             20.0,
         ),
         "large-circle" => steady(
-            "Steady circle θ = 0.05, ω_Z = 2 on the + branch: R_G ≈ (3/2) ω_Z²/sin θ ≈ 120 (NOTES §4.4)",
+            "Steady circle θ = 0.05, ω_Z = 2 on the + branch: R_G ≈ (3/2) ω_Z²/sin θ ≈ 120 (physics §4.4)",
             circle(0.05, 2.0, "+"),
             30.0,
         ),
         "spin-upright" => steady(
-            "Spinning upright in place about the vertical at Ω = 2 > √(4/5): stable (NOTES §5)",
+            "Spinning upright in place about the vertical at Ω = 2 > √(4/5): stable (physics §5)",
             SteadyFile {
                 kind: "spin-upright".into(),
                 omega_y: Some(2.0),
@@ -120,7 +120,7 @@ pub fn preset(name: &str) -> Option<SceneFile> {
                 })
             },
             ..steady(
-                "Centre-fixed motion at θ = 1.5, 0.07 rad from flat, kicked by 1e-3: tan θ ≈ 14, fast φ̇ (NOTES §7)",
+                "Centre-fixed motion at θ = 1.5, 0.07 rad from flat, kicked by 1e-3: tan θ ≈ 14, fast φ̇ (physics §7)",
                 SteadyFile::default(),
                 20.0,
             )

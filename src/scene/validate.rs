@@ -1,4 +1,4 @@
-//! [`SceneFile`] → [`Scene`]: every range check of CONTRACT, all problems collected before failing, and the
+//! [`SceneFile`] → [`Scene`]: every range check of format.md, all problems collected before failing, and the
 //! way back (a resolved scene as a file with every default written out).
 
 use super::file::{

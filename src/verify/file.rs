@@ -562,7 +562,7 @@ fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances 
     )
 }
 
-/// CONTRACT: a file in which integrity, energy and at least one of constraint / steady could not run
+/// format.md: a file in which integrity, energy and at least one of constraint / steady could not run
 /// fails, whatever else passed. The check that could not run is turned into a failure saying so.
 fn require_physics(results: &mut [CheckResult]) {
     let skipped = |results: &[CheckResult], id: CheckId| {

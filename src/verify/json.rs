@@ -1,4 +1,4 @@
-//! The fast path of message parsing (issue 9): a flat JSON object of numbers in exactly the form the
+//! The fast path of message parsing: a flat JSON object of numbers in exactly the form the
 //! recorder writes (`{"t":0.001,"x":1.5,...}`: the schema's fields in order, no whitespace).
 //!
 //! Anything else (other order, whitespace, escapes, unknown or missing fields, a number outside JSON's

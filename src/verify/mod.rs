@@ -1,4 +1,4 @@
-//! `coin-log verify`: judge a stored log from the file alone (CONTRACT: verify).
+//! `coin-log verify`: judge a stored log from the file alone (format.md: verify).
 //!
 //! The parameters come from the file's `coin-log` metadata; the physics is recomputed from the stored
 //! channels, never re-simulated. The file is read once, as a stream ([`crate::mcap_io::read`]), in memory

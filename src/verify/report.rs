@@ -1,11 +1,11 @@
-//! What `verify` reports: one [`CheckResult`] per check id and file, serialised exactly as CONTRACT's
+//! What `verify` reports: one [`CheckResult`] per check id and file, serialised exactly as format.md's
 //! `--json` shape (`{"files": [{"path", "exit_code", "checks": [{"id", "status", "value", "tolerance",
 //! "reason"}]}]}`).
 
 use serde::Serialize;
 use std::fmt;
 
-/// The checks, with the contract's ids (CONTRACT: verify).
+/// The checks, with the contract's ids (format.md: verify).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum CheckId {
@@ -13,9 +13,9 @@ pub enum CheckId {
     Integrity,
     /// Energy recomputed from the stored state; its drift and agreement with `/coin/energy`.
     Energy,
-    /// Chaplygin–Appell integrals C1, C2 (NOTES §6).
+    /// Chaplygin–Appell integrals C1, C2 (physics §6).
     Invariants,
-    /// Steady motions stay steady (NOTES §4).
+    /// Steady motions stay steady (physics §4).
     Steady,
     /// The rolling constraint: centre velocity from positions against a(−ω_Z e_X + ω_X e_Z).
     Constraint,

@@ -1,4 +1,4 @@
-//! Default tolerances of `verify`, derived from how the log was integrated (CONTRACT: verify).
+//! Default tolerances of `verify`, derived from how the log was integrated (format.md: verify).
 //!
 //! Let τ = √(a/g) be the time unit, T the recorded span, Ω = max(max|ω|, 1/τ) over the run, and
 //!

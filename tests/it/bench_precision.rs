@@ -1,4 +1,4 @@
-//! Acceptance of `bench precision` (issue 8) on a reduced sweep: on `wobble`, dop853 reaches a state error
+//! Acceptance of `bench precision` on a reduced sweep: on `wobble`, dop853 reaches a state error
 //! ≤ 1e-10, and every integrator's measured slope (log error against log RHS evaluations, the
 //! deterministic cost; wall time is never asserted) matches its order within ±0.5. The output formats
 //! (CSV columns, SVG) are pinned too.
@@ -11,9 +11,9 @@ use coin_log::bench::ReferenceKind;
 use coin_log::integrate::Method;
 use std::sync::OnceLock;
 
-/// Slopes must match the orders within this (issue 8).
+/// Slopes must match the orders within this.
 const SLOPE_TOLERANCE: f64 = 0.5;
-/// dop853 must reach this state error on wobble (issue 8).
+/// dop853 must reach this state error on wobble.
 const DOP853_TARGET: f64 = 1e-10;
 
 /// The reduced sweep on wobble, computed once for the tests of this file.

@@ -1,4 +1,4 @@
-//! The hard-case suite of `bench stability` (issue 8) as tests, one per case, each with an assertion on
+//! The hard-case suite of `bench stability` as tests, one per case, each with an assertion on
 //! what the case measures. Horizons are those of `SuiteOptions::quick()`: the same 100 nutation periods
 //! for the fast-spin step limits, 10 nutation periods near flat (bench: 20), 20 time units of marginal
 //! rolling (bench: 30), a long horizon of 10³ (bench: 10⁴) and 5 time units of scale invariance (bench: 10).
@@ -128,7 +128,7 @@ fn flat_landing_and_lift_off_are_located_to_1e_9_against_the_quadrature() {
 fn straight_rolling_at_the_critical_spin_grows_like_t_squared() {
     let coin = Coin::new(CoinParams::unit_disk());
     let wc = coin_log::model::critical_spin(&coin);
-    // The linear theory at ω_c is the thin disk's δθ₀(1 + 2t²/5) (NOTES §5).
+    // The linear theory at ω_c is the thin disk's δθ₀(1 + 2t²/5) (physics §5).
     for t in [1.0, 7.0, 20.0] {
         let linear = straight_tilt_linear(&coin, wc, 1.0, t);
         assert!(

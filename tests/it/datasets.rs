@@ -1,4 +1,4 @@
-//! The committed datasets (issue 6): each `coin-log record` line of `datasets/README.md` re-run into a
+//! The committed datasets: each `coin-log record` line of `datasets/README.md` re-run into a
 //! temporary folder gives the committed file byte for byte; the five required scenes are there; every
 //! `.mcap` in `datasets/` is listed; the whole set stays small.
 //!

@@ -1,7 +1,7 @@
 //! Events end a run at the right time: a coin released from rest falls about its contact point, and the
 //! energy integral (I_X + Ma²)·θ̇²/2 = Mga(cos θ₀ − cos θ) gives the time to reach any tilt by quadrature
 //! ([`release_time`], checked in its own unit tests), independently of the integrators. The flat landing (|θ| = π/2 − flat_margin) and the lift-off
-//! (N = 0, NOTES §3/§7) must be located at those times to 1e-9.
+//! (N = 0, physics §3/§7) must be located at those times to 1e-9.
 
 use coin_log::bench::stability::release_time;
 use coin_log::integrate::{
@@ -14,7 +14,7 @@ use std::f64::consts::FRAC_PI_2;
 /// Flat margin of the runs (the contract's default).
 const FLAT_MARGIN: f64 = 1e-4;
 
-/// Required agreement of the event time with the quadrature (issue 4).
+/// Required agreement of the event time with the quadrature.
 const TIME_TOLERANCE: f64 = 1e-9;
 
 /// Tilt where the falling coin's normal force vanishes: with c = cos θ and ω_Y = ω_Z = 0,

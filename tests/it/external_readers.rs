@@ -1,4 +1,4 @@
-//! Independent readers in CI (issue 6): every committed dataset and a fresh recording are read with
+//! Independent readers in CI: every committed dataset and a fresh recording are read with
 //! `@mcap/core`'s indexed reader (the library Foxglove uses; `scripts/readers/check.mjs`) and with the
 //! Python `mcap` package (`scripts/readers/check.py`): all messages decoded, counts equal to the statistics,
 //! `foxglove.*` messages valid against `@foxglove/schemas`, `coin_log.*` against `schemas/`.

@@ -1,4 +1,4 @@
-//! Every formula of NOTES §3 against an independent computation along simulated motions:
+//! Every formula of physics §3 against an independent computation along simulated motions:
 //! energy constant; R = M dv/dt + M g e_y with dv/dt from finite differences of the centre's position;
 //! F = √(R_x² + R_z²) and its closed form; N = Mg − Ma(ω_X² cos θ + ω̇_X sin θ); the quaternion equal to the
 //! rotation of eq (7); the contact point's speed a|ψ̇|.
@@ -123,7 +123,7 @@ fn the_reaction_equals_mass_times_the_differenced_centre_acceleration_plus_weigh
                 &[r.force.x, r.force.y, r.force.z],
                 &expected,
             ));
-            // N from NOTES §3's "equivalently" form, ω̇_X by differences.
+            // N from physics §3's "equivalently" form, ω̇_X by differences.
             let wx_dot = fd(&FD1, &wx, i, 1.0 / big_h);
             let wz_dot = fd(&FD1, &wz, i, 1.0 / big_h);
             let (st, ct) = s.theta.sin_cos();
@@ -156,7 +156,7 @@ fn the_reaction_equals_mass_times_the_differenced_centre_acceleration_plus_weigh
             1e-15,
         );
         physics::check(
-            &format!("{label}: max |F - closed form of NOTES 3| / (M g)"),
+            &format!("{label}: max |F - closed form of physics §3| / (M g)"),
             worst_closed / weight,
             0.0,
             1e-9,
@@ -165,7 +165,7 @@ fn the_reaction_equals_mass_times_the_differenced_centre_acceleration_plus_weigh
 }
 
 /// The centre's velocity from an 8th-order first difference of its position equals the no-slip velocity
-/// −ω × ρ, ρ = −a e_Y, computed from the lean frame of NOTES §1 (not from the library's ẋ, ż).
+/// −ω × ρ, ρ = −a e_Y, computed from the lean frame of physics §1 (not from the library's ẋ, ż).
 #[test]
 fn the_differenced_centre_velocity_is_the_no_slip_velocity() {
     for (label, p) in cases() {
@@ -194,7 +194,7 @@ fn the_differenced_centre_velocity_is_the_no_slip_velocity() {
     }
 }
 
-/// The contact point moves at speed a|ψ̇| (NOTES §3): both sides by 8th-order differences (of the contact
+/// The contact point moves at speed a|ψ̇| (physics §3): both sides by 8th-order differences (of the contact
 /// point and of ψ), so neither eq (19) nor ẋ, ż enter.
 #[test]
 fn the_contact_point_moves_at_speed_a_times_the_spin_rate() {

@@ -1,4 +1,4 @@
-//! What Foxglove needs from a recording (issue 6, FOXGLOVE.md): the frame tree world → table → coin (one
+//! What Foxglove needs from a recording (format.md: Frames and Foxglove output): the frame tree world → table → coin (one
 //! parent each, no cycle, each transform published before a scene update uses its frame), the cylinder in
 //! `coin`, the track in `table`, Foxglove timestamps equal to log times, `/scene` at ≈ 30 per time unit,
 //! and the shipped layout (`/scene` visible, following `world`, the plots on numeric fields).

@@ -355,7 +355,7 @@ fn every_method_shows_its_order_on_the_wobbling_coin() {
     }
 }
 
-/// Relative energy error max|E − E₀| / max(|E₀|, Mga) over the samples of a run (CONTRACT definition).
+/// Relative energy error max|E − E₀| / max(|E₀|, Mga) over the samples of a run (format.md definition).
 fn relative_energy_error(coin: &Coin, samples: &[(f64, [f64; STATE_LEN])], until: f64) -> f64 {
     let scale_of = |y: &[f64; STATE_LEN]| energy(coin, &State::from_array(y)).total;
     let e0 = scale_of(&samples[0].1);

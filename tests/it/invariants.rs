@@ -1,4 +1,4 @@
-//! C1, C2 of NOTES §6: the Legendre basis against an independent integration of Legendre's equation, the
+//! C1, C2 of physics §6: the Legendre basis against an independent integration of Legendre's equation, the
 //! Wronskian, conservation along simulated motions (with negative controls), and dC/dt = 0 at random states.
 //!
 //! The reference integrates Legendre's equation (1 − s²) y″ − 2s y′ − μ y = 0 in the variable τ = artanh s

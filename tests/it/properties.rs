@@ -98,7 +98,7 @@ proptest! {
     #![proptest_config(config())]
 
     /// dE/dt = ∂E/∂θ θ̇ + Σ ∂E/∂ω_i ω̇_i with ∂E/∂θ = −Mga sin θ, ∂E/∂ω_X = (I_X + Ma²) ω_X,
-    /// ∂E/∂ω_Y = I_X ω_Y, ∂E/∂ω_Z = (I_Z + Ma²) ω_Z (NOTES §3), must vanish for the RHS of eqs (14)–(17).
+    /// ∂E/∂ω_Y = I_X ω_Y, ∂E/∂ω_Z = (I_Z + Ma²) ω_Z (physics §3), must vanish for the RHS of eqs (14)–(17).
     /// Scale: the sum of the absolute values of every product that enters.
     #[test]
     fn the_exact_flow_conserves_energy(p in body(), u in state()) {
@@ -126,7 +126,7 @@ proptest! {
     }
 
     /// The centre's velocity from the RHS, (ẋ, −a sin θ θ̇, ż), equals −ω × ρ with ρ = −a e_Y and
-    /// ω = ω_X e_X + ω_Y e_Y + ω_Z e_Z from the lean frame built independently (NOTES §1).
+    /// ω = ω_X e_X + ω_Y e_Y + ω_Z e_Z from the lean frame built independently (physics §1).
     #[test]
     fn the_centre_moves_with_the_no_slip_velocity(p in body(), u in state()) {
         let coin = Coin::new(p);
@@ -141,7 +141,7 @@ proptest! {
     }
 
     /// |q| = 1; q rotates the body normal (0, 0, 1) to e_Z = (cos θ sin φ, −sin θ, cos θ cos φ) (eq (7)'s
-    /// third row, derived from the rotations of NOTES §1); and the contact point is centre − a e_Y with
+    /// third row, derived from the rotations of physics §1); and the contact point is centre − a e_Y with
     /// e_Y = e_Z × (e_y × e_Z)/|e_y × e_Z| built from that rotated normal.
     #[test]
     fn the_quaternion_carries_the_normal_and_places_the_contact_point(p in body(), u in state()) {
@@ -160,7 +160,7 @@ proptest! {
         within("|contact - (centre - a e_Y)|", max_diff(&[cp_lib.x, cp_lib.y, cp_lib.z], &expected), p.radius() * (1.0 + u[6].abs() + u[7].abs()))?;
     }
 
-    /// At any state, the library's reaction (NOTES §3) equals the contact force the Newton–Euler model
+    /// At any state, the library's reaction (physics §3) equals the contact force the Newton–Euler model
     /// solves for, and its angular acceleration, carried to the world frame
     /// (ω̇ = Σ ω̇_i e_i + Ω × ω with the lean frame's rate Ω = θ̇ e_X + φ̇ e_y), equals the Newton–Euler ω̇.
     #[test]

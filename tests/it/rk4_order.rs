@@ -6,7 +6,7 @@
 use crate::support::physics::{self, rate_unit, wobbling};
 use coin_log::model::{Coin, CoinParams};
 
-/// Error floor below which a ratio is not trusted: 1e3 × machine epsilon (issue 3).
+/// Error floor below which a ratio is not trusted: 1e3 × machine epsilon.
 const FLOOR: f64 = 1e3 * f64::EPSILON;
 /// Allowed deviation of the observed order from 4.
 const ORDER_SLACK: f64 = 0.15;

@@ -146,7 +146,7 @@ fn the_angle_model_and_a_newton_euler_model_agree_for_a_scaled_thin_disk() {
     models_agree("thin disk M = 0.5, a = 2, g = 9.81", &p);
 }
 
-/// The contact force the Newton–Euler model solves for is the reaction of NOTES §3.
+/// The contact force the Newton–Euler model solves for is the reaction of physics §3.
 #[test]
 fn the_newton_euler_contact_force_equals_the_reaction_of_notes_section_3() {
     for p in [

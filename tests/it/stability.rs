@@ -1,4 +1,4 @@
-//! Linear stability of the steady motions (NOTES §5), measured from simulated small perturbations and
+//! Linear stability of the steady motions (physics §5), measured from simulated small perturbations and
 //! compared with the formulas: straight rolling's growth rate √λ², its oscillation frequency √(−λ²), the
 //! t² growth at the critical spin, the upright spin's σ and the centre-fixed nutation σ, for the unit thin
 //! disk and general parameters. Perturbations are 1e-10..1e-8 rad, so nonlinear corrections (relative
@@ -14,7 +14,7 @@ use coin_log::model::{
     Branch, Coin, CoinParams, State, Steady, SteadyKind,
 };
 
-/// Relative accuracy required of measured rates and frequencies (issue 3).
+/// Relative accuracy required of measured rates and frequencies.
 const RATE: f64 = 1e-3;
 
 /// (t, θ, ω_X) every rk4 step of 1e-3 natural time units, for `duration` natural time units.
@@ -94,7 +94,7 @@ fn slow_straight_rolling_is_unstable_with_the_growth_rate_of_notes_section_5() {
             RATE,
         );
         if label.starts_with("unit") {
-            // Thin disk, unit scales: λ² = 4/5 (1 − 3 ω_Z0²) (NOTES §5).
+            // Thin disk, unit scales: λ² = 4/5 (1 − 3 ω_Z0²) (physics §5).
             physics::check_relative(
                 "unit disk: lambda^2 formula",
                 lambda2,
@@ -129,7 +129,7 @@ fn fast_straight_rolling_oscillates_at_the_frequency_of_notes_section_5() {
         );
         if label.starts_with("unit") {
             physics::check_relative(
-                "unit disk, w_Z0 = 1: frequency vs NOTES 1.26491",
+                "unit disk, w_Z0 = 1: frequency vs physics §5: 1.26491",
                 measured,
                 1.26491,
                 RATE,
@@ -139,7 +139,7 @@ fn fast_straight_rolling_oscillates_at_the_frequency_of_notes_section_5() {
 }
 
 /// At |ω_Z0| = ω_c the linearisation has a triple zero eigenvalue: a tilt δθ₀ grows like
-/// δθ₀(1 + c t²) with c = Mga / (2(I_X + Ma²)) (thin disk, unit scales: 2/5, NOTES §5), and a pure ω_X kick
+/// δθ₀(1 + c t²) with c = Mga / (2(I_X + Ma²)) (thin disk, unit scales: 2/5, physics §5), and a pure ω_X kick
 /// grows like δω t. Both coefficients are fitted over t ∈ [0, 10] where δθ ≤ 41 δθ₀ = 4e-8.
 #[test]
 fn at_the_critical_spin_a_tilt_grows_quadratically_and_a_kick_linearly() {
@@ -175,7 +175,12 @@ fn at_the_critical_spin_a_tilt_grows_quadratically_and_a_kick_linearly() {
             RATE,
         );
         if label == "unit disk" {
-            physics::check_relative("unit disk: t^2 coefficient vs NOTES 2/5", c, 0.4, RATE);
+            physics::check_relative(
+                "unit disk: t^2 coefficient vs physics §5: 2/5",
+                c,
+                0.4,
+                RATE,
+            );
         }
         let shape = samples
             .iter()

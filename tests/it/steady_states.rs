@@ -1,4 +1,4 @@
-//! The steady motions of NOTES §4 stay steady when integrated: θ and ω stay constant, φ and ψ advance at
+//! The steady motions of physics §4 stay steady when integrated: θ and ω stay constant, φ and ψ advance at
 //! the analytic rates, the centre stays on the circle of radius R_G about `circle_centre` and the contact
 //! point on the circle of radius R_C (or, rolling straight, on the analytic line), over 20 time units
 //! with rk4 at h = 1e-3 natural time units. Tolerance 1e-9 relative to the natural scales (a, √(g/a),
@@ -105,7 +105,7 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
         0.0,
         STEADY,
     );
-    // NOTES §4: in every steady motion N = Mg and the friction is the centripetal force Ma|ω_Y ω_Z|/cos θ₀.
+    // physics §4: in every steady motion N = Mg and the friction is the centripetal force Ma|ω_Y ω_Z|/cos θ₀.
     let r = reaction(&coin, &steady.state);
     let weight = p.mass() * p.gravity();
     let s0 = steady.state;
@@ -127,7 +127,7 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
     steady
 }
 
-/// R_C = a |R_G/a + sgn(ω_Y ω_Z) sin θ₀| (NOTES §4 item 3), checked against the library's r_c.
+/// R_C = a |R_G/a + sgn(ω_Y ω_Z) sin θ₀| (physics §4.3), checked against the library's r_c.
 fn sign_rule(label: &str, p: &CoinParams, steady: &Steady) {
     let s = steady.state;
     let a = p.radius();
@@ -178,7 +178,7 @@ fn the_coin_rolling_round_its_fixed_centre_stays_on_its_circle() {
                     &p,
                     SteadyKind::CentreFixed { theta, branch },
                 );
-                // R_C = a |sin θ₀| and R_G = 0 (NOTES §4 item 2).
+                // R_C = a |sin θ₀| and R_G = 0 (physics §4.2).
                 physics::check("R_G / a", s.r_g.unwrap() / p.radius(), 0.0, 0.0);
                 physics::check(
                     "R_C / a",
@@ -203,8 +203,8 @@ fn the_notes_circle_example_has_the_stated_radii_and_stays_on_them() {
             branch: Branch::Plus,
         },
     );
-    physics::check("R_G (NOTES §4 example)", s.r_g.unwrap(), 4.897855, 1e-6);
-    physics::check("R_C (NOTES §4 example)", s.r_c.unwrap(), 5.193375, 1e-6);
+    physics::check("R_G (physics §4 example)", s.r_g.unwrap(), 4.897855, 1e-6);
+    physics::check("R_C (physics §4 example)", s.r_c.unwrap(), 5.193375, 1e-6);
     sign_rule("circle theta 0.3, w_Z 1, +", &p, &s);
 }
 
@@ -245,7 +245,7 @@ fn a_stably_spinning_upright_coin_stays_upright() {
         ("unit disk", physics::unit_disk()),
         ("general", physics::general()),
     ] {
-        // Ω² = 4 g/a is above the stability bound Mga/(I_X + Ma²) for both bodies (NOTES §5).
+        // Ω² = 4 g/a is above the stability bound Mga/(I_X + Ma²) for both bodies (physics §5).
         let omega = 2.0 * rate_unit(&p);
         let s = stays_steady(
             &format!("{label}, spin upright, Omega = 2 sqrt(g/a)"),
@@ -256,7 +256,7 @@ fn a_stably_spinning_upright_coin_stays_upright() {
     }
 }
 
-/// For general parameters the steady relation of NOTES §4 holds at the constructed states:
+/// For general parameters the steady relation of physics §4 holds at the constructed states:
 /// I_X tan θ ω_Y² + (I_Z + Ma²) ω_Z ω_Y − Mga sin θ = 0 to round-off (relative to its largest term), and
 /// eq (14) then gives ω̇_X = 0.
 #[test]

@@ -188,7 +188,7 @@ fn the_json_output_has_exactly_the_contract_fields() {
         k
     };
     assert_eq!(keys(&v), ["files"]);
-    // The contract's fields plus `peak_rss_bytes` (issue 9), an allowed extension.
+    // The contract's fields plus `peak_rss_bytes`, an allowed extension.
     assert_eq!(
         keys(&v["files"][0]),
         ["checks", "exit_code", "path", "peak_rss_bytes"]

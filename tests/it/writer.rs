@@ -1,4 +1,4 @@
-//! `mcap_io::McapWriter` (issue 9): files read back through the `mcap` crate's linear and indexed
+//! `mcap_io::McapWriter`: files read back through the `mcap` crate's linear and indexed
 //! paths for every compression, with many chunks; statistics, indexes and CRCs are right (and a flipped
 //! byte is caught); the bytes do not depend on the worker count; a failing output is an error, never a
 //! panic or a hang.

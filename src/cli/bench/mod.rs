@@ -1,5 +1,5 @@
-//! `coin-log bench`: accuracy against cost of every integrator, the hard-case suite (issue 8), and throughput
-//! and memory of record and verify (issue 9).
+//! `coin-log bench`: accuracy against cost of every integrator, the hard-case suite, and throughput
+//! and memory of record and verify.
 
 mod throughput;
 
@@ -36,7 +36,7 @@ enum BenchCommand {
     /// scale invariance; every case with every integrator.
     Stability(StabilityArgs),
     /// Record and verify speed and memory on the real channel set, against the zstd bound, and the cost of
-    /// integration (issue 9).
+    /// integration.
     ///
     /// Records `wobble` with the seven channels omega, angles, quaternion, position, contact, reaction,
     /// energy at 1 kHz with zstd, each run in a child `coin-log record` process; times zstd alone on the

@@ -1,7 +1,7 @@
 //! `consistency`: the stored channels agree with each other. The quaternion equals q(e_y, φ)·q(e_x, θ)·
-//! q(e_z, ψ) of the stored angles up to sign (NOTES §1) and has unit norm; the contact point is the centre
-//! plus c (x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y_c = 0, NOTES §3); the centre's height is
-//! a cos θ; the stored reaction equals R recomputed from the stored state (NOTES §3), with F = √(R_x² + R_z²)
+//! q(e_z, ψ) of the stored angles up to sign (physics §1) and has unit norm; the contact point is the centre
+//! plus c (x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y_c = 0, physics §3); the centre's height is
+//! a cos θ; the stored reaction equals R recomputed from the stored state (physics §3), with F = √(R_x² + R_z²)
 //! and N = R_y. Each is a recomputation from stored numbers, held to the recomputation tolerance.
 
 use super::{fmt_num, worst, Context, Max};

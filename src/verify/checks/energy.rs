@@ -1,5 +1,5 @@
-//! `energy`: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ (NOTES §3) recomputed from
-//! the stored ω and θ; drift = max|E − E₀| / max(|E₀|, Mga) (CONTRACT); agreement of `/coin/energy` with
+//! `energy`: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ (physics §3) recomputed from
+//! the stored ω and θ; drift = max|E − E₀| / max(|E₀|, Mga) (format.md); agreement of `/coin/energy` with
 //! the recomputed total, kinetic and potential parts, in the same units.
 
 use super::{fmt_num, worst, Context, Max};

@@ -1,5 +1,5 @@
-//! `invariants`: the Chaplygin–Appell integrals C1, C2 (NOTES §6) recomputed from the stored θ, ω_Y, ω_Z;
-//! drift = max|C − C₀| / (|C1₀| + |C2₀|) (CONTRACT), and agreement with `/coin/invariants` when stored.
+//! `invariants`: the Chaplygin–Appell integrals C1, C2 (physics §6) recomputed from the stored θ, ω_Y, ω_Z;
+//! drift = max|C − C₀| / (|C1₀| + |C2₀|) (format.md), and agreement with `/coin/invariants` when stored.
 
 use super::{fmt_num, worst, Max};
 use crate::model::drift::InvariantDrift;

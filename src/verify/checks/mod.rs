@@ -26,7 +26,7 @@ pub struct Context {
     pub result: Option<ResultMetadata>,
     /// The steady motion the scene asks for, or why the steady check does not apply.
     pub steady: Result<Steady, String>,
-    /// C1, C2 for these parameters (NOTES §6), or why they cannot be evaluated.
+    /// C1, C2 for these parameters (physics §6), or why they cannot be evaluated.
     pub chaplygin: Result<Chaplygin, String>,
 }
 

@@ -1,4 +1,4 @@
-//! `steady`: a steady motion (NOTES §4) stays steady. At every sample the right-hand side of eqs (14)–(16)
+//! `steady`: a steady motion (physics §4) stays steady. At every sample the right-hand side of eqs (14)–(16)
 //! must vanish, θ and ω must equal the steady values, and the circles traced by the stored centre and
 //! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
 

@@ -2,7 +2,7 @@
 //! with the contact force solved from the no-slip constraint at every evaluation.
 //!
 //! State (13): unit quaternion q = [w, x, y, z] (body → world, the body being the coin lying in the x–y
-//! plane with normal +z, NOTES §1), world angular velocity ω, centre position r_G and velocity v_G.
+//! plane with normal +z, physics §1), world angular velocity ω, centre position r_G and velocity v_G.
 //!
 //! Derivation (first principles, nothing taken from eqs (14)–(19)):
 //! - the lean frame is geometric: e_Z = Q e_z (the normal), e_X = e_y × e_Z / |e_y × e_Z|, e_Y = e_Z × e_X;
@@ -100,7 +100,7 @@ impl NewtonEuler {
         }
     }
 
-    /// Converts the library's state: angles → quaternion (NOTES §1), lean-frame ω → world ω, centre from
+    /// Converts the library's state: angles → quaternion (physics §1), lean-frame ω → world ω, centre from
     /// the contact point on the table (r_G = r_P − ρ, so y_G = a e_Y·e_y), v_G from no slip (v_G = −ω × ρ).
     pub fn state_from(&self, s: &State) -> [f64; NE_LEN] {
         let q = quaternion_from_angles(s.theta, s.phi, s.psi);

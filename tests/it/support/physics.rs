@@ -30,7 +30,7 @@ pub fn general() -> CoinParams {
     )
     .unwrap()
 }
-/// The natural rate unit √(g/a) (NOTES §2).
+/// The natural rate unit √(g/a) (physics §2).
 pub fn rate_unit(p: &CoinParams) -> f64 {
     (p.gravity() / p.radius()).sqrt()
 }

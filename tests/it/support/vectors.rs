@@ -1,7 +1,7 @@
 //! Small vector and quaternion algebra written here (not the library's), and the angle → quaternion and
-//! lean-frame constructions of NOTES §1 done independently of the library.
+//! lean-frame constructions of physics §1 done independently of the library.
 
-/// A world-frame vector (y up, NOTES §1).
+/// A world-frame vector (y up, physics §1).
 pub type V3 = [f64; 3];
 
 pub fn add(a: V3, b: V3) -> V3 {
@@ -77,13 +77,13 @@ pub fn mat_vec(m: &[[f64; 3]; 3], v: V3) -> V3 {
 pub fn column(m: &[[f64; 3]; 3], j: usize) -> V3 {
     [m[0][j], m[1][j], m[2][j]]
 }
-/// Distance between two quaternions up to sign (q and −q are the same rotation, NOTES §1).
+/// Distance between two quaternions up to sign (q and −q are the same rotation, physics §1).
 pub fn quat_distance(p: Quat, q: Quat) -> f64 {
     let minus: Vec<f64> = q.iter().map(|v| -v).collect();
     max_diff(&p, &q).min(max_diff(&p, &minus))
 }
 
-/// NOTES §1, built here from three axis–angle quaternions: q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ).
+/// physics §1, built here from three axis–angle quaternions: q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ).
 pub fn quaternion_from_angles(theta: f64, phi: f64, psi: f64) -> Quat {
     quat_mul(
         quat_axis_angle([0.0, 1.0, 0.0], phi),
@@ -94,7 +94,7 @@ pub fn quaternion_from_angles(theta: f64, phi: f64, psi: f64) -> Quat {
     )
 }
 
-/// The lean frame (e_X, e_Y, e_Z) from the coin's normal e_Z by the geometric definition of NOTES §1 and
+/// The lean frame (e_X, e_Y, e_Z) from the coin's normal e_Z by the geometric definition of physics §1 and
 /// §8 item 1: e_X = e_y × e_Z / |e_y × e_Z| (horizontal), e_Y = e_Z × e_X (in the coin, pointing up).
 pub fn lean_frame_from_normal(e_z: V3) -> [V3; 3] {
     let u = cross([0.0, 1.0, 0.0], e_z);
@@ -102,7 +102,7 @@ pub fn lean_frame_from_normal(e_z: V3) -> [V3; 3] {
     [e_x, cross(e_z, e_x), e_z]
 }
 
-/// The lean frame of angles (θ, φ) through the quaternion of NOTES §1 (its image of the body normal).
+/// The lean frame of angles (θ, φ) through the quaternion of physics §1 (its image of the body normal).
 pub fn lean_frame(theta: f64, phi: f64) -> [V3; 3] {
     let q = quaternion_from_angles(theta, phi, 0.0);
     lean_frame_from_normal(column(&quat_matrix(q), 2))

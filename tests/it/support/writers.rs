@@ -326,7 +326,7 @@ pub fn steady_circle() -> Spec {
     }
 }
 
-/// Simulates `spec` with rk4 and writes it as a coin-log MCAP at `path`, following CONTRACT.
+/// Simulates `spec` with rk4 and writes it as a coin-log MCAP at `path`, following format.md.
 pub fn record(spec: &Spec, path: &Path) {
     let coin = Coin::new(CoinParams::unit_disk());
     let p = coin.params();
