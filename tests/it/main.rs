@@ -22,6 +22,7 @@ mod integrators;
 mod invariants;
 mod params;
 mod properties;
+mod readme;
 mod record_roundtrip;
 mod rk4_order;
 mod scenes;
