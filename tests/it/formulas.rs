@@ -116,13 +116,10 @@ fn the_reaction_equals_mass_times_the_differenced_centre_acceleration_plus_weigh
             (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
         for i in (4..states.len() - 4).step_by(25) {
             let s = &states[i];
-            let acc: V3 = [0, 1, 2].map(|k| fd(&FD2, &pos[k], i, 1.0 / (big_h * big_h)));
-            let expected = [m * acc[0], m * acc[1] + m * g, m * acc[2]];
+            let acc = V3::from([0, 1, 2].map(|k| fd(&FD2, &pos[k], i, 1.0 / (big_h * big_h))));
+            let expected = acc * m + V3::y() * (m * g);
             let r = reaction(&coin, s);
-            worst_r = worst_r.max(vectors::max_diff(
-                &[r.force.x, r.force.y, r.force.z],
-                &expected,
-            ));
+            worst_r = worst_r.max((r.force - expected).amax());
             // N from physics §3's "equivalently" form, ω̇_X by differences.
             let wx_dot = fd(&FD1, &wx, i, 1.0 / big_h);
             let wz_dot = fd(&FD1, &wz, i, 1.0 / big_h);
@@ -179,11 +176,11 @@ fn the_differenced_centre_velocity_is_the_no_slip_velocity() {
         let mut worst = 0.0_f64;
         for i in (4..states.len() - 4).step_by(25) {
             let s = &states[i];
-            let v: V3 = [0, 1, 2].map(|k| fd(&FD1, &pos[k], i, 1.0 / big_h));
+            let v = V3::from([0, 1, 2].map(|k| fd(&FD1, &pos[k], i, 1.0 / big_h)));
             let [_, e_y_lean, _] = vectors::lean_frame(s.theta, s.phi);
             let omega = vectors::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
-            let no_slip = vectors::scale(-1.0, vectors::cross(omega, vectors::scale(-a, e_y_lean)));
-            worst = worst.max(vectors::max_diff(&v, &no_slip));
+            let no_slip = -omega.cross(&(e_y_lean * -a));
+            worst = worst.max((v - no_slip).amax());
         }
         physics::check(
             &format!("{label}: max |dr_G/dt (differenced) + omega x rho| / (a sqrt(g/a))"),
@@ -220,10 +217,10 @@ fn the_contact_point_moves_at_speed_a_times_the_spin_rate() {
         let s = &states[777];
         let (c, cp) = (centre(&coin, s), contact_point(&coin, s));
         let [_, e_y_lean, _] = vectors::lean_frame(s.theta, s.phi);
-        let expected = vectors::sub([c.x, c.y, c.z], vectors::scale(p.radius(), e_y_lean));
+        let expected = c - e_y_lean * p.radius();
         physics::check(
             &format!("{label}: |contact point - (centre - a e_Y)| / a"),
-            vectors::max_diff(&[cp.x, cp.y, cp.z], &expected) / p.radius(),
+            (cp - expected).amax() / p.radius(),
             0.0,
             4e-15, // a few ulps of the coordinates
         );
@@ -246,26 +243,18 @@ fn the_quaternion_is_the_rotation_of_eq_7_followed_by_the_spin() {
                 let (sp, cp) = phi.sin_cos();
                 let (ss, cs) = psi.sin_cos();
                 // Eq (7), row by row.
-                let e_x: V3 = [cp, 0.0, -sp];
-                let e_y: V3 = [st * sp, ct, st * cp];
-                let e_z: V3 = [ct * sp, -st, ct * cp];
+                let e_x = V3::new(cp, 0.0, -sp);
+                let e_y = V3::new(st * sp, ct, st * cp);
+                let e_z = V3::new(ct * sp, -st, ct * cp);
                 let q = orientation(&State {
                     theta,
                     phi,
                     psi,
                     ..State::default()
                 });
-                let expected = [
-                    vectors::add(vectors::scale(cs, e_x), vectors::scale(ss, e_y)),
-                    vectors::add(vectors::scale(-ss, e_x), vectors::scale(cs, e_y)),
-                    e_z,
-                ];
-                for (axis, want) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-                    .iter()
-                    .zip(expected)
-                {
-                    let rotated = q.transform_vector(&nalgebra::Vector3::from(*axis));
-                    worst = worst.max(vectors::max_diff(rotated.as_slice(), &want));
+                let expected = [e_x * cs + e_y * ss, e_x * -ss + e_y * cs, e_z];
+                for (axis, want) in [V3::x(), V3::y(), V3::z()].iter().zip(expected) {
+                    worst = worst.max((q.transform_vector(axis) - want).amax());
                 }
                 worst_norm = worst_norm.max((q.norm() - 1.0).abs());
             }

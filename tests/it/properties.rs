@@ -10,7 +10,7 @@
 
 use crate::support::newton_euler::NewtonEuler;
 use crate::support::physics::{self, rate_unit};
-use crate::support::vectors::{self, add, cross, max_diff, norm, scale, V3};
+use crate::support::vectors::{self, V3};
 use coin_log::model::{
     centre, contact_point, orientation, reaction, Branch, Coin, CoinParams, Inertia, State, Steady,
     SteadyKind, STATE_LEN,
@@ -133,11 +133,11 @@ proptest! {
         let s = scaled(&p, &u);
         let f = rhs(&coin, &s);
         let a = p.radius();
-        let v = [f[6], -a * s.theta.sin() * f[0], f[7]];
+        let v = V3::new(f[6], -a * s.theta.sin() * f[0], f[7]);
         let [_, e_y_lean, _] = vectors::lean_frame(s.theta, s.phi);
         let omega = vectors::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
-        let no_slip = scale(-1.0, cross(omega, scale(-a, e_y_lean)));
-        within("|v_G + omega x rho|", max_diff(&v, &no_slip), a * (norm(omega) + rate_unit(&p)))?;
+        let no_slip = -omega.cross(&(e_y_lean * -a));
+        within("|v_G + omega x rho|", (v - no_slip).amax(), a * (omega.norm() + rate_unit(&p)))?;
     }
 
     /// |q| = 1; q rotates the body normal (0, 0, 1) to e_Z = (cos θ sin φ, −sin θ, cos θ cos φ) (eq (7)'s
@@ -149,15 +149,14 @@ proptest! {
         let s = scaled(&p, &u);
         let q = orientation(&s);
         within("|q| - 1", q.norm() - 1.0, 1.0)?;
-        let n: V3 = q.transform_vector(&nalgebra::Vector3::z()).into();
+        let n = q.transform_vector(&V3::z());
         let (st, ct) = s.theta.sin_cos();
         let (sp, cp) = s.phi.sin_cos();
-        within("|q e_z - e_Z|", max_diff(&n, &[ct * sp, -st, ct * cp]), 1.0)?;
-        let [_, e_y_lean, _] = vectors::lean_frame_from_normal(n);
-        let c = centre(&coin, &s);
-        let expected = vectors::sub([c.x, c.y, c.z], scale(p.radius(), e_y_lean));
+        within("|q e_z - e_Z|", (n - V3::new(ct * sp, -st, ct * cp)).amax(), 1.0)?;
+        let [_, e_y_lean, _] = vectors::lean_frame_from_normal(&n);
+        let expected = centre(&coin, &s) - e_y_lean * p.radius();
         let cp_lib = contact_point(&coin, &s);
-        within("|contact - (centre - a e_Y)|", max_diff(&[cp_lib.x, cp_lib.y, cp_lib.z], &expected), p.radius() * (1.0 + u[6].abs() + u[7].abs()))?;
+        within("|contact - (centre - a e_Y)|", (cp_lib - expected).amax(), p.radius() * (1.0 + u[6].abs() + u[7].abs()))?;
     }
 
     /// At any state, the library's reaction (physics §3) equals the contact force the Newton–Euler model
@@ -171,20 +170,17 @@ proptest! {
         let eval = ne.evaluate(&ne.state_from(&s));
         let r = reaction(&coin, &s).force;
         let w = rate_unit(&p);
-        let omega_size = norm([s.omega_x, s.omega_y, s.omega_z]) + w;
+        let omega_size = V3::new(s.omega_x, s.omega_y, s.omega_z).norm() + w;
         let tan = s.theta.tan().abs().max(1.0);
         let force_scale = p.mass() * (p.gravity() + p.radius() * omega_size * omega_size * tan);
-        within("|R_library - R_Newton-Euler|", max_diff(&[r.x, r.y, r.z], &eval.reaction), force_scale)?;
+        within("|R_library - R_Newton-Euler|", (r - eval.reaction).amax(), force_scale)?;
 
         let f = rhs(&coin, &s);
         let [e_x, e_y_lean, e_z] = vectors::lean_frame(s.theta, s.phi);
         let omega = vectors::world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
-        let frame_rate: V3 = add(scale(f[0], e_x), scale(f[1], [0.0, 1.0, 0.0]));
-        let omega_dot = add(
-            add(add(scale(f[3], e_x), scale(f[4], e_y_lean)), scale(f[5], e_z)),
-            cross(frame_rate, omega),
-        );
-        within("|omega dot library - Newton-Euler|", max_diff(&omega_dot, &eval.omega_dot), omega_size * omega_size * tan / s.theta.cos())?;
+        let frame_rate = e_x * f[0] + V3::y() * f[1];
+        let omega_dot = e_x * f[3] + e_y_lean * f[4] + e_z * f[5] + frame_rate.cross(&omega);
+        within("|omega dot library - Newton-Euler|", (omega_dot - eval.omega_dot).amax(), omega_size * omega_size * tan / s.theta.cos())?;
     }
 
     /// Each steady constructor gives a fixed point of eqs (14)–(17): θ̇ = ω̇ = 0 to round-off (relative to

@@ -5,7 +5,7 @@
 
 use crate::support::newton_euler::{NewtonEuler, NE_LEN};
 use crate::support::physics::{self, rate_unit, wobbling};
-use crate::support::vectors::{max_diff, quat_distance, world_omega};
+use crate::support::vectors::{quat_distance, world_omega};
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Termination,
 };
@@ -79,10 +79,10 @@ fn disagreement<S: OdeSystem<STATE_LEN>>(
         let q = orientation(&s);
         let omega = world_omega(s.theta, s.phi, [s.omega_x, s.omega_y, s.omega_z]);
         let d = [
-            max_diff(&[c.x, c.y, c.z], &NewtonEuler::centre(yn)) / a,
-            max_diff(&[cp.x, cp.y, cp.z], &ne.contact_point(yn)) / a,
-            quat_distance([q.w, q.i, q.j, q.k], NewtonEuler::quaternion(yn)),
-            max_diff(&omega, &NewtonEuler::omega(yn)) / w,
+            (c - NewtonEuler::centre(yn)).amax() / a,
+            (cp - ne.contact_point(yn)).amax() / a,
+            quat_distance(&q, &NewtonEuler::quaternion(yn)),
+            (omega - NewtonEuler::omega(yn)).amax() / w,
         ];
         for (wk, dk) in worst.iter_mut().zip(d) {
             *wk = wk.max(dk);
@@ -163,7 +163,7 @@ fn the_newton_euler_contact_force_equals_the_reaction_of_notes_section_3() {
         // Two algebraically different round-off paths: 1e-13 of the weight.
         physics::check(
             "max |R_library - R_Newton-Euler| / (M g)",
-            max_diff(&[r.x, r.y, r.z], &r_ne) / weight,
+            (r - r_ne).amax() / weight,
             0.0,
             1e-13,
         );
