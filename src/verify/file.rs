@@ -6,7 +6,7 @@ use super::checks::{
     invariants::InvariantsCheck, steady, steady::SteadyCheck, validity::ValidityCheck, Context,
     RunStats,
 };
-use super::json;
+use crate::format::json;
 use super::report::{CheckId, CheckResult, FileReport, Status};
 use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};

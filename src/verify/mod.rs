@@ -8,7 +8,6 @@
 
 pub mod checks;
 mod file;
-mod json;
 pub mod report;
 pub mod samples;
 pub mod tolerances;
