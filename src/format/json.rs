@@ -246,7 +246,7 @@ mod tests {
         let fields = ["t", "x", "y"];
         let mut out = [0.0; 3];
         // Another order, spaces, an escaped key and a 17-digit number: the slow path, bit for bit.
-        let x = 0.1 + 0.2;
+        let x: f64 = 0.1 + 0.2;
         let text = format!(
             "{{ \"y\" : -1e-300, \"\\u0074\": 2.5, \"x\": {} }}",
             ryu::Buffer::new().format_finite(x)
