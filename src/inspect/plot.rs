@@ -383,7 +383,8 @@ type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 fn draw(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> Result<String, String> {
     let (heading, subheading) = title(c, run, name, broken);
     let end = c.result.as_ref().map(|r| (r.termination.name(), r.termination_time));
-    let t_max = c.last_t.max(end.map_or(0.0, |e| e.1)).max(1e-9);
+    // 2 % beyond the last time, so that the termination's mark stands clear of the frame.
+    let t_max = 1.02 * c.last_t.max(end.map_or(0.0, |e| e.1)).max(1e-9);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
@@ -399,7 +400,7 @@ fn draw(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> Res
         time.linear(&panels[1], PANELS[1], "θ [rad]", &[("θ", &c.theta, BLUE)], None)?;
         time.log(&panels[2], PANELS[2], &[("energy", &c.energy, BLUE)])?;
         time.log(&panels[3], PANELS[3], &[("C1", &c.c1, BLUE), ("C2", &c.c2, ORANGE)])?;
-        time.linear(&panels[4], PANELS[4], "N / (Mg)", &[("N/(Mg)", &c.normal, BLUE)], Some(("N = 0", 0.0)))?;
+        time.linear(&panels[4], PANELS[4], "N / (Mg)", &[("N/(Mg)", &c.normal, BLUE)], Some(("N", 0.0)))?;
         let mu = run.friction.map(|m| ("μ", m));
         time.linear(&panels[5], PANELS[5], "|F| / N", &[("|F|/N", &c.ratio, BLUE)], mu)?;
         root.present().map_err(|e| e.to_string())?;

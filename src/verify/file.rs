@@ -439,6 +439,17 @@ pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 
+/// Judges one file, reporting the bytes read (see [`super::verify_file_with_progress`]).
+pub fn verify_file_with_progress(
+    path: &Path,
+    options: &Options,
+    progress: &(dyn Fn(u64) + Sync),
+) -> FileReport {
+    let mut judge = Judge::default();
+    let (structure, error) = mcap_io::read_with_progress(path, &mut judge, progress);
+    verdict(path.display().to_string(), judge, structure, error, options)
+}
+
 /// Judges an MCAP held in memory (see [`super::verify_bytes`]).
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();

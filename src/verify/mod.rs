@@ -33,6 +33,16 @@ pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     file::verify_file(path, options)
 }
 
+/// [`verify_file`], calling `progress` with the bytes read so far (from the reading thread).
+#[must_use]
+pub fn verify_file_with_progress(
+    path: &Path,
+    options: &Options,
+    progress: &(dyn Fn(u64) + Sync),
+) -> FileReport {
+    file::verify_file_with_progress(path, options, progress)
+}
+
 /// Judges an MCAP file held in memory, named `name` in the report (for tests and fuzzing).
 #[must_use]
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
