@@ -104,7 +104,9 @@ impl Envelope {
     fn points(&self) -> Vec<(f64, f64)> {
         let mut out = Vec::with_capacity(2 * self.buckets.len());
         for &(t0, v0, t1, v1) in &self.buckets {
-            if t0 <= t1 {
+            if t0 == t1 {
+                out.push((t0, v0));
+            } else if t0 < t1 {
                 out.extend([(t0, v0), (t1, v1)]);
             } else {
                 out.extend([(t1, v1), (t0, v0)]);
