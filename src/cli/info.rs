@@ -97,14 +97,32 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// The text description of one file.
+/// The text description of one file: a row per property, then the channels.
 fn text(shown: &str, i: &FileInfo) -> String {
+    let mut rows = file_rows(i);
+    rows.extend(coin_log_rows(i));
+    rows.push((
+        "read from",
+        match i.source {
+            info::Source::Summary => "the summary section".into(),
+            info::Source::Scan => "the whole file (it has no summary section)".into(),
+        },
+    ));
+    if let Some(p) = &i.problem {
+        rows.push(("problem", p.clone()));
+    }
     let mut out = format!("{shown}\n");
-    let mut row = |key: &str, value: String| {
+    for (key, value) in rows {
         let _ = writeln!(out, "  {key:<13} {value}");
-    };
+    }
+    channels(&mut out, i);
+    out
+}
+
+/// Size, compression, writer, description, time span and message count.
+fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     let (packed, unpacked) = i.chunk_bytes;
-    row(
+    let mut rows = vec![(
         "file",
         format!(
             "{} ({} B), {} chunk{} {}, {} of records in {}",
@@ -116,67 +134,73 @@ fn text(shown: &str, i: &FileInfo) -> String {
             size(unpacked),
             size(packed)
         ),
-    );
+    )];
     let version = i
         .run
         .as_ref()
         .map_or_else(|_| String::new(), |r| format!(", format {}", r.format_version));
-    row("written by", format!("{}{version}", i.library));
+    rows.push(("written by", format!("{}{version}", i.library)));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
-        row("scene", d.clone());
+        rows.push(("scene", d.clone()));
     }
     let span = i.time_range.map_or_else(
         || "no messages".into(),
         |(a, b)| format!("t = {} … {}", seconds_text(a), seconds_text(b)),
     );
-    row("time", span);
-    row("messages", i.messages.to_string());
-    match &i.run {
-        Ok(r) => {
-            let friction = r.friction.map_or_else(|| "none".into(), n);
-            row(
-                "body",
-                format!(
-                    "M = {}, a = {}, g = {}, I_X = {}, I_Z = {}, μ {friction}, time unit √(a/g) = {}",
-                    n(r.mass),
-                    n(r.radius),
-                    n(r.gravity),
-                    n(r.inertia_x),
-                    n(r.inertia_z),
-                    n(r.time_unit)
-                ),
-            );
-            row(
-                "run",
-                format!(
-                    "{}, rtol {}, atol {}, step {}, rate {}",
-                    r.integrator,
-                    n(r.rtol),
-                    n(r.atol),
-                    n(r.step),
-                    n(r.rate)
-                ),
-            );
-            if let Some(k) = r.steady_kind {
-                let opt = |v: Option<f64>| v.map_or_else(|| "-".into(), n);
-                row(
-                    "steady",
-                    format!(
-                        "{k}: φ̇ = {}, ψ̇ = {}, R_G = {}, R_C = {}",
-                        opt(r.phi_dot),
-                        opt(r.psi_dot),
-                        opt(r.r_g),
-                        opt(r.r_c)
-                    ),
-                );
-            }
-        }
-        Err(e) => row("coin-log", e.clone()),
-    }
-    match &i.result {
-        Ok(r) => row(
-            "termination",
+    rows.push(("time", span));
+    rows.push(("messages", i.messages.to_string()));
+    rows
+}
+
+/// Body, run settings, steady motion and termination from the coin-log metadata.
+fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
+    let r = match &i.run {
+        Ok(r) => r,
+        Err(e) => return vec![("coin-log", e.clone())],
+    };
+    let friction = r.friction.map_or_else(|| "none".into(), n);
+    let mut rows = vec![
+        (
+            "body",
             format!(
+                "M = {}, a = {}, g = {}, I_X = {}, I_Z = {}, μ {friction}, time unit √(a/g) = {}",
+                n(r.mass),
+                n(r.radius),
+                n(r.gravity),
+                n(r.inertia_x),
+                n(r.inertia_z),
+                n(r.time_unit)
+            ),
+        ),
+        (
+            "run",
+            format!(
+                "{}, rtol {}, atol {}, step {}, rate {}",
+                r.integrator,
+                n(r.rtol),
+                n(r.atol),
+                n(r.step),
+                n(r.rate)
+            ),
+        ),
+    ];
+    if let Some(k) = r.steady_kind {
+        let opt = |v: Option<f64>| v.map_or_else(|| "-".into(), n);
+        rows.push((
+            "steady",
+            format!(
+                "{k}: φ̇ = {}, ψ̇ = {}, R_G = {}, R_C = {}",
+                opt(r.phi_dot),
+                opt(r.psi_dot),
+                opt(r.r_g),
+                opt(r.r_c)
+            ),
+        ));
+    }
+    rows.push((
+        "termination",
+        match &i.result {
+            Ok(r) => format!(
                 "{} at t = {} ({} steps, {} RHS evaluations, {} rejected)",
                 r.termination,
                 n(r.termination_time),
@@ -184,19 +208,10 @@ fn text(shown: &str, i: &FileInfo) -> String {
                 r.rhs_evaluations,
                 r.rejected_steps
             ),
-        ),
-        Err(e) if i.run.is_ok() => row("termination", e.clone()),
-        Err(_) => {}
-    }
-    row("read from", format!("the {}", match i.source {
-        info::Source::Summary => "summary section",
-        info::Source::Scan => "whole file (it has no summary section)",
-    }));
-    if let Some(p) = &i.problem {
-        row("problem", p.clone());
-    }
-    channels(&mut out, i);
-    out
+            Err(e) => e.clone(),
+        },
+    ));
+    rows
 }
 
 fn channels(out: &mut String, i: &FileInfo) {

@@ -387,7 +387,14 @@ fn svg_texts(svg: &str) -> Vec<String> {
     assert_eq!(doc.root_element().tag_name().name(), "svg");
     doc.descendants()
         .filter(|n| n.is_element() && n.tag_name().name() == "text")
-        .map(|n| n.descendants().filter_map(|d| d.text()).collect::<String>())
+        .map(|n| {
+            n.descendants()
+                .filter(roxmltree::Node::is_text)
+                .filter_map(|d| d.text())
+                .collect::<String>()
+                .trim()
+                .to_string()
+        })
         .collect()
 }
 
