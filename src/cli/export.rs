@@ -136,8 +136,13 @@ fn persist(temps: Vec<(String, NamedTempFile)>, dir: &Path, overwrite: bool) -> 
             .sync_all()
             .with_context(|| format!("writing `{}`", target.display()))?;
         make_readable(temp.as_file());
-        temp.persist(&target)
-            .map_err(|e| anyhow!("cannot move the table to `{}`: {}", target.display(), e.error))?;
+        temp.persist(&target).map_err(|e| {
+            anyhow!(
+                "cannot move the table to `{}`: {}",
+                target.display(),
+                e.error
+            )
+        })?;
     }
     Ok(())
 }

@@ -3,8 +3,8 @@
 use super::text::size;
 use super::Outcome;
 use anyhow::bail;
-use coin_log::inspect::info::{self, FileInfo};
 use coin_log::format::metadata::number_string as n;
+use coin_log::inspect::info::{self, FileInfo};
 use coin_log::inspect::seconds_text;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -135,10 +135,10 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
             size(packed)
         ),
     )];
-    let version = i
-        .run
-        .as_ref()
-        .map_or_else(|_| String::new(), |r| format!(", format {}", r.format_version));
+    let version = i.run.as_ref().map_or_else(
+        |_| String::new(),
+        |r| format!(", format {}", r.format_version),
+    );
     rows.push(("written by", format!("{}{version}", i.library)));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
         rows.push(("scene", d.clone()));
@@ -215,8 +215,20 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
 }
 
 fn channels(out: &mut String, i: &FileInfo) {
-    let topic_w = i.channels.iter().map(|c| c.topic.len()).max().unwrap_or(5).max(5);
-    let schema_w = i.channels.iter().map(|c| c.schema.len()).max().unwrap_or(6).max(6);
+    let topic_w = i
+        .channels
+        .iter()
+        .map(|c| c.topic.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    let schema_w = i
+        .channels
+        .iter()
+        .map(|c| c.schema.len())
+        .max()
+        .unwrap_or(6)
+        .max(6);
     let _ = writeln!(
         out,
         "  {:<topic_w$}  {:<schema_w$}  {:>9}  {:>9}",

@@ -35,15 +35,19 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
         PathBuf::from(format!("{stem}.svg"))
     });
     if target.is_dir() {
-        bail!("`{}` is a folder; give the picture a file name, e.g. --out {}", target.display(), target.join("plot.svg").display());
+        bail!(
+            "`{}` is a folder; give the picture a file name, e.g. --out {}",
+            target.display(),
+            target.join("plot.svg").display()
+        );
     }
     if target.exists() && !args.overwrite {
         bail!("`{}` already exists; pass --overwrite to replace it, or choose another file with --out", target.display());
     }
-    let name = args
-        .file
-        .file_name()
-        .map_or_else(|| args.file.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let name = args.file.file_name().map_or_else(
+        || args.file.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
     let svg = plot::plot(&args.file, &name).map_err(|e| anyhow!("{}: {e}", args.file.display()))?;
     let folder = match target.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -60,12 +64,16 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        let _ = temp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644));
+        let _ = temp
+            .as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644));
     }
     let moved = if args.overwrite {
         temp.persist(&target).map(|_| ()).map_err(|e| e.error)
     } else {
-        temp.persist_noclobber(&target).map(|_| ()).map_err(|e| e.error)
+        temp.persist_noclobber(&target)
+            .map(|_| ())
+            .map_err(|e| e.error)
     };
     moved.map_err(|e| anyhow!("cannot move the picture to `{}`: {e}", target.display()))?;
     println!("{}", target.display());

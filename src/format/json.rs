@@ -33,7 +33,11 @@ pub fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool
     };
     for (i, (field, value)) in fields.iter().zip(out.iter_mut()).enumerate() {
         let step = |rest: &[u8]| -> Option<(f64, usize)> {
-            let r = if i > 0 { rest.strip_prefix(b",")? } else { rest };
+            let r = if i > 0 {
+                rest.strip_prefix(b",")?
+            } else {
+                rest
+            };
             let r = r.strip_prefix(b"\"")?;
             let r = r.strip_prefix(field.as_bytes())?;
             let r = r.strip_prefix(b"\":")?;
@@ -257,7 +261,10 @@ mod tests {
         assert_eq!(out[2].to_bits(), (-1e-300_f64).to_bits());
         for (text, expected) in [
             (r#"{"t":1,"x":2}"#, FieldsError::Missing("y".into())),
-            (r#"{"t":1,"x":2,"y":3,"w":4}"#, FieldsError::Unknown("w".into())),
+            (
+                r#"{"t":1,"x":2,"y":3,"w":4}"#,
+                FieldsError::Unknown("w".into()),
+            ),
             (
                 r#"{"t":1,"x":"2","y":3}"#,
                 FieldsError::NotNumber {
@@ -266,7 +273,11 @@ mod tests {
                 },
             ),
         ] {
-            assert_eq!(read_fields(text.as_bytes(), &fields, &mut out), Err(expected), "{text}");
+            assert_eq!(
+                read_fields(text.as_bytes(), &fields, &mut out),
+                Err(expected),
+                "{text}"
+            );
         }
         assert!(matches!(
             read_fields(b"[1,2,3]", &fields, &mut out),

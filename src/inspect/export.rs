@@ -391,7 +391,11 @@ impl<W: Write> Exporter<'_, W> {
 impl<W: Write> Exporter<'_, W> {
     fn join(&mut self, log_time: u64, channel: Channel) {
         let t = self.values[0];
-        let later = self.wide.row.as_ref().is_some_and(|r| log_time > r.log_time);
+        let later = self
+            .wide
+            .row
+            .as_ref()
+            .is_some_and(|r| log_time > r.log_time);
         if later {
             self.flush_row();
         }

@@ -296,7 +296,10 @@ impl Visitor for Scan {
     fn message(&mut self, header: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
         *self.counts.entry(header.channel_id).or_insert(0) += 1;
         let t = header.log_time;
-        self.time_range = Some(self.time_range.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+        self.time_range = Some(
+            self.time_range
+                .map_or((t, t), |(a, b)| (a.min(t), b.max(t))),
+        );
         ControlFlow::Continue(())
     }
 }

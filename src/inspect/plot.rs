@@ -10,7 +10,9 @@
 //! k-th point with k doubling as needed.
 
 use crate::format::json::read_fields;
-use crate::format::{Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
+use crate::format::{
+    Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+};
 use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
@@ -346,13 +348,15 @@ pub fn plot(path: &Path, name: &str) -> Result<String, PlotError> {
     }
     let run = match c.run.take() {
         Some(Ok(run)) => run,
-        Some(Err(e)) => return Err(PlotError(format!("its `coin-log` metadata is unusable: {e}"))),
-        None => {
-            return Err(PlotError(
-                "not a coin-log file: it has no `coin-log` metadata record before its first message"
-                    .into(),
-            ))
+        Some(Err(e)) => {
+            return Err(PlotError(format!(
+                "its `coin-log` metadata is unusable: {e}"
+            )))
         }
+        None => return Err(PlotError(
+            "not a coin-log file: it has no `coin-log` metadata record before its first message"
+                .into(),
+        )),
     };
     draw(&c, &run, name, broken.as_deref()).map_err(PlotError)
 }
@@ -366,7 +370,10 @@ fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (S
     let end = match (&c.result, broken) {
         (_, Some(b)) => format!("file breaks off after t = {}: {b}", c.last_t),
         (Some(r), None) => format!("{} at t = {}", r.termination, r.termination_time),
-        (None, None) => format!("no coin-log.result record: unfinished, last sample t = {}", c.last_t),
+        (None, None) => format!(
+            "no coin-log.result record: unfinished, last sample t = {}",
+            c.last_t
+        ),
     };
     let friction = run
         .friction
@@ -382,9 +389,17 @@ fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (S
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
-fn draw(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> Result<String, String> {
+fn draw(
+    c: &Collect,
+    run: &RunMetadata,
+    name: &str,
+    broken: Option<&str>,
+) -> Result<String, String> {
     let (heading, subheading) = title(c, run, name, broken);
-    let end = c.result.as_ref().map(|r| (r.termination.name(), r.termination_time));
+    let end = c
+        .result
+        .as_ref()
+        .map(|r| (r.termination.name(), r.termination_time));
     // 2 % beyond the last time, so that the termination's mark stands clear of the frame.
     let t_max = 1.02 * c.last_t.max(end.map_or(0.0, |e| e.1)).max(1e-9);
     let mut svg = String::new();
@@ -392,19 +407,49 @@ fn draw(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> Res
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let (top, body) = root.split_vertically(70);
-        top.draw_text(&heading, &("sans-serif", 22).into_font().color(&BLACK), (20, 12))
-            .map_err(|e| e.to_string())?;
-        top.draw_text(&subheading, &("sans-serif", 14).into_font().color(&GREY), (20, 44))
-            .map_err(|e| e.to_string())?;
+        top.draw_text(
+            &heading,
+            &("sans-serif", 22).into_font().color(&BLACK),
+            (20, 12),
+        )
+        .map_err(|e| e.to_string())?;
+        top.draw_text(
+            &subheading,
+            &("sans-serif", 14).into_font().color(&GREY),
+            (20, 44),
+        )
+        .map_err(|e| e.to_string())?;
         let panels = body.split_evenly((3, 2));
         track(&panels[0], c)?;
         let time = TimeAxis { t_max, end };
-        time.linear(&panels[1], PANELS[1], "θ [rad]", &[("θ", &c.theta, BLUE)], None)?;
+        time.linear(
+            &panels[1],
+            PANELS[1],
+            "θ [rad]",
+            &[("θ", &c.theta, BLUE)],
+            None,
+        )?;
         time.log(&panels[2], PANELS[2], &[("energy", &c.energy, BLUE)])?;
-        time.log(&panels[3], PANELS[3], &[("C1", &c.c1, BLUE), ("C2", &c.c2, ORANGE)])?;
-        time.linear(&panels[4], PANELS[4], "N / (Mg)", &[("N/(Mg)", &c.normal, BLUE)], Some(("N", 0.0)))?;
+        time.log(
+            &panels[3],
+            PANELS[3],
+            &[("C1", &c.c1, BLUE), ("C2", &c.c2, ORANGE)],
+        )?;
+        time.linear(
+            &panels[4],
+            PANELS[4],
+            "N / (Mg)",
+            &[("N/(Mg)", &c.normal, BLUE)],
+            Some(("N", 0.0)),
+        )?;
         let mu = run.friction.map(|m| ("μ", m));
-        time.linear(&panels[5], PANELS[5], "|F| / N", &[("|F|/N", &c.ratio, BLUE)], mu)?;
+        time.linear(
+            &panels[5],
+            PANELS[5],
+            "|F| / N",
+            &[("|F|/N", &c.ratio, BLUE)],
+            mu,
+        )?;
         root.present().map_err(|e| e.to_string())?;
     }
     Ok(svg)
@@ -413,9 +458,7 @@ fn draw(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> Res
 /// A panel that says why it is empty.
 fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), String> {
     area.titled(title, ("sans-serif", 16))
-        .and_then(|a| {
-            a.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60))
-        })
+        .and_then(|a| a.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60)))
         .map_err(|e| e.to_string())
 }
 
@@ -430,7 +473,10 @@ fn padded(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
     }
 }
 
-fn min_max<'a>(points: impl Iterator<Item = &'a (f64, f64)>, pick: fn(&(f64, f64)) -> f64) -> (f64, f64) {
+fn min_max<'a>(
+    points: impl Iterator<Item = &'a (f64, f64)>,
+    pick: fn(&(f64, f64)) -> f64,
+) -> (f64, f64) {
     points.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
         (lo.min(pick(p)), hi.max(pick(p)))
     })
@@ -441,7 +487,11 @@ fn min_max<'a>(points: impl Iterator<Item = &'a (f64, f64)>, pick: fn(&(f64, f64
 fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
     let (contact, centre) = (c.contact.points(), c.centre.points());
     if contact.is_empty() && centre.is_empty() {
-        return empty(area, PANELS[0], "/coin/contact and /coin/position were not recorded");
+        return empty(
+            area,
+            PANELS[0],
+            "/coin/contact and /coin/position were not recorded",
+        );
     }
     let all = || contact.iter().chain(&centre);
     let (x0, x1) = padded_equal(min_max(all(), |p| p.0));
@@ -468,15 +518,23 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
         .y_desc("z (down the page: the view from above)")
         .draw()
         .map_err(|e| err(&e))?;
-    for (label, points, colour) in [("contact track", &contact, BLUE), ("centre", &centre, ORANGE)] {
+    for (label, points, colour) in [
+        ("contact track", &contact, BLUE),
+        ("centre", &centre, ORANGE),
+    ] {
         if points.is_empty() {
             continue;
         }
         chart
-            .draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(1)))
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                colour.stroke_width(1),
+            ))
             .map_err(|e| err(&e))?
             .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
         let (first, last) = (points[0], points[points.len() - 1]);
         chart
             .draw_series([Circle::new(first, 4, colour.filled())])
@@ -547,17 +605,29 @@ impl TimeAxis<'_> {
         for ((label, _, colour), points) in series.iter().zip(&points) {
             let colour = *colour;
             chart
-                .draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(1)))
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    colour.stroke_width(1),
+                ))
                 .map_err(|e| err(&e))?
                 .label(*label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
         }
         if let Some((label, v)) = line {
             chart
-                .draw_series(DashedLineSeries::new([(0.0, v), (self.t_max, v)], 6, 4, GREEN.stroke_width(2)))
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, v), (self.t_max, v)],
+                    6,
+                    4,
+                    GREEN.stroke_width(2),
+                ))
                 .map_err(|e| err(&e))?
                 .label(format!("{label} = {v}"))
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2)));
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2))
+                });
         }
         self.mark_end(&mut chart, y0, y1)?;
         legend(&mut chart)
@@ -576,7 +646,9 @@ impl TimeAxis<'_> {
         }
         let points: Vec<Vec<(f64, f64)>> = series.iter().map(|s| s.1.points()).collect();
         let positive = points.iter().flatten().map(|p| p.1).filter(|v| *v > 0.0);
-        let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
         let (floor, top) = if hi > 0.0 {
             (lo / 10.0, hi * 10.0)
         } else {
@@ -593,7 +665,11 @@ impl TimeAxis<'_> {
         chart
             .configure_mesh()
             .x_desc("t")
-            .y_desc(if hi > 0.0 { "relative drift (0 on the bottom edge)" } else { "identically 0" })
+            .y_desc(if hi > 0.0 {
+                "relative drift (0 on the bottom edge)"
+            } else {
+                "identically 0"
+            })
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(|e| err(&e))?;
@@ -606,7 +682,9 @@ impl TimeAxis<'_> {
                 ))
                 .map_err(|e| err(&e))?
                 .label(*label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
         }
         self.mark_end(&mut chart, floor, top)?;
         legend(&mut chart)
@@ -623,7 +701,12 @@ impl TimeAxis<'_> {
             return Ok(());
         };
         chart
-            .draw_series(DashedLineSeries::new([(t, y0), (t, y1)], 5, 4, RED.stroke_width(2)))
+            .draw_series(DashedLineSeries::new(
+                [(t, y0), (t, y1)],
+                5,
+                4,
+                RED.stroke_width(2),
+            ))
             .map_err(|e| e.to_string())?
             .label(format!("{name} at t = {t}"))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
@@ -648,7 +731,10 @@ mod tests {
         let max = e.points().iter().map(|p| p.1).fold(f64::MIN, f64::max);
         assert!(max > 1e3 - 1.0, "the spike survives decimation: max {max}");
         let times: Vec<f64> = e.points().iter().map(|p| p.0).collect();
-        assert!(times.windows(2).all(|w| w[0] <= w[1]), "points in time order");
+        assert!(
+            times.windows(2).all(|w| w[0] <= w[1]),
+            "points in time order"
+        );
     }
 
     #[test]

@@ -198,7 +198,8 @@ impl SummaryRecords {
         let mut c = Cursor::new(bytes);
         while !c.rest().is_empty() {
             let at = start + (bytes.len() - c.rest().len()) as u64;
-            let err = |e: wire::WireError| corrupt(format!("malformed summary record at byte {at}: {e}"));
+            let err =
+                |e: wire::WireError| corrupt(format!("malformed summary record at byte {at}: {e}"));
             let opcode = c.u8("opcode").map_err(err)?;
             let len = c.u64("record length").map_err(err)?;
             let body = c.take(len, "record").map_err(err)?;
@@ -339,7 +340,8 @@ fn metadata_at(
         )));
     }
     let mut c = Cursor::new(&record[9..]);
-    let err = |e: wire::WireError| corrupt(format!("malformed metadata record at byte {offset}: {e}"));
+    let err =
+        |e: wire::WireError| corrupt(format!("malformed metadata record at byte {offset}: {e}"));
     let name = c.string("name").map_err(err)?.unwrap_or("").to_string();
     let mut entries = BTreeMap::new();
     wire::for_each_entry(&mut c, "metadata", |e| {

@@ -15,8 +15,8 @@
 //! `five-hundred-yen` and `long-horizon` with each compression, where the estimate falls within
 //! [`ACCURACY`] of the file's size (a test keeps it so).
 
-use super::recorder::Compression;
 use super::foxglove::SCENE_RATE;
+use super::recorder::Compression;
 use crate::format::{schema_bytes, Channel};
 use crate::scene::Scene;
 

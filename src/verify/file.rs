@@ -6,11 +6,11 @@ use super::checks::{
     invariants::InvariantsCheck, steady, steady::SteadyCheck, validity::ValidityCheck, Context,
     RunStats,
 };
-use crate::format::json;
 use super::report::{CheckId, CheckResult, FileReport, Status};
 use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::Options;
+use crate::format::json;
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage,

@@ -12,8 +12,8 @@
 use crate::support::record::{coin_log, exe};
 use crate::support::repo;
 use coin_log::bench::throughput::{
-    self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, ExportRun, RecordRun,
-    ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
+    self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, ExportRun,
+    RecordRun, ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
 };
 use coin_log::record::{self, Compression, RecordOptions};
 use std::io::Cursor;
@@ -201,7 +201,10 @@ fn the_rows_are_medians_and_rates_of_the_runs() {
         exports: Vec::new(),
         ..runs.clone()
     };
-    assert!(matches!(no_export.rows(), Err(ThroughputError::NoRuns { .. })));
+    assert!(matches!(
+        no_export.rows(),
+        Err(ThroughputError::NoRuns { .. })
+    ));
     let empty = DurationRuns {
         verifies: Vec::new(),
         ..runs

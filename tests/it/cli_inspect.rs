@@ -29,12 +29,24 @@ fn dry_run_prints_the_resolved_scene_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = coin_log(
         dir.path(),
-        &["record", "wobble", "--dry-run", "--rate", "250", "--set", "initial.theta=0.4"],
+        &[
+            "record",
+            "wobble",
+            "--dry-run",
+            "--rate",
+            "250",
+            "--set",
+            "initial.theta=0.4",
+        ],
     );
     let text = String::from_utf8(out.stdout).unwrap();
     print!("{text}");
     assert_eq!(out.status.code(), Some(0));
-    assert!(listing(dir.path()).is_empty(), "nothing written: {:?}", listing(dir.path()));
+    assert!(
+        listing(dir.path()).is_empty(),
+        "nothing written: {:?}",
+        listing(dir.path())
+    );
     // The output is a scene file: it resolves to the scene the flags make.
     let printed = Scene::from_file(&scene::parse_with_sets(&text, &[]).unwrap()).unwrap();
     let flags = FlagOverrides {
@@ -42,16 +54,28 @@ fn dry_run_prints_the_resolved_scene_and_writes_nothing() {
         ..FlagOverrides::default()
     };
     let sets = vec!["initial.theta=0.4".to_string()];
-    let expected =
-        scene::resolve(&scene::file_with_sets(&presets::preset("wobble").unwrap(), &sets).unwrap(), &flags)
-            .unwrap();
+    let expected = scene::resolve(
+        &scene::file_with_sets(&presets::preset("wobble").unwrap(), &sets).unwrap(),
+        &flags,
+    )
+    .unwrap();
     assert_eq!(printed, expected);
-    for key in ["rate = 250.0", "integrator = \"dop853\"", "rtol =", "step =", "flat_margin =", "channels ="] {
+    for key in [
+        "rate = 250.0",
+        "integrator = \"dop853\"",
+        "rtol =",
+        "step =",
+        "flat_margin =",
+        "channels =",
+    ] {
         assert!(text.contains(key), "`{key}` in the dry run");
     }
     assert!(text.contains("7501 samples"), "30 × 250 + 1 samples");
     // A bad scene: the same errors as a real recording, exit 1, nothing written.
-    let out = coin_log(dir.path(), &["record", "wobble", "--dry-run", "--rate", "0"]);
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--dry-run", "--rate", "0"],
+    );
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--rate"));
     assert!(listing(dir.path()).is_empty());
@@ -117,18 +141,32 @@ fn the_estimate_holds_within_its_factor_on_real_recordings() {
 fn a_recording_above_a_gibibyte_is_warned_about() {
     let dir = tempfile::tempdir().unwrap();
     let mut child = Command::new(exe())
-        .args(["record", "long-horizon", "--rate", "1000", "--duration", "100000", "-o", "big.mcap"])
+        .args([
+            "record",
+            "long-horizon",
+            "--rate",
+            "1000",
+            "--duration",
+            "100000",
+            "-o",
+            "big.mcap",
+        ])
         .current_dir(dir.path())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let mut line = String::new();
-    BufReader::new(child.stderr.take().unwrap()).read_line(&mut line).unwrap();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
     let _ = child.kill();
     let _ = child.wait();
     println!("{line}");
-    assert!(line.starts_with("warning: this recording is estimated at"), "{line}");
+    assert!(
+        line.starts_with("warning: this recording is estimated at"),
+        "{line}"
+    );
     assert!(line.contains("GiB"), "{line}");
     // A small recording does not warn.
     let (code, _, err) = coin_log_text(&["record", "circle-plus", "--dry-run"]);
@@ -148,9 +186,21 @@ fn scenes_json_lists_every_built_in_resolved() {
         let preset = presets::preset(name).unwrap();
         assert_eq!(entry["description"], preset.description.clone().unwrap());
         let file: scene::SceneFile = serde_json::from_value(entry["scene"].clone()).unwrap();
-        assert_eq!(Scene::from_file(&file).unwrap(), Scene::from_file(&preset).unwrap(), "{name}");
+        assert_eq!(
+            Scene::from_file(&file).unwrap(),
+            Scene::from_file(&preset).unwrap(),
+            "{name}"
+        );
         let run = &entry["scene"]["run"];
-        for key in ["duration", "rate", "integrator", "rtol", "atol", "step", "flat_margin"] {
+        for key in [
+            "duration",
+            "rate",
+            "integrator",
+            "rtol",
+            "atol",
+            "step",
+            "flat_margin",
+        ] {
             assert!(!run[key].is_null(), "{name}: run.{key} filled in");
         }
         assert!(entry["scene"]["record"]["channels"].is_array());
@@ -163,12 +213,25 @@ fn scenes_show_prints_every_default() {
     for name in presets::NAMES {
         let (code, out, _) = coin_log_text(&["scenes", "--show", name]);
         assert_eq!(code, 0);
-        for key in ["rate =", "integrator =", "rtol =", "atol =", "step =", "flat_margin =", "thickness =", "channels ="] {
+        for key in [
+            "rate =",
+            "integrator =",
+            "rtol =",
+            "atol =",
+            "step =",
+            "flat_margin =",
+            "thickness =",
+            "channels =",
+        ] {
             assert!(out.contains(key), "{name}: `{key}` in\n{out}");
         }
         let file = scene::parse_with_sets(&out, &[]).unwrap();
         let resolved = Scene::from_file(&presets::preset(name).unwrap()).unwrap();
-        assert_eq!(file, resolved.to_file(), "{name}: the resolved scene, written out");
+        assert_eq!(
+            file,
+            resolved.to_file(),
+            "{name}: the resolved scene, written out"
+        );
     }
 }
 
@@ -193,7 +256,11 @@ fn completions_and_man_pages_name_every_command() {
     assert_eq!(code, 2, "an unknown shell is a usage error: {out}");
     let (code, man, _) = coin_log_text(&["man"]);
     assert_eq!(code, 0);
-    assert!(man.starts_with(".ie") || man.contains(".TH coin-log"), "roff: {}", &man[..200.min(man.len())]);
+    assert!(
+        man.starts_with(".ie") || man.contains(".TH coin-log"),
+        "roff: {}",
+        &man[..200.min(man.len())]
+    );
     for c in COMMANDS {
         assert!(man.contains(c), "`{c}` in the man page");
     }
@@ -203,7 +270,10 @@ fn completions_and_man_pages_name_every_command() {
     let pages = listing(&dir.path().join("man1"));
     println!("{pages:?}");
     for c in COMMANDS {
-        assert!(pages.contains(&format!("coin-log-{c}.1")), "coin-log-{c}.1 written");
+        assert!(
+            pages.contains(&format!("coin-log-{c}.1")),
+            "coin-log-{c}.1 written"
+        );
     }
     assert!(pages.contains(&"coin-log.1".to_string()));
     assert!(pages.contains(&"coin-log-bench-precision.1".to_string()));
@@ -216,13 +286,28 @@ fn verify_totals_several_files_in_one_line() {
     let dir = tempfile::tempdir().unwrap();
     record_scene(dir.path(), "circle-plus", &["--duration", "2"]);
     std::fs::write(dir.path().join("junk.mcap"), b"junk").unwrap();
-    let out = coin_log(dir.path(), &["verify", "circle-plus.mcap", "junk.mcap", "circle-plus.mcap"]);
+    let out = coin_log(
+        dir.path(),
+        &[
+            "verify",
+            "circle-plus.mcap",
+            "junk.mcap",
+            "circle-plus.mcap",
+        ],
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     print!("{text}");
     assert_eq!(out.status.code(), Some(2));
-    assert_eq!(text.lines().last(), Some("3 files: 2 ok, 0 failed, 1 unusable"));
+    assert_eq!(
+        text.lines().last(),
+        Some("3 files: 2 ok, 0 failed, 1 unusable")
+    );
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(err.lines().count(), 1, "only junk.mcap's error, no bar: {err}");
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "only junk.mcap's error, no bar: {err}"
+    );
     let out = coin_log(dir.path(), &["verify", "circle-plus.mcap"]);
     assert!(!String::from_utf8_lossy(&out.stdout).contains("files:"));
     assert!(out.stderr.is_empty());

@@ -53,8 +53,13 @@ fn without_summary(src: &Path, dst: &Path) {
             let sid = w
                 .add_schema(&schema.name, &schema.encoding, &schema.data)
                 .unwrap();
-            w.add_channel(sid, &m.channel.topic, &m.channel.message_encoding, &BTreeMap::new())
-                .unwrap()
+            w.add_channel(
+                sid,
+                &m.channel.topic,
+                &m.channel.message_encoding,
+                &BTreeMap::new(),
+            )
+            .unwrap()
         });
         w.write_to_known_channel(
             &mcap::records::MessageHeader {
@@ -91,7 +96,12 @@ fn info_reports_what_the_file_holds_with_or_without_a_summary() {
     let file = read_back(&std::fs::read(&path).unwrap());
     let (expected, start, end) = counts(&file);
     let out = coin_log(dir.path(), &["info", "--json", "topple.mcap", "bare.mcap"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v = json(&out);
     let files = v["files"].as_array().unwrap();
     assert_eq!(files.len(), 2);
@@ -106,7 +116,12 @@ fn info_reports_what_the_file_holds_with_or_without_a_summary() {
             .as_array()
             .unwrap()
             .iter()
-            .map(|c| (c["topic"].as_str().unwrap().to_string(), c["messages"].as_u64().unwrap()))
+            .map(|c| {
+                (
+                    c["topic"].as_str().unwrap().to_string(),
+                    c["messages"].as_u64().unwrap(),
+                )
+            })
             .collect();
         assert_eq!(got, expected, "per-channel counts");
         assert_eq!(f["messages"], expected.values().sum::<u64>());
@@ -117,7 +132,12 @@ fn info_reports_what_the_file_holds_with_or_without_a_summary() {
         assert_eq!(f["body"]["inertia_x"], 0.25);
         assert_eq!(f["run"]["integrator"], "dop853");
         assert_eq!(f["run"]["duration"], 30.0);
-        assert_eq!(f["file_size"], std::fs::metadata(dir.path().join(f["path"].as_str().unwrap())).unwrap().len());
+        assert_eq!(
+            f["file_size"],
+            std::fs::metadata(dir.path().join(f["path"].as_str().unwrap()))
+                .unwrap()
+                .len()
+        );
         assert!(f["description"].as_str().unwrap().contains("flat landing"));
         // omega has one message per sample: (n - 1) samples over the span.
         let omega = &f["channels"][0];
@@ -132,7 +152,13 @@ fn info_reports_what_the_file_holds_with_or_without_a_summary() {
     let (code, text, _) = coin_log_text(&["info", path.to_str().unwrap()]);
     print!("{text}");
     assert_eq!(code, 0);
-    for expected in ["flat-landing at t = 1.9", "/coin/omega", "coin_log.AngularVelocity", "lz4", "summary section"] {
+    for expected in [
+        "flat-landing at t = 1.9",
+        "/coin/omega",
+        "coin_log.AngularVelocity",
+        "lz4",
+        "summary section",
+    ] {
         assert!(text.contains(expected), "`{expected}` in:\n{text}");
     }
 }
@@ -181,13 +207,29 @@ fn the_stored_scene_records_the_same_bytes_again_for_every_built_in() {
             again.to_str().unwrap(),
         ]);
         assert_eq!(code, 0, "{name}: {err}");
-        let (a, b) = (std::fs::read(&original).unwrap(), std::fs::read(&again).unwrap());
-        println!("{name:<18} {} bytes, re-recorded from its stored scene: {}", a.len(), if a == b { "identical" } else { "DIFFERENT" });
+        let (a, b) = (
+            std::fs::read(&original).unwrap(),
+            std::fs::read(&again).unwrap(),
+        );
+        println!(
+            "{name:<18} {} bytes, re-recorded from its stored scene: {}",
+            a.len(),
+            if a == b { "identical" } else { "DIFFERENT" }
+        );
         assert!(a == b, "{name}: the re-recording differs\n{text}");
         let preset = coin_log::scene::presets::preset(name).unwrap();
         let description = preset.description.unwrap();
         assert!(text.contains(&description), "{name}: description kept");
-        for key in ["rate =", "integrator =", "rtol =", "atol =", "step =", "flat_margin =", "thickness =", "channels ="] {
+        for key in [
+            "rate =",
+            "integrator =",
+            "rtol =",
+            "atol =",
+            "step =",
+            "flat_margin =",
+            "thickness =",
+            "channels =",
+        ] {
             assert!(text.contains(key), "{name}: `{key}` written out:\n{text}");
         }
         assert!(!text.contains("copied-"), "{name}");
@@ -198,7 +240,11 @@ fn the_stored_scene_records_the_same_bytes_again_for_every_built_in() {
 #[test]
 fn the_stored_scene_names_a_non_default_compression() {
     let dir = tempfile::tempdir().unwrap();
-    let original = record_scene(dir.path(), "circle-plus", &["--compression", "none", "--duration", "2"]);
+    let original = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--compression", "none", "--duration", "2"],
+    );
     let (code, text, _) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
     assert_eq!(code, 0);
     assert!(text.contains("--compression none"), "{text}");
@@ -214,7 +260,12 @@ fn the_stored_scene_names_a_non_default_compression() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(std::fs::read(&original).unwrap() == std::fs::read(&again).unwrap());
-    let (code, _, err) = coin_log_text(&["info", "--scene", original.to_str().unwrap(), original.to_str().unwrap()]);
+    let (code, _, err) = coin_log_text(&[
+        "info",
+        "--scene",
+        original.to_str().unwrap(),
+        original.to_str().unwrap(),
+    ]);
     assert_eq!(code, 1);
     assert!(err.contains("one file"), "{err}");
 }
@@ -223,8 +274,18 @@ fn the_stored_scene_names_a_non_default_compression() {
 fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
-    (header, lines.map(|l| l.split(',').map(str::to_string).collect()).collect())
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    (
+        header,
+        lines
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect(),
+    )
 }
 
 /// Every value of `table` against the messages of `topic` read by the `mcap` crate and serde_json:
@@ -234,14 +295,23 @@ fn compare_flat(file: &ReadBack, topic: &str, table: &Path) -> usize {
     let messages = file.on_topic(topic);
     assert_eq!(rows.len(), messages.len(), "{topic}: one row per message");
     let channel = Channel::from_topic(topic).unwrap();
-    assert_eq!(header, channel.fields().unwrap(), "{topic}: header = the schema's fields");
+    assert_eq!(
+        header,
+        channel.fields().unwrap(),
+        "{topic}: header = the schema's fields"
+    );
     let mut compared = 0;
     for (row, m) in rows.iter().zip(messages) {
-        let v: serde_json::Map<String, serde_json::Value> = serde_json::from_slice(&m.data).unwrap();
+        let v: serde_json::Map<String, serde_json::Value> =
+            serde_json::from_slice(&m.data).unwrap();
         for (name, cell) in header.iter().zip(row) {
             let expected = v[name].as_f64().unwrap();
             let got: f64 = cell.parse().unwrap();
-            assert_eq!(got.to_bits(), expected.to_bits(), "{topic}.{name}: {cell} vs {expected:?}");
+            assert_eq!(
+                got.to_bits(),
+                expected.to_bits(),
+                "{topic}.{name}: {cell} vs {expected:?}"
+            );
             compared += 1;
         }
     }
@@ -254,8 +324,16 @@ fn compare_flat(file: &ReadBack, topic: &str, table: &Path) -> usize {
 fn export_writes_every_value_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let path = record_scene(dir.path(), "wobble", &["--duration", "5"]);
-    let out = coin_log(dir.path(), &["export", "wobble.mcap", "--out", "tables", "--json"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = coin_log(
+        dir.path(),
+        &["export", "wobble.mcap", "--out", "tables", "--json"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary = json(&out);
     println!("{summary}");
     let file = read_back(&std::fs::read(&path).unwrap());
@@ -273,27 +351,54 @@ fn export_writes_every_value_bit_for_bit() {
     assert_eq!(rows.len(), tf.len());
     for (row, m) in rows.iter().zip(tf) {
         let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
-        let ns = v["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000 + v["timestamp"]["nsec"].as_u64().unwrap();
+        let ns = v["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
+            + v["timestamp"]["nsec"].as_u64().unwrap();
         assert_eq!(ns, m.log_time);
-        assert_eq!(row[0].parse::<f64>().unwrap(), ns as f64 / 1e9, "t is the exact timestamp");
+        assert_eq!(
+            row[0].parse::<f64>().unwrap(),
+            ns as f64 / 1e9,
+            "t is the exact timestamp"
+        );
         assert_eq!(row[1], v["parent_frame_id"].as_str().unwrap());
         assert_eq!(row[2], v["child_frame_id"].as_str().unwrap());
-        for (cell, (part, axis)) in row[3..].iter().zip([("translation", "x"), ("translation", "y"), ("translation", "z"), ("rotation", "x"), ("rotation", "y"), ("rotation", "z"), ("rotation", "w")]) {
-            assert_eq!(cell.parse::<f64>().unwrap().to_bits(), v[part][axis].as_f64().unwrap().to_bits());
+        for (cell, (part, axis)) in row[3..].iter().zip([
+            ("translation", "x"),
+            ("translation", "y"),
+            ("translation", "z"),
+            ("rotation", "x"),
+            ("rotation", "y"),
+            ("rotation", "z"),
+            ("rotation", "w"),
+        ]) {
+            assert_eq!(
+                cell.parse::<f64>().unwrap().to_bits(),
+                v[part][axis].as_f64().unwrap().to_bits()
+            );
         }
     }
     let skipped = summary["skipped"].as_array().unwrap();
     assert_eq!(skipped.len(), 1);
     assert_eq!(skipped[0]["topic"], "/scene");
-    assert!(skipped[0]["reason"].as_str().unwrap().contains("/coin/contact"));
+    assert!(skipped[0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("/coin/contact"));
     // Again without --overwrite: refused, the tables untouched, no temporary file left.
     let before = std::fs::read(tables.join("omega.csv")).unwrap();
     let out = coin_log(dir.path(), &["export", "wobble.mcap", "--out", "tables"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--overwrite"));
     assert_eq!(std::fs::read(tables.join("omega.csv")).unwrap(), before);
-    let names: Vec<String> = std::fs::read_dir(&tables).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    assert!(names.iter().all(|n| n.ends_with(".csv") && !n.starts_with('.')), "{names:?}");
+    let names: Vec<String> = std::fs::read_dir(&tables)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names
+            .iter()
+            .all(|n| n.ends_with(".csv") && !n.starts_with('.')),
+        "{names:?}"
+    );
     assert_eq!(names.len(), 9);
 }
 
@@ -301,7 +406,11 @@ fn export_writes_every_value_bit_for_bit() {
 #[test]
 fn the_bit_comparison_catches_one_ulp() {
     let dir = tempfile::tempdir().unwrap();
-    let path = record_scene(dir.path(), "circle-plus", &["--duration", "1", "--channels", "omega"]);
+    let path = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--duration", "1", "--channels", "omega"],
+    );
     let out = coin_log(dir.path(), &["export", "circle-plus.mcap", "--out", "t"]);
     assert_eq!(out.status.code(), Some(0));
     let table = dir.path().join("t/omega.csv");
@@ -309,7 +418,9 @@ fn the_bit_comparison_catches_one_ulp() {
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     let mut cells: Vec<String> = lines[5].split(',').map(str::to_string).collect();
     let x: f64 = cells[2].parse().unwrap();
-    cells[2] = ryu::Buffer::new().format_finite(f64::from_bits(x.to_bits() + 1)).to_string();
+    cells[2] = ryu::Buffer::new()
+        .format_finite(f64::from_bits(x.to_bits() + 1))
+        .to_string();
     lines[5] = cells.join(",");
     std::fs::write(&table, lines.join("\n") + "\n").unwrap();
     let file = read_back(&std::fs::read(&path).unwrap());
@@ -328,7 +439,12 @@ fn the_wide_table_joins_the_channels_on_t() {
     let file = read_back(&std::fs::read(&path).unwrap());
     for (source, folder) in [("topple.mcap", "wide"), ("bare.mcap", "wide-bare")] {
         let out = coin_log(dir.path(), &["export", source, "--wide", "--out", folder]);
-        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         print!("{}", String::from_utf8_lossy(&out.stdout));
         let (header, rows) = csv(&dir.path().join(folder).join(WIDE_TABLE));
         let samples = file.on_topic("/coin/omega");
@@ -340,8 +456,15 @@ fn the_wide_table_joins_the_channels_on_t() {
             let channel: Channel = channel.parse().unwrap();
             for (row, m) in rows.iter().zip(file.on_topic(channel.topic())) {
                 let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
-                assert_eq!(row[col].parse::<f64>().unwrap().to_bits(), v[field].as_f64().unwrap().to_bits(), "{name}");
-                assert_eq!(row[0].parse::<f64>().unwrap().to_bits(), v["t"].as_f64().unwrap().to_bits());
+                assert_eq!(
+                    row[col].parse::<f64>().unwrap().to_bits(),
+                    v[field].as_f64().unwrap().to_bits(),
+                    "{name}"
+                );
+                assert_eq!(
+                    row[0].parse::<f64>().unwrap().to_bits(),
+                    v["t"].as_f64().unwrap().to_bits()
+                );
                 compared += 1;
             }
         }
@@ -359,7 +482,10 @@ fn the_wide_table_joins_the_channels_on_t() {
 fn parquet_is_refused_with_the_way_to_convert() {
     let dir = tempfile::tempdir().unwrap();
     record_scene(dir.path(), "circle-plus", &["--duration", "1"]);
-    let out = coin_log(dir.path(), &["export", "circle-plus.mcap", "--format", "parquet"]);
+    let out = coin_log(
+        dir.path(),
+        &["export", "circle-plus.mcap", "--format", "parquet"],
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     for expected in ["not built in", "crates", "polars", "round_trip"] {
@@ -378,12 +504,16 @@ fn a_failed_export_leaves_nothing_behind() {
     let out = coin_log(dir.path(), &["export", "half.mcap", "--out", "t"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("truncated") && err.contains("nothing exported"), "{err}");
+    assert!(
+        err.contains("truncated") && err.contains("nothing exported"),
+        "{err}"
+    );
     assert_eq!(std::fs::read_dir(dir.path().join("t")).unwrap().count(), 0);
 }
 
 fn svg_texts(svg: &str) -> Vec<String> {
-    let doc = roxmltree::Document::parse(svg).unwrap_or_else(|e| panic!("not well-formed XML: {e}"));
+    let doc =
+        roxmltree::Document::parse(svg).unwrap_or_else(|e| panic!("not well-formed XML: {e}"));
     assert_eq!(doc.root_element().tag_name().name(), "svg");
     doc.descendants()
         .filter(|n| n.is_element() && n.tag_name().name() == "text")
@@ -402,9 +532,15 @@ fn svg_texts(svg: &str) -> Vec<String> {
 fn check_plot(svg: &str, termination: &str) {
     let texts = svg_texts(svg);
     for panel in PANELS {
-        assert!(texts.iter().any(|t| t == panel), "panel `{panel}` missing; texts: {texts:?}");
+        assert!(
+            texts.iter().any(|t| t == panel),
+            "panel `{panel}` missing; texts: {texts:?}"
+        );
     }
-    assert!(texts.iter().any(|t| t.contains(termination)), "`{termination}` marked");
+    assert!(
+        texts.iter().any(|t| t.contains(termination)),
+        "`{termination}` marked"
+    );
 }
 
 /// `plot` of wobble and topple: well-formed SVG with every panel and the termination; the committed
@@ -412,13 +548,22 @@ fn check_plot(svg: &str, termination: &str) {
 #[test]
 fn plot_draws_every_panel_and_marks_the_termination() {
     let dir = tempfile::tempdir().unwrap();
-    for (name, termination) in [("wobble", "completed at t = 30"), ("topple", "flat-landing at t = 1.9")] {
+    for (name, termination) in [
+        ("wobble", "completed at t = 30"),
+        ("topple", "flat-landing at t = 1.9"),
+    ] {
         record_scene(dir.path(), name, &[]);
         let out = coin_log(dir.path(), &["plot", &format!("{name}.mcap")]);
-        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let svg = std::fs::read_to_string(dir.path().join(format!("{name}.svg"))).unwrap();
         check_plot(&svg, termination);
-        let committed = std::fs::read_to_string(repo().join(format!("docs/plot-{name}.svg"))).unwrap();
+        let committed =
+            std::fs::read_to_string(repo().join(format!("docs/plot-{name}.svg"))).unwrap();
         check_plot(&committed, termination);
         // Again: refused without --overwrite.
         let out = coin_log(dir.path(), &["plot", &format!("{name}.mcap")]);
@@ -445,7 +590,12 @@ fn info_describes_every_committed_dataset_from_its_summary() {
         let file = read_back(&std::fs::read(path).unwrap());
         let (expected, _, _) = counts(&file);
         assert_eq!(f["read_from"], "summary");
-        assert_eq!(f["messages"], expected.values().sum::<u64>(), "{}", path.display());
+        assert_eq!(
+            f["messages"],
+            expected.values().sum::<u64>(),
+            "{}",
+            path.display()
+        );
         assert_eq!(f["result"]["termination"], "completed");
     }
 }

@@ -176,7 +176,9 @@ fn export_run(exe: &Path, path: &Path) -> anyhow::Result<ExportRun> {
     let (json, seconds) = result?;
     Ok(ExportRun {
         seconds,
-        peak_rss: json.get("peak_rss_bytes").and_then(serde_json::Value::as_u64),
+        peak_rss: json
+            .get("peak_rss_bytes")
+            .and_then(serde_json::Value::as_u64),
     })
 }
 
