@@ -77,7 +77,7 @@ fn corrupt(detail: String) -> ReadError {
 }
 
 /// Reads the summary of the MCAP file at `path`. `Ok(None)` when the file has no summary section, its
-/// summary has no statistics record, or it is larger than [`MAX_RECORD`] (then only a streaming pass
+/// summary has no statistics record, or it is larger than 64 MiB (then only a streaming pass
 /// can tell what the file holds).
 ///
 /// # Errors
