@@ -599,3 +599,25 @@ fn info_describes_every_committed_dataset_from_its_summary() {
         assert_eq!(f["result"]["termination"], "completed");
     }
 }
+
+/// A summary section whose CRC does not match is not trusted: `info` reads the whole file instead, and
+/// names the damage (exit 1); the counts still come from the messages themselves.
+#[test]
+fn info_does_not_trust_a_summary_whose_crc_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "circle-plus", &["--duration", "2"]);
+    let mut bytes = std::fs::read(&path).unwrap();
+    let footer = bytes.len() - 37;
+    let summary_start = u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap()) as usize;
+    // A byte inside the first summary record's body (the schema's data): only the CRC can tell.
+    bytes[summary_start + 40] ^= 0x20;
+    std::fs::write(dir.path().join("bad.mcap"), &bytes).unwrap();
+    let out = coin_log(dir.path(), &["info", "--json", "bad.mcap"]);
+    assert_eq!(out.status.code(), Some(1));
+    let f = &json(&out)["files"][0];
+    println!("{f}");
+    assert_eq!(f["read_from"], "scan");
+    assert!(f["problem"].as_str().unwrap().contains("summary"), "{f}");
+    let file = read_back(&std::fs::read(&path).unwrap());
+    assert_eq!(f["messages"], file.messages.len());
+}
