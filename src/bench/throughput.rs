@@ -11,6 +11,7 @@
 //!   as each compression worker does ([`compression_bound`]); the ratio record time / bound says how close
 //!   recording is to what compression alone costs;
 //! - **verify**: `coin-log verify --json` of that file, every check on ([`VerifyRun`]);
+//! - **export**: `coin-log export --json` of that file, one CSV table per channel ([`ExportRun`]);
 //! - **integration**: dop853 on `wobble` (30 time units) at the loosest tolerance whose state error against
 //!   the dop853 reference (atol 1e-16) is ≤ 1e-10, and one RHS evaluation (`Coin::derivative`)
 //!   ([`integration_cost`]).
@@ -73,7 +74,7 @@ pub mod targets {
     pub const BOUND_RATIO: f64 = 2.0;
     /// Verify, messages per second.
     pub const VERIFY_MESSAGES_PER_SECOND: f64 = 2e6;
-    /// Peak RSS of record and verify \[bytes\].
+    /// Peak RSS of record, verify and export \[bytes\].
     pub const PEAK_RSS_BYTES: f64 = 64.0 * 1024.0 * 1024.0;
     /// dop853 on wobble \[s\].
     pub const INTEGRATION_SECONDS: f64 = 0.5e-3;
@@ -254,6 +255,15 @@ pub struct RecordRun {
     pub peak_rss: Option<u64>,
 }
 
+/// One export run (`coin-log export --json` of the recording: one CSV table per channel).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExportRun {
+    /// Wall time of the export process \[s\].
+    pub seconds: f64,
+    /// Its peak RSS \[bytes\], if reported.
+    pub peak_rss: Option<u64>,
+}
+
 /// One verify run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VerifyRun {
@@ -404,6 +414,8 @@ pub struct DurationRuns {
     pub bounds: Vec<Bound>,
     /// The verify runs of their recordings.
     pub verifies: Vec<VerifyRun>,
+    /// The export runs of their recordings.
+    pub exports: Vec<ExportRun>,
 }
 
 impl DurationRuns {
@@ -422,10 +434,11 @@ impl DurationRuns {
     /// # Errors
     /// [`ThroughputError::NoRuns`] when any of the three lists is empty.
     pub fn rows(&self) -> Result<Vec<ThroughputRow>, ThroughputError> {
-        let (Some(record), Some(bound), false) = (
+        let (Some(record), Some(bound), false, false) = (
             self.records.last(),
             self.bounds.last(),
             self.verifies.is_empty(),
+            self.exports.is_empty(),
         ) else {
             return Err(ThroughputError::NoRuns {
                 duration: self.duration,
@@ -436,7 +449,32 @@ impl DurationRuns {
         let mut rows = self.record_rows(record, bound, record_s);
         rows.extend(self.bound_rows(bound, bound_s, record_s));
         rows.extend(self.verify_rows(record.messages));
+        rows.extend(self.export_rows(record.messages));
         Ok(rows)
+    }
+
+    /// Messages/s and peak RSS of the export workload.
+    fn export_rows(&self, messages: u64) -> Vec<ThroughputRow> {
+        let export_s = median(&self.exports.iter().map(|v| v.seconds).collect::<Vec<_>>());
+        let workload = format!("export {} u, one CSV per channel", self.duration);
+        vec![
+            row(
+                &workload,
+                "messages/s",
+                rate(messages, export_s),
+                "1/s",
+                None,
+                &format!("{export_s:.3} s wall of the export process"),
+            ),
+            row(
+                &workload,
+                "peak RSS",
+                median_peak(self.exports.iter().map(|v| v.peak_rss)),
+                "B",
+                Some(Target::Below(targets::PEAK_RSS_BYTES)),
+                "VmHWM of the export process",
+            ),
+        ]
     }
 
     /// Messages/s, MB/s, file size and peak RSS of the record workload.

@@ -1,9 +1,15 @@
 //! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints.
 
 mod bench;
+mod completions;
+mod export;
+mod info;
+mod plot;
+mod progress;
 mod record;
 mod rss;
 mod scenes;
+mod text;
 mod verify;
 
 use clap::{Parser, Subcommand};
@@ -30,6 +36,16 @@ enum Command {
     Scenes(scenes::ScenesArgs),
     /// Benchmarks: error against cost of every integrator, and the hard-case stability suite.
     Bench(bench::BenchArgs),
+    /// Show what files hold: channels, time range, body, run settings, termination; or the stored scene.
+    Info(info::InfoArgs),
+    /// Write a file's channels as CSV tables (one per channel, or one joined on t).
+    Export(export::ExportArgs),
+    /// Draw a one-page SVG overview of a file.
+    Plot(plot::PlotArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(completions::CompletionsArgs),
+    /// Print the man page, or write one per command into a folder.
+    Man(completions::ManArgs),
 }
 
 /// What a command ended with; the one place exit codes are decided (format.md: Exit codes).
@@ -74,6 +90,11 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Verify(args) => verify::run(args),
         Command::Scenes(args) => scenes::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Info(args) => info::run(&args),
+        Command::Export(args) => export::run(&args),
+        Command::Plot(args) => plot::run(&args),
+        Command::Completions(args) => completions::completions(&args),
+        Command::Man(args) => completions::man(&args),
     }
 }
 

@@ -1,10 +1,11 @@
 //! `coin-log verify`: prints each file's checks as a table (or the contract's JSON) and maps the worst
 //! verdict to the exit code.
 
+use super::progress::{file_len, FileProgress};
 use super::rss::peak_rss_bytes;
 use super::Outcome;
 use coin_log::verify::{self, FileReport, Options, Report};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What `coin-log verify --help` adds after the options: the checks, the tolerance formula, exit codes.
 const AFTER_HELP: &str = "\
@@ -60,7 +61,7 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     let mut report = Report { files: Vec::new() };
     let mut peaks = Vec::new();
     for path in &args.files {
-        report.files.push(verify::verify_file(path, &options));
+        report.files.push(verify_with_progress(path, &options));
         peaks.push(peak_rss_bytes());
     }
     for file in &report.files {
@@ -75,12 +76,35 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
         );
     } else {
         print!("{}", table(&report));
+        if report.files.len() > 1 {
+            println!("{}", total(&report));
+        }
     }
     Ok(match report.exit_code() {
         0 => Outcome::Success,
         1 => Outcome::Failure,
         _ => Outcome::Unusable,
     })
+}
+
+/// Judges one file with a progress bar on stderr (a terminal only, after a second).
+fn verify_with_progress(path: &Path, options: &Options) -> FileReport {
+    let progress = FileProgress::new(&path.display().to_string(), file_len(path));
+    let report = verify::verify_file_with_progress(path, options, &|b| progress.update(b));
+    progress.finish();
+    report
+}
+
+/// The one-line total of several files: `N files: x ok, y failed, z unusable`.
+fn total(report: &Report) -> String {
+    let count = |code: u8| report.files.iter().filter(|f| f.exit_code == code).count();
+    format!(
+        "{} files: {} ok, {} failed, {} unusable",
+        report.files.len(),
+        count(0),
+        count(1),
+        report.files.len() - count(0) - count(1)
+    )
 }
 
 /// The contract's JSON plus `peak_rss_bytes` in each file object: the process's peak resident set size

@@ -99,6 +99,26 @@ impl Channel {
         }
     }
 
+    /// The fields of the channel's messages in schema order (the JSON keys, `t` first) for the
+    /// `coin_log.*` channels; `None` for Foxglove's `/tf` and `/scene`, whose messages are nested.
+    #[must_use]
+    pub fn fields(self) -> Option<&'static [&'static str]> {
+        use super::messages::{
+            Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
+            ReactionMessage,
+        };
+        Some(match self {
+            Self::Omega => AngularVelocity::FIELDS,
+            Self::Angles => Angles::FIELDS,
+            Self::Quaternion => QuaternionMessage::FIELDS,
+            Self::Position | Self::Contact => Position::FIELDS,
+            Self::Reaction => ReactionMessage::FIELDS,
+            Self::Energy => EnergyMessage::FIELDS,
+            Self::Invariants => InvariantsMessage::FIELDS,
+            Self::Tf | Self::Scene => return None,
+        })
+    }
+
     /// Every channel's name, comma-separated, for messages.
     #[must_use]
     pub fn names() -> String {

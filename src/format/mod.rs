@@ -1,6 +1,7 @@
 //! The file format, typed: everything a coin-log MCAP file contains that `scene`, `record` and `verify` must
 //! agree on (docs/format.md). The channels with their topics, schema names and schema bytes
-//! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`]); the two metadata
+//! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`], read back by
+//! [`json`]); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
 //! simulation time to log time ([`log_time`]).
 //!
@@ -9,6 +10,7 @@
 //! nothing about scenes, the recorder or the checks, which all import it.
 
 pub mod channels;
+pub mod json;
 pub mod messages;
 pub mod metadata;
 mod termination;

@@ -15,16 +15,23 @@
 //! data, summary and chunk CRCs. Along the way the reader checks the file's structure (message indexes,
 //! chunk indexes, statistics, metadata indexes, summary offsets, footer) and returns what it found as a
 //! [`Structure`]; a file that cannot be read to its end is a [`ReadError`] whose [`ReadErrorKind`] says
-//! why.
+//! why. [`read_with_progress`] also reports the bytes read so far.
+//!
+//! **Summary**: [`read_summary`] reads what a file says about itself (statistics, channels, chunk
+//! indexes, metadata) from its summary section alone, in a few seeks, whatever the file's length.
 
 mod prefetch;
 mod problems;
 mod reader;
+mod summary;
 mod wire;
 mod writer;
 
 pub use problems::Problems;
-pub use reader::{read, read_from, ReadError, ReadErrorKind, Structure, Visitor};
+pub use reader::{
+    read, read_from, read_with_progress, ReadError, ReadErrorKind, Structure, Visitor,
+};
+pub use summary::{read_summary, ChannelSummary, Summary};
 pub use wire::MessageHeader;
 pub use writer::{
     ChunkCompression, ChunkCompressor, McapWriter, WriteError, WriterOptions, DEFAULT_CHUNK_SIZE,

@@ -88,6 +88,12 @@ pub struct Structure {
     pub has_summary: bool,
     /// The `library` of the header record.
     pub library: String,
+    /// Chunks by compression name (`""` for uncompressed chunks).
+    pub compressions: BTreeMap<String, u64>,
+    /// The chunks' records, compressed \[bytes\].
+    pub compressed_bytes: u64,
+    /// The chunks' records, uncompressed \[bytes\].
+    pub uncompressed_bytes: u64,
 }
 
 /// What a schema or channel record is, given the ones seen before with the same id.
@@ -230,6 +236,43 @@ pub fn read(path: &Path, visitor: &mut impl Visitor) -> (Structure, Option<ReadE
     match open(path) {
         Ok((file, len)) => read_from(file, len, visitor),
         Err(e) => (Structure::default(), Some(e)),
+    }
+}
+
+/// [`read`], calling `progress` with the number of bytes read from the file so far (from the reading
+/// thread, at every block of a few hundred KiB), e.g. for a progress bar.
+pub fn read_with_progress(
+    path: &Path,
+    visitor: &mut impl Visitor,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (Structure, Option<ReadError>) {
+    match open(path) {
+        Ok((file, len)) => read_from(
+            Counting {
+                inner: file,
+                read: 0,
+                progress,
+            },
+            len,
+            visitor,
+        ),
+        Err(e) => (Structure::default(), Some(e)),
+    }
+}
+
+/// A reader that reports how many bytes went through it.
+struct Counting<'a, R> {
+    inner: R,
+    read: u64,
+    progress: &'a (dyn Fn(u64) + Sync),
+}
+
+impl<R: Read> Read for Counting<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.read += n as u64;
+        (self.progress)(self.read);
+        Ok(n)
     }
 }
 
@@ -473,6 +516,10 @@ impl Book {
         let header = wire::chunk_header(data).map_err(|e| wire_error("chunk", at, e))?;
         let mut compression = Digest::default();
         compression.push_bytes(header.compression);
+        let name = String::from_utf8_lossy(header.compression).into_owned();
+        *self.s.compressions.entry(name).or_insert(0) += 1;
+        self.s.compressed_bytes += header.compressed_size;
+        self.s.uncompressed_bytes += header.uncompressed_size;
         self.chunk = Some(ChunkBook {
             start: at,
             length: RECORD_PREFIX + data.len() as u64,

@@ -2,10 +2,12 @@
 //! simulate/write → persist; the CLI does the loading and persisting) through [`crate::mcap_io::McapWriter`],
 //! and the Foxglove 3D output. What goes into the file is defined by [`crate::format`].
 
+pub mod estimate;
 pub mod foxglove;
 pub mod recorder;
 pub mod summary;
 
+pub use estimate::{estimate, Estimate};
 pub use foxglove::{Foxglove3d, FoxgloveBatch};
 pub use recorder::{
     record, run_metadata, write_options, Compression, RecordError, RecordOptions,

@@ -6,11 +6,11 @@ use super::checks::{
     invariants::InvariantsCheck, steady, steady::SteadyCheck, validity::ValidityCheck, Context,
     RunStats,
 };
-use super::json;
 use super::report::{CheckId, CheckResult, FileReport, Status};
 use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::Options;
+use crate::format::json;
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage,
@@ -436,6 +436,17 @@ fn unusable(path: &str, problem: String) -> FileReport {
 pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     let mut judge = Judge::default();
     let (structure, error) = mcap_io::read(path, &mut judge);
+    verdict(path.display().to_string(), judge, structure, error, options)
+}
+
+/// Judges one file, reporting the bytes read (see [`super::verify_file_with_progress`]).
+pub fn verify_file_with_progress(
+    path: &Path,
+    options: &Options,
+    progress: &(dyn Fn(u64) + Sync),
+) -> FileReport {
+    let mut judge = Judge::default();
+    let (structure, error) = mcap_io::read_with_progress(path, &mut judge, progress);
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 

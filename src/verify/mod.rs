@@ -8,7 +8,6 @@
 
 pub mod checks;
 mod file;
-mod json;
 pub mod report;
 pub mod samples;
 pub mod tolerances;
@@ -32,6 +31,16 @@ pub struct Options {
 #[must_use]
 pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     file::verify_file(path, options)
+}
+
+/// [`verify_file`], calling `progress` with the bytes read so far (from the reading thread).
+#[must_use]
+pub fn verify_file_with_progress(
+    path: &Path,
+    options: &Options,
+    progress: &(dyn Fn(u64) + Sync),
+) -> FileReport {
+    file::verify_file_with_progress(path, options, progress)
 }
 
 /// Judges an MCAP file held in memory, named `name` in the report (for tests and fuzzing).

@@ -20,7 +20,7 @@ const LAYERS: &[&[&str]] = &[
     &["simulation"],
     &["format"],
     &["scene"],
-    &["record", "verify", "analyse"],
+    &["record", "verify", "analyse", "inspect"],
     &["bench"],
 ];
 

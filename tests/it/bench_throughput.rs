@@ -12,8 +12,8 @@
 use crate::support::record::{coin_log, exe};
 use crate::support::repo;
 use coin_log::bench::throughput::{
-    self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, RecordRun,
-    ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
+    self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, ExportRun,
+    RecordRun, ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
 };
 use coin_log::record::{self, Compression, RecordOptions};
 use std::io::Cursor;
@@ -77,9 +77,10 @@ fn the_throughput_command_records_the_library_workload_and_prints_sane_rows() {
     let csv = std::fs::read_to_string(dir.path().join("throughput.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some(CSV_HEADER));
-    // Nine rows per duration (record 5, bound 2, verify 2), then dop853 and one RHS evaluation.
+    // Eleven rows per duration (record 5, bound 2, verify 2, export 2), then dop853 and one RHS
+    // evaluation.
     let rows: Vec<Vec<String>> = lines.map(csv_fields).collect();
-    assert_eq!(rows.len(), 2 * 9 + 2, "{csv}");
+    assert_eq!(rows.len(), 2 * 11 + 2, "{csv}");
     for fields in &rows {
         let value: f64 = fields[2].parse().unwrap();
         println!("{} / {}: {value}", fields[0], fields[1]);
@@ -146,6 +147,10 @@ fn the_rows_are_medians_and_rates_of_the_runs() {
         seconds,
         peak_rss: None,
     };
+    let export = |seconds| ExportRun {
+        seconds,
+        peak_rss: Some(3 * MIB),
+    };
     let runs = DurationRuns {
         records: vec![
             record(3.0, Some(10 * MIB)),
@@ -154,13 +159,14 @@ fn the_rows_are_medians_and_rates_of_the_runs() {
         ],
         bounds: vec![bound(0.5), bound(1.5), bound(1.0)],
         verifies: vec![verify(1.0), verify(1.0), verify(4.0)],
+        exports: vec![export(7.0), export(0.5), export(3.5)],
         ..DurationRuns::new(0.5)
     };
     let rows = runs.rows().unwrap();
     let report = ThroughputReport::new(rows.clone());
     print!("{}", throughput::table(&report));
-    assert_eq!(rows.len(), 9);
-    // Medians: record 2 s, bound 1 s, verify 1 s; peak RSS of the two reported, 11 MiB.
+    assert_eq!(rows.len(), 11);
+    // Medians: record 2 s, bound 1 s, verify 1 s, export 3.5 s; peak RSS of the two reported, 11 MiB.
     let checks = [
         ("record wobble 0.5", "messages/s", 7007.0 / 2.0),
         ("record wobble 0.5", "JSON MB/s", 400_000.0 / 2.0 / 1e6),
@@ -169,6 +175,8 @@ fn the_rows_are_medians_and_rates_of_the_runs() {
         ("zstd bound 0.5", "compression time", 1.0),
         ("zstd bound 0.5", "record time / bound", 2.0),
         ("verify 0.5", "messages/s", 7007.0),
+        ("export 0.5", "messages/s", 7007.0 / 3.5),
+        ("export 0.5", "peak RSS", 3.0 * 1_048_576.0),
     ];
     for (workload, quantity, expected) in checks {
         let r = row(&rows, workload, quantity);
@@ -189,6 +197,14 @@ fn the_rows_are_medians_and_rates_of_the_runs() {
     assert!(csv.starts_with(CSV_HEADER));
     assert_eq!(csv.lines().count(), rows.len() + 1);
 
+    let no_export = DurationRuns {
+        exports: Vec::new(),
+        ..runs.clone()
+    };
+    assert!(matches!(
+        no_export.rows(),
+        Err(ThroughputError::NoRuns { .. })
+    ));
     let empty = DurationRuns {
         verifies: Vec::new(),
         ..runs

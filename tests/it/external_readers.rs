@@ -94,3 +94,48 @@ fn both_readers_refuse_a_coin_log_message_with_an_undeclared_field() {
     assert!(!node_ok && node_out.contains("power"), "{node_out}");
     assert!(!py_ok && py_out.contains("power"), "{py_out}");
 }
+
+/// `coin-log export` read back by Python (`csv`, `float`) against the MCAP read by the Python `mcap`
+/// package and `json`: every value equal bit for bit; a table with one value changed by one unit in the
+/// last place is refused.
+#[test]
+fn python_reads_the_exported_tables_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = crate::support::record::record_scene(dir.path(), "wobble", &["--duration", "3"]);
+    let out =
+        crate::support::record::coin_log(dir.path(), &["export", "wobble.mcap", "--out", "t"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let check = |what: &str| {
+        let o = Command::new(python())
+            .arg(repo().join("scripts/readers/check_export.py"))
+            .arg(&path)
+            .arg(dir.path().join("t"))
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        println!("--- check_export.py ({what})\n{text}");
+        (o.status.success(), text)
+    };
+    let (ok, text) = check("as exported");
+    assert!(ok && text.contains("values equal bit for bit"), "{text}");
+    let table = dir.path().join("t/energy.csv");
+    let csv = std::fs::read_to_string(&table).unwrap();
+    let mut lines: Vec<String> = csv.lines().map(str::to_string).collect();
+    let mut cells: Vec<String> = lines[10].split(',').map(str::to_string).collect();
+    let x: f64 = cells[1].parse().unwrap();
+    cells[1] = ryu::Buffer::new()
+        .format_finite(f64::from_bits(x.to_bits() + 1))
+        .to_string();
+    lines[10] = cells.join(",");
+    std::fs::write(&table, lines.join("\n") + "\n").unwrap();
+    let (ok, text) = check("one value changed by one ulp");
+    assert!(!ok && text.contains("energy.csv row 10 `total`"), "{text}");
+}

@@ -7,7 +7,7 @@ use super::{create_dir, write};
 use crate::cli::Outcome;
 use anyhow::{anyhow, bail, Context};
 use coin_log::bench::throughput::{
-    self, channel_list, compression_bound, recording_path, DurationRuns, RecordRun,
+    self, channel_list, compression_bound, recording_path, DurationRuns, ExportRun, RecordRun,
     ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
 };
 use std::fs;
@@ -97,6 +97,7 @@ fn record_and_verify(
         runs.records.push(record_run(exe, &path, duration)?);
         runs.bounds.push(compression_bound(&path)?);
         runs.verifies.push(verify_run(exe, &path)?);
+        runs.exports.push(export_run(exe, &path)?);
     }
     Ok(runs.rows()?)
 }
@@ -156,6 +157,28 @@ fn record_run(exe: &Path, path: &Path, duration: f64) -> anyhow::Result<RecordRu
             .and_then(serde_json::Value::as_f64)
             .ok_or_else(|| bad("wall_time_s"))?,
         peak_rss: u64_field("peak_rss_bytes"),
+    })
+}
+
+/// Exports `path` as CSV tables into a folder beside it (removed afterwards) in a child process.
+fn export_run(exe: &Path, path: &Path) -> anyhow::Result<ExportRun> {
+    let out = path.with_extension("csv.d");
+    let args = vec![
+        "export".to_string(),
+        path.display().to_string(),
+        "--out".to_string(),
+        out.display().to_string(),
+        "--overwrite".to_string(),
+        "--json".to_string(),
+    ];
+    let result = child_json(exe, &args);
+    let _ = fs::remove_dir_all(&out);
+    let (json, seconds) = result?;
+    Ok(ExportRun {
+        seconds,
+        peak_rss: json
+            .get("peak_rss_bytes")
+            .and_then(serde_json::Value::as_u64),
     })
 }
 

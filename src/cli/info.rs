@@ -1,0 +1,245 @@
+//! `coin-log info`: what each file holds, as text or JSON, or the scene stored in one file.
+
+use super::text::size;
+use super::Outcome;
+use anyhow::bail;
+use coin_log::format::metadata::number_string as n;
+use coin_log::inspect::info::{self, FileInfo};
+use coin_log::inspect::seconds_text;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `coin-log info`.
+///
+/// Shows what each file holds without opening a viewer: its channels (topic, schema, message count,
+/// rate), the time range, the body and run settings, the termination, the file's size and compression and
+/// the version that wrote it. Read from the summary section when the file has one (instant whatever its
+/// size), otherwise by one pass over the file. `--scene` prints the stored scene as TOML:
+/// `coin-log info F --scene > s.toml && coin-log record s.toml -o G` writes G byte for byte equal to F
+/// (with the same `--compression`, and the same coin-log version).
+#[derive(Debug, clap::Args)]
+pub struct InfoArgs {
+    /// MCAP files.
+    #[arg(required = true, value_name = "FILE")]
+    files: Vec<PathBuf>,
+    /// Print `{"files": [{"path", "file_size", "channels": [...], "body", "run", "result", ...}]}`
+    /// (docs/format.md: info --json).
+    #[arg(long, conflicts_with = "scene")]
+    json: bool,
+    /// Print the scene stored in FILE as a TOML scene file (one FILE).
+    #[arg(long)]
+    scene: bool,
+}
+
+/// Runs `coin-log info`: exit 0 when every file was described, 1 otherwise.
+pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
+    if args.scene {
+        return scene(args);
+    }
+    let mut failed = false;
+    let mut json_files = Vec::new();
+    for path in &args.files {
+        let shown = path.display().to_string();
+        match info::info(path) {
+            Ok(i) => {
+                failed |= i.problem.is_some();
+                if args.json {
+                    json_files.push(i.to_json(&shown));
+                } else {
+                    print!("{}", text(&shown, &i));
+                }
+            }
+            Err(e) => {
+                failed = true;
+                eprintln!("error: {shown}: {e}");
+                if args.json {
+                    json_files.push(serde_json::json!({"path": shown, "problem": e.to_string()}));
+                }
+            }
+        }
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&serde_json::json!({ "files": json_files }))?
+        );
+    }
+    Ok(if failed {
+        Outcome::Failure
+    } else {
+        Outcome::Success
+    })
+}
+
+/// `--scene`: the stored scene, after comment lines saying where it comes from and how to reproduce it.
+fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
+    let [path] = args.files.as_slice() else {
+        bail!(
+            "--scene prints the scene of one file; {} were given",
+            args.files.len()
+        );
+    };
+    let shown = path.display().to_string();
+    let i = info::info(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+    let run = match &i.run {
+        Ok(run) => run,
+        Err(e) => bail!("{shown}: {e}"),
+    };
+    let compression = i.compression();
+    let flag = match compression.as_str() {
+        "zstd" => String::new(),
+        other => format!(" and --compression {other}"),
+    };
+    print!(
+        "# The scene stored in `{shown}` (written by coin-log {}). `coin-log record` this file\n# with that version{flag} to write the same bytes again.\n{}",
+        run.tool_version, run.scene
+    );
+    Ok(Outcome::Success)
+}
+
+/// The text description of one file: a row per property, then the channels.
+fn text(shown: &str, i: &FileInfo) -> String {
+    let mut rows = file_rows(i);
+    rows.extend(coin_log_rows(i));
+    rows.push((
+        "read from",
+        match i.source {
+            info::Source::Summary => "the summary section".into(),
+            info::Source::Scan => "the whole file (it has no summary section)".into(),
+        },
+    ));
+    if let Some(p) = &i.problem {
+        rows.push(("problem", p.clone()));
+    }
+    let mut out = format!("{shown}\n");
+    for (key, value) in rows {
+        let _ = writeln!(out, "  {key:<13} {value}");
+    }
+    channels(&mut out, i);
+    out
+}
+
+/// Size, compression, writer, description, time span and message count.
+fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
+    let (packed, unpacked) = i.chunk_bytes;
+    let mut rows = vec![(
+        "file",
+        format!(
+            "{} ({} B), {} chunk{} {}, {} of records in {}",
+            size(i.file_size),
+            i.file_size,
+            i.chunks,
+            if i.chunks == 1 { "" } else { "s" },
+            i.compression(),
+            size(unpacked),
+            size(packed)
+        ),
+    )];
+    let version = i.run.as_ref().map_or_else(
+        |_| String::new(),
+        |r| format!(", format {}", r.format_version),
+    );
+    rows.push(("written by", format!("{}{version}", i.library)));
+    if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
+        rows.push(("scene", d.clone()));
+    }
+    let span = i.time_range.map_or_else(
+        || "no messages".into(),
+        |(a, b)| format!("t = {} … {}", seconds_text(a), seconds_text(b)),
+    );
+    rows.push(("time", span));
+    rows.push(("messages", i.messages.to_string()));
+    rows
+}
+
+/// Body, run settings, steady motion and termination from the coin-log metadata.
+fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
+    let r = match &i.run {
+        Ok(r) => r,
+        Err(e) => return vec![("coin-log", e.clone())],
+    };
+    let friction = r.friction.map_or_else(|| "none".into(), n);
+    let mut rows = vec![
+        (
+            "body",
+            format!(
+                "M = {}, a = {}, g = {}, I_X = {}, I_Z = {}, μ {friction}, time unit √(a/g) = {}",
+                n(r.mass),
+                n(r.radius),
+                n(r.gravity),
+                n(r.inertia_x),
+                n(r.inertia_z),
+                n(r.time_unit)
+            ),
+        ),
+        (
+            "run",
+            format!(
+                "{}, rtol {}, atol {}, step {}, rate {}",
+                r.integrator,
+                n(r.rtol),
+                n(r.atol),
+                n(r.step),
+                n(r.rate)
+            ),
+        ),
+    ];
+    if let Some(k) = r.steady_kind {
+        let opt = |v: Option<f64>| v.map_or_else(|| "-".into(), n);
+        rows.push((
+            "steady",
+            format!(
+                "{k}: φ̇ = {}, ψ̇ = {}, R_G = {}, R_C = {}",
+                opt(r.phi_dot),
+                opt(r.psi_dot),
+                opt(r.r_g),
+                opt(r.r_c)
+            ),
+        ));
+    }
+    rows.push((
+        "termination",
+        match &i.result {
+            Ok(r) => format!(
+                "{} at t = {} ({} steps, {} RHS evaluations, {} rejected)",
+                r.termination,
+                n(r.termination_time),
+                r.steps,
+                r.rhs_evaluations,
+                r.rejected_steps
+            ),
+            Err(e) => e.clone(),
+        },
+    ));
+    rows
+}
+
+fn channels(out: &mut String, i: &FileInfo) {
+    let topic_w = i
+        .channels
+        .iter()
+        .map(|c| c.topic.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    let schema_w = i
+        .channels
+        .iter()
+        .map(|c| c.schema.len())
+        .max()
+        .unwrap_or(6)
+        .max(6);
+    let _ = writeln!(
+        out,
+        "  {:<topic_w$}  {:<schema_w$}  {:>9}  {:>9}",
+        "topic", "schema", "messages", "rate"
+    );
+    for c in &i.channels {
+        let rate = c.rate.map_or_else(|| "-".into(), |r| format!("{r:.2}"));
+        let _ = writeln!(
+            out,
+            "  {:<topic_w$}  {:<schema_w$}  {:>9}  {rate:>9}",
+            c.topic, c.schema, c.messages
+        );
+    }
+}

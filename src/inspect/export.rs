@@ -1,0 +1,619 @@
+//! `coin-log export`: a file's channels as CSV tables, in one streaming pass (memory bounded by a few
+//! records and one write buffer per table, whatever the file's length).
+//!
+//! - **Per channel** (the default): one table per `coin_log.*` channel, named after the channel
+//!   (`omega.csv`, `angles.csv`, ...), its header the message's fields in schema order ([`Channel::fields`],
+//!   so a field added to the format appears without a change here), one row per message.
+//! - **Wide**: one table `samples.csv` joined on the sample time: `t`, then `<channel>.<field>` for every
+//!   `coin_log.*` channel present at the first sample, one row per sample.
+//! - `/tf` (per channel only) is flattened into `tf.csv`: `t`, the two frame ids, translation and
+//!   rotation. `/scene` is skipped: it holds display geometry (the coin, the table, pieces of the track),
+//!   and the track's points are `/coin/contact`.
+//!
+//! Numbers are written in the shortest form that reads back to the same f64 (ryu) after an exact read
+//! ([`crate::format::json`]), so every value equals the file's bit for bit. Timestamps of `/tf` are
+//! written as the exact decimal of their nanoseconds.
+
+use super::seconds_text;
+use crate::format::json::read_fields;
+use crate::format::Channel;
+use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::io::{self, BufWriter, Write};
+use std::ops::ControlFlow;
+use std::path::Path;
+
+/// Write buffer per table.
+const BUFFER: usize = 1 << 16;
+
+/// How the tables are laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Layout {
+    /// One table per channel.
+    #[default]
+    PerChannel,
+    /// One table of samples joined on t.
+    Wide,
+}
+
+/// The name of the wide table.
+pub const WIDE_TABLE: &str = "samples.csv";
+
+/// The columns of `/tf`'s table.
+pub const TF_COLUMNS: [&str; 10] = [
+    "t",
+    "parent_frame_id",
+    "child_frame_id",
+    "translation.x",
+    "translation.y",
+    "translation.z",
+    "rotation.x",
+    "rotation.y",
+    "rotation.z",
+    "rotation.w",
+];
+
+/// One table written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Table {
+    /// File name (`omega.csv`).
+    pub name: String,
+    /// The topics it holds.
+    pub topics: Vec<String>,
+    /// Its header.
+    pub columns: Vec<String>,
+    /// Rows below the header.
+    pub rows: u64,
+}
+
+/// A channel not exported, and why.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Skipped {
+    /// Topic.
+    pub topic: String,
+    /// Why.
+    pub reason: String,
+}
+
+/// What an export wrote.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ExportSummary {
+    /// The tables, in the order they were opened.
+    pub tables: Vec<Table>,
+    /// Channels left out.
+    pub skipped: Vec<Skipped>,
+    /// Messages read.
+    pub messages: u64,
+}
+
+/// Why an export stopped. Tables opened before it may hold part of the data: the caller discards them.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The file could not be read (to its end).
+    #[error("{0}")]
+    Read(String),
+    /// A message does not have its schema's form.
+    #[error("{topic}: the message at log time {log_time} ns {reason}")]
+    Message {
+        /// Topic.
+        topic: String,
+        /// Its log time \[ns\].
+        log_time: u64,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The messages cannot be joined into one row per sample.
+    #[error("cannot join the channels into one table: {0}; export one table per channel instead (without --wide)")]
+    Join(String),
+    /// A table could not be written.
+    #[error("writing `{table}`: {source}")]
+    Write {
+        /// The table's name.
+        table: String,
+        /// The I/O error.
+        source: io::Error,
+    },
+}
+
+/// What each channel id is exported as.
+enum Target {
+    /// A `coin_log.*` channel: its fields, and its table (per channel) or its place in the wide row.
+    Flat {
+        channel: Channel,
+        fields: &'static [&'static str],
+        table: Option<usize>,
+    },
+    /// `/tf`, flattened into its table.
+    Tf { table: usize },
+    /// Not exported.
+    Skip,
+}
+
+/// An open table.
+struct Open<W: Write> {
+    out: BufWriter<W>,
+    table: Table,
+}
+
+/// The row being assembled in the wide layout.
+struct Row {
+    log_time: u64,
+    t: f64,
+    values: Vec<(Channel, Vec<f64>)>,
+}
+
+/// The wide table's state.
+#[derive(Default)]
+struct Wide {
+    /// The columns' channels, fixed when the first row is written.
+    channels: Option<Vec<(Channel, &'static [&'static str])>>,
+    row: Option<Row>,
+}
+
+struct Exporter<'a, W: Write> {
+    layout: Layout,
+    open: &'a mut dyn FnMut(&str) -> io::Result<W>,
+    schemas: BTreeMap<u16, String>,
+    targets: BTreeMap<u16, (String, Target)>,
+    tables: Vec<Open<W>>,
+    skipped: Vec<Skipped>,
+    wide: Wide,
+    values: Vec<f64>,
+    number: ryu::Buffer,
+    line: Vec<u8>,
+    messages: u64,
+    error: Option<ExportError>,
+}
+
+/// Exports the file at `path` as CSV tables, each written to what `open(name)` returns (the CLI opens a
+/// temporary file in the output folder). `progress` is called with the bytes read so far.
+///
+/// # Errors
+/// [`ExportError`] if the file cannot be read to its end, a message does not fit its schema, the wide
+/// layout cannot join the channels, or a table cannot be written.
+pub fn export<W: Write>(
+    path: &Path,
+    layout: Layout,
+    open: &mut dyn FnMut(&str) -> io::Result<W>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<ExportSummary, ExportError> {
+    let mut e = Exporter {
+        layout,
+        open,
+        schemas: BTreeMap::new(),
+        targets: BTreeMap::new(),
+        tables: Vec::new(),
+        skipped: Vec::new(),
+        wide: Wide::default(),
+        values: Vec::new(),
+        number: ryu::Buffer::new(),
+        line: Vec::new(),
+        messages: 0,
+        error: None,
+    };
+    let (_, read_error) = mcap_io::read_with_progress(path, &mut e, progress);
+    if let Some(err) = e.error.take() {
+        return Err(err);
+    }
+    if let Some(err) = read_error {
+        let detail = match err.kind {
+            ReadErrorKind::Truncated | ReadErrorKind::Corrupt => format!(
+                "{}; nothing exported (`coin-log verify` says more about the file)",
+                err.detail
+            ),
+            _ => err.detail,
+        };
+        return Err(ExportError::Read(detail));
+    }
+    e.finish()
+}
+
+impl<W: Write> Exporter<'_, W> {
+    /// Opens table `name` with `columns` and writes its header.
+    fn open_table(&mut self, name: &str, topic: &str, columns: Vec<String>) -> Option<usize> {
+        let writer = match (self.open)(name) {
+            Ok(w) => w,
+            Err(source) => {
+                self.fail(ExportError::Write {
+                    table: name.to_string(),
+                    source,
+                });
+                return None;
+            }
+        };
+        let mut out = BufWriter::with_capacity(BUFFER, writer);
+        let header: Vec<String> = columns.iter().map(|c| csv_text(c)).collect();
+        if let Err(source) = writeln!(out, "{}", header.join(",")) {
+            self.fail(ExportError::Write {
+                table: name.to_string(),
+                source,
+            });
+            return None;
+        }
+        self.tables.push(Open {
+            out,
+            table: Table {
+                name: name.to_string(),
+                topics: vec![topic.to_string()],
+                columns,
+                rows: 0,
+            },
+        });
+        Some(self.tables.len() - 1)
+    }
+
+    fn fail(&mut self, e: ExportError) {
+        if self.error.is_none() {
+            self.error = Some(e);
+        }
+    }
+
+    fn skip(&mut self, topic: &str, reason: &str) -> Target {
+        self.skipped.push(Skipped {
+            topic: topic.to_string(),
+            reason: reason.to_string(),
+        });
+        Target::Skip
+    }
+
+    /// What a channel with this topic and schema becomes.
+    fn target(&mut self, topic: &str, schema: &str) -> Target {
+        let Some(channel) = Channel::from_topic(topic) else {
+            return self.skip(topic, "not a coin-log channel");
+        };
+        if schema != channel.schema_name() {
+            return self.skip(
+                topic,
+                &format!(
+                    "its schema is `{schema}`, not coin-log's `{}`",
+                    channel.schema_name()
+                ),
+            );
+        }
+        let fields = channel.fields().filter(|f| f.first() == Some(&"t"));
+        match (fields, channel, self.layout) {
+            (Some(fields), _, Layout::PerChannel) => {
+                let columns = fields.iter().map(ToString::to_string).collect();
+                let name = format!("{}.csv", channel.name());
+                match self.open_table(&name, topic, columns) {
+                    Some(table) => Target::Flat {
+                        channel,
+                        fields,
+                        table: Some(table),
+                    },
+                    None => Target::Skip,
+                }
+            }
+            (Some(fields), _, Layout::Wide) => Target::Flat {
+                channel,
+                fields,
+                table: None,
+            },
+            (None, Channel::Tf, Layout::PerChannel) => {
+                let columns = TF_COLUMNS.iter().map(ToString::to_string).collect();
+                match self.open_table("tf.csv", topic, columns) {
+                    Some(table) => Target::Tf { table },
+                    None => Target::Skip,
+                }
+            }
+            (None, Channel::Tf, Layout::Wide) => self.skip(
+                topic,
+                "frame transforms are not one per sample; export per channel for tf.csv",
+            ),
+            (None, _, _) => self.skip(
+                topic,
+                "display geometry (the coin, the table, pieces of the track); the track's points are /coin/contact",
+            ),
+        }
+    }
+
+    /// Writes the numbers in `self.values` as one CSV row of table `table`.
+    fn write_numbers(&mut self, table: usize) {
+        self.line.clear();
+        for (i, v) in self.values.iter().enumerate() {
+            if i > 0 {
+                self.line.push(b',');
+            }
+            self.line
+                .extend_from_slice(self.number.format_finite(*v).as_bytes());
+        }
+        self.line.push(b'\n');
+        self.write_line(table);
+    }
+
+    fn write_line(&mut self, table: usize) {
+        let open = &mut self.tables[table];
+        open.table.rows += 1;
+        if let Err(source) = open.out.write_all(&self.line) {
+            let table = open.table.name.clone();
+            self.fail(ExportError::Write { table, source });
+        }
+    }
+
+    fn flat(
+        &mut self,
+        h: &MessageHeader,
+        data: &[u8],
+        channel: Channel,
+        fields: &'static [&'static str],
+        table: Option<usize>,
+    ) {
+        self.values.clear();
+        self.values.resize(fields.len(), 0.0);
+        if let Err(e) = read_fields(data, fields, &mut self.values) {
+            return self.fail(ExportError::Message {
+                topic: channel.topic().to_string(),
+                log_time: h.log_time,
+                reason: e.to_string(),
+            });
+        }
+        match table {
+            Some(table) => self.write_numbers(table),
+            None => self.join(h.log_time, channel),
+        }
+    }
+
+    fn tf(&mut self, h: &MessageHeader, data: &[u8], table: usize) {
+        let m: FrameTransform = match serde_json::from_slice(data) {
+            Ok(m) => m,
+            Err(e) => {
+                return self.fail(ExportError::Message {
+                    topic: Channel::Tf.topic().to_string(),
+                    log_time: h.log_time,
+                    reason: format!("is not a foxglove.FrameTransform: {e}"),
+                })
+            }
+        };
+        let ns = m
+            .timestamp
+            .sec
+            .saturating_mul(1_000_000_000)
+            .saturating_add(u64::from(m.timestamp.nsec));
+        self.line.clear();
+        self.line.extend_from_slice(seconds_text(ns).as_bytes());
+        for id in [&m.parent_frame_id, &m.child_frame_id] {
+            self.line.push(b',');
+            self.line.extend_from_slice(csv_text(id).as_bytes());
+        }
+        let (tr, ro) = (&m.translation, &m.rotation);
+        for v in [tr.x, tr.y, tr.z, ro.x, ro.y, ro.z, ro.w] {
+            self.line.push(b',');
+            self.line
+                .extend_from_slice(self.number.format_finite(v).as_bytes());
+        }
+        self.line.push(b'\n');
+        self.write_line(table);
+    }
+}
+
+/// The wide layout: messages of one log time form a row, written when a later log time arrives.
+impl<W: Write> Exporter<'_, W> {
+    fn join(&mut self, log_time: u64, channel: Channel) {
+        let t = self.values[0];
+        let later = self
+            .wide
+            .row
+            .as_ref()
+            .is_some_and(|r| log_time > r.log_time);
+        if later {
+            self.flush_row();
+        }
+        let values = self.values[1..].to_vec();
+        let Some(row) = self.wide.row.as_mut() else {
+            self.wide.row = Some(Row {
+                log_time,
+                t,
+                values: vec![(channel, values)],
+            });
+            return;
+        };
+        let err = if log_time < row.log_time {
+            Some(format!(
+                "{} has a message at log time {log_time} ns after one at {} ns: the messages are not in time order",
+                channel.topic(),
+                row.log_time
+            ))
+        } else if row.values.iter().any(|(c, _)| *c == channel) {
+            Some(format!(
+                "{} has two messages at log time {log_time} ns",
+                channel.topic()
+            ))
+        } else if t.to_bits() != row.t.to_bits() {
+            Some(format!(
+                "at log time {log_time} ns, {} has t = {t} where the sample has t = {}",
+                channel.topic(),
+                row.t
+            ))
+        } else {
+            row.values.push((channel, values));
+            None
+        };
+        if let Some(e) = err {
+            self.fail(ExportError::Join(e));
+        }
+    }
+
+    /// Writes the pending row (and, before the first, the header).
+    fn flush_row(&mut self) {
+        let Some(row) = self.wide.row.take() else {
+            return;
+        };
+        if self.wide.channels.is_none() {
+            let channels: Vec<(Channel, &'static [&'static str])> = self
+                .targets
+                .values()
+                .filter_map(|(_, t)| match t {
+                    Target::Flat {
+                        channel, fields, ..
+                    } => Some((*channel, *fields)),
+                    _ => None,
+                })
+                .collect();
+            let mut channels = channels;
+            channels.sort_by_key(|(c, _)| *c);
+            let mut columns = vec!["t".to_string()];
+            for (c, fields) in &channels {
+                columns.extend(fields[1..].iter().map(|f| format!("{}.{f}", c.name())));
+            }
+            let topics: Vec<String> = channels.iter().map(|(c, _)| c.topic().into()).collect();
+            if let Some(table) = self.open_table(WIDE_TABLE, "", columns) {
+                self.tables[table].table.topics = topics;
+            }
+            self.wide.channels = Some(channels);
+        }
+        let Some(channels) = self.wide.channels.as_ref() else {
+            return;
+        };
+        if let Some((c, _)) = row
+            .values
+            .iter()
+            .find(|(c, _)| !channels.iter().any(|(k, _)| k == c))
+        {
+            let e = format!(
+                "{} first appears at log time {} ns, after the table's columns were fixed by the first sample",
+                c.topic(),
+                row.log_time
+            );
+            return self.fail(ExportError::Join(e));
+        }
+        self.line.clear();
+        self.line
+            .extend_from_slice(self.number.format_finite(row.t).as_bytes());
+        for (c, fields) in channels {
+            let found = row.values.iter().find(|(k, _)| k == c);
+            for i in 0..fields.len() - 1 {
+                self.line.push(b',');
+                if let Some((_, v)) = found {
+                    self.line
+                        .extend_from_slice(self.number.format_finite(v[i]).as_bytes());
+                }
+            }
+        }
+        self.line.push(b'\n');
+        if !self.tables.is_empty() {
+            self.write_line(0);
+        }
+    }
+
+    /// Flushes the last row and every table.
+    fn finish(mut self) -> Result<ExportSummary, ExportError> {
+        self.flush_row();
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        let mut tables = Vec::new();
+        for open in self.tables {
+            let Open { mut out, table } = open;
+            out.flush().map_err(|source| ExportError::Write {
+                table: table.name.clone(),
+                source,
+            })?;
+            tables.push(table);
+        }
+        Ok(ExportSummary {
+            tables,
+            skipped: self.skipped,
+            messages: self.messages,
+        })
+    }
+}
+
+impl<W: Write> Visitor for Exporter<'_, W> {
+    fn schema(&mut self, id: u16, name: &str, _: &str, _: &[u8]) {
+        self.schemas.insert(id, name.to_string());
+    }
+    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, _: &str) {
+        let schema = self.schemas.get(&schema_id).cloned().unwrap_or_default();
+        let target = self.target(topic, &schema);
+        self.targets.insert(id, (topic.to_string(), target));
+    }
+    fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
+    fn library(&mut self, _: &str) {}
+    fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
+        self.messages += 1;
+        match self.targets.get(&h.channel_id) {
+            Some((
+                _,
+                Target::Flat {
+                    channel,
+                    fields,
+                    table,
+                },
+            )) => {
+                let (channel, fields, table) = (*channel, *fields, *table);
+                self.flat(h, data, channel, fields, table);
+            }
+            Some((_, Target::Tf { table })) => {
+                let table = *table;
+                self.tf(h, data, table);
+            }
+            Some((_, Target::Skip)) => {}
+            None => {
+                let id = h.channel_id;
+                self.fail(ExportError::Message {
+                    topic: format!("channel {id}"),
+                    log_time: h.log_time,
+                    reason: "is on a channel that no channel record declares".into(),
+                });
+            }
+        }
+        if self.error.is_some() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// A CSV field: quoted (with quotes doubled) when it holds a comma, a quote or a line break.
+fn csv_text(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The fields of `foxglove.FrameTransform` that the table holds (others are ignored).
+#[derive(Deserialize)]
+struct FrameTransform {
+    timestamp: Time,
+    parent_frame_id: String,
+    child_frame_id: String,
+    translation: Vector3,
+    rotation: Quaternion,
+}
+
+#[derive(Deserialize)]
+struct Time {
+    sec: u64,
+    nsec: u32,
+}
+
+#[derive(Deserialize)]
+struct Vector3 {
+    x: f64,
+    y: f64,
+    z: f64,
+}
+
+#[derive(Deserialize)]
+struct Quaternion {
+    x: f64,
+    y: f64,
+    z: f64,
+    w: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::csv_text;
+
+    #[test]
+    fn csv_fields_are_quoted_only_when_needed() {
+        assert_eq!(csv_text("coin"), "coin");
+        assert_eq!(csv_text("a,b"), "\"a,b\"");
+        assert_eq!(csv_text("say \"hi\""), "\"say \"\"hi\"\"\"");
+    }
+}

@@ -1,0 +1,344 @@
+//! `coin-log info`: what a file holds, from the file alone. The channels (topic, schema, message count,
+//! rate), the time range, the body and run settings and the stored scene from the `coin-log` metadata,
+//! the termination from `coin-log.result`, the file's size and compression and the version that wrote it.
+//!
+//! The summary section is read when the file has one ([`mcap_io::read_summary`]: a few seeks, instant on
+//! a file of gigabytes); a file without one (an unfinished recording, another writer) is read in one
+//! streaming pass ([`mcap_io::read`]), and a file that breaks off part way is described up to the break.
+//! The summary is taken as the file states it: `verify` is what checks it.
+
+use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
+use crate::mcap_io::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
+use crate::scene::SceneFile;
+use serde_json::{json, Value};
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
+use std::path::Path;
+
+/// One channel of a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelInfo {
+    /// Topic.
+    pub topic: String,
+    /// Schema name (`""` without a schema).
+    pub schema: String,
+    /// Message encoding.
+    pub message_encoding: String,
+    /// Messages on the channel.
+    pub messages: u64,
+    /// Messages per second of log time (per time unit of a coin-log scene) over the file's time span:
+    /// (messages − 1) / span; `None` with fewer than two messages or a zero span.
+    pub rate: Option<f64>,
+}
+
+/// Where [`FileInfo`] was read from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// The summary section (statistics, chunk indexes, metadata index).
+    Summary,
+    /// A streaming pass over the whole file (it has no usable summary).
+    Scan,
+}
+
+impl Source {
+    /// `summary` or `scan`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Summary => "summary",
+            Self::Scan => "scan",
+        }
+    }
+}
+
+/// What a file holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FileInfo {
+    /// File size \[bytes\].
+    pub file_size: u64,
+    /// The header's `library` (`coin-log/<version>` for this tool's files).
+    pub library: String,
+    /// Where this was read from.
+    pub source: Source,
+    /// Messages.
+    pub messages: u64,
+    /// Earliest and latest log time \[ns\]; `None` without messages.
+    pub time_range: Option<(u64, u64)>,
+    /// Chunks.
+    pub chunks: u64,
+    /// Chunks by compression (`""` = uncompressed).
+    pub compressions: BTreeMap<String, u64>,
+    /// The chunks' records compressed and uncompressed \[bytes\].
+    pub chunk_bytes: (u64, u64),
+    /// Channels, by id.
+    pub channels: Vec<ChannelInfo>,
+    /// The `coin-log` record, or why it is missing or unusable.
+    pub run: Result<RunMetadata, String>,
+    /// The `coin-log.result` record, or why it is missing or unusable.
+    pub result: Result<ResultMetadata, String>,
+    /// The stored scene as a file (for its description and duration), when it parses.
+    pub scene: Option<SceneFile>,
+    /// Why the file could not be read to its end (then the rest describes what came before).
+    pub problem: Option<String>,
+}
+
+impl FileInfo {
+    /// The compression of the file's chunks as a word: `zstd`, `lz4`, `none`, `mixed (...)`, or `no
+    /// chunks`.
+    #[must_use]
+    pub fn compression(&self) -> String {
+        let name = |c: &str| if c.is_empty() { "none" } else { c }.to_string();
+        match self.compressions.len() {
+            0 => "no chunks".into(),
+            1 => self.compressions.keys().map(|c| name(c)).collect(),
+            _ => format!(
+                "mixed ({})",
+                self.compressions
+                    .iter()
+                    .map(|(c, n)| format!("{} × {n}", name(c)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
+    }
+
+    /// The stored scene's TOML text (the `scene` value of the `coin-log` record).
+    #[must_use]
+    pub fn scene_toml(&self) -> Option<&str> {
+        self.run.as_ref().ok().map(|r| r.scene.as_str())
+    }
+
+    /// The contract's JSON object of this file (format.md: info --json), `path` as given.
+    #[must_use]
+    #[allow(clippy::cast_precision_loss)]
+    pub fn to_json(&self, path: &str) -> Value {
+        let seconds = |ns: u64| ns as f64 / 1e9;
+        let run = self.run.as_ref().ok();
+        json!({
+            "path": path,
+            "file_size": self.file_size,
+            "library": self.library,
+            "read_from": self.source.name(),
+            "coin_log": run.is_some(),
+            "format_version": run.map(|r| r.format_version.clone()),
+            "tool_version": run.map(|r| r.tool_version.clone()),
+            "description": self.scene.as_ref().and_then(|s| s.description.clone()),
+            "messages": self.messages,
+            "start_time": self.time_range.map(|r| seconds(r.0)),
+            "end_time": self.time_range.map(|r| seconds(r.1)),
+            "chunks": self.chunks,
+            "compression": self.compression(),
+            "compressed_bytes": self.chunk_bytes.0,
+            "uncompressed_bytes": self.chunk_bytes.1,
+            "channels": self.channels.iter().map(|c| json!({
+                "topic": c.topic,
+                "schema": c.schema,
+                "message_encoding": c.message_encoding,
+                "messages": c.messages,
+                "rate": c.rate,
+            })).collect::<Vec<_>>(),
+            "body": run.map(body_json),
+            "run": run.map(|r| run_json(r, self.scene.as_ref())),
+            "result": self.result.as_ref().ok().map(result_json),
+            "scene": self.scene_toml(),
+            "problem": self.problem,
+        })
+    }
+}
+
+fn body_json(r: &RunMetadata) -> Value {
+    json!({
+        "mass": r.mass,
+        "radius": r.radius,
+        "gravity": r.gravity,
+        "inertia_x": r.inertia_x,
+        "inertia_z": r.inertia_z,
+        "friction": r.friction,
+        "time_unit": r.time_unit,
+    })
+}
+
+fn run_json(r: &RunMetadata, scene: Option<&SceneFile>) -> Value {
+    json!({
+        "duration": scene.and_then(|s| s.run.as_ref()).and_then(|r| r.duration),
+        "rate": r.rate,
+        "integrator": r.integrator.name(),
+        "rtol": r.rtol,
+        "atol": r.atol,
+        "step": r.step,
+        "steady_kind": r.steady_kind.map(|k| k.to_string()),
+        "phi_dot": r.phi_dot,
+        "psi_dot": r.psi_dot,
+        "r_g": r.r_g,
+        "r_c": r.r_c,
+    })
+}
+
+fn result_json(r: &ResultMetadata) -> Value {
+    json!({
+        "termination": r.termination.name(),
+        "termination_time": r.termination_time,
+        "steps": r.steps,
+        "rhs_evaluations": r.rhs_evaluations,
+        "rejected_steps": r.rejected_steps,
+    })
+}
+
+/// Why a file could not be described at all.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct InfoError(pub String);
+
+/// Describes the file at `path`: from its summary when it has one, else by one streaming pass.
+///
+/// # Errors
+/// [`InfoError`] if the file cannot be opened, is not MCAP, or breaks off before anything is known.
+pub fn info(path: &Path) -> Result<FileInfo, InfoError> {
+    match mcap_io::read_summary(path) {
+        Ok(Some(summary)) => Ok(from_summary(summary)),
+        Err(e) if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) => {
+            Err(InfoError(e.detail))
+        }
+        // No summary, or a damaged one: the streaming pass says what the file holds (and where it breaks).
+        Ok(None) | Err(_) => scan(path),
+    }
+}
+
+/// The `coin-log` and `coin-log.result` records among `metadata` (the first of each name).
+fn records(
+    metadata: &[(String, BTreeMap<String, String>)],
+) -> (Result<RunMetadata, String>, Result<ResultMetadata, String>) {
+    let find = |name: &str| metadata.iter().find(|(n, _)| n == name).map(|(_, e)| e);
+    let run = find(RUN_METADATA_NAME).map_or_else(
+        || Err("no `coin-log` metadata record: not a coin-log file".to_string()),
+        |e| RunMetadata::from_map(e).map_err(|e| e.to_string()),
+    );
+    let result = find(RESULT_METADATA_NAME).map_or_else(
+        || Err("no `coin-log.result` metadata record: the run did not finish writing".to_string()),
+        |e| ResultMetadata::from_map(e).map_err(|e| e.to_string()),
+    );
+    (run, result)
+}
+
+fn scene_of(run: &Result<RunMetadata, String>) -> Option<SceneFile> {
+    run.as_ref()
+        .ok()
+        .and_then(|r| toml::from_str::<SceneFile>(&r.scene).ok())
+}
+
+/// (n − 1) / span in messages per second.
+#[allow(clippy::cast_precision_loss)]
+fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
+    let (start, end) = time_range?;
+    (messages >= 2 && end > start).then(|| (messages - 1) as f64 / ((end - start) as f64 / 1e9))
+}
+
+fn from_summary(s: mcap_io::Summary) -> FileInfo {
+    let (run, result) = records(&s.metadata);
+    let scene = scene_of(&run);
+    FileInfo {
+        file_size: s.file_len,
+        library: s.library,
+        source: Source::Summary,
+        messages: s.messages,
+        time_range: s.time_range,
+        chunks: s.chunks,
+        compressions: s.compressions,
+        chunk_bytes: (s.compressed_bytes, s.uncompressed_bytes),
+        channels: s
+            .channels
+            .iter()
+            .map(|c| ChannelInfo {
+                topic: c.topic.clone(),
+                schema: c.schema_name.clone(),
+                message_encoding: c.message_encoding.clone(),
+                messages: c.messages,
+                rate: rate(c.messages, s.time_range),
+            })
+            .collect(),
+        run,
+        result,
+        scene,
+        problem: None,
+    }
+}
+
+/// What the streaming pass gathers.
+#[derive(Default)]
+struct Scan {
+    schemas: BTreeMap<u16, String>,
+    channels: BTreeMap<u16, ChannelInfo>,
+    metadata: Vec<(String, BTreeMap<String, String>)>,
+    counts: BTreeMap<u16, u64>,
+    time_range: Option<(u64, u64)>,
+}
+
+impl Visitor for Scan {
+    fn schema(&mut self, id: u16, name: &str, _: &str, _: &[u8]) {
+        self.schemas.insert(id, name.to_string());
+    }
+    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
+        self.channels.insert(
+            id,
+            ChannelInfo {
+                topic: topic.to_string(),
+                schema: self.schemas.get(&schema_id).cloned().unwrap_or_default(),
+                message_encoding: message_encoding.to_string(),
+                messages: 0,
+                rate: None,
+            },
+        );
+    }
+    fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
+        self.metadata.push((name.to_string(), entries.clone()));
+    }
+    fn library(&mut self, _: &str) {}
+    fn message(&mut self, header: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
+        *self.counts.entry(header.channel_id).or_insert(0) += 1;
+        let t = header.log_time;
+        self.time_range = Some(
+            self.time_range
+                .map_or((t, t), |(a, b)| (a.min(t), b.max(t))),
+        );
+        ControlFlow::Continue(())
+    }
+}
+
+fn scan(path: &Path) -> Result<FileInfo, InfoError> {
+    let mut v = Scan::default();
+    let (s, error) = mcap_io::read(path, &mut v);
+    let problem = match error {
+        Some(ReadError {
+            kind: ReadErrorKind::Io | ReadErrorKind::NotMcap,
+            detail,
+        }) => return Err(InfoError(detail)),
+        Some(e) => Some(e.detail),
+        None => None,
+    };
+    let (run, result) = records(&v.metadata);
+    let scene = scene_of(&run);
+    let channels = v
+        .channels
+        .into_iter()
+        .map(|(id, mut c)| {
+            c.messages = v.counts.get(&id).copied().unwrap_or(0);
+            c.rate = rate(c.messages, v.time_range);
+            c
+        })
+        .collect();
+    Ok(FileInfo {
+        file_size: s.file_len,
+        library: s.library,
+        source: Source::Scan,
+        messages: s.messages,
+        time_range: v.time_range,
+        chunks: s.chunks,
+        compressions: s.compressions,
+        chunk_bytes: (s.compressed_bytes, s.uncompressed_bytes),
+        channels,
+        run,
+        result,
+        scene,
+        problem,
+    })
+}

@@ -1,0 +1,41 @@
+//! What a user does with a recording after it is written (format.md: info, export, plot): see what is in
+//! it ([`info`]), get its channels out as tables ([`export`]), draw a one-page overview ([`plot`]).
+//!
+//! Everything here reads files with [`crate::mcap_io`] (the summary section when the file has one, else
+//! one streaming pass in bounded memory) and interprets them with [`crate::format`]: the channel list and
+//! each channel's message fields drive the tables, so a channel or field added to the format is exported
+//! without a change here. Nothing here judges a file; that is `verify`'s job.
+
+pub mod export;
+pub mod info;
+pub mod plot;
+
+/// The exact decimal text of a log time in ns as seconds (`1500000000` → `1.5`, `10000000` → `0.01`,
+/// `0` → `0`): no rounding, so it reads back as the f64 nearest to the log time.
+#[must_use]
+pub fn seconds_text(ns: u64) -> String {
+    let (sec, nsec) = (ns / 1_000_000_000, ns % 1_000_000_000);
+    if nsec == 0 {
+        return sec.to_string();
+    }
+    let fraction = format!("{nsec:09}");
+    format!("{sec}.{}", fraction.trim_end_matches('0'))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::seconds_text;
+
+    #[test]
+    fn log_times_print_as_exact_decimals() {
+        for (ns, text) in [
+            (0, "0"),
+            (1_500_000_000, "1.5"),
+            (10_000_000, "0.01"),
+            (1, "0.000000001"),
+            (30_000_000_001, "30.000000001"),
+        ] {
+            assert_eq!(seconds_text(ns), text);
+        }
+    }
+}

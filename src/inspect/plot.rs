@@ -1,0 +1,755 @@
+//! `coin-log plot`: a one-page SVG overview of a recording, read in one streaming pass.
+//!
+//! Six panels: the contact track and the centre's path seen from above (equal axes, z pointing down the
+//! page as in Foxglove's top view), θ(t), the energy drift |E − E₀| / max(|E₀|, Mga) and the invariant
+//! drift |C − C₀| / (|C1₀| + |C2₀|) on log scales (the scales of `model::drift`), N/(Mg), and |F|/N with
+//! μ when the file has one. The termination is marked on every time axis and named in the title.
+//!
+//! Memory stays bounded whatever the file's length: each time series keeps at most [`POINTS`] buckets
+//! with the minimum and maximum of the samples in each (so no spike is lost), and the paths keep every
+//! k-th point with k doubling as needed.
+
+use crate::format::json::read_fields;
+use crate::format::{
+    Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+};
+use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
+use crate::model::drift::{EnergyDrift, InvariantDrift};
+use crate::model::{CoinParams, Inertia};
+use crate::scene::SceneFile;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
+use std::path::Path;
+
+/// Buckets per time series (each drawn as its minimum and maximum) and points per path.
+pub const POINTS: usize = 2000;
+/// Size of the page \[px\].
+pub const SIZE: (u32, u32) = (1400, 1560);
+/// The panels' titles, in page order (a test finds each in the SVG).
+pub const PANELS: [&str; 6] = [
+    "contact track and centre path, seen from above",
+    "lean θ(t)",
+    "energy drift |E − E₀| / max(|E₀|, Mga)",
+    "invariant drift |C − C₀| / (|C1₀| + |C2₀|)",
+    "normal force N / (Mg)",
+    "friction ratio |F| / N",
+];
+
+const BLUE: RGBColor = RGBColor(31, 119, 180);
+const ORANGE: RGBColor = RGBColor(255, 127, 14);
+const GREEN: RGBColor = RGBColor(44, 160, 44);
+const RED: RGBColor = RGBColor(214, 39, 40);
+const GREY: RGBColor = RGBColor(120, 120, 120);
+
+/// Why a file could not be plotted.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct PlotError(pub String);
+
+/// A time series kept as min/max buckets of a doubling width.
+#[derive(Debug, Clone, Default)]
+struct Envelope {
+    /// Samples per bucket.
+    width: usize,
+    /// Samples in the last bucket.
+    filled: usize,
+    /// (t of min, min, t of max, max) per bucket.
+    buckets: Vec<(f64, f64, f64, f64)>,
+}
+
+impl Envelope {
+    fn push(&mut self, t: f64, v: f64) {
+        if self.width == 0 {
+            self.width = 1;
+        }
+        if self.filled == 0 || self.filled == self.width {
+            if self.buckets.len() == 2 * POINTS {
+                self.halve();
+            }
+            self.buckets.push((t, v, t, v));
+            self.filled = 1;
+            return;
+        }
+        self.filled += 1;
+        if let Some(b) = self.buckets.last_mut() {
+            if v < b.1 {
+                (b.0, b.1) = (t, v);
+            }
+            if v > b.3 {
+                (b.2, b.3) = (t, v);
+            }
+        }
+    }
+
+    /// Merges neighbouring buckets: half as many, twice as wide.
+    fn halve(&mut self) {
+        let merged = self
+            .buckets
+            .chunks(2)
+            .map(|p| match p {
+                [a, b] => {
+                    let low = if b.1 < a.1 { (b.0, b.1) } else { (a.0, a.1) };
+                    let high = if b.3 > a.3 { (b.2, b.3) } else { (a.2, a.3) };
+                    (low.0, low.1, high.0, high.1)
+                }
+                [a] => *a,
+                _ => unreachable!("chunks(2) gives one or two"),
+            })
+            .collect();
+        self.buckets = merged;
+        self.width *= 2;
+    }
+
+    /// The points to draw, in time order: each bucket's minimum and maximum.
+    fn points(&self) -> Vec<(f64, f64)> {
+        let mut out = Vec::with_capacity(2 * self.buckets.len());
+        for &(t0, v0, t1, v1) in &self.buckets {
+            if t0 == t1 {
+                out.push((t0, v0));
+            } else if t0 < t1 {
+                out.extend([(t0, v0), (t1, v1)]);
+            } else {
+                out.extend([(t1, v1), (t0, v0)]);
+            }
+        }
+        out
+    }
+
+    fn is_empty(&self) -> bool {
+        self.buckets.is_empty()
+    }
+}
+
+/// A path kept as every k-th point (k doubling as needed) and the last point.
+#[derive(Debug, Clone, Default)]
+struct Path2 {
+    stride: usize,
+    seen: usize,
+    points: Vec<(f64, f64)>,
+    last: Option<(f64, f64)>,
+}
+
+impl Path2 {
+    fn push(&mut self, p: (f64, f64)) {
+        if self.stride == 0 {
+            self.stride = 1;
+        }
+        if self.seen % self.stride == 0 {
+            if self.points.len() == 2 * POINTS {
+                self.points = self.points.iter().step_by(2).copied().collect();
+                self.stride *= 2;
+            }
+            if self.seen % self.stride == 0 {
+                self.points.push(p);
+            }
+        }
+        self.seen += 1;
+        self.last = Some(p);
+    }
+
+    fn points(&self) -> Vec<(f64, f64)> {
+        let mut out = self.points.clone();
+        if let Some(p) = self.last {
+            if out.last() != Some(&p) {
+                out.push(p);
+            }
+        }
+        out
+    }
+}
+
+/// Field values by name of one message.
+struct Fields<'a> {
+    names: &'static [&'static str],
+    values: &'a [f64],
+}
+
+impl Fields<'_> {
+    fn get(&self, name: &str) -> Option<f64> {
+        self.names
+            .iter()
+            .position(|n| *n == name)
+            .map(|i| self.values[i])
+    }
+}
+
+/// Everything the page draws, gathered in one pass.
+#[derive(Default)]
+struct Collect {
+    schemas: BTreeMap<u16, String>,
+    channels: BTreeMap<u16, Channel>,
+    run: Option<Result<RunMetadata, String>>,
+    result: Option<ResultMetadata>,
+    params: Option<CoinParams>,
+    values: Vec<f64>,
+    problem: Option<String>,
+    contact: Path2,
+    centre: Path2,
+    theta: Envelope,
+    energy: Envelope,
+    energy_drift: Option<EnergyDrift>,
+    c1: Envelope,
+    c2: Envelope,
+    invariant_drift: Option<InvariantDrift>,
+    normal: Envelope,
+    ratio: Envelope,
+    last_t: f64,
+}
+
+impl Collect {
+    fn observe(&mut self, channel: Channel, f: &Fields<'_>) {
+        let Some(t) = f.get("t") else {
+            return;
+        };
+        self.last_t = self.last_t.max(t);
+        let Some(params) = self.params else {
+            return;
+        };
+        let mg = params.mass() * params.gravity();
+        match channel {
+            Channel::Angles => {
+                if let Some(theta) = f.get("theta") {
+                    self.theta.push(t, theta);
+                }
+            }
+            Channel::Position | Channel::Contact => {
+                if let (Some(x), Some(z)) = (f.get("x"), f.get("z")) {
+                    let path = if channel == Channel::Position {
+                        &mut self.centre
+                    } else {
+                        &mut self.contact
+                    };
+                    path.push((x, z));
+                }
+            }
+            Channel::Energy => {
+                if let Some(e) = f.get("total") {
+                    let drift = *self
+                        .energy_drift
+                        .get_or_insert_with(|| EnergyDrift::new(&params, e));
+                    self.energy
+                        .push(t, (e - drift.reference()).abs() / drift.scale());
+                }
+            }
+            Channel::Invariants => {
+                if let (Some(c1), Some(c2)) = (f.get("c1"), f.get("c2")) {
+                    let drift = *self
+                        .invariant_drift
+                        .get_or_insert_with(|| InvariantDrift::new(&params, c1, c2));
+                    let (a, b) = drift.reference();
+                    self.c1.push(t, (c1 - a).abs() / drift.scale());
+                    self.c2.push(t, (c2 - b).abs() / drift.scale());
+                }
+            }
+            Channel::Reaction => {
+                if let (Some(n), Some(fr)) = (f.get("normal"), f.get("friction")) {
+                    self.normal.push(t, n / mg);
+                    if n > 0.0 {
+                        self.ratio.push(t, fr / n);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn run_metadata(&mut self, entries: &BTreeMap<String, String>) {
+        let run = RunMetadata::from_map(entries).map_err(|e| e.to_string());
+        if let Ok(r) = &run {
+            let inertia = Inertia::Explicit {
+                inertia_x: r.inertia_x,
+                inertia_z: r.inertia_z,
+            };
+            match CoinParams::new(r.mass, r.radius, r.gravity, inertia) {
+                Ok(p) => self.params = Some(p),
+                Err(e) => {
+                    let list: Vec<String> = e.iter().map(ToString::to_string).collect();
+                    self.problem = Some(format!("unusable body parameters: {}", list.join("; ")));
+                }
+            }
+        }
+        self.run = Some(run);
+    }
+}
+
+impl Visitor for Collect {
+    fn schema(&mut self, id: u16, name: &str, _: &str, _: &[u8]) {
+        self.schemas.insert(id, name.to_string());
+    }
+    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, _: &str) {
+        let schema = self.schemas.get(&schema_id).map_or("", String::as_str);
+        if let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) {
+            self.channels.insert(id, c);
+        }
+    }
+    fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
+        if name == RUN_METADATA_NAME && self.run.is_none() {
+            self.run_metadata(entries);
+        } else if name == RESULT_METADATA_NAME {
+            self.result = ResultMetadata::from_map(entries).ok();
+        }
+    }
+    fn library(&mut self, _: &str) {}
+    fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
+        if self.run.is_none() {
+            return ControlFlow::Break(());
+        }
+        let Some(&channel) = self.channels.get(&h.channel_id) else {
+            return ControlFlow::Continue(());
+        };
+        let Some(names) = channel.fields() else {
+            return ControlFlow::Continue(());
+        };
+        let mut values = std::mem::take(&mut self.values);
+        values.clear();
+        values.resize(names.len(), 0.0);
+        match read_fields(data, names, &mut values) {
+            Ok(()) => self.observe(
+                channel,
+                &Fields {
+                    names,
+                    values: &values,
+                },
+            ),
+            Err(e) => {
+                self.problem = Some(format!(
+                    "{}: the message at log time {} ns {e}",
+                    channel.topic(),
+                    h.log_time
+                ));
+                return ControlFlow::Break(());
+            }
+        }
+        self.values = values;
+        ControlFlow::Continue(())
+    }
+}
+
+/// The one-page overview of the file at `path` as an SVG document; `name` is shown in the title.
+///
+/// # Errors
+/// [`PlotError`] if the file cannot be read, is not a coin-log file, or a message does not fit its
+/// schema. A file that breaks off part way is drawn up to the break, and the title says so.
+pub fn plot(path: &Path, name: &str) -> Result<String, PlotError> {
+    let mut c = Collect::default();
+    let (_, error) = mcap_io::read(path, &mut c);
+    let mut broken = None;
+    if let Some(e) = error {
+        match e.kind {
+            ReadErrorKind::Io | ReadErrorKind::NotMcap => return Err(PlotError(e.detail)),
+            ReadErrorKind::Stopped => {}
+            ReadErrorKind::Truncated | ReadErrorKind::Corrupt => broken = Some(e.detail),
+        }
+    }
+    if let Some(p) = c.problem.take() {
+        return Err(PlotError(p));
+    }
+    let run = match c.run.take() {
+        Some(Ok(run)) => run,
+        Some(Err(e)) => {
+            return Err(PlotError(format!(
+                "its `coin-log` metadata is unusable: {e}"
+            )))
+        }
+        None => return Err(PlotError(
+            "not a coin-log file: it has no `coin-log` metadata record before its first message"
+                .into(),
+        )),
+    };
+    draw(&c, &run, name, broken.as_deref()).map_err(PlotError)
+}
+
+/// The page's title: the file, the scene's description, how the run ended.
+fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (String, String) {
+    let description = toml::from_str::<SceneFile>(&run.scene)
+        .ok()
+        .and_then(|s| s.description)
+        .unwrap_or_default();
+    let end = match (&c.result, broken) {
+        (_, Some(b)) => format!("file breaks off after t = {}: {b}", c.last_t),
+        (Some(r), None) => format!("{} at t = {}", r.termination, r.termination_time),
+        (None, None) => format!(
+            "no coin-log.result record: unfinished, last sample t = {}",
+            c.last_t
+        ),
+    };
+    let friction = run
+        .friction
+        .map_or_else(|| "no μ".to_string(), |m| format!("μ = {m}"));
+    (
+        format!("{name}: {end}"),
+        format!(
+            "{description} — M = {}, a = {}, g = {}, I_X = {}, I_Z = {}, {friction}; {} rtol {:e} atol {:e}, rate {}",
+            run.mass, run.radius, run.gravity, run.inertia_x, run.inertia_z, run.integrator, run.rtol, run.atol, run.rate
+        ),
+    )
+}
+
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+fn draw(
+    c: &Collect,
+    run: &RunMetadata,
+    name: &str,
+    broken: Option<&str>,
+) -> Result<String, String> {
+    let (heading, subheading) = title(c, run, name, broken);
+    let end = c
+        .result
+        .as_ref()
+        .map(|r| (r.termination.name(), r.termination_time));
+    // 2 % beyond the last time, so that the termination's mark stands clear of the frame.
+    let t_max = 1.02 * c.last_t.max(end.map_or(0.0, |e| e.1)).max(1e-9);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (top, body) = root.split_vertically(70);
+        top.draw_text(
+            &heading,
+            &("sans-serif", 22).into_font().color(&BLACK),
+            (20, 12),
+        )
+        .map_err(|e| e.to_string())?;
+        top.draw_text(
+            &subheading,
+            &("sans-serif", 14).into_font().color(&GREY),
+            (20, 44),
+        )
+        .map_err(|e| e.to_string())?;
+        let panels = body.split_evenly((3, 2));
+        track(&panels[0], c)?;
+        let time = TimeAxis { t_max, end };
+        time.linear(
+            &panels[1],
+            PANELS[1],
+            "θ [rad]",
+            &[("θ", &c.theta, BLUE)],
+            None,
+        )?;
+        time.log(&panels[2], PANELS[2], &[("energy", &c.energy, BLUE)])?;
+        time.log(
+            &panels[3],
+            PANELS[3],
+            &[("C1", &c.c1, BLUE), ("C2", &c.c2, ORANGE)],
+        )?;
+        time.linear(
+            &panels[4],
+            PANELS[4],
+            "N / (Mg)",
+            &[("N/(Mg)", &c.normal, BLUE)],
+            Some(("N", 0.0)),
+        )?;
+        let mu = run.friction.map(|m| ("μ", m));
+        time.linear(
+            &panels[5],
+            PANELS[5],
+            "|F| / N",
+            &[("|F|/N", &c.ratio, BLUE)],
+            mu,
+        )?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(svg)
+}
+
+/// A panel that says why it is empty.
+fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), String> {
+    area.titled(title, ("sans-serif", 16))
+        .and_then(|a| a.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60)))
+        .map_err(|e| e.to_string())
+}
+
+/// Range `lo..hi` widened by `pad` of its span on each side (a fixed span when it is empty).
+fn padded(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+    let span = hi - lo;
+    if span > 0.0 {
+        (lo - pad * span, hi + pad * span)
+    } else {
+        let w = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
+        (lo - w, hi + w)
+    }
+}
+
+fn min_max<'a>(
+    points: impl Iterator<Item = &'a (f64, f64)>,
+    pick: fn(&(f64, f64)) -> f64,
+) -> (f64, f64) {
+    points.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+        (lo.min(pick(p)), hi.max(pick(p)))
+    })
+}
+
+/// The path of the contact point and of the centre in the table plane: x across, z down the page,
+/// one length unit the same on both axes.
+fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
+    let (contact, centre) = (c.contact.points(), c.centre.points());
+    if contact.is_empty() && centre.is_empty() {
+        return empty(
+            area,
+            PANELS[0],
+            "/coin/contact and /coin/position were not recorded",
+        );
+    }
+    let all = || contact.iter().chain(&centre);
+    let (x0, x1) = padded_equal(min_max(all(), |p| p.0));
+    let (z0, z1) = padded_equal(min_max(all(), |p| p.1));
+    // Equal axes: widen the shorter range to the plotting area's aspect ratio.
+    let (label_x, label_y, margin) = (40u32, 60u32, 12u32);
+    let (w, h) = area.dim_in_pixel();
+    let plot_w = f64::from(w.saturating_sub(label_y + 2 * margin).max(1));
+    let plot_h = f64::from(h.saturating_sub(label_x + 2 * margin + 24).max(1));
+    let scale = ((x1 - x0) / plot_w).max((z1 - z0) / plot_h);
+    let (xc, zc) = (0.5 * (x0 + x1), 0.5 * (z0 + z1));
+    let (hx, hz) = (0.5 * scale * plot_w, 0.5 * scale * plot_h);
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let mut chart = ChartBuilder::on(area)
+        .caption(PANELS[0], ("sans-serif", 16))
+        .margin(margin)
+        .x_label_area_size(label_x)
+        .y_label_area_size(label_y)
+        .build_cartesian_2d(xc - hx..xc + hx, zc + hz..zc - hz)
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("x")
+        .y_desc("z (down the page: the view from above)")
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (label, points, colour) in [
+        ("contact track", &contact, BLUE),
+        ("centre", &centre, ORANGE),
+    ] {
+        if points.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                colour.stroke_width(1),
+            ))
+            .map_err(|e| err(&e))?
+            .label(label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        let (first, last) = (points[0], points[points.len() - 1]);
+        chart
+            .draw_series([Circle::new(first, 4, colour.filled())])
+            .map_err(|e| err(&e))?;
+        chart
+            .draw_series([Cross::new(last, 6, RED.stroke_width(2))])
+            .map_err(|e| err(&e))?;
+    }
+    legend(&mut chart)
+}
+
+/// `lo..hi` padded by 5 % (a unit span around a single value).
+fn padded_equal((lo, hi): (f64, f64)) -> (f64, f64) {
+    padded(lo, hi, 0.05)
+}
+
+fn legend<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
+/// The common time axis of the time panels, with the termination marked.
+struct TimeAxis<'a> {
+    t_max: f64,
+    end: Option<(&'a str, f64)>,
+}
+
+impl TimeAxis<'_> {
+    /// A panel of `series` against t; `line` draws a labelled horizontal line (N = 0, μ).
+    fn linear(
+        &self,
+        area: &Area<'_>,
+        title: &str,
+        y_desc: &str,
+        series: &[(&str, &Envelope, RGBColor)],
+        line: Option<(&str, f64)>,
+    ) -> Result<(), String> {
+        if series.iter().all(|s| s.1.is_empty()) {
+            return empty(area, title, "the channel this needs was not recorded");
+        }
+        let points: Vec<Vec<(f64, f64)>> = series.iter().map(|s| s.1.points()).collect();
+        let (mut lo, mut hi) = min_max(points.iter().flatten(), |p| p.1);
+        if let Some((_, v)) = line {
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+        let (y0, y1) = padded(lo, hi, 0.05);
+        let err = |e: &dyn std::fmt::Display| e.to_string();
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 16))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..self.t_max, y0..y1)
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("t")
+            .y_desc(y_desc)
+            .draw()
+            .map_err(|e| err(&e))?;
+        for ((label, _, colour), points) in series.iter().zip(&points) {
+            let colour = *colour;
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    colour.stroke_width(1),
+                ))
+                .map_err(|e| err(&e))?
+                .label(*label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        if let Some((label, v)) = line {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, v), (self.t_max, v)],
+                    6,
+                    4,
+                    GREEN.stroke_width(2),
+                ))
+                .map_err(|e| err(&e))?
+                .label(format!("{label} = {v}"))
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2))
+                });
+        }
+        self.mark_end(&mut chart, y0, y1)?;
+        legend(&mut chart)
+    }
+
+    /// A panel of non-negative `series` on a log scale; zeros are drawn on the bottom edge, which sits a
+    /// decade below the smallest positive value (at 1e-17 when every value is 0).
+    fn log(
+        &self,
+        area: &Area<'_>,
+        title: &str,
+        series: &[(&str, &Envelope, RGBColor)],
+    ) -> Result<(), String> {
+        if series.iter().all(|s| s.1.is_empty()) {
+            return empty(area, title, "the channel this needs was not recorded");
+        }
+        let points: Vec<Vec<(f64, f64)>> = series.iter().map(|s| s.1.points()).collect();
+        let positive = points.iter().flatten().map(|p| p.1).filter(|v| *v > 0.0);
+        let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+        let (floor, top) = if hi > 0.0 {
+            (lo / 10.0, hi * 10.0)
+        } else {
+            (1e-17, 1e-15)
+        };
+        let err = |e: &dyn std::fmt::Display| e.to_string();
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 16))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..self.t_max, (floor..top).log_scale())
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("t")
+            .y_desc(if hi > 0.0 {
+                "relative drift (0 on the bottom edge)"
+            } else {
+                "identically 0"
+            })
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(|e| err(&e))?;
+        for ((label, _, colour), points) in series.iter().zip(&points) {
+            let colour = *colour;
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().map(|&(t, v)| (t, v.max(floor))),
+                    colour.stroke_width(1),
+                ))
+                .map_err(|e| err(&e))?
+                .label(*label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        self.mark_end(&mut chart, floor, top)?;
+        legend(&mut chart)
+    }
+
+    /// The termination as a dashed red vertical line, labelled.
+    fn mark_end<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
+        &self,
+        chart: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
+        y0: f64,
+        y1: f64,
+    ) -> Result<(), String> {
+        let Some((name, t)) = self.end else {
+            return Ok(());
+        };
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(t, y0), (t, y1)],
+                5,
+                4,
+                RED.stroke_width(2),
+            ))
+            .map_err(|e| e.to_string())?
+            .label(format!("{name} at t = {t}"))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Envelope, Path2, POINTS};
+
+    #[test]
+    fn the_envelope_stays_bounded_and_keeps_every_extreme() {
+        let mut e = Envelope::default();
+        let n = 10 * POINTS + 7;
+        for i in 0..n {
+            let spike = if i == 12_345 { 1e3 } else { 0.0 };
+            #[allow(clippy::cast_precision_loss)]
+            e.push(i as f64, (i as f64).sin() + spike);
+        }
+        assert!(e.buckets.len() <= 2 * POINTS, "{} buckets", e.buckets.len());
+        let max = e.points().iter().map(|p| p.1).fold(f64::MIN, f64::max);
+        assert!(max > 1e3 - 1.0, "the spike survives decimation: max {max}");
+        let times: Vec<f64> = e.points().iter().map(|p| p.0).collect();
+        assert!(
+            times.windows(2).all(|w| w[0] <= w[1]),
+            "points in time order"
+        );
+    }
+
+    #[test]
+    fn the_path_stays_bounded_and_ends_at_the_last_point() {
+        let mut p = Path2::default();
+        let n = 7 * POINTS + 3;
+        for i in 0..n {
+            #[allow(clippy::cast_precision_loss)]
+            p.push((i as f64, 0.0));
+        }
+        let points = p.points();
+        assert!(points.len() <= 2 * POINTS + 1, "{} points", points.len());
+        assert_eq!(points[0], (0.0, 0.0));
+        #[allow(clippy::cast_precision_loss)]
+        let last = (n - 1) as f64;
+        assert_eq!(points[points.len() - 1], (last, 0.0));
+    }
+}

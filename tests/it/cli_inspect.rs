@@ -1,0 +1,314 @@
+//! The commands around recording: `record --dry-run` (the resolved scene and an estimate that real
+//! recordings keep within its stated factor), the warning before a large recording, `scenes --json` and
+//! `--show` with every default, shell completions and man pages that name every command, and `verify`'s
+//! total line over several files.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{coin_log, coin_log_text, exe, listing, read_back, record_scene};
+use coin_log::record::estimate::ACCURACY;
+use coin_log::scene::{self, presets, FlagOverrides, Scene};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+/// The subcommands, as `coin-log --help` lists them.
+const COMMANDS: [&str; 9] = [
+    "record",
+    "verify",
+    "scenes",
+    "bench",
+    "info",
+    "export",
+    "plot",
+    "completions",
+    "man",
+];
+
+#[test]
+fn dry_run_prints_the_resolved_scene_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "wobble",
+            "--dry-run",
+            "--rate",
+            "250",
+            "--set",
+            "initial.theta=0.4",
+        ],
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    print!("{text}");
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        listing(dir.path()).is_empty(),
+        "nothing written: {:?}",
+        listing(dir.path())
+    );
+    // The output is a scene file: it resolves to the scene the flags make.
+    let printed = Scene::from_file(&scene::parse_with_sets(&text, &[]).unwrap()).unwrap();
+    let flags = FlagOverrides {
+        rate: Some(250.0),
+        ..FlagOverrides::default()
+    };
+    let sets = vec!["initial.theta=0.4".to_string()];
+    let expected = scene::resolve(
+        &scene::file_with_sets(&presets::preset("wobble").unwrap(), &sets).unwrap(),
+        &flags,
+    )
+    .unwrap();
+    assert_eq!(printed, expected);
+    for key in [
+        "rate = 250.0",
+        "integrator = \"dop853\"",
+        "rtol =",
+        "step =",
+        "flat_margin =",
+        "channels =",
+    ] {
+        assert!(text.contains(key), "`{key}` in the dry run");
+    }
+    assert!(text.contains("7501 samples"), "30 × 250 + 1 samples");
+    // A bad scene: the same errors as a real recording, exit 1, nothing written.
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--dry-run", "--rate", "0"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--rate"));
+    assert!(listing(dir.path()).is_empty());
+}
+
+/// The estimate against real recordings: messages exact for runs that complete, never fewer for runs
+/// ended by an event; bytes within the stated factor for every compression.
+#[test]
+fn the_estimate_holds_within_its_factor_on_real_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &[&str]); 6] = [
+        ("wobble", &[]),
+        ("circle-plus", &[]),
+        ("high-spin", &[]),
+        // Before its flat landing (t = 1.907): the run completes and the estimate is exact in messages.
+        ("topple", &["--duration", "1.9"]),
+        ("five-hundred-yen", &[]),
+        ("long-horizon", &["--duration", "200"]),
+    ];
+    let mut worst: f64 = 1.0;
+    for (name, extra) in cases {
+        for compression in ["zstd", "lz4", "none"] {
+            let mut args = vec!["record", name, "--compression", compression];
+            args.extend_from_slice(extra);
+            let mut dry = args.clone();
+            dry.extend(["--dry-run", "--json"]);
+            let (code, out, err) = coin_log_text(&dry);
+            assert_eq!(code, 0, "{err}");
+            let estimate: serde_json::Value = serde_json::from_str(&out).unwrap();
+            let path = record_scene(
+                dir.path(),
+                name,
+                &[&["--compression", compression][..], extra].concat(),
+            );
+            let bytes = std::fs::metadata(&path).unwrap().len() as f64;
+            let file = read_back(&std::fs::read(&path).unwrap());
+            let messages = file.messages.len() as u64;
+            let ratio = estimate["estimated_bytes"].as_f64().unwrap() / bytes;
+            println!(
+                "{name:<17} {compression:<4} estimate {:>9} B, file {bytes:>9} B, ratio {ratio:.2}; messages {} vs {messages}",
+                estimate["estimated_bytes"], estimate["messages"]
+            );
+            worst = worst.max(ratio).max(1.0 / ratio);
+            assert!(
+                (1.0 / ACCURACY..=ACCURACY).contains(&ratio),
+                "{name} {compression}: estimate/file = {ratio:.3}, outside the factor {ACCURACY}"
+            );
+            let estimated = estimate["messages"].as_u64().unwrap();
+            assert_eq!(estimated, messages, "{name}: messages of a completed run");
+        }
+    }
+    // A run ended by an event writes less than the estimate of its full duration.
+    let (_, out, _) = coin_log_text(&["record", "topple", "--dry-run", "--json"]);
+    let estimate: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let path = record_scene(dir.path(), "topple", &[]);
+    let file = read_back(&std::fs::read(&path).unwrap());
+    assert!(estimate["messages"].as_u64().unwrap() > file.messages.len() as u64);
+    println!("worst factor {worst:.2} (allowed {ACCURACY})");
+}
+
+/// A recording estimated above 1 GiB warns on stderr before it starts (stopped right after the warning).
+#[test]
+fn a_recording_above_a_gibibyte_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = Command::new(exe())
+        .args([
+            "record",
+            "long-horizon",
+            "--rate",
+            "1000",
+            "--duration",
+            "100000",
+            "-o",
+            "big.mcap",
+        ])
+        .current_dir(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let _ = child.kill();
+    let _ = child.wait();
+    println!("{line}");
+    assert!(
+        line.starts_with("warning: this recording is estimated at"),
+        "{line}"
+    );
+    assert!(line.contains("GiB"), "{line}");
+    // A small recording does not warn.
+    let (code, _, err) = coin_log_text(&["record", "circle-plus", "--dry-run"]);
+    assert_eq!(code, 0);
+    assert!(err.is_empty(), "{err}");
+}
+
+#[test]
+fn scenes_json_lists_every_built_in_resolved() {
+    let (code, out, err) = coin_log_text(&["scenes", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let all = v.as_array().unwrap();
+    assert_eq!(all.len(), presets::NAMES.len());
+    for (entry, name) in all.iter().zip(presets::NAMES) {
+        assert_eq!(entry["name"], name);
+        let preset = presets::preset(name).unwrap();
+        assert_eq!(entry["description"], preset.description.clone().unwrap());
+        let file: scene::SceneFile = serde_json::from_value(entry["scene"].clone()).unwrap();
+        assert_eq!(
+            Scene::from_file(&file).unwrap(),
+            Scene::from_file(&preset).unwrap(),
+            "{name}"
+        );
+        let run = &entry["scene"]["run"];
+        for key in [
+            "duration",
+            "rate",
+            "integrator",
+            "rtol",
+            "atol",
+            "step",
+            "flat_margin",
+        ] {
+            assert!(!run[key].is_null(), "{name}: run.{key} filled in");
+        }
+        assert!(entry["scene"]["record"]["channels"].is_array());
+        assert!(!entry["scene"]["body"]["thickness"].is_null());
+    }
+}
+
+#[test]
+fn scenes_show_prints_every_default() {
+    for name in presets::NAMES {
+        let (code, out, _) = coin_log_text(&["scenes", "--show", name]);
+        assert_eq!(code, 0);
+        for key in [
+            "rate =",
+            "integrator =",
+            "rtol =",
+            "atol =",
+            "step =",
+            "flat_margin =",
+            "thickness =",
+            "channels =",
+        ] {
+            assert!(out.contains(key), "{name}: `{key}` in\n{out}");
+        }
+        let file = scene::parse_with_sets(&out, &[]).unwrap();
+        let resolved = Scene::from_file(&presets::preset(name).unwrap()).unwrap();
+        assert_eq!(
+            file,
+            resolved.to_file(),
+            "{name}: the resolved scene, written out"
+        );
+    }
+}
+
+#[test]
+fn completions_and_man_pages_name_every_command() {
+    let (code, help, _) = coin_log_text(&["--help"]);
+    assert_eq!(code, 0);
+    for c in COMMANDS {
+        assert!(help.contains(c), "`{c}` in --help");
+    }
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let (code, out, err) = coin_log_text(&["completions", shell]);
+        assert_eq!(code, 0, "{shell}: {err}");
+        for c in COMMANDS {
+            assert!(out.contains(c), "{shell}: `{c}` completed");
+        }
+        for flag in ["dry-run", "overwrite", "wide"] {
+            assert!(out.contains(flag), "{shell}: `--{flag}` completed");
+        }
+    }
+    let (code, out, _) = coin_log_text(&["completions", "tcsh"]);
+    assert_eq!(code, 2, "an unknown shell is a usage error: {out}");
+    let (code, man, _) = coin_log_text(&["man"]);
+    assert_eq!(code, 0);
+    assert!(
+        man.starts_with(".ie") || man.contains(".TH coin-log"),
+        "roff: {}",
+        &man[..200.min(man.len())]
+    );
+    for c in COMMANDS {
+        assert!(man.contains(c), "`{c}` in the man page");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(dir.path(), &["man", "--out", "man1"]);
+    assert_eq!(out.status.code(), Some(0));
+    let pages = listing(&dir.path().join("man1"));
+    println!("{pages:?}");
+    for c in COMMANDS {
+        assert!(
+            pages.contains(&format!("coin-log-{c}.1")),
+            "coin-log-{c}.1 written"
+        );
+    }
+    assert!(pages.contains(&"coin-log.1".to_string()));
+    assert!(pages.contains(&"coin-log-bench-precision.1".to_string()));
+}
+
+/// With several files verify ends with a one-line total; with one it does not; no progress bar when
+/// stderr is not a terminal.
+#[test]
+fn verify_totals_several_files_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(dir.path(), "circle-plus", &["--duration", "2"]);
+    std::fs::write(dir.path().join("junk.mcap"), b"junk").unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "verify",
+            "circle-plus.mcap",
+            "junk.mcap",
+            "circle-plus.mcap",
+        ],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    print!("{text}");
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        text.lines().last(),
+        Some("3 files: 2 ok, 0 failed, 1 unusable")
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "only junk.mcap's error, no bar: {err}"
+    );
+    let out = coin_log(dir.path(), &["verify", "circle-plus.mcap"]);
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("files:"));
+    assert!(out.stderr.is_empty());
+}

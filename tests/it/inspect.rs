@@ -1,0 +1,629 @@
+//! `info`, `export` and `plot` on real recordings (the binary's own, and the same data written by the
+//! `mcap` crate without a summary section): what `info` reports against what the file holds when read
+//! independently, the stored scene recording the same bytes again for every built-in scene, the exported
+//! tables equal to the MCAP's messages bit for bit, and the plot a well-formed SVG with its panels.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{coin_log, coin_log_text, read_back, record_scene, ReadBack};
+use crate::support::repo;
+use coin_log::format::{Channel, RUN_METADATA_NAME};
+use coin_log::inspect::export::{TF_COLUMNS, WIDE_TABLE};
+use coin_log::inspect::plot::PANELS;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "{e}: {}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        )
+    })
+}
+
+/// Copies `src` into `dst` with the `mcap` crate's writer and no summary section (no statistics, no
+/// indexes), as a recording from another writer or an unfinished one might be.
+fn without_summary(src: &Path, dst: &Path) {
+    let bytes = std::fs::read(src).unwrap();
+    let file = read_back(&bytes);
+    let out = std::io::BufWriter::new(std::fs::File::create(dst).unwrap());
+    let mut w = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Lz4))
+        .library("another-writer")
+        .emit_summary_records(false)
+        .emit_summary_offsets(false)
+        .emit_statistics(false)
+        .emit_chunk_indexes(false)
+        .emit_metadata_indexes(false)
+        .create(out)
+        .unwrap();
+    let run = &file.metadata[RUN_METADATA_NAME].1;
+    w.write_metadata(&mcap::records::Metadata {
+        name: RUN_METADATA_NAME.into(),
+        metadata: run.clone(),
+    })
+    .unwrap();
+    let mut ids = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        let id = *ids.entry(m.channel.topic.clone()).or_insert_with(|| {
+            let schema = m.channel.schema.as_ref().unwrap();
+            let sid = w
+                .add_schema(&schema.name, &schema.encoding, &schema.data)
+                .unwrap();
+            w.add_channel(
+                sid,
+                &m.channel.topic,
+                &m.channel.message_encoding,
+                &BTreeMap::new(),
+            )
+            .unwrap()
+        });
+        w.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+            },
+            &m.data,
+        )
+        .unwrap();
+    }
+    w.finish().unwrap();
+}
+
+/// The per-topic message counts and the time range of a recording, read by the `mcap` crate.
+fn counts(file: &ReadBack) -> (BTreeMap<String, u64>, u64, u64) {
+    let mut counts = BTreeMap::new();
+    for m in &file.messages {
+        *counts.entry(m.topic.clone()).or_insert(0) += 1;
+    }
+    let start = file.messages.iter().map(|m| m.log_time).min().unwrap();
+    let end = file.messages.iter().map(|m| m.log_time).max().unwrap();
+    (counts, start, end)
+}
+
+/// `info --json` against the file read independently, from the summary and from a file without one.
+#[test]
+fn info_reports_what_the_file_holds_with_or_without_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "topple", &["--compression", "lz4"]);
+    let bare = dir.path().join("bare.mcap");
+    without_summary(&path, &bare);
+    let file = read_back(&std::fs::read(&path).unwrap());
+    let (expected, start, end) = counts(&file);
+    let out = coin_log(dir.path(), &["info", "--json", "topple.mcap", "bare.mcap"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = json(&out);
+    let files = v["files"].as_array().unwrap();
+    assert_eq!(files.len(), 2);
+    for (f, from, library) in [
+        (&files[0], "summary", "coin-log/"),
+        (&files[1], "scan", "another-writer"),
+    ] {
+        println!("{}", serde_json::to_string_pretty(f).unwrap());
+        assert_eq!(f["read_from"], from);
+        assert!(f["library"].as_str().unwrap().starts_with(library));
+        let got: BTreeMap<String, u64> = f["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                (
+                    c["topic"].as_str().unwrap().to_string(),
+                    c["messages"].as_u64().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(got, expected, "per-channel counts");
+        assert_eq!(f["messages"], expected.values().sum::<u64>());
+        assert_eq!(f["start_time"].as_f64().unwrap(), start as f64 / 1e9);
+        assert_eq!(f["end_time"].as_f64().unwrap(), end as f64 / 1e9);
+        assert_eq!(f["coin_log"], true);
+        assert_eq!(f["body"]["mass"], 1.0);
+        assert_eq!(f["body"]["inertia_x"], 0.25);
+        assert_eq!(f["run"]["integrator"], "dop853");
+        assert_eq!(f["run"]["duration"], 30.0);
+        assert_eq!(
+            f["file_size"],
+            std::fs::metadata(dir.path().join(f["path"].as_str().unwrap()))
+                .unwrap()
+                .len()
+        );
+        assert!(f["description"].as_str().unwrap().contains("flat landing"));
+        // omega has one message per sample: (n - 1) samples over the span.
+        let omega = &f["channels"][0];
+        let rate = (expected["/coin/omega"] - 1) as f64 / ((end - start) as f64 / 1e9);
+        assert_eq!(omega["rate"].as_f64().unwrap(), rate);
+    }
+    assert_eq!(files[0]["compression"], "lz4");
+    assert_eq!(files[0]["result"]["termination"], "flat-landing");
+    assert!(files[0]["result"]["termination_time"].as_f64().unwrap() > 1.8);
+    // The copy has no result record: info says so rather than inventing one.
+    assert!(files[1]["result"].is_null());
+    let (code, text, _) = coin_log_text(&["info", path.to_str().unwrap()]);
+    print!("{text}");
+    assert_eq!(code, 0);
+    for expected in [
+        "flat-landing at t = 1.9",
+        "/coin/omega",
+        "coin_log.AngularVelocity",
+        "lz4",
+        "summary section",
+    ] {
+        assert!(text.contains(expected), "`{expected}` in:\n{text}");
+    }
+}
+
+/// A file cut in half is described up to the break, with the problem named and exit 1; a file that is not
+/// MCAP is an error naming the problem.
+#[test]
+fn info_describes_a_truncated_file_up_to_the_break_and_refuses_a_non_mcap_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "wobble", &[]);
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(dir.path().join("half.mcap"), &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::write(dir.path().join("notes.mcap"), b"just some text\n").unwrap();
+    let out = coin_log(dir.path(), &["info", "--json", "half.mcap"]);
+    assert_eq!(out.status.code(), Some(1));
+    let f = &json(&out)["files"][0];
+    println!("{f}");
+    assert_eq!(f["read_from"], "scan");
+    assert!(f["problem"].as_str().unwrap().contains("truncated"), "{f}");
+    let n = f["messages"].as_u64().unwrap();
+    assert!(n > 0 && n < 27912, "{n} messages before the break");
+    let (code, _, err) = coin_log_text(&["info", dir.path().join("notes.mcap").to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains("not an MCAP file"), "{err}");
+}
+
+/// `info F --scene > s.toml && record s.toml -o G` writes G equal to F byte for byte, for every built-in
+/// scene; the description and every default survive, and the scene file's name does not enter the file.
+#[test]
+fn the_stored_scene_records_the_same_bytes_again_for_every_built_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = coin_log::scene::presets::NAMES;
+    for name in names {
+        let original = record_scene(dir.path(), name, &[]);
+        let out = coin_log(dir.path(), &["info", original.to_str().unwrap(), "--scene"]);
+        assert_eq!(out.status.code(), Some(0), "{name}");
+        let text = String::from_utf8(out.stdout).unwrap();
+        // Another stem than the scene's name: the file must not depend on it.
+        let toml = dir.path().join(format!("copied-{name}.toml"));
+        std::fs::write(&toml, &text).unwrap();
+        let again = dir.path().join(format!("again-{name}.mcap"));
+        let (code, _, err) = coin_log_text(&[
+            "record",
+            toml.to_str().unwrap(),
+            "-o",
+            again.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{name}: {err}");
+        let (a, b) = (
+            std::fs::read(&original).unwrap(),
+            std::fs::read(&again).unwrap(),
+        );
+        println!(
+            "{name:<18} {} bytes, re-recorded from its stored scene: {}",
+            a.len(),
+            if a == b { "identical" } else { "DIFFERENT" }
+        );
+        assert!(a == b, "{name}: the re-recording differs\n{text}");
+        let preset = coin_log::scene::presets::preset(name).unwrap();
+        let description = preset.description.unwrap();
+        assert!(text.contains(&description), "{name}: description kept");
+        for key in [
+            "rate =",
+            "integrator =",
+            "rtol =",
+            "atol =",
+            "step =",
+            "flat_margin =",
+            "thickness =",
+            "channels =",
+        ] {
+            assert!(text.contains(key), "{name}: `{key}` written out:\n{text}");
+        }
+        assert!(!text.contains("copied-"), "{name}");
+    }
+}
+
+/// Non-default compression: the comment names the flag that reproduces the bytes.
+#[test]
+fn the_stored_scene_names_a_non_default_compression() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--compression", "none", "--duration", "2"],
+    );
+    let (code, text, _) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0);
+    assert!(text.contains("--compression none"), "{text}");
+    std::fs::write(dir.path().join("s.toml"), &text).unwrap();
+    let again = dir.path().join("g.mcap");
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        dir.path().join("s.toml").to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+        "--compression",
+        "none",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(std::fs::read(&original).unwrap() == std::fs::read(&again).unwrap());
+    let (code, _, err) = coin_log_text(&[
+        "info",
+        "--scene",
+        original.to_str().unwrap(),
+        original.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("one file"), "{err}");
+}
+
+/// The rows of a CSV table: the header and the fields of each line (no quoting in number tables).
+fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    (
+        header,
+        lines
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect(),
+    )
+}
+
+/// Every value of `table` against the messages of `topic` read by the `mcap` crate and serde_json:
+/// equal bits, one row per message in order. Returns the values compared.
+fn compare_flat(file: &ReadBack, topic: &str, table: &Path) -> usize {
+    let (header, rows) = csv(table);
+    let messages = file.on_topic(topic);
+    assert_eq!(rows.len(), messages.len(), "{topic}: one row per message");
+    let channel = Channel::from_topic(topic).unwrap();
+    assert_eq!(
+        header,
+        channel.fields().unwrap(),
+        "{topic}: header = the schema's fields"
+    );
+    let mut compared = 0;
+    for (row, m) in rows.iter().zip(messages) {
+        let v: serde_json::Map<String, serde_json::Value> =
+            serde_json::from_slice(&m.data).unwrap();
+        for (name, cell) in header.iter().zip(row) {
+            let expected = v[name].as_f64().unwrap();
+            let got: f64 = cell.parse().unwrap();
+            assert_eq!(
+                got.to_bits(),
+                expected.to_bits(),
+                "{topic}.{name}: {cell} vs {expected:?}"
+            );
+            compared += 1;
+        }
+    }
+    compared
+}
+
+/// Every table of a per-channel export equals the MCAP's messages bit for bit; `/tf` is flattened with
+/// its exact timestamps; `/scene` is skipped with the reason; a second export refuses to overwrite.
+#[test]
+fn export_writes_every_value_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "wobble", &["--duration", "5"]);
+    let out = coin_log(
+        dir.path(),
+        &["export", "wobble.mcap", "--out", "tables", "--json"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = json(&out);
+    println!("{summary}");
+    let file = read_back(&std::fs::read(&path).unwrap());
+    let tables = dir.path().join("tables");
+    let mut compared = 0;
+    for c in Channel::ALL.iter().filter(|c| c.fields().is_some()) {
+        compared += compare_flat(&file, c.topic(), &tables.join(format!("{}.csv", c.name())));
+    }
+    println!("{compared} values equal bit for bit");
+    assert!(compared > 8 * 501 * 3);
+    // /tf: the frame ids, the exact timestamp, translation and rotation.
+    let (header, rows) = csv(&tables.join("tf.csv"));
+    assert_eq!(header, TF_COLUMNS);
+    let tf = file.on_topic("/tf");
+    assert_eq!(rows.len(), tf.len());
+    for (row, m) in rows.iter().zip(tf) {
+        let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+        let ns = v["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
+            + v["timestamp"]["nsec"].as_u64().unwrap();
+        assert_eq!(ns, m.log_time);
+        assert_eq!(
+            row[0].parse::<f64>().unwrap(),
+            ns as f64 / 1e9,
+            "t is the exact timestamp"
+        );
+        assert_eq!(row[1], v["parent_frame_id"].as_str().unwrap());
+        assert_eq!(row[2], v["child_frame_id"].as_str().unwrap());
+        for (cell, (part, axis)) in row[3..].iter().zip([
+            ("translation", "x"),
+            ("translation", "y"),
+            ("translation", "z"),
+            ("rotation", "x"),
+            ("rotation", "y"),
+            ("rotation", "z"),
+            ("rotation", "w"),
+        ]) {
+            assert_eq!(
+                cell.parse::<f64>().unwrap().to_bits(),
+                v[part][axis].as_f64().unwrap().to_bits()
+            );
+        }
+    }
+    let skipped = summary["skipped"].as_array().unwrap();
+    assert_eq!(skipped.len(), 1);
+    assert_eq!(skipped[0]["topic"], "/scene");
+    assert!(skipped[0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("/coin/contact"));
+    // Again without --overwrite: refused, the tables untouched, no temporary file left.
+    let before = std::fs::read(tables.join("omega.csv")).unwrap();
+    let out = coin_log(dir.path(), &["export", "wobble.mcap", "--out", "tables"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--overwrite"));
+    assert_eq!(std::fs::read(tables.join("omega.csv")).unwrap(), before);
+    let names: Vec<String> = std::fs::read_dir(&tables)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names
+            .iter()
+            .all(|n| n.ends_with(".csv") && !n.starts_with('.')),
+        "{names:?}"
+    );
+    assert_eq!(names.len(), 9);
+}
+
+/// The comparison above fails when one value differs by one unit in the last place (negative control).
+#[test]
+fn the_bit_comparison_catches_one_ulp() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--duration", "1", "--channels", "omega"],
+    );
+    let out = coin_log(dir.path(), &["export", "circle-plus.mcap", "--out", "t"]);
+    assert_eq!(out.status.code(), Some(0));
+    let table = dir.path().join("t/omega.csv");
+    let text = std::fs::read_to_string(&table).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut cells: Vec<String> = lines[5].split(',').map(str::to_string).collect();
+    let x: f64 = cells[2].parse().unwrap();
+    cells[2] = ryu::Buffer::new()
+        .format_finite(f64::from_bits(x.to_bits() + 1))
+        .to_string();
+    lines[5] = cells.join(",");
+    std::fs::write(&table, lines.join("\n") + "\n").unwrap();
+    let file = read_back(&std::fs::read(&path).unwrap());
+    let caught = std::panic::catch_unwind(|| compare_flat(&file, "/coin/omega", &table));
+    assert!(caught.is_err(), "a one-ulp change must fail the comparison");
+}
+
+/// The wide table: one row per sample, `<channel>.<field>` columns, values bit for bit; the same from a
+/// file without a summary.
+#[test]
+fn the_wide_table_joins_the_channels_on_t() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "topple", &[]);
+    let bare = dir.path().join("bare.mcap");
+    without_summary(&path, &bare);
+    let file = read_back(&std::fs::read(&path).unwrap());
+    for (source, folder) in [("topple.mcap", "wide"), ("bare.mcap", "wide-bare")] {
+        let out = coin_log(dir.path(), &["export", source, "--wide", "--out", folder]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        print!("{}", String::from_utf8_lossy(&out.stdout));
+        let (header, rows) = csv(&dir.path().join(folder).join(WIDE_TABLE));
+        let samples = file.on_topic("/coin/omega");
+        assert_eq!(rows.len(), samples.len());
+        assert_eq!(header[0], "t");
+        let mut compared = 0;
+        for (col, name) in header.iter().enumerate().skip(1) {
+            let (channel, field) = name.split_once('.').unwrap();
+            let channel: Channel = channel.parse().unwrap();
+            for (row, m) in rows.iter().zip(file.on_topic(channel.topic())) {
+                let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+                assert_eq!(
+                    row[col].parse::<f64>().unwrap().to_bits(),
+                    v[field].as_f64().unwrap().to_bits(),
+                    "{name}"
+                );
+                assert_eq!(
+                    row[0].parse::<f64>().unwrap().to_bits(),
+                    v["t"].as_f64().unwrap().to_bits()
+                );
+                compared += 1;
+            }
+        }
+        // t, then every other field of the eight coin_log channels, from the format's field lists.
+        let fields: usize = Channel::ALL
+            .iter()
+            .filter_map(|c| c.fields())
+            .map(|f| f.len() - 1)
+            .sum();
+        assert_eq!(header.len(), 1 + fields);
+        println!("{source}: {compared} values equal bit for bit");
+    }
+    assert_eq!(
+        std::fs::read(dir.path().join("wide/samples.csv")).unwrap(),
+        std::fs::read(dir.path().join("wide-bare/samples.csv")).unwrap()
+    );
+}
+
+/// Parquet is not built in: a clear error naming why and how to convert; nothing is written.
+#[test]
+fn parquet_is_refused_with_the_way_to_convert() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(dir.path(), "circle-plus", &["--duration", "1"]);
+    let out = coin_log(
+        dir.path(),
+        &["export", "circle-plus.mcap", "--format", "parquet"],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    for expected in ["not built in", "crates", "polars", "round_trip"] {
+        assert!(err.contains(expected), "`{expected}` in {err}");
+    }
+    assert!(!dir.path().join("circle-plus-csv").exists());
+}
+
+/// An export that stops part way (a truncated file) leaves no table and no temporary file behind.
+#[test]
+fn a_failed_export_leaves_nothing_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "wobble", &[]);
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(dir.path().join("half.mcap"), &bytes[..bytes.len() * 2 / 3]).unwrap();
+    let out = coin_log(dir.path(), &["export", "half.mcap", "--out", "t"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("truncated") && err.contains("nothing exported"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path().join("t")).unwrap().count(), 0);
+}
+
+fn svg_texts(svg: &str) -> Vec<String> {
+    let doc =
+        roxmltree::Document::parse(svg).unwrap_or_else(|e| panic!("not well-formed XML: {e}"));
+    assert_eq!(doc.root_element().tag_name().name(), "svg");
+    doc.descendants()
+        .filter(|n| n.is_element() && n.tag_name().name() == "text")
+        .map(|n| {
+            n.descendants()
+                .filter(roxmltree::Node::is_text)
+                .filter_map(|d| d.text())
+                .collect::<String>()
+                .trim()
+                .to_string()
+        })
+        .collect()
+}
+
+/// Checks an overview SVG: well-formed, every panel titled, the termination named.
+fn check_plot(svg: &str, termination: &str) {
+    let texts = svg_texts(svg);
+    for panel in PANELS {
+        assert!(
+            texts.iter().any(|t| t == panel),
+            "panel `{panel}` missing; texts: {texts:?}"
+        );
+    }
+    assert!(
+        texts.iter().any(|t| t.contains(termination)),
+        "`{termination}` marked"
+    );
+}
+
+/// `plot` of wobble and topple: well-formed SVG with every panel and the termination; the committed
+/// pictures in docs/ are such pictures too; a file that is not coin-log's is refused.
+#[test]
+fn plot_draws_every_panel_and_marks_the_termination() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, termination) in [
+        ("wobble", "completed at t = 30"),
+        ("topple", "flat-landing at t = 1.9"),
+    ] {
+        record_scene(dir.path(), name, &[]);
+        let out = coin_log(dir.path(), &["plot", &format!("{name}.mcap")]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let svg = std::fs::read_to_string(dir.path().join(format!("{name}.svg"))).unwrap();
+        check_plot(&svg, termination);
+        let committed =
+            std::fs::read_to_string(repo().join(format!("docs/plot-{name}.svg"))).unwrap();
+        check_plot(&committed, termination);
+        // Again: refused without --overwrite.
+        let out = coin_log(dir.path(), &["plot", &format!("{name}.mcap")]);
+        assert_eq!(out.status.code(), Some(1));
+    }
+    // Negative control: an SVG without the panels fails the check.
+    let bare = "<svg xmlns=\"http://www.w3.org/2000/svg\"><text>lean θ(t)</text></svg>";
+    assert!(std::panic::catch_unwind(|| check_plot(bare, "completed")).is_err());
+    std::fs::write(dir.path().join("other.mcap"), b"\x89MCAP0\r\n").unwrap();
+    let out = coin_log(dir.path(), &["plot", "other.mcap"]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+/// The paths the test used, for the README's example: every committed dataset is described by `info`.
+#[test]
+fn info_describes_every_committed_dataset_from_its_summary() {
+    let files: Vec<PathBuf> = crate::support::dataset_files();
+    let mut args = vec!["info".to_string(), "--json".to_string()];
+    args.extend(files.iter().map(|p| p.display().to_string()));
+    let out = coin_log(&repo(), &args);
+    assert_eq!(out.status.code(), Some(0));
+    let v = json(&out);
+    for (f, path) in v["files"].as_array().unwrap().iter().zip(&files) {
+        let file = read_back(&std::fs::read(path).unwrap());
+        let (expected, _, _) = counts(&file);
+        assert_eq!(f["read_from"], "summary");
+        assert_eq!(
+            f["messages"],
+            expected.values().sum::<u64>(),
+            "{}",
+            path.display()
+        );
+        assert_eq!(f["result"]["termination"], "completed");
+    }
+}
+
+/// A summary section whose CRC does not match is not trusted: `info` reads the whole file instead, and
+/// names the damage (exit 1); the counts still come from the messages themselves.
+#[test]
+fn info_does_not_trust_a_summary_whose_crc_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "circle-plus", &["--duration", "2"]);
+    let mut bytes = std::fs::read(&path).unwrap();
+    let footer = bytes.len() - 37;
+    let summary_start = u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap()) as usize;
+    // A byte inside the first summary record's body (the schema's data): only the CRC can tell.
+    bytes[summary_start + 40] ^= 0x20;
+    std::fs::write(dir.path().join("bad.mcap"), &bytes).unwrap();
+    let out = coin_log(dir.path(), &["info", "--json", "bad.mcap"]);
+    assert_eq!(out.status.code(), Some(1));
+    let f = &json(&out)["files"][0];
+    println!("{f}");
+    assert_eq!(f["read_from"], "scan");
+    assert!(f["problem"].as_str().unwrap().contains("summary"), "{f}");
+    let file = read_back(&std::fs::read(&path).unwrap());
+    assert_eq!(f["messages"], file.messages.len());
+}
