@@ -2,7 +2,8 @@
 //! agree on (docs/format.md). The channels with their topics, schema names and schema bytes
 //! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`]); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
-//! simulation time to log time ([`log_time`]).
+//! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
+//! recorded integrator settings ([`tolerances`]).
 //!
 //! It knows the physics' vocabulary (integrator [`Method`](crate::integrate::Method), steady
 //! [`SteadyFamily`](crate::model::SteadyFamily), [`Branch`](crate::model::Branch), physical events) but
@@ -13,6 +14,7 @@ pub mod messages;
 pub mod metadata;
 mod termination;
 mod time;
+pub mod tolerances;
 
 pub use channels::{schema_bytes, Channel, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING};
 pub use metadata::{
