@@ -1,8 +1,12 @@
 //! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints.
 
+#[macro_use]
+mod output;
 mod bench;
+mod destination;
 mod record;
 mod rss;
+mod scene_arg;
 mod scenes;
 mod verify;
 
@@ -59,13 +63,11 @@ impl From<Outcome> for ExitCode {
 /// Parses the command line, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
-        Ok(outcome) => outcome.into(),
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            Outcome::Failure.into()
-        }
-    }
+    let outcome = run(cli).unwrap_or_else(|e| {
+        output::errln!("error: {e:#}");
+        Outcome::Failure
+    });
+    output::settle(outcome).into()
 }
 
 fn run(cli: Cli) -> anyhow::Result<Outcome> {

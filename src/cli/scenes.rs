@@ -25,7 +25,7 @@ pub fn run(args: ScenesArgs) -> anyhow::Result<Outcome> {
                     presets::NAMES.join(", ")
                 );
             };
-            print!("{}", show(&name, &file));
+            out!("{}", show(&name, &file));
         }
         None => {
             let width = presets::NAMES.iter().map(|n| n.len()).max().unwrap_or(0);
@@ -33,7 +33,7 @@ pub fn run(args: ScenesArgs) -> anyhow::Result<Outcome> {
                 let description = presets::preset(name)
                     .and_then(|f| f.description)
                     .unwrap_or_default();
-                println!("{name:<width$}  {description}");
+                outln!("{name:<width$}  {description}");
             }
         }
     }

@@ -65,16 +65,16 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     }
     for file in &report.files {
         if let Some(problem) = &file.problem {
-            eprintln!("error: {}: {problem}", file.path);
+            errln!("error: {}: {problem}", file.path);
         }
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string(&with_peak_rss(&report, &peaks)?)?
         );
     } else {
-        print!("{}", table(&report));
+        out!("{}", table(&report));
     }
     Ok(match report.exit_code() {
         0 => Outcome::Success,
