@@ -1,4 +1,5 @@
-//! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints.
+//! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints, through
+//! [`output`].
 
 #[macro_use]
 mod output;
@@ -16,7 +17,9 @@ use std::process::ExitCode;
 /// Simulate a coin rolling without slipping and record it as MCAP datasets for Foxglove.
 ///
 /// Exit codes: 0 success; 1 error (bad scene or flag, I/O, numerical failure) or, for `verify`, a failed
-/// check; 2 usage error or, for `verify`, an unreadable file; 130 interrupted.
+/// check; 2 usage error or, for `verify`, an unreadable file; 130 interrupted (SIGINT, SIGTERM, SIGHUP).
+/// When stdout is closed by its reader the command exits quietly with its own code; another error writing
+/// stdout (a full disk) is reported and exits 1 unless the code was already worse.
 #[derive(Debug, Parser)]
 #[command(name = "coin-log", version, about, long_about)]
 pub struct Cli {
@@ -45,7 +48,7 @@ pub enum Outcome {
     Failure,
     /// 2: unreadable input or usage error.
     Unusable,
-    /// 130: interrupted by SIGINT.
+    /// 130: interrupted by SIGINT, SIGTERM or SIGHUP.
     Interrupted,
 }
 

@@ -28,12 +28,14 @@ const WRITE_BUFFER: usize = 1 << 20;
 ///
 /// Integrates SCENE and writes its trajectory as an MCAP file. The file is written to a temporary file
 /// beside the target and moved into place only when finished; an existing file is never replaced without
-/// `--overwrite`. A physical event (flat landing, lift-off, slip) ends the run normally (exit 0); a
-/// numerical failure leaves the file finished up to it (exit 1); Ctrl-C finishes the file with what was
-/// recorded, marked `interrupted` (exit 130).
+/// `--overwrite`, and never anything but a regular file (not a device, pipe, symbolic link, folder or the
+/// scene file). A physical event (flat landing, lift-off, slip) ends the run normally (exit 0); a
+/// numerical failure leaves the file finished up to it (exit 1); Ctrl-C, SIGTERM or SIGHUP finishes the
+/// file with what was recorded, marked `interrupted` (exit 130), and a second signal abandons it.
 #[derive(Debug, clap::Args)]
 pub struct RecordArgs {
-    /// A built-in scene (listed by `coin-log scenes`) or a path to a `.toml` scene file.
+    /// A built-in scene (listed by `coin-log scenes`) or a scene file: a path (with a `/` or ending in
+    /// `.toml`) is always the file; a bare name is the built-in, with a note if a file of that name is here.
     scene: String,
     /// Output file [default: <scene name or file stem>.mcap in the current folder].
     #[arg(short, long, value_name = "FILE")]
@@ -47,13 +49,15 @@ pub struct RecordArgs {
     /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
     #[arg(long, value_name = "NAME")]
     integrator: Option<String>,
-    /// Relative tolerance of adaptive methods (overrides `run.rtol`; scene default 1e-10).
+    /// Relative tolerance of adaptive methods, 2.2e-15 to 1e-3 (overrides `run.rtol`; default 1e-10).
     #[arg(long, value_name = "X")]
     rtol: Option<f64>,
-    /// Absolute tolerance of adaptive methods (overrides `run.atol`; scene default 1e-12).
+    /// Absolute tolerance of adaptive methods, at most 1e-3·min(1, a, 1/τ) (overrides `run.atol`; default
+    /// 1e-12).
     #[arg(long, value_name = "X")]
     atol: Option<f64>,
-    /// Step of fixed-step methods, rounded down to divide 1/rate (overrides `run.step`; default 1e-3).
+    /// Step of fixed-step methods, rounded down to divide 1/rate; step·W ≤ 0.178 with W the fastest rate at
+    /// t = 0 (overrides `run.step`; default 1e-3).
     #[arg(long, value_name = "H")]
     step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
