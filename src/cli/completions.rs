@@ -34,7 +34,11 @@ pub struct ManArgs {
 /// Runs `coin-log completions`.
 pub fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
     let mut cmd = Cli::command();
-    clap_complete::generate(args.shell, &mut cmd, "coin-log", &mut std::io::stdout());
+    // Into a buffer first: clap_complete panics when its writer fails (a closed pipe), and every print
+    // goes through `output` so that a closed or full stdout ends cleanly.
+    let mut script = Vec::new();
+    clap_complete::generate(args.shell, &mut cmd, "coin-log", &mut script);
+    out!("{}", String::from_utf8_lossy(&script));
     Ok(Outcome::Success)
 }
 
@@ -43,16 +47,18 @@ pub fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
     let cmd = Cli::command();
     match &args.out {
         None => {
+            let mut page = Vec::new();
             clap_mangen::Man::new(cmd)
-                .render(&mut std::io::stdout())
+                .render(&mut page)
                 .context("writing the man page")?;
+            out!("{}", String::from_utf8_lossy(&page));
         }
         Some(dir) => {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("cannot create the folder `{}`", dir.display()))?;
             clap_mangen::generate_to(cmd, dir)
                 .with_context(|| format!("writing man pages into `{}`", dir.display()))?;
-            println!("{}", dir.display());
+            outln!("{}", dir.display());
         }
     }
     Ok(Outcome::Success)

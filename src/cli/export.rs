@@ -172,11 +172,11 @@ fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()
             })).collect::<Vec<_>>(),
             "peak_rss_bytes": peak_rss_bytes(),
         });
-        println!("{}", serde_json::to_string(&json)?);
+        outln!("{}", serde_json::to_string(&json)?);
         return Ok(());
     }
     for t in &s.tables {
-        println!(
+        outln!(
             "{}: {} rows × {} columns ({})",
             dir.join(&t.name).display(),
             t.rows,
@@ -185,7 +185,7 @@ fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()
         );
     }
     for k in &s.skipped {
-        println!("skipped {}: {}", k.topic, k.reason);
+        outln!("skipped {}: {}", k.topic, k.reason);
     }
     Ok(())
 }

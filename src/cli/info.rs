@@ -46,12 +46,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
                 if args.json {
                     json_files.push(i.to_json(&shown));
                 } else {
-                    print!("{}", text(&shown, &i));
+                    out!("{}", text(&shown, &i));
                 }
             }
             Err(e) => {
                 failed = true;
-                eprintln!("error: {shown}: {e}");
+                errln!("error: {shown}: {e}");
                 if args.json {
                     json_files.push(serde_json::json!({"path": shown, "problem": e.to_string()}));
                 }
@@ -59,7 +59,7 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
         }
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string(&serde_json::json!({ "files": json_files }))?
         );
@@ -90,7 +90,7 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
         "zstd" => String::new(),
         other => format!(" and --compression {other}"),
     };
-    print!(
+    out!(
         "# The scene stored in `{shown}` (written by coin-log {}). `coin-log record` this file\n# with that version{flag} to write the same bytes again.\n{}",
         run.tool_version, run.scene
     );

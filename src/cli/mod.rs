@@ -1,13 +1,18 @@
-//! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints.
+//! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints, through
+//! [`output`].
 
+#[macro_use]
+mod output;
 mod bench;
 mod completions;
+mod destination;
 mod export;
 mod info;
 mod plot;
 mod progress;
 mod record;
 mod rss;
+mod scene_arg;
 mod scenes;
 mod text;
 mod verify;
@@ -18,7 +23,9 @@ use std::process::ExitCode;
 /// Simulate a coin rolling without slipping and record it as MCAP datasets for Foxglove.
 ///
 /// Exit codes: 0 success; 1 error (bad scene or flag, I/O, numerical failure) or, for `verify`, a failed
-/// check; 2 usage error or, for `verify`, an unreadable file; 130 interrupted.
+/// check; 2 usage error or, for `verify`, an unreadable file; 130 interrupted (SIGINT, SIGTERM, SIGHUP).
+/// When stdout is closed by its reader the command exits quietly with its own code; another error writing
+/// stdout (a full disk) is reported and exits 1 unless the code was already worse.
 #[derive(Debug, Parser)]
 #[command(name = "coin-log", version, about, long_about)]
 pub struct Cli {
@@ -57,7 +64,7 @@ pub enum Outcome {
     Failure,
     /// 2: unreadable input or usage error.
     Unusable,
-    /// 130: interrupted by SIGINT.
+    /// 130: interrupted by SIGINT, SIGTERM or SIGHUP.
     Interrupted,
 }
 
@@ -75,13 +82,11 @@ impl From<Outcome> for ExitCode {
 /// Parses the command line, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
-        Ok(outcome) => outcome.into(),
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            Outcome::Failure.into()
-        }
-    }
+    let outcome = run(cli).unwrap_or_else(|e| {
+        output::errln!("error: {e:#}");
+        Outcome::Failure
+    });
+    output::settle(outcome).into()
 }
 
 fn run(cli: Cli) -> anyhow::Result<Outcome> {

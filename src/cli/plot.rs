@@ -76,6 +76,6 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
             .map_err(|e| e.error)
     };
     moved.map_err(|e| anyhow!("cannot move the picture to `{}`: {e}", target.display()))?;
-    println!("{}", target.display());
+    outln!("{}", target.display());
     Ok(Outcome::Success)
 }

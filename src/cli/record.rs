@@ -3,17 +3,18 @@
 //! signals, the progress bar, printing and exit codes.
 
 use super::rss::peak_rss_bytes;
+use super::scene_arg::{self, SceneArg};
 use super::text::size;
-use super::Outcome;
+use super::{destination, output, Outcome};
 use anyhow::{anyhow, bail, Context};
 use coin_log::format::Termination;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
-use coin_log::scene::{self, presets, FlagOverrides, Scene, SceneFile};
+use coin_log::scene::{self, limits, presets, FlagOverrides, Scene, SceneFile};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 use tempfile::NamedTempFile;
 
@@ -28,12 +29,14 @@ const WRITE_BUFFER: usize = 1 << 20;
 ///
 /// Integrates SCENE and writes its trajectory as an MCAP file. The file is written to a temporary file
 /// beside the target and moved into place only when finished; an existing file is never replaced without
-/// `--overwrite`. A physical event (flat landing, lift-off, slip) ends the run normally (exit 0); a
-/// numerical failure leaves the file finished up to it (exit 1); Ctrl-C finishes the file with what was
-/// recorded, marked `interrupted` (exit 130).
+/// `--overwrite`, and never anything but a regular file (not a device, pipe, symbolic link, folder or the
+/// scene file). A physical event (flat landing, lift-off, slip) ends the run normally (exit 0); a
+/// numerical failure leaves the file finished up to it (exit 1); Ctrl-C, SIGTERM or SIGHUP finishes the
+/// file with what was recorded, marked `interrupted` (exit 130), and a second signal abandons it.
 #[derive(Debug, clap::Args)]
 pub struct RecordArgs {
-    /// A built-in scene (listed by `coin-log scenes`) or a path to a `.toml` scene file.
+    /// A built-in scene (listed by `coin-log scenes`) or a scene file: a path (with a `/` or ending in
+    /// `.toml`) is always the file; a bare name is the built-in, with a note if a file of that name is here.
     scene: String,
     /// Output file [default: <scene name or file stem>.mcap in the current folder].
     #[arg(short, long, value_name = "FILE")]
@@ -47,13 +50,15 @@ pub struct RecordArgs {
     /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
     #[arg(long, value_name = "NAME")]
     integrator: Option<String>,
-    /// Relative tolerance of adaptive methods (overrides `run.rtol`; scene default 1e-10).
+    /// Relative tolerance of adaptive methods, 2.2e-15 to 1e-3 (overrides `run.rtol`; default 1e-10).
     #[arg(long, value_name = "X")]
     rtol: Option<f64>,
-    /// Absolute tolerance of adaptive methods (overrides `run.atol`; scene default 1e-12).
+    /// Absolute tolerance of adaptive methods, at most 1e-3·min(1, a, 1/τ) (overrides `run.atol`; default
+    /// 1e-12).
     #[arg(long, value_name = "X")]
     atol: Option<f64>,
-    /// Step of fixed-step methods, rounded down to divide 1/rate (overrides `run.step`; default 1e-3).
+    /// Step of fixed-step methods, rounded down to divide 1/rate; step·W ≤ 0.178 with W the fastest rate at
+    /// t = 0 (overrides `run.step`; default 1e-3).
     #[arg(long, value_name = "H")]
     step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
@@ -100,30 +105,29 @@ impl From<CompressionArg> for Compression {
     }
 }
 
-/// Where a scene came from: its name in messages and its default output stem.
+/// Where a scene came from: its name in messages, its default output stem, and its file if it is one.
 struct SceneSource {
     label: String,
     stem: String,
     file: SceneFile,
+    path: Option<PathBuf>,
 }
 
 fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
-    if let Some(preset) = presets::preset(arg) {
-        let file =
-            scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
-        return Ok(SceneSource {
-            label: arg.to_string(),
-            stem: arg.to_string(),
-            file,
-        });
-    }
-    let path = Path::new(arg);
-    if !path.exists() && !arg.ends_with(".toml") && !arg.contains(std::path::MAIN_SEPARATOR) {
-        bail!(
-            "no built-in scene `{arg}` and no such file; built-in scenes: {}",
-            presets::NAMES.join(", ")
-        );
-    }
+    let path = match scene_arg::classify(arg)? {
+        SceneArg::Builtin(name) => {
+            let preset = presets::preset(name).unwrap_or_default();
+            let file =
+                scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
+            return Ok(SceneSource {
+                label: arg.to_string(),
+                stem: arg.to_string(),
+                file,
+                path: None,
+            });
+        }
+        SceneArg::File(path) => path,
+    };
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
     let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
@@ -134,21 +138,29 @@ fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
         label: arg.to_string(),
         stem,
         file,
+        path: Some(path.to_path_buf()),
     })
 }
 
 /// Runs `coin-log record`: load → resolve → prepare the output → record → persist → summary and exit code.
 pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
+    // First, so that a signal at any later stage finishes or abandons cleanly (never kills the process
+    // with a temporary file behind).
+    let signals = Signals::install()?;
     let source = load_source(&args.scene, &args.set)?;
     let scene = resolve(&args, &source)?;
     if args.dry_run {
         return dry_run(&args, &scene, &source.label);
     }
     warn_if_large(&args, &scene);
-    let target = output_path(&args, &source)?;
-    let mut temp = temp_file_beside(&target)?;
-    let (summary, wall) = record_into(&args, &scene, &target, &mut temp)?;
-    persist(temp, &target, args.overwrite)?;
+    let target = output_path(&args, &source);
+    let mut temp = prepare_output(&target, &args, &source, &signals)?;
+    if signals.stopped() {
+        errln!("interrupted before recording began: nothing was written");
+        return Ok(Outcome::Interrupted);
+    }
+    let (summary, wall) = record_into(&args, &scene, &target, &mut temp, &signals)?;
+    persist(temp, &target, args.overwrite, &signals)?;
     print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
     Ok(outcome(&summary, &target))
 }
@@ -170,10 +182,10 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
             "channels": e.per_channel.iter().map(|(c, n)| (c.name().to_string(), *n)).collect::<std::collections::BTreeMap<_, _>>(),
             "estimated_bytes": e.bytes,
         });
-        println!("{}", serde_json::to_string(&json)?);
+        outln!("{}", serde_json::to_string(&json)?);
         return Ok(Outcome::Success);
     }
-    print!(
+    out!(
         "# `{label}` resolved, every default filled in (coin-log record --dry-run: nothing written).\n\
          # Estimate for the full duration: {} samples, {} messages, about {} with {} chunks\n\
          # (within a factor of {} on typical scenes; a run ended by an event writes less).\n{toml}",
@@ -191,7 +203,7 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
 fn warn_if_large(args: &RecordArgs, scene: &Scene) {
     let e = record::estimate(scene, args.compression.into());
     if e.bytes > LARGE {
-        eprintln!(
+        errln!(
             "warning: this recording is estimated at {} ({} messages); `--dry-run` shows the estimate, \
              --duration, --rate and --channels make it smaller",
             size(e.bytes),
@@ -200,7 +212,46 @@ fn warn_if_large(args: &RecordArgs, scene: &Scene) {
     }
 }
 
-/// The scene with the command-line flags applied and validated.
+/// SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): the first finishes the file with what was
+/// recorded, marked `interrupted`; a second abandons the recording at once, deleting the temporary file.
+struct Signals {
+    stop: Arc<AtomicBool>,
+    /// The temporary file while it exists (locked while it is created and moved into place).
+    temp: Arc<Mutex<Option<PathBuf>>>,
+}
+
+impl Signals {
+    fn install() -> anyhow::Result<Self> {
+        let stop = Arc::new(AtomicBool::new(false));
+        let temp: Arc<Mutex<Option<PathBuf>>> = Arc::new(Mutex::new(None));
+        let (flag, slot) = (Arc::clone(&stop), Arc::clone(&temp));
+        ctrlc::set_handler(move || {
+            if !flag.swap(true, Ordering::SeqCst) {
+                errln!("stopping: finishing the file with what was recorded (signal again to abandon it)");
+                return;
+            }
+            let slot = slot.lock().unwrap_or_else(PoisonError::into_inner);
+            if let Some(path) = slot.as_ref() {
+                let _ = std::fs::remove_file(path);
+            }
+            errln!("stopped again: the recording is abandoned and nothing is written");
+            std::process::exit(130);
+        })
+        .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;
+        Ok(Self { stop, temp })
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::SeqCst)
+    }
+
+    fn slot(&self) -> MutexGuard<'_, Option<PathBuf>> {
+        self.temp.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// The scene with the command-line flags applied and validated; warns about settings the integrator does
+/// not use and notes a step rounded to the sampling grid.
 fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
     let flags = FlagOverrides {
         duration: args.duration,
@@ -211,38 +262,71 @@ fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
         step: args.step,
         channels: args.channels.clone(),
     };
-    scene::resolve(&source.file, &flags).map_err(|e| anyhow!("scene `{}`: {e}", source.label))
+    let scene = scene::resolve(&source.file, &flags)
+        .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
+    let (file, provenance) = flags.apply(&source.file);
+    let method = scene.run.method.method;
+    for (key, value) in limits::ignored_settings(file.run.as_ref(), method) {
+        let by = provenance
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map_or_else(String::new, |(_, flag)| format!(" (set by `{flag}`)"));
+        let uses = if method.is_adaptive() {
+            "an adaptive method: it uses rtol and atol"
+        } else {
+            "a fixed-step method: it uses the step"
+        };
+        errln!(
+            "warning: `{key}` = {value}{by} does not apply to {method}, {uses}; ignored (stored as 0)"
+        );
+    }
+    if !method.is_adaptive() {
+        let asked = file
+            .run
+            .as_ref()
+            .and_then(|r| r.step)
+            .unwrap_or(scene::defaults::STEP);
+        let used = scene.run.method.step;
+        if (asked - used).abs() > 1e-12 * asked {
+            errln!(
+                "note: step {asked} rounded down to {} so that a whole number of steps ({}) fits between samples (1/rate = {})",
+                compact(used),
+                (scene.run.sample_interval() / used).round(),
+                compact(scene.run.sample_interval())
+            );
+        }
+    }
+    Ok(scene)
 }
 
-/// Where the recording goes (`-o`, or the scene's stem in the current folder): never a folder, and an
-/// existing file only with `--overwrite`.
-fn output_path(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<PathBuf> {
-    let target = args
-        .output
+/// Where the recording goes (`-o`, or the scene's stem in the current folder).
+fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
+    args.output
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)));
-    if target.is_dir() {
-        bail!(
-            "`{}` is a folder; give the recording a file name, e.g. -o {}",
-            target.display(),
-            target.join(format!("{}.mcap", source.stem)).display()
-        );
-    }
-    if target.exists() && !args.overwrite {
-        bail!(
-            "`{}` already exists; pass --overwrite to replace it, or choose another file with -o",
-            target.display()
-        );
-    }
-    Ok(target)
+        .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)))
+}
+
+/// Checks the target and creates the temporary file beside it, all before simulating: the target must be
+/// absent or (with `--overwrite`) a regular file other than the scene, and its name must be creatable.
+fn prepare_output(
+    target: &Path,
+    args: &RecordArgs,
+    source: &SceneSource,
+    signals: &Signals,
+) -> anyhow::Result<NamedTempFile> {
+    let existing =
+        destination::check_target(target, args.overwrite, source.path.as_deref(), &source.stem)?;
+    let mut slot = signals.slot();
+    let temp = temp_file_beside(target)?;
+    *slot = Some(temp.path().to_path_buf());
+    drop(slot);
+    destination::probe_target(target, existing.as_ref(), &temp)?;
+    Ok(temp)
 }
 
 /// A temporary file in the target's folder, so that the finished recording is moved, not copied.
 fn temp_file_beside(target: &Path) -> anyhow::Result<NamedTempFile> {
-    let folder = match target.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let folder = destination::folder_of(target);
     tempfile::Builder::new()
         .prefix(".coin-log-")
         .suffix(".mcap.tmp")
@@ -256,21 +340,15 @@ fn temp_file_beside(target: &Path) -> anyhow::Result<NamedTempFile> {
         })
 }
 
-/// Records the scene into `temp` with Ctrl-C finishing the file early and a progress bar on long runs;
+/// Records the scene into `temp` with a signal finishing the file early and a progress bar on long runs;
 /// returns the summary and the wall time, the file synced to disk and readable.
 fn record_into(
     args: &RecordArgs,
     scene: &Scene,
     target: &Path,
     temp: &mut NamedTempFile,
+    signals: &Signals,
 ) -> anyhow::Result<(RecordSummary, Duration)> {
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = Arc::clone(&stop);
-        ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed))
-            .context("cannot install the Ctrl-C handler")?;
-    }
-
     let options = RecordOptions {
         compression: args.compression.into(),
     };
@@ -281,7 +359,7 @@ fn record_into(
         scene,
         &options,
         BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut()),
-        &stop,
+        &signals.stop,
         |t| update_progress(&bar, started, t / duration),
     );
     bar.finish_and_clear();
@@ -296,7 +374,15 @@ fn record_into(
 
 /// Moves the finished recording into place; without `--overwrite` a file that appeared meanwhile is left
 /// alone and the recording kept under its temporary name.
-fn persist(temp: NamedTempFile, target: &Path, overwrite: bool) -> anyhow::Result<()> {
+fn persist(
+    temp: NamedTempFile,
+    target: &Path,
+    overwrite: bool,
+    signals: &Signals,
+) -> anyhow::Result<()> {
+    // Held until the move is done, so that a second signal cannot delete a file being moved.
+    let mut slot = signals.slot();
+    *slot = None;
     if overwrite {
         temp.persist(target).map_err(|e| {
             anyhow!(
@@ -321,7 +407,7 @@ fn persist(temp: NamedTempFile, target: &Path, overwrite: bool) -> anyhow::Resul
 fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
     match &summary.failure {
         Some(f) => {
-            eprintln!(
+            errln!(
                 "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
                 summary.termination_time,
                 target.display()
@@ -362,7 +448,7 @@ fn make_readable(file: &std::fs::File) {
     let _ = file;
 }
 
-#[allow(clippy::cast_precision_loss)]
+/// The end-of-run summary on stdout (format.md: record, Summary): a table, or one JSON object.
 fn print_summary(
     args: &RecordArgs,
     scene: &Scene,
@@ -371,35 +457,114 @@ fn print_summary(
     s: &RecordSummary,
     wall: Duration,
 ) -> anyhow::Result<()> {
-    let seconds = wall.as_secs_f64();
-    let rate = if seconds > 0.0 {
+    if args.json {
+        let json = json_summary(scene, label, target, s, wall);
+        outln!("{}", serde_json::to_string(&json)?);
+    } else {
+        for (key, value) in summary_rows(scene, label, target, s, wall) {
+            outln!("{key:<16} {value}");
+        }
+    }
+    if s.event_trusted == Some(false) {
+        errln!("warning: {}", untrusted_event(s));
+    }
+    if output::stdout_failed() {
+        errln!(
+            "note: the recording `{}` is complete; only its summary was lost",
+            target.display()
+        );
+    }
+    Ok(())
+}
+
+/// Why an event is not to be trusted, in one sentence.
+fn untrusted_event(s: &RecordSummary) -> String {
+    format!(
+        "the {} at t = {} is not to be trusted: the energy drift {:.3e} is above {:.3e}, the energy \
+         tolerance verify derives from these integrator settings, so the integration had gone wrong \
+         before the event, which may be an artefact of it; tighten --rtol/--atol (dopri5, dop853) or \
+         --step (rk4, gauss4)",
+        s.termination.name(),
+        s.termination_time,
+        s.energy_drift,
+        s.energy_tolerance
+    )
+}
+
+/// The integrator with the settings it used: `dop853 (rtol 1e-10, atol 1e-12)`, `rk4 (step 0.001)`.
+fn integrator_settings(scene: &Scene) -> String {
+    let m = &scene.run.method;
+    if m.method.is_adaptive() {
+        format!("{} (rtol {:e}, atol {:e})", m.method, m.rtol, m.atol)
+    } else {
+        format!("{} (step {})", m.method, compact(m.step))
+    }
+}
+
+/// A number in its shortest form when that is short (`0.001`, `0.0025`), else to 5 digits (`8.3333e-4`).
+fn compact(x: f64) -> String {
+    let shortest = x.to_string();
+    let digits = shortest.trim_start_matches(['-', '0', '.']).len();
+    if digits <= 6 {
+        shortest
+    } else {
+        format!("{x:.4e}")
+    }
+}
+
+#[allow(clippy::cast_precision_loss)]
+fn messages_per_second(s: &RecordSummary, seconds: f64) -> f64 {
+    if seconds > 0.0 {
         s.messages as f64 / seconds
     } else {
         0.0
-    };
-    if args.json {
-        let json = serde_json::json!({
-            "scene": label,
-            "file": target.display().to_string(),
-            "samples": s.samples,
-            "messages": s.messages,
-            "bytes": s.bytes,
-            "wall_time_s": seconds,
-            "messages_per_second": rate,
-            "integrator": scene.run.method.method.name(),
-            "steps": s.stats.steps,
-            "rhs_evaluations": s.stats.rhs_evaluations,
-            "rejected_steps": s.stats.rejected_steps,
-            "energy_drift": s.energy_drift,
-            "invariant_drift": s.invariant_drift,
-            "steady_residual": s.steady_residual,
-            "termination": s.termination.name(),
-            "termination_time": s.termination_time,
-            "peak_rss_bytes": peak_rss_bytes(),
-        });
-        println!("{}", serde_json::to_string(&json)?);
-        return Ok(());
     }
+}
+
+fn json_summary(
+    scene: &Scene,
+    label: &str,
+    target: &Path,
+    s: &RecordSummary,
+    wall: Duration,
+) -> serde_json::Value {
+    let seconds = wall.as_secs_f64();
+    let m = &scene.run.method;
+    let adaptive = m.method.is_adaptive();
+    serde_json::json!({
+        "scene": label,
+        "file": target.display().to_string(),
+        "samples": s.samples,
+        "messages": s.messages,
+        "bytes": s.bytes,
+        "wall_time_s": seconds,
+        "messages_per_second": messages_per_second(s, seconds),
+        "integrator": m.method.name(),
+        "rtol": adaptive.then_some(m.rtol),
+        "atol": adaptive.then_some(m.atol),
+        "step": (!adaptive).then_some(m.step),
+        "steps": s.stats.steps,
+        "rhs_evaluations": s.stats.rhs_evaluations,
+        "rejected_steps": s.stats.rejected_steps,
+        "energy_drift": s.energy_drift,
+        "energy_tolerance": s.energy_tolerance,
+        "invariant_drift": s.invariant_drift,
+        "steady_residual": s.steady_residual,
+        "termination": s.termination.name(),
+        "termination_time": s.termination_time,
+        "event_trusted": s.event_trusted,
+        "peak_rss_bytes": peak_rss_bytes(),
+    })
+}
+
+fn summary_rows(
+    scene: &Scene,
+    label: &str,
+    target: &Path,
+    s: &RecordSummary,
+    wall: Duration,
+) -> Vec<(&'static str, String)> {
+    let seconds = wall.as_secs_f64();
     let mut rows: Vec<(&str, String)> = vec![
         ("scene", label.to_string()),
         ("file", format!("{} ({})", target.display(), size(s.bytes))),
@@ -407,13 +572,16 @@ fn print_summary(
         ("messages", s.messages.to_string()),
         (
             "wall time",
-            format!("{seconds:.3} s ({:.0} messages/s)", rate),
+            format!(
+                "{seconds:.3} s ({:.0} messages/s)",
+                messages_per_second(s, seconds)
+            ),
         ),
         (
             "integrator",
             format!(
                 "{}: {} steps, {} RHS evaluations, {} rejected",
-                scene.run.method.method.name(),
+                integrator_settings(scene),
                 s.stats.steps,
                 s.stats.rhs_evaluations,
                 s.stats.rejected_steps
@@ -427,12 +595,10 @@ fn print_summary(
     if let Some(r) = s.steady_residual {
         rows.push(("steady residual", format!("{r:.3e}")));
     }
-    rows.push((
-        "termination",
-        format!("{} at t = {}", s.termination.name(), s.termination_time),
-    ));
-    for (key, value) in rows {
-        println!("{key:<16} {value}");
+    let mut termination = format!("{} at t = {}", s.termination.name(), s.termination_time);
+    if s.event_trusted == Some(false) {
+        termination.push_str(" (not to be trusted: energy drift above the tolerance)");
     }
-    Ok(())
+    rows.push(("termination", termination));
+    rows
 }

@@ -32,7 +32,7 @@ pub fn run(args: ScenesArgs) -> anyhow::Result<Outcome> {
                 "scene": file,
             }));
         }
-        println!("{}", serde_json::to_string(&all)?);
+        outln!("{}", serde_json::to_string(&all)?);
         return Ok(Outcome::Success);
     }
     match args.show {
@@ -43,7 +43,7 @@ pub fn run(args: ScenesArgs) -> anyhow::Result<Outcome> {
                     presets::NAMES.join(", ")
                 );
             }
-            print!("{}", show(&name, &resolved(&name)?));
+            out!("{}", show(&name, &resolved(&name)?));
         }
         None => {
             let width = presets::NAMES.iter().map(|n| n.len()).max().unwrap_or(0);
@@ -51,7 +51,7 @@ pub fn run(args: ScenesArgs) -> anyhow::Result<Outcome> {
                 let description = presets::preset(name)
                     .and_then(|f| f.description)
                     .unwrap_or_default();
-                println!("{name:<width$}  {description}");
+                outln!("{name:<width$}  {description}");
             }
         }
     }

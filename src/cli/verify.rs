@@ -16,8 +16,8 @@ pass/fail, or skip with the reason. A file on which integrity, energy and at lea
 steady cannot run fails.
 
 Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
-W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a), or for fixed-step methods of order p with step h
-(rk4, gauss4: p = 4) eps = max(rtol, atol/a, (h W)^p):
+W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a) for adaptive methods, or for fixed-step methods
+of order p with step h (rk4, gauss4: p = 4) eps = (h W)^p (only the settings the method uses count):
   energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
   constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
 Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
@@ -66,18 +66,18 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     }
     for file in &report.files {
         if let Some(problem) = &file.problem {
-            eprintln!("error: {}: {problem}", file.path);
+            errln!("error: {}: {problem}", file.path);
         }
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string(&with_peak_rss(&report, &peaks)?)?
         );
     } else {
-        print!("{}", table(&report));
+        out!("{}", table(&report));
         if report.files.len() > 1 {
-            println!("{}", total(&report));
+            outln!("{}", total(&report));
         }
     }
     Ok(match report.exit_code() {

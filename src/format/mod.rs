@@ -3,7 +3,8 @@
 //! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`], read back by
 //! [`json`]); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
-//! simulation time to log time ([`log_time`]).
+//! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
+//! recorded integrator settings ([`tolerances`]).
 //!
 //! It knows the physics' vocabulary (integrator [`Method`](crate::integrate::Method), steady
 //! [`SteadyFamily`](crate::model::SteadyFamily), [`Branch`](crate::model::Branch), physical events) but
@@ -15,6 +16,7 @@ pub mod messages;
 pub mod metadata;
 mod termination;
 mod time;
+pub mod tolerances;
 
 pub use channels::{schema_bytes, Channel, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING};
 pub use metadata::{

@@ -234,8 +234,9 @@ where
     /// Emits the grid samples up to the step's end, or strictly before the event; `Some` when the run
     /// ends on one of them (t_end reached, or the observer stopped).
     fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<Termination> {
-        // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly).
-        let grid_slack = 1e-9 * self.settings.sample_interval;
+        // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly), and
+        // so is one within EVENT_SAMPLE_GAP of it: two samples that close would share a log time.
+        let grid_slack = (1e-9 * self.settings.sample_interval).max(EVENT_SAMPLE_GAP);
         let t_stop = event.map_or(t_new, |(_, t)| t);
         loop {
             let mut t_k = sample_time(self.settings, self.k);

@@ -17,6 +17,7 @@ use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField, Position,
     QuaternionMessage, ReactionMessage,
 };
+use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError,
     FORMAT_VERSION, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
@@ -230,6 +231,8 @@ struct Drift {
     steady: Option<[f64; 4]>,
     time_unit: f64,
     steady_residual: f64,
+    /// max|ω| over the samples (for the tolerance `verify` will derive).
+    max_omega: f64,
 }
 
 impl Drift {
@@ -244,6 +247,7 @@ impl Drift {
             }),
             time_unit: params.time_unit(),
             steady_residual: 0.0,
+            max_omega: 0.0,
         }
     }
 }
@@ -415,6 +419,8 @@ impl<W: Write + Seek> Sampler<W> {
     fn track(&mut self, t: f64, s: &State, total: f64, invariants: Option<(f64, f64)>) {
         let d = &mut self.drift;
         d.energy.observe(t, total);
+        let omega = (s.omega_x * s.omega_x + s.omega_y * s.omega_y + s.omega_z * s.omega_z).sqrt();
+        d.max_omega = d.max_omega.max(omega);
         if let Some((c1, c2)) = invariants {
             let params = self.coin.params();
             d.invariants
@@ -454,7 +460,30 @@ pub fn record<W: Write + Seek>(
         Some(SampleError::Failure(f)) => (f.termination(), outcome.t_last, Some(f)),
         None => ending(&outcome.termination, outcome.t_last),
     };
-    sampler.finish(outcome.stats, termination, termination_time, failure)
+    let tolerance = energy_tolerance(scene, sampler.drift.max_omega, termination_time);
+    let mut summary = sampler.finish(outcome.stats, termination, termination_time, failure)?;
+    summary.energy_tolerance = tolerance;
+    summary.event_trusted = termination
+        .is_event()
+        .then(|| summary.energy_drift <= tolerance);
+    Ok(summary)
+}
+
+/// The energy drift tolerance `verify` will derive for the file (format.md: Tolerances).
+fn energy_tolerance(scene: &Scene, max_omega: f64, span: f64) -> f64 {
+    let m = &scene.run.method;
+    let p = &scene.params;
+    let accuracy = RunAccuracy {
+        integrator: m.method,
+        rtol: m.rtol,
+        atol: m.atol,
+        step: m.step,
+        radius: p.radius(),
+        time_unit: p.time_unit(),
+        span,
+        max_omega,
+    };
+    Tolerances::derive(&accuracy, None, None).energy
 }
 
 /// How the integration ended, as the file records it: termination, its time, and the failure if any.
@@ -608,6 +637,8 @@ impl<W: Write + Seek> Sampler<W> {
             energy_drift: drift.energy.value(),
             invariant_drift: drift.invariants.map(|d| d.value()),
             steady_residual: drift.steady.map(|_| drift.steady_residual),
+            energy_tolerance: f64::NAN,
+            event_trusted: None,
         })
     }
 }

@@ -62,4 +62,11 @@ pub struct RecordSummary {
     /// For an unperturbed steady scene: max over the samples of |θ − θ*| and |ω − ω*|·√(a/g)
     /// (dimensionless), the distance from the steady motion.
     pub steady_residual: Option<f64>,
+    /// The energy drift tolerance `verify` derives for this file from its integrator settings, span and
+    /// max|ω| ([`crate::format::tolerances`]).
+    pub energy_tolerance: f64,
+    /// For a run ended by a physical event (flat landing, lift-off, slip): whether the energy drift at the
+    /// event is within [`energy_tolerance`](Self::energy_tolerance). When it is not, the integration had
+    /// already gone wrong and the event may be an artefact of it, not physics. `None` without an event.
+    pub event_trusted: Option<bool>,
 }

@@ -6,6 +6,7 @@
 //! explicit flags ([`FlagOverrides`]) → [`Scene::from_file`], which reports every problem at once.
 
 mod file;
+pub mod limits;
 mod overrides;
 pub mod presets;
 mod validate;
@@ -14,6 +15,7 @@ pub use file::{
     BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
 };
 pub use overrides::{apply_set, FlagOverrides};
+pub use validate::UNEXPLAINED;
 
 use crate::format::Channel;
 use crate::integrate::MethodConfig;
@@ -70,6 +72,73 @@ impl fmt::Display for Problem {
     }
 }
 
+/// Every problem found in a scene: never empty, by construction (a first problem is required), so that an
+/// invalid scene always says what is wrong.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ProblemList {
+    first: Problem,
+    rest: Vec<Problem>,
+}
+
+impl ProblemList {
+    /// A list of one problem.
+    #[must_use]
+    pub fn new(first: Problem) -> Self {
+        Self {
+            first,
+            rest: Vec::new(),
+        }
+    }
+
+    /// The problems of `list`, or `None` when it is empty.
+    #[must_use]
+    pub fn from_vec(list: Vec<Problem>) -> Option<Self> {
+        let mut list = list.into_iter();
+        let first = list.next()?;
+        Some(Self {
+            first,
+            rest: list.collect(),
+        })
+    }
+
+    /// Adds a problem.
+    pub fn push(&mut self, problem: Problem) {
+        self.rest.push(problem);
+    }
+
+    /// How many problems (at least one).
+    #[must_use]
+    pub fn count(&self) -> usize {
+        1 + self.rest.len()
+    }
+
+    /// The problems, in the order found.
+    pub fn iter(&self) -> impl Iterator<Item = &Problem> {
+        std::iter::once(&self.first).chain(&self.rest)
+    }
+
+    /// The problems as a vector (never empty).
+    #[must_use]
+    pub fn into_vec(self) -> Vec<Problem> {
+        let mut all = vec![self.first];
+        all.extend(self.rest);
+        all
+    }
+}
+
+impl fmt::Display for ProblemList {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.rest.is_empty() {
+            return self.first.fmt(f);
+        }
+        write!(f, "{} problems:", self.count())?;
+        for p in self.iter() {
+            write!(f, "\n  {p}")?;
+        }
+        Ok(())
+    }
+}
+
 /// Why a scene could not be loaded.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SceneError {
@@ -92,23 +161,9 @@ pub enum SceneError {
         /// The valid names, comma-separated.
         valid: String,
     },
-    /// Values out of range, missing or contradictory; every problem found.
-    #[error("{}", format_problems(.0))]
-    Invalid(Vec<Problem>),
-}
-
-fn format_problems(problems: &[Problem]) -> String {
-    match problems {
-        [one] => one.to_string(),
-        many => {
-            let mut s = format!("{} problems:", many.len());
-            for p in many {
-                s.push_str("\n  ");
-                s.push_str(&p.to_string());
-            }
-            s
-        }
-    }
+    /// Values out of range, missing or contradictory; every problem found (at least one).
+    #[error("{0}")]
+    Invalid(ProblemList),
 }
 
 /// How the initial state was specified.
@@ -127,7 +182,8 @@ pub struct RunConfig {
     pub duration: f64,
     /// Samples per time unit, > 0.
     pub rate: f64,
-    /// Method with rtol, atol and the step actually used (rounded down to divide 1/rate).
+    /// Method with the settings it uses: rtol and atol for adaptive methods (step 0), the step actually
+    /// used for fixed-step ones, rounded down to divide 1/rate (rtol and atol 0).
     pub method: MethodConfig,
     /// The run ends at |θ| ≥ π/2 − flat_margin \[rad\].
     pub flat_margin: f64,

@@ -4,20 +4,23 @@
 use super::file::{
     BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
 };
-use super::{defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, MAX_SAMPLES};
+use super::limits;
+use super::{
+    defaults, InitialSpec, Problem, ProblemList, RunConfig, Scene, SceneError, MAX_SAMPLES,
+};
 use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
 use crate::model::{Branch, Coin, CoinParams, Inertia, State, Steady, SteadyFamily, SteadyKind};
 use std::f64::consts::FRAC_PI_2;
 
 /// Collects problems, naming the flag that set a key when one did.
-struct Problems<'a> {
-    list: Vec<Problem>,
+pub(super) struct Problems<'a> {
+    pub(super) list: Vec<Problem>,
     provenance: &'a [(&'static str, &'static str)],
 }
 
 impl Problems<'_> {
-    fn push(&mut self, key: &str, value: String, reason: impl Into<String>) {
+    pub(super) fn push(&mut self, key: &str, value: String, reason: impl Into<String>) {
         let flag = self
             .provenance
             .iter()
@@ -89,7 +92,7 @@ impl Problems<'_> {
 }
 
 /// A number as the user would write it (`-1`, `0.5`, `1e-9`, `NaN`, `inf`).
-fn number(value: f64) -> String {
+pub(super) fn number(value: f64) -> String {
     let magnitude = value.abs();
     if value.is_finite() && value != 0.0 && !(1e-4..1e16).contains(&magnitude) {
         ryu::Buffer::new().format_finite(value).to_string()
@@ -142,13 +145,13 @@ pub(super) fn scene_from_file(
     }
     let run = check_run(&run_file, flat_margin, margin_ok, &mut problems);
     let channels = check_channels(file.record.as_ref(), &mut problems);
-    match (body, initial, run, channels) {
+    let scene = match (body, initial, run, channels) {
         (
             Some((params, inertia, friction, thickness)),
             Some((base, spec, perturbation)),
             Some(run),
             Some(channels),
-        ) if problems.list.is_empty() => Ok(Scene {
+        ) if problems.list.is_empty() => Some(Scene {
             description: file.description.clone().unwrap_or_default(),
             params,
             inertia,
@@ -161,9 +164,27 @@ pub(super) fn scene_from_file(
             run,
             channels,
         }),
-        _ => Err(SceneError::Invalid(problems.list)),
+        _ => None,
+    };
+    if let Some(scene) = &scene {
+        limits::check_resolved(scene, file, &mut problems);
+    }
+    match (scene, ProblemList::from_vec(problems.list)) {
+        (Some(scene), None) => Ok(scene),
+        (_, Some(list)) => Err(SceneError::Invalid(list)),
+        // Every check that rejects a part reports why; should one ever fail to, still say something.
+        (None, None) => Err(SceneError::Invalid(ProblemList::new(Problem {
+            key: "scene".into(),
+            value: String::new(),
+            reason: UNEXPLAINED.into(),
+            flag: None,
+        }))),
     }
 }
+
+/// The reason given if a scene were refused without a problem (a bug; the fuzz targets look for it).
+pub const UNEXPLAINED: &str =
+    "could not be resolved, and no check said why: this is a bug in coin-log, please report it with the scene";
 
 type Body = (CoinParams, Inertia, Option<f64>, f64);
 
@@ -171,7 +192,32 @@ fn check_body(body: &BodyFile, problems: &mut Problems) -> Option<Body> {
     let mut ok = problems.positive("body.mass", body.mass);
     ok &= problems.positive("body.radius", body.radius);
     ok &= problems.positive("body.gravity", body.gravity);
-    let inertia = match (&body.shape, body.inertia_x, body.inertia_z) {
+    let inertia = check_inertia(body, problems);
+    if let Some(mu) = body.friction {
+        ok &= problems.positive("body.friction", mu);
+    }
+    let thickness = body.thickness.unwrap_or(defaults::THICKNESS);
+    ok &= problems.positive("body.thickness", thickness);
+    let inertia = inertia?;
+    if !ok || !limits::check_scales(body, inertia, problems) {
+        return None;
+    }
+    match CoinParams::new(body.mass, body.radius, body.gravity, inertia) {
+        Ok(params) => Some((params, inertia, body.friction, thickness)),
+        Err(errors) => {
+            // Unreachable after the checks above (each value positive, each scale in range); reported
+            // rather than dropped should it ever happen.
+            for e in errors {
+                problems.push("body", String::new(), e.to_string());
+            }
+            None
+        }
+    }
+}
+
+/// The inertia: a shape, or both moments (I_Z ≤ 2 I_X).
+fn check_inertia(body: &BodyFile, problems: &mut Problems) -> Option<Inertia> {
+    match (&body.shape, body.inertia_x, body.inertia_z) {
         (Some(shape), None, None) => match shape.as_str() {
             "thin-disk" => Some(Inertia::ThinDisk),
             "hoop" => Some(Inertia::Hoop),
@@ -233,18 +279,7 @@ fn check_body(body: &BodyFile, problems: &mut Problems) -> Option<Body> {
             );
             None
         }
-    };
-    if let Some(mu) = body.friction {
-        ok &= problems.positive("body.friction", mu);
     }
-    let thickness = body.thickness.unwrap_or(defaults::THICKNESS);
-    ok &= problems.positive("body.thickness", thickness);
-    let inertia = inertia?;
-    if !ok {
-        return None;
-    }
-    let params = CoinParams::new(body.mass, body.radius, body.gravity, inertia).ok()?;
-    Some((params, inertia, body.friction, thickness))
 }
 
 type Initial = (State, InitialSpec, [f64; 4]);
@@ -632,8 +667,11 @@ fn check_run(
             None
         }
     };
+    limits::check_rate(rate, duration, problems);
     let rtol = run.rtol.unwrap_or(defaults::RTOL);
-    problems.positive("run.rtol", rtol);
+    if problems.positive("run.rtol", rtol) {
+        limits::check_rtol(method, rtol, problems);
+    }
     let atol = run.atol.unwrap_or(defaults::ATOL);
     problems.positive("run.atol", atol);
     let step = run.step.unwrap_or(defaults::STEP);
@@ -648,17 +686,33 @@ fn check_run(
     if problems.list.len() != before {
         return None;
     }
+    let method = method?;
     Some(RunConfig {
         duration,
         rate,
-        method: MethodConfig {
-            method: method?,
-            rtol,
-            atol,
-            step: fitted_step(step, 1.0 / rate),
-        },
+        method: used_settings(method, rtol, atol, step, rate),
         flat_margin,
     })
+}
+
+/// The settings `method` uses; the others are 0 (format.md: Metadata records): an adaptive method uses
+/// rtol and atol, a fixed-step one the step, rounded down to divide 1/rate.
+fn used_settings(method: Method, rtol: f64, atol: f64, step: f64, rate: f64) -> MethodConfig {
+    if method.is_adaptive() {
+        MethodConfig {
+            method,
+            rtol,
+            atol,
+            step: 0.0,
+        }
+    } else {
+        MethodConfig {
+            method,
+            rtol: 0.0,
+            atol: 0.0,
+            step: fitted_step(step, 1.0 / rate),
+        }
+    }
 }
 
 /// The largest step ≤ `step` that divides the sample interval into a whole number of steps, so that fixed
@@ -677,6 +731,8 @@ fn check_channels(record: Option<&RecordFile>, problems: &mut Problems) -> Optio
     let before = problems.list.len();
     let mut channels = Vec::new();
     for name in names {
+        // `--channels "omega, angles"`: spaces around a name are not part of it.
+        let name = name.trim();
         match name.parse::<Channel>() {
             Ok(c) if channels.contains(&c) => problems.push(
                 "record.channels",
@@ -750,15 +806,7 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
                 omega: Some(vec![dwx, dwy, dwz]),
             }),
         },
-        run: Some(RunFile {
-            duration: Some(scene.run.duration),
-            rate: Some(scene.run.rate),
-            integrator: Some(scene.run.method.method.name().to_string()),
-            rtol: Some(scene.run.method.rtol),
-            atol: Some(scene.run.method.atol),
-            step: Some(scene.run.method.step),
-            flat_margin: Some(scene.run.flat_margin),
-        }),
+        run: Some(run_file(&scene.run)),
         record: Some(RecordFile {
             channels: Some(
                 scene
@@ -768,6 +816,21 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
                     .collect(),
             ),
         }),
+    }
+}
+
+/// `[run]` of a resolved scene: every key the integrator uses, none it ignores.
+fn run_file(run: &RunConfig) -> RunFile {
+    let m = &run.method;
+    let adaptive = m.method.is_adaptive();
+    RunFile {
+        duration: Some(run.duration),
+        rate: Some(run.rate),
+        integrator: Some(m.method.name().to_string()),
+        rtol: adaptive.then_some(m.rtol),
+        atol: adaptive.then_some(m.atol),
+        step: (!adaptive).then_some(m.step),
+        flat_margin: Some(run.flat_margin),
     }
 }
 

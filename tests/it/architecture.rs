@@ -182,6 +182,35 @@ fn the_library_never_prints_nor_starts_a_process() {
     assert!(found.is_empty(), "{}", found.join("\n"));
 }
 
+/// `println!` panics when stdout is a closed pipe or a full disk; the command line prints only through
+/// `src/cli/output.rs`, whose macros handle both (format.md: Exit codes).
+#[test]
+fn the_command_line_prints_only_through_its_output_module() {
+    let cli = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/cli");
+    let mut files = Vec::new();
+    rust_files(&cli, &mut files);
+    files.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/main.rs"));
+    let mut found = Vec::new();
+    for path in files.iter().filter(|p| !p.ends_with("cli/output.rs")) {
+        let text = without_tests(&fs::read_to_string(path).unwrap());
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for f in ["println!", "eprintln!", "print!(", "eprint!("] {
+                // `outln!`/`errln!` do not contain these; `out!(` does not either.
+                if code.contains(f) {
+                    found.push(format!("{}:{}: `{f}`", path.display(), n + 1));
+                }
+            }
+        }
+    }
+    println!("{} files of src/cli checked", files.len());
+    assert!(
+        found.is_empty(),
+        "use out!/outln!/errln! of src/cli/output.rs:\n{}",
+        found.join("\n")
+    );
+}
+
 /// Longest function body allowed, in lines (about a screen): longer functions mix stages.
 const LONGEST_FUNCTION: usize = 80;
 

@@ -473,12 +473,11 @@ fn a_run_ended_by_an_event_writes_a_last_sample_at_the_event_time() {
     }
 }
 
-#[test]
-fn a_sample_that_cannot_be_written_whole_is_not_written_at_all() {
-    // ω_Z = 1e200: the state is finite but its energy overflows, so the first sample cannot be formatted.
+/// `wobble` with rk4 and the initial ω replaced by `omega` after validation: scene validation refuses such
+/// states (tests/it/cli_record.rs checks that), but the recorder must still end cleanly on one.
+fn wobble_rk4_with_omega(omega: [f64; 3]) -> Scene {
     let file = presets::preset("wobble").unwrap();
-    let file = scene::file_with_sets(&file, &["initial.omega=[0, 0, 1e200]".into()]).unwrap();
-    let scene = scene::resolve(
+    let mut scene = scene::resolve(
         &file,
         &FlagOverrides {
             integrator: Some("rk4".into()),
@@ -486,6 +485,18 @@ fn a_sample_that_cannot_be_written_whole_is_not_written_at_all() {
         },
     )
     .unwrap();
+    [
+        scene.initial.omega_x,
+        scene.initial.omega_y,
+        scene.initial.omega_z,
+    ] = omega;
+    scene
+}
+
+#[test]
+fn a_sample_that_cannot_be_written_whole_is_not_written_at_all() {
+    // ω_Z = 1e200: the state is finite but its energy overflows, so the first sample cannot be formatted.
+    let scene = wobble_rk4_with_omega([0.0, 0.0, 1e200]);
     let (bytes, summary) = record_to_memory(&scene, &RecordOptions::default());
     let back = read_back(&bytes);
     println!(
@@ -501,4 +512,28 @@ fn a_sample_that_cannot_be_written_whole_is_not_written_at_all() {
         (0, 0, 0)
     );
     assert!(back.topics().is_empty(), "no channel without messages");
+}
+
+/// A numerical failure finishes the file with the samples up to it, marked `non-finite` (format.md:
+/// Metadata records). ω_Z = 1e150 is finite, but the first rk4 step overflows.
+#[test]
+fn a_numerical_failure_finishes_the_file_with_the_samples_up_to_it() {
+    let scene = wobble_rk4_with_omega([0.0, 0.0, 1e150]);
+    let (bytes, summary) = record_to_memory(&scene, &RecordOptions::default());
+    let file = read_back(&bytes);
+    let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+    println!(
+        "termination {} at {} ({:?}), {} messages",
+        result.termination,
+        result.termination_time,
+        summary.failure,
+        file.messages.len()
+    );
+    assert_eq!(result.termination, Termination::NonFinite);
+    assert!(summary.failure.is_some(), "the summary carries the failure");
+    assert_eq!(
+        file.on_topic("/coin/omega").len(),
+        1,
+        "the sample at t = 0 is in the file"
+    );
 }

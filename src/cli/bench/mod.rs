@@ -12,7 +12,6 @@ use coin_log::bench::stability;
 use coin_log::bench::table::{precision_csv, precision_table, stability_csv, stability_table};
 use coin_log::bench::BenchCase;
 use coin_log::integrate::Method;
-use coin_log::scene::presets;
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -83,12 +82,13 @@ fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
     fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
 }
 
-/// A built-in scene by name, or a `.toml` scene file by path (named by its stem).
+/// A built-in scene by name, or a scene file by path (named by its stem), by the rule of
+/// [`super::scene_arg`].
 fn load_case(arg: &str) -> anyhow::Result<BenchCase> {
-    let path = Path::new(arg);
-    if presets::preset(arg).is_some() || !(path.exists() || arg.ends_with(".toml")) {
-        return Ok(bench_case(arg)?);
-    }
+    let path = match super::scene_arg::classify(arg)? {
+        super::scene_arg::SceneArg::Builtin(name) => return Ok(bench_case(name)?),
+        super::scene_arg::SceneArg::File(path) => path,
+    };
     let text = fs::read_to_string(path)
         .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
     let stem = path
@@ -116,11 +116,11 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
     let mut all_rows = Vec::new();
     for case in &cases {
         let report = precision_bench(case, Method::ALL, &options)?;
-        println!("scene {} — reference: {}", report.scene, report.reference);
-        print!("{}", precision_table(&report.rows));
+        outln!("scene {} — reference: {}", report.scene, report.reference);
+        out!("{}", precision_table(&report.rows));
         for s in &report.slopes {
             let expected = s.integrator.order();
-            println!(
+            outln!(
                 "  {:>8}: slope {} (vs time), {} (vs RHS evaluations), order -{expected}, {} points",
                 s.integrator.name(),
                 s.time.map_or_else(|| "-".into(), |v| format!("{v:.2}")),
@@ -130,21 +130,21 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         }
         let svg_path = args.out.join(format!("precision-{}.svg", report.scene));
         write(&svg_path, &work_precision_svg(&report)?)?;
-        println!("  diagram: {}\n", svg_path.display());
+        outln!("  diagram: {}\n", svg_path.display());
         all_rows.extend(report.rows);
     }
     let csv_path = args.out.join("precision.csv");
     write(&csv_path, &precision_csv(&all_rows))?;
-    println!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", csv_path.display());
     Ok(Outcome::Success)
 }
 
 fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     create_dir(&args.out)?;
     let rows = stability::run_suite(&stability::SuiteOptions::full())?;
-    print!("{}", stability_table(&rows));
+    out!("{}", stability_table(&rows));
     let csv_path = args.out.join("stability.csv");
     write(&csv_path, &stability_csv(&rows))?;
-    println!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", csv_path.display());
     Ok(Outcome::Success)
 }

@@ -48,11 +48,11 @@ pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
         }
     }
     let report = result?;
-    println!("cores available: {}", report.cores);
-    print!("{}", throughput::table(&report));
+    outln!("cores available: {}", report.cores);
+    out!("{}", throughput::table(&report));
     let csv_path = args.out.join("throughput.csv");
     write(&csv_path, &throughput::csv(&report))?;
-    println!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", csv_path.display());
     Ok(Outcome::Success)
 }
 

@@ -1,0 +1,110 @@
+//! Standard output and standard error of every command (format.md: Exit codes). Every print of `src/cli`
+//! goes through the macros of this module (a test of tests/it/architecture.rs checks it), because
+//! `println!` panics when a write fails, and writes do fail: Rust ignores SIGPIPE, so `coin-log scenes |
+//! head -1` gets EPIPE once `head` has gone, and `> /dev/full` gets ENOSPC.
+//!
+//! - stdout closed by the reader (EPIPE): the rest of the output is dropped quietly and the command ends
+//!   with the exit code it would have had: the reader chose to stop reading, nothing went wrong.
+//! - any other write error on stdout (ENOSPC, EIO): the rest of the output is dropped, and [`settle`]
+//!   reports the error on stderr and turns a success into exit 1 (a code that already says something went
+//!   wrong, like verify's 1 and 2 or record's 130, is kept).
+//! - stderr: written when possible; a failure to write there has nowhere to be reported and is ignored.
+
+use super::Outcome;
+use std::fmt;
+use std::io::{self, ErrorKind, Write};
+use std::sync::Mutex;
+
+/// What became of stdout.
+enum State {
+    /// Every write so far succeeded.
+    Open,
+    /// The reader closed the pipe (EPIPE).
+    Closed,
+    /// Another write error: the first one, reported by [`settle`].
+    Failed(io::Error),
+}
+
+static STDOUT: Mutex<State> = Mutex::new(State::Open);
+
+fn state() -> std::sync::MutexGuard<'static, State> {
+    // A panic while holding the lock cannot leave the state half-updated (each update is one assignment).
+    STDOUT
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+fn note_error(state: &mut State, e: io::Error) {
+    if matches!(state, State::Open) {
+        *state = if e.kind() == ErrorKind::BrokenPipe {
+            State::Closed
+        } else {
+            State::Failed(e)
+        };
+    }
+}
+
+/// Writes to stdout unless an earlier write failed (use [`out!`] and [`outln!`]).
+pub fn write_stdout(args: fmt::Arguments<'_>) {
+    let mut state = state();
+    if matches!(*state, State::Open) {
+        if let Err(e) = io::stdout().lock().write_fmt(args) {
+            note_error(&mut state, e);
+        }
+    }
+}
+
+/// Writes to stderr, ignoring failures (use [`errln!`]).
+pub fn write_stderr(args: fmt::Arguments<'_>) {
+    let _ = io::stderr().lock().write_fmt(args);
+}
+
+/// True once a write to stdout failed with an error other than EPIPE (the output is incomplete).
+pub fn stdout_failed() -> bool {
+    matches!(*state(), State::Failed(_))
+}
+
+/// Flushes stdout and gives the exit code: `outcome`, or 1 instead of a success when stdout could not
+/// be written for a reason other than a closed pipe (the error is then printed on stderr).
+pub fn settle(outcome: Outcome) -> Outcome {
+    let mut state = state();
+    if matches!(*state, State::Open) {
+        if let Err(e) = io::stdout().lock().flush() {
+            note_error(&mut state, e);
+        }
+    }
+    match &*state {
+        State::Open | State::Closed => outcome,
+        State::Failed(e) => {
+            write_stderr(format_args!(
+                "error: cannot write to standard output: {e}; the output is incomplete\n"
+            ));
+            match outcome {
+                Outcome::Success => Outcome::Failure,
+                other => other,
+            }
+        }
+    }
+}
+
+/// `print!` that survives a closed or full stdout.
+macro_rules! out {
+    ($($arg:tt)*) => { $crate::cli::output::write_stdout(format_args!($($arg)*)) };
+}
+
+/// `println!` that survives a closed or full stdout.
+macro_rules! outln {
+    () => { $crate::cli::output::write_stdout(format_args!("\n")) };
+    ($($arg:tt)*) => {
+        $crate::cli::output::write_stdout(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// `eprintln!` that survives a closed stderr.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        $crate::cli::output::write_stderr(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+pub(crate) use errln;

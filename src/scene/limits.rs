@@ -1,0 +1,484 @@
+//! The limits a scene must respect beyond "finite and positive" (format.md: Scene files, Limits): what
+//! double precision, the 1 ns log-time base and the integrators can deliver. A scene outside them is refused
+//! before anything is written, naming the key, the value, the limit and why, instead of running into a
+//! NaN, a repeated log time, a run that never reaches its next sample, or numerical trouble that the
+//! summary would report as physics.
+
+use super::file::{RunFile, SceneFile};
+use super::validate::{number, Problems};
+use super::Scene;
+use crate::integrate::Method;
+use crate::model::{energy, reaction, CoinParams, Inertia, State};
+
+/// Smallest scale (mass, length, inertia, energy, ...) a scene may have. Double precision holds normal
+/// numbers from 2.2e-308 to 1.8e308; the model multiplies and divides pairs of scales (μ = I_Z·Ma² /
+/// (I_X (I_Z + Ma²)) of C1, C2; squared forces |R|² ~ (Mg)² and speeds (aω)² ~ a g; E/(Mga)), so each scale
+/// must stay within 1e±150 for every such product, times the O(1)–O(1e8) dimensionless factors of the
+/// equations (tan θ up to 1e4 at the default flat margin, ωτ), to remain a normal number.
+pub const SCALE_MIN: f64 = 1e-150;
+/// Largest scale; see [`SCALE_MIN`].
+pub const SCALE_MAX: f64 = 1e150;
+
+/// Smallest rtol: ten units of rounding (10·2⁻⁵²), the limit Hairer's DOP853 enforces ("tolerances are
+/// too small"). Below it the error estimate is rounding noise: `--rtol 1e-30 --atol 1e-30` made dop853
+/// shrink its step forever without reaching the first sample (measured: no sample in 60 s).
+pub const RTOL_MIN: f64 = 10.0 * f64::EPSILON;
+/// Largest rtol. Error estimates of embedded pairs hold only asymptotically (small steps); 1e-3 is the
+/// loosest common default (MATLAB's ode45). Measured on `wobble` (dop853, 30 time units): rtol 1e-3 gives
+/// an energy drift of 2.0e-4 and completes; rtol 1 takes 22 steps of ~1.4 time units and reports a
+/// lift-off at t = 8.71 with a drift of 0.19, an artefact of the integration.
+pub const RTOL_MAX: f64 = 1e-3;
+/// Largest atol, as a fraction of the smallest natural scale of the state: 1 rad for the angles, a for the
+/// centre, 1/τ for ω (the same 1e-3 as [`RTOL_MAX`]).
+pub const ATOL_MAX_FRACTION: f64 = 1e-3;
+/// Largest h·W for fixed-step methods, W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0: (h W)⁴ = 1e-3, the accuracy
+/// ε that `verify` derives for an order-4 method (format.md: Tolerances), so the same ceiling as
+/// [`RTOL_MAX`]. Measured on `wobble` (rk4, 30 time units, W = 1.54): h W = 0.19 drifts 2.5e-5 in energy,
+/// h W = 0.96 drifts 1.1e-2.
+pub const STEP_MAX_PRODUCT: f64 = 0.177_827_941_003_892_3; // 1e-3^(1/4)
+/// Largest duration × W: radians of the fastest motion a run may turn through. At ≥ 1/[`STEP_MAX_PRODUCT`]
+/// ≈ 5.6 steps per radian this is ≥ 5.6e10 steps, hours of work; beyond it a run (for instance with
+/// ω = 1e100) would not reach its next sample, so neither its progress nor Ctrl-C would ever be seen.
+pub const MAX_RADIANS: f64 = 1e10;
+/// Unit roundoff 2⁻⁵³.
+const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
+
+/// The highest rate whose samples get strictly increasing log times (round(t·10⁹) ns) over `duration`.
+///
+/// Samples fall on t_k = k·(1/rate), computed in floating point: t_k·10⁹ carries an error of at most
+/// 3u·10⁹·t_k ns (u = 2⁻⁵³: the interval 1/rate, the product k·interval, the product with 10⁹). Two
+/// neighbours k, k+1 round to different nanoseconds when their computed distance is ≥ 1 ns, which holds
+/// when 10⁹/rate − 6u·10⁹·duration ≥ 1: rate ≤ 1 / (10⁻⁹ + 6u·duration), just under 10⁹ for any
+/// duration below ~10⁴. (The last sample, at the duration itself, keeps ≥ 2 ns from the grid point
+/// before it: the driver replaces a grid point within 2 ns of the end by the end.)
+#[must_use]
+pub fn max_rate(duration: f64) -> f64 {
+    1.0 / (1e-9 + 6.0 * UNIT_ROUNDOFF * duration.max(0.0))
+}
+
+/// A number as a power of ten from its decimal logarithm, for scales that may not be representable
+/// (`1e-400`, `2.5e310`).
+fn power_of_ten(log10: f64) -> String {
+    let exponent = log10.floor();
+    let mantissa = 10f64.powf(log10 - exponent);
+    if (mantissa - 1.0).abs() < 1e-9 || (mantissa - 10.0).abs() < 1e-8 {
+        let exponent = if mantissa > 5.0 {
+            exponent + 1.0
+        } else {
+            exponent
+        };
+        format!("1e{exponent}")
+    } else {
+        format!("{mantissa:.2}e{exponent}")
+    }
+}
+
+/// `x` to four significant digits, rounded towards zero (`Down`, for a ceiling to stay under) or away from
+/// it (`Up`, for a floor to stay over), or to nearest.
+#[derive(Clone, Copy, PartialEq)]
+enum Round {
+    Down,
+    Up,
+    Nearest,
+}
+
+fn short(x: f64, round: Round) -> String {
+    if !x.is_finite() || x == 0.0 {
+        return number(x);
+    }
+    let exponent = x.abs().log10().floor();
+    let unit = 10f64.powf(exponent - 3.0);
+    let scaled = x / unit;
+    let digits = match round {
+        Round::Down => scaled.trunc(),
+        Round::Up => scaled.abs().ceil().copysign(scaled),
+        Round::Nearest => scaled.round(),
+    };
+    let value = digits * unit;
+    if (1e-4..1e16).contains(&value.abs()) {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let decimals = (3.0 - exponent).max(0.0) as usize;
+        let text = format!("{value:.decimals$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        let mantissa = format!("{:.3}", digits / 1000.0);
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        format!("{mantissa}e{exponent}")
+    }
+}
+
+const SCALE_WHY: &str = "the model multiplies and divides pairs of such scales (e.g. I_Z·Ma² in C1, C2), \
+     so each must lie within 1e-150 … 1e150 for the products to stay normal double-precision numbers \
+     (2.2e-308 … 1.8e308): express the scene in units where M, a and g are nearer 1";
+
+fn in_scale_range(log10: f64) -> bool {
+    (SCALE_MIN.log10()..=SCALE_MAX.log10()).contains(&log10)
+}
+
+/// Checks M, a, g (and explicit inertias) and the scales the model forms from them; `false` when one is
+/// outside [`SCALE_MIN`] … [`SCALE_MAX`] (reported on the key that contributes most).
+pub(super) fn check_scales(
+    body: &super::file::BodyFile,
+    inertia: Inertia,
+    problems: &mut Problems,
+) -> bool {
+    let mut inputs = vec![
+        ("body.mass", body.mass),
+        ("body.radius", body.radius),
+        ("body.gravity", body.gravity),
+    ];
+    if let Inertia::Explicit {
+        inertia_x,
+        inertia_z,
+    } = inertia
+    {
+        inputs.push(("body.inertia_x", inertia_x));
+        inputs.push(("body.inertia_z", inertia_z));
+    }
+    let mut ok = true;
+    for (key, value) in &inputs {
+        if !in_scale_range(value.log10()) {
+            problems.push(
+                key,
+                number(*value),
+                format!("is outside 1e-150 … 1e150: {SCALE_WHY}"),
+            );
+            ok = false;
+        }
+    }
+    ok && check_derived_scales(body, problems)
+}
+
+/// The scales formed from M, a, g: (name, exponents of M, a, g).
+const DERIVED_SCALES: [(&str, [f64; 3]); 5] = [
+    ("the inertia scale M·a²", [1.0, 2.0, 0.0]),
+    ("the energy scale M·g·a", [1.0, 1.0, 1.0]),
+    ("the force scale M·g", [1.0, 0.0, 1.0]),
+    ("the squared time unit τ² = a/g", [0.0, 1.0, -1.0]),
+    ("the squared speed scale a·g", [0.0, 1.0, 1.0]),
+];
+
+fn check_derived_scales(body: &super::file::BodyFile, problems: &mut Problems) -> bool {
+    let keys = ["body.mass", "body.radius", "body.gravity"];
+    let values = [body.mass, body.radius, body.gravity];
+    let logs = values.map(f64::log10);
+    // Per key, the scales it puts out of range (a key is blamed when its share of the exponent is largest).
+    let mut blamed: Vec<(usize, Vec<String>)> = Vec::new();
+    for (name, exponents) in DERIVED_SCALES {
+        let shares: Vec<f64> = exponents.iter().zip(&logs).map(|(e, l)| e * l).collect();
+        let log10: f64 = shares.iter().sum();
+        if in_scale_range(log10) {
+            continue;
+        }
+        let culprit = (0..3)
+            .max_by(|&i, &j| shares[i].abs().total_cmp(&shares[j].abs()))
+            .unwrap_or(0);
+        let text = format!("{name} = {}", power_of_ten(log10));
+        match blamed.iter_mut().find(|(k, _)| *k == culprit) {
+            Some((_, list)) => list.push(text),
+            None => blamed.push((culprit, vec![text])),
+        }
+    }
+    for (key, scales) in &blamed {
+        let others: Vec<String> = (0..3)
+            .filter(|i| i != key)
+            .map(|i| format!("`{}` = {}", keys[i], number(values[i])))
+            .collect();
+        problems.push(
+            keys[*key],
+            number(values[*key]),
+            format!(
+                "with {} gives {}, outside 1e-150 … 1e150: {SCALE_WHY}",
+                others.join(" and "),
+                scales.join(" and ")
+            ),
+        );
+    }
+    blamed.is_empty()
+}
+
+/// rtol and atol ranges that need no body (atol's ceiling needs the body: [`check_resolved`]); only for
+/// adaptive methods, which use them.
+pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Problems) {
+    if !method.is_some_and(Method::is_adaptive) || !(rtol.is_finite() && rtol > 0.0) {
+        return;
+    }
+    if rtol < RTOL_MIN {
+        problems.push(
+            "run.rtol",
+            number(rtol),
+            format!(
+                "is below {}, ten units of double-precision rounding (10·2⁻⁵²): the error estimate would be rounding noise and the step would shrink without end; use rtol ≥ {}",
+                short(RTOL_MIN, Round::Nearest),
+                short(RTOL_MIN, Round::Up)
+            ),
+        );
+    } else if rtol > RTOL_MAX {
+        problems.push(
+            "run.rtol",
+            number(rtol),
+            "is above 1e-3: an adaptive method's error estimate does not hold at such tolerances, and its events (lift-off, slip) would be artefacts; use rtol ≤ 1e-3",
+        );
+    }
+}
+
+/// The sample rate against the 1 ns log-time base ([`max_rate`]).
+pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut Problems) {
+    if !(rate.is_finite() && rate > 0.0 && duration.is_finite() && duration > 0.0) {
+        return;
+    }
+    let max = max_rate(duration);
+    if rate > max {
+        problems.push(
+            "run.rate",
+            number(rate),
+            format!(
+                "is above {}, the highest rate whose samples stay ≥ 1 ns apart over duration {} (log times are whole nanoseconds, round(t·1e9), and must increase from sample to sample): use rate ≤ {}",
+                number(max.floor()),
+                number(duration),
+                number(max.floor())
+            ),
+        );
+    }
+}
+
+/// W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) of a state: the fastest rate of the equations.
+fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
+    let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
+    let (sin_t, cos_t) = s.theta.sin_cos();
+    let phi_dot = s.omega_y / cos_t;
+    let psi_dot = s.omega_z + s.omega_y * sin_t / cos_t;
+    omega
+        .max(phi_dot.abs())
+        .max(psi_dot.abs())
+        .max(1.0 / params.time_unit())
+}
+
+/// Checks that need the whole scene: the initial state inside the model (finite energy and reaction,
+/// N > 0, |F| < μN), atol's ceiling, the fixed step against the fastest motion, and the work.
+pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Problems) {
+    let before = problems.list.len();
+    check_start(scene, problems);
+    if problems.list.len() != before {
+        return; // the rates below are meaningless for a state outside the model
+    }
+    let run = &scene.run;
+    let w = fastest_rate(&scene.params, &scene.initial);
+    if run.method.method.is_adaptive() {
+        check_atol(scene, problems);
+    } else if run.method.step * w > STEP_MAX_PRODUCT {
+        let given = file.run.as_ref().and_then(|r| r.step);
+        let used = if given.is_some_and(|h| h != run.method.step) {
+            format!(
+                " (used: {}, rounded to divide 1/rate)",
+                number(run.method.step)
+            )
+        } else {
+            String::new()
+        };
+        problems.push(
+            "run.step",
+            number(given.unwrap_or(run.method.step)),
+            format!(
+                "{used} is above 0.178/W = {}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {}",
+                short(STEP_MAX_PRODUCT / w, Round::Down),
+                short(w, Round::Nearest),
+                run.method.method,
+                short(STEP_MAX_PRODUCT / w, Round::Down)
+            )
+            .trim_start()
+            .to_string(),
+        );
+    }
+    if run.duration * w > MAX_RADIANS {
+        problems.push(
+            "run.duration",
+            number(run.duration),
+            format!(
+                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than 1e10 (≥ 5.6e10 integrator steps): use duration ≤ {}, or slow the motion",
+                short(w, Round::Nearest),
+                short(run.duration * w, Round::Nearest),
+                short(MAX_RADIANS / w, Round::Down)
+            ),
+        );
+    }
+}
+
+/// atol ≤ 1e-3 × the smallest natural scale of the state: 1 rad, a, 1/τ.
+fn check_atol(scene: &Scene, problems: &mut Problems) {
+    let p = &scene.params;
+    let atol = scene.run.method.atol;
+    let smallest = 1f64.min(p.radius()).min(1.0 / p.time_unit());
+    let max = ATOL_MAX_FRACTION * smallest;
+    if atol > max {
+        problems.push(
+            "run.atol",
+            number(atol),
+            format!(
+                "is above {}, 1e-3 of the smallest scale of the state (1 rad for the angles, a = {} for the centre, 1/τ = {} for ω): the error estimate would not hold; use atol ≤ {}",
+                short(max, Round::Down),
+                number(p.radius()),
+                short(1.0 / p.time_unit(), Round::Nearest),
+                short(max, Round::Down)
+            ),
+        );
+    }
+}
+
+/// The key the initial state came from (for problems of the state as a whole).
+fn initial_key(scene: &Scene) -> &'static str {
+    match scene.spec {
+        super::InitialSpec::Explicit => "initial.omega",
+        super::InitialSpec::Steady(_) => "initial.steady",
+    }
+}
+
+/// The initial state must be inside the model: finite energy and reaction, the table pushing (N > 0)
+/// and, with μ, friction within the cone (|F| < μN). Otherwise the run would end at t = 0 with one sample.
+fn check_start(scene: &Scene, problems: &mut Problems) {
+    let coin = scene.coin();
+    let s = &scene.initial;
+    let e = energy(&coin, s).total;
+    let r = reaction(&coin, s);
+    let key = initial_key(scene);
+    let value = || describe_state(s);
+    let p = &scene.params;
+    let weight = p.mass() * p.gravity();
+    if !(e.is_finite() && r.normal.is_finite() && r.friction.is_finite()) {
+        problems.push(
+            key,
+            value(),
+            format!(
+                "gives a non-finite energy or reaction at t = 0 (E = {}, N = {}): ω is too large for double precision; keep |ω| well below 1e150/τ = {}",
+                short(e, Round::Nearest),
+                short(r.normal, Round::Nearest),
+                power_of_ten(150.0 - p.time_unit().log10())
+            ),
+        );
+        return;
+    }
+    if r.normal <= 0.0 {
+        problems.push(
+            key,
+            value(),
+            format!(
+                "gives N = {} = {}·Mg ≤ 0 at t = 0: the coin would leave the table at once (lift-off), outside the rolling model; lower the spin or the lean so that N > 0",
+                short(r.normal, Round::Nearest),
+                short(r.normal / weight, Round::Nearest)
+            ),
+        );
+        return;
+    }
+    if let Some(mu) = scene.friction {
+        let needed = r.friction / r.normal;
+        if needed >= mu {
+            problems.push(
+                "body.friction",
+                number(mu),
+                format!(
+                    "is below |F|/N = {} needed at t = 0 (|F| = {}, N = {}): the coin would slip at once; give friction ≥ {} or leave it out",
+                    short(needed, Round::Nearest),
+                    short(r.friction, Round::Nearest),
+                    short(r.normal, Round::Nearest),
+                    short(needed * (1.0 + 1e-9), Round::Up)
+                ),
+            );
+        }
+    }
+}
+
+/// The initial state in a few words: θ and ω.
+fn describe_state(s: &State) -> String {
+    format!(
+        "(θ = {}, ω = [{}, {}, {}])",
+        number(s.theta),
+        number(s.omega_x),
+        number(s.omega_y),
+        number(s.omega_z)
+    )
+}
+
+/// Settings given that the integrator does not use: `run.step` for adaptive methods, `run.rtol` and
+/// `run.atol` for fixed-step ones (format.md: record). They are ignored (and stored as 0), never used to
+/// loosen `verify`'s tolerances; the caller warns about each.
+#[must_use]
+pub fn ignored_settings(run: Option<&RunFile>, method: Method) -> Vec<(&'static str, f64)> {
+    let Some(run) = run else {
+        return Vec::new();
+    };
+    let candidates: [(&'static str, Option<f64>, bool); 3] = [
+        ("run.rtol", run.rtol, !method.is_adaptive()),
+        ("run.atol", run.atol, !method.is_adaptive()),
+        ("run.step", run.step, method.is_adaptive()),
+    ];
+    candidates
+        .into_iter()
+        .filter_map(|(key, value, ignored)| value.filter(|_| ignored).map(|v| (key, v)))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{max_rate, power_of_ten, short, Round};
+    use crate::format::log_time;
+
+    /// Every sample of a run at the highest rate gets its own nanosecond, at several durations; a rate
+    /// 20 % above 1e9 repeats log times (the negative control).
+    #[test]
+    #[allow(
+        clippy::cast_precision_loss,
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss
+    )]
+    fn samples_at_the_highest_rate_have_strictly_increasing_log_times() {
+        // The first 10⁵ samples and the last 10⁶ (where the rounding of t is largest) of each run.
+        for duration in [1e-3, 1.0, 1e3, 1e5] {
+            let rate = max_rate(duration);
+            let interval = 1.0 / rate;
+            let n = (duration * rate) as u64;
+            let windows = [0..n.min(100_000), n.saturating_sub(1_000_000)..n];
+            for window in windows {
+                let mut last = log_time(window.start as f64 * interval).unwrap_or(0);
+                for k in window.start + 1..=window.end {
+                    let t = k as f64 * interval;
+                    let ns = log_time(t).unwrap_or(0);
+                    assert!(
+                        ns > last,
+                        "duration {duration}, rate {rate}: sample {k} at t = {t} repeats {ns} ns"
+                    );
+                    last = ns;
+                }
+            }
+            println!("duration {duration:e}: rate {rate:.9e}, {n} samples, checked ones distinct");
+        }
+        let (rate, duration) = (1.2e9, 1e-6);
+        let interval = 1.0 / rate;
+        let times: Vec<u64> = (0..=(duration * rate) as u64)
+            .map(|k| log_time(k as f64 * interval).unwrap_or(0))
+            .collect();
+        let repeats = times.windows(2).filter(|w| w[0] == w[1]).count();
+        println!("control: rate {rate:e} over {duration}: {repeats} repeated log times");
+        assert!(repeats > 0, "the control should repeat log times");
+    }
+
+    #[test]
+    fn limits_print_with_four_digits_rounded_the_safe_way() {
+        assert_eq!(short(0.110_502_893, Round::Down), "0.1105");
+        assert_eq!(short(0.204_171, Round::Up), "0.2042");
+        assert_eq!(short(999_980_016.38, Round::Down), "999900000");
+        assert_eq!(short(2.220_446e-15, Round::Up), "2.221e-15");
+        assert_eq!(short(1.609_26, Round::Nearest), "1.609");
+        assert_eq!(short(-0.5, Round::Nearest), "-0.5");
+    }
+
+    #[test]
+    fn powers_of_ten_print_beyond_double_precision() {
+        assert_eq!(power_of_ten(-400.0), "1e-400");
+        assert_eq!(power_of_ten(300.0), "1e300");
+        assert_eq!(power_of_ten(2.0_f64.log10() + 310.0), "2.00e310");
+    }
+}

@@ -1,0 +1,313 @@
+//! `coin-log record`'s output path and signals: nothing but a regular file is ever replaced (device nodes,
+//! named pipes, symbolic links, folders, the scene file itself are refused, with or without
+//! `--overwrite`), a target that cannot be created fails before the simulation with the system's reason,
+//! and SIGTERM and SIGHUP finish the file like SIGINT. No case leaves a file behind that it should not.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{coin_log, exe, listing, read_back};
+use coin_log::format::{ResultMetadata, Termination, RESULT_METADATA_NAME};
+use std::os::unix::fs::{FileTypeExt, MetadataExt};
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn code(output: &Output) -> i32 {
+    output.status.code().expect("exited normally")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// A run long enough (1e5 time units at 1000 samples per unit) that a test finishing quickly proves it
+/// never simulated.
+const LONG: [&str; 6] = [
+    "--duration",
+    "100000",
+    "--rate",
+    "1000",
+    "--integrator",
+    "rk4",
+];
+
+/// Runs `record wobble` (a long run) in `dir` with `-o target --overwrite`; expects exit 1 with every
+/// needle in stderr, within a few seconds (before any simulation), and the folder unchanged.
+fn refused(dir: &Path, target: &str, needles: &[&str]) {
+    let before = listing(dir);
+    let started = Instant::now();
+    let mut args = vec!["record", "wobble", "-o", target, "--overwrite"];
+    args.extend_from_slice(&LONG);
+    let out = coin_log(dir, &args);
+    let err = stderr(&out);
+    println!(
+        "-o {target}: exit {} after {:.2} s: {err}",
+        code(&out),
+        started.elapsed().as_secs_f64()
+    );
+    assert_eq!(code(&out), 1, "exit code; stderr: {err}");
+    for needle in needles {
+        assert!(err.contains(needle), "stderr should say {needle:?}: {err}");
+    }
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "refused only after {:?}: it simulated first",
+        started.elapsed()
+    );
+    assert_eq!(listing(dir), before, "the folder is unchanged");
+}
+
+#[test]
+fn a_device_node_is_never_replaced_even_with_overwrite() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        dir.path(),
+        "/dev/null",
+        &[
+            "`/dev/null` is a character device, not a regular file",
+            "would replace the character device",
+            "choose a file path",
+        ],
+    );
+    let meta = std::fs::symlink_metadata("/dev/null").unwrap();
+    assert!(meta.file_type().is_char_device(), "/dev/null is intact");
+}
+
+#[test]
+fn dev_stdout_is_a_symbolic_link_and_is_refused() {
+    // /dev/stdout is a link to /proc/self/fd/1; replacing it would break the machine for everyone.
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        dir.path(),
+        "/dev/stdout",
+        &["`/dev/stdout` is a symbolic link", "not a regular file"],
+    );
+    assert!(std::fs::symlink_metadata("/dev/stdout")
+        .unwrap()
+        .file_type()
+        .is_symlink());
+}
+
+#[test]
+fn a_named_pipe_is_never_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    let status = Command::new("mkfifo")
+        .arg(dir.path().join("pipe"))
+        .status()
+        .unwrap();
+    assert!(status.success(), "mkfifo");
+    refused(
+        dir.path(),
+        "pipe",
+        &["`pipe` is a named pipe, not a regular file"],
+    );
+    let meta = std::fs::symlink_metadata(dir.path().join("pipe")).unwrap();
+    assert!(meta.file_type().is_fifo(), "the pipe is intact");
+}
+
+#[test]
+fn a_symbolic_link_is_never_replaced_by_a_plain_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("real.mcap"), "precious").unwrap();
+    std::os::unix::fs::symlink("real.mcap", dir.path().join("link.mcap")).unwrap();
+    refused(
+        dir.path(),
+        "link.mcap",
+        &[
+            "`link.mcap` is a symbolic link (to `real.mcap`)",
+            "would replace the link itself with a plain file",
+        ],
+    );
+    assert!(std::fs::symlink_metadata(dir.path().join("link.mcap"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(
+        std::fs::read(dir.path().join("real.mcap")).unwrap(),
+        b"precious"
+    );
+}
+
+#[test]
+fn the_scene_file_is_never_the_output_by_any_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(crate::support::repo().join("datasets/scenes/wobble.toml"))
+        .unwrap();
+    std::fs::write(dir.path().join("scene.toml"), &text).unwrap();
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    std::fs::hard_link(
+        dir.path().join("scene.toml"),
+        dir.path().join("sub/same.toml"),
+    )
+    .unwrap();
+    for (scene, target) in [
+        ("scene.toml", "scene.toml"),
+        ("scene.toml", "./scene.toml"),
+        ("./scene.toml", "sub/../scene.toml"),
+        ("scene.toml", "sub/same.toml"),
+    ] {
+        let before = listing(dir.path());
+        let out = coin_log(
+            dir.path(),
+            &[
+                "record",
+                scene,
+                "-o",
+                target,
+                "--overwrite",
+                "--duration",
+                "1",
+            ],
+        );
+        let err = stderr(&out);
+        println!("record {scene} -o {target}: exit {}: {err}", code(&out));
+        assert_eq!(code(&out), 1);
+        assert!(
+            err.contains("is the scene file being recorded") && err.contains("-o scene.mcap"),
+            "{err}"
+        );
+        assert_eq!(listing(dir.path()), before);
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("scene.toml")).unwrap(),
+            text
+        );
+    }
+}
+
+#[test]
+fn a_name_too_long_fails_at_once_with_the_systems_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = format!("{}.mcap", "a".repeat(300));
+    refused(dir.path(), &name, &["File name too long"]);
+    // Without --overwrite too, and no temporary file is left in either case.
+    let out = coin_log(dir.path(), &["record", "wobble", "-o", &name]);
+    assert_eq!(code(&out), 1, "{}", stderr(&out));
+    assert!(stderr(&out).contains("File name too long"));
+    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+}
+
+#[test]
+fn a_missing_folder_or_a_file_used_as_a_folder_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("plain"), "x").unwrap();
+    refused(
+        dir.path(),
+        "nowhere/x.mcap",
+        &["the folder `nowhere` does not exist", "create it first"],
+    );
+    refused(dir.path(), "plain/x.mcap", &["Not a directory"]);
+}
+
+#[test]
+fn a_folder_without_write_permission_fails_before_simulating() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let locked = dir.path().join("locked");
+    std::fs::create_dir(&locked).unwrap();
+    std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let probe = dir.path().join("probe");
+    std::fs::write(&probe, "").unwrap();
+    let root = std::fs::metadata(&probe).unwrap().uid() == 0;
+    if root {
+        // Root writes anywhere; the check cannot be exercised (CI runs it as a user).
+        println!("running as root: a folder without write permission is writable; skipped");
+    } else {
+        refused(
+            dir.path(),
+            "locked/x.mcap",
+            &["Permission denied", "locked"],
+        );
+        assert!(listing(&locked).is_empty());
+    }
+    std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o755)).unwrap();
+}
+
+/// Starts a long recording in `dir`, waits for its temporary file, and sends `signals` (`-TERM`, ...),
+/// each after its delay; returns the exit code and the process's stderr. Only the first signal must be
+/// delivered: the process may be gone before a later one.
+fn record_and_signal(dir: &Path, signals: &[(&str, Duration)]) -> (Option<i32>, String) {
+    let mut child = Command::new(exe())
+        .args(["record", "long-horizon", "-o", "long.mcap"])
+        .args(LONG)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while listing(dir).is_empty() {
+        assert!(
+            started.elapsed() < Duration::from_secs(30),
+            "no temporary file appeared"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    for (i, (signal, delay)) in signals.iter().enumerate() {
+        std::thread::sleep(*delay);
+        let status = Command::new("kill")
+            .args([*signal, &child.id().to_string()])
+            .stderr(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(status.success() || i > 0, "kill {signal}");
+    }
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let exit = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the recording did not stop within 60 s of {signals:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let out = child.wait_with_output().unwrap();
+    (exit.code(), stderr(&out))
+}
+
+/// SIGTERM (a service manager, `kill`) and SIGHUP (the terminal closed) finish the file like Ctrl-C:
+/// marked interrupted, exit 130, and no hidden temporary file left.
+#[test]
+fn sigterm_and_sighup_finish_the_file_marked_interrupted() {
+    for signal in ["-TERM", "-HUP"] {
+        let dir = tempfile::tempdir().unwrap();
+        let (exit, err) = record_and_signal(dir.path(), &[(signal, Duration::from_millis(500))]);
+        println!("{signal}: exit {exit:?}: {err}");
+        assert_eq!(exit, Some(130), "{signal}: {err}");
+        assert!(err.contains("finishing the file"), "{err}");
+        assert_eq!(listing(dir.path()), vec!["long.mcap".to_string()]);
+        let file = read_back(&std::fs::read(dir.path().join("long.mcap")).unwrap());
+        let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+        println!(
+            "  termination {} at t = {}, {} messages",
+            result.termination,
+            result.termination_time,
+            file.messages.len()
+        );
+        assert_eq!(result.termination, Termination::Interrupted);
+        assert!(result.termination_time > 0.0 && result.termination_time < 100_000.0);
+    }
+}
+
+/// A second signal abandons the recording at once: exit 130, nothing written, no temporary file.
+#[test]
+fn a_second_signal_abandons_the_recording_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    // The second SIGTERM comes 1 ms after the first. Finishing the file takes a few milliseconds too, so
+    // either may win; both outcomes must be clean: the finished file, or nothing at all.
+    let (exit, err) = record_and_signal(
+        dir.path(),
+        &[
+            ("-TERM", Duration::from_millis(500)),
+            ("-TERM", Duration::from_millis(1)),
+        ],
+    );
+    println!("exit {exit:?}: {err}");
+    assert_eq!(exit, Some(130), "{err}");
+    let files = listing(dir.path());
+    assert!(
+        files.is_empty() || files == vec!["long.mcap".to_string()],
+        "a finished file or nothing, never a temporary file: {files:?}"
+    );
+}

@@ -1,0 +1,394 @@
+//! Scenes and flags at the limits of double precision, of the 1 ns time base and of the integrators
+//! (format.md: Scene files, Limits): refused at once naming key, value and limit, never a NaN, an empty
+//! problem list, a repeated log time or an event that is an artefact of integration error; flags that do
+//! not apply are warned about and cannot move verify's tolerances; a built-in name never hides a local
+//! file silently.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{coin_log, listing, read_back};
+use coin_log::format::{RunMetadata, RUN_METADATA_NAME};
+use std::path::Path;
+use std::process::Output;
+
+fn code(output: &Output) -> i32 {
+    output.status.code().expect("exited normally")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// `record` with `args` in a fresh folder: exit 1, stderr holding every needle, never an empty problem
+/// list, and nothing written.
+fn refused(args: &[&str], needles: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let mut all = vec!["record"];
+    all.extend_from_slice(args);
+    let out = coin_log(dir.path(), &all);
+    let err = stderr(&out);
+    println!("{args:?} → exit {}: {err}", code(&out));
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(!err.contains("0 problems"), "{err}");
+    for needle in needles {
+        assert!(err.contains(needle), "stderr should say {needle:?}: {err}");
+    }
+    assert!(listing(dir.path()).is_empty(), "nothing is written");
+    err
+}
+
+#[test]
+fn scales_beyond_double_precision_are_refused_naming_key_and_range() {
+    for (set, needle) in [
+        ("body.radius=1e-200", "`body.radius` = 1e-200 is outside 1e-150 … 1e150"),
+        ("body.radius=1e300", "`body.radius` = 1e300 is outside 1e-150 … 1e150"),
+        (
+            "body.radius=1e-100",
+            "`body.radius` = 1e-100 with `body.mass` = 1 and `body.gravity` = 1 gives the inertia scale M·a² = 1e-200",
+        ),
+    ] {
+        let err = refused(&["wobble", "--set", set], &[needle, "normal double-precision"]);
+        assert!(!err.contains("NaN"), "{err}");
+    }
+    refused(
+        &[
+            "wobble",
+            "--set",
+            "body.mass=1e100",
+            "--set",
+            "body.radius=1e100",
+        ],
+        &["M·a² = 1e300", "M·g·a = 1e200"],
+    );
+}
+
+#[test]
+fn a_rate_the_nanosecond_time_base_cannot_hold_apart_is_refused() {
+    let max = coin_log::scene::limits::max_rate(30.0).floor();
+    refused(
+        &["wobble", "--rate", "2e9"],
+        &[
+            "`run.rate` = 2000000000 is above",
+            &format!("use rate ≤ {max}"),
+            "(set by `--rate`)",
+        ],
+    );
+}
+
+/// At the highest rate, and with a duration 0.3 ns past a grid point, every sample has its own log time
+/// and the last one is at the duration.
+#[test]
+fn samples_at_the_limits_of_the_time_base_have_strictly_increasing_log_times() {
+    let dir = tempfile::tempdir().unwrap();
+    let rate = coin_log::scene::limits::max_rate(1e-6).floor().to_string();
+    for (name, args) in [
+        (
+            "fast.mcap",
+            vec!["--duration", "1e-6", "--rate", rate.as_str()],
+        ),
+        ("odd.mcap", vec!["--duration", "1.0000000003"]),
+    ] {
+        let mut all = vec!["record", "wobble", "--channels", "omega", "-o", name];
+        all.extend_from_slice(&args);
+        let out = coin_log(dir.path(), &all);
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        let file = read_back(&std::fs::read(dir.path().join(name)).unwrap());
+        let times: Vec<u64> = file
+            .on_topic("/coin/omega")
+            .iter()
+            .map(|m| m.log_time)
+            .collect();
+        let repeats = times.windows(2).filter(|w| w[0] >= w[1]).count();
+        println!(
+            "{args:?}: {} samples, last at {} ns, {repeats} not increasing",
+            times.len(),
+            times.last().unwrap()
+        );
+        assert_eq!(repeats, 0);
+        let end: f64 = args[1].parse().unwrap();
+        assert_eq!(
+            *times.last().unwrap(),
+            coin_log::format::log_time(end).unwrap()
+        );
+    }
+}
+
+#[test]
+fn an_initial_state_outside_the_model_is_refused_saying_what_it_needs() {
+    refused(
+        &["circle-plus", "--set", "body.friction=0.01"],
+        &[
+            "`body.friction` = 0.01 is below |F|/N = 0.2042 needed at t = 0",
+            "give friction ≥ 0.2042",
+        ],
+    );
+    refused(
+        &["wobble", "--set", "initial.omega=[3, 0, 0]"],
+        &["`initial.omega`", "≤ 0 at t = 0", "lift-off", "N > 0"],
+    );
+    // ω_Z = 1e150 overflowed in the first step (a numerical failure after one sample); now refused.
+    refused(
+        &[
+            "wobble",
+            "--integrator",
+            "rk4",
+            "--set",
+            "initial.omega=[0, 0, 1e150]",
+        ],
+        &["`run.step` = 0.001 is above", "(hW)⁴ would exceed 1e-3"],
+    );
+    refused(
+        &["straight", "--set", "initial.steady.omega_z=1e100"],
+        &["`run.duration` = 20 times W", "more than 1e10"],
+    );
+}
+
+#[test]
+fn tolerances_and_steps_beyond_what_the_integrators_deliver_are_refused() {
+    refused(
+        &["wobble", "--rtol", "1"],
+        &["`run.rtol` = 1 is above 1e-3", "(set by `--rtol`)"],
+    );
+    refused(
+        &["wobble", "--rtol", "1e-30", "--atol", "1e-30"],
+        &[
+            "`run.rtol` = 1e-30 is below 2.22e-15",
+            "use rtol ≥ 2.221e-15",
+        ],
+    );
+    refused(
+        &["wobble", "--atol", "1"],
+        &["`run.atol` = 1 is above 0.001"],
+    );
+    refused(
+        &[
+            "wobble",
+            "--integrator",
+            "rk4",
+            "--step",
+            "0.5",
+            "--rate",
+            "1",
+        ],
+        &[
+            "`run.step` = 0.5 is above 0.178/W = 0.1105",
+            "W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = 1.609",
+            "use step ≤ 0.1105",
+        ],
+    );
+}
+
+fn json_summary(dir: &Path, args: &[&str]) -> (serde_json::Value, String) {
+    let mut all = vec!["record"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--json", "--overwrite"]);
+    let out = coin_log(dir, &all);
+    let err = stderr(&out);
+    assert_eq!(code(&out), 0, "{err}");
+    (serde_json::from_slice(&out.stdout).unwrap(), err)
+}
+
+/// `lift-off` at rtol 1e-3 misses the lift-off and lands flat half a time unit later, with an energy
+/// drift 40 times verify's tolerance: the summary says the event is not to be trusted. At rtol 1e-4 the
+/// lift-off is found and trusted (the control).
+#[test]
+fn an_event_after_too_much_energy_drift_is_flagged_as_not_to_be_trusted() {
+    let dir = tempfile::tempdir().unwrap();
+    let loose = [
+        "lift-off", "--rtol", "1e-3", "--atol", "1e-6", "-o", "l.mcap",
+    ];
+    let (s, err) = json_summary(dir.path(), &loose);
+    println!("{s}\n{err}");
+    assert_eq!(s["termination"], "flat-landing");
+    assert_eq!(s["event_trusted"], false);
+    assert!(s["energy_drift"].as_f64().unwrap() > s["energy_tolerance"].as_f64().unwrap());
+    assert!(
+        err.contains("warning: the flat-landing at t = 3.14")
+            && err.contains("is not to be trusted"),
+        "{err}"
+    );
+    let table_args: Vec<&str> = ["record"]
+        .into_iter()
+        .chain(loose)
+        .chain(["--overwrite"])
+        .collect();
+    let out = coin_log(dir.path(), &table_args);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("(not to be trusted: energy drift above the tolerance)"),
+        "{table}"
+    );
+    let (s, err) = json_summary(
+        dir.path(),
+        &[
+            "lift-off", "--rtol", "1e-4", "--atol", "1e-6", "-o", "l.mcap",
+        ],
+    );
+    println!("{s}\n{err}");
+    assert_eq!(s["termination"], "lift-off");
+    assert_eq!(s["event_trusted"], true);
+    assert!(!err.contains("not to be trusted"), "{err}");
+    let (s, _) = json_summary(dir.path(), &["wobble", "--duration", "1", "-o", "w.mcap"]);
+    assert_eq!(s["event_trusted"], serde_json::Value::Null, "no event");
+}
+
+/// The `coin-log` metadata of `path` and verify's energy tolerance for it.
+fn metadata_and_tolerance(dir: &Path, name: &str) -> (RunMetadata, f64) {
+    let file = read_back(&std::fs::read(dir.join(name)).unwrap());
+    let metadata = RunMetadata::from_map(&file.metadata[RUN_METADATA_NAME].1).unwrap();
+    let out = coin_log(dir, &["verify", name, "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let energy = report["files"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"] == "energy")
+        .unwrap()["tolerance"]
+        .as_f64()
+        .unwrap();
+    (metadata, energy)
+}
+
+/// `--step` with dop853 and `--rtol`/`--atol` with rk4 are warned about, stored as 0, left out of the
+/// stored scene, and leave verify's tolerance where the settings that applied put it.
+#[test]
+fn settings_the_integrator_does_not_use_are_warned_about_and_change_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    for (flags, name, key) in [
+        (vec!["--step", "0.1"], "a.mcap", "run.step"),
+        (vec![], "a0.mcap", ""),
+        (
+            vec!["--integrator", "rk4", "--rtol", "1e-3", "--atol", "1e-3"],
+            "f.mcap",
+            "run.rtol",
+        ),
+        (vec!["--integrator", "rk4"], "f0.mcap", ""),
+    ] {
+        let mut args = vec!["wobble", "--duration", "2", "-o", name];
+        args.extend_from_slice(&flags);
+        let (_, err) = json_summary(dir.path(), &args);
+        println!("{flags:?}: {err}");
+        if key.is_empty() {
+            assert!(!err.contains("warning"), "{err}");
+        } else {
+            assert!(
+                err.contains(&format!("warning: `{key}` = "))
+                    && err.contains("does not apply to")
+                    && err.contains("ignored (stored as 0)"),
+                "{err}"
+            );
+        }
+    }
+    let (adaptive, tol_a) = metadata_and_tolerance(dir.path(), "a.mcap");
+    let (_, tol_a0) = metadata_and_tolerance(dir.path(), "a0.mcap");
+    let (fixed, tol_f) = metadata_and_tolerance(dir.path(), "f.mcap");
+    let (_, tol_f0) = metadata_and_tolerance(dir.path(), "f0.mcap");
+    println!("dop853: step {} tol {tol_a} (without --step {tol_a0}); rk4: rtol {} atol {} tol {tol_f} (without {tol_f0})", adaptive.step, fixed.rtol, fixed.atol);
+    assert_eq!(adaptive.step, 0.0);
+    assert_eq!((fixed.rtol, fixed.atol), (0.0, 0.0));
+    assert_eq!(fixed.step, 1e-3);
+    assert!(!adaptive.scene.contains("step ="), "{}", adaptive.scene);
+    assert!(
+        !fixed.scene.contains("rtol =") && !fixed.scene.contains("atol ="),
+        "{}",
+        fixed.scene
+    );
+    assert_eq!(tol_a, tol_a0, "--step cannot move dop853's tolerance");
+    assert_eq!(tol_f, tol_f0, "--rtol cannot loosen rk4's tolerance");
+}
+
+#[test]
+fn the_step_actually_used_is_shown() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "wobble",
+            "--integrator",
+            "rk4",
+            "--rate",
+            "300",
+            "--duration",
+            "1",
+        ],
+    );
+    let (err, table) = (
+        stderr(&out),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+    );
+    println!("{err}{table}");
+    assert_eq!(code(&out), 0, "{err}");
+    assert!(
+        err.contains("note: step 0.001 rounded down to 8.3333e-4 so that a whole number of steps (4) fits between samples (1/rate = 3.3333e-3)"),
+        "{err}"
+    );
+    assert!(
+        table.contains("integrator       rk4 (step 8.3333e-4): 1200 steps"),
+        "{table}"
+    );
+    let (s, _) = json_summary(
+        dir.path(),
+        &[
+            "wobble",
+            "--integrator",
+            "rk4",
+            "--rate",
+            "300",
+            "--duration",
+            "1",
+        ],
+    );
+    let step = s["step"].as_f64().unwrap();
+    assert!((step - 1.0 / 1200.0).abs() < 1e-18, "{step}");
+    assert_eq!(s["rtol"], serde_json::Value::Null);
+}
+
+#[test]
+fn channel_names_are_trimmed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "wobble",
+            "--duration",
+            "1",
+            "--channels",
+            "omega, angles",
+            "-o",
+            "c.mcap",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let file = read_back(&std::fs::read(dir.path().join("c.mcap")).unwrap());
+    assert_eq!(file.topics(), vec!["/coin/angles", "/coin/omega"]);
+}
+
+/// A bare name is the built-in, and a local file of that name is named in a note; a path is the file.
+#[test]
+fn a_local_file_named_like_a_built_in_is_never_shadowed_silently() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(crate::support::repo().join("datasets/scenes/wobble.toml"))
+        .unwrap()
+        .replace("duration = 30.0", "duration = 1.0");
+    std::fs::write(dir.path().join("wobble"), &text).unwrap();
+    let (s, err) = json_summary(dir.path(), &["wobble", "-o", "builtin.mcap"]);
+    println!("{err}");
+    assert_eq!(s["samples"], 3001, "the built-in (30 time units)");
+    assert!(
+        err.contains("note: `wobble` is the built-in scene; the file `wobble` in this folder is not used (give `./wobble` to use it)"),
+        "{err}"
+    );
+    let (s, err) = json_summary(dir.path(), &["./wobble", "-o", "file.mcap"]);
+    assert_eq!(s["samples"], 101, "the file (1 time unit)");
+    assert!(!err.contains("note"), "{err}");
+    std::fs::rename(dir.path().join("wobble"), dir.path().join("wobble.toml")).unwrap();
+    let (_, err) = json_summary(dir.path(), &["wobble", "-o", "builtin.mcap"]);
+    assert!(
+        err.contains("the file `wobble.toml` in this folder is not used"),
+        "{err}"
+    );
+    let (s, _) = json_summary(dir.path(), &["wobble.toml", "-o", "file.mcap"]);
+    assert_eq!(s["samples"], 101);
+}
