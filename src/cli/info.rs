@@ -174,14 +174,18 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
         ),
         (
             "run",
-            format!(
-                "{}, rtol {}, atol {}, step {}, rate {}",
-                r.integrator,
-                n(r.rtol),
-                n(r.atol),
-                n(r.step),
-                n(r.rate)
-            ),
+            // The settings the method used (the others are stored as 0: docs/format.md).
+            if r.integrator.is_adaptive() {
+                format!(
+                    "{}, rtol {}, atol {}, rate {}",
+                    r.integrator,
+                    n(r.rtol),
+                    n(r.atol),
+                    n(r.rate)
+                )
+            } else {
+                format!("{}, step {}, rate {}", r.integrator, n(r.step), n(r.rate))
+            },
         ),
     ];
     if let Some(k) = r.steady_kind {

@@ -199,8 +199,21 @@ pub fn info(path: &Path) -> Result<FileInfo, InfoError> {
         Err(e) if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) => {
             Err(InfoError(e.detail))
         }
-        // No summary, or a damaged one: the streaming pass says what the file holds (and where it breaks).
-        Ok(None) | Err(_) => scan(path),
+        // No summary: the streaming pass says what the file holds (and where it breaks).
+        Ok(None) => scan(path),
+        // A damaged one: the same pass, and the problem names the summary first.
+        Err(e) => {
+            let mut info = scan(path)?;
+            let damaged = format!(
+                "the summary section is damaged ({}), so the whole file was read instead",
+                e.detail
+            );
+            info.problem = Some(match info.problem.take() {
+                Some(p) => format!("{damaged}; {p}"),
+                None => damaged,
+            });
+            Ok(info)
+        }
     }
 }
 

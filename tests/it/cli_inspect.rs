@@ -64,12 +64,14 @@ fn dry_run_prints_the_resolved_scene_and_writes_nothing() {
         "rate = 250.0",
         "integrator = \"dop853\"",
         "rtol =",
-        "step =",
+        "atol =",
         "flat_margin =",
         "channels =",
     ] {
         assert!(text.contains(key), "`{key}` in the dry run");
     }
+    // Every setting the integrator uses, none it ignores: dop853 has no fixed step.
+    assert!(!text.contains("step ="), "no `step =` for dop853 in the dry run");
     assert!(text.contains("7501 samples"), "30 × 250 + 1 samples");
     // A bad scene: the same errors as a real recording, exit 1, nothing written.
     let out = coin_log(
@@ -192,16 +194,13 @@ fn scenes_json_lists_every_built_in_resolved() {
             "{name}"
         );
         let run = &entry["scene"]["run"];
-        for key in [
-            "duration",
-            "rate",
-            "integrator",
-            "rtol",
-            "atol",
-            "step",
-            "flat_margin",
-        ] {
+        for key in ["duration", "rate", "integrator", "flat_margin"] {
             assert!(!run[key].is_null(), "{name}: run.{key} filled in");
+        }
+        // The settings the integrator uses are filled in, the others left out.
+        let adaptive = matches!(run["integrator"].as_str(), Some("dop853" | "dopri5"));
+        for (key, used) in [("rtol", adaptive), ("atol", adaptive), ("step", !adaptive)] {
+            assert_eq!(!run[key].is_null(), used, "{name}: run.{key} filled in iff used");
         }
         assert!(entry["scene"]["record"]["channels"].is_array());
         assert!(!entry["scene"]["body"]["thickness"].is_null());
@@ -216,15 +215,13 @@ fn scenes_show_prints_every_default() {
         for key in [
             "rate =",
             "integrator =",
-            "rtol =",
-            "atol =",
-            "step =",
             "flat_margin =",
             "thickness =",
             "channels =",
         ] {
             assert!(out.contains(key), "{name}: `{key}` in\n{out}");
         }
+        crate::support::assert_uses_its_settings(name, &out);
         let file = scene::parse_with_sets(&out, &[]).unwrap();
         let resolved = Scene::from_file(&presets::preset(name).unwrap()).unwrap();
         assert_eq!(

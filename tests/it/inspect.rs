@@ -223,15 +223,13 @@ fn the_stored_scene_records_the_same_bytes_again_for_every_built_in() {
         for key in [
             "rate =",
             "integrator =",
-            "rtol =",
-            "atol =",
-            "step =",
             "flat_margin =",
             "thickness =",
             "channels =",
         ] {
             assert!(text.contains(key), "{name}: `{key}` written out:\n{text}");
         }
+        crate::support::assert_uses_its_settings(name, &text);
         assert!(!text.contains("copied-"), "{name}");
     }
 }
