@@ -56,7 +56,7 @@ pub struct RecordArgs {
     #[arg(long, value_name = "H")]
     step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
-    /// invariants, tf, scene (overrides `record.channels`; default all).
+    /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     channels: Option<Vec<String>>,
     /// Chunk compression.
@@ -339,6 +339,8 @@ fn print_summary(
             "steady_residual": s.steady_residual,
             "termination": s.termination.name(),
             "termination_time": s.termination_time,
+            "dissipated_work": s.dissipated_work,
+            "termination_alpha": s.termination_alpha,
             "peak_rss_bytes": peak_rss_bytes(),
         });
         println!("{}", serde_json::to_string(&json)?);
@@ -363,22 +365,46 @@ fn print_summary(
                 s.stats.rejected_steps
             ),
         ),
-        ("energy drift", format!("{:.3e}", s.energy_drift)),
     ];
+    rows.extend(physics_rows(s));
+    for (key, value) in rows {
+        println!("{key:<16} {value}");
+    }
+    Ok(())
+}
+
+/// The summary's rows after the integrator: drift (of E + W with dissipation, physics §10), W, C1/C2
+/// drift, steady residual, termination (with α for a dissipative run).
+fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
+    let mut rows = Vec::new();
+    match s.dissipated_work {
+        Some(w) => {
+            rows.push((
+                "energy balance",
+                format!("{:.3e} (drift of E + W)", s.energy_drift),
+            ));
+            rows.push(("dissipated W", format!("{w:.6e}")));
+        }
+        None => rows.push(("energy drift", format!("{:.3e}", s.energy_drift))),
+    }
     if let Some(d) = s.invariant_drift {
         rows.push(("C1/C2 drift", format!("{d:.3e}")));
     }
     if let Some(r) = s.steady_residual {
         rows.push(("steady residual", format!("{r:.3e}")));
     }
+    let alpha = s.termination_alpha.map_or_else(String::new, |a| {
+        format!(" (α = {a:.4e} rad from the table)")
+    });
     rows.push((
         "termination",
-        format!("{} at t = {}", s.termination.name(), s.termination_time),
+        format!(
+            "{} at t = {}{alpha}",
+            s.termination.name(),
+            s.termination_time
+        ),
     ));
-    for (key, value) in rows {
-        println!("{key:<16} {value}");
-    }
-    Ok(())
+    rows
 }
 
 #[allow(clippy::cast_precision_loss)]

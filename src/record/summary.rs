@@ -54,7 +54,8 @@ pub struct RecordSummary {
     pub termination_time: f64,
     /// The numerical failure that ended the run, when one did (its detail for the user).
     pub failure: Option<Failure>,
-    /// Energy drift over the samples ([`EnergyDrift`](crate::model::drift::EnergyDrift)).
+    /// Energy drift over the samples ([`EnergyDrift`](crate::model::drift::EnergyDrift)); with
+    /// dissipation, the drift of E + W.
     pub energy_drift: f64,
     /// Invariant drift over the samples, when C1, C2 were computed
     /// ([`InvariantDrift`](crate::model::drift::InvariantDrift)).
@@ -62,4 +63,9 @@ pub struct RecordSummary {
     /// For an unperturbed steady scene: max over the samples of |θ − θ*| and |ω − ω*|·√(a/g)
     /// (dimensionless), the distance from the steady motion.
     pub steady_residual: Option<f64>,
+    /// With dissipation: the work W dissipated by the end of the run \[energy\] (physics §10); the energy
+    /// drift is then that of the balance E + W.
+    pub dissipated_work: Option<f64>,
+    /// With dissipation: α = π/2 − |θ| at the last sample, how flat the coin was when the run ended.
+    pub termination_alpha: Option<f64>,
 }

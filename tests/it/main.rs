@@ -9,11 +9,13 @@
 mod support;
 
 mod architecture;
+mod bench_euler;
 mod bench_precision;
 mod bench_stability;
 mod bench_throughput;
 mod cli_record;
 mod datasets;
+mod dissipation;
 mod events;
 mod external_readers;
 mod formulas;
