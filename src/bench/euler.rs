@@ -143,6 +143,8 @@ pub struct EulerRow {
     pub time_scale: f64,
     /// How the run without μ ended (the scene has none): `lift-off`, `flat-landing` or `completed`.
     pub end: RunEnd,
+    /// The smallest N/(Mg) of the run without μ, and α there.
+    pub lowest_normal: (f64, f64),
     /// How the same run with μ = [`SLIP_FRICTION`] ended: a `slip` when friction gives out first.
     pub with_friction: RunEnd,
     /// The thinned samples (t, α) of the whole run, for the diagram.
@@ -310,6 +312,7 @@ struct AlphaSeries {
     series: Vec<(f64, f64)>,
     end: RunEnd,
     spin_alpha: f64,
+    lowest_normal: (f64, f64),
     wall_seconds: f64,
 }
 
@@ -353,8 +356,23 @@ fn alpha_series(setting: &EulerSetting, case: &BenchCase, spin_share: f64) -> Al
         series,
         end,
         spin_alpha,
+        lowest_normal: lowest_normal(case, &run),
         wall_seconds,
     }
+}
+
+/// The smallest N/(Mg) over the samples of a run, and α there (physics §10: how close it came to lift-off).
+fn lowest_normal(case: &BenchCase, run: &Trajectory) -> (f64, f64) {
+    let dynamics = case.dynamics();
+    let p = case.coin.params();
+    let weight = p.mass() * p.gravity();
+    run.states
+        .iter()
+        .map(|y| {
+            let s = State::from_array(y);
+            (dynamics.reaction(&s).normal / weight, alpha_of(&s))
+        })
+        .fold((f64::INFINITY, 0.0), |low, n| if n.0 < low.0 { n } else { low })
 }
 
 /// Runs one preset on the setting and fits its law; runs it again with μ = [`SLIP_FRICTION`] to see
@@ -416,6 +434,7 @@ pub fn run_model(
         points: window.len(),
         time_scale: setting.time_scale,
         end: free.end,
+        lowest_normal: free.lowest_normal,
         with_friction,
         samples: thin(&series, f64::INFINITY, 0.0),
         wall_seconds: free.wall_seconds,

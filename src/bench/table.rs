@@ -183,7 +183,7 @@ pub fn stability_table(rows: &[StabilityRow]) -> String {
 }
 
 /// The CSV header of `bench euler`.
-pub const EULER_CSV_HEADER: &str = "model,m,k,p,kappa,time_scale,predicted_n,fitted_n,relative_error,singular,t0,alpha_min,alpha_max,window_limit,t_start,t_end,points,termination,end_time,end_alpha,termination_mu,end_time_mu,end_alpha_mu,wall_seconds";
+pub const EULER_CSV_HEADER: &str = "model,m,k,p,kappa,time_scale,predicted_n,fitted_n,relative_error,singular,t0,alpha_min,alpha_max,window_limit,t_start,t_end,points,termination,end_time,end_alpha,min_normal,min_normal_alpha,termination_mu,end_time_mu,end_alpha_mu,wall_seconds";
 
 /// The Euler's disk rows as CSV with [`EULER_CSV_HEADER`]; `_mu` columns are the run with μ = 0.3.
 #[must_use]
@@ -213,6 +213,8 @@ pub fn euler_csv(rows: &[EulerRow]) -> String {
             r.end.termination.clone(),
             number(Some(r.end.time)),
             number(Some(r.end.alpha)),
+            number(Some(r.lowest_normal.0)),
+            number(Some(r.lowest_normal.1)),
             r.with_friction.termination.clone(),
             number(Some(r.with_friction.time)),
             number(Some(r.with_friction.alpha)),
@@ -240,6 +242,7 @@ pub fn euler_table(rows: &[EulerRow]) -> String {
         "window alpha",
         "window t",
         "end (no mu)",
+        "min N/Mg (at alpha)",
         "end (mu = 0.3)",
     ];
     let end =
@@ -268,6 +271,7 @@ pub fn euler_table(rows: &[EulerRow]) -> String {
                 ),
                 format!("{:.1}..{:.1}", r.time_window.0, r.time_window.1),
                 end(&r.end),
+                format!("{:.5} ({:.2e})", r.lowest_normal.0, r.lowest_normal.1),
                 end(&r.with_friction),
             ]
         })
