@@ -118,7 +118,7 @@ impl EventFunctions<STATE_LEN> for CoinEvents {
     }
 }
 
-/// The events of the dissipative coin: those of [`CoinEvents`], with the reaction of eqs (30)–(32)
+/// The events of the dissipative coin: those of [`CoinEvents`], with the reaction of eqs (31)–(33)
 /// (physics §10), on the 9-component state.
 #[derive(Debug, Clone, Copy)]
 pub struct DissipativeEvents {

@@ -113,7 +113,7 @@ pub fn reaction(coin: &Coin, s: &State) -> Reaction {
 }
 
 /// The reaction of physics §3 for given angular accelerations (ω̇_X, ω̇_Y, ω̇_Z): those of eqs (14)–(16)
-/// ([`reaction`]), or of eqs (30)–(32) with a dissipative couple (physics §10).
+/// ([`reaction`]), or of eqs (31)–(33) with a dissipative couple (physics §10).
 #[must_use]
 pub(super) fn reaction_with(coin: &Coin, s: &State, acc: AngularAcceleration) -> Reaction {
     let p = coin.params();

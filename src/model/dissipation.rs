@@ -235,25 +235,25 @@ impl Dissipation {
     }
 }
 
-/// The coin with a dissipative couple: eqs (30)–(33) of physics §10 on the state (θ, φ, ψ, ω, x, z, W).
+/// The coin with a dissipative couple: eqs (30)–(34) of physics §10 on the state (θ, φ, ψ, ω, x, z, W).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DissipativeCoin {
     coin: Coin,
     dissipation: Dissipation,
-    /// 1/(I_X + Ma²), eq (30).
+    /// 1/(I_X + Ma²), eq (31).
     inv_x: f64,
-    /// 1/I_X, eq (31).
+    /// 1/I_X, eq (32).
     inv_y: f64,
-    /// 1/(I_Z + Ma²), eq (32).
+    /// 1/(I_Z + Ma²), eq (33).
     inv_z: f64,
 }
 
-/// The couple's effect at one state: the angular accelerations of eqs (30)–(32) and the power P.
+/// The couple's effect at one state: the angular accelerations of eqs (31)–(33) and the power P.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DissipativeRates {
     /// (ω̇_X, ω̇_Y, ω̇_Z) with the couple.
     pub acceleration: AngularAcceleration,
-    /// P = Ẇ ≥ 0 (eq (33)).
+    /// P = Ẇ ≥ 0 (eq (34)).
     pub power: f64,
 }
 
@@ -284,11 +284,11 @@ impl DissipativeCoin {
         &self.dissipation
     }
 
-    /// Angular accelerations of eqs (30)–(32) and the power P of eq (34):
+    /// Angular accelerations of eqs (31)–(33) and the power P of eq (34):
     ///
-    /// (I_X + Ma²) ω̇_X = [right-hand side of (14)] − (P/|ω|²) ω_X   (30)
-    /// I_X ω̇_Y         = [right-hand side of (15)] − (P/|ω|²) ω_Y   (31)
-    /// (I_Z + Ma²) ω̇_Z = [right-hand side of (16)] − (P/|ω|²) ω_Z   (32)
+    /// (I_X + Ma²) ω̇_X = [right-hand side of (14)] − (P/|ω|²) ω_X   (31)
+    /// I_X ω̇_Y         = [right-hand side of (15)] − (P/|ω|²) ω_Y   (32)
+    /// (I_Z + Ma²) ω̇_Z = [right-hand side of (16)] − (P/|ω|²) ω_Z   (33)
     ///
     /// At ω = 0 the couple is 0 (P = 0 there, since m ≥ 1).
     #[must_use]
@@ -310,7 +310,7 @@ impl DissipativeCoin {
         }
     }
 
-    /// The right-hand side: eqs (17)–(19), (30)–(33) and the centre's velocity (physics §2, §10). The
+    /// The right-hand side: eqs (17)–(19), (31)–(34) and the centre's velocity (physics §2, §10). The
     /// couple changes only ω̇; the kinematics and the rolling constraint are those of the conservative coin.
     #[inline]
     pub fn derivative(
@@ -327,15 +327,15 @@ impl DissipativeCoin {
         dydt[0] = wx; // (17)
         dydt[1] = wy / cos_t; // (18)
         dydt[2] = wz + wy * tan_t; // (19)
-        dydt[3] = rates.acceleration.x; // (30)
-        dydt[4] = rates.acceleration.y; // (31)
-        dydt[5] = rates.acceleration.z; // (32)
+        dydt[3] = rates.acceleration.x; // (31)
+        dydt[4] = rates.acceleration.y; // (32)
+        dydt[5] = rates.acceleration.z; // (33)
         dydt[6] = a * (-wz * cos_p + wx * cos_t * sin_p);
         dydt[7] = a * (wz * sin_p + wx * cos_t * cos_p);
-        dydt[WORK_INDEX] = rates.power; // (33)
+        dydt[WORK_INDEX] = rates.power; // (34)
     }
 
-    /// The table's reaction (physics §3) with the accelerations of eqs (30)–(32): the couple is a pure
+    /// The table's reaction (physics §3) with the accelerations of eqs (31)–(33): the couple is a pure
     /// torque, so R = M dv/dt + Mg e_y as before, but dv/dt follows the dissipative ω̇.
     #[must_use]
     pub fn reaction(&self, s: &State) -> Reaction {

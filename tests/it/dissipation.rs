@@ -81,7 +81,7 @@ fn energy_rate(p: &CoinParams, y: &[f64], dydt: &[f64]) -> (f64, f64) {
 proptest! {
     #![proptest_config(config())]
 
-    /// dE/dt = −P = −Ẇ exactly along eqs (30)–(33), for any body, state and law: the conservative terms
+    /// dE/dt = −P = −Ẇ exactly along eqs (31)–(34), for any body, state and law: the conservative terms
     /// cancel to round-off and the couple removes exactly P.
     #[test]
     fn the_energy_falls_at_exactly_the_dissipated_power(
