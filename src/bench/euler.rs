@@ -372,7 +372,10 @@ fn lowest_normal(case: &BenchCase, run: &Trajectory) -> (f64, f64) {
             let s = State::from_array(y);
             (dynamics.reaction(&s).normal / weight, alpha_of(&s))
         })
-        .fold((f64::INFINITY, 0.0), |low, n| if n.0 < low.0 { n } else { low })
+        .fold(
+            (f64::INFINITY, 0.0),
+            |low, n| if n.0 < low.0 { n } else { low },
+        )
 }
 
 /// Runs one preset on the setting and fits its law; runs it again with μ = [`SLIP_FRICTION`] to see
