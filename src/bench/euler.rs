@@ -346,7 +346,7 @@ fn alpha_series(setting: &EulerSetting, case: &BenchCase, spin_share: f64) -> Al
     let spin_alpha = run
         .states
         .iter()
-        .map(|y| State::from_array(y))
+        .map(State::from_array)
         .find(|s| {
             let w2 = s.omega_x * s.omega_x + s.omega_y * s.omega_y + s.omega_z * s.omega_z;
             s.omega_z * s.omega_z > spin_share * w2
@@ -486,7 +486,7 @@ fn linear_fit(points: &[(f64, f64)], t0: f64) -> Option<(f64, f64, f64)> {
     let my = xy.iter().map(|p| p.1).sum::<f64>() / count;
     let sxx: f64 = xy.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
     let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    if !(sxx > 0.0) {
+    if sxx.is_nan() || sxx <= 0.0 {
         return None;
     }
     let n = sxy / sxx;
@@ -539,7 +539,7 @@ fn fit_side(points: &[(f64, f64)], anchor: f64, side: f64, span: f64) -> Option<
 pub fn fit_power_law(points: &[(f64, f64)]) -> Option<PowerLawFit> {
     let (first, last) = (points.first()?.0, points.last()?.0);
     let span = last - first;
-    if !(span > 0.0) {
+    if span.is_nan() || span <= 0.0 {
         return None;
     }
     let after = fit_side(points, last, 1.0, span);

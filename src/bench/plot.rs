@@ -194,8 +194,12 @@ pub fn euler_svg(rows: &[EulerRow]) -> Result<String, BenchError> {
     Ok(svg)
 }
 
+/// One law in the Euler's disk diagram: its label, the run's (log10 |t₀ − t|, log10 α) and the fitted
+/// line's.
+type EulerCurve = (String, Vec<(f64, f64)>, Vec<(f64, f64)>);
+
 /// For each fitted row: its label, the run's (log10 |t₀ − t|, log10 α) and the fitted line's.
-fn euler_curves(rows: &[EulerRow]) -> Vec<(String, Vec<(f64, f64)>, Vec<(f64, f64)>)> {
+fn euler_curves(rows: &[EulerRow]) -> Vec<EulerCurve> {
     rows.iter()
         .filter_map(|r| {
             let fit = r.fit?;

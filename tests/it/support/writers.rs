@@ -127,7 +127,9 @@ pub fn message_json_with(
             .write_json(&mut buf)
         }
         Channel::Work => {
-            let w = work.expect("the work channel needs W");
+            let Some(w) = work else {
+                panic!("the work channel needs W")
+            };
             WorkMessage {
                 t,
                 dissipated: w,
