@@ -444,7 +444,7 @@ pub fn run_model(
     })
 }
 
-/// The samples with α in [bottom, top], thinned to about [`WINDOW_POINTS`] evenly spaced in ln α: a
+/// The samples with α in [bottom, top], thinned to about `WINDOW_POINTS` (400) evenly spaced in ln α: a
 /// sample is kept when α has fallen by the spacing since the last kept one (the first sample in range is
 /// kept). With `top` infinite, the whole run, thinned the same way over its own range.
 #[must_use]
