@@ -2,14 +2,12 @@
 //! is judged against, and the error measures shared by the precision and stability benches.
 
 use super::BenchError;
-use crate::integrate::{
-    run_method, Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination,
-};
+use crate::integrate::{Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::invariants::Chaplygin;
-use crate::model::{energy, Coin, State, Steady, STATE_LEN};
+use crate::model::{energy, Coin, Dissipation, Dynamics, State, Steady, STATE_LEN};
 use crate::scene::defaults;
-use crate::simulation::CoinEvents;
+use crate::simulation::{run_dynamics, CoinEvents};
 
 /// Samples per natural time unit √(a/g) at which errors are measured ("100 per time unit").
 pub const SAMPLES_PER_TIME_UNIT: f64 = 100.0;
@@ -40,6 +38,9 @@ pub struct BenchCase {
     pub flat_margin: f64,
     /// Friction coefficient μ; with it the run ends at a slip.
     pub friction: Option<f64>,
+    /// A dissipative couple (physics §11): the run then integrates W with the state, and the energy
+    /// error is that of the balance E + W.
+    pub dissipation: Option<Dissipation>,
 }
 
 impl BenchCase {
@@ -59,10 +60,16 @@ impl BenchCase {
         }
     }
 
-    /// The physical events of the case.
+    /// The physical events of the case (conservative dynamics; a dissipative run builds its own).
     #[must_use]
     pub fn events(&self) -> CoinEvents {
         CoinEvents::new(self.coin, self.flat_margin, self.friction)
+    }
+
+    /// The equations of the case: the coin, with its dissipation if any.
+    #[must_use]
+    pub fn dynamics(&self) -> Dynamics {
+        Dynamics::new(self.coin, self.dissipation)
     }
 }
 
@@ -86,6 +93,8 @@ pub struct Trajectory {
     pub times: Vec<f64>,
     /// States at the sample times.
     pub states: Vec<[f64; STATE_LEN]>,
+    /// The dissipated work W at the sample times (dissipative runs; empty otherwise).
+    pub work: Vec<f64>,
     /// How the run ended; `None` before the first run.
     pub outcome: Option<RunOutcome>,
 }
@@ -97,6 +106,7 @@ impl Trajectory {
         Self {
             times: Vec::with_capacity(samples),
             states: Vec::with_capacity(samples),
+            work: Vec::new(),
             outcome: None,
         }
     }
@@ -141,16 +151,21 @@ pub fn run_sampled_with(
 ) {
     out.times.clear();
     out.states.clear();
-    let (times, states) = (&mut out.times, &mut out.states);
-    let outcome = run_method(
+    out.work.clear();
+    let (times, states, work) = (&mut out.times, &mut out.states, &mut out.work);
+    let outcome = run_dynamics(
         config,
-        &case.coin,
-        &case.initial.to_array(),
+        &case.dynamics(),
+        &case.initial,
         settings,
-        &case.events(),
-        |t, y| {
+        case.flat_margin,
+        case.friction,
+        |t, y, w| {
             times.push(t);
             states.push(*y);
+            if let Some(w) = w {
+                work.push(w);
+            }
             Flow::Continue
         },
     );
@@ -349,6 +364,24 @@ pub fn energy_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> f64 {
     let mut drift = EnergyDrift::new(coin.params(), energy(coin, &State::from_array(first)).total);
     for y in states {
         drift.observe(0.0, energy(coin, &State::from_array(y)).total);
+    }
+    drift.value()
+}
+
+/// Drift of the energy balance E + W over the samples of a dissipative run (physics §11), defined as the
+/// energy drift ([`EnergyDrift`]) with E + W in place of E; the plain energy drift when `work` is empty.
+#[must_use]
+pub fn balance_drift(coin: &Coin, states: &[[f64; STATE_LEN]], work: &[f64]) -> f64 {
+    if work.is_empty() {
+        return energy_drift(coin, states);
+    }
+    let balance = |y: &[f64; STATE_LEN], w: f64| energy(coin, &State::from_array(y)).total + w;
+    let Some((first, w0)) = states.first().zip(work.first()) else {
+        return 0.0;
+    };
+    let mut drift = EnergyDrift::new(coin.params(), balance(first, *w0));
+    for (y, w) in states.iter().zip(work) {
+        drift.observe(0.0, balance(y, *w));
     }
     drift.value()
 }

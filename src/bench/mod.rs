@@ -7,6 +7,7 @@
 //! The physics of the hard cases is physics §5 and §7.
 
 mod case;
+pub mod euler;
 pub mod plot;
 pub mod precision;
 pub mod presets;
@@ -16,9 +17,9 @@ pub mod throughput;
 pub mod table;
 
 pub use case::{
-    analytic_steady_state, default_config, energy_drift, invariant_drift, reference_trajectory,
-    run_sampled, state_difference, state_error, BenchCase, Reference, ReferenceKind, Trajectory,
-    DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
+    analytic_steady_state, balance_drift, default_config, energy_drift, invariant_drift,
+    reference_trajectory, run_sampled, state_difference, state_error, BenchCase, Reference,
+    ReferenceKind, Trajectory, DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
 };
 
 use thiserror::Error;

@@ -1,6 +1,7 @@
 //! Work-precision diagrams as SVG (plotters' SVG backend only: no system fonts are needed, text is
 //! written as SVG `<text>` elements).
 
+use super::euler::EulerRow;
 use super::precision::PrecisionReport;
 use super::BenchError;
 use plotters::prelude::*;
@@ -123,4 +124,108 @@ fn bounds(series: &[(String, Vec<(f64, f64)>)]) -> (f64, f64, f64, f64) {
         y0.floor() - 0.5,
         y1.ceil() + 0.5,
     )
+}
+
+/// Points of each fitted line in the Euler's disk diagram.
+const FIT_LINE_POINTS: usize = 50;
+
+/// The exponent diagram of `bench euler`: log10 α against log10 |t₀ − t| for each preset (t₀ its fitted
+/// singular time, or the decay's origin), the run as a thin line and the fitted law α = A |t₀ − t|^n over
+/// the window as a thick one; the legend gives the fitted n against 1/(1 − p). Returns the SVG document.
+///
+/// # Errors
+/// [`BenchError::Plot`] if drawing fails (it does not for finite data).
+pub fn euler_svg(rows: &[EulerRow]) -> Result<String, BenchError> {
+    let fail = |e: &dyn std::fmt::Display| BenchError::Plot {
+        scene: "euler".into(),
+        reason: e.to_string(),
+    };
+    let curves = euler_curves(rows);
+    let all: Vec<(String, Vec<(f64, f64)>)> = curves
+        .iter()
+        .flat_map(|(label, run, fit)| [(label.clone(), run.clone()), (label.clone(), fit.clone())])
+        .collect();
+    let (x0, x1, y0, y1) = bounds(&all);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Euler's disk: α = A |t0 − t|^n, fitted on the window (thick) of each run (thin)",
+                ("sans-serif", 16),
+            )
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(56)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("log10 |t0 − t| [s]")
+            .y_desc("log10 α [rad]")
+            .draw()
+            .map_err(|e| fail(&e))?;
+        for (i, (label, run, fit)) in curves.iter().enumerate() {
+            let colour = PALETTE[i % PALETTE.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    run.iter().copied(),
+                    colour.mix(0.5).stroke_width(1),
+                ))
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(LineSeries::new(fit.iter().copied(), colour.stroke_width(4)))
+                .map_err(|e| fail(&e))?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(4))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| fail(&e))?;
+        root.present().map_err(|e| fail(&e))?;
+    }
+    Ok(svg)
+}
+
+/// One law in the Euler's disk diagram: its label, the run's (log10 |t₀ − t|, log10 α) and the fitted
+/// line's.
+type EulerCurve = (String, Vec<(f64, f64)>, Vec<(f64, f64)>);
+
+/// For each fitted row: its label, the run's (log10 |t₀ − t|, log10 α) and the fitted line's.
+fn euler_curves(rows: &[EulerRow]) -> Vec<EulerCurve> {
+    rows.iter()
+        .filter_map(|r| {
+            let fit = r.fit?;
+            // Only the side of t₀ the law describes: before a singularity, after a decay's origin (a run
+            // that goes on past its fitted t₀ would fold back on the logarithmic axis).
+            let point = |t: f64, alpha: f64| {
+                let d = if fit.singular { fit.t0 - t } else { t - fit.t0 };
+                (d > 0.0 && alpha > 0.0).then(|| (d.log10(), alpha.log10()))
+            };
+            let run: Vec<(f64, f64)> = r.samples.iter().filter_map(|&(t, a)| point(t, a)).collect();
+            let (t_a, t_b) = r.time_window;
+            #[allow(clippy::cast_precision_loss)]
+            let line: Vec<(f64, f64)> = (0..=FIT_LINE_POINTS)
+                .filter_map(|i| {
+                    let t = t_a + (t_b - t_a) * i as f64 / FIT_LINE_POINTS as f64;
+                    point(t, fit.alpha(t))
+                })
+                .collect();
+            let kind = if fit.singular { "" } else { ", decay" };
+            let label = format!(
+                "{}: n = {:.4} (1/(1 − p) = {:.4}{kind})",
+                r.dissipation.model(),
+                fit.exponent,
+                r.predicted
+            );
+            Some((label, run, line))
+        })
+        .collect()
 }

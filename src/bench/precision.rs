@@ -7,7 +7,7 @@
 
 use super::case::{run_sampled, termination_name, Reference, ReferenceKind, Trajectory};
 use super::{
-    energy_drift, invariant_drift, reference_trajectory, state_error, BenchCase, BenchError,
+    balance_drift, invariant_drift, reference_trajectory, state_error, BenchCase, BenchError,
 };
 use crate::integrate::{Method, MethodConfig};
 use std::time::Instant;
@@ -247,8 +247,13 @@ fn measure(
         tolerance: config.method.is_adaptive().then_some(config.atol),
         step: (!config.method.is_adaptive()).then_some(config.step),
         state_error: state_error(case, buffer, reference),
-        energy_error: energy_drift(&case.coin, &buffer.states),
-        invariant_error: invariant_drift(&case.coin, &buffer.states),
+        energy_error: balance_drift(&case.coin, &buffer.states, &buffer.work),
+        // With dissipation C1, C2 are not conserved (physics §11): no drift to report.
+        invariant_error: case
+            .dissipation
+            .is_none()
+            .then(|| invariant_drift(&case.coin, &buffer.states))
+            .flatten(),
         wall_seconds,
         rhs_evaluations: stats.rhs_evaluations,
         steps: stats.steps,

@@ -21,6 +21,7 @@ impl BenchCase {
             duration: scene.run.duration,
             flat_margin: scene.run.flat_margin,
             friction: scene.friction,
+            dissipation: scene.dissipation,
         }
     }
 }

@@ -235,6 +235,7 @@ pub fn fast_spin_case(omega_z: f64, periods: f64) -> Result<(BenchCase, f64), Be
             duration: periods * TAU / sigma,
             flat_margin: DEFAULT_FLAT_MARGIN,
             friction: None,
+            dissipation: None,
         },
         sigma,
     ))
@@ -351,6 +352,7 @@ pub fn near_flat(theta: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>
         duration: options.near_flat_periods * TAU / sigma,
         flat_margin: DEFAULT_FLAT_MARGIN,
         friction: None,
+        dissipation: None,
     };
     let mut kicked = steady_case.clone();
     kicked.name = format!("near-flat-{theta}-kicked");
@@ -501,6 +503,7 @@ pub fn release(theta0: f64, case_name: &str) -> Vec<StabilityRow> {
         duration: 4.0 * expected_time + 1.0,
         flat_margin: DEFAULT_FLAT_MARGIN,
         friction: None,
+        dissipation: None,
     };
     Method::ALL
         .iter()
@@ -564,6 +567,7 @@ pub fn marginal(offset: f64, horizon: f64) -> Vec<StabilityRow> {
         duration: horizon,
         flat_margin: DEFAULT_FLAT_MARGIN,
         friction: None,
+        dissipation: None,
     };
     Method::ALL
         .iter()
@@ -766,6 +770,7 @@ pub fn scaled_wobble(
         duration: horizon * t,
         flat_margin: DEFAULT_FLAT_MARGIN,
         friction: None,
+        dissipation: None,
     })
 }
 

@@ -1,5 +1,6 @@
 //! Text tables and CSV of bench results, returned as strings (the CLI prints or writes them).
 
+use super::euler::EulerRow;
 use super::precision::PrecisionRow;
 use super::stability::StabilityRow;
 
@@ -175,6 +176,103 @@ pub fn stability_table(rows: &[StabilityRow]) -> String {
                     .map_or_else(|| "-".into(), |v| format!("{v:.10e}")),
                 r.expected
                     .map_or_else(|| "-".into(), |v| format!("{v:.10e}")),
+            ]
+        })
+        .collect();
+    render(&header, &body)
+}
+
+/// The CSV header of `bench euler`.
+pub const EULER_CSV_HEADER: &str = "model,m,k,p,kappa,time_scale,predicted_n,fitted_n,relative_error,singular,t0,alpha_min,alpha_max,window_limit,t_start,t_end,points,termination,end_time,end_alpha,min_normal,min_normal_alpha,termination_mu,end_time_mu,end_alpha_mu,wall_seconds";
+
+/// The Euler's disk rows as CSV with [`EULER_CSV_HEADER`]; `_mu` columns are the run with μ = 0.3.
+#[must_use]
+pub fn euler_csv(rows: &[EulerRow]) -> String {
+    let mut out = String::from(EULER_CSV_HEADER);
+    out.push('\n');
+    for r in rows {
+        let d = &r.dissipation;
+        let fields = [
+            d.model().name().to_string(),
+            number(Some(d.m())),
+            number(Some(d.k())),
+            number(Some(r.p)),
+            number(Some(d.coefficient())),
+            number(Some(r.time_scale)),
+            number(Some(r.predicted)),
+            number(r.fit.map(|f| f.exponent)),
+            number(r.relative_error()),
+            r.fit.map_or_else(String::new, |f| f.singular.to_string()),
+            number(r.fit.map(|f| f.t0)),
+            number(Some(r.alpha_window.0)),
+            number(Some(r.alpha_window.1)),
+            r.limit.name().to_string(),
+            number(Some(r.time_window.0)),
+            number(Some(r.time_window.1)),
+            r.points.to_string(),
+            r.end.termination.clone(),
+            number(Some(r.end.time)),
+            number(Some(r.end.alpha)),
+            number(Some(r.lowest_normal.0)),
+            number(Some(r.lowest_normal.1)),
+            r.with_friction.termination.clone(),
+            number(Some(r.with_friction.time)),
+            number(Some(r.with_friction.alpha)),
+            number(Some(r.wall_seconds)),
+        ];
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// The Euler's disk rows as a text table.
+#[must_use]
+pub fn euler_table(rows: &[EulerRow]) -> String {
+    let header = [
+        "model",
+        "m",
+        "k",
+        "p",
+        "kappa",
+        "n = 1/(1-p)",
+        "n fitted",
+        "rel. error",
+        "t0 fitted",
+        "window alpha",
+        "window t",
+        "end (no mu)",
+        "min N/Mg (at alpha)",
+        "end (mu = 0.3)",
+    ];
+    let end =
+        |e: &super::euler::RunEnd| format!("{} t={:.4} a={:.3e}", e.termination, e.time, e.alpha);
+    let body: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let d = &r.dissipation;
+            vec![
+                d.model().name().to_string(),
+                format!("{}", d.m()),
+                format!("{}", d.k()),
+                format!("{}", r.p),
+                short(Some(d.coefficient())),
+                format!("{:.4}", r.predicted),
+                r.fit
+                    .map_or_else(|| "-".into(), |f| format!("{:.4}", f.exponent)),
+                r.relative_error()
+                    .map_or_else(|| "-".into(), |e| format!("{:.2}%", 100.0 * e)),
+                r.fit.map_or_else(|| "-".into(), |f| format!("{:.2}", f.t0)),
+                format!(
+                    "{:.4}..{:.4} ({})",
+                    r.alpha_window.0,
+                    r.alpha_window.1,
+                    r.limit.name()
+                ),
+                format!("{:.1}..{:.1}", r.time_window.0, r.time_window.1),
+                end(&r.end),
+                format!("{:.5} ({:.2e})", r.lowest_normal.0, r.lowest_normal.1),
+                end(&r.with_friction),
             ]
         })
         .collect();

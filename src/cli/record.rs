@@ -62,7 +62,7 @@ pub struct RecordArgs {
     #[arg(long, value_name = "H")]
     step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
-    /// invariants, tf, scene (overrides `record.channels`; default all).
+    /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     channels: Option<Vec<String>>,
     /// Chunk compression.
@@ -553,6 +553,8 @@ fn json_summary(
         "termination": s.termination.name(),
         "termination_time": s.termination_time,
         "event_trusted": s.event_trusted,
+        "dissipated_work": s.dissipated_work,
+        "termination_alpha": s.termination_alpha,
         "peak_rss_bytes": peak_rss_bytes(),
     })
 }
@@ -587,8 +589,26 @@ fn summary_rows(
                 s.stats.rejected_steps
             ),
         ),
-        ("energy drift", format!("{:.3e}", s.energy_drift)),
     ];
+    rows.extend(physics_rows(s));
+    rows
+}
+
+/// The summary's rows after the integrator: drift (of E + W with dissipation, physics §11), W, C1/C2
+/// drift, steady residual, termination (with α for a dissipative run, and a warning when the event is
+/// not to be trusted).
+fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
+    let mut rows = Vec::new();
+    match s.dissipated_work {
+        Some(w) => {
+            rows.push((
+                "energy balance",
+                format!("{:.3e} (drift of E + W)", s.energy_drift),
+            ));
+            rows.push(("dissipated W", format!("{w:.6e}")));
+        }
+        None => rows.push(("energy drift", format!("{:.3e}", s.energy_drift))),
+    }
     if let Some(d) = s.invariant_drift {
         rows.push(("C1/C2 drift", format!("{d:.3e}")));
     }
@@ -596,6 +616,9 @@ fn summary_rows(
         rows.push(("steady residual", format!("{r:.3e}")));
     }
     let mut termination = format!("{} at t = {}", s.termination.name(), s.termination_time);
+    if let Some(a) = s.termination_alpha {
+        termination.push_str(&format!(" (α = {a:.4e} rad from the table)"));
+    }
     if s.event_trusted == Some(false) {
         termination.push_str(" (not to be trusted: energy drift above the tolerance)");
     }

@@ -32,11 +32,30 @@ pub enum Channel {
     Tf,
     /// Foxglove scene (coin and track).
     Scene,
+    /// Dissipated work W and the balance E + W (only with dissipation, physics §11).
+    Work,
 }
 
 impl Channel {
-    /// Every channel, in the contract's order (also the order channels are registered in a file).
-    pub const ALL: [Channel; 10] = [
+    /// Every channel. `work` is last here, but in a file it is written, and registered, with the other
+    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table).
+    pub const ALL: [Channel; 11] = [
+        Self::Omega,
+        Self::Angles,
+        Self::Quaternion,
+        Self::Position,
+        Self::Contact,
+        Self::Reaction,
+        Self::Energy,
+        Self::Invariants,
+        Self::Tf,
+        Self::Scene,
+        Self::Work,
+    ];
+
+    /// The channels a scene records when it lists none and has no dissipation (format.md: all ten); with
+    /// dissipation, `work` is added.
+    pub const DEFAULT: [Channel; 10] = [
         Self::Omega,
         Self::Angles,
         Self::Quaternion,
@@ -63,6 +82,7 @@ impl Channel {
             Self::Invariants => "invariants",
             Self::Tf => "tf",
             Self::Scene => "scene",
+            Self::Work => "work",
         }
     }
 
@@ -80,6 +100,7 @@ impl Channel {
             Self::Invariants => "/coin/invariants",
             Self::Tf => "/tf",
             Self::Scene => "/scene",
+            Self::Work => "/coin/work",
         }
     }
 
@@ -96,6 +117,7 @@ impl Channel {
             Self::Invariants => "coin_log.Invariants",
             Self::Tf => "foxglove.FrameTransform",
             Self::Scene => "foxglove.SceneUpdate",
+            Self::Work => "coin_log.Work",
         }
     }
 
@@ -143,6 +165,7 @@ pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
         "coin_log.Reaction" => include_bytes!("../../schemas/coin_log.Reaction.json"),
         "coin_log.Energy" => include_bytes!("../../schemas/coin_log.Energy.json"),
         "coin_log.Invariants" => include_bytes!("../../schemas/coin_log.Invariants.json"),
+        "coin_log.Work" => include_bytes!("../../schemas/coin_log.Work.json"),
         "foxglove.FrameTransform" => include_bytes!("../../schemas/foxglove.FrameTransform.json"),
         "foxglove.SceneUpdate" => include_bytes!("../../schemas/foxglove.SceneUpdate.json"),
         _ => return None,

@@ -172,6 +172,17 @@ message!(
     c2,
 });
 
+message!(
+    /// `/coin/work`: the dissipated work and the energy balance (physics §11) [mass·length²/time²].
+    WorkMessage, "coin_log.Work", {
+    /// Simulation time.
+    t,
+    /// W, the energy dissipated since t = 0.
+    dissipated,
+    /// E + W, constant for an exact solution.
+    balance,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

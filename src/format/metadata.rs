@@ -5,7 +5,7 @@
 
 use super::Termination;
 use crate::integrate::Method;
-use crate::model::SteadyFamily;
+use crate::model::{Dissipation, DissipationModel, SteadyFamily};
 use std::collections::BTreeMap;
 use std::str::FromStr;
 
@@ -13,6 +13,8 @@ use std::str::FromStr;
 pub const RUN_METADATA_NAME: &str = "coin-log";
 /// Name of the metadata record written at the end.
 pub const RESULT_METADATA_NAME: &str = "coin-log.result";
+/// Key of α at the end of a dissipative run in the `coin-log.result` record.
+pub const TERMINATION_ALPHA_KEY: &str = "termination_alpha";
 /// `format_version` of this contract.
 pub const FORMAT_VERSION: &str = "1";
 
@@ -95,6 +97,10 @@ pub struct RunMetadata {
     pub r_g: Option<f64>,
     /// Steady R_C.
     pub r_c: Option<f64>,
+    /// The dissipation law (physics §11): keys `dissipation` (the model), `dissipation_coefficient` (κ),
+    /// `dissipation_m`, `dissipation_k`, written only when there is one. A file without them is
+    /// conservative.
+    pub dissipation: Option<Dissipation>,
 }
 
 /// The `coin-log.result` record: how the run ended.
@@ -110,6 +116,9 @@ pub struct ResultMetadata {
     pub termination: Termination,
     /// Time the run ended.
     pub termination_time: f64,
+    /// α = π/2 − |θ| at the last sample (`termination_alpha`), written only with dissipation: how flat
+    /// the coin was when the run ended (physics §11).
+    pub termination_alpha: Option<f64>,
 }
 
 fn get<'a>(
@@ -212,10 +221,21 @@ impl RunMetadata {
             ("r_g", optional_string(self.r_g)),
             ("r_c", optional_string(self.r_c)),
         ];
-        entries
+        let mut map: BTreeMap<String, String> = entries
             .into_iter()
             .map(|(k, v)| (k.to_string(), v))
-            .collect()
+            .collect();
+        if let Some(d) = &self.dissipation {
+            for (k, v) in [
+                (DISSIPATION_KEYS[0], d.model().to_string()),
+                (DISSIPATION_KEYS[1], number_string(d.coefficient())),
+                (DISSIPATION_KEYS[2], number_string(d.m())),
+                (DISSIPATION_KEYS[3], number_string(d.k())),
+            ] {
+                map.insert(k.to_string(), v);
+            }
+        }
+        map
     }
 
     /// Reads the record back.
@@ -248,8 +268,39 @@ impl RunMetadata {
             psi_dot: get_optional_f64(map, r, "psi_dot")?,
             r_g: get_optional_f64(map, r, "r_g")?,
             r_c: get_optional_f64(map, r, "r_c")?,
+            dissipation: dissipation_from_map(map)?,
         })
     }
+}
+
+/// The keys of the dissipation law in the `coin-log` record, present together or not at all.
+pub const DISSIPATION_KEYS: [&str; 4] = [
+    "dissipation",
+    "dissipation_coefficient",
+    "dissipation_m",
+    "dissipation_k",
+];
+
+/// The dissipation law of a `coin-log` record: `None` when none of its keys is there.
+fn dissipation_from_map(
+    map: &BTreeMap<String, String>,
+) -> Result<Option<Dissipation>, MetadataError> {
+    let r = RUN_METADATA_NAME;
+    if DISSIPATION_KEYS.iter().all(|k| !map.contains_key(*k)) {
+        return Ok(None);
+    }
+    let model: DissipationModel = get_parsed(map, r, DISSIPATION_KEYS[0])?;
+    let coefficient = get_f64(map, r, DISSIPATION_KEYS[1])?;
+    let m = get_f64(map, r, DISSIPATION_KEYS[2])?;
+    let k = get_f64(map, r, DISSIPATION_KEYS[3])?;
+    Dissipation::new(model, coefficient, m, k)
+        .map(Some)
+        .map_err(|e| MetadataError::Invalid {
+            record: r,
+            key: DISSIPATION_KEYS[0],
+            value: model.to_string(),
+            reason: e.to_string(),
+        })
 }
 
 impl ResultMetadata {
@@ -263,10 +314,14 @@ impl ResultMetadata {
             ("termination", self.termination.to_string()),
             ("termination_time", number_string(self.termination_time)),
         ];
-        entries
+        let mut map: BTreeMap<String, String> = entries
             .into_iter()
             .map(|(k, v)| (k.to_string(), v))
-            .collect()
+            .collect();
+        if let Some(alpha) = self.termination_alpha {
+            map.insert(TERMINATION_ALPHA_KEY.to_string(), number_string(alpha));
+        }
+        map
     }
 
     /// Reads the record back.
@@ -281,6 +336,10 @@ impl ResultMetadata {
             rejected_steps: get_u64(map, r, "rejected_steps")?,
             termination: get_parsed(map, r, "termination")?,
             termination_time: get_f64(map, r, "termination_time")?,
+            termination_alpha: match map.get(TERMINATION_ALPHA_KEY) {
+                None => None,
+                Some(_) => Some(get_f64(map, r, TERMINATION_ALPHA_KEY)?),
+            },
         })
     }
 }

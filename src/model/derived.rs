@@ -1,6 +1,6 @@
 //! Quantities derived from a state (physics §1, §3): centre, contact point, quaternion, energy, reaction.
 
-use super::equations::Coin;
+use super::equations::{AngularAcceleration, Coin};
 use super::state::State;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -108,9 +108,16 @@ pub struct Reaction {
 /// ```
 #[must_use]
 pub fn reaction(coin: &Coin, s: &State) -> Reaction {
+    let acc = coin.angular_acceleration(s.theta, s.omega_x, s.omega_y, s.omega_z);
+    reaction_with(coin, s, acc)
+}
+
+/// The reaction of physics §3 for given angular accelerations (ω̇_X, ω̇_Y, ω̇_Z): those of eqs (14)–(16)
+/// ([`reaction`]), or of eqs (31)–(33) with a dissipative couple (physics §11).
+#[must_use]
+pub(super) fn reaction_with(coin: &Coin, s: &State, acc: AngularAcceleration) -> Reaction {
     let p = coin.params();
     let ma = p.mass() * p.radius();
-    let acc = coin.angular_acceleration(s.theta, s.omega_x, s.omega_y, s.omega_z);
     let (st, ct) = s.theta.sin_cos();
     let (sp, cp) = s.phi.sin_cos();
     let tan_t = st / ct;

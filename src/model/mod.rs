@@ -2,6 +2,7 @@
 //! Pure functions; no I/O and no knowledge of integrators or files.
 
 mod derived;
+mod dissipation;
 pub mod drift;
 mod equations;
 pub mod invariants;
@@ -11,6 +12,10 @@ mod state;
 mod steady;
 
 pub use derived::{centre, contact_point, energy, orientation, reaction, Energy, Reaction};
+pub use dissipation::{
+    Dissipation, DissipationError, DissipationModel, DissipativeCoin, DissipativeRates, Dynamics,
+    UnknownDissipationModel, DISSIPATIVE_STATE_LEN, MIN_RATE_EXPONENT, WORK_INDEX,
+};
 pub use equations::{AngularAcceleration, Coin};
 pub use invariants::{Chaplygin, Invariants, InvariantsError, LegendreBasis};
 pub use params::{CoinParams, Inertia, ParamError};

@@ -15,22 +15,22 @@ use super::foxglove::{Foxglove3d, FoxgloveBatch};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField, Position,
-    QuaternionMessage, ReactionMessage,
+    QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError,
     FORMAT_VERSION, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use crate::integrate::{self, run_method, Flow, RunOutcome, RunSettings};
+use crate::integrate::{self, Flow, RunOutcome, RunSettings};
 use crate::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{
-    centre, contact_point, energy, orientation, reaction, Chaplygin, Coin, InvariantsError, State,
+    centre, contact_point, energy, orientation, Chaplygin, Coin, Dynamics, InvariantsError, State,
     STATE_LEN,
 };
 use crate::scene::Scene;
-use crate::simulation::CoinEvents;
+use crate::simulation::run_dynamics;
 use std::collections::BTreeMap;
 use std::fmt;
 use std::io::{Seek, Write};
@@ -156,6 +156,7 @@ pub fn run_metadata(scene: &Scene) -> RunMetadata {
         psi_dot: steady.map(|s| s.psi_dot),
         r_g: steady.and_then(|s| s.r_g),
         r_c: steady.and_then(|s| s.r_c),
+        dissipation: scene.dissipation,
     }
 }
 
@@ -222,9 +223,13 @@ impl<W: Write + Seek> Output<W> {
     }
 }
 
-/// Running measures for the summary: energy and invariant drift, distance from the steady motion.
+/// Running measures for the summary: energy (or, with dissipation, energy balance E + W) and invariant
+/// drift, distance from the steady motion, and the last sample's W and θ.
 struct Drift {
     energy: EnergyDrift,
+    /// The last sample's W (dissipative runs) and θ.
+    last_work: Option<f64>,
+    last_theta: f64,
     /// Set at the first sample that has C1, C2.
     invariants: Option<InvariantDrift>,
     /// (θ*, ω_X*, ω_Y*, ω_Z*) of an unperturbed steady scene.
@@ -236,10 +241,18 @@ struct Drift {
 }
 
 impl Drift {
+    /// α = π/2 − |θ| at the last sample, for dissipative runs (format.md: `termination_alpha`).
+    fn termination_alpha(&self) -> Option<f64> {
+        self.last_work
+            .map(|_| std::f64::consts::FRAC_PI_2 - self.last_theta.abs())
+    }
+
     fn new(scene: &Scene, coin: &Coin) -> Self {
         let params = scene.params;
         Self {
             energy: EnergyDrift::new(&params, energy(coin, &scene.initial).total),
+            last_work: None,
+            last_theta: scene.initial.theta,
             invariants: None,
             steady: scene.unperturbed_steady().map(|s| {
                 let s = &s.state;
@@ -256,6 +269,8 @@ impl Drift {
 struct Sampler<W: Write + Seek> {
     out: Output<W>,
     coin: Coin,
+    /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
+    dynamics: Dynamics,
     on: [bool; Channel::ALL.len()],
     /// The formatted messages of the current sample, back to back.
     buffer: Vec<u8>,
@@ -290,14 +305,25 @@ impl<W: Write + Seek> Sampler<W> {
         Ok(())
     }
 
-    /// Writes the sample (t, y): all its messages or, if one cannot be formatted, none.
-    fn sample(&mut self, t: f64, y: &[f64; STATE_LEN], last: bool) -> Result<(), SampleError> {
+    /// Writes the sample (t, y) with the dissipated work W of a dissipative run: all its messages or, if
+    /// one cannot be formatted, none.
+    fn sample(
+        &mut self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        work: Option<f64>,
+        last: bool,
+    ) -> Result<(), SampleError> {
         let ns = log_time(t)?;
         let s = State::from_array(y);
         self.buffer.clear();
         self.staged_len = 0;
         self.stage_kinematics(t, &s)?;
         let (total, invariants) = self.stage_dynamics(t, &s)?;
+        let total = match work {
+            Some(w) => self.stage_work(t, total, w)?,
+            None => total,
+        };
         if let Some((foxglove, batch)) = &mut self.foxglove {
             batch.clear();
             foxglove.sample(t, ns, &s, last, batch)?;
@@ -311,8 +337,25 @@ impl<W: Write + Seek> Sampler<W> {
             }
         }
         self.track(t, &s, total, invariants);
+        self.drift.last_work = work;
         self.samples += 1;
         Ok(())
+    }
+
+    /// Stages `/coin/work` (when recorded) and returns the balance E + W, which the summary's drift
+    /// follows in place of E (physics §11).
+    #[inline]
+    fn stage_work(&mut self, t: f64, total: f64, work: f64) -> Result<f64, SampleError> {
+        let balance = total + work;
+        if self.on(Channel::Work) {
+            let m = WorkMessage {
+                t,
+                dissipated: work,
+                balance,
+            };
+            self.stage(Channel::Work, |b| m.write_json(b))?;
+        }
+        Ok(balance)
     }
 
     /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
@@ -381,7 +424,7 @@ impl<W: Write + Seek> Sampler<W> {
     ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
         let coin = self.coin;
         if self.on(Channel::Reaction) {
-            let r = reaction(&coin, s);
+            let r = self.dynamics.reaction(s);
             let m = ReactionMessage {
                 t,
                 x: r.force.x,
@@ -421,7 +464,9 @@ impl<W: Write + Seek> Sampler<W> {
         d.energy.observe(t, total);
         let omega = (s.omega_x * s.omega_x + s.omega_y * s.omega_y + s.omega_z * s.omega_z).sqrt();
         d.max_omega = d.max_omega.max(omega);
-        if let Some((c1, c2)) = invariants {
+        d.last_theta = s.theta;
+        // With dissipation C1, C2 are not conserved (physics §11): their change is no drift.
+        if let (Some((c1, c2)), None) = (invariants, self.dynamics.dissipation()) {
             let params = self.coin.params();
             d.invariants
                 .get_or_insert_with(|| InvariantDrift::new(params, c1, c2))
@@ -519,20 +564,20 @@ fn integrate_into<W: Write + Seek>(
         t_end: scene.run.duration,
         sample_interval: scene.run.sample_interval(),
     };
-    let coin = sampler.coin;
-    let events = CoinEvents::new(coin, scene.run.flat_margin, scene.friction);
-    let mut pending: Option<(f64, [f64; STATE_LEN])> = None;
+    let dynamics = sampler.dynamics;
+    let mut pending: Option<(f64, [f64; STATE_LEN], Option<f64>)> = None;
     let mut error: Option<SampleError> = None;
     let mut observed: u64 = 0;
-    let outcome = run_method(
+    let outcome = run_dynamics(
         &scene.run.method,
-        &coin,
-        &scene.initial.to_array(),
+        &dynamics,
+        &scene.initial,
         &settings,
-        &events,
-        |t, y| {
-            if let Some((tp, yp)) = pending.replace((t, *y)) {
-                if let Err(e) = sampler.sample(tp, &yp, false) {
+        scene.run.flat_margin,
+        scene.friction,
+        |t, y, work| {
+            if let Some((tp, yp, wp)) = pending.replace((t, *y, work)) {
+                if let Err(e) = sampler.sample(tp, &yp, wp, false) {
                     error = Some(e);
                     return Flow::Stop;
                 }
@@ -549,8 +594,8 @@ fn integrate_into<W: Write + Seek>(
         },
     );
     if error.is_none() {
-        if let Some((t, y)) = pending {
-            error = sampler.sample(t, &y, true).err();
+        if let Some((t, y, w)) = pending {
+            error = sampler.sample(t, &y, w, true).err();
         }
     }
     progress(outcome.t_last);
@@ -561,7 +606,8 @@ impl<W: Write + Seek> Sampler<W> {
     /// Opens the file: writer, `coin-log` metadata, and what each sample will compute. A body whose C1, C2
     /// cannot be evaluated fails here, before the first byte, so no half-written file is left.
     fn start(scene: &Scene, options: &RecordOptions, writer: W) -> Result<Self, RecordError> {
-        let coin = scene.coin();
+        let dynamics = scene.dynamics();
+        let coin = *dynamics.coin();
         let mut on = [false; Channel::ALL.len()];
         for c in &scene.channels {
             on[*c as usize] = true;
@@ -588,6 +634,7 @@ impl<W: Write + Seek> Sampler<W> {
                 messages: 0,
             },
             coin,
+            dynamics,
             on,
             buffer: Vec::with_capacity(1024),
             staged: [(Channel::Omega, 0, 0); Channel::ALL.len()],
@@ -621,6 +668,7 @@ impl<W: Write + Seek> Sampler<W> {
                 rejected_steps: stats.rejected_steps,
                 termination,
                 termination_time,
+                termination_alpha: drift.termination_alpha(),
             }
             .to_map(),
         )?;
@@ -639,6 +687,8 @@ impl<W: Write + Seek> Sampler<W> {
             steady_residual: drift.steady.map(|_| drift.steady_residual),
             energy_tolerance: f64::NAN,
             event_trusted: None,
+            dissipated_work: drift.last_work,
+            termination_alpha: drift.termination_alpha(),
         })
     }
 }

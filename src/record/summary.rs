@@ -54,7 +54,8 @@ pub struct RecordSummary {
     pub termination_time: f64,
     /// The numerical failure that ended the run, when one did (its detail for the user).
     pub failure: Option<Failure>,
-    /// Energy drift over the samples ([`EnergyDrift`](crate::model::drift::EnergyDrift)).
+    /// Energy drift over the samples ([`EnergyDrift`](crate::model::drift::EnergyDrift)); with
+    /// dissipation, the drift of E + W.
     pub energy_drift: f64,
     /// Invariant drift over the samples, when C1, C2 were computed
     /// ([`InvariantDrift`](crate::model::drift::InvariantDrift)).
@@ -69,4 +70,9 @@ pub struct RecordSummary {
     /// event is within [`energy_tolerance`](Self::energy_tolerance). When it is not, the integration had
     /// already gone wrong and the event may be an artefact of it, not physics. `None` without an event.
     pub event_trusted: Option<bool>,
+    /// With dissipation: the work W dissipated by the end of the run \[energy\] (physics §11); the energy
+    /// drift is then that of the balance E + W.
+    pub dissipated_work: Option<f64>,
+    /// With dissipation: α = π/2 − |θ| at the last sample, how flat the coin was when the run ended.
+    pub termination_alpha: Option<f64>,
 }

@@ -48,6 +48,27 @@ pub struct BodyFile {
     /// Display thickness, as a fraction of a (default 0.05).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness: Option<f64>,
+    /// A dissipative couple (physics §11).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dissipation: Option<DissipationFile>,
+}
+
+/// `dissipation = { model = ..., coefficient = ..., m = ..., k = ... }`: the couple −P ω/|ω|² with
+/// P = κ |φ̇|^m (sin α)^(−k) (physics §11).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DissipationFile {
+    /// `moffatt`, `air-drag`, `viscous`, `rolling`, `pivoting` or `power-law`.
+    pub model: String,
+    /// κ ≥ 0, in the scene's units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coefficient: Option<f64>,
+    /// m ≥ 1 (`power-law` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub m: Option<f64>,
+    /// k (`power-law` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k: Option<f64>,
 }
 
 /// `[initial]`: an explicit state (θ and ω, optionally φ, ψ, x, z) or a steady motion, plus an optional kick.

@@ -12,14 +12,15 @@ pub mod presets;
 mod validate;
 
 pub use file::{
-    BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
+    BodyFile, DissipationFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile,
+    SteadyFile,
 };
 pub use overrides::{apply_set, FlagOverrides};
 pub use validate::UNEXPLAINED;
 
 use crate::format::Channel;
 use crate::integrate::MethodConfig;
-use crate::model::{Coin, CoinParams, Inertia, State, Steady};
+use crate::model::{Coin, CoinParams, Dissipation, Dynamics, Inertia, State, Steady};
 use std::fmt;
 
 /// Defaults of the optional scene keys (format.md: Scene files).
@@ -210,6 +211,8 @@ pub struct Scene {
     pub friction: Option<f64>,
     /// Display thickness, fraction of a.
     pub thickness: f64,
+    /// The dissipative couple (physics §11), if any.
+    pub dissipation: Option<Dissipation>,
     /// The state at t = 0, perturbation included.
     pub initial: State,
     /// The state before the perturbation (the explicit state or the steady motion, with φ, ψ, x, z).
@@ -239,12 +242,23 @@ impl Scene {
         Coin::new(self.params)
     }
 
-    /// The steady motion the scene starts on, when it was given as one and not perturbed: then the whole
-    /// run should stay on it (the `steady_kind` of the metadata).
+    /// The coin with its dissipation, if any: the equations the scene integrates (physics §2, §11).
+    #[must_use]
+    pub fn dynamics(&self) -> Dynamics {
+        Dynamics::new(self.coin(), self.dissipation)
+    }
+
+    /// The steady motion the scene starts on, when it was given as one, not perturbed and without
+    /// dissipation: then the whole run should stay on it (the `steady_kind` of the metadata). A dissipative
+    /// couple moves the coin off every steady motion (physics §11), so a dissipative scene has none.
     #[must_use]
     pub fn unperturbed_steady(&self) -> Option<&Steady> {
         match &self.spec {
-            InitialSpec::Steady(s) if self.perturbation.iter().all(|&p| p == 0.0) => Some(s),
+            InitialSpec::Steady(s)
+                if self.perturbation.iter().all(|&p| p == 0.0) && self.dissipation.is_none() =>
+            {
+                Some(s)
+            }
             _ => None,
         }
     }

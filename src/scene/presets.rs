@@ -4,10 +4,12 @@
 //! Unless said otherwise: the unit thin disk (M = a = g = 1, physics §2), the default run settings and all
 //! channels, durations of 20–30 time units at 100 samples per unit so that recordings stay small.
 
-use super::file::{BodyFile, InitialFile, PerturbationFile, RunFile, SceneFile, SteadyFile};
+use super::file::{
+    BodyFile, DissipationFile, InitialFile, PerturbationFile, RunFile, SceneFile, SteadyFile,
+};
 
 /// Every built-in scene name, in listing order.
-pub const NAMES: [&str; 14] = [
+pub const NAMES: [&str; 15] = [
     "straight",
     "straight-unstable",
     "centre-fixed",
@@ -22,7 +24,22 @@ pub const NAMES: [&str; 14] = [
     "lift-off",
     "long-horizon",
     "five-hundred-yen",
+    "euler-disk",
 ];
+
+/// Dynamic viscosity of air at about 20 °C \[Pa·s\], for the `euler-disk` scene's Moffatt coefficient.
+pub const AIR_VISCOSITY: f64 = 1.8e-5;
+
+/// Radius of the `euler-disk` toy \[m\]: a 75 mm disk.
+pub const EULER_DISK_RADIUS: f64 = 0.0375;
+
+/// Moffatt's coefficient of a disk of radius `a` in air of viscosity `mu` (physics §11, eq (39)):
+/// κ = (π/4) μ a³, the value for which P = κ φ̇²/sin α reproduces Moffatt's spin time
+/// t₀ = α₀³ M / (2π μ a) on the thin disk's centre-fixed motion.
+#[must_use]
+pub fn moffatt_coefficient(mu: f64, a: f64) -> f64 {
+    std::f64::consts::FRAC_PI_4 * mu * a * a * a
+}
 
 /// The built-in scene `name`, as a file.
 #[must_use]
@@ -171,8 +188,49 @@ pub fn preset(name: &str) -> Option<SceneFile> {
             }),
             record: None,
         },
+        "euler-disk" => euler_disk(),
         _ => return None,
     })
+}
+
+/// The `euler-disk` scene: a toy-like steel disk in SI units on its centre-fixed motion at α₀ = 0.2,
+/// losing energy by Moffatt's air film (physics §11) until an event ends the run. No μ: the rolling model
+/// is followed to the end of the collapse (`bench euler` reports where μ = 0.3 would slip first).
+fn euler_disk() -> SceneFile {
+    let a = EULER_DISK_RADIUS;
+    SceneFile {
+        description: Some(
+            "Euler's disk: a 75 mm, 0.45 kg steel toy in SI units (a = 37.5 mm, g = 9.81 m/s²; time unit 61.8 ms) started on its centre-fixed motion at α0 = 0.2 rad from the table, losing energy to Moffatt's air film (κ = (π/4)·1.8e-5 Pa·s·a³, physics §11) until an event ends the run (the flat landing, 860 s later; with --set body.friction=0.3 a slip at α = 0.095)".into(),
+        ),
+        body: BodyFile {
+            mass: 0.45,
+            radius: a,
+            gravity: 9.81,
+            shape: Some("thin-disk".into()),
+            // 13 mm thick for a 37.5 mm radius.
+            thickness: Some(0.35),
+            dissipation: Some(DissipationFile {
+                model: "moffatt".into(),
+                coefficient: Some(moffatt_coefficient(AIR_VISCOSITY, a)),
+                m: None,
+                k: None,
+            }),
+            ..BodyFile::default()
+        },
+        initial: steady_initial(SteadyFile {
+            kind: "centre-fixed".into(),
+            theta: Some(std::f64::consts::FRAC_PI_2 - 0.2),
+            ..SteadyFile::default()
+        }),
+        // Longer than the collapse (≈ 860 s): an event ends the run. 400 samples/s resolve the precession
+        // (72 rad/s at α = 0.2, 100 rad/s at α = 0.1) for verify's constraint check over most of the run.
+        run: Some(RunFile {
+            duration: Some(2000.0),
+            rate: Some(400.0),
+            ..RunFile::default()
+        }),
+        record: None,
+    }
 }
 
 fn unit_disk() -> BodyFile {

@@ -2,7 +2,8 @@
 //! way back (a resolved scene as a file with every default written out).
 
 use super::file::{
-    BodyFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile, SteadyFile,
+    BodyFile, DissipationFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile,
+    SteadyFile,
 };
 use super::limits;
 use super::{
@@ -10,7 +11,10 @@ use super::{
 };
 use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
-use crate::model::{Branch, Coin, CoinParams, Inertia, State, Steady, SteadyFamily, SteadyKind};
+use crate::model::{
+    Branch, Coin, CoinParams, Dissipation, DissipationModel, Inertia, State, Steady, SteadyFamily,
+    SteadyKind, MIN_RATE_EXPONENT,
+};
 use std::f64::consts::FRAC_PI_2;
 
 /// Collects problems, naming the flag that set a key when one did.
@@ -143,20 +147,27 @@ pub(super) fn scene_from_file(
             &mut problems,
         );
     }
+    let dissipation = check_dissipation(file.body.dissipation.as_ref(), &mut problems);
     let run = check_run(&run_file, flat_margin, margin_ok, &mut problems);
-    let channels = check_channels(file.record.as_ref(), &mut problems);
-    let scene = match (body, initial, run, channels) {
+    let channels = check_channels(
+        file.record.as_ref(),
+        file.body.dissipation.is_some(),
+        &mut problems,
+    );
+    let scene = match (body, initial, run, channels, dissipation) {
         (
             Some((params, inertia, friction, thickness)),
             Some((base, spec, perturbation)),
             Some(run),
             Some(channels),
+            Some(dissipation),
         ) if problems.list.is_empty() => Some(Scene {
             description: file.description.clone().unwrap_or_default(),
             params,
             inertia,
             friction,
             thickness,
+            dissipation,
             initial: perturbed(&base, &perturbation),
             base,
             spec,
@@ -283,6 +294,126 @@ fn check_inertia(body: &BodyFile, problems: &mut Problems) -> Option<Inertia> {
 }
 
 type Initial = (State, InitialSpec, [f64; 4]);
+
+/// `body.dissipation` (physics §11): `Some(None)` without one, `Some(Some(law))` for a valid one, `None`
+/// when something is wrong (reported).
+fn check_dissipation(
+    file: Option<&DissipationFile>,
+    problems: &mut Problems,
+) -> Option<Option<Dissipation>> {
+    let Some(d) = file else {
+        return Some(None);
+    };
+    let before = problems.list.len();
+    let model = match d.model.parse::<DissipationModel>() {
+        Ok(m) => Some(m),
+        Err(e) => {
+            problems.push("body.dissipation.model", quoted(&d.model), format!("{e}"));
+            None
+        }
+    };
+    let coefficient = match d.coefficient {
+        Some(c) if c.is_finite() && c >= 0.0 => c,
+        Some(c) => {
+            problems.push(
+                "body.dissipation.coefficient",
+                number(c),
+                "is outside [0, ∞): give κ as a finite number ≥ 0, in the scene's units",
+            );
+            f64::NAN
+        }
+        None => {
+            problems.missing(
+                "body.dissipation.coefficient",
+                "is missing: give κ of P = κ |φ̇|^m (sin α)^(−k), e.g. coefficient = 1e-6",
+            );
+            f64::NAN
+        }
+    };
+    let (m, k) = match model.map(DissipationModel::exponents) {
+        Some(Some((m, k))) => {
+            preset_exponent_given(d, model, problems);
+            (m, k)
+        }
+        Some(None) => power_law_exponents(d, problems),
+        None => (f64::NAN, f64::NAN),
+    };
+    if problems.list.len() != before {
+        return None;
+    }
+    let model = model?;
+    match Dissipation::new(model, coefficient, m, k) {
+        Ok(law) => Some(Some(law)),
+        Err(e) => {
+            problems.push(
+                "body.dissipation",
+                format!("{{ model = \"{model}\" }}"),
+                format!("cannot be built: {e}"),
+            );
+            None
+        }
+    }
+}
+
+/// A preset fixes m and k: giving them is an error that names `power-law`.
+fn preset_exponent_given(
+    d: &DissipationFile,
+    model: Option<DissipationModel>,
+    problems: &mut Problems,
+) {
+    let Some(model) = model else { return };
+    let Some((m, k)) = model.exponents() else {
+        return;
+    };
+    for (name, value) in [("m", d.m), ("k", d.k)] {
+        if let Some(v) = value {
+            problems.push(
+                &format!("body.dissipation.{name}"),
+                number(v),
+                format!(
+                    "does not apply to model \"{model}\", which fixes m = {m}, k = {k}: use model = \"power-law\" to choose m and k"
+                ),
+            );
+        }
+    }
+}
+
+/// `power-law`'s m ≥ 1 and k, both required.
+fn power_law_exponents(d: &DissipationFile, problems: &mut Problems) -> (f64, f64) {
+    let m = match d.m {
+        Some(m) if m.is_finite() && m >= MIN_RATE_EXPONENT => m,
+        Some(m) => {
+            problems.push(
+                "body.dissipation.m",
+                number(m),
+                "is outside [1, ∞): the couple P/|ω| ∝ |ω|^(m−1) must stay bounded as the coin stops",
+            );
+            f64::NAN
+        }
+        None => {
+            problems.missing(
+                "body.dissipation.m",
+                "is missing: model \"power-law\" needs m (≥ 1) and k",
+            );
+            f64::NAN
+        }
+    };
+    let k = match d.k {
+        Some(k) if k.is_finite() => k,
+        Some(k) => {
+            problems.push("body.dissipation.k", number(k), "is not a finite number");
+            f64::NAN
+        }
+        None => {
+            problems.missing(
+                "body.dissipation.k",
+                "is missing: model \"power-law\" needs m (≥ 1) and k",
+            );
+            f64::NAN
+        }
+    };
+    (m, k)
+}
 
 /// Checks of `[initial]` that need no body (used when the body is invalid).
 fn check_initial_alone(initial: &InitialFile, flat_margin: Option<f64>, problems: &mut Problems) {
@@ -724,9 +855,17 @@ pub(super) fn fitted_step(step: f64, interval: f64) -> f64 {
     interval / steps
 }
 
-fn check_channels(record: Option<&RecordFile>, problems: &mut Problems) -> Option<Vec<Channel>> {
+fn check_channels(
+    record: Option<&RecordFile>,
+    dissipative: bool,
+    problems: &mut Problems,
+) -> Option<Vec<Channel>> {
     let Some(names) = record.and_then(|r| r.channels.as_ref()) else {
-        return Some(Channel::ALL.to_vec());
+        let mut channels = Channel::DEFAULT.to_vec();
+        if dissipative {
+            channels.push(Channel::Work);
+        }
+        return Some(channels);
     };
     let before = problems.list.len();
     let mut channels = Vec::new();
@@ -738,6 +877,11 @@ fn check_channels(record: Option<&RecordFile>, problems: &mut Problems) -> Optio
                 "record.channels",
                 quoted(name),
                 "is listed twice: list each channel once",
+            ),
+            Ok(Channel::Work) if !dissipative => problems.push(
+                "record.channels",
+                quoted(name),
+                "records the work of a dissipative couple, and the scene has none: add body.dissipation = { model = \"moffatt\", coefficient = ... } (format.md: Dissipation) or leave \"work\" out",
             ),
             Ok(c) => channels.push(c),
             Err(_) => problems.push(
@@ -792,6 +936,7 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
             inertia_z,
             friction: scene.friction,
             thickness: Some(scene.thickness),
+            dissipation: scene.dissipation.as_ref().map(dissipation_file),
         },
         initial: InitialFile {
             theta,
@@ -831,6 +976,17 @@ fn run_file(run: &RunConfig) -> RunFile {
         atol: adaptive.then_some(m.atol),
         step: (!adaptive).then_some(m.step),
         flat_margin: Some(run.flat_margin),
+    }
+}
+
+/// The scene keys of a dissipation law: m and k only for `power-law` (a preset fixes them).
+fn dissipation_file(d: &Dissipation) -> DissipationFile {
+    let explicit = d.model().exponents().is_none();
+    DissipationFile {
+        model: d.model().name().to_string(),
+        coefficient: Some(d.coefficient()),
+        m: explicit.then_some(d.m()),
+        k: explicit.then_some(d.k()),
     }
 }
 

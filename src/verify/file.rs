@@ -13,7 +13,7 @@ use super::Options;
 use crate::format::json;
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage,
+    ReactionMessage, WorkMessage,
 };
 use crate::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
@@ -21,7 +21,7 @@ use crate::format::{
 };
 use crate::mcap_io::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
 use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, CoinParams, Inertia};
+use crate::model::{Coin, CoinParams, Dynamics, Inertia};
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -86,6 +86,7 @@ fn fields_of(schema: &str) -> Option<&'static [&'static str]> {
         ReactionMessage::SCHEMA => ReactionMessage::FIELDS,
         EnergyMessage::SCHEMA => EnergyMessage::FIELDS,
         InvariantsMessage::SCHEMA => InvariantsMessage::FIELDS,
+        WorkMessage::SCHEMA => WorkMessage::FIELDS,
         _ => return None,
     })
 }
@@ -183,6 +184,14 @@ impl Judge {
                 }
             ),
             Slot::Invariants => typed!(Invariants, InvariantsMessage { t, c1, c2 }),
+            Slot::Work => typed!(
+                Work,
+                WorkMessage {
+                    t,
+                    dissipated,
+                    balance
+                }
+            ),
         })
     }
 
@@ -222,11 +231,20 @@ impl Judge {
             }
         };
         let coin = Coin::new(params);
-        let steady = steady::plan(&coin, &run);
+        let dynamics = Dynamics::new(coin, run.dissipation);
+        let steady = match &run.dissipation {
+            Some(d) => Err(format!(
+                "the run has dissipation ({}, κ = {}): a dissipative couple moves the coin off every steady motion (physics §11)",
+                d.model(),
+                super::checks::fmt_num(d.coefficient())
+            )),
+            None => steady::plan(&coin, &run),
+        };
         let chaplygin = Chaplygin::new(&params)
             .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
         self.ctx = Some(Context {
             coin,
+            dynamics,
             run,
             result: None,
             steady,
@@ -299,6 +317,7 @@ impl Visitor for Judge {
                     Channel::Reaction => Kind::Coin(Slot::Reaction),
                     Channel::Energy => Kind::Coin(Slot::Energy),
                     Channel::Invariants => Kind::Coin(Slot::Invariants),
+                    Channel::Work => Kind::Coin(Slot::Work),
                     Channel::Tf | Channel::Scene => Kind::Foxglove,
                 }
             }
@@ -492,9 +511,8 @@ fn verdict(
     let c = &judge.checks;
     let mut results = vec![
         integrity::finish(&problems, &read, &judge.notes),
-        c.energy.finish(&tol),
-        c.invariants
-            .finish(&tol, ctx.chaplygin.as_ref().err().map(String::as_str)),
+        c.energy.finish(&tol, &ctx),
+        c.invariants.finish(&tol, invariants_skip(&ctx).as_deref()),
         c.steady.finish(&ctx, &tol),
         c.constraint.finish(ctx.coin.params().radius(), &tol),
         c.consistency.finish(),
@@ -540,6 +558,11 @@ impl Judge {
             self.problems
                 .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
         }
+        if ctx.run.dissipation.is_none() && self.assembler.declared(Slot::Work) {
+            self.problems.push_with(|| {
+                "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
+            });
+        }
         if ctx.result.is_none() && read_whole {
             self.problems.push_with(|| {
                 "no `coin-log.result` metadata record (the run did not finish writing)".into()
@@ -552,6 +575,19 @@ impl Judge {
         }
         problems
     }
+}
+
+/// Why the invariants check does not run: C1, C2 cannot be evaluated for the body, or the run has
+/// dissipation, which changes them (physics §11).
+fn invariants_skip(ctx: &Context) -> Option<String> {
+    if let Some(d) = ctx.dynamics.dissipation() {
+        return Some(format!(
+            "the run has dissipation ({}, κ = {}): C1, C2 are not conserved by the dissipative couple (physics §11); the energy check judges E + W = E0 instead",
+            d.model(),
+            super::checks::fmt_num(d.coefficient())
+        ));
+    }
+    ctx.chaplygin.as_ref().err().cloned()
 }
 
 /// The tolerances of this file: derived from its recorded settings and span, or the flags'.

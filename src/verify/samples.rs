@@ -6,7 +6,7 @@
 
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage,
+    ReactionMessage, WorkMessage,
 };
 use crate::model::State;
 use std::collections::VecDeque;
@@ -33,10 +33,12 @@ pub enum Slot {
     Energy = 6,
     /// `/coin/invariants`.
     Invariants = 7,
+    /// `/coin/work` (dissipative runs).
+    Work = 8,
 }
 
 /// Number of slots.
-pub const SLOTS: usize = 8;
+pub const SLOTS: usize = 9;
 
 /// A parsed message of one slot.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,6 +59,8 @@ pub enum Value {
     Energy(EnergyMessage),
     /// C1, C2.
     Invariants(InvariantsMessage),
+    /// W, E + W.
+    Work(WorkMessage),
 }
 
 /// The stored values at one log time.
@@ -82,7 +86,9 @@ pub struct Sample {
     pub energy: Option<EnergyMessage>,
     /// C1, C2.
     pub invariants: Option<InvariantsMessage>,
-    present: u8,
+    /// W, E + W.
+    pub work: Option<WorkMessage>,
+    present: u16,
 }
 
 impl Sample {
@@ -113,6 +119,7 @@ impl Sample {
             Value::Reaction(m) => self.reaction = Some(m),
             Value::Energy(m) => self.energy = Some(m),
             Value::Invariants(m) => self.invariants = Some(m),
+            Value::Work(m) => self.work = Some(m),
         }
     }
 }
@@ -122,13 +129,19 @@ impl Sample {
 pub struct Assembler {
     pending: VecDeque<Sample>,
     last: [Option<u64>; SLOTS],
-    declared: u8,
+    declared: u16,
 }
 
 impl Assembler {
     /// Marks a slot as present in the file (its channel record was read).
     pub fn declare(&mut self, slot: Slot) {
-        self.declared |= 1 << slot as u8;
+        self.declared |= 1 << slot as u16;
+    }
+
+    /// True when the slot's channel is in the file.
+    #[must_use]
+    pub fn declared(&self, slot: Slot) -> bool {
+        self.declared & (1 << slot as u16) != 0
     }
 
     /// Adds one message; calls `out` with every sample that can no longer grow.
@@ -140,7 +153,7 @@ impl Assembler {
         value: Value,
         out: &mut impl FnMut(&Sample),
     ) {
-        let bit = 1u8 << slot as u8;
+        let bit = 1u16 << slot as u16;
         self.declared |= bit;
         self.last[slot as usize] = Some(log_time);
         let position = self.pending.iter().rposition(|s| s.log_time <= log_time);

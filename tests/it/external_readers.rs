@@ -1,4 +1,5 @@
-//! Independent readers in CI: every committed dataset and a fresh recording are read with
+//! Independent readers in CI: every committed dataset and two fresh recordings (a steady circle, and the
+//! dissipative `euler-disk` with its `coin_log.Work` channel, physics §11) are read with
 //! `@mcap/core`'s indexed reader (the library Foxglove uses; `scripts/readers/check.mjs`) and with the
 //! Python `mcap` package (`scripts/readers/check.py`): all messages decoded, counts equal to the statistics,
 //! `foxglove.*` messages valid against `@foxglove/schemas`, `coin_log.*` against `schemas/`.
@@ -6,6 +7,7 @@
 //!
 //! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
 
+use crate::support::record::coin_log_text;
 use crate::support::writers::{record_circle, Damage};
 use crate::support::{dataset_files, repo};
 use std::path::PathBuf;
@@ -59,8 +61,19 @@ fn both_independent_readers_accept_every_dataset_and_a_fresh_recording() {
     let dir = tempfile::tempdir().unwrap();
     let fresh = dir.path().join("fresh-circle.mcap");
     record_circle(&fresh, 3.0, Damage::None);
+    let dissipative = dir.path().join("fresh-euler-disk.mcap");
+    let (code, out, err) = coin_log_text(&[
+        "record",
+        "euler-disk",
+        "--duration",
+        "2",
+        "-o",
+        dissipative.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
     let mut files = dataset_files();
     files.push(fresh);
+    files.push(dissipative);
     let [(node_ok, node_out), (py_ok, py_out)] = run_readers(&files);
     println!("--- @mcap/core (check.mjs)\n{node_out}--- python mcap (check.py)\n{py_out}");
     assert!(node_ok, "@mcap/core reader refused a file:\n{node_out}");

@@ -9,6 +9,7 @@
 mod support;
 
 mod architecture;
+mod bench_euler;
 mod bench_precision;
 mod bench_stability;
 mod bench_throughput;
@@ -18,6 +19,7 @@ mod cli_pipes;
 mod cli_record;
 mod cli_scene_limits;
 mod datasets;
+mod dissipation;
 mod events;
 mod external_readers;
 mod formulas;

@@ -4,19 +4,19 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use crate::support::record::{read_back, schema_file, validate_flat, ReadBack};
-use crate::support::writers::{message_json, COIN_CHANNELS};
+use crate::support::writers::{message_json_with, COIN_CHANNELS};
 use crate::support::FailingWriter;
 use coin_log::format::{
     log_time, Channel, ResultMetadata, RunMetadata, Termination, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,
 };
 use coin_log::integrate::{run_method, Flow, RunSettings};
-use coin_log::model::{Chaplygin, State, STATE_LEN};
+use coin_log::model::{Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use coin_log::record::{
     self, run_metadata, Compression, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
 };
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
-use coin_log::simulation::CoinEvents;
+use coin_log::simulation::{CoinEvents, DissipativeEvents};
 use std::io::Cursor;
 use std::sync::atomic::AtomicBool;
 
@@ -45,40 +45,60 @@ fn record_to_memory(scene: &Scene, options: &RecordOptions) -> (Vec<u8>, RecordS
     (cursor.into_inner(), summary)
 }
 
-/// The messages the recorder should write, computed here from the model and the message types
-/// (`support::writers::message_json`, which shares no code with the recorder).
-fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
-    let coin = scene.coin();
+/// The samples of a scene's run, (t, y, W), integrated here with the library's integrator on the scene's
+/// own equations (W only with dissipation, physics §11).
+fn simulated_samples(scene: &Scene) -> Vec<(f64, [f64; STATE_LEN], Option<f64>)> {
     let settings = RunSettings {
         t0: 0.0,
         t_end: scene.run.duration,
         sample_interval: 1.0 / scene.run.rate,
     };
-    let events = CoinEvents::new(coin, scene.run.flat_margin, scene.friction);
-    let mut samples: Vec<(f64, [f64; STATE_LEN])> = Vec::new();
-    let _ = run_method(
-        &scene.run.method,
-        &coin,
-        &scene.initial.to_array(),
-        &settings,
-        &events,
-        |t, y| {
-            samples.push((t, *y));
-            Flow::Continue
-        },
-    );
+    let (margin, mu) = (scene.run.flat_margin, scene.friction);
+    let mut samples = Vec::new();
+    match scene.dynamics() {
+        Dynamics::Conservative(coin) => {
+            let events = CoinEvents::new(coin, margin, mu);
+            let y0 = scene.initial.to_array();
+            let _ = run_method(&scene.run.method, &coin, &y0, &settings, &events, |t, y| {
+                samples.push((t, *y, None));
+                Flow::Continue
+            });
+        }
+        Dynamics::Dissipative(coin) => {
+            let events = DissipativeEvents::new(coin, margin, mu);
+            let mut y0 = [0.0; DISSIPATIVE_STATE_LEN];
+            y0[..STATE_LEN].copy_from_slice(&scene.initial.to_array());
+            let _ = run_method(&scene.run.method, &coin, &y0, &settings, &events, |t, y| {
+                let mut s = [0.0; STATE_LEN];
+                s.copy_from_slice(&y[..STATE_LEN]);
+                samples.push((t, s, Some(y[STATE_LEN])));
+                Flow::Continue
+            });
+        }
+    }
+    samples
+}
+
+/// The messages the recorder should write, computed here from the model and the message types
+/// (`support::writers::message_json_with`, which shares no code with the recorder).
+fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
+    let dynamics = scene.dynamics();
+    let coin = scene.coin();
+    let samples = simulated_samples(scene);
     let (tf, scene_on) = (scene.records(Channel::Tf), scene.records(Channel::Scene));
     let mut foxglove = Foxglove3d::new(&coin, scene.thickness, tf, scene_on);
     let mut batch = FoxgloveBatch::default();
     let chaplygin = Chaplygin::new(&scene.params).unwrap();
     let mut out = Vec::new();
     let last = samples.len() - 1;
-    for (k, (t, y)) in samples.iter().enumerate() {
+    for (k, (t, y, work)) in samples.iter().enumerate() {
         let (t, s) = (*t, State::from_array(y));
         let ns = log_time(t).expect("log time");
-        for channel in COIN_CHANNELS {
+        // The coin_log channels in the contract's table order: work after invariants, before /tf.
+        for channel in COIN_CHANNELS.into_iter().chain([Channel::Work]) {
             if scene.records(channel) {
-                out.push((channel, ns, message_json(&coin, &chaplygin, channel, t, &s)));
+                let data = message_json_with(&dynamics, &chaplygin, channel, t, &s, *work);
+                out.push((channel, ns, data));
             }
         }
         if tf || scene_on {
@@ -256,9 +276,10 @@ fn check_recording(name: &str, scene: &Scene, bytes: &[u8], summary: &RecordSumm
         "{name:<18} {:>6} samples {:>7} messages {:>8} bytes, termination {} at t = {}, energy drift {:.2e}, C1/C2 drift {:?}",
         summary.samples, summary.messages, summary.bytes, summary.termination.name(), summary.termination_time, summary.energy_drift, summary.invariant_drift
     );
+    // With dissipation C1, C2 are not conserved, so there is no drift to report (physics §11).
     assert_eq!(
         summary.invariant_drift.is_some(),
-        scene.records(Channel::Invariants)
+        scene.records(Channel::Invariants) && scene.dissipation.is_none()
     );
 }
 

@@ -109,7 +109,8 @@ fn defaults_are_those_of_the_contract() {
     assert_eq!((s.run.method.rtol, s.run.method.atol), (0.0, 0.0));
     assert_eq!(s.run.flat_margin, 1e-4);
     assert_eq!(s.thickness, 0.05);
-    assert_eq!(s.channels, coin_log::format::Channel::ALL.to_vec());
+    // The contract's ten channels (`work` only comes with dissipation, physics §11).
+    assert_eq!(s.channels, coin_log::format::Channel::DEFAULT.to_vec());
     assert_eq!(scene::defaults::INTEGRATOR, "dop853");
     assert_eq!(
         scene::defaults::INTEGRATOR,

@@ -5,11 +5,14 @@ mod throughput;
 
 use super::Outcome;
 use anyhow::Context;
-use coin_log::bench::plot::work_precision_svg;
+use coin_log::bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
+use coin_log::bench::plot::{euler_svg, work_precision_svg};
 use coin_log::bench::precision::{precision_bench, PrecisionOptions};
 use coin_log::bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
 use coin_log::bench::stability;
-use coin_log::bench::table::{precision_csv, precision_table, stability_csv, stability_table};
+use coin_log::bench::table::{
+    euler_csv, euler_table, precision_csv, precision_table, stability_csv, stability_table,
+};
 use coin_log::bench::BenchCase;
 use coin_log::integrate::Method;
 use std::fs;
@@ -43,6 +46,25 @@ enum BenchCommand {
     /// MB/s, file size and peak RSS at two durations (100 and 1000 time units; 1000 and 10000 with
     /// --long), then dop853 on wobble and one RHS evaluation. Medians of --repeats runs.
     Throughput(throughput::ThroughputArgs),
+    /// Euler's disk: the time law α = A (t0 − t)^n of each dissipation preset against n = 1/(1 − p).
+    ///
+    /// Each preset (moffatt, air-drag, viscous, rolling, pivoting) on the `euler-disk` toy from its
+    /// centre-fixed motion at α0 = 0.2, κ set so that every preset has the time scale of the scene's
+    /// Moffatt law (docs/physics.md §11); dop853 at the default tolerances until an event (or 3 time
+    /// scales without a finite-time singularity). α = A |t0 − t|^n is fitted with t0 free on the window
+    /// from α = 0.1 down to where the slow-change approximation starts to fail (|α̇|/(α σ) = 1e-3, σ the
+    /// nutation frequency) or the motion has drifted off the centre-fixed family (ω_Z²/|ω|² = 1e-2),
+    /// whichever comes first. Each preset is run again with μ = 0.3 to see where it slips. Writes
+    /// euler.csv and euler.svg (log α against log |t0 − t| with the fitted lines).
+    Euler(EulerArgs),
+}
+
+/// Arguments of `coin-log bench euler`.
+#[derive(Debug, clap::Args)]
+struct EulerArgs {
+    /// Folder for `euler.csv` and `euler.svg` (created if missing).
+    #[arg(long, default_value = "bench-results")]
+    out: PathBuf,
 }
 
 /// Arguments of `coin-log bench precision`.
@@ -71,6 +93,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
         BenchCommand::Precision(a) => precision(&a),
         BenchCommand::Stability(a) => stability_suite(&a),
         BenchCommand::Throughput(a) => throughput::run(&a),
+        BenchCommand::Euler(a) => euler(&a),
     }
 }
 
@@ -146,5 +169,28 @@ fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     let csv_path = args.out.join("stability.csv");
     write(&csv_path, &stability_csv(&rows))?;
     outln!("CSV: {}", csv_path.display());
+    Ok(Outcome::Success)
+}
+
+fn euler(args: &EulerArgs) -> anyhow::Result<Outcome> {
+    create_dir(&args.out)?;
+    let options = EulerOptions::full();
+    let rows = euler_bench(&options)?;
+    if let Some(first) = rows.first() {
+        println!(
+            "euler-disk toy, every preset at the time scale T = {:.2} s of its Moffatt law; window from α = {WINDOW_TOP} down to |α̇|/(α σ) = {:e} or ω_Z²/|ω|² = {:e}, whichever comes first; ends without μ and with μ = {SLIP_FRICTION}",
+            first.time_scale, options.epsilon, options.spin_share
+        );
+    }
+    print!("{}", euler_table(&rows));
+    let csv_path = args.out.join("euler.csv");
+    write(&csv_path, &euler_csv(&rows))?;
+    let svg_path = args.out.join("euler.svg");
+    write(&svg_path, &euler_svg(&rows)?)?;
+    println!(
+        "CSV: {}\ndiagram: {}",
+        csv_path.display(),
+        svg_path.display()
+    );
     Ok(Outcome::Success)
 }

@@ -5,7 +5,7 @@
 //! and N = R_y. Each is a recomputation from stored numbers, held to the recomputation tolerance.
 
 use super::{fmt_num, worst, Context, Max};
-use crate::model::{orientation, reaction};
+use crate::model::orientation;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
@@ -60,7 +60,7 @@ impl ConsistencyCheck {
         }
         if let (Some(r), Some(state)) = (s.reaction, s.state()) {
             self.counts[3] += 1;
-            let e = reaction(&ctx.coin, &state);
+            let e = ctx.dynamics.reaction(&state);
             let scale =
                 p.mass() * p.gravity() + e.force.x.abs().max(e.force.y.abs()).max(e.force.z.abs());
             let d = (r.x - e.force.x)

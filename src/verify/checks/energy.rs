@@ -1,6 +1,10 @@
 //! `energy`: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ (physics §3) recomputed from
 //! the stored ω and θ; drift = max|E − E₀| / max(|E₀|, Mga) (format.md); agreement of `/coin/energy` with
 //! the recomputed total, kinetic and potential parts, in the same units.
+//!
+//! With dissipation (physics §11) the conserved quantity is the balance E + W, W the dissipated work stored
+//! in `/coin/work`: the drift is max|E + W − E₀| / max(|E₀|, Mga) (W₀ = 0), and the stored balance must
+//! equal E recomputed plus the stored W. Without `/coin/work` a dissipative file's energy cannot be judged.
 
 use super::{fmt_num, worst, Context, Max};
 use crate::model::drift::EnergyDrift;
@@ -16,6 +20,10 @@ pub struct EnergyCheck {
     agreement: Max,
     samples: u64,
     stored: u64,
+    /// Dissipative runs: samples with ω and angles but no W (they cannot enter the balance).
+    without_work: u64,
+    /// Dissipative runs: W at the last judged sample.
+    last_work: Option<f64>,
 }
 
 impl EnergyCheck {
@@ -23,10 +31,23 @@ impl EnergyCheck {
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Some(state) = s.state() else { return };
         let e = energy(&ctx.coin, &state);
+        let dissipative = ctx.dynamics.dissipation().is_some();
+        let work = match (dissipative, s.work) {
+            (false, _) => 0.0,
+            (true, Some(w)) => w.dissipated,
+            (true, None) => {
+                self.without_work += 1;
+                return;
+            }
+        };
+        let balance = e.total + work;
         self.drift
-            .get_or_insert_with(|| EnergyDrift::new(ctx.coin.params(), e.total))
-            .observe(s.t, e.total);
+            .get_or_insert_with(|| EnergyDrift::new(ctx.coin.params(), balance))
+            .observe(s.t, balance);
         self.samples += 1;
+        if dissipative {
+            self.last_work = Some(work);
+        }
         if let Some(m) = s.energy {
             self.stored += 1;
             let d = (m.total - e.total)
@@ -35,16 +56,22 @@ impl EnergyCheck {
                 .max((m.potential - e.potential).abs());
             self.agreement.offer(d, s.t);
         }
+        if let Some(w) = s.work.filter(|_| dissipative) {
+            self.stored += 1;
+            self.agreement.offer((w.balance - balance).abs(), s.t);
+        }
     }
 
     /// The result.
     #[must_use]
-    pub fn finish(&self, tol: &Tolerances) -> CheckResult {
+    pub fn finish(&self, tol: &Tolerances, ctx: &Context) -> CheckResult {
         let Some(energy_drift) = self.drift else {
-            return CheckResult::skip(
-                CheckId::Energy,
-                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed",
-            );
+            let reason = if self.without_work > 0 {
+                "the run has dissipation (physics §11) but no sample has /coin/work, so the balance E + W = E0 cannot be judged: record the work channel"
+            } else {
+                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed"
+            };
+            return CheckResult::skip(CheckId::Energy, reason);
         };
         let drift = energy_drift.value();
         let agreement = self.agreement.value / energy_drift.scale();
@@ -56,8 +83,13 @@ impl EnergyCheck {
             return CheckResult::skip(CheckId::Energy, "nothing measured");
         };
         let stored = if self.stored > 0 {
+            let what = if self.last_work.is_some() {
+                "/coin/energy and the /coin/work balance differ from E and E + W recomputed"
+            } else {
+                "/coin/energy differs from E recomputed"
+            };
             format!(
-                "; /coin/energy differs from E recomputed by {} (worst at t = {}, tolerance {})",
+                "; {what} by {} (worst at t = {}, tolerance {})",
                 fmt_num(agreement),
                 fmt_num(self.agreement.t),
                 fmt_num(RECOMPUTE_TOLERANCE)
@@ -65,13 +97,30 @@ impl EnergyCheck {
         } else {
             "; no /coin/energy channel to compare".into()
         };
+        let quantity = match (ctx.dynamics.dissipation(), self.last_work) {
+            (Some(d), Some(w)) => format!(
+                "dissipation {} (κ = {}): drift of the balance max|E + W - E0|/max(|E0|, Mga) = {}, W = {} at the end",
+                d.model(),
+                fmt_num(d.coefficient()),
+                fmt_num(drift),
+                fmt_num(w)
+            ),
+            _ => format!("drift max|E - E0|/max(|E0|, Mga) = {}", fmt_num(drift)),
+        };
+        let missing = if self.without_work > 0 {
+            format!(
+                "; {} samples without /coin/work not judged",
+                self.without_work
+            )
+        } else {
+            String::new()
+        };
         CheckResult::measured(
             CheckId::Energy,
             value,
             tolerance,
             format!(
-                "{which} is the worst measure: drift max|E - E0|/max(|E0|, Mga) = {} over {} samples (worst at t = {}, tolerance {}){stored}",
-                fmt_num(drift),
+                "{which} is the worst measure: {quantity} over {} samples (worst at t = {}, tolerance {}){stored}{missing}",
                 self.samples,
                 fmt_num(energy_drift.worst_time()),
                 fmt_num(tol.energy),

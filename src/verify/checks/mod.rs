@@ -12,7 +12,7 @@ pub mod validity;
 use super::samples::Sample;
 use crate::format::{ResultMetadata, RunMetadata};
 use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, Steady};
+use crate::model::{Coin, Dynamics, Steady};
 use nalgebra::Vector3;
 
 /// What the checks know about the run besides its samples: the file's metadata.
@@ -20,6 +20,8 @@ use nalgebra::Vector3;
 pub struct Context {
     /// The coin built from the metadata's M, a, g, I_X, I_Z.
     pub coin: Coin,
+    /// Its equations with the metadata's dissipation, if any (physics §11): the reaction follows them.
+    pub dynamics: Dynamics,
     /// The `coin-log` record.
     pub run: RunMetadata,
     /// The `coin-log.result` record, if the run finished writing it.

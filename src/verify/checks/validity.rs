@@ -4,7 +4,6 @@
 
 use super::{fmt_num, Context, Max};
 use crate::format::Termination;
-use crate::model::reaction;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::VALIDITY_TOLERANCE;
@@ -36,7 +35,7 @@ impl ValidityCheck {
             (r.normal, r.friction)
         } else if let Some(state) = s.state() {
             self.recomputed = true;
-            let r = reaction(&ctx.coin, &state);
+            let r = ctx.dynamics.reaction(&state);
             (r.normal, r.friction)
         } else {
             return;

@@ -19,6 +19,13 @@
 //!
 //! Only the velocity-level and position-level constraints' second derivatives are imposed, so they drift
 //! with the integrator's truncation error; with rk4 at h = 1e-3 that drift is far below the tolerances.
+//!
+//! A dissipative couple T (physics §11), when given, is one more torque in Euler's equation:
+//! I_w ω̇ + ω × I_w ω = ρ × R + T with T = −P ω/|ω|², P = κ |φ̇|^m (sin α)^(−k). Here P is built from the
+//! geometry, not from the library's angles: sin α = e_Y·e_y (the coin's in-plane upward axis against the
+//! vertical) and φ̇ = (ω·e_Y)/(e_Y·e_y) (ω = φ̇ e_y + θ̇ e_X + ψ̇ e_Z with e_X ⊥ e_Y and e_Z ⊥ e_Y). T enters
+//! the contact-force system through ω̇: its right-hand side gains + [ρ]× I⁻¹ T. [`Dissipating`] carries the
+//! dissipated work W = ∫P dt as a 14th state component.
 
 // A test model: a matrix that is not positive definite is a failed test, with the reason.
 #![allow(clippy::expect_used)]
@@ -31,7 +38,15 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 /// Dimension of the Newton–Euler state.
 pub const NE_LEN: usize = 13;
 
-/// Body constants of the second model.
+/// The couple's law P = κ |φ̇|^m (sin α)^(−k) (physics §11), as plain numbers.
+#[derive(Debug, Clone, Copy)]
+pub struct Couple {
+    pub kappa: f64,
+    pub m: f64,
+    pub k: f64,
+}
+
+/// Body constants of the second model, and an optional dissipative couple.
 #[derive(Debug, Clone, Copy)]
 pub struct NewtonEuler {
     pub mass: f64,
@@ -39,6 +54,7 @@ pub struct NewtonEuler {
     pub gravity: f64,
     pub inertia_x: f64,
     pub inertia_z: f64,
+    pub couple: Option<Couple>,
 }
 
 /// What one evaluation of the second model computes.
@@ -47,6 +63,8 @@ pub struct Evaluation {
     pub omega_dot: V3,
     pub acceleration: V3,
     pub reaction: V3,
+    /// The couple's power P (0 without a couple).
+    pub power: f64,
 }
 
 impl NewtonEuler {
@@ -58,7 +76,31 @@ impl NewtonEuler {
             gravity: p.gravity(),
             inertia_x: p.inertia_x(),
             inertia_z: p.inertia_z(),
+            couple: None,
         }
+    }
+
+    /// The same body with a dissipative couple.
+    pub fn with_couple(self, couple: Couple) -> Self {
+        Self {
+            couple: Some(couple),
+            ..self
+        }
+    }
+
+    /// The couple T = −P ω/|ω|² and its power P at world ω, with the lean axis e_Y (physics §11).
+    fn couple_torque(&self, omega: &V3, e_y_lean: &V3) -> (V3, f64) {
+        let Some(c) = self.couple else {
+            return (Vector3::zeros(), 0.0);
+        };
+        let sin_alpha = e_y_lean.dot(&Vector3::y());
+        let phi_dot = omega.dot(e_y_lean) / sin_alpha;
+        let power = c.kappa * phi_dot.abs().powf(c.m) * sin_alpha.powf(-c.k);
+        let w2 = omega.norm_squared();
+        if w2 == 0.0 {
+            return (Vector3::zeros(), power);
+        }
+        (omega * (-power / w2), power)
     }
 
     /// Converts the library's state: angles → quaternion (physics §1), lean-frame ω → world ω, centre from
@@ -131,23 +173,59 @@ impl NewtonEuler {
         let inertia_inv =
             rot * body.map(|v| if v == 0.0 { 0.0 } else { 1.0 / v }) * rot.transpose();
         let gyro = omega.cross(&(inertia * omega)); // ω × I_w ω
-                                                    // (1/M − [ρ]× I⁻¹ [ρ]×) R = g e_y − ω × ρ̇ − [ρ]× I⁻¹ (ω × I_w ω); the matrix is SPD.
+        let (torque, power) = self.couple_torque(&omega, &e_y_lean);
+        // (1/M − [ρ]× I⁻¹ [ρ]×) R = g e_y − ω × ρ̇ − [ρ]× I⁻¹ (ω × I_w ω − T); the matrix is SPD.
         let p = rho.cross_matrix();
         let a = Matrix3::identity() / self.mass - p * inertia_inv * p;
-        let b = e_up * self.gravity - omega.cross(&rho_dot) - p * (inertia_inv * gyro);
+        let b = e_up * self.gravity - omega.cross(&rho_dot) - p * (inertia_inv * (gyro - torque));
         let reaction = a
             .cholesky()
             .expect("the contact-force matrix is symmetric positive definite")
             .solve(&b);
         let acceleration = reaction / self.mass - e_up * self.gravity;
-        let omega_dot = inertia_inv * (rho.cross(&reaction) - gyro);
+        let omega_dot = inertia_inv * (rho.cross(&reaction) - gyro + torque);
         let wq = Quaternion::from_imag(omega) * Self::quaternion(y);
         Evaluation {
             q_dot: wq * 0.5,
             omega_dot,
             acceleration,
             reaction,
+            power,
         }
+    }
+
+    /// The lean θ of a state, from the normal alone: e_Z·e_y = −sin θ (physics §1, eq (9)).
+    pub fn lean(y: &[f64]) -> f64 {
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(y[0], y[1], y[2], y[3]));
+        (-(q * Vector3::z()).y).asin()
+    }
+}
+
+/// Dimension of the dissipating Newton–Euler state: the 13 of [`NewtonEuler`] and W.
+pub const NE_DISSIPATING_LEN: usize = NE_LEN + 1;
+
+/// The Newton–Euler model with its couple's work W = ∫P dt as a 14th component.
+pub struct Dissipating(pub NewtonEuler);
+
+impl Dissipating {
+    /// The 14-component state of a library state, with W = 0.
+    pub fn state_from(&self, s: &State) -> [f64; NE_DISSIPATING_LEN] {
+        let mut y = [0.0; NE_DISSIPATING_LEN];
+        y[..NE_LEN].copy_from_slice(&self.0.state_from(s));
+        y
+    }
+}
+
+impl OdeSystem<NE_DISSIPATING_LEN> for Dissipating {
+    fn rhs(&self, _t: f64, y: &[f64; NE_DISSIPATING_LEN], dydt: &mut [f64; NE_DISSIPATING_LEN]) {
+        let mut inner = [0.0; NE_LEN];
+        inner.copy_from_slice(&y[..NE_LEN]);
+        let e = self.0.evaluate(&inner);
+        dydt[0..4].copy_from_slice(&[e.q_dot.w, e.q_dot.i, e.q_dot.j, e.q_dot.k]);
+        dydt[4..7].copy_from_slice(e.omega_dot.as_slice());
+        dydt[7..10].copy_from_slice(&y[10..13]);
+        dydt[10..13].copy_from_slice(e.acceleration.as_slice());
+        dydt[NE_LEN] = e.power;
     }
 }
 

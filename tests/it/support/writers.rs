@@ -8,7 +8,7 @@
 
 use coin_log::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage,
+    ReactionMessage, WorkMessage,
 };
 use coin_log::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
@@ -16,7 +16,7 @@ use coin_log::format::{
 };
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
 use coin_log::model::{
-    centre, contact_point, energy, orientation, reaction, Branch, Chaplygin, Coin, CoinParams,
+    centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams, Dynamics,
     State, Steady, SteadyKind,
 };
 use coin_log::record::{Foxglove3d, FoxgloveBatch};
@@ -40,6 +40,20 @@ pub const COIN_CHANNELS: [Channel; 8] = [
 /// The JSON of per-sample channel `c` (one of [`COIN_CHANNELS`]) at state `s`, time `t`, computed here from
 /// the model's functions and the message types, independently of the recorder.
 pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &State) -> Vec<u8> {
+    message_json_with(&Dynamics::Conservative(*coin), chaplygin, c, t, s, None)
+}
+
+/// [`message_json`] for any dynamics: the reaction follows them (physics §11), and `/coin/work` carries W
+/// (`work`, for a dissipative run) and E + W.
+pub fn message_json_with(
+    dynamics: &Dynamics,
+    chaplygin: &Chaplygin,
+    c: Channel,
+    t: f64,
+    s: &State,
+    work: Option<f64>,
+) -> Vec<u8> {
+    let coin = dynamics.coin();
     let mut buf = Vec::new();
     match c {
         Channel::Omega => AngularVelocity {
@@ -82,7 +96,7 @@ pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &
             .write_json(&mut buf)
         }
         Channel::Reaction => {
-            let r = reaction(coin, s);
+            let r = dynamics.reaction(s);
             ReactionMessage {
                 t,
                 x: r.force.x,
@@ -109,6 +123,17 @@ pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &
                 t,
                 c1: i.c1,
                 c2: i.c2,
+            }
+            .write_json(&mut buf)
+        }
+        Channel::Work => {
+            let Some(w) = work else {
+                panic!("the work channel needs W")
+            };
+            WorkMessage {
+                t,
+                dissipated: w,
+                balance: energy(coin, s).total + w,
             }
             .write_json(&mut buf)
         }
@@ -351,6 +376,7 @@ pub fn record(spec: &Spec, path: &Path) {
         psi_dot: spec.steady.map(|s| s.psi_dot),
         r_g: spec.steady.and_then(|s| s.r_g),
         r_c: spec.steady.and_then(|s| s.r_c),
+        dissipation: None,
     };
     let file = BufWriter::new(std::fs::File::create(path).unwrap());
     let mut options = mcap::WriteOptions::new()
@@ -408,6 +434,7 @@ pub fn record(spec: &Spec, path: &Path) {
         rejected_steps: outcome.stats.rejected_steps,
         termination,
         termination_time: outcome.t_last,
+        termination_alpha: None,
     };
     w.write_metadata(&mcap::records::Metadata {
         name: RESULT_METADATA_NAME.into(),

@@ -1,0 +1,445 @@
+//! Dissipation (physics §11): a couple −P ω/|ω|² on the coin, with power P = κ |φ̇|^m (sin α)^(−k),
+//! α = π/2 − |θ| the angle between the coin and the table, and the dissipated work W as a ninth state
+//! component (Ẇ = P), so that E + W = E₀ holds along the equations (eqs (30)–(34)).
+//!
+//! The conservative coin ([`Coin`]) is left exactly as it is: a dissipative run integrates the separate
+//! system [`DissipativeCoin`], chosen once before the integration starts.
+
+use super::derived::{reaction_with, Reaction};
+use super::equations::{AngularAcceleration, Coin};
+use super::state::{State, STATE_LEN};
+use std::fmt;
+use std::str::FromStr;
+use thiserror::Error;
+
+/// Number of state components of the dissipative coin: the eight of [`State`] and the dissipated work W.
+pub const DISSIPATIVE_STATE_LEN: usize = STATE_LEN + 1;
+
+/// Index of W in the dissipative state.
+pub const WORK_INDEX: usize = STATE_LEN;
+
+/// A dissipation law by name (format.md: `body.dissipation.model`): the exponents m, k of
+/// P = κ |φ̇|^m (sin α)^(−k) (physics §11).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DissipationModel {
+    /// Moffatt's viscous air film under the coin: m = 2, k = 1 (α ∝ (t₀ − t)^{1/3}).
+    Moffatt,
+    /// Air drag in a viscous boundary layer (Bildsten): m = 2.5, k = 0 (α ∝ (t₀ − t)^{4/9}).
+    AirDrag,
+    /// A couple linear in the rate, P ∝ φ̇²: m = 2, k = 0 (α ∝ (t₀ − t)^{1/2}).
+    Viscous,
+    /// Rolling resistance, a constant resisting force at the rim: m = 1, k = 0 (α ∝ (t₀ − t)^{2/3}).
+    Rolling,
+    /// Pivoting (drilling) friction of Le Saux, Leine & Glocker (2005), a Coulomb torque about the table
+    /// normal, in the form it takes on the centre-fixed motion: m = 1, k = −2 (no finite-time singularity).
+    Pivoting,
+    /// Any exponents: `m` and `k` given in the scene.
+    PowerLaw,
+}
+
+impl DissipationModel {
+    /// Every model, in the order of format.md's table.
+    pub const ALL: [DissipationModel; 6] = [
+        Self::Moffatt,
+        Self::AirDrag,
+        Self::Viscous,
+        Self::Rolling,
+        Self::Pivoting,
+        Self::PowerLaw,
+    ];
+
+    /// The models with fixed exponents (every one but `power-law`).
+    pub const PRESETS: [DissipationModel; 5] = [
+        Self::Moffatt,
+        Self::AirDrag,
+        Self::Viscous,
+        Self::Rolling,
+        Self::Pivoting,
+    ];
+
+    /// The name in scene files and metadata.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Moffatt => "moffatt",
+            Self::AirDrag => "air-drag",
+            Self::Viscous => "viscous",
+            Self::Rolling => "rolling",
+            Self::Pivoting => "pivoting",
+            Self::PowerLaw => "power-law",
+        }
+    }
+
+    /// The fixed exponents (m, k) of a preset; `None` for `power-law`.
+    #[must_use]
+    pub fn exponents(self) -> Option<(f64, f64)> {
+        match self {
+            Self::Moffatt => Some((2.0, 1.0)),
+            Self::AirDrag => Some((2.5, 0.0)),
+            Self::Viscous => Some((2.0, 0.0)),
+            Self::Rolling => Some((1.0, 0.0)),
+            Self::Pivoting => Some((1.0, -2.0)),
+            Self::PowerLaw => None,
+        }
+    }
+
+    /// Every name, quoted and comma-separated, for messages.
+    #[must_use]
+    pub fn names() -> String {
+        Self::ALL.map(|m| format!("\"{}\"", m.name())).join(", ")
+    }
+}
+
+impl fmt::Display for DissipationModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A dissipation model name this tool does not know.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("`{0}` is not a dissipation model: use one of {names}", names = DissipationModel::names())]
+pub struct UnknownDissipationModel(pub String);
+
+impl FromStr for DissipationModel {
+    type Err = UnknownDissipationModel;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| UnknownDissipationModel(s.to_string()))
+    }
+}
+
+/// Smallest exponent m: with m ≥ 1 the couple's magnitude P/|ω| ≤ κ |ω|^(m−1) (cos θ)^(−m−k) stays
+/// bounded as the coin stops (|ω| → 0); below 1 it would grow without bound (physics §11).
+pub const MIN_RATE_EXPONENT: f64 = 1.0;
+
+/// Why a dissipation cannot be built.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum DissipationError {
+    /// κ is negative or not finite.
+    #[error("the coefficient κ = {0} must be a finite number ≥ 0")]
+    Coefficient(f64),
+    /// m is below 1 or not finite.
+    #[error("m = {0} must be a finite number ≥ 1 (the couple P/|ω| ∝ |ω|^(m−1) must stay bounded as the coin stops)")]
+    RateExponent(f64),
+    /// k is not finite.
+    #[error("k = {0} must be a finite number")]
+    AngleExponent(f64),
+}
+
+/// A validated dissipation law: model, κ ≥ 0, m ≥ 1, k finite (physics §11).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dissipation {
+    model: DissipationModel,
+    coefficient: f64,
+    m: f64,
+    k: f64,
+}
+
+impl Dissipation {
+    /// A preset's law with coefficient κ (the preset fixes m and k).
+    ///
+    /// ```
+    /// use coin_log::model::{Dissipation, DissipationModel};
+    /// let d = Dissipation::preset(DissipationModel::Moffatt, 1e-6).unwrap();
+    /// assert_eq!((d.m(), d.k(), d.angle_exponent()), (2.0, 1.0, -2.0));
+    /// assert_eq!(d.predicted_exponent(), Some(1.0 / 3.0));
+    /// ```
+    ///
+    /// # Errors
+    /// [`DissipationError`] for a bad κ; `power-law` has no fixed exponents and is refused as m = NaN.
+    pub fn preset(model: DissipationModel, coefficient: f64) -> Result<Self, DissipationError> {
+        let (m, k) = model.exponents().unwrap_or((f64::NAN, f64::NAN));
+        Self::new(model, coefficient, m, k)
+    }
+
+    /// A law with explicit exponents (`power-law`, or a preset with its own m, k).
+    ///
+    /// # Errors
+    /// [`DissipationError`] naming the first bad value.
+    pub fn new(
+        model: DissipationModel,
+        coefficient: f64,
+        m: f64,
+        k: f64,
+    ) -> Result<Self, DissipationError> {
+        if !(coefficient.is_finite() && coefficient >= 0.0) {
+            return Err(DissipationError::Coefficient(coefficient));
+        }
+        if !(m.is_finite() && m >= MIN_RATE_EXPONENT) {
+            return Err(DissipationError::RateExponent(m));
+        }
+        if !k.is_finite() {
+            return Err(DissipationError::AngleExponent(k));
+        }
+        Ok(Self {
+            model,
+            coefficient,
+            m,
+            k,
+        })
+    }
+
+    /// The model.
+    #[must_use]
+    pub fn model(&self) -> DissipationModel {
+        self.model
+    }
+    /// κ [energy·time^(1−m)], the scene's `coefficient`.
+    #[must_use]
+    pub fn coefficient(&self) -> f64 {
+        self.coefficient
+    }
+    /// m, the exponent of |φ̇|.
+    #[must_use]
+    pub fn m(&self) -> f64 {
+        self.m
+    }
+    /// k, the exponent of 1/sin α.
+    #[must_use]
+    pub fn k(&self) -> f64 {
+        self.k
+    }
+
+    /// p = −m/2 − k: along the centre-fixed family P ∝ (sin α)^p (physics §11, eq (36)).
+    #[must_use]
+    pub fn angle_exponent(&self) -> f64 {
+        -0.5 * self.m - self.k
+    }
+
+    /// n = 1/(1 − p) of the finite-time law α ∝ (t₀ − t)^n (eq (38)); `None` when p ≥ 1, where there is
+    /// no finite-time singularity (α decays exponentially for p = 1, algebraically for p > 1).
+    #[must_use]
+    pub fn predicted_exponent(&self) -> Option<f64> {
+        let p = self.angle_exponent();
+        (p < 1.0).then(|| 1.0 / (1.0 - p))
+    }
+
+    /// The dissipated power P = κ |φ̇|^m (sin α)^(−k) at lean θ and ω_Y (eq (34)), with φ̇ = ω_Y / cos θ
+    /// (eq (18)) and sin α = cos |θ| = cos θ.
+    ///
+    /// Finite wherever the rolling model is (|θ| < π/2: the run ends at the flat landing before cos θ
+    /// reaches 0), and 0 when ω_Y = 0 (m ≥ 1).
+    #[must_use]
+    #[inline]
+    pub fn power(&self, theta: f64, omega_y: f64) -> f64 {
+        self.power_trig(theta.cos(), omega_y)
+    }
+
+    #[inline]
+    fn power_trig(&self, cos_t: f64, omega_y: f64) -> f64 {
+        let phi_dot = omega_y / cos_t;
+        self.coefficient * phi_dot.abs().powf(self.m) * cos_t.powf(-self.k)
+    }
+}
+
+/// The coin with a dissipative couple: eqs (30)–(34) of physics §11 on the state (θ, φ, ψ, ω, x, z, W).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DissipativeCoin {
+    coin: Coin,
+    dissipation: Dissipation,
+    /// 1/(I_X + Ma²), eq (31).
+    inv_x: f64,
+    /// 1/I_X, eq (32).
+    inv_y: f64,
+    /// 1/(I_Z + Ma²), eq (33).
+    inv_z: f64,
+}
+
+/// The couple's effect at one state: the angular accelerations of eqs (31)–(33) and the power P.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DissipativeRates {
+    /// (ω̇_X, ω̇_Y, ω̇_Z) with the couple.
+    pub acceleration: AngularAcceleration,
+    /// P = Ẇ ≥ 0 (eq (34)).
+    pub power: f64,
+}
+
+impl DissipativeCoin {
+    /// The coin `coin` with the couple of `dissipation`.
+    #[must_use]
+    pub fn new(coin: Coin, dissipation: Dissipation) -> Self {
+        let p = coin.params();
+        let ma2 = p.ma2();
+        Self {
+            coin,
+            dissipation,
+            inv_x: 1.0 / (p.inertia_x() + ma2),
+            inv_y: 1.0 / p.inertia_x(),
+            inv_z: 1.0 / (p.inertia_z() + ma2),
+        }
+    }
+
+    /// The conservative coin underneath.
+    #[must_use]
+    pub fn coin(&self) -> &Coin {
+        &self.coin
+    }
+
+    /// The dissipation law.
+    #[must_use]
+    pub fn dissipation(&self) -> &Dissipation {
+        &self.dissipation
+    }
+
+    /// Angular accelerations of eqs (31)–(33) and the power P of eq (34):
+    ///
+    /// (I_X + Ma²) ω̇_X = [right-hand side of (14)] − (P/|ω|²) ω_X   (31)
+    /// I_X ω̇_Y         = [right-hand side of (15)] − (P/|ω|²) ω_Y   (32)
+    /// (I_Z + Ma²) ω̇_Z = [right-hand side of (16)] − (P/|ω|²) ω_Z   (33)
+    ///
+    /// At ω = 0 the couple is 0 (P = 0 there, since m ≥ 1).
+    #[must_use]
+    #[inline]
+    pub fn rates(&self, theta: f64, omega_x: f64, omega_y: f64, omega_z: f64) -> DissipativeRates {
+        let conservative = self
+            .coin
+            .angular_acceleration(theta, omega_x, omega_y, omega_z);
+        let power = self.dissipation.power(theta, omega_y);
+        let w2 = omega_x * omega_x + omega_y * omega_y + omega_z * omega_z;
+        let couple = if w2 > 0.0 { power / w2 } else { 0.0 };
+        DissipativeRates {
+            acceleration: AngularAcceleration {
+                x: conservative.x - couple * omega_x * self.inv_x,
+                y: conservative.y - couple * omega_y * self.inv_y,
+                z: conservative.z - couple * omega_z * self.inv_z,
+            },
+            power,
+        }
+    }
+
+    /// The right-hand side: eqs (17)–(19), (31)–(34) and the centre's velocity (physics §2, §11). The
+    /// couple changes only ω̇; the kinematics and the rolling constraint are those of the conservative coin.
+    #[inline]
+    pub fn derivative(
+        &self,
+        y: &[f64; DISSIPATIVE_STATE_LEN],
+        dydt: &mut [f64; DISSIPATIVE_STATE_LEN],
+    ) {
+        let [theta, phi, _psi, wx, wy, wz, _x, _z, _w] = *y;
+        let rates = self.rates(theta, wx, wy, wz);
+        let (sin_t, cos_t) = theta.sin_cos();
+        let (sin_p, cos_p) = phi.sin_cos();
+        let tan_t = sin_t / cos_t;
+        let a = self.coin.params().radius();
+        dydt[0] = wx; // (17)
+        dydt[1] = wy / cos_t; // (18)
+        dydt[2] = wz + wy * tan_t; // (19)
+        dydt[3] = rates.acceleration.x; // (31)
+        dydt[4] = rates.acceleration.y; // (32)
+        dydt[5] = rates.acceleration.z; // (33)
+        dydt[6] = a * (-wz * cos_p + wx * cos_t * sin_p);
+        dydt[7] = a * (wz * sin_p + wx * cos_t * cos_p);
+        dydt[WORK_INDEX] = rates.power; // (34)
+    }
+
+    /// The table's reaction (physics §3) with the accelerations of eqs (31)–(33): the couple is a pure
+    /// torque, so R = M dv/dt + Mg e_y as before, but dv/dt follows the dissipative ω̇.
+    #[must_use]
+    pub fn reaction(&self, s: &State) -> Reaction {
+        let rates = self.rates(s.theta, s.omega_x, s.omega_y, s.omega_z);
+        reaction_with(&self.coin, s, rates.acceleration)
+    }
+
+    /// The power P at a state (eq (34)).
+    #[must_use]
+    pub fn power(&self, s: &State) -> f64 {
+        self.dissipation.power(s.theta, s.omega_y)
+    }
+}
+
+/// How the coin moves: conservative (eqs (14)–(19)) or with a dissipative couple (eqs (30)–(34)). The
+/// one choice a scene makes; every per-state quantity that depends on ω̇ (the reaction) goes through it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Dynamics {
+    /// No dissipation: E, C1, C2 are conserved.
+    Conservative(Coin),
+    /// A dissipative couple: E + W is conserved.
+    Dissipative(DissipativeCoin),
+}
+
+impl Dynamics {
+    /// The dynamics of `coin` with an optional dissipation.
+    #[must_use]
+    pub fn new(coin: Coin, dissipation: Option<Dissipation>) -> Self {
+        match dissipation {
+            None => Self::Conservative(coin),
+            Some(d) => Self::Dissipative(DissipativeCoin::new(coin, d)),
+        }
+    }
+
+    /// The coin (parameters and conservative equations).
+    #[must_use]
+    pub fn coin(&self) -> &Coin {
+        match self {
+            Self::Conservative(c) => c,
+            Self::Dissipative(d) => d.coin(),
+        }
+    }
+
+    /// The dissipation law, if any.
+    #[must_use]
+    pub fn dissipation(&self) -> Option<&Dissipation> {
+        match self {
+            Self::Conservative(_) => None,
+            Self::Dissipative(d) => Some(d.dissipation()),
+        }
+    }
+
+    /// The table's reaction at a state (physics §3, §11).
+    #[must_use]
+    pub fn reaction(&self, s: &State) -> Reaction {
+        match self {
+            Self::Conservative(c) => super::derived::reaction(c, s),
+            Self::Dissipative(d) => d.reaction(s),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::CoinParams;
+
+    #[test]
+    fn presets_have_the_documented_exponents_and_names_round_trip() {
+        for m in DissipationModel::ALL {
+            assert_eq!(m.name().parse::<DissipationModel>(), Ok(m));
+        }
+        assert!("stokes".parse::<DissipationModel>().is_err());
+        let n = |model| {
+            Dissipation::preset(model, 1.0)
+                .unwrap()
+                .predicted_exponent()
+        };
+        assert_eq!(n(DissipationModel::Moffatt), Some(1.0 / 3.0));
+        assert_eq!(n(DissipationModel::AirDrag), Some(4.0 / 9.0));
+        assert_eq!(n(DissipationModel::Viscous), Some(0.5));
+        assert_eq!(n(DissipationModel::Rolling), Some(2.0 / 3.0));
+        assert_eq!(n(DissipationModel::Pivoting), None);
+        assert!(Dissipation::preset(DissipationModel::PowerLaw, 1.0).is_err());
+    }
+
+    #[test]
+    fn bad_values_are_refused() {
+        let m = DissipationModel::PowerLaw;
+        assert!(Dissipation::new(m, -1.0, 2.0, 0.0).is_err());
+        assert!(Dissipation::new(m, f64::NAN, 2.0, 0.0).is_err());
+        assert!(Dissipation::new(m, 1.0, 0.5, 0.0).is_err());
+        assert!(Dissipation::new(m, 1.0, 2.0, f64::INFINITY).is_err());
+        assert!(Dissipation::new(m, 0.0, 1.0, -3.0).is_ok());
+    }
+
+    #[test]
+    fn the_couple_vanishes_at_rest_without_nan() {
+        let d = Dissipation::preset(DissipationModel::Rolling, 2.0).unwrap();
+        let coin = DissipativeCoin::new(Coin::new(CoinParams::unit_disk()), d);
+        let r = coin.rates(0.3, 0.0, 0.0, 0.0);
+        assert_eq!(r.power, 0.0);
+        let conservative =
+            Coin::new(CoinParams::unit_disk()).angular_acceleration(0.3, 0.0, 0.0, 0.0);
+        assert_eq!(r.acceleration, conservative);
+    }
+}
