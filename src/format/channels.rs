@@ -127,7 +127,7 @@ impl Channel {
     pub fn fields(self) -> Option<&'static [&'static str]> {
         use super::messages::{
             Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-            ReactionMessage,
+            ReactionMessage, WorkMessage,
         };
         Some(match self {
             Self::Omega => AngularVelocity::FIELDS,
@@ -137,6 +137,7 @@ impl Channel {
             Self::Reaction => ReactionMessage::FIELDS,
             Self::Energy => EnergyMessage::FIELDS,
             Self::Invariants => InvariantsMessage::FIELDS,
+            Self::Work => WorkMessage::FIELDS,
             Self::Tf | Self::Scene => return None,
         })
     }
