@@ -1,8 +1,10 @@
 //! Command-line parsing and the exit-code policy (format.md: Exit codes). Only this module prints.
 
+mod analyse;
 mod bench;
 mod record;
 mod rss;
+mod scene_arg;
 mod scenes;
 mod verify;
 
@@ -30,6 +32,8 @@ enum Command {
     Scenes(scenes::ScenesArgs),
     /// Benchmarks: error against cost of every integrator, and the hard-case stability suite.
     Bench(bench::BenchArgs),
+    /// What a scene's motion will do, without simulating it; `analyse map`: the stability map.
+    Analyse(analyse::AnalyseArgs),
 }
 
 /// What a command ended with; the one place exit codes are decided (format.md: Exit codes).
@@ -74,7 +78,19 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Verify(args) => verify::run(args),
         Command::Scenes(args) => scenes::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Analyse(args) => analyse::run(args),
     }
+}
+
+/// Temporary files are created owner-only; a finished output file is an ordinary file.
+pub(crate) fn make_readable(file: &std::fs::File) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    #[cfg(not(unix))]
+    let _ = file;
 }
 
 #[cfg(test)]

@@ -3,11 +3,12 @@
 //! signals, the progress bar, printing and exit codes.
 
 use super::rss::peak_rss_bytes;
-use super::Outcome;
+use super::scene_arg::{load_source, SceneSource};
+use super::{make_readable, Outcome};
 use anyhow::{anyhow, bail, Context};
 use coin_log::format::Termination;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
-use coin_log::scene::{self, presets, FlagOverrides, Scene, SceneFile};
+use coin_log::scene::{self, FlagOverrides, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
@@ -93,43 +94,6 @@ impl From<CompressionArg> for Compression {
             CompressionArg::None => Compression::None,
         }
     }
-}
-
-/// Where a scene came from: its name in messages and its default output stem.
-struct SceneSource {
-    label: String,
-    stem: String,
-    file: SceneFile,
-}
-
-fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
-    if let Some(preset) = presets::preset(arg) {
-        let file =
-            scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
-        return Ok(SceneSource {
-            label: arg.to_string(),
-            stem: arg.to_string(),
-            file,
-        });
-    }
-    let path = Path::new(arg);
-    if !path.exists() && !arg.ends_with(".toml") && !arg.contains(std::path::MAIN_SEPARATOR) {
-        bail!(
-            "no built-in scene `{arg}` and no such file; built-in scenes: {}",
-            presets::NAMES.join(", ")
-        );
-    }
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
-    let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
-    let stem = path
-        .file_stem()
-        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
-    Ok(SceneSource {
-        label: arg.to_string(),
-        stem,
-        file,
-    })
 }
 
 /// Runs `coin-log record`: load → resolve → prepare the output → record → persist → summary and exit code.
@@ -293,17 +257,6 @@ fn update_progress(bar: &ProgressBar, started: Instant, fraction: f64) {
     }
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     bar.set_position((fraction.clamp(0.0, 1.0) * PROGRESS_STEPS as f64) as u64);
-}
-
-/// Temporary files are created owner-only; a recording is an ordinary file.
-fn make_readable(file: &std::fs::File) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = file;
 }
 
 #[allow(clippy::cast_precision_loss)]
