@@ -20,6 +20,7 @@ mod formulas;
 mod foxglove;
 mod integrators;
 mod invariants;
+mod linearisation;
 mod params;
 mod properties;
 mod readme;
