@@ -7,6 +7,7 @@
 //! The physics of the hard cases is physics §5 and §7.
 
 mod case;
+pub mod nutation;
 pub mod plot;
 pub mod precision;
 pub mod presets;

@@ -10,7 +10,9 @@
 //! - marginal stability of straight rolling at ω_c(1 ± 1e-3) and ω_c, against the linear theory (t² growth
 //!   at ω_c);
 //! - long horizon on a wobbling motion: energy drift against time;
-//! - scale invariance: M, a, g over 1e-3 … 1e3, disk and hoop, against the unit-scale run.
+//! - scale invariance: M, a, g over 1e-3 … 1e3, disk and hoop, against the unit-scale run;
+//! - the predictions of `analyse` ([`super::nutation`]): kicked stable circles nutate at σ, displaced
+//!   unstable circles grow at √(−σ²), generic motions have the quadrature's period and heading advance.
 //!
 //! Horizons are options ([`SuiteOptions`]) so that the tests run the same cases shorter.
 
@@ -62,6 +64,8 @@ pub struct SuiteOptions {
     pub long_horizon: f64,
     /// Horizon of the scale-invariance runs [natural time units].
     pub scale_horizon: f64,
+    /// Nutation periods of the analyse cases (kicked circles, generic motions; [`super::nutation`]).
+    pub analyse_periods: f64,
 }
 
 impl SuiteOptions {
@@ -74,6 +78,7 @@ impl SuiteOptions {
             marginal_horizon: 30.0,
             long_horizon: 1e4,
             scale_horizon: 10.0,
+            analyse_periods: 20.0,
         }
     }
 
@@ -86,6 +91,7 @@ impl SuiteOptions {
             marginal_horizon: 20.0,
             long_horizon: 1e3,
             scale_horizon: 5.0,
+            analyse_periods: 10.0,
         }
     }
 }
@@ -850,6 +856,9 @@ pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError
     }
     rows.extend(long_horizon(options.long_horizon));
     rows.extend(scale_invariance(options.scale_horizon)?);
+    rows.extend(super::nutation::stable_circles(options.analyse_periods)?);
+    rows.extend(super::nutation::unstable_circles()?);
+    rows.extend(super::nutation::generic_periods(options.analyse_periods)?);
     Ok(rows)
 }
 
