@@ -8,6 +8,7 @@
 
 mod support;
 
+mod analyse;
 mod architecture;
 mod bench_precision;
 mod bench_stability;
