@@ -32,9 +32,9 @@ pub const NUTATION_AMPLITUDE: f64 = 1e-5;
 /// Initial amplitude of the perturbed unstable circles \[rad\].
 pub const GROWTH_START: f64 = 1e-10;
 /// Window of the growth-rate fit: from this amplitude ...
-const GROWTH_FROM: f64 = 1e-9;
+pub const GROWTH_FROM: f64 = 1e-9;
 /// ... to this one \[rad\].
-const GROWTH_TO: f64 = 1e-5;
+pub const GROWTH_TO: f64 = 1e-5;
 /// Fixed step of rk4 and gauss4 in the nutation cases, as a fraction of a nutation period.
 const FIXED_STEP_PER_PERIOD: f64 = 1.0 / 2048.0;
 
@@ -192,7 +192,7 @@ pub fn growth_rate(
         |t, y| {
             let s = State::from_array(y);
             let amplitude = (s.theta - base.theta).abs();
-            if amplitude >= GROWTH_FROM && amplitude <= GROWTH_TO && s.omega_x != 0.0 {
+            if (GROWTH_FROM..=GROWTH_TO).contains(&amplitude) && s.omega_x != 0.0 {
                 points.push((t, s.omega_x.abs().ln()));
             }
             if amplitude > GROWTH_TO {

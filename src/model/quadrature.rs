@@ -47,7 +47,7 @@ const FINE: usize = 20;
 const MAX_DEPTH: u32 = 24;
 /// A halved panel whose two halves together still differ by more than this fraction of the whole
 /// panel's difference is noise-limited (see [`Adaptive`]).
-const NOISE_RATIO: f64 = 0.25;
+pub const NOISE_RATIO: f64 = 0.25;
 /// The two rules of a noise-limited panel agree to this fraction of ∫|f| over it.
 const NOISE_FLOOR: f64 = 1e-10;
 /// Most integrand evaluations of one [`Adaptive::integrate`]; past it every panel is accepted as it is.
