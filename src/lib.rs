@@ -4,8 +4,9 @@
 //! The physics is that of `docs/physics.md` (cited as "physics §n" and "eq (n)"): a thin axisymmetric body in
 //! rim contact with a flat table, no slip. The file format is `docs/format.md`. Dependencies point one way
 //! (docs/architecture.md): [`model`], [`mcap_io`] → [`integrate`] → [`simulation`] → [`format`](mod@format) → [`scene`] →
-//! [`record`] / [`verify`] / [`inspect`] → [`bench`](mod@bench) → the `coin-log` binary.
+//! [`record`] / [`verify`] / [`analyse`] / [`inspect`] → [`bench`](mod@bench) → the `coin-log` binary.
 
+pub mod analyse;
 pub mod bench;
 pub mod format;
 pub mod inspect;

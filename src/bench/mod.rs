@@ -8,6 +8,7 @@
 
 mod case;
 pub mod euler;
+pub mod nutation;
 pub mod plot;
 pub mod precision;
 pub mod presets;

@@ -10,7 +10,9 @@
 //! - marginal stability of straight rolling at ω_c(1 ± 1e-3) and ω_c, against the linear theory (t² growth
 //!   at ω_c);
 //! - long horizon on a wobbling motion: energy drift against time;
-//! - scale invariance: M, a, g over 1e-3 … 1e3, disk and hoop, against the unit-scale run.
+//! - scale invariance: M, a, g over 1e-3 … 1e3, disk and hoop, against the unit-scale run;
+//! - the predictions of `analyse` ([`super::nutation`]): kicked stable circles nutate at σ, displaced
+//!   unstable circles grow at √(−σ²), generic motions have the quadrature's period and heading advance.
 //!
 //! Horizons are options ([`SuiteOptions`]) so that the tests run the same cases shorter.
 
@@ -21,8 +23,8 @@ use super::{
 };
 use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
 use crate::model::{
-    energy, straight_lambda_squared, Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
-    STATE_LEN,
+    energy, steady_sigma_squared, straight_lambda_squared, Branch, Coin, CoinParams, Inertia,
+    State, Steady, SteadyKind, STATE_LEN,
 };
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::time::Instant;
@@ -62,6 +64,8 @@ pub struct SuiteOptions {
     pub long_horizon: f64,
     /// Horizon of the scale-invariance runs [natural time units].
     pub scale_horizon: f64,
+    /// Nutation periods of the analyse cases (kicked circles, generic motions; [`super::nutation`]).
+    pub analyse_periods: f64,
 }
 
 impl SuiteOptions {
@@ -74,6 +78,7 @@ impl SuiteOptions {
             marginal_horizon: 30.0,
             long_horizon: 1e4,
             scale_horizon: 10.0,
+            analyse_periods: 20.0,
         }
     }
 
@@ -86,6 +91,7 @@ impl SuiteOptions {
             marginal_horizon: 20.0,
             long_horizon: 1e3,
             scale_horizon: 5.0,
+            analyse_periods: 10.0,
         }
     }
 }
@@ -171,31 +177,12 @@ fn row_for(
 // ---------------------------------------------------------------------------------------------------------
 // Fast spin
 
-/// Nutation frequency σ of a steady motion (physics §5): the linearisation of eqs (14)–(17) in
-/// (θ, ω_X, ω_Y, ω_Z) about ω_X = 0 has eigenvalues 0, 0, ±iσ (the steady family is two-dimensional), so
-/// σ² = −tr(J²)/2 = −(∂ω̇_X/∂θ + ∂ω̇_X/∂ω_Y · ∂ω̇_Y/∂ω_X + ∂ω̇_X/∂ω_Z · ∂ω̇_Z/∂ω_X). `None` when σ² ≤ 0
-/// (an unstable steady motion).
+/// Nutation frequency σ of a steady motion: σ² of physics §9, eq (21) (the linearisation of eqs
+/// (14)–(17) about ω_X = 0 has eigenvalues 0, 0, ±iσ). `None` when σ² ≤ 0 (an unstable steady motion).
 #[must_use]
 pub fn nutation_frequency(coin: &Coin, steady: &Steady) -> Option<f64> {
-    let p = coin.params();
-    let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
-    let mga = p.mass() * p.gravity() * p.radius();
-    let (theta, wy, wz) = (
-        steady.state.theta,
-        steady.state.omega_y,
-        steady.state.omega_z,
-    );
-    let (st, ct) = theta.sin_cos();
-    let tan_t = st / ct;
-    let (gyro, centrifugal, grav) = ((iz + ma2) / (ix + ma2), ix / (ix + ma2), mga / (ix + ma2));
-    // Eq (14) derivatives.
-    let dx_dtheta = -centrifugal * wy * wy / (ct * ct) + grav * ct;
-    let dx_dwy = -gyro * wz - 2.0 * centrifugal * wy * tan_t;
-    let dx_dwz = -gyro * wy;
-    // Eqs (15), (16) derivatives with respect to ω_X at ω_X = 0.
-    let dy_dwx = wy * tan_t + iz / ix * wz;
-    let dz_dwx = ma2 / (iz + ma2) * wy;
-    let sigma2 = -(dx_dtheta + dx_dwy * dy_dwx + dx_dwz * dz_dwx);
+    let s = &steady.state;
+    let sigma2 = steady_sigma_squared(coin, s.theta, s.omega_y, s.omega_z);
     (sigma2 > 0.0).then(|| sigma2.sqrt())
 }
 
@@ -385,36 +372,8 @@ pub fn near_flat(theta: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>
 // ---------------------------------------------------------------------------------------------------------
 // Flat landing and lift-off
 
-/// Nodes and weights of n-point Gauss–Legendre quadrature on [−1, 1] (Newton on P_n from Chebyshev
-/// guesses; Abramowitz & Stegun 25.4.29).
-#[must_use]
-#[allow(clippy::cast_precision_loss)]
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let nf = n as f64;
-    (1..=n)
-        .map(|i| {
-            let mut x = (std::f64::consts::PI * (i as f64 - 0.25) / (nf + 0.5)).cos();
-            let mut dp = 1.0;
-            for _ in 0..100 {
-                // P_n(x) and P_n'(x) by the three-term recurrence.
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let kf = k as f64;
-                    let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = nf * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
+/// Gauss–Legendre nodes and weights (kept here under their old path; the rule lives in the model).
+pub use crate::model::quadrature::gauss_legendre;
 
 /// Time for a coin released at rest at lean θ₀ (no spin) to reach lean θ₁, from the energy integral
 /// (I_X + Ma²)θ̇²/2 = Mga(cos θ₀ − cos θ): t = ∫ dθ / √(2K(cos θ₀ − cos θ)), K = Mga/(I_X + Ma²). The
@@ -902,6 +861,9 @@ pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError
     }
     rows.extend(long_horizon(options.long_horizon));
     rows.extend(scale_invariance(options.scale_horizon)?);
+    rows.extend(super::nutation::stable_circles(options.analyse_periods)?);
+    rows.extend(super::nutation::unstable_circles()?);
+    rows.extend(super::nutation::generic_periods(options.analyse_periods)?);
     Ok(rows)
 }
 

@@ -4,7 +4,7 @@
 
 use super::progress::{file_len, FileProgress};
 use super::rss::peak_rss_bytes;
-use super::Outcome;
+use super::{make_readable, Outcome};
 use anyhow::{anyhow, bail, Context};
 use coin_log::inspect::export::{self, ExportSummary, Layout};
 use std::fs::File;
@@ -145,17 +145,6 @@ fn persist(temps: Vec<(String, NamedTempFile)>, dir: &Path, overwrite: bool) -> 
         })?;
     }
     Ok(())
-}
-
-/// Temporary files are created owner-only; a table is an ordinary file.
-fn make_readable(file: &File) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = file;
 }
 
 fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()> {

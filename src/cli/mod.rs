@@ -3,6 +3,7 @@
 
 #[macro_use]
 mod output;
+mod analyse;
 mod bench;
 mod completions;
 mod destination;
@@ -53,6 +54,8 @@ enum Command {
     Completions(completions::CompletionsArgs),
     /// Print the man page, or write one per command into a folder.
     Man(completions::ManArgs),
+    /// What a scene's motion will do, without simulating it; `analyse map`: the stability map.
+    Analyse(analyse::AnalyseArgs),
 }
 
 /// What a command ended with; the one place exit codes are decided (format.md: Exit codes).
@@ -100,7 +103,19 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Plot(args) => plot::run(&args),
         Command::Completions(args) => completions::completions(&args),
         Command::Man(args) => completions::man(&args),
+        Command::Analyse(args) => analyse::run(args),
     }
+}
+
+/// Temporary files are created owner-only; a finished output file is an ordinary file.
+pub(crate) fn make_readable(file: &std::fs::File) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    #[cfg(not(unix))]
+    let _ = file;
 }
 
 #[cfg(test)]

@@ -3,13 +3,13 @@
 //! signals, the progress bar, printing and exit codes.
 
 use super::rss::peak_rss_bytes;
-use super::scene_arg::{self, SceneArg};
+use super::scene_arg::{load_source, SceneSource};
 use super::text::size;
-use super::{destination, output, Outcome};
+use super::{destination, make_readable, output, Outcome};
 use anyhow::{anyhow, bail, Context};
 use coin_log::format::Termination;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
-use coin_log::scene::{self, limits, presets, FlagOverrides, Scene, SceneFile};
+use coin_log::scene::{self, limits, FlagOverrides, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
@@ -103,43 +103,6 @@ impl From<CompressionArg> for Compression {
             CompressionArg::None => Compression::None,
         }
     }
-}
-
-/// Where a scene came from: its name in messages, its default output stem, and its file if it is one.
-struct SceneSource {
-    label: String,
-    stem: String,
-    file: SceneFile,
-    path: Option<PathBuf>,
-}
-
-fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
-    let path = match scene_arg::classify(arg)? {
-        SceneArg::Builtin(name) => {
-            let preset = presets::preset(name).unwrap_or_default();
-            let file =
-                scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
-            return Ok(SceneSource {
-                label: arg.to_string(),
-                stem: arg.to_string(),
-                file,
-                path: None,
-            });
-        }
-        SceneArg::File(path) => path,
-    };
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
-    let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
-    let stem = path
-        .file_stem()
-        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
-    Ok(SceneSource {
-        label: arg.to_string(),
-        stem,
-        file,
-        path: Some(path.to_path_buf()),
-    })
 }
 
 /// Runs `coin-log record`: load → resolve → prepare the output → record → persist → summary and exit code.
@@ -435,17 +398,6 @@ fn update_progress(bar: &ProgressBar, started: Instant, fraction: f64) {
     }
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     bar.set_position((fraction.clamp(0.0, 1.0) * PROGRESS_STEPS as f64) as u64);
-}
-
-/// Temporary files are created owner-only; a recording is an ordinary file.
-fn make_readable(file: &std::fs::File) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = file;
 }
 
 /// The end-of-run summary on stdout (format.md: record, Summary): a table, or one JSON object.

@@ -2,10 +2,12 @@
 //! every command. A path (it holds a path separator or ends in `.toml`) is a file, whatever built-in has
 //! its stem; a bare name is the built-in of that name, and a file of that name in the current folder is
 //! then named in a note on stderr, so that it is never shadowed silently; a bare name that is no built-in
-//! is a file if one exists.
+//! is a file if one exists. [`load_source`] is the one loader of `record` and `analyse`: the scene, with
+//! the `--set KEY=VALUE` edits applied (format.md: Scene edits).
 
-use coin_log::scene::presets;
-use std::path::Path;
+use anyhow::{anyhow, Context};
+use coin_log::scene::{self, presets, SceneFile};
+use std::path::{Path, PathBuf};
 
 /// The scene an argument names.
 pub enum SceneArg<'a> {
@@ -46,4 +48,49 @@ pub fn classify(arg: &str) -> anyhow::Result<SceneArg<'_>> {
         "no built-in scene `{arg}` and no such file; built-in scenes: {}",
         presets::NAMES.join(", ")
     )
+}
+
+/// Where a scene came from: its name in messages, its default output stem, and its file if it is one.
+pub struct SceneSource {
+    /// SCENE as given.
+    pub label: String,
+    /// The built-in name or the file's stem.
+    pub stem: String,
+    /// The scene with the `--set` edits applied, not yet validated.
+    pub file: SceneFile,
+    /// The scene file, when SCENE is one (`record` refuses to write over it).
+    pub path: Option<PathBuf>,
+}
+
+/// Loads SCENE by the module's rule and applies `sets`.
+///
+/// # Errors
+/// No such scene, an unreadable file, or a scene or edit that does not parse.
+pub fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
+    let path = match classify(arg)? {
+        SceneArg::Builtin(name) => {
+            let preset = presets::preset(name).unwrap_or_default();
+            let file =
+                scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
+            return Ok(SceneSource {
+                label: arg.to_string(),
+                stem: arg.to_string(),
+                file,
+                path: None,
+            });
+        }
+        SceneArg::File(path) => path,
+    };
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
+    let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
+    Ok(SceneSource {
+        label: arg.to_string(),
+        stem,
+        file,
+        path: Some(path.to_path_buf()),
+    })
 }

@@ -14,9 +14,12 @@
 //!
 //!   energy drift tolerance        = min(1e-6, max(1e-12, 100 ε (1 + T/τ)))
 //!   residual tolerance            = min(1e-6, max(1e-10, 1000 ε (1 + T/τ)))   (constraint, steady)
+//!   nutation tolerance            = min(1e-6, max(1e-11, 100 ε))              (relative, T and ΔΦ)
 //!
 //! The factor 1 + T/τ lets errors grow linearly with the run's length, as they do for non-symplectic
-//! methods; the floors are what rounding alone produces (sums of ~1e-16 errors, and finite differences that
+//! methods (the nutation tolerance has no such factor: it judges a period, an average over the run, whose
+//! relative error is the integrator's relative error per unit time, ε, not its accumulation); the floors
+//! are what rounding alone produces (sums of ~1e-16 errors, and finite differences that
 //! divide them by the sample interval); the ceilings are the contract's: a tolerance is never looser than
 //! 1e-6, whatever the integrator settings. `--energy-tol` and `--residual-tol` replace the defaults.
 //! Recomputations of a stored quantity from other stored values (energy against `/coin/energy`, the
@@ -37,6 +40,12 @@ pub const RESIDUAL_FLOOR: f64 = 1e-10;
 pub const ENERGY_FACTOR: f64 = 100.0;
 /// Safety factor between ε(1 + T/τ) and the residual tolerance (finite differences amplify noise).
 pub const RESIDUAL_FACTOR: f64 = 1000.0;
+/// Contract ceiling of the nutation tolerance.
+pub const NUTATION_CEILING: f64 = 1e-6;
+/// Smallest default nutation tolerance: the rounding of crossing times a few ulp of t apart, averaged.
+pub const NUTATION_FLOOR: f64 = 1e-11;
+/// Safety factor between ε and the nutation tolerance.
+pub const NUTATION_FACTOR: f64 = 100.0;
 /// Relative tolerance of a stored quantity against its recomputation from other stored values: the same
 /// formula on the same numbers agrees to a few ulps; 1e-12 (≈ 4500 ε_machine) leaves room for a recorder
 /// that orders its arithmetic differently.
@@ -51,6 +60,9 @@ pub struct Tolerances {
     pub energy: f64,
     /// Constraint residual relative to a·max|ω|, and the steady residuals.
     pub residual: f64,
+    /// Relative error of the measured nutation period and heading advance (before the quadrature's and
+    /// the interpolation's shares are added).
+    pub nutation: f64,
     /// The accuracy ε the defaults were derived from.
     pub epsilon: f64,
 }
@@ -126,6 +138,7 @@ impl Tolerances {
                     RESIDUAL_CEILING,
                 )
             }),
+            nutation: clamp(NUTATION_FACTOR * epsilon, NUTATION_FLOOR, NUTATION_CEILING),
             epsilon,
         }
     }

@@ -6,7 +6,9 @@ mod dissipation;
 pub mod drift;
 mod equations;
 pub mod invariants;
+pub mod nutation;
 mod params;
+pub mod quadrature;
 mod stability;
 mod state;
 mod steady;
@@ -20,7 +22,8 @@ pub use equations::{AngularAcceleration, Coin};
 pub use invariants::{Chaplygin, Invariants, InvariantsError, LegendreBasis};
 pub use params::{CoinParams, Inertia, ParamError};
 pub use stability::{
-    centre_fixed_sigma_squared, critical_spin, spin_upright_sigma_squared, straight_lambda_squared,
+    centre_fixed_sigma_squared, critical_spin, eigenvalues, spin_upright_sigma_squared,
+    steady_sigma_squared, straight_lambda_squared, Linearisation,
 };
 pub use state::{State, StateRate, STATE_LEN};
 pub use steady::{

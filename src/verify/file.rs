@@ -3,8 +3,8 @@
 
 use super::checks::{
     consistency::ConsistencyCheck, constraint::ConstraintCheck, energy::EnergyCheck, integrity,
-    invariants::InvariantsCheck, steady, steady::SteadyCheck, validity::ValidityCheck, Context,
-    RunStats,
+    invariants::InvariantsCheck, nutation::NutationCheck, steady, steady::SteadyCheck,
+    validity::ValidityCheck, Context, RunStats,
 };
 use super::report::{CheckId, CheckResult, FileReport, Status};
 use super::samples::{Assembler, Sample, Slot, Value};
@@ -51,6 +51,7 @@ struct Checks {
     constraint: ConstraintCheck,
     consistency: ConsistencyCheck,
     validity: ValidityCheck,
+    nutation: NutationCheck,
 }
 
 impl Checks {
@@ -63,6 +64,7 @@ impl Checks {
         self.constraint.observe(s, ctx.coin.params().radius());
         self.consistency.observe(s, ctx);
         self.validity.observe(s, ctx);
+        self.nutation.observe(s, ctx);
     }
 }
 
@@ -517,6 +519,7 @@ fn verdict(
         c.constraint.finish(ctx.coin.params().radius(), &tol),
         c.consistency.finish(),
         c.validity.finish(&ctx),
+        c.nutation.finish(&ctx, &tol),
     ];
     require_physics(&mut results);
     let failed = results.iter().any(|r| r.status == Status::Fail);

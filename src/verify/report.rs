@@ -23,11 +23,13 @@ pub enum CheckId {
     Consistency,
     /// The model is valid: N ≥ 0 and |F| ≤ μN.
     Validity,
+    /// The nutation period and heading advance per period against the quadrature (physics §10).
+    Nutation,
 }
 
 impl CheckId {
     /// Every check, in report order.
-    pub const ALL: [CheckId; 7] = [
+    pub const ALL: [CheckId; 8] = [
         Self::Integrity,
         Self::Energy,
         Self::Invariants,
@@ -35,6 +37,7 @@ impl CheckId {
         Self::Constraint,
         Self::Consistency,
         Self::Validity,
+        Self::Nutation,
     ];
 
     /// The contract's id.
@@ -48,6 +51,7 @@ impl CheckId {
             Self::Constraint => "constraint",
             Self::Consistency => "consistency",
             Self::Validity => "validity",
+            Self::Nutation => "nutation",
         }
     }
 }

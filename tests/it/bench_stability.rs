@@ -218,3 +218,34 @@ fn scaled_coins_agree_with_the_unit_coin_to_1e_10() {
     println!("control: a = 4 without rescaling the spin differs by {difference:e} (≥ 1e-3)");
     assert!(difference >= 1e-3);
 }
+
+#[test]
+fn the_analyse_rows_confirm_sigma_growth_and_the_quadrature_with_every_integrator() {
+    // The rows `bench stability` adds for `analyse` (bench::nutation), over 10 periods: σ of kicked
+    // circles to 1e-6, growth rates to 1e-4, T and ΔΦ of generic motions to 1e-9 (the bounds),
+    // with every integrator (rk4 and gauss4 at 2048 steps per period: (2π/2048)⁴ ≈ 1e-10).
+    use coin_log::bench::nutation::{generic_periods, stable_circles, unstable_circles};
+    let mut rows = stable_circles(10.0).unwrap();
+    rows.extend(unstable_circles().unwrap());
+    rows.extend(generic_periods(10.0).unwrap());
+    assert_honest_ending(&rows, &["completed"]);
+    assert_eq!(rows.len(), 4 * 4 + 2 * 4 + 3 * 4 * 2);
+    for r in &rows {
+        let bound = if r.case.starts_with("growth") {
+            1e-4
+        } else if r.case.starts_with("nutation-circle") || r.case.contains("band") {
+            1e-6
+        } else {
+            1e-9
+        };
+        let error = r.max_error.unwrap();
+        println!(
+            "{:<28} {:<8} {:<28} measured {:?} expected {:?} relative error {error:.2e} (bound {bound:e}), {:.3} s",
+            r.case, r.integrator.to_string(), r.quantity, r.measured, r.expected, r.wall_seconds
+        );
+        assert!(
+            error <= bound,
+            "{r:?}: relative error {error:e} > {bound:e}"
+        );
+    }
+}

@@ -8,6 +8,7 @@
 
 mod support;
 
+mod analyse;
 mod architecture;
 mod bench_euler;
 mod bench_precision;
@@ -27,6 +28,7 @@ mod foxglove;
 mod inspect;
 mod integrators;
 mod invariants;
+mod linearisation;
 mod params;
 mod properties;
 mod readme;

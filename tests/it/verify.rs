@@ -211,7 +211,8 @@ fn the_json_output_has_exactly_the_contract_fields() {
             "steady",
             "constraint",
             "consistency",
-            "validity"
+            "validity",
+            "nutation"
         ]
     );
 }

@@ -6,6 +6,7 @@ pub mod constraint;
 pub mod energy;
 pub mod integrity;
 pub mod invariants;
+pub mod nutation;
 pub mod steady;
 pub mod validity;
 

@@ -1,0 +1,612 @@
+//! The stability map of the steady circles (format.md: analyse; physics §9): σ² over a grid of (θ₀, ω_Z0)
+//! on either branch of the steady family, the boundary σ² = 0 in closed form, where the band of unstable
+//! circles closes, and the built-in scenes' steady motions on the map.
+//!
+//! **The boundary in closed form** (physics §9, eqs (22)–(24)). For θ₀ ≠ 0 and ω_Z0 ≠ 0 the steady family
+//! turns σ² into a quadratic form in (ω_Y0, ω_Z0), so σ² = 0 fixes the ratio r = ω_Y0/ω_Z0 as a root of
+//! P(r) = (3 I_X tan²θ₀ + Ma²) r² + ((3 I_Z + Ma²) tan θ₀ − (I_Z + Ma²)/tan θ₀) r + I_Z (I_Z + Ma²)/I_X,
+//! and the family then fixes ω_Z0² = Mga sin θ₀ / (r (I_X tan θ₀ r + I_Z + Ma²)). The two roots of P meet,
+//! and the band closes, where its discriminant vanishes: a quadratic in tan²θ₀.
+
+use super::plot;
+use super::steady::{SteadyAnalysis, Verdict};
+use crate::model::{
+    critical_spin, steady_omega_y, steady_sigma_squared, Branch, Coin, Linearisation,
+};
+use crate::scene::{self, presets, InitialSpec, Scene};
+use std::f64::consts::FRAC_PI_2;
+use std::fmt::Write as _;
+use std::str::FromStr;
+use thiserror::Error;
+
+/// Most grid points per axis.
+pub const MAX_COUNT: usize = 10_000;
+/// Most grid points in all (θ₀ × ω_Z0 × branches): 4 million points are 250 MB of CSV.
+pub const MAX_POINTS: usize = 4_000_000;
+
+/// Why a map cannot be made.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MapError {
+    /// A grid flag that does not parse or is out of range.
+    #[error("`{flag} {value}`: {reason}")]
+    Grid {
+        /// The flag (`--theta`, `--omega-z`).
+        flag: &'static str,
+        /// The value given.
+        value: String,
+        /// What is wrong and what would do.
+        reason: String,
+    },
+    /// More points than [`MAX_POINTS`].
+    #[error("{points} grid points is more than {MAX_POINTS}: use fewer points per axis")]
+    TooLarge {
+        /// θ₀ count × ω_Z0 count × branches.
+        points: usize,
+    },
+    /// `--branch` other than `+`, `-` or `both`.
+    #[error("`--branch {0}`: use `+`, `-` or `both`")]
+    Branch(String),
+    /// Drawing the SVG failed.
+    #[error("drawing the stability map: {0}")]
+    Plot(String),
+}
+
+/// `A:B:N`: N values from A to B, equally spaced (N = 1: A alone).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Number of values, 1 ..= [`MAX_COUNT`].
+    pub count: usize,
+}
+
+impl Grid {
+    /// Parses `A:B:N` given to `flag`.
+    ///
+    /// # Errors
+    /// [`MapError::Grid`] naming the flag, the value and the expected form.
+    pub fn parse(flag: &'static str, text: &str) -> Result<Self, MapError> {
+        let error = |reason: String| MapError::Grid {
+            flag,
+            value: text.to_string(),
+            reason,
+        };
+        let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+        let [from, to, count] = parts[..] else {
+            return Err(error(
+                "expected A:B:N, e.g. `0.01:1.5:200` (N values from A to B)".into(),
+            ));
+        };
+        let number = |s: &str, what: &str| {
+            s.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| error(format!("{what} `{s}` is not a finite number")))
+        };
+        let (from, to) = (number(from, "A")?, number(to, "B")?);
+        let count = count
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (1..=MAX_COUNT).contains(n))
+            .ok_or_else(|| {
+                error(format!(
+                    "N `{count}` is not a whole number from 1 to {MAX_COUNT}"
+                ))
+            })?;
+        Ok(Self { from, to, count })
+    }
+
+    /// Value number `i` (0-based).
+    #[must_use]
+    pub fn value(&self, i: usize) -> f64 {
+        if self.count == 1 {
+            return self.from;
+        }
+        #[allow(clippy::cast_precision_loss)]
+        let x = i as f64 / (self.count - 1) as f64;
+        self.from + (self.to - self.from) * x
+    }
+
+    /// The spacing between values (the whole span for one value, or 0 when A = B).
+    #[must_use]
+    pub fn step(&self) -> f64 {
+        #[allow(clippy::cast_precision_loss)]
+        let gaps = self.count.saturating_sub(1).max(1) as f64;
+        (self.to - self.from).abs() / gaps
+    }
+
+    /// The smallest and largest value.
+    #[must_use]
+    pub fn bounds(&self) -> (f64, f64) {
+        (self.from.min(self.to), self.from.max(self.to))
+    }
+}
+
+impl std::fmt::Display for Grid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}:{}", self.from, self.to, self.count)
+    }
+}
+
+/// Which branches a map covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Branches {
+    /// The + root only.
+    Plus,
+    /// The − root only.
+    Minus,
+    /// Both.
+    Both,
+}
+
+impl Branches {
+    /// The branches, + first.
+    #[must_use]
+    pub fn list(self) -> &'static [Branch] {
+        match self {
+            Self::Plus => &[Branch::Plus],
+            Self::Minus => &[Branch::Minus],
+            Self::Both => &Branch::ALL,
+        }
+    }
+}
+
+impl FromStr for Branches {
+    type Err = MapError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "+" | "plus" => Ok(Self::Plus),
+            "-" | "minus" => Ok(Self::Minus),
+            "both" => Ok(Self::Both),
+            other => Err(MapError::Branch(other.to_string())),
+        }
+    }
+}
+
+/// The grid of a map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapOptions {
+    /// θ₀ values \[rad\]; each must satisfy 0 < |θ₀| < π/2.
+    pub theta: Grid,
+    /// ω_Z0 values [rad/time].
+    pub omega_z: Grid,
+    /// Which roots of the steady family.
+    pub branches: Branches,
+}
+
+/// The default θ₀ grid of `analyse map`.
+pub const DEFAULT_THETA: &str = "0.0075:1.5:200";
+/// The default ω_Z0 grid of `analyse map`.
+pub const DEFAULT_OMEGA_Z: &str = "0:2:200";
+
+impl MapOptions {
+    /// Checks the grid: every θ₀ leaning (0 < |θ₀| < π/2), at most [`MAX_POINTS`] points.
+    ///
+    /// # Errors
+    /// [`MapError`] naming the flag and the allowed range.
+    pub fn validate(&self) -> Result<(), MapError> {
+        let (lo, hi) = self.theta.bounds();
+        let leaning = |t: f64| t != 0.0 && t.abs() < FRAC_PI_2;
+        let crosses_zero = lo < 0.0 && hi > 0.0 && self.theta.count > 1;
+        let zero_on_grid = (0..self.theta.count).any(|i| !leaning(self.theta.value(i)));
+        if !leaning(lo) || !leaning(hi) || crosses_zero || zero_on_grid {
+            return Err(MapError::Grid {
+                flag: "--theta",
+                value: self.theta.to_string(),
+                reason: "every θ0 must lean: 0 < |θ0| < π/2 (upright θ0 = 0 is straight rolling or the upright spin, physics §4.1, §4.5; on one side of 0)".into(),
+            });
+        }
+        let points = self.theta.count * self.omega_z.count * self.branches.list().len();
+        if points > MAX_POINTS {
+            return Err(MapError::TooLarge { points });
+        }
+        Ok(())
+    }
+}
+
+impl Default for MapOptions {
+    fn default() -> Self {
+        // The defaults parse: they are the constants above.
+        let grid = |flag, text| {
+            Grid::parse(flag, text).unwrap_or(Grid {
+                from: 0.5,
+                to: 0.5,
+                count: 1,
+            })
+        };
+        Self {
+            theta: grid("--theta", DEFAULT_THETA),
+            omega_z: grid("--omega-z", DEFAULT_OMEGA_Z),
+            branches: Branches::Both,
+        }
+    }
+}
+
+/// One steady circle of the map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapPoint {
+    /// θ₀ \[rad\].
+    pub theta0: f64,
+    /// ω_Z0 [rad/time].
+    pub omega_z0: f64,
+    /// The root of the steady family.
+    pub branch: Branch,
+    /// ω_Y0 on that root [rad/time].
+    pub omega_y0: f64,
+    /// σ², eq (21) [1/time²].
+    pub sigma_squared: f64,
+    /// Stable, unstable or marginal.
+    pub verdict: Verdict,
+}
+
+/// A steady circle with σ² = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundaryPoint {
+    /// θ₀ \[rad\].
+    pub theta0: f64,
+    /// ω_Z0 [rad/time].
+    pub omega_z0: f64,
+    /// ω_Y0 [rad/time].
+    pub omega_y0: f64,
+    /// The root of the steady family it lies on.
+    pub branch: Branch,
+}
+
+/// A built-in (or the given) scene's steady motion on the map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenePoint {
+    /// The scene's name.
+    pub name: String,
+    /// θ₀ \[rad\] (0 for straight rolling and the upright spin).
+    pub theta0: f64,
+    /// ω_Z0 in the map body's units [rad/time].
+    pub omega_z0: f64,
+    /// The branch whose panel shows it (straight rolling: the root it continues).
+    pub branch: Branch,
+    /// Its verdict.
+    pub verdict: Verdict,
+}
+
+/// The stability map: the grid's points, the boundary and the band's closing points, ω_c and the scenes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StabilityMap {
+    /// The body.
+    pub coin: Coin,
+    /// The grid.
+    pub options: MapOptions,
+    /// θ₀-major, then ω_Z0, then branch (+ first).
+    pub points: Vec<MapPoint>,
+    /// ω_c of straight rolling (physics §5).
+    pub critical_spin: f64,
+    /// Where the two edges of an unstable band meet (the folds of the boundary).
+    pub closures: Vec<BoundaryPoint>,
+    /// The scenes' steady motions.
+    pub scenes: Vec<ScenePoint>,
+}
+
+/// σ² and its verdict for the circle (θ₀, ω_Z0) on `branch`.
+#[must_use]
+pub fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> MapPoint {
+    let omega_y0 = steady_omega_y(coin, theta0, omega_z0, branch);
+    let sigma_squared = steady_sigma_squared(coin, theta0, omega_y0, omega_z0);
+    let scale = Linearisation::at(coin, theta0, omega_y0, omega_z0).scale();
+    MapPoint {
+        theta0,
+        omega_z0,
+        branch,
+        omega_y0,
+        sigma_squared,
+        verdict: Verdict::of(sigma_squared, scale),
+    }
+}
+
+/// The map over `options`' grid for `coin`, with the built-in scenes of the same shape and `extra`
+/// (a scene of the caller's) placed on it.
+///
+/// # Errors
+/// [`MapError`] for a grid that [`MapOptions::validate`] refuses.
+pub fn stability_map(
+    coin: &Coin,
+    options: &MapOptions,
+    extra: Option<(&str, &Scene)>,
+) -> Result<StabilityMap, MapError> {
+    options.validate()?;
+    let branches = options.branches.list();
+    let mut points =
+        Vec::with_capacity(options.theta.count * options.omega_z.count * branches.len());
+    for i in 0..options.theta.count {
+        let theta0 = options.theta.value(i);
+        for j in 0..options.omega_z.count {
+            let omega_z0 = options.omega_z.value(j);
+            for &branch in branches {
+                points.push(map_point(coin, theta0, omega_z0, branch));
+            }
+        }
+    }
+    Ok(StabilityMap {
+        coin: *coin,
+        options: *options,
+        points,
+        critical_spin: critical_spin(coin),
+        closures: closures(coin),
+        scenes: scene_points(coin, extra),
+    })
+}
+
+impl StabilityMap {
+    /// `stability-map.csv`: the header `theta0,omega_z0,branch,omega_y0,sigma_squared,verdict` and one
+    /// line per point, numbers as shortest round-trip decimals.
+    #[must_use]
+    pub fn csv(&self) -> String {
+        let mut out = String::with_capacity(64 * (self.points.len() + 1));
+        out.push_str("theta0,omega_z0,branch,omega_y0,sigma_squared,verdict\n");
+        let mut buffer = ryu::Buffer::new();
+        for p in &self.points {
+            for value in [p.theta0, p.omega_z0] {
+                out.push_str(buffer.format(value));
+                out.push(',');
+            }
+            out.push_str(p.branch.name());
+            for value in [p.omega_y0, p.sigma_squared] {
+                out.push(',');
+                out.push_str(buffer.format(value));
+            }
+            out.push(',');
+            out.push_str(p.verdict.name());
+            out.push('\n');
+        }
+        out
+    }
+
+    /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes.
+    ///
+    /// # Errors
+    /// [`MapError::Plot`] if drawing fails (it does not for a validated grid).
+    pub fn svg(&self) -> Result<String, MapError> {
+        plot::map_svg(self)
+    }
+
+    /// Points of the grid that are unstable.
+    #[must_use]
+    pub fn unstable_count(&self) -> usize {
+        self.points
+            .iter()
+            .filter(|p| p.verdict == Verdict::Unstable)
+            .count()
+    }
+
+    /// The points of one θ₀ column on one branch, in ω_Z0 order.
+    pub fn column(&self, i: usize, branch: Branch) -> impl Iterator<Item = &MapPoint> {
+        let per_theta = self.options.omega_z.count * self.options.branches.list().len();
+        self.points[i * per_theta..(i + 1) * per_theta]
+            .iter()
+            .filter(move |p| p.branch == branch)
+    }
+}
+
+/// Every steady circle with σ² = 0 at lean θ₀, in closed form (module doc): for each real root r of P
+/// with ω_Z0² > 0, both signs of ω_Z0, each on the branch whose ω_Y0 it is. Empty at θ₀ = 0.
+#[must_use]
+pub fn boundary(coin: &Coin, theta0: f64) -> Vec<BoundaryPoint> {
+    let p = coin.params();
+    let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
+    let mga = p.mass() * p.gravity() * p.radius();
+    let (s, c) = theta0.sin_cos();
+    let t = s / c;
+    if t == 0.0 || !t.is_finite() {
+        return Vec::new();
+    }
+    let qa = 3.0 * ix * t * t + ma2;
+    let qb = (3.0 * iz + ma2) * t - (iz + ma2) / t;
+    let qc = iz * (iz + ma2) / ix;
+    let discriminant = qb * qb - 4.0 * qa * qc;
+    if discriminant < 0.0 {
+        return Vec::new();
+    }
+    // Stable quadratic formula: q = −(b + sgn(b)√D)/2, roots q/a and c/q.
+    let q = -0.5 * (qb + qb.signum() * discriminant.sqrt());
+    let mut out = Vec::new();
+    for r in [q / qa, qc / q] {
+        let omega2 = mga * s / (r * (ix * t * r + iz + ma2));
+        if !(omega2.is_finite() && omega2 > 0.0) {
+            continue;
+        }
+        for omega_z0 in [omega2.sqrt(), -omega2.sqrt()] {
+            out.push(on_branch(coin, theta0, omega_z0, r * omega_z0));
+        }
+    }
+    out
+}
+
+/// The boundary point (θ₀, ω_Z0, ω_Y0) with the branch whose root ω_Y0 is.
+fn on_branch(coin: &Coin, theta0: f64, omega_z0: f64, omega_y0: f64) -> BoundaryPoint {
+    let distance = |b: Branch| (steady_omega_y(coin, theta0, omega_z0, b) - omega_y0).abs();
+    let branch = if distance(Branch::Plus) <= distance(Branch::Minus) {
+        Branch::Plus
+    } else {
+        Branch::Minus
+    };
+    BoundaryPoint {
+        theta0,
+        omega_z0,
+        omega_y0,
+        branch,
+    }
+}
+
+/// Where the two roots of P meet (its discriminant is zero), θ₀ > 0 and ω_Z0 > 0: the leans where a band
+/// of unstable circles closes (physics §9, eq (24)). The discriminant times tan²θ₀ is the quadratic
+/// (Ma⁴ − 6 I_Z Ma² − 3 I_Z²) u² − 2 (I_Z + Ma²)(3 I_Z + Ma² + 2 Ma² I_Z/I_X) u + (I_Z + Ma²)² in
+/// u = tan²θ₀. The mirror images (−θ₀, −ω_Z0) are closures too.
+#[must_use]
+pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
+    let p = coin.params();
+    let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
+    let k = iz + ma2;
+    let a = ma2 * ma2 - 6.0 * iz * ma2 - 3.0 * iz * iz;
+    let b = -2.0 * k * (3.0 * iz + ma2 + 2.0 * ma2 * iz / ix);
+    let c = k * k;
+    let roots: Vec<f64> = if a == 0.0 {
+        vec![-c / b]
+    } else {
+        let d = b * b - 4.0 * a * c;
+        if d < 0.0 {
+            Vec::new()
+        } else {
+            let q = -0.5 * (b + b.signum() * d.sqrt());
+            vec![q / a, c / q]
+        }
+    };
+    let mga = p.mass() * p.gravity() * p.radius();
+    roots
+        .into_iter()
+        .filter(|u| u.is_finite() && *u > 0.0)
+        .filter_map(|u| {
+            let t = u.sqrt();
+            let theta0 = t.atan();
+            // The double root of P.
+            let r = -((3.0 * iz + ma2) * t - k / t) / (2.0 * (3.0 * ix * t * t + ma2));
+            let omega2 = mga * theta0.sin() / (r * (ix * t * r + k));
+            (omega2.is_finite() && omega2 > 0.0).then(|| {
+                let omega_z0 = omega2.sqrt();
+                on_branch(coin, theta0, omega_z0, r * omega_z0)
+            })
+        })
+        .collect()
+}
+
+/// The ω_Z0 in [lo, hi] where σ² changes sign on `branch` at lean θ₀, by root finding on the closed form
+/// σ²(θ₀, ω_Z0) (eq (21)): sign changes over `samples` equal steps, each bisected to adjacent floats. An
+/// independent route to the boundary of [`boundary`].
+#[must_use]
+pub fn sign_changes(
+    coin: &Coin,
+    theta0: f64,
+    branch: Branch,
+    (lo, hi): (f64, f64),
+    samples: usize,
+) -> Vec<f64> {
+    let sigma2 = |w: f64| {
+        let wy = steady_omega_y(coin, theta0, w, branch);
+        steady_sigma_squared(coin, theta0, wy, w)
+    };
+    let mut out = Vec::new();
+    let at = |j: usize| {
+        #[allow(clippy::cast_precision_loss)]
+        let x = j as f64 / samples.max(1) as f64;
+        lo + (hi - lo) * x
+    };
+    let mut previous = (at(0), sigma2(at(0)));
+    for j in 1..=samples {
+        let w = at(j);
+        let v = sigma2(w);
+        if (v < 0.0) != (previous.1 < 0.0) {
+            let negative_first = previous.1 < 0.0;
+            let (a, b) = crate::model::quadrature::bisect(
+                |x| (sigma2(x) < 0.0) == negative_first,
+                previous.0,
+                w,
+            );
+            out.push(0.5 * (a + b));
+        }
+        previous = (w, v);
+    }
+    out
+}
+
+/// A few round leans below the highest closure (steps of 1, 2 or 5 × 10ⁿ, about six of them) at which
+/// to report the band's edges; the leans 0.05 … 0.3 for the thin disk.
+#[must_use]
+pub fn edge_leans(coin: &Coin) -> Vec<f64> {
+    let Some(top) = closures(coin).iter().map(|c| c.theta0).reduce(f64::max) else {
+        return Vec::new();
+    };
+    let rough = top / 6.0;
+    let decade = 10f64.powf(rough.log10().floor());
+    let multiple = [5.0, 2.0, 1.0]
+        .into_iter()
+        .find(|m| m * decade <= rough)
+        .unwrap_or(1.0);
+    // (i·m)·10ⁿ rather than i·(m·10ⁿ): 0.15, not 0.15000000000000002.
+    (1..=12)
+        .map(|i| f64::from(i) * multiple * decade)
+        .take_while(|t| *t < top)
+        .collect()
+}
+
+/// The steady motions of the built-in scenes whose body has the map body's shape (the same I_X/Ma² and
+/// I_Z/Ma²), in the map's units (ω scaled by the ratio of the time units), and `extra`'s.
+fn scene_points(coin: &Coin, extra: Option<(&str, &Scene)>) -> Vec<ScenePoint> {
+    let mut scenes: Vec<(String, Scene)> = presets::NAMES
+        .iter()
+        .filter_map(|name| {
+            let file = presets::preset(name)?;
+            let scene = scene::resolve(&file, &scene::FlagOverrides::default()).ok()?;
+            Some(((*name).to_string(), scene))
+        })
+        .collect();
+    if let Some((name, scene)) = extra {
+        if !scenes.iter().any(|(n, _)| n == name) {
+            scenes.push((name.to_string(), scene.clone()));
+        }
+    }
+    let p = coin.params();
+    let shape = |c: &crate::model::CoinParams| (c.inertia_x() / c.ma2(), c.inertia_z() / c.ma2());
+    let (sx, sz) = shape(p);
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs());
+    scenes
+        .into_iter()
+        .filter_map(|(name, scene)| {
+            let (kx, kz) = shape(&scene.params);
+            if !(same(kx, sx) && same(kz, sz)) {
+                return None;
+            }
+            let InitialSpec::Steady(steady) = scene.spec else {
+                return None;
+            };
+            let s = steady.state;
+            let scale = scene.params.time_unit() / p.time_unit();
+            let analysis = SteadyAnalysis::of_state(&scene.coin(), &s, Some(&steady));
+            // Straight rolling continues the + root for ω_Z0 > 0 and the − root for ω_Z0 < 0; the upright
+            // spin is the centre-fixed motion's limit, on the branch of the sign of ω_Y0.
+            let branch = analysis
+                .branch
+                .unwrap_or(if s.omega_y < 0.0 || s.omega_z < 0.0 {
+                    Branch::Minus
+                } else {
+                    Branch::Plus
+                });
+            Some(ScenePoint {
+                name,
+                theta0: s.theta,
+                omega_z0: s.omega_z * scale,
+                branch,
+                verdict: analysis.verdict,
+            })
+        })
+        .collect()
+}
+
+/// One line per closure and per edge lean: the band's edges as text, for the command's summary.
+#[must_use]
+pub fn band_report(coin: &Coin) -> String {
+    let mut out = String::new();
+    for lean in edge_leans(coin) {
+        let spins: Vec<String> = boundary(coin, lean)
+            .iter()
+            .filter(|b| b.omega_z0 > 0.0)
+            .map(|b| format!("{:.6} ({} branch)", b.omega_z0, b.branch))
+            .collect();
+        let _ = writeln!(out, "  θ0 = {lean}: σ² = 0 at ω_Z0 = {}", spins.join(", "));
+    }
+    for c in closures(coin) {
+        let _ = writeln!(
+            out,
+            "  closes at θ0 = {:.6}, ω_Z0 = {:.6} ({} branch)",
+            c.theta0, c.omega_z0, c.branch
+        );
+    }
+    out
+}

@@ -1,0 +1,239 @@
+//! What a motion will do, without simulating it (format.md: analyse): the linear stability of a steady
+//! motion (physics §9), the nutation of any motion by quadrature (physics §10), and the stability map of
+//! the steady circles ([`map`]).
+//!
+//! The library returns values; `coin-log analyse` prints them and writes the map's files.
+
+pub mod map;
+mod plot;
+mod steady;
+
+pub use steady::{SteadyAnalysis, Verdict};
+
+use crate::model::invariants::Chaplygin;
+use crate::model::nutation::{Motion, NutationError, Orbit};
+use crate::model::{Coin, InvariantsError, State, Steady};
+use crate::scene::{InitialSpec, Scene};
+use serde::Serialize;
+use thiserror::Error;
+
+/// Why a motion cannot be analysed.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum AnalyseError {
+    /// C1, C2 cannot be evaluated for the body (physics §6).
+    #[error(transparent)]
+    Invariants(#[from] InvariantsError),
+    /// The state is not a rolling coin.
+    #[error(transparent)]
+    Nutation(#[from] NutationError),
+}
+
+/// The analysis of one initial state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Analysis {
+    /// The body.
+    pub coin: Coin,
+    /// The state analysed (the scene's initial state).
+    pub state: State,
+    /// The motion by quadrature: E, C1, C2, θ range, period and heading advance, N and |F|/N.
+    pub orbit: Orbit,
+    /// The steady motion the state is, analysed; `None` when it is not steady.
+    pub steady: Option<SteadyAnalysis>,
+    /// The steady motion a perturbed steady scene starts from, analysed (its σ is the nutation
+    /// frequency of small perturbations); `None` otherwise.
+    pub base_steady: Option<SteadyAnalysis>,
+    /// μ of the scene, if given.
+    pub friction: Option<f64>,
+}
+
+impl Analysis {
+    /// The analysis of a scene's initial state (the scene's flat margin and μ apply).
+    ///
+    /// # Errors
+    /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body.
+    pub fn of_scene(scene: &Scene) -> Result<Self, AnalyseError> {
+        let (given, base) = match &scene.spec {
+            InitialSpec::Steady(s) if scene.unperturbed_steady().is_some() => (Some(s), None),
+            InitialSpec::Steady(s) => (None, Some(s)),
+            InitialSpec::Explicit => (None, None),
+        };
+        let mut analysis = Self::of_state(
+            &scene.coin(),
+            &scene.initial,
+            scene.run.flat_margin,
+            scene.friction,
+            given,
+        )?;
+        analysis.base_steady =
+            base.map(|s| SteadyAnalysis::of_state(&analysis.coin, &s.state, Some(s)));
+        Ok(analysis)
+    }
+
+    /// The analysis of `state`; `given` is the steady motion the state is known to be (then it is
+    /// analysed as steady whatever rounding says).
+    ///
+    /// # Errors
+    /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body or the state is not rolling.
+    pub fn of_state(
+        coin: &Coin,
+        state: &State,
+        flat_margin: f64,
+        friction: Option<f64>,
+        given: Option<&Steady>,
+    ) -> Result<Self, AnalyseError> {
+        let chaplygin = Chaplygin::new(coin.params())?;
+        let orbit = if given.is_some() {
+            Orbit::steady(coin, &chaplygin, state)
+        } else {
+            Orbit::new(coin, &chaplygin, state, flat_margin)?
+        };
+        let steady =
+            (orbit.motion == Motion::Steady).then(|| SteadyAnalysis::of_state(coin, state, given));
+        Ok(Self {
+            coin: *coin,
+            state: *state,
+            orbit,
+            steady,
+            base_steady: None,
+            friction,
+        })
+    }
+
+    /// Whether N stays positive over the motion.
+    #[must_use]
+    pub fn normal_stays_positive(&self) -> bool {
+        self.orbit.min_normal.value > 0.0
+    }
+
+    /// With μ given: whether the motion needs more friction than μ (|F| > μN somewhere, or N reaching 0,
+    /// where |F|/N is unbounded).
+    #[must_use]
+    pub fn slips(&self) -> Option<bool> {
+        self.friction.map(|mu| {
+            self.orbit
+                .max_friction_ratio
+                .is_none_or(|ratio| ratio.value > mu)
+        })
+    }
+
+    /// The object of `coin-log analyse --json` (format.md: analyse --json).
+    #[must_use]
+    pub fn json(&self) -> serde_json::Value {
+        let o = &self.orbit;
+        let (period, precession, spin_advance) = match o.motion {
+            Motion::Periodic {
+                period,
+                precession,
+                spin_advance,
+            } => (Some(period), Some(precession), Some(spin_advance)),
+            _ => (None, None, None),
+        };
+        let json = AnalysisJson {
+            energy: o.energy,
+            c1: o.c1,
+            c2: o.c2,
+            theta_min: o.theta_min,
+            theta_max: o.theta_max,
+            period,
+            precession,
+            max_friction_ratio: o.max_friction_ratio.map(|e| e.value),
+            min_normal: o.min_normal.value,
+            steady: self.steady.as_ref().map(SteadyJson::from),
+            motion: motion_name(&o.motion),
+            spin_advance,
+            flat_landing_time: match o.motion {
+                Motion::FlatLanding { time, .. } => Some(time),
+                _ => None,
+            },
+            lift_off_time: o.lift_off.map(|e| e.time),
+            lift_off_theta: o.lift_off.map(|e| e.theta),
+            normal_stays_positive: self.normal_stays_positive(),
+            friction: self.friction,
+            slips: self.slips(),
+            quadrature_error: o.error,
+            base_steady: self.base_steady.as_ref().map(SteadyJson::from),
+        };
+        serde_json::to_value(json).unwrap_or(serde_json::Value::Null)
+    }
+}
+
+/// `steady`, `nutation` or `flat-landing`.
+#[must_use]
+pub fn motion_name(motion: &Motion) -> &'static str {
+    match motion {
+        Motion::Steady => "steady",
+        Motion::Periodic { .. } => "nutation",
+        Motion::FlatLanding { .. } => "flat-landing",
+    }
+}
+
+/// The `analyse --json` object, keys in the contract's order, then the extensions.
+#[derive(Serialize)]
+struct AnalysisJson {
+    energy: f64,
+    c1: f64,
+    c2: f64,
+    theta_min: f64,
+    theta_max: f64,
+    period: Option<f64>,
+    precession: Option<f64>,
+    max_friction_ratio: Option<f64>,
+    min_normal: f64,
+    steady: Option<SteadyJson>,
+    motion: &'static str,
+    spin_advance: Option<f64>,
+    flat_landing_time: Option<f64>,
+    lift_off_time: Option<f64>,
+    lift_off_theta: Option<f64>,
+    normal_stays_positive: bool,
+    friction: Option<f64>,
+    slips: Option<bool>,
+    quadrature_error: f64,
+    base_steady: Option<SteadyJson>,
+}
+
+/// The contract's `steady` object, then the extensions.
+#[derive(Serialize)]
+struct SteadyJson {
+    kind: &'static str,
+    omega_y: f64,
+    phi_dot: f64,
+    psi_dot: f64,
+    r_g: Option<f64>,
+    r_c: Option<f64>,
+    sigma_squared: f64,
+    eigenvalues: Vec<[f64; 2]>,
+    verdict: &'static str,
+    branch: Option<&'static str>,
+    normal: f64,
+    friction: f64,
+    nutation_period: Option<f64>,
+    e_folding_time: Option<f64>,
+}
+
+impl From<&SteadyAnalysis> for SteadyJson {
+    fn from(s: &SteadyAnalysis) -> Self {
+        // +0.0 for the zero eigenvalues and parts (JSON would show −0.0 as "-0.0").
+        let clean = |x: f64| if x == 0.0 { 0.0 } else { x };
+        Self {
+            kind: s.kind.name(),
+            omega_y: s.omega_y,
+            phi_dot: s.phi_dot,
+            psi_dot: s.psi_dot,
+            r_g: s.r_g,
+            r_c: s.r_c,
+            sigma_squared: s.sigma_squared,
+            eigenvalues: s
+                .eigenvalues
+                .iter()
+                .map(|&(re, im)| [clean(re), clean(im)])
+                .collect(),
+            verdict: s.verdict.name(),
+            branch: s.branch.map(crate::model::Branch::name),
+            normal: s.normal,
+            friction: s.friction,
+            nutation_period: s.nutation_period(),
+            e_folding_time: s.e_folding_time(),
+        }
+    }
+}

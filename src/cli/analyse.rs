@@ -1,0 +1,376 @@
+//! `coin-log analyse`: what a scene's motion will do, without simulating it, and the stability map of the
+//! steady circles (format.md: analyse). The library computes (`coin_log::analyse`); this file loads the
+//! scene, prints, and writes the map's files.
+
+use super::scene_arg::load_source;
+use super::{make_readable, Outcome};
+use anyhow::{anyhow, Context};
+use coin_log::analyse::map::{
+    band_report, stability_map, Branches, Grid, MapOptions, DEFAULT_OMEGA_Z, DEFAULT_THETA,
+};
+use coin_log::analyse::{motion_name, Analysis, SteadyAnalysis, Verdict};
+use coin_log::model::nutation::Motion;
+use coin_log::model::{Coin, CoinParams, SteadyFamily};
+use coin_log::scene::{RunFile, Scene};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `coin-log analyse`.
+///
+/// `coin-log analyse SCENE` says what the scene's initial state will do without simulating it: E, C1, C2,
+/// the range of θ, the nutation period T and the heading advance ΔΦ per period by quadrature
+/// (docs/physics.md §10), the smallest normal force and the friction coefficient the motion needs; for a
+/// steady motion its rates, radii, σ², the eigenvalues of its linearisation and whether it is stable
+/// (docs/physics.md §9). `coin-log analyse map` maps the stability of the steady circles.
+///
+/// `map` is a subcommand: to analyse a scene file called `map`, write its path as `./map`.
+#[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct AnalyseArgs {
+    #[command(subcommand)]
+    command: Option<AnalyseCommand>,
+    /// A built-in scene (listed by `coin-log scenes`) or a path to a `.toml` scene file.
+    #[arg(required = true)]
+    scene: Option<String>,
+    /// Print one JSON object (docs/format.md: analyse --json).
+    #[arg(long)]
+    json: bool,
+    /// Set a scene key first: KEY is a dotted path (`initial.theta`, `body.shape`), VALUE a TOML value or
+    /// a bare string. Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(Debug, clap::Subcommand)]
+enum AnalyseCommand {
+    /// The stability map of the steady circles: σ² over a grid of (θ0, ω_Z0) on either branch, written as
+    /// stability-map.csv and stability-map.svg.
+    ///
+    /// The CSV has the columns theta0, omega_z0, branch, omega_y0, sigma_squared, verdict. The SVG shows
+    /// σ² by colour (blue stable, red unstable, darker for larger |σ²|), the boundary σ² = 0 in closed
+    /// form, ω_c of straight rolling and the built-in scenes' steady motions. The summary gives the
+    /// unstable band's edges and where it closes (docs/physics.md §9).
+    Map(MapArgs),
+}
+
+/// Arguments of `coin-log analyse map`.
+#[derive(Debug, clap::Args)]
+struct MapArgs {
+    /// A scene whose body to map (built-in name or `.toml` file) [default: the thin disk, M = a = g = 1].
+    scene: Option<String>,
+    /// θ0 grid A:B:N: N values from A to B, each with 0 < |θ0| < π/2 [rad].
+    #[arg(long, value_name = "A:B:N", default_value = DEFAULT_THETA)]
+    theta: String,
+    /// ω_Z0 grid A:B:N: N values from A to B [rad per time unit].
+    #[arg(long = "omega-z", value_name = "A:B:N", default_value = DEFAULT_OMEGA_Z)]
+    omega_z: String,
+    /// Which root of the steady family: +, - or both.
+    #[arg(
+        long,
+        value_name = "+|-|both",
+        default_value = "both",
+        allow_hyphen_values = true
+    )]
+    branch: String,
+    /// Folder for stability-map.csv and stability-map.svg (created if missing; the files are replaced).
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    out: PathBuf,
+}
+
+/// Runs `coin-log analyse`.
+pub fn run(args: AnalyseArgs) -> anyhow::Result<Outcome> {
+    match (args.command, args.scene) {
+        (Some(AnalyseCommand::Map(map)), _) => run_map(&map),
+        (None, Some(scene)) => run_scene(&scene, &args.set, args.json),
+        (None, None) => Err(anyhow!("give a SCENE to analyse, or `map`")),
+    }
+}
+
+/// The scene SCENE with `sets`, validated; `run.duration` (which analyse does not use) may be left out.
+fn load_scene(arg: &str, sets: &[String]) -> anyhow::Result<Scene> {
+    let mut source = load_source(arg, sets)?;
+    let run = source.file.run.get_or_insert_with(RunFile::default);
+    if run.duration.is_none() {
+        run.duration = Some(1.0);
+    }
+    Scene::from_file(&source.file).map_err(|e| anyhow!("scene `{arg}`: {e}"))
+}
+
+fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> {
+    let scene = load_scene(arg, sets)?;
+    let analysis = Analysis::of_scene(&scene).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
+    if let Some(d) = &scene.dissipation {
+        errln!(
+            "note: scene `{arg}` has dissipation ({}): this is the conservative motion from its initial \
+             state; the couple changes E, C1 and C2 (docs/physics.md §11), so the prediction holds for \
+             times short against the dissipation's",
+            d.model()
+        );
+    }
+    if json {
+        outln!("{}", serde_json::to_string(&analysis.json())?);
+    } else {
+        for (key, value) in summary(arg, &scene, &analysis) {
+            outln!("{key:<16} {value}");
+        }
+    }
+    Ok(Outcome::Success)
+}
+
+fn body(p: &CoinParams) -> String {
+    format!(
+        "M = {}, a = {}, g = {}, I_X = {}, I_Z = {}",
+        p.mass(),
+        p.radius(),
+        p.gravity(),
+        p.inertia_x(),
+        p.inertia_z()
+    )
+}
+
+/// The rows of the human summary.
+fn summary(label: &str, scene: &Scene, a: &Analysis) -> Vec<(&'static str, String)> {
+    let s = &a.state;
+    let o = &a.orbit;
+    let mut rows = vec![
+        ("scene", label.to_string()),
+        ("body", body(&scene.params)),
+        (
+            "state",
+            format!(
+                "θ = {}, ω = ({}, {}, {})",
+                s.theta, s.omega_x, s.omega_y, s.omega_z
+            ),
+        ),
+        ("energy", format!("E = {}", o.energy)),
+        ("invariants", format!("C1 = {}, C2 = {}", o.c1, o.c2)),
+    ];
+    match (&a.steady, o.motion) {
+        (Some(steady), _) => rows.extend(steady_rows(steady)),
+        (None, motion) => rows.extend(motion_rows(a, motion, scene.run.flat_margin)),
+    }
+    if let Some(base) = &a.base_steady {
+        rows.push((
+            "perturbed from",
+            format!(
+                "{}; σ² = {}, {}",
+                family(base),
+                base.sigma_squared,
+                verdict(base)
+            ),
+        ));
+    }
+    rows.extend(force_rows(a));
+    rows
+}
+
+fn family(s: &SteadyAnalysis) -> String {
+    let name = match s.kind {
+        SteadyFamily::Straight => "steady: straight rolling",
+        SteadyFamily::CentreFixed => "steady: centre at rest",
+        SteadyFamily::Circle => "steady circle",
+        SteadyFamily::SpinUpright => "steady: spinning upright in place",
+    };
+    match s.branch {
+        Some(b) => format!("{name} ({b} branch)"),
+        None => name.to_string(),
+    }
+}
+
+fn verdict(s: &SteadyAnalysis) -> String {
+    match s.verdict {
+        Verdict::Stable => format!(
+            "stable: small perturbations nutate with period 2π/σ = {}",
+            s.nutation_period().unwrap_or(f64::NAN)
+        ),
+        Verdict::Unstable => format!(
+            "unstable: small perturbations grow like e^(t/τ), τ = 1/√(−σ²) = {}",
+            s.e_folding_time().unwrap_or(f64::NAN)
+        ),
+        Verdict::Marginal => {
+            "marginal: σ² = 0 to rounding, the linearisation does not decide".to_string()
+        }
+    }
+}
+
+fn steady_rows(s: &SteadyAnalysis) -> Vec<(&'static str, String)> {
+    let radius = |r: Option<f64>| r.map_or_else(|| "∞".to_string(), |r| r.to_string());
+    let root = s.eigenvalues[2];
+    let pair = if root.1 != 0.0 {
+        format!("±{} i", root.1)
+    } else {
+        format!("±{}", root.0)
+    };
+    vec![
+        ("motion", family(s)),
+        (
+            "rates",
+            format!("ω_Y = {}, φ̇ = {}, ψ̇ = {}", s.omega_y, s.phi_dot, s.psi_dot),
+        ),
+        (
+            "radii",
+            format!("R_G = {}, R_C = {}", radius(s.r_g), radius(s.r_c)),
+        ),
+        ("forces", format!("N = {}, |F| = {}", s.normal, s.friction)),
+        (
+            "σ²",
+            format!("{} (docs/physics.md §9, eq (21))", s.sigma_squared),
+        ),
+        ("eigenvalues", format!("0, 0, {pair}")),
+        ("verdict", verdict(s)),
+    ]
+}
+
+fn motion_rows(a: &Analysis, motion: Motion, flat_margin: f64) -> Vec<(&'static str, String)> {
+    let o = &a.orbit;
+    let mut rows = Vec::new();
+    match motion {
+        Motion::Periodic {
+            period,
+            precession,
+            spin_advance,
+        } => {
+            rows.push((
+                "motion",
+                format!(
+                    "{}: θ between {} and {}",
+                    motion_name(&motion),
+                    o.theta_min,
+                    o.theta_max
+                ),
+            ));
+            rows.push(("period", format!("T = {period}")));
+            rows.push((
+                "heading",
+                format!(
+                    "ΔΦ = {precession} rad per period (mean φ̇ = {})",
+                    precession / period
+                ),
+            ));
+            rows.push(("spin", format!("ΔΨ = {spin_advance} rad per period")));
+        }
+        Motion::FlatLanding { theta, time } => {
+            let first = match o.lift_off {
+                Some(e) if e.time < time => format!(
+                    "lifts off at t = {} (N reaches 0, θ = {}) before it would land flat: ",
+                    e.time, e.theta
+                ),
+                _ => String::new(),
+            };
+            rows.push((
+                "motion",
+                format!(
+                    "{first}lands flat: θ reaches {theta} (flat margin {flat_margin}) at t = {time}, from θ = {}",
+                    if theta > 0.0 { o.theta_min } else { o.theta_max }
+                ),
+            ));
+        }
+        Motion::Steady => {}
+    }
+    rows.push((
+        "quadrature",
+        format!("estimated relative error {:.1e}", o.error),
+    ));
+    rows
+}
+
+fn force_rows(a: &Analysis) -> Vec<(&'static str, String)> {
+    let o = &a.orbit;
+    let normal = match o.lift_off {
+        Some(event) => format!(
+            "min N = {} at θ = {}: N reaches 0 at θ = {}, t = {}, where the coin lifts off",
+            o.min_normal.value, o.min_normal.theta, event.theta, event.time
+        ),
+        None => format!(
+            "min N = {} at θ = {}: stays positive",
+            o.min_normal.value, o.min_normal.theta
+        ),
+    };
+    let need = o.max_friction_ratio.map_or_else(
+        || "|F|/N grows without bound as N reaches 0: no μ keeps it rolling".to_string(),
+        |e| format!("needs μ ≥ max |F|/N = {} (at θ = {})", e.value, e.theta),
+    );
+    let friction = match (a.friction, a.slips()) {
+        (Some(mu), Some(true)) => format!("{need}; the scene's μ = {mu}: it slips"),
+        (Some(mu), _) => format!("{need}; the scene's μ = {mu} holds"),
+        (None, _) => need,
+    };
+    vec![("normal force", normal), ("friction", friction)]
+}
+
+fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
+    let options = MapOptions {
+        theta: Grid::parse("--theta", &args.theta)?,
+        omega_z: Grid::parse("--omega-z", &args.omega_z)?,
+        branches: args.branch.parse::<Branches>()?,
+    };
+    let scene = args
+        .scene
+        .as_deref()
+        .map(|s| load_scene(s, &[]).map(|scene| (s, scene)))
+        .transpose()?;
+    let coin = scene
+        .as_ref()
+        .map_or_else(|| Coin::new(CoinParams::unit_disk()), |(_, s)| s.coin());
+    let started = Instant::now();
+    let map = stability_map(&coin, &options, scene.as_ref().map(|(n, s)| (*n, s)))?;
+    let csv = map.csv();
+    let svg = map.svg()?;
+    let elapsed = started.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating the output folder `{}`", args.out.display()))?;
+    let csv_path = args.out.join("stability-map.csv");
+    let svg_path = args.out.join("stability-map.svg");
+    write_replacing(&csv_path, &csv)?;
+    write_replacing(&svg_path, &svg)?;
+    let branches = match options.branches {
+        Branches::Plus => "the + branch",
+        Branches::Minus => "the − branch",
+        Branches::Both => "both branches",
+    };
+    outln!("{:<16} {}", "body", body(coin.params()));
+    outln!(
+        "{:<16} θ0 {} × ω_Z0 {} on {branches}: {} circles, {} unstable",
+        "grid",
+        options.theta,
+        options.omega_z,
+        map.points.len(),
+        map.unstable_count()
+    );
+    outln!(
+        "{:<16} {} (straight rolling is unstable below it, docs/physics.md §5)",
+        "ω_c", map.critical_spin
+    );
+    let report = band_report(&coin);
+    if !report.is_empty() {
+        outln!("unstable band    σ² = 0 in closed form (docs/physics.md §9):");
+        out!("{report}");
+    }
+    outln!(
+        "{:<16} {}, {} ({elapsed:.3} s)",
+        "wrote",
+        csv_path.display(),
+        svg_path.display()
+    );
+    Ok(Outcome::Success)
+}
+
+/// Writes `text` to `path` through a temporary file in the same folder, so that a failure leaves the old
+/// file (or none), never half of the new one.
+fn write_replacing(path: &Path, text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let folder = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut temp = tempfile::Builder::new()
+        .prefix(".coin-log-")
+        .tempfile_in(folder)
+        .with_context(|| format!("cannot write in `{}`", folder.display()))?;
+    temp.write_all(text.as_bytes())
+        .with_context(|| format!("writing `{}`", path.display()))?;
+    make_readable(temp.as_file());
+    temp.persist(path)
+        .map_err(|e| anyhow!("cannot write `{}`: {}", path.display(), e.error))?;
+    Ok(())
+}

@@ -1,0 +1,792 @@
+//! The nutation of any motion by quadrature (physics §10): with E, C1 and C2 fixed, ω_Y and ω_Z are
+//! functions of θ alone (physics §6), so is θ̇² = f(θ), and the turning points, the nutation period and
+//! the heading advance per period are one-dimensional integrals.
+//!
+//! # Method
+//!
+//! * **The reduced motion.** ω_Z(θ) = C1 y_e + C2 y_o and ω_Y(θ) = k (C1 p_e + C2 p_o)/cos θ (the 2 × 2
+//!   system of physics §6 inverted with its Wronskian, which makes its determinant 1), and
+//!   (I_X + Ma²) θ̇² = 2(E − U(θ)) with U(θ) = ½ I_X ω_Y² + ½ (I_Z + Ma²) ω_Z² + Mga cos θ, eq (25).
+//! * **θ̇² without cancellation.** dU/dθ = S(θ) = I_X tan θ ω_Y² + (I_Z + Ma²) ω_Y ω_Z − Mga sin θ, the
+//!   left-hand side of the steady family, eq (26). Within [`SHORT_RANGE`] of θ₀, U(θ) − U(θ₀) is the
+//!   16-point Gauss–Legendre integral of S rather than a difference of two values of U: near a steady
+//!   motion (or near upright) S is small, and so is the rounding of its integral, where the difference of
+//!   two O(U) numbers would carry ~1e-16·U. Measured on a 1e-6 tilt of straight rolling this turns a
+//!   1e-4 relative error of θ̇² into 1e-15.
+//! * **Turning points** by a geometric scan outwards from θ₀ (first step 1e-12 rad, doubling up to
+//!   1/128 rad), then bisection of the bracket to adjacent floating-point numbers.
+//! * **T and ΔΦ** with θ = θ_min + (θ_max − θ_min)(1 − cos u)/2, u ∈ [0, π]: then
+//!   dθ/√f = du/√g with g = f/((θ − θ_min)(θ_max − θ)) smooth and positive, and the integrand is a
+//!   smooth even periodic function of u, so the midpoint rule in u (Gauss–Chebyshev) converges
+//!   geometrically. The number of nodes is doubled from 32 until two estimates agree to 1e-14.
+//! * **Times to an event** (flat landing, lift-off) along the path from θ₀, leg by leg, by adaptive
+//!   Gauss–Legendre; a leg that starts or ends at a turning point r is integrated in v with
+//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there.
+//! * **N and |F|/N** are functions of θ on the orbit (θ̇² = f(θ), ω̇ from eqs (14)–(16)); their extremes
+//!   by a scan of 257 points and golden-section refinement.
+
+use super::derived::{energy, reaction};
+use super::equations::Coin;
+use super::invariants::Chaplygin;
+use super::quadrature::{bisect, gauss_legendre, Adaptive};
+use super::state::State;
+use std::f64::consts::{FRAC_PI_2, PI};
+use thiserror::Error;
+
+/// |θ − θ₀| within which U(θ) − U(θ₀) is integrated from S (see the module doc) \[rad\].
+pub const SHORT_RANGE: f64 = 0.02;
+/// Order of the Gauss–Legendre rule of that integral.
+const SHORT_RULE: usize = 16;
+/// A state is steady when ω_X and S(θ₀) are both below this fraction of their natural scales (64 ulp).
+pub const STEADY_TOLERANCE: f64 = 64.0 * f64::EPSILON;
+/// First step of the turning-point scan \[rad\].
+const FIRST_STEP: f64 = 1e-12;
+/// Largest step of the turning-point scan \[rad\].
+const LARGEST_STEP: f64 = 1.0 / 128.0;
+/// Agreement at which the period quadrature stops doubling its nodes.
+const CONVERGED: f64 = 1e-14;
+/// Below this change between doublings, a change that stops shrinking is rounding noise.
+const NOISE_FLOOR: f64 = 1e-10;
+/// Fewest and most nodes of the period quadrature.
+const FIRST_NODES: usize = 32;
+/// See [`FIRST_NODES`].
+const MOST_NODES: usize = 1 << 19;
+/// Relative tolerance of the adaptive travel-time integrals.
+const TRAVEL_RTOL: f64 = 1e-14;
+/// Points of the scan for the extremes of N and |F|/N.
+const EXTREME_SCAN: usize = 257;
+
+/// Why the quadrature cannot be done.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum NutationError {
+    /// The state is not finite or leans flat.
+    #[error("the state is not a rolling coin: θ = {theta} must satisfy |θ| < π/2 − flat_margin = {limit}, and every ω must be finite")]
+    BadState {
+        /// θ given.
+        theta: f64,
+        /// π/2 − flat_margin.
+        limit: f64,
+    },
+}
+
+/// What the motion does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    /// ω_X = 0 and the steady family holds (to [`STEADY_TOLERANCE`]): θ stays where it is.
+    Steady,
+    /// θ oscillates between two turning points.
+    Periodic {
+        /// The nutation period T = 2∫dθ/|θ̇| \[time\].
+        period: f64,
+        /// The heading advance per period ΔΦ = 2∫φ̇ dθ/|θ̇| \[rad\].
+        precession: f64,
+        /// The spin advance per period ΔΨ = 2∫ψ̇ dθ/|θ̇| \[rad\].
+        spin_advance: f64,
+    },
+    /// θ reaches the flat margin: the coin lands flat (physics §7).
+    FlatLanding {
+        /// The lean it lands at, ±(π/2 − flat_margin).
+        theta: f64,
+        /// When, from t = 0.
+        time: f64,
+    },
+}
+
+/// A lean and the time the motion first reaches it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Event {
+    /// θ \[rad\].
+    pub theta: f64,
+    /// Time from t = 0.
+    pub time: f64,
+}
+
+/// An extreme value over the motion and where it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extremum {
+    /// The value.
+    pub value: f64,
+    /// The lean where it is attained \[rad\].
+    pub theta: f64,
+}
+
+/// The motion from one state, by quadrature (physics §10).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Orbit {
+    /// E of the state (physics §3).
+    pub energy: f64,
+    /// C1 (physics §6).
+    pub c1: f64,
+    /// C2 (physics §6).
+    pub c2: f64,
+    /// What the motion does.
+    pub motion: Motion,
+    /// The smallest lean the motion reaches (up to the landing for a flat landing) \[rad\].
+    pub theta_min: f64,
+    /// The largest lean the motion reaches \[rad\].
+    pub theta_max: f64,
+    /// The smallest normal force N over [θ_min, θ_max] (negative: the rim-contact model would need the
+    /// table to pull, and the coin lifts off where N first reaches 0).
+    pub min_normal: Extremum,
+    /// The largest |F|/N over [θ_min, θ_max], the friction coefficient the motion needs; `None` when N
+    /// reaches 0 (the ratio is unbounded).
+    pub max_friction_ratio: Option<Extremum>,
+    /// Where and when N first reaches 0 along the motion, if it does.
+    pub lift_off: Option<Event>,
+    /// Estimated relative error of the period and the heading advance (or of the landing time): the
+    /// quadrature's convergence and the rounding of θ̇² near the turning points.
+    pub error: f64,
+}
+
+impl Orbit {
+    /// The motion of `state` for `coin`, with the flat landing at |θ| = π/2 − `flat_margin`.
+    ///
+    /// ```
+    /// use coin_log::model::{Chaplygin, Coin, CoinParams, State};
+    /// use coin_log::model::nutation::{Motion, Orbit};
+    /// let coin = Coin::new(CoinParams::unit_disk());
+    /// let chaplygin = Chaplygin::new(coin.params()).unwrap();
+    /// let wobble = State { theta: 0.5, omega_x: 0.3, omega_y: 0.2, omega_z: 1.5, ..State::default() };
+    /// let orbit = Orbit::new(&coin, &chaplygin, &wobble, 1e-4).unwrap();
+    /// assert!(matches!(orbit.motion, Motion::Periodic { .. }));
+    /// assert!(orbit.theta_min < 0.5 && 0.5 < orbit.theta_max);
+    /// ```
+    ///
+    /// # Errors
+    /// [`NutationError::BadState`] for a non-finite state or one at or beyond the flat margin.
+    pub fn new(
+        coin: &Coin,
+        chaplygin: &Chaplygin,
+        state: &State,
+        flat_margin: f64,
+    ) -> Result<Self, NutationError> {
+        let limit = FRAC_PI_2 - flat_margin;
+        let finite = [state.theta, state.omega_x, state.omega_y, state.omega_z]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite || state.theta.abs() >= limit {
+            return Err(NutationError::BadState {
+                theta: state.theta,
+                limit,
+            });
+        }
+        if is_steady(coin, state) {
+            return Ok(Self::steady(coin, chaplygin, state));
+        }
+        let mut reduced = Reduced::new(coin, chaplygin, state, limit);
+        let mut orbit = Self::steady(coin, chaplygin, state);
+        reduced.fill(&mut orbit);
+        Ok(orbit)
+    }
+
+    /// The motion of a state taken as steady (θ stays where it is): E, C1, C2, N and |F|/N of the state.
+    #[must_use]
+    pub fn steady(coin: &Coin, chaplygin: &Chaplygin, state: &State) -> Self {
+        let invariants = chaplygin.of_state(state);
+        let r = reaction(coin, state);
+        Self {
+            energy: energy(coin, state).total,
+            c1: invariants.c1,
+            c2: invariants.c2,
+            motion: Motion::Steady,
+            theta_min: state.theta,
+            theta_max: state.theta,
+            min_normal: Extremum {
+                value: r.normal,
+                theta: state.theta,
+            },
+            max_friction_ratio: (r.normal > 0.0).then_some(Extremum {
+                value: r.friction / r.normal,
+                theta: state.theta,
+            }),
+            lift_off: (r.normal <= 0.0).then_some(Event {
+                theta: state.theta,
+                time: 0.0,
+            }),
+            error: 0.0,
+        }
+    }
+}
+
+/// S(θ) = I_X tan θ ω_Y² + (I_Z + Ma²) ω_Y ω_Z − Mga sin θ and the sum of the magnitudes of its terms:
+/// (I_X + Ma²) ω̇_X = −S (eq (14)); S = 0 is the steady family (physics §4).
+#[must_use]
+pub fn steady_residual(coin: &Coin, theta: f64, omega_y: f64, omega_z: f64) -> (f64, f64) {
+    let p = coin.params();
+    let (st, ct) = theta.sin_cos();
+    let terms = [
+        p.inertia_x() * st / ct * omega_y * omega_y,
+        (p.inertia_z() + p.ma2()) * omega_y * omega_z,
+        -p.mass() * p.gravity() * p.radius() * st,
+    ];
+    (
+        terms.iter().sum(),
+        terms.iter().map(|t| t.abs()).sum::<f64>(),
+    )
+}
+
+/// Whether `state` is a steady motion to rounding: ω_X = 0 and the steady family holds, each to
+/// [`STEADY_TOLERANCE`] of its natural scale (|ω| + √(g/a) for ω_X, the size of S's terms for S).
+#[must_use]
+pub fn is_steady(coin: &Coin, state: &State) -> bool {
+    let p = coin.params();
+    let rate = (state.omega_x.powi(2) + state.omega_y.powi(2) + state.omega_z.powi(2)).sqrt()
+        + 1.0 / p.time_unit();
+    let (s, terms) = steady_residual(coin, state.theta, state.omega_y, state.omega_z);
+    state.omega_x.abs() <= STEADY_TOLERANCE * rate && s.abs() <= STEADY_TOLERANCE * terms
+}
+
+/// One end of the θ range in one direction from θ₀.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum End {
+    /// A turning point (θ̇ = 0).
+    Turn(f64),
+    /// The flat margin, reached with θ̇ ≠ 0.
+    Flat(f64),
+}
+
+/// A stretch of the path from `from` to `to`, each end possibly a turning point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Leg {
+    from: f64,
+    to: f64,
+    from_turns: bool,
+    to_turns: bool,
+}
+
+/// The motion reduced to θ alone, for one state's E, C1, C2.
+struct Reduced<'a> {
+    coin: &'a Coin,
+    chaplygin: &'a Chaplygin,
+    c1: f64,
+    c2: f64,
+    k: f64,
+    /// I_X + Ma².
+    lever: f64,
+    theta0: f64,
+    omega_x0: f64,
+    /// U(θ₀).
+    u0: f64,
+    /// |θ − θ₀| within which ΔU is integrated from S.
+    short: f64,
+    /// The turning points found so far, each with the distance within which θ̇² is integrated from it.
+    anchors: Vec<(f64, f64)>,
+    /// π/2 − flat_margin.
+    limit: f64,
+    rule: Vec<(f64, f64)>,
+    adaptive: Adaptive,
+}
+
+impl<'a> Reduced<'a> {
+    fn new(coin: &'a Coin, chaplygin: &'a Chaplygin, state: &State, limit: f64) -> Self {
+        let p = coin.params();
+        let c = chaplygin.of_state(state);
+        let mut reduced = Self {
+            coin,
+            chaplygin,
+            c1: c.c1,
+            c2: c.c2,
+            k: chaplygin.k(),
+            lever: p.inertia_x() + p.ma2(),
+            theta0: state.theta,
+            omega_x0: state.omega_x,
+            u0: 0.0,
+            short: SHORT_RANGE.min(0.1 * (FRAC_PI_2 - state.theta.abs())),
+            anchors: Vec::new(),
+            limit,
+            rule: gauss_legendre(SHORT_RULE),
+            adaptive: Adaptive::new(),
+        };
+        reduced.u0 = reduced.potential(state.theta);
+        reduced
+    }
+
+    /// (ω_Y, ω_Z) at θ for this motion's C1, C2 (physics §6 inverted).
+    fn rates(&self, theta: f64) -> (f64, f64) {
+        let b = self.chaplygin.basis(theta);
+        let omega_z = self.c1 * b.y_even + self.c2 * b.y_odd;
+        let omega_y = self.k * (self.c1 * b.flux_even + self.c2 * b.flux_odd) / theta.cos();
+        (omega_y, omega_z)
+    }
+
+    /// U(θ) = ½ I_X ω_Y² + ½ (I_Z + Ma²) ω_Z² + Mga cos θ, eq (25).
+    fn potential(&self, theta: f64) -> f64 {
+        let p = self.coin.params();
+        let (wy, wz) = self.rates(theta);
+        0.5 * p.inertia_x() * wy * wy
+            + 0.5 * (p.inertia_z() + p.ma2()) * wz * wz
+            + p.mass() * p.gravity() * p.radius() * theta.cos()
+    }
+
+    /// S(θ) = dU/dθ, eq (26).
+    fn slope(&self, theta: f64) -> f64 {
+        let (wy, wz) = self.rates(theta);
+        steady_residual(self.coin, theta, wy, wz).0
+    }
+
+    /// The mean of S over [a, b] by the 16-point Gauss–Legendre rule (a, b close: see the module doc).
+    fn mean_slope(&self, a: f64, b: f64) -> f64 {
+        let (centre, half) = (0.5 * (a + b), 0.5 * (b - a));
+        0.5 * self
+            .rule
+            .iter()
+            .map(|&(x, w)| w * self.slope(centre + half * x))
+            .sum::<f64>()
+    }
+
+    /// The turning point θ is integrated from, if it is close to one.
+    fn anchor(&self, theta: f64) -> Option<f64> {
+        self.anchors
+            .iter()
+            .find(|(a, reach)| (theta - a).abs() <= *reach)
+            .map(|&(a, _)| a)
+    }
+
+    /// θ̇² = f(θ) = ω_X0² − 2(U(θ) − U(θ₀))/(I_X + Ma²), eq (27). Close to a turning point r (once found)
+    /// f = −2(θ − r) mean(S)/(I_X + Ma²), close to θ₀ U(θ) − U(θ₀) = (θ − θ₀) mean(S), and elsewhere
+    /// the difference of the two potentials.
+    fn theta_dot_squared(&self, theta: f64) -> f64 {
+        if let Some(r) = self.anchor(theta) {
+            return -2.0 * (theta - r) * self.mean_slope(r, theta) / self.lever;
+        }
+        let offset = theta - self.theta0;
+        let change = if offset.abs() <= self.short {
+            offset * self.mean_slope(self.theta0, theta)
+        } else {
+            self.potential(theta) - self.u0
+        };
+        self.omega_x0 * self.omega_x0 - 2.0 * change / self.lever
+    }
+
+    /// f(θ)/((θ − lo)(hi − θ)) between the turning points lo < hi, without dividing small by small near
+    /// them: there f = −2(θ − r) mean(S)/(I_X + Ma²) and the factor θ − r cancels.
+    fn reduced_rate(&self, theta: f64, below: f64, above: f64) -> f64 {
+        match self.anchor(theta) {
+            Some(r) if below <= above => -2.0 * self.mean_slope(r, theta) / self.lever / above,
+            Some(r) => 2.0 * self.mean_slope(theta, r) / self.lever / below,
+            None => self.theta_dot_squared(theta) / (below * above),
+        }
+    }
+
+    /// The state on the orbit at θ (ω_X ≥ 0; N and |F| do not depend on its sign).
+    fn state(&self, theta: f64) -> State {
+        let (omega_y, omega_z) = self.rates(theta);
+        State {
+            theta,
+            omega_x: self.theta_dot_squared(theta).max(0.0).sqrt(),
+            omega_y,
+            omega_z,
+            ..State::default()
+        }
+    }
+
+    /// The direction θ moves in at t = 0: the sign of ω_X0, or of θ̈ = −S/(I_X + Ma²) when ω_X0 = 0.
+    fn direction(&self) -> f64 {
+        if self.omega_x0 != 0.0 {
+            self.omega_x0.signum()
+        } else {
+            -self.slope(self.theta0).signum()
+        }
+    }
+
+    /// The end of the θ range from θ₀ in `direction` (±1).
+    fn end(&self, direction: f64) -> End {
+        let limit = direction * self.limit;
+        let inside = |theta: f64| self.theta_dot_squared(theta) > 0.0;
+        let (mut last_inside, mut step, mut offset) = (self.theta0, FIRST_STEP, 0.0);
+        loop {
+            offset += step;
+            step = (2.0 * step).min(LARGEST_STEP);
+            let theta = self.theta0 + direction * offset;
+            if direction * (theta - limit) >= 0.0 {
+                return if inside(limit) {
+                    End::Flat(limit)
+                } else {
+                    let (a, b) = bisect(inside, last_inside, limit);
+                    End::Turn(0.5 * (a + b))
+                };
+            }
+            if !inside(theta) {
+                let (a, b) = bisect(inside, last_inside, theta);
+                return End::Turn(0.5 * (a + b));
+            }
+            last_inside = theta;
+        }
+    }
+
+    /// Classifies the motion and computes everything else.
+    fn fill(&mut self, orbit: &mut Orbit) {
+        let d = self.direction();
+        let forward = self.end(d);
+        // With ω_X0 = 0, θ₀ is itself the turning point behind.
+        let backward = if self.omega_x0 == 0.0 {
+            End::Turn(self.theta0)
+        } else {
+            self.end(-d)
+        };
+        self.anchor_at(forward, backward);
+        let from_turns = self.omega_x0 == 0.0;
+        let (legs, motion, error) = match (forward, backward) {
+            (End::Flat(flat), _) => {
+                let leg = Leg {
+                    from: self.theta0,
+                    to: flat,
+                    from_turns,
+                    to_turns: false,
+                };
+                self.landing(&[leg])
+            }
+            (End::Turn(turn), End::Flat(flat)) => {
+                let first = Leg {
+                    from: self.theta0,
+                    to: turn,
+                    from_turns,
+                    to_turns: true,
+                };
+                let second = Leg {
+                    from: turn,
+                    to: flat,
+                    from_turns: true,
+                    to_turns: false,
+                };
+                self.landing(&[first, second])
+            }
+            (End::Turn(a), End::Turn(b)) => self.periodic(a, b),
+        };
+        orbit.motion = motion;
+        orbit.error = error;
+        let ends = legs.iter().flat_map(|l| [l.from, l.to]);
+        orbit.theta_min = ends.clone().fold(self.theta0, f64::min);
+        orbit.theta_max = ends.fold(self.theta0, f64::max);
+        self.extremes(orbit);
+        orbit.lift_off = self.lift_off(&legs);
+    }
+
+    /// Records the turning points among the two ends, each with the reach of its integral form: at most
+    /// [`SHORT_RANGE`], half the distance to the other end, and a tenth of its distance from flat.
+    fn anchor_at(&mut self, forward: End, backward: End) {
+        let (a, b) = match (forward, backward) {
+            (End::Turn(a) | End::Flat(a), End::Turn(b) | End::Flat(b)) => (a, b),
+        };
+        for end in [forward, backward] {
+            if let End::Turn(r) = end {
+                let other = if r == a { b } else { a };
+                let reach = SHORT_RANGE
+                    .min(0.5 * (other - r).abs())
+                    .min(0.1 * (FRAC_PI_2 - r.abs()));
+                self.anchors.push((r, reach));
+            }
+        }
+    }
+
+    /// A motion that lands flat along `legs`.
+    fn landing(&self, legs: &[Leg]) -> (Vec<Leg>, Motion, f64) {
+        let (mut time, mut error) = (0.0, 0.0);
+        for leg in legs {
+            let (t, e) = self.travel(leg);
+            time += t;
+            error += e;
+        }
+        let theta = legs.last().map_or(self.theta0, |l| l.to);
+        (
+            legs.to_vec(),
+            Motion::FlatLanding { theta, time },
+            error / time,
+        )
+    }
+
+    /// A periodic motion between the turning points `a` and `b` (any order).
+    fn periodic(&self, a: f64, b: f64) -> (Vec<Leg>, Motion, f64) {
+        let (lo, hi) = (a.min(b), a.max(b));
+        let (period, precession, spin_advance, error) = self.period_integrals(lo, hi);
+        // The path: from θ₀ on to the turning point ahead, then across to the other.
+        let (ahead, behind) = if self.direction() > 0.0 {
+            (hi, lo)
+        } else {
+            (lo, hi)
+        };
+        let legs = vec![
+            Leg {
+                from: self.theta0,
+                to: ahead,
+                from_turns: self.omega_x0 == 0.0,
+                to_turns: true,
+            },
+            Leg {
+                from: ahead,
+                to: behind,
+                from_turns: true,
+                to_turns: true,
+            },
+        ];
+        (
+            legs,
+            Motion::Periodic {
+                period,
+                precession,
+                spin_advance,
+            },
+            error,
+        )
+    }
+}
+
+impl Reduced<'_> {
+    /// (T, ΔΦ, ΔΨ, estimated relative error) over one period between the turning points lo < hi, by the
+    /// midpoint rule in u with θ = lo + (hi − lo)(1 − cos u)/2 (see the module doc).
+    fn period_integrals(&self, lo: f64, hi: f64) -> (f64, f64, f64, f64) {
+        let width = hi - lo;
+        // g → f′/(hi − lo) at the ends, f′ = −2S/(I_X + Ma²): the limit where rounding leaves f ≤ 0.
+        let end_g = [lo, hi].map(|t| (2.0 * self.slope(t) / self.lever).abs() / width);
+        let sums = |n: usize| {
+            let (mut time, mut heading, mut spin, mut heading_scale, mut f_max) =
+                (0.0, 0.0, 0.0, 0.0, 0.0_f64);
+            for j in 0..n {
+                #[allow(clippy::cast_precision_loss)]
+                let u = PI * (j as f64 + 0.5) / n as f64;
+                let (below, above) = (
+                    width * (0.5 * u).sin().powi(2),
+                    width * (0.5 * u).cos().powi(2),
+                );
+                let theta = if below <= above {
+                    lo + below
+                } else {
+                    hi - above
+                };
+                let g = self.reduced_rate(theta, below, above);
+                f_max = f_max.max(g * below * above);
+                let g = if g > 0.0 {
+                    g
+                } else {
+                    end_g[usize::from(below > above)]
+                };
+                let w = 1.0 / g.sqrt();
+                let (wy, wz) = self.rates(theta);
+                let (st, ct) = theta.sin_cos();
+                let phi_dot = wy / ct;
+                time += w;
+                heading += w * phi_dot;
+                heading_scale += w * phi_dot.abs();
+                spin += w * (wz + wy * st / ct);
+            }
+            #[allow(clippy::cast_precision_loss)]
+            let step = 2.0 * PI / n as f64;
+            (
+                time * step,
+                heading * step,
+                spin * step,
+                heading_scale * step,
+                f_max,
+            )
+        };
+        let mut n = FIRST_NODES;
+        let mut previous = sums(n);
+        let mut previous_change = f64::INFINITY;
+        loop {
+            n *= 2;
+            let next = sums(n);
+            let change_t = (next.0 - previous.0).abs() / next.0;
+            let change_phi = (next.1 - previous.1).abs() / next.3.max(f64::MIN_POSITIVE);
+            let change = change_t.max(change_phi);
+            // Geometric convergence shrinks the change by orders of magnitude per doubling; a change that
+            // no longer shrinks fourfold below NOISE_FLOOR is the rounding noise of θ̇².
+            let noisy = change <= NOISE_FLOOR && change > 0.25 * previous_change;
+            previous_change = change;
+            let converged = change <= CONVERGED || noisy;
+            if converged || n >= MOST_NODES {
+                let rounding = self.rounding(lo, hi, next.4);
+                return (
+                    next.0,
+                    next.1,
+                    next.2,
+                    change_t.max(change_phi).max(rounding),
+                );
+            }
+            previous = next;
+        }
+    }
+
+    /// Relative rounding error of θ̇² at the scale of its largest value `f_max` on [lo, hi]: a few ulp of
+    /// the terms of U where U(θ) − U(θ₀) is a difference, of the terms of S times the distance where it
+    /// is an integral (module doc); the period inherits about half of it.
+    fn rounding(&self, lo: f64, hi: f64, f_max: f64) -> f64 {
+        let p = self.coin.params();
+        let mid = 0.5 * (lo + hi);
+        let (wy, wz) = self.rates(mid);
+        let u_terms = 0.5 * p.inertia_x() * wy * wy
+            + 0.5 * (p.inertia_z() + p.ma2()) * wz * wz
+            + p.mass() * p.gravity() * p.radius();
+        let reach = (hi - self.theta0).abs().max((lo - self.theta0).abs());
+        let (_, s_terms) = steady_residual(self.coin, mid, wy, wz);
+        let du = if reach <= self.short {
+            s_terms * reach
+        } else {
+            u_terms
+        };
+        16.0 * f64::EPSILON * 2.0 * du / self.lever / f_max.max(f64::MIN_POSITIVE)
+    }
+
+    /// ∫dθ/|θ̇| along `leg` and its error bound.
+    fn travel(&self, leg: &Leg) -> (f64, f64) {
+        match (leg.from_turns, leg.to_turns) {
+            (true, true) => {
+                let mid = 0.5 * (leg.from + leg.to);
+                let (a, ea) = self.leaving_turning_point(leg.from, mid);
+                let (b, eb) = self.leaving_turning_point(leg.to, mid);
+                (a + b, ea + eb)
+            }
+            (true, false) => self.leaving_turning_point(leg.from, leg.to),
+            (false, true) => self.leaving_turning_point(leg.to, leg.from),
+            (false, false) => {
+                let f = |theta: f64| 1.0 / self.theta_dot_squared(theta).max(0.0).sqrt();
+                let (a, b) = (leg.from.min(leg.to), leg.from.max(leg.to));
+                let r = self.adaptive.integrate(&f, a, b, TRAVEL_RTOL);
+                (r.value, r.error)
+            }
+        }
+    }
+
+    /// ∫dθ/|θ̇| from the turning point `turn` to `other` (where θ̇ ≠ 0), with θ = turn + (other − turn) v².
+    fn leaving_turning_point(&self, turn: f64, other: f64) -> (f64, f64) {
+        let span = other - turn;
+        if span == 0.0 {
+            return (0.0, 0.0);
+        }
+        let slope = (2.0 * self.slope(turn) / self.lever).abs();
+        let f = |v: f64| {
+            let theta = turn + span * v * v;
+            // Near the turning point f = −2 span v² mean(S)/(I_X + Ma²): the factor v² cancels.
+            let per_v2 = match self.anchor(theta) {
+                Some(r) if r == turn => -2.0 * span * self.mean_slope(turn, theta) / self.lever,
+                _ => self.theta_dot_squared(theta) / (v * v),
+            };
+            if per_v2 > 0.0 {
+                2.0 * span.abs() / per_v2.sqrt()
+            } else {
+                // Rounding at the turning point: f ≈ f′(turn)(θ − turn) there.
+                2.0 * (span.abs() / slope).sqrt()
+            }
+        };
+        let r = self.adaptive.integrate(&f, 0.0, 1.0, TRAVEL_RTOL);
+        (r.value, r.error)
+    }
+
+    /// The smallest N and the largest |F|/N over [θ_min, θ_max].
+    fn extremes(&self, orbit: &mut Orbit) {
+        let normal = |theta: f64| reaction(self.coin, &self.state(theta)).normal;
+        orbit.min_normal = extreme(orbit.theta_min, orbit.theta_max, |t| -normal(t));
+        orbit.min_normal.value = -orbit.min_normal.value;
+        orbit.max_friction_ratio = (orbit.min_normal.value > 0.0).then(|| {
+            extreme(orbit.theta_min, orbit.theta_max, |t| {
+                let r = reaction(self.coin, &self.state(t));
+                r.friction / r.normal
+            })
+        });
+    }
+
+    /// The first place along `legs` where N reaches 0, and when.
+    fn lift_off(&self, legs: &[Leg]) -> Option<Event> {
+        let normal = |theta: f64| reaction(self.coin, &self.state(theta)).normal;
+        if normal(self.theta0) <= 0.0 {
+            return Some(Event {
+                theta: self.theta0,
+                time: 0.0,
+            });
+        }
+        let mut elapsed = 0.0;
+        for leg in legs {
+            let scan = EXTREME_SCAN - 1;
+            let mut previous = leg.from;
+            for j in 1..=scan {
+                #[allow(clippy::cast_precision_loss)]
+                let theta = leg.from + (leg.to - leg.from) * j as f64 / scan as f64;
+                if normal(theta) <= 0.0 {
+                    let (_, at) = bisect(|t| normal(t) > 0.0, previous, theta);
+                    let part = Leg {
+                        to: at,
+                        to_turns: false,
+                        ..*leg
+                    };
+                    return Some(Event {
+                        theta: at,
+                        time: elapsed + self.travel(&part).0,
+                    });
+                }
+                previous = theta;
+            }
+            elapsed += self.travel(leg).0;
+        }
+        None
+    }
+}
+
+/// The largest value of `h` on [lo, hi] and where: the best of [`EXTREME_SCAN`] points (denser towards
+/// the ends), refined by golden-section search between its neighbours.
+fn extreme(lo: f64, hi: f64, h: impl Fn(f64) -> f64) -> Extremum {
+    if hi <= lo {
+        return Extremum {
+            value: h(lo),
+            theta: lo,
+        };
+    }
+    let at = |j: usize| {
+        #[allow(clippy::cast_precision_loss)]
+        let u = PI * j as f64 / (EXTREME_SCAN - 1) as f64;
+        lo + (hi - lo) * 0.5 * (1.0 - u.cos())
+    };
+    let (mut best, mut best_value) = (0, f64::NEG_INFINITY);
+    for j in 0..EXTREME_SCAN {
+        let v = h(at(j));
+        if v > best_value || v.is_nan() {
+            best = j;
+            best_value = v;
+        }
+    }
+    let (mut a, mut b) = (
+        at(best.saturating_sub(1)),
+        at((best + 1).min(EXTREME_SCAN - 1)),
+    );
+    // Golden section; the ends count, so an extreme at lo or hi is found too.
+    let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (b - ratio * (b - a), a + ratio * (b - a));
+    let (mut h1, mut h2) = (h(x1), h(x2));
+    for _ in 0..200 {
+        if b - a <= 4.0 * f64::EPSILON * (a.abs() + b.abs()) {
+            break;
+        }
+        if h1 >= h2 {
+            b = x2;
+            x2 = x1;
+            h2 = h1;
+            x1 = b - ratio * (b - a);
+            h1 = h(x1);
+        } else {
+            a = x1;
+            x1 = x2;
+            h1 = h2;
+            x2 = a + ratio * (b - a);
+            h2 = h(x2);
+        }
+    }
+    [
+        (best_value, at(best)),
+        (h1, x1),
+        (h2, x2),
+        (h(lo), lo),
+        (h(hi), hi),
+    ]
+    .into_iter()
+    .fold(
+        Extremum {
+            value: f64::NEG_INFINITY,
+            theta: lo,
+        },
+        |m, (value, theta)| {
+            if value > m.value {
+                Extremum { value, theta }
+            } else {
+                m
+            }
+        },
+    )
+}
