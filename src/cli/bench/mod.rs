@@ -177,17 +177,17 @@ fn euler(args: &EulerArgs) -> anyhow::Result<Outcome> {
     let options = EulerOptions::full();
     let rows = euler_bench(&options)?;
     if let Some(first) = rows.first() {
-        println!(
+        outln!(
             "euler-disk toy, every preset at the time scale T = {:.2} s of its Moffatt law; window from α = {WINDOW_TOP} down to |α̇|/(α σ) = {:e} or ω_Z²/|ω|² = {:e}, whichever comes first; ends without μ and with μ = {SLIP_FRICTION}",
             first.time_scale, options.epsilon, options.spin_share
         );
     }
-    print!("{}", euler_table(&rows));
+    out!("{}", euler_table(&rows));
     let csv_path = args.out.join("euler.csv");
     write(&csv_path, &euler_csv(&rows))?;
     let svg_path = args.out.join("euler.svg");
     write(&svg_path, &euler_svg(&rows)?)?;
-    println!(
+    outln!(
         "CSV: {}\ndiagram: {}",
         csv_path.display(),
         svg_path.display()
