@@ -136,6 +136,10 @@ fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
 pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     let source = load_source(&args.scene, &args.set)?;
     let scene = resolve(&args, &source)?;
+    // Before simulating: say which required checks `verify` will not be able to run on this recording.
+    for warning in coin_log::verify::coverage(&scene) {
+        eprintln!("warning: verify will not be able to judge this recording: {warning}");
+    }
     let target = output_path(&args, &source)?;
     let mut temp = temp_file_beside(&target)?;
     let (summary, wall) = record_into(&args, &scene, &target, &mut temp)?;

@@ -18,6 +18,7 @@
 //! why.
 
 mod prefetch;
+mod prelude;
 mod problems;
 mod reader;
 mod wire;

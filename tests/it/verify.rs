@@ -6,7 +6,7 @@ use crate::support::record::{coin_log_text, record_scene, scene_names};
 use crate::support::writers::{
     nudge, record, recorded, rewrite, rewrite_with_schemas, steady_circle, wobble, Edit, Spec,
 };
-use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status};
+use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status, Verdict};
 
 fn show(r: &FileReport) -> String {
     r.checks
@@ -158,8 +158,11 @@ fn negative_control_numbers_appear_in_the_json_output() {
     assert_eq!(v["files"][0]["exit_code"], 1);
 }
 
+/// `--channels energy`: E cannot be recomputed (no ω, θ) and no motion check can run. No check fails, so
+/// the verdict is "cannot verify" (exit 1, the code the contract gave such a file), each skipped check
+/// keeps its reason, and the file's `problem` names the required checks that could not run.
 #[test]
-fn a_log_on_which_no_physics_check_can_run_fails() {
+fn a_log_on_which_no_physics_check_can_run_cannot_be_verified() {
     let spec = Spec {
         channels: vec![coin_log::format::Channel::Energy],
         ..wobble()
@@ -168,11 +171,30 @@ fn a_log_on_which_no_physics_check_can_run_fails() {
     let r = verify_file(&path, &Options::default());
     println!("{}", show(&r));
     assert_eq!(r.exit_code, 1);
+    assert_eq!(r.verdict, Verdict::CannotVerify);
     let energy = r.check(CheckId::Energy).unwrap();
-    assert_eq!(energy.status, Status::Fail);
-    assert!(energy.reason.starts_with("required check could not run"));
+    assert_eq!(energy.status, Status::Skip);
+    assert_eq!(
+        energy.reason,
+        "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed: record the channels omega and angles"
+    );
     let constraint = r.check(CheckId::Constraint).unwrap();
-    assert_eq!(constraint.status, Status::Fail);
+    assert_eq!(constraint.status, Status::Skip);
+    assert_eq!(status(&r, CheckId::Integrity), Status::Pass);
+    assert_eq!(
+        r.problem.as_deref(),
+        Some("cannot verify: the required checks energy, constraint or steady (the motion) could not run (each check's reason says why and what to record)")
+    );
+    let (code, out, err) = coin_log_text(&["verify", path.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(
+        out.starts_with(&format!("{}: CANNOT VERIFY (exit 1)\n", path.display())),
+        "{out}"
+    );
+    assert_eq!(
+        err,
+        format!("error: {}: {}\n", path.display(), r.problem.unwrap())
+    );
 }
 
 #[test]
@@ -188,11 +210,20 @@ fn the_json_output_has_exactly_the_contract_fields() {
         k
     };
     assert_eq!(keys(&v), ["files"]);
-    // The contract's fields plus `peak_rss_bytes`, an allowed extension.
+    // The contract's fields plus `peak_rss_bytes`, `verdict` and `problem`, allowed extensions.
     assert_eq!(
         keys(&v["files"][0]),
-        ["checks", "exit_code", "path", "peak_rss_bytes"]
+        [
+            "checks",
+            "exit_code",
+            "path",
+            "peak_rss_bytes",
+            "problem",
+            "verdict"
+        ]
     );
+    assert_eq!(v["files"][0]["verdict"], "ok");
+    assert_eq!(v["files"][0]["problem"], serde_json::Value::Null);
     let ids: Vec<&str> = v["files"][0]["checks"]
         .as_array()
         .unwrap()

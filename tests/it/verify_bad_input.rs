@@ -150,7 +150,7 @@ fn an_mcap_from_another_tool_is_not_a_coin_log_file() {
     assert_eq!(
         err.trim(),
         format!(
-            "error: {}: not a coin-log file: it has no `coin-log` metadata record before its first message (written by `other-tool`)",
+            "error: {}: not a coin-log file: it has no `coin-log` metadata record (written by `other-tool`)",
             path.display()
         )
     );

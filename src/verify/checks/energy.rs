@@ -43,7 +43,7 @@ impl EnergyCheck {
         let Some(energy_drift) = self.drift else {
             return CheckResult::skip(
                 CheckId::Energy,
-                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed",
+                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed: record the channels omega and angles",
             );
         };
         let drift = energy_drift.value();
