@@ -20,6 +20,7 @@ mod formulas;
 mod foxglove;
 mod integrators;
 mod invariants;
+mod other_writers;
 mod params;
 mod properties;
 mod readme;
