@@ -71,7 +71,7 @@ pub(crate) struct Prelude {
     pub(crate) metadata: Vec<EarlyMetadata>,
     /// The first bytes of the file are the MCAP magic, or its beginning when the file is shorter.
     pub(crate) magic_prefix: bool,
-    /// The file ends with the MCAP magic (its last 8 bytes).
+    /// The file ends with the MCAP magic (its last 8 bytes, not those of the start).
     pub(crate) ends_with_magic: bool,
     /// The records were found through the summary's metadata index.
     pub(crate) indexed: bool,
@@ -92,8 +92,9 @@ pub(crate) fn find(source: &mut (impl Read + Seek), len: u64) -> Prelude {
     if len < 8 || !p.magic_prefix {
         return p;
     }
+    // The end magic is a second copy: a file of 8 to 15 bytes holds only the first.
     let mut tail = [0u8; 8];
-    p.ends_with_magic = read_at(source, len - 8, &mut tail).is_ok() && tail == MAGIC;
+    p.ends_with_magic = len >= 16 && read_at(source, len - 8, &mut tail).is_ok() && tail == MAGIC;
     if p.ends_with_magic {
         if let Some(indexes) = summary_metadata_indexes(source, len) {
             if !indexes.is_empty() {

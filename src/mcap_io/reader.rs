@@ -251,7 +251,11 @@ fn corrupt(detail: String) -> ReadError {
 
 /// The message for a file that ends at byte `len` inside (or just before) the record at `at`.
 fn truncated(len: u64, at: u64) -> String {
-    if at >= len {
+    if len == MAGIC_LEN {
+        format!(
+            "truncated: the file ends at byte {len}, right after the MCAP magic, before the MCAP footer"
+        )
+    } else if at >= len {
         format!(
             "truncated: the file ends at byte {len}, after a whole record, before the MCAP footer"
         )
