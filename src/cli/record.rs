@@ -115,6 +115,10 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     if args.dry_run {
         return dry_run(&args, &scene, &source.label);
     }
+    // Before simulating: say which required checks `verify` will not be able to run on this recording.
+    for warning in coin_log::verify::coverage(&scene) {
+        errln!("warning: verify will not be able to judge this recording: {warning}");
+    }
     warn_if_large(&args, &scene);
     let target = output_path(&args, &source);
     let mut temp = prepare_output(&target, &args, &source, &signals)?;

@@ -4,16 +4,16 @@
 use super::progress::{file_len, FileProgress};
 use super::rss::peak_rss_bytes;
 use super::Outcome;
-use coin_log::verify::{self, FileReport, Options, Report};
+use coin_log::verify::{self, FileReport, Options, Report, Verdict};
 use std::path::{Path, PathBuf};
 
 /// What `coin-log verify --help` adds after the options: the checks, the tolerance formula, exit codes.
 const AFTER_HELP: &str = "\
-Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata,
-the physics is recomputed from the stored channels (never re-simulated). Checks: integrity, energy,
-invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance and
-pass/fail, or skip with the reason. A file on which integrity, energy and at least one of constraint /
-steady cannot run fails.
+Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata
+(found through the summary's metadata index wherever it sits, so files rewritten by other MCAP writers
+verify too), the physics is recomputed from the stored channels (never re-simulated). Checks: integrity,
+energy, invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance
+and pass/fail, or skip with the reason it could not run.
 
 Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
 W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a) for adaptive methods, or for fixed-step methods
@@ -23,8 +23,14 @@ of order p with step h (rk4, gauss4: p = 4) eps = (h W)^p (only the settings the
 Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
 reaction) must agree to 1e-12 relative; N >= 0 and |F| <= mu N are held to 1e-12 Mg.
 
-Exit codes: 0 every check that ran passed; 1 a check failed; 2 a file is unreadable, truncated, corrupt,
-not MCAP or not a coin-log file, or a usage error. With several files, the worst (2 > 1 > 0).";
+Verdict per file, and exit codes:
+  ok             every check that ran passed, and the required ones ran                  exit 0
+  FAILED         a check failed                                                          exit 1
+  CANNOT VERIFY  no check failed, but energy, or both constraint and steady, could not
+                 run (channels not recorded, or a rate that does not resolve the motion) exit 1
+  UNUSABLE       unreadable, truncated, corrupt, not MCAP or not a coin-log file         exit 2
+Usage errors exit 2. With several files, the worst code (2 > 1 > 0). Why a file is unusable or cannot be
+verified is printed once, on stderr (`error: FILE: reason`), and is the `problem` of its --json object.";
 
 /// Arguments of `coin-log verify` (the checks and tolerance formula are in `AFTER_HELP`).
 #[derive(Debug, clap::Args)]
@@ -33,7 +39,8 @@ pub struct VerifyArgs {
     /// MCAP files written by `coin-log record`.
     #[arg(required = true, value_name = "FILE")]
     files: Vec<PathBuf>,
-    /// Print `{"files": [{"path", "exit_code", "checks": [{"id", "status", "value", "tolerance", "reason"}]}]}`.
+    /// Print `{"files": [{"path", "exit_code", "verdict", "problem", "checks": [{"id", "status", "value",
+    /// "tolerance", "reason"}], "peak_rss_bytes"}]}`.
     #[arg(long)]
     json: bool,
     /// Energy (and invariant) drift tolerance, replacing the default derived from rtol/atol.
@@ -64,6 +71,9 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
         report.files.push(verify_with_progress(path, &options));
         peaks.push(peak_rss_bytes());
     }
+    // The reason a file is unusable or cannot be verified goes to stderr, once, in both modes: stdout
+    // stays the report alone (a table, or JSON that carries the reason as `problem`), and the line reads
+    // like every other command's errors.
     for file in &report.files {
         if let Some(problem) = &file.problem {
             errln!("error: {}: {problem}", file.path);
@@ -97,13 +107,14 @@ fn verify_with_progress(path: &Path, options: &Options) -> FileReport {
 
 /// The one-line total of several files: `N files: x ok, y failed, z unusable`.
 fn total(report: &Report) -> String {
-    let count = |code: u8| report.files.iter().filter(|f| f.exit_code == code).count();
+    let count = |v: Verdict| report.files.iter().filter(|f| f.verdict == v).count();
     format!(
-        "{} files: {} ok, {} failed, {} unusable",
+        "{} files: {} ok, {} failed, {} cannot verify, {} unusable",
         report.files.len(),
-        count(0),
-        count(1),
-        report.files.len() - count(0) - count(1)
+        count(Verdict::Ok),
+        count(Verdict::Failed),
+        count(Verdict::CannotVerify),
+        count(Verdict::Unusable)
     )
 }
 
@@ -129,15 +140,12 @@ fn number(x: Option<f64>) -> String {
 }
 
 fn file_table(f: &FileReport, out: &mut String) {
-    let verdict = match f.exit_code {
-        0 => "ok",
-        1 => "FAILED",
-        _ => "UNUSABLE",
-    };
-    out.push_str(&format!("{}: {verdict} (exit {})\n", f.path, f.exit_code));
-    if let Some(p) = &f.problem {
-        out.push_str(&format!("  {p}\n"));
-    }
+    out.push_str(&format!(
+        "{}: {} (exit {})\n",
+        f.path,
+        f.verdict.label(),
+        f.exit_code
+    ));
     if f.checks.is_empty() {
         return;
     }

@@ -324,6 +324,7 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
         Some(ReadError {
             kind: ReadErrorKind::Io | ReadErrorKind::NotMcap,
             detail,
+            ..
         }) => return Err(InfoError(detail)),
         Some(e) => Some(e.detail),
         None => None,

@@ -21,6 +21,7 @@
 //! indexes, metadata) from its summary section alone, in a few seeks, whatever the file's length.
 
 mod prefetch;
+mod prelude;
 mod problems;
 mod reader;
 mod summary;

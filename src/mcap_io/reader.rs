@@ -11,13 +11,14 @@
 //! anything is allocated for it.
 
 use super::prefetch::{self, Batch, Event};
+use super::prelude::{self, Prelude, ScanEnd};
 use super::problems::Problems;
 use super::wire::{self, Cursor, MessageHeader, WireError};
 use mcap::records::op;
 use mcap::McapError;
 use std::collections::BTreeMap;
 use std::fmt;
-use std::io::Read;
+use std::io::{Read, Seek, SeekFrom};
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::mpsc::{self, Receiver, SyncSender};
@@ -28,6 +29,9 @@ const RECORD_PREFIX: u64 = 9;
 const MAGIC_LEN: u64 = 8;
 /// How many metadata records and summary groups are remembered for the index checks (more are counted).
 const MAX_REMEMBERED: usize = 1024;
+/// A record claiming more than this (1 TiB) is not one any writer makes: a file cut inside it is not the
+/// prefix of a plausible MCAP, so it is reported as corrupt rather than truncated.
+const PLAUSIBLE_RECORD: u64 = 1 << 40;
 
 /// What the caller does with records.
 pub trait Visitor {
@@ -35,7 +39,9 @@ pub trait Visitor {
     fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]);
     /// A channel record (first definition only).
     fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str);
-    /// A metadata record with its entries.
+    /// A metadata record with its entries. Every metadata record the summary indexes (or, in a file
+    /// without one, every one a scan of the top-level records finds) comes before the first message,
+    /// wherever it sits in the file; each comes once.
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>);
     /// The header record's library string.
     fn library(&mut self, library: &str);
@@ -63,13 +69,35 @@ pub enum ReadErrorKind {
 pub struct ReadError {
     /// What kind of failure.
     pub kind: ReadErrorKind,
-    /// The message for the user (without the path).
+    /// What is wrong and where, for the user (without the path).
     pub detail: String,
+    /// What the visitor was given before it (`judged the 8008 messages read before it`); empty when the
+    /// failure came before the stream reached it.
+    pub read_before: String,
+}
+
+impl ReadError {
+    fn new(kind: ReadErrorKind, detail: impl Into<String>) -> Self {
+        Self {
+            kind,
+            detail: detail.into(),
+            read_before: String::new(),
+        }
+    }
+
+    fn after(mut self, read_before: String) -> Self {
+        self.read_before = read_before;
+        self
+    }
 }
 
 impl fmt::Display for ReadError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.detail)
+        f.write_str(&self.detail)?;
+        if !self.read_before.is_empty() {
+            write!(f, "; {}", self.read_before)?;
+        }
+        Ok(())
     }
 }
 
@@ -196,6 +224,10 @@ impl ChunkBook {
 #[derive(Debug, Default)]
 struct Book {
     s: Structure,
+    /// What was found before the stream (metadata passed on early, the file's ends).
+    prelude: Prelude,
+    /// Digests of the metadata records passed on early, by offset: the stream does not pass them again.
+    early: BTreeMap<u64, Digest>,
     pos: u64,
     in_summary: bool,
     summary_start: Option<u64>,
@@ -220,9 +252,24 @@ struct Book {
 }
 
 fn corrupt(detail: String) -> ReadError {
-    ReadError {
-        kind: ReadErrorKind::Corrupt,
-        detail,
+    ReadError::new(ReadErrorKind::Corrupt, detail)
+}
+
+/// The message for a file that ends at byte `len` inside (or just before) the record at `at`.
+fn truncated(len: u64, at: u64) -> String {
+    if len == MAGIC_LEN {
+        format!(
+            "truncated: the file ends at byte {len}, right after the MCAP magic, before the MCAP footer"
+        )
+    } else if at >= len {
+        format!(
+            "truncated: the file ends at byte {len}, after a whole record, before the MCAP footer"
+        )
+    } else {
+        format!(
+            "truncated: the file ends at byte {len} inside the record that starts at byte {at}, \
+             before the MCAP footer"
+        )
     }
 }
 
@@ -260,7 +307,7 @@ pub fn read_with_progress(
     }
 }
 
-/// A reader that reports how many bytes went through it.
+/// A reader that reports how far into the file it is (bytes read, or the position after a seek).
 struct Counting<'a, R> {
     inner: R,
     read: u64,
@@ -276,20 +323,49 @@ impl<R: Read> Read for Counting<'_, R> {
     }
 }
 
-/// Reads an MCAP stream of `len` bytes from `source` (see [`read`]).
+impl<R: Seek> Seek for Counting<'_, R> {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        let at = self.inner.seek(pos)?;
+        self.read = at;
+        Ok(at)
+    }
+}
+
+/// Reads an MCAP file of `len` bytes from `source` (see [`read`]). The source must be seekable: the
+/// metadata records are looked up (through the summary, or by a scan of the top-level records) before the
+/// stream starts at byte 0.
 pub fn read_from(
-    source: impl Read + Send,
+    mut source: impl Read + Seek + Send,
     len: u64,
     visitor: &mut impl Visitor,
 ) -> (Structure, Option<ReadError>) {
     let mut book = Book::default();
-    let error = if len == 0 {
-        Some(ReadError {
-            kind: ReadErrorKind::NotMcap,
-            detail: "empty file (0 bytes), not an MCAP file".into(),
-        })
-    } else {
-        read_into(source, len, visitor, &mut book).err()
+    if len == 0 {
+        let e = ReadError::new(
+            ReadErrorKind::NotMcap,
+            "empty file (0 bytes), not an MCAP file",
+        );
+        return (book.s, Some(e));
+    }
+    book.prelude = prelude::find(&mut source, len);
+    for m in &book.prelude.metadata {
+        let mut d = Digest::default();
+        d.push_bytes(&m.body);
+        book.early.insert(m.at, d);
+        visitor.metadata(&m.name, &m.entries);
+    }
+    let error = match source.seek(SeekFrom::Start(0)) {
+        Ok(_) => read_into(source, len, visitor, &mut book).err(),
+        Err(e) => Some(ReadError::new(
+            ReadErrorKind::Io,
+            format!("cannot read: {e}"),
+        )),
+    };
+    let error = match error {
+        // The visitor stopped before the stream reached the place where the scan found the file cut
+        // short or broken: that is what is wrong with the file.
+        Some(e) if e.kind == ReadErrorKind::Stopped => book.scan_error().or(Some(e)),
+        other => other,
     };
     if error.is_none() {
         book.finish();
@@ -298,16 +374,20 @@ pub fn read_from(
 }
 
 fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
-    let io = |e: std::io::Error| ReadError {
-        kind: ReadErrorKind::Io,
-        detail: format!("cannot read: {e}"),
-    };
+    let io = |e: std::io::Error| ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"));
     let meta = std::fs::metadata(path).map_err(io)?;
     if meta.is_dir() {
-        return Err(ReadError {
-            kind: ReadErrorKind::Io,
-            detail: "is a directory, not an MCAP file".into(),
-        });
+        return Err(ReadError::new(
+            ReadErrorKind::Io,
+            "is a directory, not an MCAP file",
+        ));
+    }
+    if !meta.is_file() {
+        return Err(ReadError::new(
+            ReadErrorKind::Io,
+            "is not a regular file (a pipe, socket or device): an MCAP file is read by seeking to its \
+             summary and metadata, which a stream cannot do; save it to a file first",
+        ));
     }
     let file = std::fs::File::open(path).map_err(io)?;
     Ok((file, meta.len()))
@@ -324,7 +404,7 @@ fn read_into(
     let (to_consumer, batches) = mpsc::sync_channel(prefetch::QUEUE);
     let (to_producer, recycled) = mpsc::sync_channel(prefetch::QUEUE + 2);
     std::thread::scope(|scope| {
-        scope.spawn(move || {
+        let worker = scope.spawn(move || {
             prefetch::produce(
                 file,
                 file_len,
@@ -334,15 +414,26 @@ fn read_into(
                 },
             );
         });
-        // Returning drops `batches`, which ends the worker at its next send.
-        consume(&batches, &to_producer, visitor, book)
+        // `consume` owns the receiving end: when it returns early (an error, or the visitor stopped) or
+        // unwinds, the receiver is dropped, so a worker blocked sending into the full queue wakes with an
+        // error and ends, and this scope can join it. Holding the receiver here instead would leave both
+        // threads waiting for each other.
+        let result = consume(batches, to_producer, visitor, book);
+        match worker.join() {
+            Ok(()) => result,
+            Err(_) => Err(ReadError::new(
+                ReadErrorKind::Corrupt,
+                "the reading thread failed (a bug in this tool on this input: please report it with the file)",
+            )),
+        }
     })
 }
 
-/// The checking half of the pipeline: walks the worker's events in file order.
+/// The checking half of the pipeline: walks the worker's events in file order. Takes both ends of its
+/// channels by value, so that they close when it returns (see [`read_into`]).
 fn consume(
-    batches: &Receiver<Batch>,
-    to_producer: &SyncSender<Batch>,
+    batches: Receiver<Batch>,
+    to_producer: SyncSender<Batch>,
     visitor: &mut impl Visitor,
     book: &mut Book,
 ) -> Result<(), ReadError> {
@@ -361,12 +452,7 @@ fn consume(
                 Event::ChunkEnd => book.chunk_end()?,
                 Event::InnerError(e) => return Err(book.chunk_error(e)),
                 Event::OuterError(e) => return Err(book.classify(e)),
-                Event::Io(detail) => {
-                    return Err(ReadError {
-                        kind: ReadErrorKind::Io,
-                        detail: detail.clone(),
-                    })
-                }
+                Event::Io(detail) => return Err(ReadError::new(ReadErrorKind::Io, detail.clone())),
             }
         }
         // The worker reuses the batch if it has room for it; otherwise it is freed here.
@@ -380,48 +466,93 @@ impl Book {
         let at = self.pos;
         let messages = self.s.messages;
         let len = self.s.file_len;
+        let before = format!("judged the {messages} messages read before it");
+        let read = format!("judged the {messages} messages read");
         match e {
             McapError::BadMagic if at == MAGIC_LEN && messages == 0 && !self.data_end_seen => {
-                ReadError {
-                    kind: ReadErrorKind::NotMcap,
-                    detail: "not an MCAP file (it does not start with the MCAP magic bytes)".into(),
-                }
+                ReadError::new(
+                    ReadErrorKind::NotMcap,
+                    "not an MCAP file (it does not start with the MCAP magic bytes)",
+                )
             }
-            McapError::UnexpectedEof if at <= MAGIC_LEN => ReadError {
-                kind: ReadErrorKind::NotMcap,
-                detail: format!("not an MCAP file ({len} bytes, shorter than an MCAP header)"),
-            },
-            McapError::UnexpectedEof => ReadError {
-                kind: ReadErrorKind::Truncated,
-                detail: format!(
-                    "truncated: the file ends at byte {len} inside the record that starts at byte \
-                     {at}, before the MCAP footer; judged the {messages} messages read before it"
+            McapError::UnexpectedEof if at <= MAGIC_LEN && !self.prelude.magic_prefix => {
+                ReadError::new(
+                    ReadErrorKind::NotMcap,
+                    format!("not an MCAP file ({len} bytes, shorter than an MCAP header)"),
+                )
+            }
+            McapError::UnexpectedEof if len < MAGIC_LEN => ReadError::new(
+                ReadErrorKind::Truncated,
+                format!(
+                    "truncated: the file ends at byte {len}, inside the MCAP magic it starts with"
                 ),
-            },
-            McapError::RecordTooLarge { opcode, len: claimed } => corrupt(format!(
-                "record (opcode {opcode:#04x}) at byte {at} claims {claimed} bytes, more than the \
-                 file's {len}: the file is corrupt or crafted; judged the {messages} messages read \
-                 before it"
-            )),
-            McapError::ChunkTooLarge(claimed) => corrupt(format!(
-                "chunk at byte {at} claims {claimed} bytes, more than the file's {len}: the file is \
-                 corrupt or crafted; judged the {messages} messages read before it"
-            )),
+            ),
+            McapError::UnexpectedEof if self.footer_seen => ReadError::new(
+                ReadErrorKind::Truncated,
+                format!("truncated: the file ends at byte {len}, inside the MCAP end magic"),
+            )
+            .after(read),
+            McapError::UnexpectedEof => self.past_end(at, None).after(before),
+            McapError::RecordTooLarge {
+                opcode,
+                len: claimed,
+            } => self
+                .past_end(
+                    at,
+                    Some((*claimed, format!("record (opcode {opcode:#04x})"))),
+                )
+                .after(before),
+            McapError::ChunkTooLarge(claimed) => self
+                .past_end(at, Some((*claimed, "chunk".into())))
+                .after(before),
             McapError::BadDataCrc { saved, calculated } => corrupt(format!(
                 "corrupt data section: CRC {calculated:#010x} does not match the stored \
-                 {saved:#010x}; judged the {messages} messages read"
-            )),
+                 {saved:#010x}"
+            ))
+            .after(read),
             McapError::BadSummaryCrc { saved, calculated } => corrupt(format!(
                 "corrupt summary section: CRC {calculated:#010x} does not match the stored \
-                 {saved:#010x}; judged the {messages} messages read"
-            )),
+                 {saved:#010x}"
+            ))
+            .after(read),
             McapError::BytesAfterEndMagic => corrupt(format!(
                 "{} bytes follow the MCAP end magic",
                 len.saturating_sub(at)
             )),
-            other => corrupt(format!(
-                "malformed MCAP at byte {at}: {other}; judged the {messages} messages read before it"
-            )),
+            other => corrupt(format!("malformed MCAP at byte {at}: {other}")).after(before),
+        }
+    }
+
+    /// The record at `at` runs past the end of the file (`claim`: the length it claims, when that is why
+    /// the reader stopped, and what it is). The file is a truncated MCAP unless it ends with the MCAP magic
+    /// (then it is whole and a length is wrong) or the claim is beyond any plausible record.
+    fn past_end(&self, at: u64, claim: Option<(u64, String)>) -> ReadError {
+        let len = self.s.file_len;
+        let plausible = claim.as_ref().is_none_or(|(c, _)| *c <= PLAUSIBLE_RECORD);
+        if !self.prelude.ends_with_magic && plausible {
+            return ReadError::new(ReadErrorKind::Truncated, truncated(len, at));
+        }
+        corrupt(match claim {
+            Some((claimed, what)) => format!(
+                "{what} at byte {at} claims {claimed} bytes, more than the file's {len}: the file \
+                 is corrupt or crafted"
+            ),
+            None => format!(
+                "corrupt: the record at byte {at} runs past the end of the file, which ends with the \
+                 MCAP magic, so a record length is wrong"
+            ),
+        })
+    }
+
+    /// What the scan before the stream found wrong, when it found the file cut short or broken.
+    fn scan_error(&self) -> Option<ReadError> {
+        match self.prelude.scan_end? {
+            ScanEnd::Cut { at, claimed } => {
+                Some(self.past_end(at, claimed.map(|c| (c, "record".to_string()))))
+            }
+            ScanEnd::Malformed { at } => Some(corrupt(format!(
+                "malformed MCAP at byte {at}: the record there cannot be read"
+            ))),
         }
     }
 
@@ -574,16 +705,17 @@ impl Book {
             .map_or((0, 0), |c| (c.start, c.messages_before));
         let read = self.s.messages;
         let inside = read - before;
-        corrupt(match e {
-            McapError::BadChunkCrc { saved, calculated } => format!(
+        match e {
+            McapError::BadChunkCrc { saved, calculated } => corrupt(format!(
                 "corrupt chunk at byte {at}: CRC {calculated:#010x} of its records does not match \
-                 the stored {saved:#010x}; judged the {read} messages read ({inside} of them from \
-                 this chunk)"
-            ),
-            other => format!(
-                "corrupt chunk at byte {at}: {other}; judged the {read} messages read before it"
-            ),
-        })
+                 the stored {saved:#010x}"
+            ))
+            .after(format!(
+                "judged the {read} messages read ({inside} of them from this chunk)"
+            )),
+            other => corrupt(format!("corrupt chunk at byte {at}: {other}"))
+                .after(format!("judged the {read} messages read before it")),
+        }
     }
 
     fn message(
@@ -609,10 +741,7 @@ impl Book {
         }
         match visitor.message(&header, body) {
             ControlFlow::Continue(()) => Ok(()),
-            ControlFlow::Break(()) => Err(ReadError {
-                kind: ReadErrorKind::Stopped,
-                detail: String::new(),
-            }),
+            ControlFlow::Break(()) => Err(ReadError::new(ReadErrorKind::Stopped, "")),
         }
     }
 
@@ -738,23 +867,28 @@ impl Book {
         at: u64,
         visitor: &mut impl Visitor,
     ) -> Result<(), ReadError> {
-        let mut c = Cursor::new(data);
-        let err = |e| wire_error("metadata", at, e);
-        let name = c.string("name").map_err(err)?.unwrap_or("").to_string();
-        let mut entries = BTreeMap::new();
-        wire::for_each_entry(&mut c, "metadata", |e| {
-            let k = e.string("key")?.unwrap_or("");
-            let v = e.string("value")?.unwrap_or("");
-            entries.insert(k.to_string(), v.to_string());
-            Ok(())
-        })
-        .map_err(err)?;
+        let (name, entries) =
+            prelude::parse_metadata(data).map_err(|e| wire_error("metadata", at, e))?;
         self.metadata_count += 1;
         if self.metadata.len() < MAX_REMEMBERED {
             self.metadata
                 .push((at, RECORD_PREFIX + data.len() as u64, name.clone()));
         }
-        visitor.metadata(&name, &entries);
+        match self.early.get(&at) {
+            // Passed on before the stream; the bytes read then must be these.
+            Some(early) => {
+                let mut d = Digest::default();
+                d.push_bytes(data);
+                if d != *early {
+                    self.problem(|| {
+                        format!(
+                            "metadata record `{name}` at byte {at} changed while the file was read"
+                        )
+                    });
+                }
+            }
+            None => visitor.metadata(&name, &entries),
+        }
         Ok(())
     }
 
@@ -934,10 +1068,13 @@ impl Book {
                 format!("metadata indexes do not match the metadata records ({n} records, {m} index entries)")
             });
         }
+        // An empty group (length 0) is valid MCAP: the Python writer lists one for each kind of record it
+        // has none of, placed where the group would have started, between two groups.
+        let boundary = |p: u64| self.groups.iter().any(|g| g.1 == p || g.1 + g.2 == p);
         let bad: Vec<(u8, u64, u64)> = self
             .summary_offsets
             .iter()
-            .filter(|o| !self.groups.contains(o))
+            .filter(|o| !(self.groups.contains(o) || (o.2 == 0 && boundary(o.1))))
             .copied()
             .collect();
         if !bad.is_empty() {
@@ -945,5 +1082,120 @@ impl Book {
                 format!("summary offsets {bad:?} (opcode, start, length) point at no group of the summary")
             });
         }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::super::writer::{ChunkCompression, McapWriter, WriterOptions};
+    use super::*;
+    use std::io::Cursor as IoCursor;
+    use std::time::Duration;
+
+    /// Generous deadline of the hang tests: reading these few MiB takes milliseconds.
+    const DEADLINE: Duration = Duration::from_secs(20);
+
+    /// An uncompressed file of `messages` 1 KiB messages in 64 KiB chunks (many more batches than the
+    /// prefetch queue holds), with a metadata record `late` written after the first `late_after` messages.
+    fn file(messages: u32, late_after: u32) -> Vec<u8> {
+        let mut options = WriterOptions::new(ChunkCompression::None, "test");
+        options.chunk_size = 1 << 16;
+        let mut w = McapWriter::new(IoCursor::new(Vec::new()), &options).unwrap();
+        let schema = w.add_schema("s", "jsonschema", b"{}").unwrap();
+        let channel = w
+            .add_channel(schema, "/t", "json", &BTreeMap::new())
+            .unwrap();
+        let data = vec![b' '; 1024];
+        for i in 0..messages {
+            if i == late_after {
+                let entries = BTreeMap::from([("k".to_string(), "v".to_string())]);
+                w.write_metadata("late", &entries).unwrap();
+            }
+            w.write_message(channel, i, u64::from(i), u64::from(i), &data)
+                .unwrap();
+        }
+        w.finish().unwrap().0.into_inner()
+    }
+
+    /// Records what it is given; stops at message `stop_at`.
+    #[derive(Default)]
+    struct Recorder {
+        stop_at: u64,
+        messages: u64,
+        events: Vec<String>,
+    }
+
+    impl Visitor for Recorder {
+        fn schema(&mut self, _: u16, _: &str, _: &str, _: &[u8]) {}
+        fn channel(&mut self, _: u16, _: u16, _: &str, _: &str) {}
+        fn metadata(&mut self, name: &str, _: &BTreeMap<String, String>) {
+            self.events
+                .push(format!("metadata {name} after {} messages", self.messages));
+        }
+        fn library(&mut self, _: &str) {}
+        fn message(&mut self, _: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
+            self.messages += 1;
+            if self.messages == self.stop_at {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        }
+    }
+
+    /// Reads `bytes` on another thread, failing the test if it has not returned by [`DEADLINE`].
+    fn read_with_deadline(
+        bytes: Vec<u8>,
+        stop_at: u64,
+    ) -> (Recorder, Structure, Option<ReadError>) {
+        let (done, result) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut v = Recorder {
+                stop_at,
+                ..Recorder::default()
+            };
+            let len = bytes.len() as u64;
+            let (s, e) = read_from(IoCursor::new(bytes), len, &mut v);
+            let _ = done.send((v, s, e));
+        });
+        result
+            .recv_timeout(DEADLINE)
+            .unwrap_or_else(|_| panic!("the reader did not return within {DEADLINE:?}: it hangs"))
+    }
+
+    #[test]
+    fn a_visitor_that_stops_early_ends_the_read_and_its_worker() {
+        // 8 MiB of records: the worker fills the queue (4 batches of ~1 MiB) long before the end.
+        let bytes = file(8192, u32::MAX);
+        assert!(bytes.len() > 8 << 20, "{} bytes", bytes.len());
+        for stop_at in [1, 100, 5000] {
+            let (v, _, e) = read_with_deadline(bytes.clone(), stop_at);
+            assert_eq!(v.messages, stop_at);
+            assert_eq!(e.unwrap().kind, ReadErrorKind::Stopped);
+        }
+    }
+
+    #[test]
+    fn a_metadata_record_after_the_first_chunks_comes_before_the_first_message() {
+        let bytes = file(8192, 3000);
+        let (v, s, e) = read_with_deadline(bytes, u64::MAX);
+        assert_eq!(e, None);
+        assert!(s.problems.is_empty(), "{}", s.problems.summary());
+        assert_eq!(v.events, ["metadata late after 0 messages"]);
+        assert_eq!(v.messages, 8192);
+    }
+
+    #[test]
+    fn an_error_in_the_middle_ends_the_read_and_its_worker() {
+        // A byte flipped in the middle of the file, inside a chunk's records (chunks are 98% of these
+        // bytes; this file is deterministic): a chunk CRC error the consumer returns while the worker is
+        // still reading ahead.
+        let mut bytes = file(8192, u32::MAX);
+        let middle = bytes.len() / 2;
+        bytes[middle] ^= 1;
+        let (_, _, e) = read_with_deadline(bytes, u64::MAX);
+        let e = e.unwrap();
+        assert_eq!(e.kind, ReadErrorKind::Corrupt, "{e}");
     }
 }

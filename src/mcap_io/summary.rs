@@ -66,6 +66,7 @@ fn io_error(e: &std::io::Error) -> ReadError {
     ReadError {
         kind: ReadErrorKind::Io,
         detail: format!("cannot read: {e}"),
+        read_before: String::new(),
     }
 }
 
@@ -73,6 +74,7 @@ fn corrupt(detail: String) -> ReadError {
     ReadError {
         kind: ReadErrorKind::Corrupt,
         detail,
+        read_before: String::new(),
     }
 }
 
@@ -89,6 +91,7 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
         return Err(ReadError {
             kind: ReadErrorKind::Io,
             detail: "is a directory, not an MCAP file".into(),
+            read_before: String::new(),
         });
     }
     let file_len = meta.len();
@@ -309,6 +312,7 @@ fn header_library(file: &mut std::fs::File, file_len: u64) -> Result<String, Rea
     let not_mcap = || ReadError {
         kind: ReadErrorKind::NotMcap,
         detail: "not an MCAP file (it does not start with the MCAP magic bytes)".into(),
+        read_before: String::new(),
     };
     if file_len < 17 {
         return Err(not_mcap());

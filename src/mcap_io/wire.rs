@@ -6,6 +6,9 @@
 
 use std::fmt;
 
+/// The MCAP magic, at the start and at the end of every file.
+pub(crate) const MAGIC: [u8; 8] = [0x89, b'M', b'C', b'A', b'P', b'0', b'\r', b'\n'];
+
 /// A record body that ends before a field it declares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct WireError {

@@ -16,8 +16,7 @@ use std::ops::Range;
 use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
 use std::thread::JoinHandle;
 
-/// The 8 bytes at both ends of an MCAP file.
-const MAGIC: [u8; 8] = [0x89, b'M', b'C', b'A', b'P', b'0', b'\r', b'\n'];
+use super::wire::MAGIC;
 
 /// Record opcodes (MCAP spec, "Records").
 mod op {

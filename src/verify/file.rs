@@ -6,7 +6,7 @@ use super::checks::{
     invariants::InvariantsCheck, nutation::NutationCheck, steady, steady::SteadyCheck,
     validity::ValidityCheck, Context, RunStats,
 };
-use super::report::{CheckId, CheckResult, FileReport, Status};
+use super::report::{CheckId, CheckResult, FileReport, Status, Verdict};
 use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::Options;
@@ -136,6 +136,8 @@ struct Judge {
     channels: Vec<Option<ChannelState>>,
     schemas: BTreeMap<u16, String>,
     ctx: Option<Context>,
+    /// The `coin-log.result` record, kept until the end (it may come before or after `coin-log`).
+    result: Option<ResultMetadata>,
     run_error: Option<String>,
     result_error: Option<String>,
     library: String,
@@ -347,15 +349,16 @@ impl Visitor for Judge {
             }
             self.run_metadata(entries);
         } else if name == RESULT_METADATA_NAME {
-            match (ResultMetadata::from_map(entries), self.ctx.as_mut()) {
-                (Ok(r), Some(ctx)) => ctx.result = Some(r),
-                (Ok(_), None) => {}
-                (Err(e), _) => self.result_error = Some(e.to_string()),
+            match ResultMetadata::from_map(entries) {
+                Ok(r) => self.result = Some(r),
+                Err(e) => self.result_error = Some(e.to_string()),
             }
         }
     }
 
     fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
+        // The reader passes every metadata record it can find before the first message: without the
+        // `coin-log` one by now, the file has none to judge it by.
         if self.ctx.is_none() {
             return ControlFlow::Break(());
         }
@@ -447,9 +450,10 @@ impl Judge {
 fn unusable(path: &str, problem: String) -> FileReport {
     FileReport {
         path: path.to_string(),
-        exit_code: 2,
-        checks: Vec::new(),
+        exit_code: Verdict::Unusable.exit_code(),
+        verdict: Verdict::Unusable,
         problem: Some(problem),
+        checks: Vec::new(),
     }
 }
 
@@ -474,7 +478,8 @@ pub fn verify_file_with_progress(
 /// Judges an MCAP held in memory (see [`super::verify_bytes`]).
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();
-    let (structure, error) = mcap_io::read_from(bytes, bytes.len() as u64, &mut judge);
+    let source = std::io::Cursor::new(bytes);
+    let (structure, error) = mcap_io::read_from(source, bytes.len() as u64, &mut judge);
     verdict(name.to_string(), judge, structure, error, options)
 }
 
@@ -485,23 +490,30 @@ fn verdict(
     error: Option<mcap_io::ReadError>,
     options: &Options,
 ) -> FileReport {
-    let mut problem = None;
     if let Some(e) = &error {
-        match e.kind {
-            ReadErrorKind::Io | ReadErrorKind::NotMcap => {
-                return unusable(&shown, e.detail.clone())
-            }
-            ReadErrorKind::Stopped => {}
-            ReadErrorKind::Truncated | ReadErrorKind::Corrupt => problem = Some(e.detail.clone()),
+        if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) {
+            return unusable(&shown, e.to_string());
         }
     }
-    let Some(ctx) = judge.ctx.take() else {
-        let why = judge.not_coin_log();
-        return unusable(
-            &shown,
-            problem.map_or(why.clone(), |p| format!("{why}; {p}")),
-        );
+    // A truncated or corrupt file is judged on what could be read, and is unusable (exit 2).
+    let read_problem = error
+        .as_ref()
+        .filter(|e| matches!(e.kind, ReadErrorKind::Truncated | ReadErrorKind::Corrupt));
+    let Some(mut ctx) = judge.ctx.take() else {
+        let why = match (judge.run_error.take(), read_problem) {
+            (Some(run), Some(e)) => format!("{run}; {e}"),
+            (Some(run), None) => run,
+            (None, Some(e)) => format!(
+                "{}; no `coin-log` metadata record comes before that point, so there is nothing to \
+                 judge",
+                e.detail
+            ),
+            (None, None) => judge.not_coin_log(),
+        };
+        return unusable(&shown, why);
     };
+    ctx.result = judge.result.take();
+    let problem = read_problem.map(ToString::to_string);
     let checks = &mut judge.checks;
     judge.assembler.finish(&mut |s| checks.observe(s, &ctx));
     let problems = judge.all_problems(&structure, &ctx, error.is_none(), problem.as_ref());
@@ -511,7 +523,7 @@ fn verdict(
         structure.messages, structure.chunks, judge.checks.stats.samples
     );
     let c = &judge.checks;
-    let mut results = vec![
+    let results = vec![
         integrity::finish(&problems, &read, &judge.notes),
         c.energy.finish(&tol, &ctx),
         c.invariants.finish(&tol, invariants_skip(&ctx).as_deref()),
@@ -521,18 +533,20 @@ fn verdict(
         c.validity.finish(&ctx),
         c.nutation.finish(&ctx, &tol),
     ];
-    require_physics(&mut results);
     let failed = results.iter().any(|r| r.status == Status::Fail);
-    let exit_code = if problem.is_some() {
-        2
-    } else {
-        u8::from(failed)
+    let missing = missing_required(&results);
+    let (verdict, problem) = match (problem, failed, missing) {
+        (Some(p), _, _) => (Verdict::Unusable, Some(p)),
+        (None, true, _) => (Verdict::Failed, None),
+        (None, false, Some(why)) => (Verdict::CannotVerify, Some(why)),
+        (None, false, None) => (Verdict::Ok, None),
     };
     FileReport {
         path: shown,
-        exit_code,
-        checks: results,
+        exit_code: verdict.exit_code(),
+        verdict,
         problem,
+        checks: results,
     }
 }
 
@@ -545,7 +559,7 @@ impl Judge {
             } else {
                 format!(" (written by `{}`)", self.library)
             };
-            format!("not a coin-log file: it has no `coin-log` metadata record before its first message{by}")
+            format!("not a coin-log file: it has no `coin-log` metadata record{by}")
         })
     }
 
@@ -612,32 +626,31 @@ fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances 
     )
 }
 
-/// format.md: a file in which integrity, energy and at least one of constraint / steady could not run
-/// fails, whatever else passed. The check that could not run is turned into a failure saying so.
-fn require_physics(results: &mut [CheckResult]) {
-    let skipped = |results: &[CheckResult], id: CheckId| {
+/// format.md: a file in which `integrity`, `energy` or both `constraint` and `steady` could not run cannot
+/// be verified, whatever else passed. Says which, or `None` when the required checks ran; the skipped
+/// checks keep their status and their reasons (which say what to record).
+fn missing_required(results: &[CheckResult]) -> Option<String> {
+    let skipped = |id: CheckId| {
         results
             .iter()
             .any(|r| r.id == id && r.status == Status::Skip)
     };
-    let fail = |results: &mut [CheckResult], id: CheckId, why: &str| {
-        if let Some(r) = results.iter_mut().find(|r| r.id == id) {
-            r.status = Status::Fail;
-            r.reason = format!("{why}: {}", r.reason);
-        }
-    };
-    for id in [CheckId::Integrity, CheckId::Energy] {
-        if skipped(results, id) {
-            fail(results, id, "required check could not run");
-        }
+    let mut missing: Vec<&str> = [CheckId::Integrity, CheckId::Energy]
+        .into_iter()
+        .filter(|id| skipped(*id))
+        .map(CheckId::as_str)
+        .collect();
+    if skipped(CheckId::Constraint) && skipped(CheckId::Steady) {
+        missing.push("constraint or steady (the motion)");
     }
-    if skipped(results, CheckId::Constraint) && skipped(results, CheckId::Steady) {
-        fail(
-            results,
-            CheckId::Constraint,
-            "neither constraint nor steady could run, so the motion is not verified",
-        );
-    }
+    (!missing.is_empty()).then(|| {
+        format!(
+            "cannot verify: the required check{} {} could not run (each check's reason says why and \
+             what to record)",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", ")
+        )
+    })
 }
 
 #[cfg(test)]

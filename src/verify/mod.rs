@@ -7,12 +7,14 @@
 //! follow from the recorded integrator settings ([`tolerances`]).
 
 pub mod checks;
+mod coverage;
 mod file;
 pub mod report;
 pub mod samples;
 pub mod tolerances;
 
-pub use report::{CheckId, CheckResult, FileReport, Report, Status};
+pub use coverage::coverage;
+pub use report::{CheckId, CheckResult, FileReport, Report, Status, Verdict};
 pub use tolerances::Tolerances;
 
 use std::path::Path;

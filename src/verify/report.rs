@@ -1,6 +1,6 @@
 //! What `verify` reports: one [`CheckResult`] per check id and file, serialised exactly as format.md's
-//! `--json` shape (`{"files": [{"path", "exit_code", "checks": [{"id", "status", "value", "tolerance",
-//! "reason"}]}]}`).
+//! `--json` shape (`{"files": [{"path", "exit_code", "verdict", "problem", "checks": [{"id", "status",
+//! "value", "tolerance", "reason"}]}]}`).
 
 use serde::Serialize;
 use std::fmt;
@@ -130,18 +130,62 @@ impl CheckResult {
     }
 }
 
+/// The overall status of one file (format.md: verify, Output).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Verdict {
+    /// Every check that ran passed, and the required ones ran (exit 0).
+    #[serde(rename = "ok")]
+    Ok,
+    /// A check failed (exit 1).
+    #[serde(rename = "failed")]
+    Failed,
+    /// No check failed, but the required checks could not run: `energy`, or both `constraint` and
+    /// `steady` (exit 1, as a failure, for scripts that only read the exit code).
+    #[serde(rename = "cannot-verify")]
+    CannotVerify,
+    /// The file is unreadable, truncated, corrupt, not MCAP or not a coin-log file (exit 2).
+    #[serde(rename = "unusable")]
+    Unusable,
+}
+
+impl Verdict {
+    /// The exit code of a file with this verdict.
+    #[must_use]
+    pub fn exit_code(self) -> u8 {
+        match self {
+            Self::Ok => 0,
+            Self::Failed | Self::CannotVerify => 1,
+            Self::Unusable => 2,
+        }
+    }
+
+    /// How the table shows it.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Ok => "ok",
+            Self::Failed => "FAILED",
+            Self::CannotVerify => "CANNOT VERIFY",
+            Self::Unusable => "UNUSABLE",
+        }
+    }
+}
+
 /// The verdict on one file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FileReport {
     /// The path as given.
     pub path: String,
-    /// 0 every check that ran passed, 1 a check failed, 2 unreadable / not MCAP / not a coin-log file.
+    /// 0 every check that ran passed, 1 a check failed or the file cannot be verified, 2 unreadable /
+    /// truncated / corrupt / not MCAP / not a coin-log file.
     pub exit_code: u8,
+    /// The overall status; `exit_code` follows from it.
+    pub verdict: Verdict,
+    /// Why the file is unusable or cannot be verified, in one sentence; `None` when every check ran or
+    /// the checks' reasons say it all.
+    pub problem: Option<String>,
     /// The checks, in [`CheckId::ALL`] order (empty when the file could not be read at all).
     pub checks: Vec<CheckResult>,
-    /// Why the file is unusable (exit code 2), for the human output; not part of the JSON.
-    #[serde(skip)]
-    pub problem: Option<String>,
 }
 
 impl FileReport {

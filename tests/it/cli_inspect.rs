@@ -297,7 +297,7 @@ fn verify_totals_several_files_in_one_line() {
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(
         text.lines().last(),
-        Some("3 files: 2 ok, 0 failed, 1 unusable")
+        Some("3 files: 2 ok, 0 failed, 0 cannot verify, 1 unusable")
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(

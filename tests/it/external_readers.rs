@@ -7,30 +7,12 @@
 //!
 //! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
 
+use crate::support::other_writers::{node_readers, python};
 use crate::support::record::coin_log_text;
 use crate::support::writers::{record_circle, Damage};
 use crate::support::{dataset_files, repo};
 use std::path::PathBuf;
 use std::process::Command;
-
-fn python() -> PathBuf {
-    let p = repo().join(".venv/bin/python");
-    assert!(
-        p.exists(),
-        "{} is missing: run scripts/test (it creates the venv with the Python `mcap` and `jsonschema` packages)",
-        p.display()
-    );
-    p
-}
-
-fn node_readers() -> PathBuf {
-    let dir = repo().join("scripts/readers");
-    assert!(
-        dir.join("node_modules/@mcap/core").exists(),
-        "scripts/readers/node_modules is missing: run scripts/test (it runs `npm ci` there)"
-    );
-    dir
-}
 
 /// Runs both readers on `files`; returns (success, output) of each.
 fn run_readers(files: &[PathBuf]) -> [(bool, String); 2] {

@@ -29,6 +29,7 @@ mod inspect;
 mod integrators;
 mod invariants;
 mod linearisation;
+mod other_writers;
 mod params;
 mod properties;
 mod readme;

@@ -2,11 +2,11 @@
 //! check, by id, with the measured number in the report.
 #![allow(clippy::unwrap_used)]
 
-use crate::support::record::{coin_log_text, record_scene, scene_names};
+use crate::support::record::{coin_log_text, read_messages, record_scene, scene_names};
 use crate::support::writers::{
     nudge, record, recorded, rewrite, rewrite_with_schemas, steady_circle, wobble, Edit, Spec,
 };
-use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status};
+use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status, Verdict};
 
 fn show(r: &FileReport) -> String {
     r.checks
@@ -158,8 +158,11 @@ fn negative_control_numbers_appear_in_the_json_output() {
     assert_eq!(v["files"][0]["exit_code"], 1);
 }
 
+/// `--channels energy`: E cannot be recomputed (no ω, θ) and no motion check can run. No check fails, so
+/// the verdict is "cannot verify" (exit 1, the code the contract gave such a file), each skipped check
+/// keeps its reason, and the file's `problem` names the required checks that could not run.
 #[test]
-fn a_log_on_which_no_physics_check_can_run_fails() {
+fn a_log_on_which_no_physics_check_can_run_cannot_be_verified() {
     let spec = Spec {
         channels: vec![coin_log::format::Channel::Energy],
         ..wobble()
@@ -168,11 +171,30 @@ fn a_log_on_which_no_physics_check_can_run_fails() {
     let r = verify_file(&path, &Options::default());
     println!("{}", show(&r));
     assert_eq!(r.exit_code, 1);
+    assert_eq!(r.verdict, Verdict::CannotVerify);
     let energy = r.check(CheckId::Energy).unwrap();
-    assert_eq!(energy.status, Status::Fail);
-    assert!(energy.reason.starts_with("required check could not run"));
+    assert_eq!(energy.status, Status::Skip);
+    assert_eq!(
+        energy.reason,
+        "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed: record the channels omega and angles"
+    );
     let constraint = r.check(CheckId::Constraint).unwrap();
-    assert_eq!(constraint.status, Status::Fail);
+    assert_eq!(constraint.status, Status::Skip);
+    assert_eq!(status(&r, CheckId::Integrity), Status::Pass);
+    assert_eq!(
+        r.problem.as_deref(),
+        Some("cannot verify: the required checks energy, constraint or steady (the motion) could not run (each check's reason says why and what to record)")
+    );
+    let (code, out, err) = coin_log_text(&["verify", path.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(
+        out.starts_with(&format!("{}: CANNOT VERIFY (exit 1)\n", path.display())),
+        "{out}"
+    );
+    assert_eq!(
+        err,
+        format!("error: {}: {}\n", path.display(), r.problem.unwrap())
+    );
 }
 
 #[test]
@@ -188,11 +210,20 @@ fn the_json_output_has_exactly_the_contract_fields() {
         k
     };
     assert_eq!(keys(&v), ["files"]);
-    // The contract's fields plus `peak_rss_bytes`, an allowed extension.
+    // The contract's fields plus `peak_rss_bytes`, `verdict` and `problem`, allowed extensions.
     assert_eq!(
         keys(&v["files"][0]),
-        ["checks", "exit_code", "path", "peak_rss_bytes"]
+        [
+            "checks",
+            "exit_code",
+            "path",
+            "peak_rss_bytes",
+            "problem",
+            "verdict"
+        ]
     );
+    assert_eq!(v["files"][0]["verdict"], "ok");
+    assert_eq!(v["files"][0]["problem"], serde_json::Value::Null);
     let ids: Vec<&str> = v["files"][0]["checks"]
         .as_array()
         .unwrap()
@@ -372,4 +403,233 @@ fn a_schema_of_another_version_typing_a_field_as_a_string_fails_integrity() {
         v["properties"]["z"]["type"] = "string".into();
     });
     assert_integrity(&r, 1, Status::Fail, "schema `coin_log.AngularVelocity` is another version than this tool's and types `z` as \"string\", the messages have a number");
+}
+
+/// The stored messages of `topic` in `path`, as JSON, in order.
+fn stored(path: &std::path::Path, topic: &str) -> Vec<serde_json::Value> {
+    read_messages(path)
+        .into_iter()
+        .filter(|(t, _, _)| t == topic)
+        .map(|(_, _, v)| v)
+        .collect()
+}
+
+/// Asserts that `id` is the one check that fails, with a value within `rel` of `expected`, and that
+/// every other check has the status it had on the untouched file.
+fn assert_only_failure(r: &FileReport, clean: &FileReport, id: CheckId, expected: f64, rel: f64) {
+    let c = r.check(id).unwrap();
+    let value = c.value.unwrap();
+    println!(
+        "{id}: measured {value:e}, expected {expected:e} (to {rel:e} relative), tolerance {:e}",
+        c.tolerance.unwrap()
+    );
+    assert_eq!(c.status, Status::Fail, "{}", show(r));
+    assert!(
+        (value - expected).abs() <= rel * expected,
+        "{id}: measured {value:e}, expected {expected:e} ± {rel:e} relative"
+    );
+    for other in CheckId::ALL.into_iter().filter(|o| *o != id) {
+        assert_eq!(
+            status(r, other),
+            status(clean, other),
+            "{other}\n{}",
+            show(r)
+        );
+    }
+    assert_eq!((r.exit_code, r.verdict), (1, Verdict::Failed));
+}
+
+/// A real `wobble` recording and a copy with `edit` applied; both verified.
+fn edited(
+    edit: impl FnMut(Edit<'_>),
+) -> (
+    tempfile::TempDir,
+    std::path::PathBuf,
+    FileReport,
+    FileReport,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), "wobble", &[]);
+    let clean = verify_file(&good, &Options::default());
+    assert_eq!(clean.verdict, Verdict::Ok, "{}", show(&clean));
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&good, &bad, edit);
+    let r = verify_file(&bad, &Options::default());
+    println!("{}", show(&r));
+    (dir, good, clean, r)
+}
+
+/// Negative control of `invariants`: one stored C1 nudged by 1e-9 disagrees with C1 recomputed from θ, ω
+/// by 1e-9 / (|C1_0| + |C2_0|), which the 1e-12 recomputation tolerance must catch.
+#[test]
+fn verify_flags_a_log_with_one_stored_c1_nudged_by_1e_9() {
+    let delta = 1e-9;
+    let (_dir, good, clean, r) = edited(|e| {
+        if e.topic == "/coin/invariants" && e.index == 500 {
+            nudge(e.data, "c1", delta);
+        }
+    });
+    let first = &stored(&good, "/coin/invariants")[0];
+    let scale = first["c1"].as_f64().unwrap().abs() + first["c2"].as_f64().unwrap().abs();
+    // The nudged value is rounded to a double near |C1| ≲ 1: δ is kept to ~1e-16 absolute, 1e-6 relative.
+    assert_only_failure(&r, &clean, CheckId::Invariants, delta / scale, 1e-6);
+    assert!(r
+        .check(CheckId::Invariants)
+        .unwrap()
+        .reason
+        .starts_with("agreement is the worst measure"));
+}
+
+/// Negative control of `consistency`: a stored quaternion component nudged by 1e-9 no longer equals the
+/// rotation of the stored angles (component difference 1e-9, tolerance 1e-12).
+#[test]
+fn verify_flags_a_log_with_one_quaternion_inconsistent_with_the_angles() {
+    let delta = 1e-9;
+    let (_dir, _good, clean, r) = edited(|e| {
+        if e.topic == "/coin/quaternion" && e.index == 500 {
+            nudge(e.data, "w", delta);
+        }
+    });
+    assert_only_failure(&r, &clean, CheckId::Consistency, delta, 1e-6);
+    assert!(r
+        .check(CheckId::Consistency)
+        .unwrap()
+        .reason
+        .starts_with("worst: quaternion;"));
+}
+
+/// Negative control of `consistency`: a stored contact point moved by 1e-9 is no longer the centre plus
+/// c; the measure is relative to max(a, |x|, |z|) of the centre at that sample.
+#[test]
+fn verify_flags_a_log_with_one_contact_point_inconsistent_with_the_angles() {
+    let delta = 1e-9;
+    let (_dir, good, clean, r) = edited(|e| {
+        if e.topic == "/coin/contact" && e.index == 500 {
+            nudge(e.data, "x", delta);
+        }
+    });
+    let centre = &stored(&good, "/coin/position")[500];
+    let scale = [
+        1.0,
+        centre["x"].as_f64().unwrap().abs(),
+        centre["z"].as_f64().unwrap().abs(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    assert_only_failure(&r, &clean, CheckId::Consistency, delta / scale, 1e-6);
+    assert!(r
+        .check(CheckId::Consistency)
+        .unwrap()
+        .reason
+        .starts_with("worst: contact;"));
+}
+
+/// Negative control of `validity`, N < 0: the lift-off release (θ0 = 0.2, no spin) integrated 0.3 time
+/// units past the point where N reaches 0 (t ≈ 2.674), with no event to end it: the file says the run
+/// completed, so the negative N is not at a recorded event. The value is -min N/(Mg) of the stored
+/// reactions (the same numbers, the same division).
+#[test]
+fn verify_flags_a_log_whose_normal_force_goes_negative_without_a_lift_off_event() {
+    let spec = Spec {
+        initial: coin_log::model::State {
+            theta: 0.2,
+            ..Default::default()
+        },
+        duration: 2.974,
+        events: false,
+        ..wobble()
+    };
+    let (_dir, path) = recorded(&spec, "past-lift-off.mcap");
+    let clean_spec = Spec {
+        events: true,
+        ..spec.clone()
+    };
+    let (_clean_dir, clean_path) = recorded(&clean_spec, "lift-off.mcap");
+    let clean = verify_file(&clean_path, &Options::default());
+    println!("stopped at the event:\n{}", show(&clean));
+    assert_eq!(clean.verdict, Verdict::Ok);
+    let r = verify_file(&path, &Options::default());
+    println!("integrated past it:\n{}", show(&r));
+    let min_normal = stored(&path, "/coin/reaction")
+        .iter()
+        .map(|m| m["normal"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    assert!(min_normal < -1e-3, "min N = {min_normal}");
+    // serde_json's default float parsing (used here) may be an ulp off; verify reads the text correctly
+    // rounded.
+    assert_only_failure(&r, &clean, CheckId::Validity, -min_normal, 1e-15);
+}
+
+/// Negative control of `validity`, |F| > μN: a steady circle (F/N constant) whose metadata gives μ at 0.9
+/// of its friction ratio, recorded without a slip event: the value is max(|F| - μN)/(Mg) of the stored
+/// reactions.
+#[test]
+fn verify_flags_a_log_whose_friction_exceeds_mu_n_without_a_slip_event() {
+    let (_dir, probe) = recorded(&steady_circle(), "probe.mcap");
+    let ratio = stored(&probe, "/coin/reaction")
+        .iter()
+        .map(|m| m["friction"].as_f64().unwrap() / m["normal"].as_f64().unwrap())
+        .fold(0.0, f64::max);
+    let mu = 0.9 * ratio;
+    let spec = Spec {
+        friction: Some(mu),
+        events: false,
+        ..steady_circle()
+    };
+    let (_dir2, path) = recorded(&spec, "slipping.mcap");
+    let clean = verify_file(&probe, &Options::default());
+    let r = verify_file(&path, &Options::default());
+    let excess = stored(&path, "/coin/reaction")
+        .iter()
+        .map(|m| m["friction"].as_f64().unwrap() - mu * m["normal"].as_f64().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!("μ = {mu} (F/N = {ratio}), max |F| - μN = {excess}");
+    assert!(excess > 1e-3);
+    // An ulp of each parsed number (see above), amplified by the cancellation in |F| - μN ≈ 0.1 |F|.
+    assert_only_failure(&r, &clean, CheckId::Validity, excess, 1e-13);
+}
+
+/// `record` warns before simulating when verify will not be able to judge the recording, with the fix;
+/// verify then says CANNOT VERIFY and its constraint check suggests the same rate.
+#[test]
+fn record_warns_when_verify_cannot_judge_the_recording_and_verify_agrees() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("undersampled.mcap");
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        "high-spin",
+        "--rate",
+        "100",
+        "--duration",
+        "1",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let warning = "warning: verify will not be able to judge this recording: neither `constraint` nor `steady` will run, so the motion will not be verified: `steady` does not apply (the scene does not start on an unperturbed steady motion), and `constraint` will find no window the sampling resolves: at 100 samples per time unit, h·Ω = 0.5 (Ω = max(|ω|, |φ̇|) = 50 at t = 0), and the finite difference's error 4(hΩ)^8/630 = 2.5e-5 exceeds a tenth of the residual tolerance 2.0e-7; raise --rate to at least 266\n";
+    assert_eq!(err, warning);
+    let (code, out, err) = coin_log_text(&["verify", path.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("CANNOT VERIFY (exit 1)"), "{out}");
+    assert!(
+        out.contains("record at a higher --rate (at least 266)"),
+        "{out}"
+    );
+    assert!(
+        err.contains(
+            "cannot verify: the required check constraint or steady (the motion) could not run"
+        ),
+        "{err}"
+    );
+    // The default rate of the scene raises no warning.
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        "high-spin",
+        "--duration",
+        "1",
+        "-o",
+        path.to_str().unwrap(),
+        "--overwrite",
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
 }

@@ -4,22 +4,13 @@
 
 #![allow(clippy::unwrap_used)]
 
-use crate::support::record::coin_log_text;
+use crate::support::other_writers::rewrites;
+use crate::support::record::{
+    coin_log_text, coin_log_within, record_scene, top_level_records as records, HANG_DEADLINE,
+};
 use crate::support::writers::{recorded, rewrite, wobble, Spec};
+use coin_log::verify::{verify_bytes, Options};
 use std::path::Path;
-
-/// The top-level records of an MCAP file: (opcode, offset, body length).
-fn records(bytes: &[u8]) -> Vec<(u8, usize, usize)> {
-    let mut out = Vec::new();
-    let mut at = 8;
-    while at + 9 <= bytes.len() - 8 {
-        let op = bytes[at];
-        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
-        out.push((op, at, len));
-        at += 9 + len;
-    }
-    out
-}
 
 /// CRC-32 (IEEE), as MCAP uses.
 fn crc32(data: &[u8]) -> u32 {
@@ -150,7 +141,7 @@ fn an_mcap_from_another_tool_is_not_a_coin_log_file() {
     assert_eq!(
         err.trim(),
         format!(
-            "error: {}: not a coin-log file: it has no `coin-log` metadata record before its first message (written by `other-tool`)",
+            "error: {}: not a coin-log file: it has no `coin-log` metadata record (written by `other-tool`)",
             path.display()
         )
     );
@@ -374,4 +365,135 @@ fn several_files_exit_with_the_worst_code() {
     assert_eq!(code, 2);
     let (code, _, _) = coin_log_text(&["verify", good.to_str().unwrap()]);
     assert_eq!(code, 0);
+}
+
+/// The cuts of `bytes` the sweep tries: every top-level record boundary, one byte and one record prefix
+/// (9 bytes) past it, every byte of the leading magic, the last 9 bytes, and about 100 evenly spaced
+/// offsets; all strictly inside the file.
+fn cuts(bytes: &[u8]) -> Vec<usize> {
+    let n = bytes.len();
+    let mut cuts: Vec<usize> = records(bytes)
+        .iter()
+        .flat_map(|(_, at, _)| [*at, at + 1, at + 9])
+        .chain(1..=8)
+        .chain(n - 9..n)
+        .chain((1..100).map(|k| k * n / 100))
+        .filter(|c| (1..n).contains(c))
+        .collect();
+    cuts.sort_unstable();
+    cuts.dedup();
+    cuts
+}
+
+/// A file cut anywhere is a prefix of a plausible MCAP: verify must say "truncated" and where, with exit
+/// code 2, never a panic, whether the cut falls in the magic, a record prefix, the metadata, a chunk, the
+/// summary, the footer or the end magic. Checked on a real recording (metadata first) and on its rewrite
+/// by the Python writer with the metadata last (the cut then usually comes before the metadata).
+#[test]
+fn a_recording_cut_anywhere_is_reported_as_truncated() {
+    let dir = tempfile::tempdir().unwrap();
+    let real = record_scene(dir.path(), "circle-plus", &["--duration", "3"]);
+    let late = rewrites().file("py-zstd-small-last").to_path_buf();
+    let mut total = 0;
+    for path in [real, late] {
+        let bytes = std::fs::read(&path).unwrap();
+        let cuts = cuts(&bytes);
+        for &cut in &cuts {
+            let r = verify_bytes("cut.mcap", &bytes[..cut], &Options::default());
+            let problem = r.problem.as_deref().unwrap_or("");
+            let expected = format!("truncated: the file ends at byte {cut}");
+            assert!(
+                r.exit_code == 2 && problem.starts_with(&expected),
+                "{} cut at {cut} of {}: exit {}, {problem:?}",
+                path.display(),
+                bytes.len(),
+                r.exit_code
+            );
+        }
+        println!("{}: {} cuts, all truncated", path.display(), cuts.len());
+        total += cuts.len();
+    }
+    assert!(total > 300, "{total} cuts");
+}
+
+/// What each kind of cut says, through the binary: printed once, on stderr; the table on stdout says
+/// UNUSABLE; the JSON carries the same sentence as `problem`.
+#[test]
+fn a_truncated_file_says_where_it_was_cut_once_on_stderr_and_in_the_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), "circle-plus", &["--duration", "3"]);
+    let bytes = std::fs::read(&good).unwrap();
+    let recs = records(&bytes);
+    let chunk = recs.iter().find(|r| r.0 == 0x06).unwrap();
+    let run = recs.iter().find(|r| r.0 == 0x0C).unwrap();
+    let footer = recs.iter().find(|r| r.0 == 0x02).unwrap();
+    let n = bytes.len();
+    let messages = |s: &str| s.to_string();
+    for (cut, detail) in [
+        (
+            3,
+            messages("truncated: the file ends at byte 3, inside the MCAP magic it starts with; no `coin-log` metadata record comes before that point, so there is nothing to judge"),
+        ),
+        (
+            8,
+            messages("truncated: the file ends at byte 8, right after the MCAP magic, before the MCAP footer; no `coin-log` metadata record comes before that point, so there is nothing to judge"),
+        ),
+        (
+            run.1 + 20,
+            format!("truncated: the file ends at byte {} inside the record that starts at byte {}, before the MCAP footer; no `coin-log` metadata record comes before that point, so there is nothing to judge", run.1 + 20, run.1),
+        ),
+        (
+            chunk.1 + 100,
+            format!("truncated: the file ends at byte {} inside the record that starts at byte {}, before the MCAP footer; judged the 0 messages read before it", chunk.1 + 100, chunk.1),
+        ),
+        (
+            footer.1,
+            format!("truncated: the file ends at byte {}, after a whole record, before the MCAP footer; judged the 2802 messages read before it", footer.1),
+        ),
+        (
+            n - 3,
+            format!("truncated: the file ends at byte {}, inside the MCAP end magic; judged the 2802 messages read", n - 3),
+        ),
+    ] {
+        let path = dir.path().join(format!("cut-{cut}.mcap"));
+        std::fs::write(&path, &bytes[..cut]).unwrap();
+        let (code, out, err) = coin_log_text(&["verify", path.to_str().unwrap()]);
+        assert_eq!(code, 2, "{out}{err}");
+        assert_eq!(err, format!("error: {}: {detail}\n", path.display()));
+        assert!(
+            out.starts_with(&format!("{}: UNUSABLE (exit 2)\n", path.display())),
+            "{out}"
+        );
+        // No second copy under the verdict line (the table, when the file was judged, follows it; the
+        // integrity row then counts the cut among its problems).
+        let second = out.lines().nth(1).unwrap_or("  check ");
+        assert!(second.starts_with("  check "), "printed once: {out}");
+        let (code, out, _) = coin_log_text(&["verify", "--json", path.to_str().unwrap()]);
+        assert_eq!(code, 2);
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["files"][0]["problem"], detail.as_str());
+        assert_eq!(v["files"][0]["verdict"], "unusable");
+    }
+}
+
+/// A pipe cannot be read twice (the metadata is looked up before the stream): refused with the reason.
+#[test]
+fn a_pipe_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.mcap");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    // Nothing ever writes to the FIFO: verify must not open it for reading (which would block).
+    let (code, out, err) = coin_log_within(HANG_DEADLINE, &["verify", fifo.to_str().unwrap()]);
+    assert_eq!(code, 2, "{out}");
+    assert_eq!(
+        err,
+        format!(
+            "error: {}: is not a regular file (a pipe, socket or device): an MCAP file is read by seeking to its summary and metadata, which a stream cannot do; save it to a file first\n",
+            fifo.display()
+        )
+    );
 }

@@ -44,6 +44,51 @@ struct Bucket {
     residual: Max,
 }
 
+/// The finite difference's truncation error relative to the velocity, estimated as 4 (hΩ)⁸/630 for
+/// samples h apart on a motion with rates up to Ω.
+#[must_use]
+pub fn truncation(h: f64, rate: f64) -> f64 {
+    TRUNCATION_SAFETY * (h * rate).powi(8) / 630.0
+}
+
+/// The bucket of a truncation estimate: d holds (10^-(d+1), 10^-d], the last one everything smaller.
+fn decade(truncation: f64) -> usize {
+    if truncation > 0.0 {
+        // Clamped to 0..=DECADES first, so the cast neither truncates nor wraps.
+        (-truncation.log10()).floor().clamp(0.0, DECADES as f64) as usize
+    } else {
+        DECADES
+    }
+}
+
+/// Whether the windows of bucket `d` are resolved at residual tolerance `tol`: 10^-d ≤ tol/10.
+fn counts(d: usize, tol: f64) -> bool {
+    d == DECADES || 10f64.powi(-i32::try_from(d).unwrap_or(i32::MAX)) <= tol * RESOLVED_FRACTION
+}
+
+/// Whether a window of samples h apart on a motion with rates up to Ω counts at residual tolerance
+/// `tol` (the rule [`ConstraintCheck::finish`] applies).
+#[must_use]
+pub fn resolves(h: f64, rate: f64, tol: f64) -> bool {
+    counts(decade(truncation(h, rate)), tol)
+}
+
+/// The smallest sampling rate (samples per time unit) at which windows on a motion with rates up to Ω
+/// count at residual tolerance `tol`; infinite when no rate does.
+#[must_use]
+pub fn min_rate(rate: f64, tol: f64) -> f64 {
+    let Some(d) = (0..=DECADES).find(|d| counts(*d, tol)) else {
+        return f64::INFINITY;
+    };
+    if d == DECADES || rate == 0.0 {
+        return 0.0;
+    }
+    // The largest truncation in bucket d is 10^-d: 4 (hΩ)⁸/630 = 10^-d.
+    let largest = 10f64.powi(-i32::try_from(d).unwrap_or(i32::MAX));
+    let h = (largest * 630.0 / TRUNCATION_SAFETY).powf(0.125) / rate;
+    1.0 / h
+}
+
 /// Running state of the constraint check.
 #[derive(Debug, Clone)]
 pub struct ConstraintCheck {
@@ -54,6 +99,8 @@ pub struct ConstraintCheck {
     samples: u64,
     irregular: u64,
     min_h: f64,
+    /// The smallest rate Ω of a window: the one the sampling comes closest to resolving.
+    min_rate: f64,
 }
 
 impl Default for ConstraintCheck {
@@ -66,6 +113,7 @@ impl Default for ConstraintCheck {
             samples: 0,
             irregular: 0,
             min_h: f64::INFINITY,
+            min_rate: f64::INFINITY,
         }
     }
 }
@@ -123,13 +171,8 @@ impl ConstraintCheck {
         }
         let residual = d / h - centre.velocity;
         let rate = win.iter().map(|e| e.rate).fold(0.0, f64::max);
-        let truncation = TRUNCATION_SAFETY * (h * rate).powi(8) / 630.0;
-        let decade = if truncation > 0.0 {
-            (-truncation.log10()).floor().clamp(0.0, DECADES as f64) as usize
-        } else {
-            DECADES
-        };
-        let bucket = &mut self.buckets[decade];
+        self.min_rate = self.min_rate.min(rate);
+        let bucket = &mut self.buckets[decade(truncation(h, rate))];
         bucket.windows += 1;
         bucket.residual.offer(residual.norm(), centre.t);
     }
@@ -141,19 +184,21 @@ impl ConstraintCheck {
             return CheckResult::skip(
                 CheckId::Constraint,
                 format!(
-                    "needs {WINDOW} consecutive samples with /coin/position, /coin/omega and /coin/angles; found {}",
-                    self.samples
+                    "needs {WINDOW} consecutive samples with /coin/position, /coin/omega and /coin/angles; found {}{}",
+                    self.samples,
+                    if self.samples == 0 {
+                        ": record the channels omega, angles and position"
+                    } else {
+                        ""
+                    }
                 ),
             );
         }
-        // Bucket d holds windows with truncation in (10^-(d+1), 10^-d]; resolved when 10^-d ≤ tol/10.
-        let limit = tol.residual * RESOLVED_FRACTION;
         let mut used = 0;
         let mut skipped = 0;
         let mut residual = Max::default();
         for (d, b) in self.buckets.iter().enumerate() {
-            let upper = 10f64.powi(-(d as i32));
-            if upper <= limit || d == DECADES {
+            if counts(d, tol.residual) {
                 used += b.windows;
                 residual.offer(b.residual.value, b.residual.t);
             } else {
@@ -164,9 +209,10 @@ impl ConstraintCheck {
             return CheckResult::skip(
                 CheckId::Constraint,
                 format!(
-                    "the sampling does not resolve the motion: at h = {} the finite difference's truncation error (h·max(|ω|, |φ̇|))^8/630 exceeds a tenth of the tolerance {} in all {skipped} windows; record at a higher --rate",
+                    "the sampling does not resolve the motion: at h = {} the finite difference's truncation error (h·max(|ω|, |φ̇|))^8/630 exceeds a tenth of the tolerance {} in all {skipped} windows; record at a higher --rate (at least {})",
                     fmt_num(self.min_h),
-                    fmt_num(tol.residual)
+                    fmt_num(tol.residual),
+                    fmt_num(min_rate(self.min_rate, tol.residual).ceil())
                 ),
             );
         }
@@ -196,5 +242,24 @@ impl ConstraintCheck {
             ));
         }
         CheckResult::measured(CheckId::Constraint, value, tol.residual, reason)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_minimum_rate_is_the_edge_of_resolution() {
+        // high-spin: Ω = 50 at tolerance 1e-6. Just above the minimum rate a window counts, just below
+        // it does not, and the check's own rule (resolves) agrees with the formula.
+        let (omega, tol) = (50.0, 1e-6);
+        let r = min_rate(omega, tol);
+        println!("minimum rate {r} for Ω = {omega}, tolerance {tol}");
+        assert!(resolves(1.0 / (r * 1.0001), omega, tol));
+        assert!(!resolves(1.0 / (r * 0.9999), omega, tol));
+        // hΩ = 0.5 (rate 100) is far from resolved; the default rate of 1000 is resolved.
+        assert!(!resolves(0.01, omega, tol));
+        assert!(resolves(0.001, omega, tol));
     }
 }

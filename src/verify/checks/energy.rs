@@ -69,7 +69,7 @@ impl EnergyCheck {
             let reason = if self.without_work > 0 {
                 "the run has dissipation (physics §11) but no sample has /coin/work, so the balance E + W = E0 cannot be judged: record the work channel"
             } else {
-                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed"
+                "no sample has both /coin/omega and /coin/angles, so E cannot be recomputed: record the channels omega and angles"
             };
             return CheckResult::skip(CheckId::Energy, reason);
         };

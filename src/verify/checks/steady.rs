@@ -156,7 +156,7 @@ impl SteadyCheck {
         if self.samples == 0 {
             return CheckResult::skip(
                 CheckId::Steady,
-                "no sample has both /coin/omega and /coin/angles",
+                "no sample has both /coin/omega and /coin/angles: record the channels omega and angles",
             );
         }
         let p = ctx.coin.params();

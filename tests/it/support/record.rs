@@ -6,8 +6,10 @@
 use super::repo;
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
+use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// One message as read back.
 #[derive(Debug, Clone)]
@@ -179,6 +181,66 @@ pub fn coin_log_text(args: &[&str]) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// How long a `verify` child may run before it counts as hung: a hang detector, generous (the files of
+/// the tests take milliseconds to read), never a speed test.
+pub const HANG_DEADLINE: Duration = Duration::from_secs(20);
+
+/// Runs the binary with `args` in the repository root like [`coin_log_text`], but kills it and fails the
+/// test if it has not exited within `deadline`.
+pub fn coin_log_within(deadline: Duration, args: &[&str]) -> (i32, String, String) {
+    let mut child = Command::new(exe())
+        .args(args)
+        .current_dir(repo())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("coin-log runs");
+    // Drained on threads, so that a child filling a pipe cannot stall.
+    let drain = |mut pipe: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut text = Vec::new();
+            pipe.read_to_end(&mut text).expect("pipe readable");
+            String::from_utf8_lossy(&text).into_owned()
+        })
+    };
+    let out = drain(Box::new(child.stdout.take().expect("stdout piped")));
+    let err = drain(Box::new(child.stderr.take().expect("stderr piped")));
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("child waitable") {
+            break status;
+        }
+        if start.elapsed() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "`coin-log {}` still ran after {deadline:?}: it hangs",
+                args.join(" ")
+            );
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    (
+        status.code().unwrap_or(-1),
+        out.join().expect("stdout thread"),
+        err.join().expect("stderr thread"),
+    )
+}
+
+/// The top-level records of the MCAP file `bytes`, in order: (opcode, offset, body length), up to the
+/// footer (the end magic is not a record).
+pub fn top_level_records(bytes: &[u8]) -> Vec<(u8, usize, usize)> {
+    let mut out = Vec::new();
+    let mut at = 8;
+    while at + 9 <= bytes.len() - 8 {
+        let op = bytes[at];
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        out.push((op, at, len));
+        at += 9 + len;
+    }
+    out
 }
 
 /// Records built-in scene `scene` with the real recorder (`coin-log record`), plus `extra` flags.

@@ -14,10 +14,12 @@ use coin_log::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
     RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
+use coin_log::integrate::{
+    run_method, Flow, Method, MethodConfig, NoEvents, Rk4, RunSettings, Termination,
+};
 use coin_log::model::{
-    centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams, Dynamics,
-    State, Steady, SteadyKind,
+    centre, contact_point, energy, orientation, reaction, Branch, Chaplygin, Coin, CoinParams,
+    Dynamics, State, Steady, SteadyKind, STATE_LEN,
 };
 use coin_log::record::{Foxglove3d, FoxgloveBatch};
 use coin_log::simulation::{simulate, CoinEvents};
@@ -306,6 +308,11 @@ pub struct Spec {
     pub rtol: f64,
     pub atol: f64,
     pub chunk_size: Option<u64>,
+    /// μ, written to the metadata (and, with `events`, ending the run at slip).
+    pub friction: Option<f64>,
+    /// Whether physical events end the run (flat landing, lift-off, slip); without, the model is
+    /// integrated past them, as a recording the model does not hold for.
+    pub events: bool,
 }
 
 /// The note's wobbling coin: θ = 0.3, ω = (0, 0.195, 1), unit thin disk.
@@ -328,6 +335,8 @@ pub fn wobble() -> Spec {
         method: Method::Dop853,
         rtol: 1e-10,
         atol: 1e-12,
+        friction: None,
+        events: true,
     }
 }
 
@@ -364,7 +373,7 @@ pub fn record(spec: &Spec, path: &Path) {
         gravity: p.gravity(),
         inertia_x: p.inertia_x(),
         inertia_z: p.inertia_z(),
-        friction: None,
+        friction: spec.friction,
         time_unit: p.time_unit(),
         integrator: spec.method,
         rtol: spec.rtol,
@@ -410,9 +419,8 @@ pub fn record(spec: &Spec, path: &Path) {
         t_end: spec.duration,
         sample_interval: 1.0 / spec.rate,
     };
-    let events = CoinEvents::new(coin, 1e-4, None);
     let y0 = spec.initial.to_array();
-    let outcome = run_method(&config, &coin, &y0, &settings, &events, |t, y| {
+    let mut observe = |t: f64, y: &[f64; STATE_LEN]| {
         let s = State::from_array(y);
         let lt = log_time(t).unwrap();
         for (c, id) in &ids {
@@ -421,7 +429,13 @@ pub fn record(spec: &Spec, path: &Path) {
             sequence += 1;
         }
         Flow::Continue
-    });
+    };
+    let outcome = if spec.events {
+        let events = CoinEvents::new(coin, 1e-4, spec.friction);
+        run_method(&config, &coin, &y0, &settings, &events, &mut observe)
+    } else {
+        run_method(&config, &coin, &y0, &settings, &NoEvents, &mut observe)
+    };
     let termination = match outcome.termination {
         Termination::Completed | Termination::Event { .. } => {
             coin_log::format::Termination::of_run(&outcome.termination)

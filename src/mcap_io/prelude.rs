@@ -1,0 +1,425 @@
+//! Before the stream: the file's metadata records, wherever they sit, and what its ends look like.
+//!
+//! MCAP lets a writer put metadata records anywhere in the data section: `coin-log record` writes its run
+//! record before the first chunk, but the Python `mcap` writer with small chunks and the TypeScript
+//! `@mcap/core` writer may write it after chunks of messages. A reader that must know the metadata before
+//! it can interpret a message therefore looks for them first:
+//!
+//! 1. through the summary: the footer gives the summary's start, the summary's MetadataIndex records give
+//!    each metadata record's offset and length, and each record is read there (one seek each);
+//! 2. without a summary or a metadata index (a file written by a streaming recorder, or cut short), by a
+//!    scan of the top-level records that reads each record's 9-byte prefix and seeks past its body, reading
+//!    only metadata bodies in full. Metadata records never sit inside chunks (the spec allows only schemas,
+//!    channels and messages there), so chunks are skipped unread and the scan costs a few reads per chunk.
+//!
+//! Both are bounded by the file: the summary is read once, metadata records are read only where they do
+//! not overlap one already read, and the scan visits each byte at most once. The records found are passed
+//! to the visitor before the first message; the stream then recognises them by offset and does not pass
+//! them again. A seekable source is required: a pipe cannot be read twice, and buffering the messages
+//! until a late metadata record arrives would hold the whole file in memory for a file whose metadata
+//! comes last.
+//!
+//! Nothing here is trusted: a record that is not what the index says is ignored (the stream's checks of
+//! the indexes against the records report it), an I/O error ends the search (the stream reports it).
+
+use super::wire::{self, Cursor, MAGIC};
+use mcap::records::op;
+use std::collections::BTreeMap;
+use std::io::{self, Read, Seek, SeekFrom};
+
+/// Bytes of an opcode and a record length.
+const PREFIX: u64 = 9;
+/// Bytes of the footer record (prefix and three fields) before the end magic.
+const FOOTER_RECORD: u64 = PREFIX + 8 + 8 + 4;
+/// Most metadata records passed on ahead of the stream (further ones come with the stream).
+const MAX_EARLY: usize = 1024;
+
+/// One metadata record found ahead of the stream.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct EarlyMetadata {
+    /// Offset of the record (its opcode) in the file.
+    pub(crate) at: u64,
+    /// Its body, as the stream will see it.
+    pub(crate) body: Vec<u8>,
+    /// The record's name.
+    pub(crate) name: String,
+    /// Its entries.
+    pub(crate) entries: BTreeMap<String, String>,
+}
+
+/// How the search ended without reaching the end of the data section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ScanEnd {
+    /// The file ends inside the record that starts at this offset (or exactly where one should start).
+    Cut {
+        /// The record's offset.
+        at: u64,
+        /// The length it claims, when its prefix is whole.
+        claimed: Option<u64>,
+    },
+    /// The record at this offset is not a well-formed metadata record or has an impossible length.
+    Malformed {
+        /// The record's offset.
+        at: u64,
+    },
+}
+
+/// What was learned before the stream.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Prelude {
+    /// The metadata records found, in file order.
+    pub(crate) metadata: Vec<EarlyMetadata>,
+    /// The first bytes of the file are the MCAP magic, or its beginning when the file is shorter.
+    pub(crate) magic_prefix: bool,
+    /// The file ends with the MCAP magic (its last 8 bytes, not those of the start).
+    pub(crate) ends_with_magic: bool,
+    /// The records were found through the summary's metadata index.
+    pub(crate) indexed: bool,
+    /// Where the scan stopped early, when it ran and did.
+    pub(crate) scan_end: Option<ScanEnd>,
+}
+
+/// Looks for the metadata records of the MCAP file of `len` bytes in `source` (see the module doc).
+/// Leaves the source at an unspecified position.
+pub(crate) fn find(source: &mut (impl Read + Seek), len: u64) -> Prelude {
+    let mut p = Prelude::default();
+    let mut head = [0u8; 8];
+    let n = usize::try_from(len.min(8)).unwrap_or(8);
+    if read_at(source, 0, &mut head[..n]).is_err() {
+        return p;
+    }
+    p.magic_prefix = head[..n] == MAGIC[..n];
+    if len < 8 || !p.magic_prefix {
+        return p;
+    }
+    // The end magic is a second copy: a file of 8 to 15 bytes holds only the first.
+    let mut tail = [0u8; 8];
+    p.ends_with_magic = len >= 16 && read_at(source, len - 8, &mut tail).is_ok() && tail == MAGIC;
+    if p.ends_with_magic {
+        if let Some(indexes) = summary_metadata_indexes(source, len) {
+            if !indexes.is_empty() {
+                let (metadata, all_valid) = read_indexed(source, len, indexes);
+                if all_valid {
+                    p.indexed = true;
+                    p.metadata = metadata;
+                    return p;
+                }
+                // An index entry that points at no metadata record of its length (e.g. @mcap/core 2.2's
+                // unchunked writer records the offset of the messages it still buffers): the index
+                // cannot be trusted to list them all; the scan finds them where they are.
+            }
+        }
+    }
+    scan(source, len, &mut p);
+    p
+}
+
+fn read_at(source: &mut (impl Read + Seek), at: u64, buf: &mut [u8]) -> io::Result<()> {
+    source.seek(SeekFrom::Start(at))?;
+    source.read_exact(buf)
+}
+
+/// Reads the 9-byte prefix at the reader's position: (opcode, length), or `None` at a short read.
+fn prefix(r: &mut impl Read) -> Option<(u8, u64)> {
+    let mut b = [0u8; 9];
+    r.read_exact(&mut b).ok()?;
+    let mut len = [0u8; 8];
+    len.copy_from_slice(&b[1..]);
+    Some((b[0], u64::from_le_bytes(len)))
+}
+
+/// The (offset, length) of every MetadataIndex record of the summary, or `None` when the file has no
+/// readable footer or summary.
+fn summary_metadata_indexes(source: &mut (impl Read + Seek), len: u64) -> Option<Vec<(u64, u64)>> {
+    let footer_at = len.checked_sub(8 + FOOTER_RECORD)?;
+    source.seek(SeekFrom::Start(footer_at)).ok()?;
+    let (opcode, body_len) = prefix(source)?;
+    if opcode != op::FOOTER || body_len != FOOTER_RECORD - PREFIX {
+        return None;
+    }
+    let mut summary_start = [0u8; 8];
+    source.read_exact(&mut summary_start).ok()?;
+    let summary_start = u64::from_le_bytes(summary_start);
+    if summary_start < 8 || summary_start >= footer_at {
+        return None;
+    }
+    // Walk the summary's records up to the footer, reading only the metadata indexes.
+    source.seek(SeekFrom::Start(summary_start)).ok()?;
+    let mut r = io::BufReader::new(source);
+    let mut at = summary_start;
+    let mut found = Vec::new();
+    while at < footer_at {
+        let (opcode, body_len) = prefix(&mut r)?;
+        let end = (at + PREFIX).checked_add(body_len)?;
+        if end > footer_at {
+            return Some(found);
+        }
+        if opcode == op::METADATA_INDEX && found.len() < MAX_EARLY {
+            let mut body = vec![0u8; usize::try_from(body_len).ok()?];
+            r.read_exact(&mut body).ok()?;
+            let mut c = Cursor::new(&body);
+            if let (Ok(offset), Ok(length)) = (c.u64("offset"), c.u64("length")) {
+                found.push((offset, length));
+            }
+        } else {
+            r.seek_relative(i64::try_from(body_len).ok()?).ok()?;
+        }
+        at = end;
+    }
+    Some(found)
+}
+
+/// Reads the metadata records the index points at: in file order, each once, never two that overlap
+/// (so that no byte is read twice), each checked to be a metadata record of the indexed length. Also says
+/// whether every entry pointed at such a record (a repeated entry counts as valid).
+fn read_indexed(
+    source: &mut (impl Read + Seek),
+    len: u64,
+    mut indexes: Vec<(u64, u64)>,
+) -> (Vec<EarlyMetadata>, bool) {
+    indexes.sort_unstable();
+    indexes.dedup();
+    let mut out: Vec<EarlyMetadata> = Vec::new();
+    let mut free_from = 8;
+    for (at, length) in indexes {
+        let end = at.saturating_add(length);
+        if at < free_from || end > len || length < PREFIX {
+            return (out, false);
+        }
+        let record = source
+            .seek(SeekFrom::Start(at))
+            .ok()
+            .and_then(|_| prefix(source))
+            .filter(|(opcode, body_len)| *opcode == op::METADATA && *body_len == length - PREFIX)
+            .and_then(|(_, body_len)| read_metadata_body(source, at, body_len));
+        match record {
+            Some(m) => {
+                out.push(m);
+                free_from = end;
+            }
+            None => return (out, false),
+        }
+    }
+    (out, true)
+}
+
+/// Reads and parses the body of the metadata record at `at` from the reader's position.
+fn read_metadata_body(r: &mut impl Read, at: u64, body_len: u64) -> Option<EarlyMetadata> {
+    let mut body = vec![0u8; usize::try_from(body_len).ok()?];
+    r.read_exact(&mut body).ok()?;
+    let (name, entries) = parse_metadata(&body).ok()?;
+    Some(EarlyMetadata {
+        at,
+        body,
+        name,
+        entries,
+    })
+}
+
+/// A metadata record's name and entries (invalid UTF-8 read as empty, as the stream reads it).
+pub(crate) fn parse_metadata(
+    body: &[u8],
+) -> Result<(String, BTreeMap<String, String>), wire::WireError> {
+    let mut c = Cursor::new(body);
+    let name = c.string("name")?.unwrap_or("").to_string();
+    let mut entries = BTreeMap::new();
+    wire::for_each_entry(&mut c, "metadata", |e| {
+        let k = e.string("key")?.unwrap_or("");
+        let v = e.string("value")?.unwrap_or("");
+        entries.insert(k.to_string(), v.to_string());
+        Ok(())
+    })?;
+    Ok((name, entries))
+}
+
+/// Walks the top-level records from the header to DataEnd (or the footer), reading metadata records and
+/// skipping everything else; notes where it stopped if the file ends or a record is impossible first.
+fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Prelude) {
+    if source.seek(SeekFrom::Start(8)).is_err() {
+        return;
+    }
+    let mut r = io::BufReader::new(source);
+    let mut at = 8;
+    loop {
+        if at == len {
+            p.scan_end = Some(ScanEnd::Cut { at, claimed: None });
+            return;
+        }
+        let Some((opcode, body_len)) = prefix(&mut r) else {
+            let end = if len - at < PREFIX {
+                ScanEnd::Cut { at, claimed: None }
+            } else {
+                ScanEnd::Malformed { at }
+            };
+            p.scan_end = Some(end);
+            return;
+        };
+        let end = (at + PREFIX).saturating_add(body_len);
+        if end > len {
+            p.scan_end = Some(ScanEnd::Cut {
+                at,
+                claimed: Some(body_len),
+            });
+            return;
+        }
+        match opcode {
+            op::DATA_END | op::FOOTER => return,
+            op::METADATA if p.metadata.len() < MAX_EARLY => {
+                match read_metadata_body(&mut r, at, body_len) {
+                    Some(m) => p.metadata.push(m),
+                    None => {
+                        p.scan_end = Some(ScanEnd::Malformed { at });
+                        return;
+                    }
+                }
+            }
+            _ => {
+                let Ok(skip) = i64::try_from(body_len) else {
+                    p.scan_end = Some(ScanEnd::Malformed { at });
+                    return;
+                };
+                if r.seek_relative(skip).is_err() {
+                    return;
+                }
+            }
+        }
+        at = end;
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use std::io::Cursor as IoCursor;
+
+    fn record(opcode: u8, body: &[u8]) -> Vec<u8> {
+        let mut r = vec![opcode];
+        r.extend_from_slice(&(body.len() as u64).to_le_bytes());
+        r.extend_from_slice(body);
+        r
+    }
+
+    fn string(s: &str) -> Vec<u8> {
+        let mut b = (s.len() as u32).to_le_bytes().to_vec();
+        b.extend_from_slice(s.as_bytes());
+        b
+    }
+
+    fn metadata(name: &str, key: &str, value: &str) -> Vec<u8> {
+        let mut entries = string(key);
+        entries.extend(string(value));
+        let mut body = string(name);
+        body.extend((entries.len() as u32).to_le_bytes());
+        body.extend(entries);
+        record(op::METADATA, &body)
+    }
+
+    /// Magic, header, a fake chunk of `chunk` bytes, a metadata record, DataEnd; with a summary holding a
+    /// metadata index when `indexed`, then the footer and the end magic.
+    fn file(chunk: usize, indexed: bool) -> (Vec<u8>, u64) {
+        let mut f = MAGIC.to_vec();
+        let mut header = string("");
+        header.extend(string("test"));
+        f.extend(record(op::HEADER, &header));
+        f.extend(record(op::CHUNK, &vec![0u8; chunk]));
+        let at = f.len() as u64;
+        let m = metadata("coin-log", "k", "v");
+        let m_len = m.len() as u64;
+        f.extend(m);
+        f.extend(record(op::DATA_END, &[0; 4]));
+        let summary_start = f.len() as u64;
+        if indexed {
+            let mut idx = at.to_le_bytes().to_vec();
+            idx.extend(m_len.to_le_bytes());
+            idx.extend(string("coin-log"));
+            f.extend(record(op::METADATA_INDEX, &idx));
+        }
+        let mut footer = if indexed { summary_start } else { 0 }
+            .to_le_bytes()
+            .to_vec();
+        footer.extend(0u64.to_le_bytes());
+        footer.extend(0u32.to_le_bytes());
+        f.extend(record(op::FOOTER, &footer));
+        f.extend(MAGIC);
+        (f, at)
+    }
+
+    #[test]
+    fn a_late_metadata_record_is_found_through_the_index_and_by_the_scan() {
+        for indexed in [true, false] {
+            let (f, at) = file(5000, indexed);
+            let p = find(&mut IoCursor::new(&f), f.len() as u64);
+            assert_eq!(p.indexed, indexed);
+            assert!(p.ends_with_magic && p.magic_prefix && p.scan_end.is_none());
+            assert_eq!(p.metadata.len(), 1, "indexed {indexed}");
+            assert_eq!(p.metadata[0].at, at);
+            assert_eq!(p.metadata[0].name, "coin-log");
+            assert_eq!(p.metadata[0].entries["k"], "v");
+        }
+    }
+
+    #[test]
+    fn a_cut_file_is_scanned_up_to_the_cut() {
+        let (f, _) = file(5000, true);
+        // Cut inside the chunk (after the magic and the 21-byte header record): its claimed length runs
+        // past the end.
+        let cut = &f[..3000];
+        let p = find(&mut IoCursor::new(cut), cut.len() as u64);
+        assert!(!p.ends_with_magic && p.metadata.is_empty());
+        assert_eq!(
+            p.scan_end,
+            Some(ScanEnd::Cut {
+                at: 8 + 21,
+                claimed: Some(5000)
+            })
+        );
+        // Cut inside a record prefix, and inside the magic.
+        let p = find(&mut IoCursor::new(&f[..12]), 12);
+        assert_eq!(
+            p.scan_end,
+            Some(ScanEnd::Cut {
+                at: 8,
+                claimed: None
+            })
+        );
+        let p = find(&mut IoCursor::new(&f[..5]), 5);
+        assert!(p.magic_prefix && p.scan_end.is_none());
+    }
+
+    #[test]
+    fn index_entries_pointing_at_the_same_bytes_are_read_once() {
+        let (mut f, at) = file(10, false);
+        // Rebuild the summary with 1000 index entries for the same record, and a footer pointing at it.
+        let tail = f.len() - 8 - FOOTER_RECORD as usize;
+        f.truncate(tail);
+        let summary_start = f.len() as u64;
+        let m_len = metadata("coin-log", "k", "v").len() as u64;
+        for _ in 0..1000 {
+            let mut idx = at.to_le_bytes().to_vec();
+            idx.extend(m_len.to_le_bytes());
+            idx.extend(string("coin-log"));
+            f.extend(record(op::METADATA_INDEX, &idx));
+        }
+        let mut footer = summary_start.to_le_bytes().to_vec();
+        footer.extend([0u8; 12]);
+        f.extend(record(op::FOOTER, &footer));
+        f.extend(MAGIC);
+        let p = find(&mut IoCursor::new(&f), f.len() as u64);
+        assert!(p.indexed);
+        assert_eq!(p.metadata.len(), 1);
+    }
+
+    #[test]
+    fn an_index_entry_pointing_elsewhere_sends_the_search_to_the_scan() {
+        let (mut f, at) = file(64, true);
+        // Point the index entry at the chunk instead of the metadata record.
+        let tail = f.len() - 8 - FOOTER_RECORD as usize;
+        let entry = (tail - 9 - 8 - 8 - 4 - 8) + 9;
+        f[entry..entry + 8].copy_from_slice(&29u64.to_le_bytes());
+        let p = find(&mut IoCursor::new(&f), f.len() as u64);
+        assert!(!p.indexed);
+        assert_eq!(p.metadata.len(), 1);
+        assert_eq!(p.metadata[0].at, at);
+    }
+}

@@ -1,0 +1,193 @@
+//! What `verify` will be able to judge in a recording of a scene, predicted before anything is recorded:
+//! the required checks (`energy`, and `constraint` or `steady`; format.md: verify) that will not run, why,
+//! and what to change. `record` warns with these sentences, so that a user learns before a long run, not
+//! from a "cannot verify" afterwards.
+//!
+//! The prediction uses what the checks themselves use: the channels they need, and for `constraint` the
+//! rule that leaves out windows the sampling does not resolve ([`constraint::resolves`]), applied to the
+//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|), with the default residual tolerance the file's settings will give.
+//! The rates at t = 0 stand for the run's: a motion that speeds up later loses only its later windows,
+//! while one that cannot be resolved at the start is in practice not resolved anywhere (the steady and
+//! high-spin scenes keep their rates).
+
+use super::checks::constraint;
+use super::tolerances::{RunAccuracy, Tolerances};
+use crate::format::Channel;
+use crate::scene::Scene;
+use nalgebra::Vector3;
+
+/// Samples the constraint's finite difference needs in a row.
+const WINDOW: f64 = 9.0;
+
+/// One sentence per required check that will not be able to run on a recording of `scene`, saying why
+/// and what to change; empty when `verify` will be able to judge the recording.
+#[must_use]
+pub fn coverage(scene: &Scene) -> Vec<String> {
+    let mut out = Vec::new();
+    let energy = missing(scene, &[Channel::Omega, Channel::Angles]);
+    if !energy.is_empty() {
+        out.push(format!(
+            "`energy` will not run: it recomputes E from ω and θ, and {} not recorded; add channels {}",
+            are(&energy),
+            energy.join(", ")
+        ));
+    }
+    let steady = match (scene.unperturbed_steady(), energy.is_empty()) {
+        (Some(_), true) => return out,
+        (Some(_), false) => "it needs the channels omega and angles",
+        (None, _) => "the scene does not start on an unperturbed steady motion",
+    };
+    if let Some(why) = constraint_blocker(scene) {
+        out.push(format!(
+            "neither `constraint` nor `steady` will run, so the motion will not be verified: `steady` \
+             does not apply ({steady}), and `constraint` {why}"
+        ));
+    }
+    out
+}
+
+/// The channels of `needed` that `scene` does not record, by name.
+fn missing(scene: &Scene, needed: &[Channel]) -> Vec<&'static str> {
+    needed
+        .iter()
+        .filter(|c| !scene.records(**c))
+        .map(|c| c.name())
+        .collect()
+}
+
+fn are(names: &[&str]) -> String {
+    match names {
+        [one] => format!("{one} is"),
+        many => format!("{} are", many.join(" and ")),
+    }
+}
+
+/// Why the constraint check will not run on a recording of `scene`, if it will not.
+fn constraint_blocker(scene: &Scene) -> Option<String> {
+    let needed = missing(scene, &[Channel::Omega, Channel::Angles, Channel::Position]);
+    if !needed.is_empty() {
+        return Some(format!(
+            "needs the centre's positions with ω and θ, and {} not recorded; add channels {}",
+            are(&needed),
+            needed.join(", ")
+        ));
+    }
+    let run = &scene.run;
+    let samples = (run.duration * run.rate).floor() + 1.0;
+    if samples < WINDOW {
+        return Some(format!(
+            "needs {WINDOW} samples in a row and the run records {samples}; raise --rate or --duration"
+        ));
+    }
+    let s = &scene.initial;
+    let omega = Vector3::new(s.omega_x, s.omega_y, s.omega_z).norm();
+    let rate = omega.max((s.omega_y / s.theta.cos()).abs());
+    let tol = Tolerances::derive(
+        &RunAccuracy {
+            integrator: run.method.method,
+            rtol: run.method.rtol,
+            atol: run.method.atol,
+            step: run.method.step,
+            radius: scene.params.radius(),
+            time_unit: scene.params.time_unit(),
+            span: run.duration,
+            max_omega: omega,
+        },
+        None,
+        None,
+    )
+    .residual;
+    let h = run.sample_interval();
+    if constraint::resolves(h, rate, tol) {
+        return None;
+    }
+    Some(format!(
+        "will find no window the sampling resolves: at {} samples per time unit, h·Ω = {} (Ω = \
+         max(|ω|, |φ̇|) = {} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
+         tenth of the residual tolerance {tol:.1e}; raise --rate to at least {}",
+        run.rate,
+        round3(h * rate),
+        round3(rate),
+        constraint::truncation(h, rate),
+        round3_up(constraint::min_rate(rate, tol))
+    ))
+}
+
+/// `x` to 3 significant digits.
+fn round3(x: f64) -> f64 {
+    scaled(x, f64::round)
+}
+
+/// `x` rounded up to 3 significant digits (a rate that is enough).
+fn round3_up(x: f64) -> f64 {
+    scaled(x, f64::ceil)
+}
+
+fn scaled(x: f64, round: fn(f64) -> f64) -> f64 {
+    if !x.is_finite() || x == 0.0 {
+        return x;
+    }
+    let unit = 10f64.powf(x.abs().log10().floor() - 2.0);
+    round(x / unit) * unit
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::scene::{self, presets, FlagOverrides};
+
+    fn scene(name: &str, sets: &[&str]) -> Scene {
+        let sets: Vec<String> = sets.iter().map(ToString::to_string).collect();
+        let file = scene::file_with_sets(&presets::preset(name).unwrap(), &sets).unwrap();
+        scene::resolve(&file, &FlagOverrides::default()).unwrap()
+    }
+
+    #[test]
+    fn every_built_in_scene_as_given_can_be_verified() {
+        for name in presets::NAMES {
+            let s = scene(name, &[]);
+            assert_eq!(coverage(&s), Vec::<String>::new(), "{name}");
+        }
+    }
+
+    #[test]
+    fn missing_channels_are_named_with_the_fix() {
+        let s = scene("wobble", &["record.channels=[\"energy\"]"]);
+        assert_eq!(
+            coverage(&s),
+            [
+                "`energy` will not run: it recomputes E from ω and θ, and omega and angles are not \
+                 recorded; add channels omega, angles",
+                "neither `constraint` nor `steady` will run, so the motion will not be verified: \
+                 `steady` does not apply (the scene does not start on an unperturbed steady motion), and \
+                 `constraint` needs the centre's positions with ω and θ, and omega and angles and \
+                 position are not recorded; add channels omega, angles, position"
+            ]
+        );
+        // A steady scene is judged by `steady` without positions.
+        let s = scene("circle-plus", &["record.channels=[\"omega\", \"angles\"]"]);
+        assert_eq!(coverage(&s), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_rate_that_does_not_resolve_the_motion_is_named_with_the_rate_that_does() {
+        let s = scene("high-spin", &["run.rate=100"]);
+        let c = coverage(&s);
+        assert_eq!(c.len(), 1, "{c:?}");
+        assert!(
+            c[0].contains(
+                "at 100 samples per time unit, h·Ω = 0.5 (Ω = max(|ω|, |φ̇|) = 50 at t = 0)"
+            ),
+            "{}",
+            c[0]
+        );
+        let fix = c[0].rsplit("raise --rate to at least ").next().unwrap();
+        let fix: f64 = fix.parse().unwrap();
+        // The suggested rate is enough, and a rate 1% lower would not be.
+        let s = scene("high-spin", &[&format!("run.rate={fix}")]);
+        assert_eq!(coverage(&s), Vec::<String>::new());
+        let s = scene("high-spin", &[&format!("run.rate={}", fix * 0.99)]);
+        assert_eq!(coverage(&s).len(), 1);
+    }
+}
