@@ -65,9 +65,11 @@ fn every_rewrite_by_the_python_and_typescript_writers_verifies_like_the_original
     let (code, original, err) = verify_json(&r.original);
     assert_eq!(code, 0, "{original}{err}");
     for check in original["checks"].as_array().unwrap() {
+        // A steady circle does not nutate: that one check is skipped, by design, with its reason.
+        let expected = if check["id"] == "nutation" { "skip" } else { "pass" };
         assert_eq!(
-            check["status"], "pass",
-            "every check runs on the original: {check}"
+            check["status"], expected,
+            "every other check runs on the original: {check}"
         );
     }
     for layout in LAYOUTS {
