@@ -8,6 +8,7 @@
 
 mod support;
 
+mod added_fields;
 mod architecture;
 mod bench_precision;
 mod bench_stability;

@@ -11,8 +11,8 @@ use coin_log::format::messages::{
     ReactionMessage,
 };
 use coin_log::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
-    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
+    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
 use coin_log::model::{
@@ -38,8 +38,16 @@ pub const COIN_CHANNELS: [Channel; 8] = [
 ];
 
 /// The JSON of per-sample channel `c` (one of [`COIN_CHANNELS`]) at state `s`, time `t`, computed here from
-/// the model's functions and the message types, independently of the recorder.
-pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &State) -> Vec<u8> {
+/// the model's functions and the message types, independently of the recorder; `e0` is the energy at the
+/// first sample (E₀ of the energy's `change`).
+pub fn message_json(
+    coin: &Coin,
+    chaplygin: &Chaplygin,
+    c: Channel,
+    t: f64,
+    s: &State,
+    e0: f64,
+) -> Vec<u8> {
     let mut buf = Vec::new();
     match c {
         Channel::Omega => AngularVelocity {
@@ -54,6 +62,8 @@ pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &
             theta: s.theta,
             phi: s.phi,
             psi: s.psi,
+            // φ̇ = ω_Y / cos θ, physics eq (18).
+            phi_dot: Some(s.omega_y / s.theta.cos()),
         }
         .write_json(&mut buf),
         Channel::Quaternion => {
@@ -90,6 +100,12 @@ pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &
                 z: r.force.z,
                 friction: r.friction,
                 normal: r.normal,
+                // F / max(N, 1e-12 Mg), docs/format.md.
+                friction_ratio: Some(
+                    r.friction
+                        / r.normal
+                            .max(1e-12 * coin.params().mass() * coin.params().gravity()),
+                ),
             }
             .write_json(&mut buf)
         }
@@ -100,6 +116,7 @@ pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &
                 total: e.total,
                 kinetic: e.kinetic,
                 potential: e.potential,
+                change: Some(e.total - e0),
             }
             .write_json(&mut buf)
         }
@@ -123,14 +140,16 @@ pub fn tool_schema(name: &str) -> Vec<u8> {
     schema_bytes(name).unwrap().to_vec()
 }
 
-/// Registers channel `c` in `w` (JSON messages, no metadata) with schema bytes `schema_of(name)`, each schema
-/// once (`schemas` maps the names registered so far to their ids); returns the channel id.
+/// Registers topic `c` (a channel's main topic, or a Foxglove extra) in `w` (JSON messages, no metadata) with
+/// schema bytes `schema_of(name)`, each schema once (`schemas` maps the names registered so far to their ids);
+/// returns the channel id.
 pub fn add_channel<W: Write + Seek>(
     w: &mut mcap::Writer<W>,
     schemas: &mut BTreeMap<&'static str, u16>,
-    c: Channel,
+    c: impl Into<Topic>,
     schema_of: &dyn Fn(&str) -> Vec<u8>,
 ) -> u16 {
+    let c: Topic = c.into();
     let name = c.schema_name();
     let schema = match schemas.get(name) {
         Some(id) => *id,
@@ -142,7 +161,7 @@ pub fn add_channel<W: Write + Seek>(
             id
         }
     };
-    w.add_channel(schema, c.topic(), MESSAGE_ENCODING, &BTreeMap::new())
+    w.add_channel(schema, c.name(), MESSAGE_ENCODING, &BTreeMap::new())
         .unwrap()
 }
 
@@ -196,10 +215,14 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         .create(file)
         .unwrap();
     let mut schemas = BTreeMap::new();
-    let ids: BTreeMap<Channel, u16> = COIN_CHANNELS
+    let mut ids: BTreeMap<Topic, u16> = COIN_CHANNELS
         .into_iter()
-        .chain([Channel::Tf, Channel::Scene])
-        .map(|c| (c, add_channel(&mut w, &mut schemas, c, &tool_schema)))
+        .map(|c| {
+            (
+                Topic::Main(c),
+                add_channel(&mut w, &mut schemas, c, &tool_schema),
+            )
+        })
         .collect();
     w.write_metadata(&mcap::records::Metadata {
         name: "coin-log".into(),
@@ -217,6 +240,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
     };
     let events = CoinEvents::new(coin, 1e-4, None);
     let chaplygin = Chaplygin::new(coin.params()).unwrap();
+    let e0 = energy(&coin, &steady.state).total;
     let mut rk4 = Rk4::new(1e-3);
     simulate(
         &coin,
@@ -227,12 +251,15 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         |t, y| {
             let s = State::from_array(y);
             let lt = log_time(t).unwrap();
-            let mut write = |c: Channel, data: &[u8]| {
+            let mut write = |c: Topic, data: &[u8]| {
                 sequence += 1;
-                write_message(&mut w, ids[&c], sequence, lt, data);
+                let id = *ids
+                    .entry(c)
+                    .or_insert_with(|| add_channel(&mut w, &mut schemas, c, &tool_schema));
+                write_message(&mut w, id, sequence, lt, data);
             };
             for c in COIN_CHANNELS {
-                let mut buf = message_json(&coin, &chaplygin, c, t, &s);
+                let mut buf = message_json(&coin, &chaplygin, c, t, &s, e0);
                 if c == Channel::Energy
                     && damage == Damage::EnergyWithExtraField
                     && t > 0.5
@@ -242,13 +269,13 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
                     buf.extend_from_slice(b",\"power\":0}");
                     damaged = true;
                 }
-                write(c, &buf);
+                write(Topic::Main(c), &buf);
             }
             batch.clear();
             let last = (t - duration).abs() < 1e-9;
             fox.sample(t, lt, &s, last, &mut batch).unwrap();
             for (c, data) in batch.iter() {
-                if c == Channel::Scene
+                if c == Topic::Main(Channel::Scene)
                     && damage == Damage::SceneEntityWithoutMetadata
                     && t > 0.5
                     && !damaged
@@ -386,11 +413,12 @@ pub fn record(spec: &Spec, path: &Path) {
     };
     let events = CoinEvents::new(coin, 1e-4, None);
     let y0 = spec.initial.to_array();
+    let e0 = energy(&coin, &spec.initial).total;
     let outcome = run_method(&config, &coin, &y0, &settings, &events, |t, y| {
         let s = State::from_array(y);
         let lt = log_time(t).unwrap();
         for (c, id) in &ids {
-            let data = message_json(&coin, &chaplygin, *c, t, &s);
+            let data = message_json(&coin, &chaplygin, *c, t, &s, e0);
             write_message(&mut w, *id, sequence, lt, &data);
             sequence += 1;
         }
@@ -464,7 +492,7 @@ pub fn rewrite_with_schemas(
             add_channel(
                 &mut w,
                 &mut schemas,
-                Channel::from_topic(&topic).unwrap(),
+                Topic::from_name(&topic).unwrap(),
                 schema_of,
             )
         });
