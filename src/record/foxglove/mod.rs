@@ -1023,7 +1023,7 @@ mod tests {
         for cut_k in (7..=900).step_by(13) {
             let cut = log_time(f64::from(cut_k) * 0.01).unwrap();
             let mut lines = latest_track_lines(&messages, cut);
-            lines.sort_by(|a, b| b.0.cmp(&a.0));
+            lines.sort_by_key(|l| std::cmp::Reverse(l.0));
             let chain: Vec<[f64; 2]> = lines.iter().fold(Vec::new(), |mut acc, (level, l)| {
                 if let Some(last) = acc.last() {
                     assert_eq!(

@@ -382,7 +382,7 @@ mod tests {
         let end = top[top.len() - 1].x;
         println!("top level ends at x = {end}, expected {boundary}");
         assert!((end - boundary).abs() < QUANTUM);
-        assert_eq!(chain(&track).len() > top.len(), true);
+        assert!(chain(&track).len() > top.len());
     }
 
     #[test]
