@@ -38,6 +38,20 @@ pub fn friction_ratio(friction: f64, normal: f64, mass: f64, gravity: f64) -> f6
     friction / normal.max(FRICTION_RATIO_FLOOR * mass * gravity)
 }
 
+/// The energy drift E − E₀ relative to the drift scale max(|E₀|, M g a) (`model::drift`), in units of
+/// [`f64::EPSILON`]: the `drift_eps` field of `coin_log.Energy`. A plot's autoscaled axis shows it where
+/// E − E₀ itself (≈ 1e-12) is below the axis' resolution.
+///
+/// ```
+/// use coin_log::format::messages::drift_eps;
+/// assert_eq!(drift_eps(2.0 + 4.0 * f64::EPSILON, 2.0, 1.0), 2.0);
+/// assert_eq!(drift_eps(0.0, 0.0, 1.0), 0.0);
+/// ```
+#[must_use]
+pub fn drift_eps(total: f64, e0: f64, energy_scale: f64) -> f64 {
+    (total - e0) / (f64::EPSILON * e0.abs().max(energy_scale))
+}
+
 /// Appends the shortest round-trip decimal form of a finite `value` to `buf`.
 #[inline]
 pub fn push_number(buf: &mut Vec<u8>, value: f64, formatter: &mut ryu::Buffer) {
@@ -221,6 +235,9 @@ message!(
 } added {
     /// E − E₀, E₀ the total energy at the first sample of the file.
     change,
+    /// (E − E₀) / (ε max(|E₀|, Mga)), ε = [`f64::EPSILON`]: the relative drift in units of round-off
+    /// ([`drift_eps`]).
+    drift_eps,
 });
 
 message!(
@@ -246,6 +263,7 @@ mod tests {
             kinetic: -0.0,
             potential: 1e-300,
             change: Some(-2.5e-17),
+            drift_eps: Some(-3.0),
         };
         let mut buf = Vec::new();
         m.write_json(&mut buf).unwrap();
@@ -272,7 +290,7 @@ mod tests {
         assert!(serde_json::from_str::<EnergyMessage>(null).is_err());
         assert_eq!(
             EnergyMessage::FIELDS,
-            &["t", "total", "kinetic", "potential", "change"]
+            &["t", "total", "kinetic", "potential", "change", "drift_eps"]
         );
         assert_eq!(
             EnergyMessage::FIRST_FIELDS,

@@ -14,8 +14,8 @@
 use super::foxglove::{Foxglove3d, FoxgloveBatch};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
-    friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField,
-    Position, QuaternionMessage, ReactionMessage,
+    drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
+    NonFiniteField, Position, QuaternionMessage, ReactionMessage,
 };
 use crate::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError, Topic,
@@ -402,6 +402,7 @@ impl<W: Write + Seek> Sampler<W> {
                 kinetic: e.kinetic,
                 potential: e.potential,
                 change: Some(e.total - e0),
+                drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
             };
             self.stage(Channel::Energy, |b| m.write_json(b))?;
         }

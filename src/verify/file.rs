@@ -188,7 +188,7 @@ impl Judge {
             ),
             Slot::Energy => typed!(
                 Energy,
-                EnergyMessage { t, total, kinetic, potential } added { change }
+                EnergyMessage { t, total, kinetic, potential } added { change, drift_eps }
             ),
             Slot::Invariants => typed!(Invariants, InvariantsMessage { t, c1, c2 }),
         })
@@ -681,7 +681,7 @@ mod tests {
                 Slot::Omega | Slot::Position => &["t", "x", "y", "z"],
                 Slot::Angles => &["t", "theta", "phi", "psi", "phi_dot"],
                 Slot::Quaternion => &["t", "x", "y", "z", "w"],
-                Slot::Energy => &["t", "total", "kinetic", "potential", "change"],
+                Slot::Energy => &["t", "total", "kinetic", "potential", "change", "drift_eps"],
                 _ => &["t", "c1", "c2"],
             };
             assert_eq!(fields, fields_fast, "{slot:?}");

@@ -41,7 +41,7 @@ fn a_file_written_before_the_added_fields_still_verifies() {
     for (schema, field) in [
         ("coin_log.Angles", "phi_dot"),
         ("coin_log.Reaction", "friction_ratio"),
-        ("coin_log.Energy", "change"),
+        ("coin_log.Energy", "change, drift_eps"),
     ] {
         let note = format!(
             "schema `{schema}` is the first version of the type, without the fields added since ({field})"
@@ -60,6 +60,7 @@ fn the_added_fields_are_recorded_with_their_formulas() {
         .as_f64()
         .unwrap();
     let mut worst: f64 = 0.0;
+    let mut worst_drift: f64 = 0.0;
     for ((e, a), (w, r)) in on("/coin/energy")
         .zip(on("/coin/angles"))
         .zip(on("/coin/omega").zip(on("/coin/reaction")))
@@ -70,13 +71,21 @@ fn the_added_fields_are_recorded_with_their_formulas() {
         let phi_dot = f(w, "y") / f(a, "theta").cos();
         let ratio = f(r, "friction") / f(r, "normal").max(1e-12);
         let change = f(e, "total") - e0;
+        // E₀ ≈ 2.6 > Mga = 1 for the wobble: the drift scale is |E₀|.
+        let drift = change / (f64::EPSILON * e0.abs());
         worst = worst
             .max((f(a, "phi_dot") - phi_dot).abs() / phi_dot.abs().max(1.0))
             .max((f(r, "friction_ratio") - ratio).abs() / ratio.abs().max(1.0))
             .max((f(e, "change") - change).abs() / e0.abs());
+        worst_drift = worst_drift.max((f(e, "drift_eps") - drift).abs());
     }
     println!("added fields vs their formulas: worst {worst:e} (tolerance 1e-15)");
     assert!(worst <= 1e-15);
+    // drift_eps is in units of ε|E₀|: the JSON parsing of this test may be an ulp off on E and E₀ (serde_json
+    // without float_roundtrip), which is up to ≈ 2 units; a wrong formula (no ε, another scale) is off by
+    // orders of magnitude.
+    println!("drift_eps vs (E − E₀)/(ε|E₀|): worst {worst_drift:e} units of ε (tolerance 4)");
+    assert!(worst_drift <= 4.0);
 }
 
 /// `wobble` recorded by `coin-log record` (2 time units), with `edit` applied, verified.
@@ -97,6 +106,8 @@ fn a_stored_added_field_that_disagrees_fails_consistency() {
         ("/coin/angles", "phi_dot", 1e-9, 1.0),
         ("/coin/reaction", "friction_ratio", 1e-9, 1.0),
         ("/coin/energy", "change", 1e-9, 2.6),
+        // drift_eps at t = 1 is ≈ −782 (E − E₀ ≈ −4.6e-13): a nudge of 1e-3 ε.
+        ("/coin/energy", "drift_eps", 1e-3, 782.0),
     ] {
         let r = tampered(|e| {
             if e.topic == topic && e.index == 100 {
@@ -106,7 +117,7 @@ fn a_stored_added_field_that_disagrees_fails_consistency() {
         let c = r.check(CheckId::Consistency).unwrap();
         let value = c.value.unwrap();
         // The nudge relative to the field's scale (max(|φ̇|, √(g/a)) ≈ 1; max(ratio, 1) = 1; max(|E₀|, Mga)
-        // ≈ 2.6): between a third of it and the nudge itself (1 % for the round-off of the nudge).
+        // ≈ 2.6; max(|drift_eps|, 1) ≈ 782): between a third of it and the nudge itself (1 % for the round-off of the nudge).
         println!("{field}: consistency {value:e} (nudge {delta:e}, scale {scale})");
         assert_eq!(c.status, Status::Fail, "{field}\n{}", show(&r));
         assert!(

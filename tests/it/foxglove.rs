@@ -318,7 +318,7 @@ fn track_chain(latest: &BTreeMap<&str, &Message>) -> Result<Vec<[f64; 2]>, Strin
                 .collect(),
         ));
     }
-    levels.sort_by(|a, b| b.0.cmp(&a.0));
+    levels.sort_by_key(|l| std::cmp::Reverse(l.0));
     let mut chain: Vec<[f64; 2]> = Vec::new();
     for (level, points) in levels {
         match chain.last() {
@@ -609,7 +609,7 @@ fn every_plotted_path_is_a_numeric_field_of_a_recorded_topic() {
         "/coin/omega.z",
         "/coin/angles.theta",
         "/coin/angles.phi_dot",
-        "/coin/energy.change",
+        "/coin/energy.drift_eps",
         "/coin/reaction.normal",
         "/coin/reaction.friction_ratio",
         "/coin/invariants.c1",

@@ -365,10 +365,12 @@ fn every_coin_log_message_validates_against_its_schema_file() {
 fn a_message_with_a_missing_or_an_extra_field_fails_validation() {
     let schema: serde_json::Value =
         serde_json::from_slice(&schema_file("coin_log.Energy")).unwrap();
-    let good = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"change":0.0}"#;
-    let missing = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"change":0.0}"#;
-    let extra = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"change":0.0,"spin":2}"#;
-    let string = br#"{"t":0.5,"total":"1","kinetic":0.25,"potential":0.75,"change":0.0}"#;
+    let good =
+        br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"change":0.0,"drift_eps":0.0}"#;
+    let missing = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"change":0.0,"drift_eps":0.0}"#;
+    let extra = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"change":0.0,"drift_eps":0.0,"spin":2}"#;
+    let string =
+        br#"{"t":0.5,"total":"1","kinetic":0.25,"potential":0.75,"change":0.0,"drift_eps":0.0}"#;
     println!("good: {:?}", validate_flat(&schema, good));
     println!("missing: {:?}", validate_flat(&schema, missing));
     println!("extra: {:?}", validate_flat(&schema, extra));

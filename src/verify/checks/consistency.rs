@@ -4,10 +4,11 @@
 //! a cos θ; the stored reaction equals R recomputed from the stored state (physics §3), with F = √(R_x² + R_z²)
 //! and N = R_y. The fields added since the format's first version, when stored: φ̇ against ω_Y / cos θ (eq 18),
 //! the friction ratio against F / max(N, 1e-12 Mg), the energy change against E − E₀ (E₀ the first stored
-//! total). Each is a recomputation from stored numbers, held to the recomputation tolerance.
+//! total), the drift in units of ε against (E − E₀)/(ε max(|E₀|, Mga)). Each is a recomputation from
+//! stored numbers, held to the recomputation tolerance.
 
 use super::{fmt_num, worst, Context, Max};
-use crate::format::messages::friction_ratio;
+use crate::format::messages::{drift_eps, friction_ratio};
 use crate::model::{orientation, reaction};
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
@@ -23,15 +24,15 @@ pub struct ConsistencyCheck {
     height: Max,
     reaction: Max,
     counts: [u64; 4],
-    /// The fields added since the first version: φ̇, friction ratio, energy change.
-    added: [Max; 3],
-    added_counts: [u64; 3],
+    /// The fields added since the first version: φ̇, friction ratio, energy change, drift in units of ε.
+    added: [Max; 4],
+    added_counts: [u64; 4],
     /// The first stored total energy (E₀ of `change`).
     energy0: Option<f64>,
 }
 
 /// Labels of the added-field measures.
-const ADDED: [&str; 3] = ["phi_dot", "friction_ratio", "energy change"];
+const ADDED: [&str; 4] = ["phi_dot", "friction_ratio", "energy change", "drift_eps"];
 
 impl ConsistencyCheck {
     /// Accounts for one sample.
@@ -112,6 +113,12 @@ impl ConsistencyCheck {
                 let scale = e0.abs().max(p.mass() * p.gravity() * p.radius());
                 self.added[2].offer((change - (e.total - e0)).abs() / scale, s.t);
                 self.added_counts[2] += 1;
+            }
+            if let Some(d) = e.drift_eps {
+                // Scale: the drift itself in units of ε, or 1 (one ε of relative drift).
+                let expected = drift_eps(e.total, e0, p.energy_scale());
+                self.added[3].offer((d - expected).abs() / expected.abs().max(1.0), s.t);
+                self.added_counts[3] += 1;
             }
         }
     }

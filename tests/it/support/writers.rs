@@ -117,6 +117,10 @@ pub fn message_json(
                 kinetic: e.kinetic,
                 potential: e.potential,
                 change: Some(e.total - e0),
+                // (E − E₀)/(ε max(|E₀|, Mga)), written out here rather than taken from the library.
+                drift_eps: Some(
+                    (e.total - e0) / (f64::EPSILON * e0.abs().max(coin.params().energy_scale())),
+                ),
             }
             .write_json(&mut buf)
         }
