@@ -148,10 +148,132 @@ impl Channel {
         Self::ALL.map(Self::name).join(", ")
     }
 
-    /// The channel with this topic.
+    /// The channel a topic belongs to: its main topic, or one of the extra Foxglove topics ([`Topic`]).
     #[must_use]
     pub fn from_topic(topic: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|c| c.topic() == topic)
+        Topic::from_name(topic).map(Topic::channel)
+    }
+}
+
+/// Track levels of the `scene` channel: topics `/scene/track/0` … `/scene/track/15` (docs/format.md: Frames
+/// and Foxglove output).
+pub const TRACK_LEVELS: usize = 16;
+
+/// The track topics, level by level.
+const TRACK_TOPICS: [&str; TRACK_LEVELS] = [
+    "/scene/track/0",
+    "/scene/track/1",
+    "/scene/track/2",
+    "/scene/track/3",
+    "/scene/track/4",
+    "/scene/track/5",
+    "/scene/track/6",
+    "/scene/track/7",
+    "/scene/track/8",
+    "/scene/track/9",
+    "/scene/track/10",
+    "/scene/track/11",
+    "/scene/track/12",
+    "/scene/track/13",
+    "/scene/track/14",
+    "/scene/track/15",
+];
+
+/// An MCAP topic of the format. Every channel writes its main topic ([`Channel::topic`]); the two Foxglove
+/// channels write more, so that a viewer that restores only the latest message of each topic after a seek
+/// still has every frame and the whole track: `tf` also writes `/tf_static`, and `scene` writes
+/// `/scene/follow`, `/scene/table` and the track levels `/scene/track/<level>`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Topic {
+    /// The channel's main topic.
+    Main(Channel),
+    /// `/tf_static` (`tf`): world → table, once.
+    TfStatic,
+    /// `/scene/follow` (`scene`): world → coin_level, the level frame at the coin's centre.
+    SceneFollow,
+    /// `/scene/table` (`scene`): the table under the coin.
+    SceneTable,
+    /// `/scene/track/<level>` (`scene`): one level of the contact track, level < [`TRACK_LEVELS`].
+    SceneTrack(u8),
+}
+
+impl Topic {
+    /// Number of topics: every channel's main topic, then the Foxglove extras.
+    pub const COUNT: usize = Channel::ALL.len() + 3 + TRACK_LEVELS;
+
+    /// Every topic, main topics first in the channel table's order.
+    pub fn all() -> impl Iterator<Item = Topic> {
+        let extras = [Self::TfStatic, Self::SceneFollow, Self::SceneTable];
+        // TRACK_LEVELS (16) fits in a u8.
+        let levels = (0..TRACK_LEVELS).map(|l| Self::SceneTrack(u8::try_from(l).unwrap_or(0)));
+        Channel::ALL
+            .into_iter()
+            .map(Self::Main)
+            .chain(extras)
+            .chain(levels)
+    }
+
+    /// A dense index in 0..[`Self::COUNT`].
+    #[must_use]
+    pub fn index(self) -> usize {
+        let n = Channel::ALL.len();
+        match self {
+            Self::Main(c) => c as usize,
+            Self::TfStatic => n,
+            Self::SceneFollow => n + 1,
+            Self::SceneTable => n + 2,
+            Self::SceneTrack(l) => n + 3 + usize::from(l).min(TRACK_LEVELS - 1),
+        }
+    }
+
+    /// The channel (recorded or not as a whole) the topic belongs to.
+    #[must_use]
+    pub fn channel(self) -> Channel {
+        match self {
+            Self::Main(c) => c,
+            Self::TfStatic => Channel::Tf,
+            Self::SceneFollow | Self::SceneTable | Self::SceneTrack(_) => Channel::Scene,
+        }
+    }
+
+    /// The MCAP topic name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Main(c) => c.topic(),
+            Self::TfStatic => "/tf_static",
+            Self::SceneFollow => "/scene/follow",
+            Self::SceneTable => "/scene/table",
+            Self::SceneTrack(l) => TRACK_TOPICS[usize::from(l).min(TRACK_LEVELS - 1)],
+        }
+    }
+
+    /// Schema name.
+    #[must_use]
+    pub fn schema_name(self) -> &'static str {
+        match self {
+            Self::Main(c) => c.schema_name(),
+            Self::TfStatic | Self::SceneFollow => Channel::Tf.schema_name(),
+            Self::SceneTable | Self::SceneTrack(_) => Channel::Scene.schema_name(),
+        }
+    }
+
+    /// The topic with this name.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::all().find(|t| t.name() == name)
+    }
+}
+
+impl From<Channel> for Topic {
+    fn from(channel: Channel) -> Self {
+        Self::Main(channel)
+    }
+}
+
+impl fmt::Display for Topic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -191,5 +313,26 @@ impl FromStr for Channel {
             .into_iter()
             .find(|c| c.name() == s)
             .ok_or_else(|| UnknownChannel(s.to_string()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn topics_have_distinct_names_and_dense_indexes() {
+        let all: Vec<Topic> = Topic::all().collect();
+        assert_eq!(all.len(), Topic::COUNT);
+        for (i, t) in all.iter().enumerate() {
+            assert_eq!(t.index(), i, "{t}");
+            assert_eq!(Topic::from_name(t.name()), Some(*t));
+            assert!(schema_bytes(t.schema_name()).is_some(), "{t}");
+        }
+        let names: std::collections::BTreeSet<&str> = all.iter().map(|t| t.name()).collect();
+        assert_eq!(names.len(), all.len());
+        assert_eq!(Channel::from_topic("/scene/track/15"), Some(Channel::Scene));
+        assert_eq!(Channel::from_topic("/tf_static"), Some(Channel::Tf));
+        assert_eq!(Channel::from_topic("/scene/track/16"), None);
     }
 }

@@ -21,28 +21,77 @@ pub struct NonFiniteField {
     pub value: f64,
 }
 
+/// The floor of N in the friction ratio, a fraction of Mg: the ratio is F / max(N, floor · Mg), finite even at
+/// the sample where N reaches 0 (a `lift-off` event), where the demand for friction grows without bound.
+pub const FRICTION_RATIO_FLOOR: f64 = 1e-12;
+
+/// The friction ratio F / max(N, [`FRICTION_RATIO_FLOOR`] · M g) of `coin_log.Reaction`: the friction
+/// coefficient needed to roll without slipping.
+///
+/// ```
+/// use coin_log::format::messages::friction_ratio;
+/// assert_eq!(friction_ratio(0.5, 2.0, 1.0, 1.0), 0.25);
+/// assert_eq!(friction_ratio(0.5, 0.0, 1.0, 1.0), 0.5e12);
+/// ```
+#[must_use]
+pub fn friction_ratio(friction: f64, normal: f64, mass: f64, gravity: f64) -> f64 {
+    friction / normal.max(FRICTION_RATIO_FLOOR * mass * gravity)
+}
+
+/// The energy drift E − E₀ relative to the drift scale max(|E₀|, M g a) (`model::drift`), in units of
+/// [`f64::EPSILON`]: the `drift_eps` field of `coin_log.Energy`. A plot's autoscaled axis shows it where
+/// E − E₀ itself (≈ 1e-12) is below the axis' resolution.
+///
+/// ```
+/// use coin_log::format::messages::drift_eps;
+/// assert_eq!(drift_eps(2.0 + 4.0 * f64::EPSILON, 2.0, 1.0), 2.0);
+/// assert_eq!(drift_eps(0.0, 0.0, 1.0), 0.0);
+/// ```
+#[must_use]
+pub fn drift_eps(total: f64, e0: f64, energy_scale: f64) -> f64 {
+    (total - e0) / (f64::EPSILON * e0.abs().max(energy_scale))
+}
+
 /// Appends the shortest round-trip decimal form of a finite `value` to `buf`.
 #[inline]
 pub fn push_number(buf: &mut Vec<u8>, value: f64, formatter: &mut ryu::Buffer) {
     buf.extend_from_slice(formatter.format_finite(value).as_bytes());
 }
 
+/// Reads a field added in a later version of a schema: a number, never `null` (a missing field gives `None`
+/// through `#[serde(default)]`).
+fn added_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    f64::deserialize(d).map(Some)
+}
+
+/// Defines a message type. Fields listed under `added` came with a later version of the schema (docs/format.md
+/// says which): they are `Option<f64>`, `None` in messages of files written before them, and the recorder
+/// always writes them.
 macro_rules! message {
-    ($(#[$doc:meta])* $name:ident, $schema:literal, { $($(#[$fdoc:meta])* $field:ident),+ $(,)? }) => {
+    ($(#[$doc:meta])* $name:ident, $schema:literal, { $($(#[$fdoc:meta])* $field:ident),+ $(,)? }
+     $(added { $($(#[$adoc:meta])* $added:ident),+ $(,)? })?) => {
         $(#[$doc])*
         #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
         #[serde(deny_unknown_fields)]
         pub struct $name {
             $($(#[$fdoc])* pub $field: f64,)+
+            $($(
+                $(#[$adoc])*
+                #[serde(default, deserialize_with = "added_number")]
+                pub $added: Option<f64>,
+            )+)?
         }
 
         impl $name {
             /// Schema name of this message type.
             pub const SCHEMA: &'static str = $schema;
-            /// Field names in schema order.
-            pub const FIELDS: &'static [&'static str] = &[$(stringify!($field)),+];
+            /// Field names in schema order (the current schema).
+            pub const FIELDS: &'static [&'static str] = &[$(stringify!($field)),+ $($(, stringify!($added))+)?];
+            /// Field names of the schema's first version (before any `added` field).
+            pub const FIRST_FIELDS: &'static [&'static str] = &[$(stringify!($field)),+];
 
-            /// Appends this message as one compact JSON object to `buf`.
+            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an added
+            /// field only when it is `Some`.
             ///
             /// # Errors
             /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
@@ -52,6 +101,11 @@ macro_rules! message {
                         return Err(NonFiniteField { schema: $schema, field: stringify!($field), value: self.$field });
                     }
                 )+
+                $($(
+                    if let Some(v) = self.$added.filter(|v| !v.is_finite()) {
+                        return Err(NonFiniteField { schema: $schema, field: stringify!($added), value: v });
+                    }
+                )+)?
                 let mut formatter = ryu::Buffer::new();
                 let mut first = true;
                 buf.push(b'{');
@@ -64,8 +118,21 @@ macro_rules! message {
                     push_number(buf, self.$field, &mut formatter);
                 )+
                 let _ = first;
+                $($(
+                    if let Some(v) = self.$added {
+                        buf.extend_from_slice(concat!(",\"", stringify!($added), "\":").as_bytes());
+                        push_number(buf, v, &mut formatter);
+                    }
+                )+)?
                 buf.push(b'}');
                 Ok(())
+            }
+
+            /// Whether every field of the current schema is present (false for a message of a file written
+            /// before an `added` field).
+            #[must_use]
+            pub fn is_complete(&self) -> bool {
+                true $($(&& self.$added.is_some())+)?
             }
 
             /// Simulation time of the message.
@@ -101,6 +168,9 @@ message!(
     phi,
     /// ψ, spin.
     psi,
+} added {
+    /// φ̇ = ω_Y / cos θ (physics eq 18), the heading rate [rad/time].
+    phi_dot,
 });
 
 message!(
@@ -146,6 +216,9 @@ message!(
     friction,
     /// N = R_y.
     normal,
+} added {
+    /// F / max(N, 1e-12 Mg): the friction coefficient needed to roll without slipping.
+    friction_ratio,
 });
 
 message!(
@@ -159,6 +232,12 @@ message!(
     kinetic,
     /// Potential energy.
     potential,
+} added {
+    /// E − E₀, E₀ the total energy at the first sample of the file.
+    change,
+    /// (E − E₀) / (ε max(|E₀|, Mga)), ε = [`f64::EPSILON`]: the relative drift in units of round-off
+    /// ([`drift_eps`]).
+    drift_eps,
 });
 
 message!(
@@ -194,12 +273,56 @@ mod tests {
             total: 1.0 / 3.0,
             kinetic: -0.0,
             potential: 1e-300,
+            change: Some(-2.5e-17),
+            drift_eps: Some(-3.0),
         };
         let mut buf = Vec::new();
         m.write_json(&mut buf).unwrap();
         let back: EnergyMessage = serde_json::from_slice(&buf).unwrap();
         assert_eq!(format!("{back:?}"), format!("{m:?}"));
         assert_eq!(back.total.to_bits(), m.total.to_bits());
+        assert_eq!(back.change.map(f64::to_bits), m.change.map(f64::to_bits));
+    }
+
+    #[test]
+    fn a_message_of_the_first_version_parses_without_its_added_fields_and_writes_back_the_same() {
+        let old = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1}"#;
+        let m: EnergyMessage = serde_json::from_str(old).unwrap();
+        assert_eq!(m.change, None);
+        assert!(!m.is_complete());
+        let mut buf = Vec::new();
+        m.write_json(&mut buf).unwrap();
+        assert_eq!(
+            String::from_utf8(buf).unwrap(),
+            r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1.0}"#
+        );
+        // An added field is a number: `null` is refused, not read as absent.
+        let null = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1,"change":null}"#;
+        assert!(serde_json::from_str::<EnergyMessage>(null).is_err());
+        assert_eq!(
+            EnergyMessage::FIELDS,
+            &["t", "total", "kinetic", "potential", "change", "drift_eps"]
+        );
+        assert_eq!(
+            EnergyMessage::FIRST_FIELDS,
+            &["t", "total", "kinetic", "potential"]
+        );
+    }
+
+    #[test]
+    fn a_non_finite_added_field_is_refused() {
+        let m = ReactionMessage {
+            t: 0.0,
+            x: 0.0,
+            y: 1.0,
+            z: 0.0,
+            friction: 0.0,
+            normal: 1.0,
+            friction_ratio: Some(f64::INFINITY),
+        };
+        let mut buf = Vec::new();
+        assert_eq!(m.write_json(&mut buf).unwrap_err().field, "friction_ratio");
+        assert!(buf.is_empty());
     }
 
     #[test]

@@ -18,7 +18,9 @@ mod termination;
 mod time;
 pub mod tolerances;
 
-pub use channels::{schema_bytes, Channel, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING};
+pub use channels::{
+    schema_bytes, Channel, Topic, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING, TRACK_LEVELS,
+};
 pub use metadata::{
     MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,

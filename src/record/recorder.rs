@@ -14,12 +14,12 @@
 use super::foxglove::{Foxglove3d, FoxgloveBatch};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
-    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, NonFiniteField, Position,
-    QuaternionMessage, ReactionMessage, WorkMessage,
+    drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
+    NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError,
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError, Topic,
     FORMAT_VERSION, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use crate::integrate::{self, Flow, RunOutcome, RunSettings};
@@ -182,21 +182,22 @@ impl From<TimeError> for SampleError {
     }
 }
 
-/// The writer with its channels: registers a channel at its first message, numbers messages per channel.
+/// The writer with its topics: registers a topic's MCAP channel at its first message, numbers messages per
+/// topic.
 struct Output<W: Write + Seek> {
     writer: McapWriter<W>,
-    ids: [Option<u16>; Channel::ALL.len()],
-    sequence: [u32; Channel::ALL.len()],
+    ids: [Option<u16>; Topic::COUNT],
+    sequence: [u32; Topic::COUNT],
     messages: u64,
 }
 
 impl<W: Write + Seek> Output<W> {
     #[inline]
-    fn write(&mut self, channel: Channel, log_time: u64, data: &[u8]) -> Result<(), SampleError> {
-        let index = channel as usize;
+    fn write(&mut self, topic: Topic, log_time: u64, data: &[u8]) -> Result<(), SampleError> {
+        let index = topic.index();
         let channel_id = match self.ids[index] {
             Some(id) => id,
-            None => self.register(channel)?,
+            None => self.register(topic)?,
         };
         let sequence = self.sequence[index];
         self.sequence[index] = sequence.wrapping_add(1);
@@ -207,18 +208,15 @@ impl<W: Write + Seek> Output<W> {
     }
 
     #[cold]
-    fn register(&mut self, channel: Channel) -> Result<u16, WriteError> {
-        let schema_name = channel.schema_name();
-        // Every channel's schema is one of the embedded files (a test checks it).
+    fn register(&mut self, topic: Topic) -> Result<u16, WriteError> {
+        let schema_name = topic.schema_name();
+        // Every topic's schema is one of the embedded files (a test checks it).
         let data = schema_bytes(schema_name).unwrap_or_default();
         let schema_id = self.writer.add_schema(schema_name, SCHEMA_ENCODING, data)?;
-        let id = self.writer.add_channel(
-            schema_id,
-            channel.topic(),
-            MESSAGE_ENCODING,
-            &BTreeMap::new(),
-        )?;
-        self.ids[channel as usize] = Some(id);
+        let id =
+            self.writer
+                .add_channel(schema_id, topic.name(), MESSAGE_ENCODING, &BTreeMap::new())?;
+        self.ids[topic.index()] = Some(id);
         Ok(id)
     }
 }
@@ -281,6 +279,8 @@ struct Sampler<W: Write + Seek> {
     /// C1, C2, only when the `invariants` channel is recorded.
     chaplygin: Option<Chaplygin>,
     drift: Drift,
+    /// E at the first sample (E₀ of the energy's `change`).
+    energy0: Option<f64>,
     /// Samples written.
     samples: u64,
 }
@@ -329,11 +329,12 @@ impl<W: Write + Seek> Sampler<W> {
             foxglove.sample(t, ns, &s, last, batch)?;
         }
         for &(channel, start, end) in &self.staged[..self.staged_len] {
-            self.out.write(channel, ns, &self.buffer[start..end])?;
+            self.out
+                .write(Topic::Main(channel), ns, &self.buffer[start..end])?;
         }
         if let Some((_, batch)) = &self.foxglove {
-            for (channel, data) in batch.iter() {
-                self.out.write(channel, ns, data)?;
+            for (topic, data) in batch.iter() {
+                self.out.write(topic, ns, data)?;
             }
         }
         self.track(t, &s, total, invariants);
@@ -377,6 +378,7 @@ impl<W: Write + Seek> Sampler<W> {
                 theta: s.theta,
                 phi: s.phi,
                 psi: s.psi,
+                phi_dot: Some(s.omega_y / s.theta.cos()),
             };
             self.stage(Channel::Angles, |b| m.write_json(b))?;
         }
@@ -425,6 +427,7 @@ impl<W: Write + Seek> Sampler<W> {
         let coin = self.coin;
         if self.on(Channel::Reaction) {
             let r = self.dynamics.reaction(s);
+            let p = coin.params();
             let m = ReactionMessage {
                 t,
                 x: r.force.x,
@@ -432,17 +435,21 @@ impl<W: Write + Seek> Sampler<W> {
                 z: r.force.z,
                 friction: r.friction,
                 normal: r.normal,
+                friction_ratio: Some(friction_ratio(r.friction, r.normal, p.mass(), p.gravity())),
             };
             self.stage(Channel::Reaction, |b| m.write_json(b))?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
         let e = energy(&coin, s);
+        let e0 = *self.energy0.get_or_insert(e.total);
         if self.on(Channel::Energy) {
             let m = EnergyMessage {
                 t,
                 total: e.total,
                 kinetic: e.kinetic,
                 potential: e.potential,
+                change: Some(e.total - e0),
+                drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
             };
             self.stage(Channel::Energy, |b| m.write_json(b))?;
         }
@@ -629,8 +636,8 @@ impl<W: Write + Seek> Sampler<W> {
         Ok(Self {
             out: Output {
                 writer,
-                ids: [None; Channel::ALL.len()],
-                sequence: [0; Channel::ALL.len()],
+                ids: [None; Topic::COUNT],
+                sequence: [0; Topic::COUNT],
                 messages: 0,
             },
             coin,
@@ -641,6 +648,7 @@ impl<W: Write + Seek> Sampler<W> {
             staged_len: 0,
             foxglove,
             chaplygin,
+            energy0: None,
             samples: 0,
             drift: Drift::new(scene, &coin),
         })

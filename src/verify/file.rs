@@ -16,13 +16,13 @@ use crate::format::messages::{
     ReactionMessage, WorkMessage,
 };
 use crate::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
-    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
+    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use crate::mcap_io::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
 
@@ -39,6 +39,8 @@ struct ChannelState {
     kind: Kind,
     topic: String,
     last: Option<u64>,
+    /// The channel's schema is the first version of its type (messages without the fields added since).
+    first_version: bool,
 }
 
 /// The physics checks' running state.
@@ -78,17 +80,20 @@ fn invariants_of(ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> 
     }
 }
 
-/// Schema names of the `coin_log.*` types and their fields, for schemas of another version.
-fn fields_of(schema: &str) -> Option<&'static [&'static str]> {
+/// Schema names of the `coin_log.*` types and their fields (current version, first version), for schemas of
+/// another version.
+type Fields = (&'static [&'static str], &'static [&'static str]);
+
+fn fields_of(schema: &str) -> Option<Fields> {
     Some(match schema {
-        AngularVelocity::SCHEMA => AngularVelocity::FIELDS,
-        Angles::SCHEMA => Angles::FIELDS,
-        QuaternionMessage::SCHEMA => QuaternionMessage::FIELDS,
-        Position::SCHEMA => Position::FIELDS,
-        ReactionMessage::SCHEMA => ReactionMessage::FIELDS,
-        EnergyMessage::SCHEMA => EnergyMessage::FIELDS,
-        InvariantsMessage::SCHEMA => InvariantsMessage::FIELDS,
-        WorkMessage::SCHEMA => WorkMessage::FIELDS,
+        AngularVelocity::SCHEMA => (AngularVelocity::FIELDS, AngularVelocity::FIRST_FIELDS),
+        Angles::SCHEMA => (Angles::FIELDS, Angles::FIRST_FIELDS),
+        QuaternionMessage::SCHEMA => (QuaternionMessage::FIELDS, QuaternionMessage::FIRST_FIELDS),
+        Position::SCHEMA => (Position::FIELDS, Position::FIRST_FIELDS),
+        ReactionMessage::SCHEMA => (ReactionMessage::FIELDS, ReactionMessage::FIRST_FIELDS),
+        EnergyMessage::SCHEMA => (EnergyMessage::FIELDS, EnergyMessage::FIRST_FIELDS),
+        InvariantsMessage::SCHEMA => (InvariantsMessage::FIELDS, InvariantsMessage::FIRST_FIELDS),
+        WorkMessage::SCHEMA => (WorkMessage::FIELDS, WorkMessage::FIRST_FIELDS),
         _ => return None,
     })
 }
@@ -135,6 +140,8 @@ fn validates(data: &[u8], fields: &[&str]) -> Result<(), String> {
 struct Judge {
     channels: Vec<Option<ChannelState>>,
     schemas: BTreeMap<u16, String>,
+    /// Ids of schemas that are the first version of a `coin_log.*` type.
+    first_versions: BTreeSet<u16>,
     ctx: Option<Context>,
     /// The `coin-log.result` record, kept until the end (it may come before or after `coin-log`).
     result: Option<ResultMetadata>,
@@ -149,43 +156,44 @@ struct Judge {
 
 impl Judge {
     /// Parses a `coin_log.*` message strictly: the recorder's own form on the fast path ([`json`]), any
-    /// other form (or an error) by serde_json.
-    fn parse(slot: Slot, data: &[u8]) -> Result<(f64, Value), serde_json::Error> {
-        /// `$ty { fields in schema order }` read by the fast path, else by serde.
+    /// other form (or an error) by serde_json. `first` says the file's schema is the type's first version
+    /// (without the fields added since); the returned flag says whether the message has every field of the
+    /// current version.
+    fn parse(
+        slot: Slot,
+        data: &[u8],
+        first: bool,
+    ) -> Result<(f64, Value, bool), serde_json::Error> {
+        /// `$ty { fields in schema order } added { later fields }` read by the fast path, else by serde.
         macro_rules! typed {
-            ($variant:ident, $ty:ident { $($f:ident),+ }) => {{
-                let m: $ty = match json::parse_numbers(data, &[$(stringify!($f)),+]) {
-                    Some([$($f),+]) => $ty { $($f),+ },
+            ($variant:ident, $ty:ident { $($f:ident),+ } $(added { $($g:ident),+ })?) => {{
+                let fast = if first {
+                    json::parse_numbers(data, &[$(stringify!($f)),+])
+                        .map(|[$($f),+]| $ty { $($f,)+ $($($g: None,)+)? })
+                } else {
+                    json::parse_numbers(data, &[$(stringify!($f)),+ $($(, stringify!($g))+)?])
+                        .map(|[$($f),+ $($(, $g)+)?]| $ty { $($f,)+ $($($g: Some($g),)+)? })
+                };
+                let m: $ty = match fast {
+                    Some(m) => m,
                     None => serde_json::from_slice(data)?,
                 };
-                (m.t, Value::$variant(m))
+                (m.t, Value::$variant(m), m.is_complete())
             }};
         }
         Ok(match slot {
             Slot::Omega => typed!(Omega, AngularVelocity { t, x, y, z }),
-            Slot::Angles => typed!(Angles, Angles { t, theta, phi, psi }),
+            Slot::Angles => typed!(Angles, Angles { t, theta, phi, psi } added { phi_dot }),
             Slot::Quaternion => typed!(Quaternion, QuaternionMessage { t, x, y, z, w }),
             Slot::Position => typed!(Position, Position { t, x, y, z }),
             Slot::Contact => typed!(Contact, Position { t, x, y, z }),
             Slot::Reaction => typed!(
                 Reaction,
-                ReactionMessage {
-                    t,
-                    x,
-                    y,
-                    z,
-                    friction,
-                    normal
-                }
+                ReactionMessage { t, x, y, z, friction, normal } added { friction_ratio }
             ),
             Slot::Energy => typed!(
                 Energy,
-                EnergyMessage {
-                    t,
-                    total,
-                    kinetic,
-                    potential
-                }
+                EnergyMessage { t, total, kinetic, potential } added { change, drift_eps }
             ),
             Slot::Invariants => typed!(Invariants, InvariantsMessage { t, c1, c2 }),
             Slot::Work => typed!(
@@ -272,10 +280,18 @@ impl Visitor for Judge {
         match schema_bytes(name) {
             Some(ours) if ours == data => {}
             Some(_) => match fields_of(name) {
-                Some(fields) => match validates(data, fields) {
+                Some((fields, first)) => match validates(data, fields) {
                     Ok(()) => self.notes.push(format!(
                         "schema `{name}` is another version than this tool's; the messages conform to it"
                     )),
+                    Err(e) if fields != first && validates(data, first).is_ok() => {
+                        self.first_versions.insert(id);
+                        self.notes.push(format!(
+                            "schema `{name}` is the first version of the type, without the fields added since ({}); the messages conform to it",
+                            fields[first.len()..].join(", ")
+                        ));
+                        let _ = e;
+                    }
                     Err(e) => self.problems.push_with(|| {
                         format!("schema `{name}` is another version than this tool's and {e}")
                     }),
@@ -291,19 +307,19 @@ impl Visitor for Judge {
     }
 
     fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
-        let kind = match Channel::from_topic(topic) {
+        let kind = match Topic::from_name(topic) {
             None => {
                 self.problems
                     .push_with(|| format!("topic `{topic}` is not one of coin-log's"));
                 Kind::Unknown
             }
-            Some(c) => {
+            Some(t) => {
                 let schema = self.schemas.get(&schema_id).map_or("", String::as_str);
-                if schema != c.schema_name() {
+                if schema != t.schema_name() {
                     self.problems.push_with(|| {
                         format!(
                             "topic `{topic}` has schema `{schema}`, the contract says `{}`",
-                            c.schema_name()
+                            t.schema_name()
                         )
                     });
                 }
@@ -312,7 +328,7 @@ impl Visitor for Judge {
                         format!("topic `{topic}` has message encoding {message_encoding:?}, not {MESSAGE_ENCODING:?}")
                     });
                 }
-                match c {
+                match t.channel() {
                     Channel::Omega => Kind::Coin(Slot::Omega),
                     Channel::Angles => Kind::Coin(Slot::Angles),
                     Channel::Quaternion => Kind::Coin(Slot::Quaternion),
@@ -337,6 +353,7 @@ impl Visitor for Judge {
             kind,
             topic: topic.to_string(),
             last: None,
+            first_version: self.first_versions.contains(&schema_id),
         });
     }
 
@@ -392,18 +409,11 @@ impl Visitor for Judge {
             }
         }
         channel.last = Some(lt);
-        let kind = channel.kind;
+        let (kind, first) = (channel.kind, channel.first_version);
         match kind {
             Kind::Coin(slot) => {
-                let (t, value) = match Self::parse(slot, data) {
-                    Ok(v) => v,
-                    Err(e) => {
-                        let topic = self.topic(h.channel_id);
-                        self.problems.push_with(|| {
-                            format!("{topic}: message at {lt} ns does not parse: {e}")
-                        });
-                        return ControlFlow::Continue(());
-                    }
+                let Some((t, value)) = self.parse_checked(slot, first, h, data) else {
+                    return ControlFlow::Continue(());
                 };
                 match log_time(t) {
                     Ok(expected) if expected == lt => {}
@@ -439,6 +449,38 @@ impl Visitor for Judge {
 }
 
 impl Judge {
+    /// [`Self::parse`], recording a problem when the message does not parse or does not have exactly the
+    /// fields of its schema's version.
+    fn parse_checked(
+        &mut self,
+        slot: Slot,
+        first: bool,
+        h: &MessageHeader,
+        data: &[u8],
+    ) -> Option<(f64, Value)> {
+        let lt = h.log_time;
+        match Self::parse(slot, data, first) {
+            Ok((_, _, complete)) if complete == first => {
+                let topic = self.topic(h.channel_id);
+                let what = if first {
+                    "has fields its schema (the first version) does not declare"
+                } else {
+                    "lacks fields its schema requires"
+                };
+                self.problems
+                    .push_with(|| format!("{topic}: message at {lt} ns {what}"));
+                None
+            }
+            Ok((t, value, _)) => Some((t, value)),
+            Err(e) => {
+                let topic = self.topic(h.channel_id);
+                self.problems
+                    .push_with(|| format!("{topic}: message at {lt} ns does not parse: {e}"));
+                None
+            }
+        }
+    }
+
     fn topic(&self, id: u16) -> String {
         self.channels
             .get(usize::from(id))
@@ -669,15 +711,25 @@ mod tests {
             z: 1e-17,
             friction: 3.0,
             normal: 0.75,
+            friction_ratio: Some(4.0),
         };
         m.write_json(&mut buf).unwrap();
         assert_eq!(
             ReactionMessage::FIELDS,
-            ["t", "x", "y", "z", "friction", "normal"]
+            ["t", "x", "y", "z", "friction", "normal", "friction_ratio"]
         );
-        let (t, v) = Judge::parse(Slot::Reaction, &buf).unwrap();
+        let (t, v, complete) = Judge::parse(Slot::Reaction, &buf, false).unwrap();
         assert_eq!(t.to_bits(), 0.5_f64.to_bits());
         assert!(matches!(v, Value::Reaction(r) if r == m));
+        assert!(complete);
+        // The same message read as the first version (no friction_ratio in its schema) is not complete
+        // only if it lacks the field: this one has it, so the caller flags it.
+        let (_, _, complete) = Judge::parse(Slot::Reaction, &buf, true).unwrap();
+        assert!(complete);
+        let old = br#"{"t":0.5,"x":0.1,"y":-0.2,"z":1e-17,"friction":3.0,"normal":0.75}"#;
+        let (_, v, complete) = Judge::parse(Slot::Reaction, old, true).unwrap();
+        assert!(!complete);
+        assert!(matches!(v, Value::Reaction(r) if r.friction_ratio.is_none()));
         for (slot, fields) in [
             (Slot::Omega, AngularVelocity::FIELDS),
             (Slot::Angles, Angles::FIELDS),
@@ -690,13 +742,16 @@ mod tests {
             let text = format!("{{{}}}", text.join(","));
             let fields_fast: &[&str] = match slot {
                 Slot::Omega | Slot::Position => &["t", "x", "y", "z"],
-                Slot::Angles => &["t", "theta", "phi", "psi"],
+                Slot::Angles => &["t", "theta", "phi", "psi", "phi_dot"],
                 Slot::Quaternion => &["t", "x", "y", "z", "w"],
-                Slot::Energy => &["t", "total", "kinetic", "potential"],
+                Slot::Energy => &["t", "total", "kinetic", "potential", "change", "drift_eps"],
                 _ => &["t", "c1", "c2"],
             };
             assert_eq!(fields, fields_fast, "{slot:?}");
-            assert!(Judge::parse(slot, text.as_bytes()).is_ok(), "{text}");
+            assert!(
+                matches!(Judge::parse(slot, text.as_bytes(), false), Ok((_, _, true))),
+                "{text}"
+            );
         }
     }
 }

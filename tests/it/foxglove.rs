@@ -1,203 +1,546 @@
-//! What Foxglove needs from a recording (format.md: Frames and Foxglove output): the frame tree world → table → coin (one
-//! parent each, no cycle, each transform published before a scene update uses its frame), the cylinder in
-//! `coin`, the track in `table`, Foxglove timestamps equal to log times, `/scene` at ≈ 30 per time unit,
-//! and the shipped layout (`/scene` visible, following `world`, the plots on numeric fields).
+//! What a Foxglove-lineage viewer needs from a recording (docs/format.md: Frames and Foxglove output), checked
+//! on every committed dataset and on a fresh recording of every built-in scene, and the shipped layouts.
+//!
+//! After a seek such a viewer restores only the latest message of each topic (and on a backward seek forgets
+//! every transform and drawn object first). So at any cut time, the latest message of each topic alone must
+//! give: the whole frame tree world → table → coin plus the level follow frame `coin_level` (at the coin's
+//! centre, in units of a); the coin; the table under it; and the contact track from t = 0 to the latest
+//! display update, within the simplification tolerance of every recorded contact point. The layouts must use
+//! numbers where the viewer expects numbers (a `""` y-limit locks a plot to [0, 0]), plot only numeric fields
+//! that exist, follow the level frame and show every drawing topic.
 
 // Helpers outside #[test] functions panic on any failure by design.
-#![allow(clippy::unwrap_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use crate::support::record::read_messages;
-use crate::support::writers::{record_circle, Damage};
+use crate::support::record::read_back;
 use crate::support::{dataset_files, repo};
+use coin_log::format::{schema_bytes, Topic};
+use coin_log::record::foxglove::track::{MAX_TOLERANCE, QUANTUM};
+use coin_log::record::foxglove::{
+    FOLLOW_FRAME, SCENE_RATE, TABLE_HALF_SIDE, TABLE_SNAP, WORLD_FRAME,
+};
+use coin_log::record::{self, RecordOptions};
+use coin_log::scene::{self, presets, FlagOverrides};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::atomic::AtomicBool;
+use std::sync::OnceLock;
 
-/// (topic, log time, message) of every message of a file.
-type Messages = Vec<(String, u64, Value)>;
+/// One message: topic, log time, JSON (only for the topics these tests read; `Null` otherwise).
+struct Message {
+    topic: String,
+    lt: u64,
+    v: Value,
+}
+
+/// A recording read back: its name, the radius a, the data rate, its messages in file order.
+struct Recording {
+    name: String,
+    a: f64,
+    rate: f64,
+    messages: Vec<Message>,
+}
+
+impl Recording {
+    fn load(name: String, bytes: &[u8]) -> Self {
+        let back = read_back(bytes);
+        let run = &back.metadata["coin-log"].1;
+        let number = |k: &str| run[k].parse::<f64>().unwrap();
+        let messages = back
+            .messages
+            .into_iter()
+            .map(|m| {
+                let wanted = !m.topic.starts_with("/coin/")
+                    || m.topic == "/coin/position"
+                    || m.topic == "/coin/contact";
+                let v = if wanted {
+                    serde_json::from_slice(&m.data).unwrap()
+                } else {
+                    Value::Null
+                };
+                assert_eq!(m.publish_time, m.log_time, "{name}: {}", m.topic);
+                Message {
+                    topic: m.topic,
+                    lt: m.log_time,
+                    v,
+                }
+            })
+            .collect();
+        Self {
+            name,
+            a: number("radius"),
+            rate: number("rate"),
+            messages,
+        }
+    }
+
+    /// The latest message of each topic at or before `cut` (what a seek to `cut` restores).
+    fn latest(&self, cut: u64) -> BTreeMap<&str, &Message> {
+        let mut out = BTreeMap::new();
+        for m in self.messages.iter().take_while(|m| m.lt <= cut) {
+            out.insert(m.topic.as_str(), m);
+        }
+        out
+    }
+
+    fn on(&self, topic: &str) -> impl Iterator<Item = &Message> + '_ {
+        let topic = topic.to_string();
+        self.messages.iter().filter(move |m| m.topic == topic)
+    }
+
+    /// Cut times: inside the run at uneven offsets, the first and the last log time.
+    fn cuts(&self) -> Vec<u64> {
+        let first = self.messages.first().unwrap().lt;
+        let last = self.messages.iter().map(|m| m.lt).max().unwrap();
+        let mut cuts: Vec<u64> = (1..=17)
+            .map(|k| (first + (last - first) / 17 * k).saturating_sub((k * 7_919_993) % 40_000_000))
+            .filter(|c| *c >= first)
+            .collect();
+        cuts.extend([first, last]);
+        cuts
+    }
+}
+
+/// Longest fresh recording, in time units, except `long-horizon`, recorded whole (1000 time units at 10
+/// samples per unit: 10⁴ display updates, which exercise the track's high levels).
+const FRESH_DURATION: f64 = 12.0;
+
+/// Every committed dataset and a fresh recording of every built-in scene (loaded once).
+fn recordings() -> &'static [Recording] {
+    static ALL: OnceLock<Vec<Recording>> = OnceLock::new();
+    ALL.get_or_init(|| {
+        let mut all: Vec<Recording> = dataset_files()
+            .into_iter()
+            .map(|p| Recording::load(p.display().to_string(), &std::fs::read(&p).unwrap()))
+            .collect();
+        for name in presets::NAMES {
+            let file = presets::preset(name).unwrap();
+            let duration = file.run.as_ref().and_then(|r| r.duration).unwrap();
+            let flags = FlagOverrides {
+                duration: (name != "long-horizon").then_some(duration.min(FRESH_DURATION)),
+                ..FlagOverrides::default()
+            };
+            let scene = scene::resolve(&file, &flags).unwrap();
+            let mut out = std::io::Cursor::new(Vec::new());
+            let stop = AtomicBool::new(false);
+            record::record(&scene, &RecordOptions::default(), &mut out, &stop, |_| {}).unwrap();
+            all.push(Recording::load(format!("fresh {name}"), &out.into_inner()));
+        }
+        all
+    })
+}
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap()
+}
 
 fn time_ns(stamp: &Value) -> u64 {
     stamp["sec"].as_u64().unwrap() * 1_000_000_000 + stamp["nsec"].as_u64().unwrap()
 }
 
-/// A recording of `duration` time units at 100 samples per time unit, read back.
-fn recording(duration: f64) -> Vec<(String, u64, Value)> {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("circle.mcap");
-    record_circle(&path, duration, Damage::None);
-    read_messages(&path)
-}
-
-/// The committed recordings (made by `coin-log record`), read back, with their names.
-fn datasets() -> Vec<(String, Messages)> {
-    dataset_files()
-        .into_iter()
-        .map(|p| (p.display().to_string(), read_messages(&p)))
-        .collect()
-}
-
-/// A fresh 2-time-unit recording and every committed dataset.
-fn recordings() -> Vec<(String, Messages)> {
-    let mut all = vec![("fresh circle".to_string(), recording(2.0))];
-    all.extend(datasets());
-    all
-}
-
-#[test]
-fn the_frames_form_the_tree_world_table_coin_with_one_parent_each() {
-    for (name, messages) in recordings() {
-        println!("{name}:");
-        check_frame_tree(&messages);
-    }
-}
-
-fn check_frame_tree(messages: &[(String, u64, Value)]) {
-    let mut parents: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    let mut first_seen: BTreeMap<String, u64> = BTreeMap::new();
-    for (topic, lt, v) in messages {
-        if topic == "/tf" {
-            let child = v["child_frame_id"].as_str().unwrap().to_string();
-            let parent = v["parent_frame_id"].as_str().unwrap().to_string();
-            assert_ne!(child, parent, "a frame is its own parent");
-            first_seen.entry(child.clone()).or_insert(*lt);
-            parents.entry(child).or_default().insert(parent);
+/// The frame tree the latest messages give at `cut`: child → parent. Err if a frame has two parents, a
+/// transform is its own parent, or the tree is not world → table → coin and world → coin_level.
+fn frame_tree(latest: &BTreeMap<&str, &Message>) -> Result<BTreeMap<String, String>, String> {
+    let mut parents: BTreeMap<String, String> = BTreeMap::new();
+    for m in latest.values() {
+        if Topic::from_name(&m.topic).map(Topic::schema_name) != Some("foxglove.FrameTransform") {
+            continue;
         }
-    }
-    println!("  parents: {parents:?}");
-    let expected: BTreeMap<String, BTreeSet<String>> = [
-        ("table".to_string(), BTreeSet::from(["world".to_string()])),
-        ("coin".to_string(), BTreeSet::from(["table".to_string()])),
-    ]
-    .into();
-    assert_eq!(parents, expected, "world → table → coin, one parent each");
-    // No cycle: walking up from every frame reaches the root `world`, which has no parent.
-    for start in parents.keys() {
-        let mut frame = start.clone();
-        let mut steps = 0;
-        while let Some(p) = parents.get(&frame) {
-            frame = p.iter().next().unwrap().clone();
-            steps += 1;
-            assert!(steps <= parents.len(), "cycle above {start}");
+        let child = m.v["child_frame_id"].as_str().unwrap().to_string();
+        let parent = m.v["parent_frame_id"].as_str().unwrap().to_string();
+        if child == parent {
+            return Err(format!("{}: {child} is its own parent", m.topic));
         }
-        assert_eq!(frame, "world");
-    }
-    // The static transform once, at t = 0, before the first scene update.
-    let table_tfs = messages
-        .iter()
-        .filter(|(t, _, v)| t == "/tf" && v["child_frame_id"] == "table")
-        .count();
-    assert_eq!(table_tfs, 1, "world → table published once");
-    let first_scene = messages.iter().position(|(t, _, _)| t == "/scene").unwrap();
-    let first_table = messages
-        .iter()
-        .position(|(t, _, v)| t == "/tf" && v["child_frame_id"] == "table")
-        .unwrap();
-    let first_coin = messages
-        .iter()
-        .position(|(t, _, v)| t == "/tf" && v["child_frame_id"] == "coin")
-        .unwrap();
-    assert!(first_table < first_scene && first_coin < first_scene);
-    let t0 = messages[0].1;
-    assert_eq!(first_seen["table"], t0);
-    assert_eq!(first_seen["coin"], t0);
-}
-
-#[test]
-fn the_coin_is_a_cylinder_in_the_coin_frame_and_the_track_lies_in_the_table_frame() {
-    for (name, messages) in datasets() {
-        let (scenes, points) = check_scene_entities(&messages);
-        println!("{name}: {scenes} scene updates, {points} track points");
-        assert!(scenes > 0);
-    }
-    let (scenes, track_points) = check_scene_entities(&recording(2.0));
-    println!("{scenes} scene updates, {track_points} new track points (expected 200: one per sample after the first)");
-    assert_eq!(track_points, 200);
-}
-
-/// Checks every scene entity; returns (scene updates, new track points).
-fn check_scene_entities(messages: &[(String, u64, Value)]) -> (usize, usize) {
-    let mut track_points = 0;
-    let mut scenes = 0;
-    for (topic, _, v) in messages.iter().filter(|(t, _, _)| t == "/scene") {
-        assert_eq!(topic, "/scene");
-        scenes += 1;
-        for e in v["entities"].as_array().unwrap() {
-            let id = e["id"].as_str().unwrap();
-            match id {
-                "coin" => {
-                    assert_eq!(e["frame_id"], "coin");
-                    assert_eq!(e["cylinders"].as_array().unwrap().len(), 1);
-                    assert_eq!(e["frame_locked"], true);
-                }
-                "table" => assert_eq!(e["frame_id"], "table"),
-                _ => {
-                    assert!(id.starts_with("track-"), "unexpected entity {id}");
-                    assert_eq!(e["frame_id"], "table");
-                    let line = &e["lines"][0];
-                    assert_eq!(line["type"], 0);
-                    let points = line["points"].as_array().unwrap();
-                    assert!(points.len() >= 2);
-                    // On the table plane y = 0 of the note's frame.
-                    assert!(points.iter().all(|p| p["y"].as_f64() == Some(0.0)));
-                    track_points += points.len() - 1;
-                }
+        if let Some(p) = parents.insert(child.clone(), parent.clone()) {
+            if p != parent {
+                return Err(format!("{child} has two parents, {p} and {parent}"));
             }
         }
     }
-    (scenes, track_points)
+    let expected: BTreeMap<String, String> = [
+        ("table", "world"),
+        ("coin", "table"),
+        (FOLLOW_FRAME, WORLD_FRAME),
+    ]
+    .into_iter()
+    .map(|(c, p)| (c.to_string(), p.to_string()))
+    .collect();
+    if parents == expected {
+        Ok(parents)
+    } else {
+        Err(format!("frame tree {parents:?}, expected {expected:?}"))
+    }
 }
 
 #[test]
-fn every_foxglove_timestamp_equals_its_log_time() {
+fn after_any_seek_the_latest_message_of_each_topic_gives_the_whole_frame_tree() {
     let mut checked = 0;
-    for (topic, lt, v) in recordings().iter().flat_map(|(_, m)| m) {
-        let stamps: Vec<&Value> = match topic.as_str() {
-            "/tf" => vec![&v["timestamp"]],
-            "/scene" => v["entities"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|e| &e["timestamp"])
-                .collect(),
-            _ => vec![],
-        };
-        for s in stamps {
-            assert_eq!(time_ns(s), *lt, "{topic}: {s} vs log time {lt}");
-            assert!(s["nsec"].as_u64().unwrap() < 1_000_000_000);
+    for r in recordings() {
+        for cut in r.cuts() {
+            if let Err(e) = frame_tree(&r.latest(cut)) {
+                panic!("{}: seek to {cut} ns: {e}", r.name);
+            }
             checked += 1;
         }
     }
-    println!("{checked} timestamps equal to their log time");
-    assert!(checked > 200);
+    println!(
+        "{checked} seeks over {} recordings: full frame tree each time",
+        recordings().len()
+    );
+    // Negative control: without /tf_static, a seek past t = 0 loses world → table.
+    let r = &recordings()[0];
+    let cut = r.cuts()[5];
+    let mut latest = r.latest(cut);
+    latest.remove("/tf_static");
+    let e = frame_tree(&latest).unwrap_err();
+    println!("without /tf_static: {e}");
 }
 
 #[test]
-fn scene_updates_come_at_about_thirty_per_time_unit() {
-    let duration = 5.0;
-    let messages = recording(duration);
-    let times: Vec<u64> = messages
-        .iter()
-        .filter(|(t, _, _)| t == "/scene")
-        .map(|(_, lt, _)| *lt)
-        .collect();
-    #[allow(clippy::cast_precision_loss)]
-    let rate = (times.len() - 1) as f64 / duration;
-    let max_gap = times.windows(2).map(|w| w[1] - w[0]).max().unwrap();
-    println!(
-        "/scene: {} updates, {rate} per time unit (expected 30 ± 1), largest gap {max_gap} ns (≤ 4e7)",
-        times.len()
-    );
-    assert!((rate - 30.0).abs() <= 1.0);
-    assert!(max_gap <= 40_000_000);
-    assert_eq!(
-        *times.last().unwrap(),
-        5_000_000_000,
-        "the last sample has a scene update"
-    );
+fn every_transform_and_drawing_timestamp_equals_its_log_time() {
+    let mut checked = 0;
+    for r in recordings() {
+        for m in &r.messages {
+            let stamps: Vec<&Value> = match Topic::from_name(&m.topic).map(Topic::schema_name) {
+                Some("foxglove.FrameTransform") => vec![&m.v["timestamp"]],
+                Some("foxglove.SceneUpdate") => m.v["entities"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .chain(m.v["deletions"].as_array().unwrap())
+                    .map(|e| &e["timestamp"])
+                    .collect(),
+                _ => vec![],
+            };
+            for s in stamps {
+                assert_eq!(time_ns(s), m.lt, "{}: {}: {s} vs log time", r.name, m.topic);
+                assert!(s["nsec"].as_u64().unwrap() < 1_000_000_000);
+                checked += 1;
+            }
+        }
+    }
+    println!("{checked} timestamps equal to their log time");
+    assert!(checked > 100_000);
 }
 
-fn layout() -> Value {
-    let text = std::fs::read_to_string(repo().join("datasets/foxglove-layout.json")).unwrap();
+#[test]
+fn the_static_transform_is_first_on_tf_and_alone_on_tf_static() {
+    for r in recordings() {
+        let tf: Vec<&Message> = r.on("/tf").collect();
+        assert_eq!(tf[0].v["child_frame_id"], "table", "{}", r.name);
+        assert_eq!(tf[0].lt, r.messages[0].lt);
+        let coin = tf
+            .iter()
+            .filter(|m| m.v["child_frame_id"] == "coin")
+            .count();
+        let samples = r.on("/coin/position").count();
+        assert_eq!(coin, samples, "{}: table → coin at every sample", r.name);
+        let statics: Vec<&Message> = r.on("/tf_static").collect();
+        assert_eq!(statics.len(), 1, "{}", r.name);
+        assert_eq!(statics[0].v, tf[0].v, "{}: the same transform", r.name);
+    }
+}
+
+#[test]
+fn the_camera_follows_a_level_frame_at_the_coins_centre_in_units_of_a() {
+    let mut checked = 0;
+    for r in recordings() {
+        let centres: BTreeMap<u64, &Value> = r.on("/coin/position").map(|m| (m.lt, &m.v)).collect();
+        for m in r.on("/scene/follow") {
+            assert_eq!(m.v["parent_frame_id"], WORLD_FRAME);
+            assert_eq!(m.v["child_frame_id"], FOLLOW_FRAME);
+            assert_eq!(
+                m.v["rotation"],
+                serde_json::json!({"x": 0, "y": 0, "z": 0, "w": 1}),
+                "{}: the follow frame stays level",
+                r.name
+            );
+            // World (z up) from the physics frame (y up): (x, −z, y), divided by a.
+            let c = centres[&m.lt];
+            let expected = [num(&c["x"]) / r.a, -num(&c["z"]) / r.a, num(&c["y"]) / r.a];
+            let t = &m.v["translation"];
+            for (got, want) in [num(&t["x"]), num(&t["y"]), num(&t["z"])]
+                .iter()
+                .zip(expected)
+            {
+                // Round-off of a division and of cos θ: 1e-12 of the coordinate or of a.
+                assert!(
+                    (got - want).abs() <= 1e-12 * want.abs().max(1.0),
+                    "{}: follow {got} vs centre/a {want}",
+                    r.name
+                );
+            }
+            checked += 1;
+        }
+    }
+    println!("{checked} follow transforms at the coin's centre, level");
+}
+
+#[test]
+fn after_any_seek_the_coin_and_the_table_under_it_are_drawn() {
+    for r in recordings() {
+        for cut in r.cuts() {
+            let latest = r.latest(cut);
+            let coin = &latest["/scene"].v["entities"][0];
+            assert_eq!(coin["id"], "coin", "{}", r.name);
+            assert_eq!(coin["frame_id"], FOLLOW_FRAME);
+            let table = &latest["/scene/table"].v["entities"][0]["cubes"][0]["pose"]["position"];
+            let follow = &latest["/scene/follow"].v["translation"];
+            let d = (num(&follow["x"]) - num(&table["x"]))
+                .abs()
+                .max((num(&follow["y"]) - num(&table["y"])).abs());
+            assert!(
+                d <= TABLE_SNAP + 1e-9,
+                "{}: at {cut} ns the coin is {d} a from the table's centre (half side {TABLE_HALF_SIDE})",
+                r.name
+            );
+        }
+    }
+}
+
+/// The track the latest track messages draw at a cut, as one chain from the highest level down. Err if a
+/// level does not start where the level above ends.
+fn track_chain(latest: &BTreeMap<&str, &Message>) -> Result<Vec<[f64; 2]>, String> {
+    let mut levels: Vec<(usize, Vec<[f64; 2]>)> = Vec::new();
+    for (topic, m) in latest {
+        let Some(Topic::SceneTrack(level)) = Topic::from_name(topic) else {
+            continue;
+        };
+        let Some(e) = m.v["entities"].as_array().unwrap().first() else {
+            continue; // a deletion: the level is empty
+        };
+        let points = e["lines"][0]["points"].as_array().unwrap();
+        levels.push((
+            usize::from(level),
+            points
+                .iter()
+                .map(|p| [num(&p["x"]), num(&p["y"])])
+                .collect(),
+        ));
+    }
+    levels.sort_by_key(|l| std::cmp::Reverse(l.0));
+    let mut chain: Vec<[f64; 2]> = Vec::new();
+    for (level, points) in levels {
+        match chain.last() {
+            Some(end) if *end != points[0] => {
+                return Err(format!(
+                    "level {level} starts at {:?}, the levels above end at {end:?}",
+                    points[0]
+                ))
+            }
+            Some(_) => chain.extend_from_slice(&points[1..]),
+            None => chain.extend_from_slice(&points),
+        }
+    }
+    Ok(chain)
+}
+
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let s = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - s * dx).hypot(p[1] - a[1] - s * dy)
+}
+
+/// Checks that `chain` draws the contact points `path` (in time order, display units) from the first to the
+/// last within `tolerance`: its ends are the path's ends, and every point lies within `tolerance` of it.
+/// The chain's vertices are path points in order, so a pointer moves along it; a point not matched near the
+/// pointer is searched in the whole chain.
+fn covers(chain: &[[f64; 2]], path: &[[f64; 2]], tolerance: f64) -> Result<f64, String> {
+    let (first, last) = (path[0], path[path.len() - 1]);
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) <= QUANTUM;
+    if chain.len() < 2 || !near(chain[0], first) || !near(chain[chain.len() - 1], last) {
+        return Err(format!(
+            "the track runs {:?} → {:?}, the path {first:?} → {last:?}",
+            chain.first(),
+            chain.last()
+        ));
+    }
+    let mut at = 0;
+    let mut worst: f64 = 0.0;
+    for p in path {
+        let window = at..(at + 64).min(chain.len() - 1);
+        let best = window
+            .map(|i| (i, segment_distance(*p, chain[i], chain[i + 1])))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .filter(|(_, d)| *d <= tolerance)
+            .or_else(|| {
+                (0..chain.len() - 1)
+                    .map(|i| (i, segment_distance(*p, chain[i], chain[i + 1])))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+            })
+            .unwrap();
+        if best.1 > tolerance {
+            return Err(format!("contact point {p:?} is {} from the track", best.1));
+        }
+        at = best.0;
+        worst = worst.max(best.1);
+    }
+    Ok(worst)
+}
+
+/// The contact points (display units) with log time ≤ `until`.
+fn contact_path(r: &Recording, until: u64) -> Vec<[f64; 2]> {
+    r.on("/coin/contact")
+        .take_while(|m| m.lt <= until)
+        .map(|m| [num(&m.v["x"]) / r.a, -num(&m.v["z"]) / r.a])
+        .collect()
+}
+
+#[test]
+fn after_any_seek_the_latest_track_messages_draw_the_whole_path_up_to_the_latest_update() {
+    let tolerance = MAX_TOLERANCE + QUANTUM;
+    let (mut checked, mut worst, mut deepest) = (0, 0.0_f64, 0);
+    for r in recordings() {
+        let updates: Vec<u64> = r.on("/scene").map(|m| m.lt).collect();
+        for cut in r.cuts() {
+            let latest = r.latest(cut);
+            let last_update = *updates.iter().rev().find(|u| **u <= cut).unwrap();
+            // Within one display interval: updates are ≤ 1/SCENE_RATE + 1/rate apart (docs/format.md).
+            let gap = (cut - last_update) as f64 * 1e-9;
+            assert!(
+                gap <= 1.0 / SCENE_RATE + 1.0 / r.rate + 1e-9,
+                "{}: {gap}",
+                r.name
+            );
+            let path = contact_path(r, last_update);
+            let moved = path
+                .iter()
+                .any(|p| (p[0] - path[0][0]).abs().max((p[1] - path[0][1]).abs()) > QUANTUM);
+            let chain = track_chain(&latest).unwrap_or_else(|e| panic!("{}: {e}", r.name));
+            if !moved {
+                assert!(chain.is_empty(), "{}: no motion, no track", r.name);
+                continue;
+            }
+            let d = covers(&chain, &path, tolerance)
+                .unwrap_or_else(|e| panic!("{}: seek to {cut} ns: {e}", r.name));
+            worst = worst.max(d);
+            deepest = deepest.max(
+                latest
+                    .keys()
+                    .filter(|t| t.starts_with("/scene/track/"))
+                    .count(),
+            );
+            checked += 1;
+        }
+    }
+    println!(
+        "{checked} seeks: the track covers every contact point up to the latest update; worst distance \
+         {worst:e} a (tolerance {tolerance:e}); up to {deepest} track levels in use"
+    );
+    assert!(deepest >= 12, "the long recordings use the high levels");
+    // Negative control: dropping one level's latest message breaks the chain (or leaves points uncovered).
+    let r = recordings()
+        .iter()
+        .find(|r| r.name.ends_with("wobble.mcap"))
+        .unwrap();
+    let cut = r.cuts()[9];
+    let mut latest = r.latest(cut);
+    let dropped = latest
+        .keys()
+        .find(|t| t.starts_with("/scene/track/") && latest[**t].v["entities"][0].is_object())
+        .copied()
+        .unwrap();
+    latest.remove(dropped);
+    let path = contact_path(r, cut);
+    let broken = track_chain(&latest).and_then(|c| covers(&c, &path, tolerance));
+    println!("without {dropped}: {broken:?}");
+    assert!(broken.is_err());
+}
+
+#[test]
+fn drawing_updates_come_at_about_thirty_per_time_unit() {
+    for r in recordings().iter().filter(|r| r.rate >= SCENE_RATE) {
+        let times: Vec<u64> = r.on("/scene").map(|m| m.lt).collect();
+        let span = (times[times.len() - 1] - times[0]) as f64 * 1e-9;
+        let rate = (times.len() - 1) as f64 / span;
+        println!("{}: {rate:.2} drawing updates per time unit", r.name);
+        assert!((rate - SCENE_RATE).abs() <= 1.0, "{}: {rate}", r.name);
+        assert_eq!(r.on("/scene/follow").count(), times.len());
+        let last = r.messages.iter().map(|m| m.lt).max().unwrap();
+        assert_eq!(
+            times[times.len() - 1],
+            last,
+            "{}: the last sample is drawn",
+            r.name
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The shipped layouts.
+
+const LAYOUTS: [&str; 2] = ["foxglove-layout.json", "foxglove-layout-physics.json"];
+
+fn layout(name: &str) -> Value {
+    let text = std::fs::read_to_string(repo().join("datasets").join(name)).unwrap();
     serde_json::from_str(&text).unwrap()
+}
+
+/// Keys whose values the viewers read as numbers (Lichtblick's and Foxglove's panel configs).
+const NUMERIC_KEYS: [&str; 14] = [
+    "distance",
+    "phi",
+    "thetaOffset",
+    "fovy",
+    "near",
+    "far",
+    "minYValue",
+    "maxYValue",
+    "minXValue",
+    "maxXValue",
+    "splitPercentage",
+    "speed",
+    "sidebarDimension",
+    "followingViewWidth",
+];
+
+/// Every place in `v` where a numeric key holds something else than a number, or a string looks like a
+/// number or is empty (a viewer converting it with `+` gets a number the author did not mean: `+"" = 0`).
+fn non_numbers(v: &Value, path: &str, out: &mut Vec<String>) {
+    match v {
+        Value::Object(o) => {
+            for (k, x) in o {
+                let here = format!("{path}.{k}");
+                if NUMERIC_KEYS.contains(&k.as_str()) && !x.is_number() {
+                    out.push(format!("{here} = {x}: a number or absent"));
+                }
+                non_numbers(x, &here, out);
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                non_numbers(x, &format!("{path}[{i}]"), out);
+            }
+        }
+        Value::String(s) if s.trim().is_empty() || s.trim().parse::<f64>().is_ok() => {
+            out.push(format!(
+                "{path} = {s:?}: a string where a number or nothing is meant"
+            ));
+        }
+        _ => {}
+    }
+}
+
+#[test]
+fn every_numeric_field_of_the_layouts_is_a_number_or_absent() {
+    for name in LAYOUTS {
+        let mut problems = Vec::new();
+        non_numbers(&layout(name), "", &mut problems);
+        assert!(problems.is_empty(), "{name}: {problems:#?}");
+        println!("{name}: every numeric field is a number");
+    }
+    // Negative control: the y-limits that emptied every plot.
+    let mut bad = layout(LAYOUTS[0]);
+    bad["configById"]["Plot!omega"]["minYValue"] = Value::from("");
+    let mut problems = Vec::new();
+    non_numbers(&bad, "", &mut problems);
+    println!("negative control: {problems:?}");
+    assert!(!problems.is_empty() && problems.iter().all(|p| p.contains("Plot!omega.minYValue")));
 }
 
 /// Panel ids in a layout tree (a string, or {first, second, direction, ...}).
@@ -212,78 +555,133 @@ fn panel_ids(node: &Value, out: &mut Vec<String>) {
     }
 }
 
-#[test]
-fn the_layout_shows_the_scene_following_world_and_plots_the_main_quantities() {
-    let layout = layout();
-    for key in [
-        "configById",
-        "globalVariables",
-        "userNodes",
-        "playbackConfig",
-        "layout",
-    ] {
-        assert!(layout.get(key).is_some(), "layout lacks `{key}`");
-    }
-    let configs = layout["configById"].as_object().unwrap();
-    let mut ids = Vec::new();
-    panel_ids(&layout["layout"], &mut ids);
-    let in_tree: BTreeSet<&String> = ids.iter().collect();
-    let configured: BTreeSet<&String> = configs.keys().collect();
-    assert_eq!(
-        in_tree, configured,
-        "every panel in the tree is configured and vice versa"
-    );
-
-    let three_d: Vec<&Value> = configs
-        .iter()
-        .filter(|(id, _)| id.starts_with("3D!"))
-        .map(|(_, c)| c)
-        .collect();
-    assert_eq!(three_d.len(), 1, "one 3D panel");
-    let c = three_d[0];
-    assert_eq!(c["followTf"], "world");
-    assert_eq!(
-        c["topics"]["/scene"]["visible"], true,
-        "SceneUpdate topics are hidden by default"
-    );
-    assert_eq!(c["topics"]["/tf"]["visible"], true);
-
+/// The plotted paths of a layout.
+fn plotted(layout: &Value) -> BTreeSet<String> {
     let mut paths = BTreeSet::new();
-    for (id, c) in configs {
+    for (id, c) in layout["configById"].as_object().unwrap() {
         if id.starts_with("Plot!") {
             for p in c["paths"].as_array().unwrap() {
                 assert_eq!(p["enabled"], true);
                 paths.insert(p["value"].as_str().unwrap().to_string());
             }
-        } else {
-            assert!(id.starts_with("3D!"), "unexpected panel {id}");
         }
     }
-    let wanted = [
+    paths
+}
+
+#[test]
+fn every_plotted_path_is_a_numeric_field_of_a_recorded_topic() {
+    let recorded: BTreeSet<&str> = recordings()[0]
+        .messages
+        .iter()
+        .map(|m| m.topic.as_str())
+        .collect();
+    for name in LAYOUTS {
+        for p in plotted(&layout(name)) {
+            let (topic, field) = p.split_once('.').unwrap();
+            let t = Topic::from_name(topic).unwrap_or_else(|| panic!("{name}: {p}: unknown topic"));
+            assert!(recorded.contains(topic), "{name}: {p}: not in the datasets");
+            let schema: Value =
+                serde_json::from_slice(schema_bytes(t.schema_name()).unwrap()).unwrap();
+            assert_eq!(
+                schema["properties"][field]["type"],
+                "number",
+                "{name}: {p}: not a number field of {}",
+                t.schema_name()
+            );
+        }
+    }
+    let main = plotted(&layout(LAYOUTS[0]));
+    for w in [
         "/coin/omega.x",
         "/coin/omega.y",
         "/coin/omega.z",
         "/coin/angles.theta",
         "/coin/energy.total",
         "/coin/reaction.normal",
-    ];
-    for w in wanted {
-        assert!(paths.contains(w), "no plot of {w}");
+    ] {
+        assert!(main.contains(w), "{}: no plot of {w}", LAYOUTS[0]);
     }
-    // Each plotted path ends on a numeric field of its topic's schema.
-    for p in &paths {
-        let (topic, field) = p.split_once('.').unwrap();
-        let channel = coin_log::format::Channel::from_topic(topic)
-            .unwrap_or_else(|| panic!("{p}: unknown topic"));
-        let schema: Value =
-            serde_json::from_slice(coin_log::format::schema_bytes(channel.schema_name()).unwrap())
-                .unwrap();
+    let physics = plotted(&layout(LAYOUTS[1]));
+    for w in [
+        "/coin/omega.x",
+        "/coin/omega.y",
+        "/coin/omega.z",
+        "/coin/angles.theta",
+        "/coin/angles.phi_dot",
+        "/coin/energy.drift_eps",
+        "/coin/reaction.normal",
+        "/coin/reaction.friction_ratio",
+        "/coin/invariants.c1",
+        "/coin/invariants.c2",
+    ] {
+        assert!(physics.contains(w), "{}: no plot of {w}", LAYOUTS[1]);
+    }
+}
+
+#[test]
+fn the_layouts_follow_the_level_frame_show_every_drawing_topic_and_name_every_panel() {
+    for name in LAYOUTS {
+        let layout = layout(name);
+        let configs = layout["configById"].as_object().unwrap();
+        let mut ids = Vec::new();
+        panel_ids(&layout["layout"], &mut ids);
+        let in_tree: BTreeSet<&String> = ids.iter().collect();
         assert_eq!(
-            schema["properties"][field]["type"],
-            "number",
-            "{p}: not a number field of {}",
-            channel.schema_name()
+            in_tree,
+            configs.keys().collect(),
+            "{name}: panels in the tree = panels configured"
+        );
+        for (id, c) in configs {
+            let title = c["lichtblickPanelTitle"].as_str().unwrap_or_default();
+            assert!(
+                !title.is_empty(),
+                "{name}: {id} has no lichtblickPanelTitle"
+            );
+            assert_eq!(
+                c["foxglovePanelTitle"], title,
+                "{name}: {id}: both title keys, the same"
+            );
+            if id.starts_with("Plot!") {
+                for k in ["minYValue", "maxYValue"] {
+                    assert!(
+                        c.get(k).is_none(),
+                        "{name}: {id}: {k} set, the plot would not autoscale"
+                    );
+                }
+            } else {
+                assert!(id.starts_with("3D!"), "{name}: unexpected panel {id}");
+                check_3d_panel(name, c);
+            }
+        }
+    }
+}
+
+fn check_3d_panel(name: &str, c: &Value) {
+    assert_eq!(
+        c["followTf"], FOLLOW_FRAME,
+        "{name}: the camera follows the level frame"
+    );
+    assert_eq!(c["followMode"], "follow-pose");
+    for t in Topic::all().filter(|t| t.schema_name() == "foxglove.SceneUpdate") {
+        assert_eq!(
+            c["topics"][t.name()]["visible"],
+            true,
+            "{name}: {t} hidden (SceneUpdate topics are hidden by default)"
         );
     }
-    println!("plotted: {paths:?}");
+    for frame in [WORLD_FRAME, "table", "coin", FOLLOW_FRAME] {
+        assert_eq!(
+            c["transforms"][format!("frame:{frame}")]["visible"],
+            false,
+            "{name}: frame {frame} would draw axes and a connector line"
+        );
+    }
+    let camera = &c["cameraState"];
+    // Units of a: the coin (diameter 2) and ≥ 5 a of track around it in view.
+    let distance = num(&camera["distance"]);
+    assert!(
+        (10.0..=30.0).contains(&distance),
+        "{name}: camera distance {distance}"
+    );
 }

@@ -8,6 +8,7 @@
 
 mod support;
 
+mod added_fields;
 mod analyse;
 mod architecture;
 mod bench_euler;

@@ -7,11 +7,11 @@ use crate::support::record::{read_back, schema_file, validate_flat, ReadBack};
 use crate::support::writers::{message_json_with, COIN_CHANNELS};
 use crate::support::FailingWriter;
 use coin_log::format::{
-    log_time, Channel, ResultMetadata, RunMetadata, Termination, RESULT_METADATA_NAME,
+    log_time, Channel, ResultMetadata, RunMetadata, Termination, Topic, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,
 };
 use coin_log::integrate::{run_method, Flow, RunSettings};
-use coin_log::model::{Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
+use coin_log::model::{energy, Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use coin_log::record::{
     self, run_metadata, Compression, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
 };
@@ -81,7 +81,7 @@ fn simulated_samples(scene: &Scene) -> Vec<(f64, [f64; STATE_LEN], Option<f64>)>
 
 /// The messages the recorder should write, computed here from the model and the message types
 /// (`support::writers::message_json_with`, which shares no code with the recorder).
-fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
+fn expected_messages(scene: &Scene) -> Vec<(Topic, u64, Vec<u8>)> {
     let dynamics = scene.dynamics();
     let coin = scene.coin();
     let samples = simulated_samples(scene);
@@ -89,6 +89,7 @@ fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
     let mut foxglove = Foxglove3d::new(&coin, scene.thickness, tf, scene_on);
     let mut batch = FoxgloveBatch::default();
     let chaplygin = Chaplygin::new(&scene.params).unwrap();
+    let e0 = energy(&coin, &State::from_array(&samples[0].1)).total;
     let mut out = Vec::new();
     let last = samples.len() - 1;
     for (k, (t, y, work)) in samples.iter().enumerate() {
@@ -97,15 +98,15 @@ fn expected_messages(scene: &Scene) -> Vec<(Channel, u64, Vec<u8>)> {
         // The coin_log channels in the contract's table order: work after invariants, before /tf.
         for channel in COIN_CHANNELS.into_iter().chain([Channel::Work]) {
             if scene.records(channel) {
-                let data = message_json_with(&dynamics, &chaplygin, channel, t, &s, *work);
-                out.push((channel, ns, data));
+                let data = message_json_with(&dynamics, &chaplygin, channel, t, &s, *work, e0);
+                out.push((Topic::Main(channel), ns, data));
             }
         }
         if tf || scene_on {
             batch.clear();
             foxglove.sample(t, ns, &s, k == last, &mut batch).unwrap();
-            for (channel, data) in batch.iter() {
-                out.push((channel, ns, data.to_vec()));
+            for (topic, data) in batch.iter() {
+                out.push((topic, ns, data.to_vec()));
             }
         }
     }
@@ -225,7 +226,7 @@ fn check_recording(name: &str, scene: &Scene, bytes: &[u8], summary: &RecordSumm
         "{name}: message count vs re-simulation"
     );
     for (k, (m, (channel, ns, data))) in file.messages.iter().zip(&expected).enumerate() {
-        assert_eq!(m.topic, channel.topic(), "{name}: message {k} topic");
+        assert_eq!(m.topic, channel.name(), "{name}: message {k} topic");
         assert_eq!(m.log_time, *ns, "{name}: message {k} log time");
         assert!(
             m.data == *data,
@@ -384,10 +385,12 @@ fn every_coin_log_message_validates_against_its_schema_file() {
 fn a_message_with_a_missing_or_an_extra_field_fails_validation() {
     let schema: serde_json::Value =
         serde_json::from_slice(&schema_file("coin_log.Energy")).unwrap();
-    let good = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75}"#;
-    let missing = br#"{"t":0.5,"total":1.0,"kinetic":0.25}"#;
-    let extra = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"spin":2}"#;
-    let string = br#"{"t":0.5,"total":"1","kinetic":0.25,"potential":0.75}"#;
+    let good =
+        br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"change":0.0,"drift_eps":0.0}"#;
+    let missing = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"change":0.0,"drift_eps":0.0}"#;
+    let extra = br#"{"t":0.5,"total":1.0,"kinetic":0.25,"potential":0.75,"change":0.0,"drift_eps":0.0,"spin":2}"#;
+    let string =
+        br#"{"t":0.5,"total":"1","kinetic":0.25,"potential":0.75,"change":0.0,"drift_eps":0.0}"#;
     println!("good: {:?}", validate_flat(&schema, good));
     println!("missing: {:?}", validate_flat(&schema, missing));
     println!("extra: {:?}", validate_flat(&schema, extra));

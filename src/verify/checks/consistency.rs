@@ -2,9 +2,13 @@
 //! q(e_z, ψ) of the stored angles up to sign (physics §1) and has unit norm; the contact point is the centre
 //! plus c (x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y_c = 0, physics §3); the centre's height is
 //! a cos θ; the stored reaction equals R recomputed from the stored state (physics §3), with F = √(R_x² + R_z²)
-//! and N = R_y. Each is a recomputation from stored numbers, held to the recomputation tolerance.
+//! and N = R_y. The fields added since the format's first version, when stored: φ̇ against ω_Y / cos θ (eq 18),
+//! the friction ratio against F / max(N, 1e-12 Mg), the energy change against E − E₀ (E₀ the first stored
+//! total), the drift in units of ε against (E − E₀)/(ε max(|E₀|, Mga)). Each is a recomputation from
+//! stored numbers, held to the recomputation tolerance.
 
 use super::{fmt_num, worst, Context, Max};
+use crate::format::messages::{drift_eps, friction_ratio};
 use crate::model::orientation;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
@@ -20,7 +24,15 @@ pub struct ConsistencyCheck {
     height: Max,
     reaction: Max,
     counts: [u64; 4],
+    /// The fields added since the first version: φ̇, friction ratio, energy change, drift in units of ε.
+    added: [Max; 4],
+    added_counts: [u64; 4],
+    /// The first stored total energy (E₀ of `change`).
+    energy0: Option<f64>,
 }
+
+/// Labels of the added-field measures.
+const ADDED: [&str; 4] = ["phi_dot", "friction_ratio", "energy change", "drift_eps"];
 
 impl ConsistencyCheck {
     /// Accounts for one sample.
@@ -71,6 +83,44 @@ impl ConsistencyCheck {
                 .max((r.normal - r.y).abs());
             self.reaction.offer(d / scale, s.t);
         }
+        self.observe_added(s, ctx);
+    }
+
+    /// The fields added since the first version, each against its recomputation from other stored fields,
+    /// relative to the quantity's natural scale.
+    fn observe_added(&mut self, s: &Sample, ctx: &Context) {
+        let p = ctx.coin.params();
+        if let (Some(phi_dot), Some(ang), Some(w)) =
+            (s.angles.and_then(|m| m.phi_dot), s.angles, s.omega)
+        {
+            let expected = w.y / ang.theta.cos();
+            // Scale: the heading rate itself, or √(g/a) for a coin that barely turns.
+            let scale = expected.abs().max((p.gravity() / p.radius()).sqrt());
+            self.added[0].offer((phi_dot - expected).abs() / scale, s.t);
+            self.added_counts[0] += 1;
+        }
+        if let Some(r) = s.reaction {
+            if let Some(ratio) = r.friction_ratio {
+                let expected = friction_ratio(r.friction, r.normal, p.mass(), p.gravity());
+                self.added[1].offer((ratio - expected).abs() / expected.abs().max(1.0), s.t);
+                self.added_counts[1] += 1;
+            }
+        }
+        if let Some(e) = s.energy {
+            let e0 = *self.energy0.get_or_insert(e.total);
+            if let Some(change) = e.change {
+                // Scale: that of the energy drift, max(|E₀|, Mga).
+                let scale = e0.abs().max(p.mass() * p.gravity() * p.radius());
+                self.added[2].offer((change - (e.total - e0)).abs() / scale, s.t);
+                self.added_counts[2] += 1;
+            }
+            if let Some(d) = e.drift_eps {
+                // Scale: the drift itself in units of ε, or 1 (one ε of relative drift).
+                let expected = drift_eps(e.total, e0, p.energy_scale());
+                self.added[3].offer((d - expected).abs() / expected.abs().max(1.0), s.t);
+                self.added_counts[3] += 1;
+            }
+        }
     }
 
     /// The result.
@@ -112,6 +162,16 @@ impl ConsistencyCheck {
                 fmt_num(self.reaction.value),
                 fmt_num(self.reaction.t)
             ));
+        }
+        for ((m, count), label) in self.added.iter().zip(self.added_counts).zip(ADDED) {
+            if count > 0 {
+                measures.push((m.value, tol, label));
+                parts.push(format!(
+                    "{label} {} (t = {})",
+                    fmt_num(m.value),
+                    fmt_num(m.t)
+                ));
+            }
         }
         let Some((value, tolerance, which)) = worst(&measures) else {
             return CheckResult::skip(

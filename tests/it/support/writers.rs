@@ -11,14 +11,14 @@ use coin_log::format::messages::{
     ReactionMessage, WorkMessage,
 };
 use coin_log::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, FORMAT_VERSION, MESSAGE_ENCODING,
-    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
+    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, Rk4, RunSettings, Termination,
 };
 use coin_log::model::{
-    centre, contact_point, energy, orientation, reaction, Branch, Chaplygin, Coin, CoinParams,
+    centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams,
     Dynamics, State, Steady, SteadyKind, STATE_LEN,
 };
 use coin_log::record::{Foxglove3d, FoxgloveBatch};
@@ -40,9 +40,17 @@ pub const COIN_CHANNELS: [Channel; 8] = [
 ];
 
 /// The JSON of per-sample channel `c` (one of [`COIN_CHANNELS`]) at state `s`, time `t`, computed here from
-/// the model's functions and the message types, independently of the recorder.
-pub fn message_json(coin: &Coin, chaplygin: &Chaplygin, c: Channel, t: f64, s: &State) -> Vec<u8> {
-    message_json_with(&Dynamics::Conservative(*coin), chaplygin, c, t, s, None)
+/// the model's functions and the message types, independently of the recorder; `e0` is the energy at the
+/// first sample (E₀ of the energy's `change`).
+pub fn message_json(
+    coin: &Coin,
+    chaplygin: &Chaplygin,
+    c: Channel,
+    t: f64,
+    s: &State,
+    e0: f64,
+) -> Vec<u8> {
+    message_json_with(&Dynamics::Conservative(*coin), chaplygin, c, t, s, None, e0)
 }
 
 /// [`message_json`] for any dynamics: the reaction follows them (physics §11), and `/coin/work` carries W
@@ -54,6 +62,7 @@ pub fn message_json_with(
     t: f64,
     s: &State,
     work: Option<f64>,
+    e0: f64,
 ) -> Vec<u8> {
     let coin = dynamics.coin();
     let mut buf = Vec::new();
@@ -70,6 +79,8 @@ pub fn message_json_with(
             theta: s.theta,
             phi: s.phi,
             psi: s.psi,
+            // φ̇ = ω_Y / cos θ, physics eq (18).
+            phi_dot: Some(s.omega_y / s.theta.cos()),
         }
         .write_json(&mut buf),
         Channel::Quaternion => {
@@ -106,6 +117,12 @@ pub fn message_json_with(
                 z: r.force.z,
                 friction: r.friction,
                 normal: r.normal,
+                // F / max(N, 1e-12 Mg), docs/format.md.
+                friction_ratio: Some(
+                    r.friction
+                        / r.normal
+                            .max(1e-12 * coin.params().mass() * coin.params().gravity()),
+                ),
             }
             .write_json(&mut buf)
         }
@@ -116,6 +133,11 @@ pub fn message_json_with(
                 total: e.total,
                 kinetic: e.kinetic,
                 potential: e.potential,
+                change: Some(e.total - e0),
+                // (E − E₀)/(ε max(|E₀|, Mga)), written out here rather than taken from the library.
+                drift_eps: Some(
+                    (e.total - e0) / (f64::EPSILON * e0.abs().max(coin.params().energy_scale())),
+                ),
             }
             .write_json(&mut buf)
         }
@@ -150,14 +172,16 @@ pub fn tool_schema(name: &str) -> Vec<u8> {
     schema_bytes(name).unwrap().to_vec()
 }
 
-/// Registers channel `c` in `w` (JSON messages, no metadata) with schema bytes `schema_of(name)`, each schema
-/// once (`schemas` maps the names registered so far to their ids); returns the channel id.
+/// Registers topic `c` (a channel's main topic, or a Foxglove extra) in `w` (JSON messages, no metadata) with
+/// schema bytes `schema_of(name)`, each schema once (`schemas` maps the names registered so far to their ids);
+/// returns the channel id.
 pub fn add_channel<W: Write + Seek>(
     w: &mut mcap::Writer<W>,
     schemas: &mut BTreeMap<&'static str, u16>,
-    c: Channel,
+    c: impl Into<Topic>,
     schema_of: &dyn Fn(&str) -> Vec<u8>,
 ) -> u16 {
+    let c: Topic = c.into();
     let name = c.schema_name();
     let schema = match schemas.get(name) {
         Some(id) => *id,
@@ -169,7 +193,7 @@ pub fn add_channel<W: Write + Seek>(
             id
         }
     };
-    w.add_channel(schema, c.topic(), MESSAGE_ENCODING, &BTreeMap::new())
+    w.add_channel(schema, c.name(), MESSAGE_ENCODING, &BTreeMap::new())
         .unwrap()
 }
 
@@ -223,10 +247,14 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         .create(file)
         .unwrap();
     let mut schemas = BTreeMap::new();
-    let ids: BTreeMap<Channel, u16> = COIN_CHANNELS
+    let mut ids: BTreeMap<Topic, u16> = COIN_CHANNELS
         .into_iter()
-        .chain([Channel::Tf, Channel::Scene])
-        .map(|c| (c, add_channel(&mut w, &mut schemas, c, &tool_schema)))
+        .map(|c| {
+            (
+                Topic::Main(c),
+                add_channel(&mut w, &mut schemas, c, &tool_schema),
+            )
+        })
         .collect();
     w.write_metadata(&mcap::records::Metadata {
         name: "coin-log".into(),
@@ -244,6 +272,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
     };
     let events = CoinEvents::new(coin, 1e-4, None);
     let chaplygin = Chaplygin::new(coin.params()).unwrap();
+    let e0 = energy(&coin, &steady.state).total;
     let mut rk4 = Rk4::new(1e-3);
     simulate(
         &coin,
@@ -254,12 +283,15 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         |t, y| {
             let s = State::from_array(y);
             let lt = log_time(t).unwrap();
-            let mut write = |c: Channel, data: &[u8]| {
+            let mut write = |c: Topic, data: &[u8]| {
                 sequence += 1;
-                write_message(&mut w, ids[&c], sequence, lt, data);
+                let id = *ids
+                    .entry(c)
+                    .or_insert_with(|| add_channel(&mut w, &mut schemas, c, &tool_schema));
+                write_message(&mut w, id, sequence, lt, data);
             };
             for c in COIN_CHANNELS {
-                let mut buf = message_json(&coin, &chaplygin, c, t, &s);
+                let mut buf = message_json(&coin, &chaplygin, c, t, &s, e0);
                 if c == Channel::Energy
                     && damage == Damage::EnergyWithExtraField
                     && t > 0.5
@@ -269,13 +301,13 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
                     buf.extend_from_slice(b",\"power\":0}");
                     damaged = true;
                 }
-                write(c, &buf);
+                write(Topic::Main(c), &buf);
             }
             batch.clear();
             let last = (t - duration).abs() < 1e-9;
             fox.sample(t, lt, &s, last, &mut batch).unwrap();
             for (c, data) in batch.iter() {
-                if c == Channel::Scene
+                if c == Topic::Main(Channel::Scene)
                     && damage == Damage::SceneEntityWithoutMetadata
                     && t > 0.5
                     && !damaged
@@ -420,11 +452,12 @@ pub fn record(spec: &Spec, path: &Path) {
         sample_interval: 1.0 / spec.rate,
     };
     let y0 = spec.initial.to_array();
+    let e0 = energy(&coin, &spec.initial).total;
     let mut observe = |t: f64, y: &[f64; STATE_LEN]| {
         let s = State::from_array(y);
         let lt = log_time(t).unwrap();
         for (c, id) in &ids {
-            let data = message_json(&coin, &chaplygin, *c, t, &s);
+            let data = message_json(&coin, &chaplygin, *c, t, &s, e0);
             write_message(&mut w, *id, sequence, lt, &data);
             sequence += 1;
         }
@@ -505,7 +538,7 @@ pub fn rewrite_with_schemas(
             add_channel(
                 &mut w,
                 &mut schemas,
-                Channel::from_topic(&topic).unwrap(),
+                Topic::from_name(&topic).unwrap(),
                 schema_of,
             )
         });
