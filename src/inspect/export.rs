@@ -6,7 +6,8 @@
 //!   so a field added to the format appears without a change here), one row per message.
 //! - **Wide**: one table `samples.csv` joined on the sample time: `t`, then `<channel>.<field>` for every
 //!   `coin_log.*` channel present at the first sample, one row per sample.
-//! - `/tf` (per channel only) is flattened into `tf.csv`: `t`, the two frame ids, translation and
+//! - `/tf` (per channel only) is flattened into `tf.csv`, and so are the other frame-transform topics
+//!   (`/tf_static` into `tf_static.csv`, `/scene/follow` into `scene_follow.csv`): `t`, the two frame ids, translation and
 //!   rotation. `/scene` is skipped: it holds display geometry (the coin, the table, pieces of the track),
 //!   and the track's points are `/coin/contact`.
 //!
@@ -262,6 +263,24 @@ impl<W: Write> Exporter<'_, W> {
         let Some(channel) = Channel::from_topic(topic) else {
             return self.skip(topic, "not a coin-log channel");
         };
+        // Every frame-transform topic (/tf, /tf_static, /scene/follow) is flattened into a table named
+        // after the topic, so that two topics of one channel never share a file.
+        if schema == Channel::Tf.schema_name() && matches!(channel, Channel::Tf | Channel::Scene) {
+            return match self.layout {
+                Layout::PerChannel => {
+                    let columns = TF_COLUMNS.iter().map(ToString::to_string).collect();
+                    let name = format!("{}.csv", topic.trim_start_matches('/').replace('/', "_"));
+                    match self.open_table(&name, topic, columns) {
+                        Some(table) => Target::Tf { table },
+                        None => Target::Skip,
+                    }
+                }
+                Layout::Wide => self.skip(
+                    topic,
+                    "frame transforms are not one per sample; export per channel for tf.csv",
+                ),
+            };
+        }
         if schema != channel.schema_name() {
             return self.skip(
                 topic,
@@ -290,17 +309,6 @@ impl<W: Write> Exporter<'_, W> {
                 fields,
                 table: None,
             },
-            (None, Channel::Tf, Layout::PerChannel) => {
-                let columns = TF_COLUMNS.iter().map(ToString::to_string).collect();
-                match self.open_table("tf.csv", topic, columns) {
-                    Some(table) => Target::Tf { table },
-                    None => Target::Skip,
-                }
-            }
-            (None, Channel::Tf, Layout::Wide) => self.skip(
-                topic,
-                "frame transforms are not one per sample; export per channel for tf.csv",
-            ),
             (None, _, _) => self.skip(
                 topic,
                 "display geometry (the coin, the table, pieces of the track); the track's points are /coin/contact",

@@ -26,6 +26,8 @@ pub const TIME_CHARS: u64 = 5;
 pub const NUMBER_CHARS: u64 = 19;
 /// Bytes of a `/tf` message (measured: 283–289; 236 on `topple`, whose numbers are shorter).
 pub const TF_BYTES: u64 = 285;
+/// Messages per display update on the `scene` channel's topics (follow frame, coin, ~2 track levels).
+pub const SCENE_MESSAGES_PER_UPDATE: u64 = 4;
 /// Bytes of a `/scene` update without its track points (measured: 1700–1760).
 pub const SCENE_BYTES: u64 = 1700;
 /// Bytes of one track point in a `/scene` update (`{"x":...,"y":0.0,"z":...},`).
@@ -99,10 +101,15 @@ pub fn estimate(scene: &Scene, compression: Compression) -> Estimate {
     let mut seen_schemas = Vec::new();
     for &c in &scene.channels {
         let (count, bytes) = match c {
-            Channel::Tf => (n + 1, TF_BYTES),
+            // /tf: world → table once, then table → coin per sample; /tf_static: world → table once.
+            Channel::Tf => (n + 2, TF_BYTES),
+            // Per display update: the follow frame and the coin, and on average about two track levels
+            // (level k changes every 2^k updates: a binary counter); the table once, then when it moves.
+            // The bytes per message are averaged over these.
             Channel::Scene => (
-                updates,
-                SCENE_BYTES + TRACK_POINT_BYTES * n.div_ceil(updates.max(1)),
+                SCENE_MESSAGES_PER_UPDATE * updates + 1,
+                (SCENE_BYTES + TRACK_POINT_BYTES * n.div_ceil(updates.max(1)))
+                    / SCENE_MESSAGES_PER_UPDATE,
             ),
             _ => (n, c.fields().map_or(100, flat_bytes)),
         };
