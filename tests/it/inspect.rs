@@ -399,7 +399,7 @@ fn export_writes_every_value_bit_for_bit() {
             .all(|n| n.ends_with(".csv") && !n.starts_with('.')),
         "{names:?}"
     );
-    assert_eq!(names.len(), 9);
+    assert_eq!(names.len(), 11, "eight channels, tf, tf_static, scene_follow");
 }
 
 /// The comparison above fails when one value differs by one unit in the last place (negative control).
