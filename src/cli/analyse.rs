@@ -339,7 +339,8 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     );
     outln!(
         "{:<16} {} (straight rolling is unstable below it, docs/physics.md §5)",
-        "ω_c", map.critical_spin
+        "ω_c",
+        map.critical_spin
     );
     let report = band_report(&coin);
     if !report.is_empty() {

@@ -517,7 +517,7 @@ pub fn record<W: Write + Seek>(
     summary.energy_tolerance = tolerance;
     summary.event_trusted = termination
         .is_event()
-        .then(|| summary.energy_drift <= tolerance);
+        .then_some(summary.energy_drift <= tolerance);
     Ok(summary)
 }
 

@@ -204,7 +204,7 @@ fn check_derived_scales(body: &super::file::BodyFile, problems: &mut Problems) -
 /// rtol and atol ranges that need no body (atol's ceiling needs the body: [`check_resolved`]); only for
 /// adaptive methods, which use them.
 pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Problems) {
-    if !method.is_some_and(Method::is_adaptive) || !(rtol.is_finite() && rtol > 0.0) {
+    if !(method.is_some_and(Method::is_adaptive) && rtol.is_finite() && rtol > 0.0) {
         return;
     }
     if rtol < RTOL_MIN {

@@ -72,7 +72,10 @@ fn dry_run_prints_the_resolved_scene_and_writes_nothing() {
         assert!(text.contains(key), "`{key}` in the dry run");
     }
     // Every setting the integrator uses, none it ignores: dop853 has no fixed step.
-    assert!(!text.contains("step ="), "no `step =` for dop853 in the dry run");
+    assert!(
+        !text.contains("step ="),
+        "no `step =` for dop853 in the dry run"
+    );
     assert!(text.contains("7501 samples"), "30 × 250 + 1 samples");
     // A bad scene: the same errors as a real recording, exit 1, nothing written.
     let out = coin_log(
@@ -214,7 +217,11 @@ fn scenes_json_lists_every_built_in_resolved() {
         // The settings the integrator uses are filled in, the others left out.
         let adaptive = matches!(run["integrator"].as_str(), Some("dop853" | "dopri5"));
         for (key, used) in [("rtol", adaptive), ("atol", adaptive), ("step", !adaptive)] {
-            assert_eq!(!run[key].is_null(), used, "{name}: run.{key} filled in iff used");
+            assert_eq!(
+                !run[key].is_null(),
+                used,
+                "{name}: run.{key} filled in iff used"
+            );
         }
         assert!(entry["scene"]["record"]["channels"].is_array());
         assert!(!entry["scene"]["body"]["thickness"].is_null());

@@ -380,7 +380,10 @@ fn export_writes_every_value_bit_for_bit() {
     for k in skipped {
         let topic = k["topic"].as_str().unwrap();
         assert!(topic == "/scene" || topic.starts_with("/scene/t"), "{k}");
-        assert!(k["reason"].as_str().unwrap().contains("/coin/contact"), "{k}");
+        assert!(
+            k["reason"].as_str().unwrap().contains("/coin/contact"),
+            "{k}"
+        );
     }
     assert!(tables.join("tf_static.csv").exists() && tables.join("scene_follow.csv").exists());
     // Again without --overwrite: refused, the tables untouched, no temporary file left.
@@ -399,7 +402,11 @@ fn export_writes_every_value_bit_for_bit() {
             .all(|n| n.ends_with(".csv") && !n.starts_with('.')),
         "{names:?}"
     );
-    assert_eq!(names.len(), 11, "eight channels, tf, tf_static, scene_follow");
+    assert_eq!(
+        names.len(),
+        11,
+        "eight channels, tf, tf_static, scene_follow"
+    );
 }
 
 /// The comparison above fails when one value differs by one unit in the last place (negative control).
@@ -615,7 +622,8 @@ fn info_does_not_trust_a_summary_whose_crc_fails() {
     let path = record_scene(dir.path(), "circle-plus", &["--duration", "2"]);
     let mut bytes = std::fs::read(&path).unwrap();
     let footer = bytes.len() - 37;
-    let summary_start = u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap()) as usize;
+    let summary_start =
+        u64::from_le_bytes(bytes[footer + 9..footer + 17].try_into().unwrap()) as usize;
     // A byte inside the first summary record's body (the schema's data): only the CRC can tell.
     bytes[summary_start + 40] ^= 0x20;
     std::fs::write(dir.path().join("bad.mcap"), &bytes).unwrap();

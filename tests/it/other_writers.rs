@@ -66,7 +66,11 @@ fn every_rewrite_by_the_python_and_typescript_writers_verifies_like_the_original
     assert_eq!(code, 0, "{original}{err}");
     for check in original["checks"].as_array().unwrap() {
         // A steady circle does not nutate: that one check is skipped, by design, with its reason.
-        let expected = if check["id"] == "nutation" { "skip" } else { "pass" };
+        let expected = if check["id"] == "nutation" {
+            "skip"
+        } else {
+            "pass"
+        };
         assert_eq!(
             check["status"], expected,
             "every other check runs on the original: {check}"
@@ -115,7 +119,10 @@ fn a_rewrite_without_summary_or_with_a_wrong_metadata_index_is_judged_and_fails_
         .iter()
         .filter(|(op, _, _)| *op == 0x06)
         .count();
-    assert!(chunks > 10, "{chunks} chunks: small chunks, as the layout is meant to have");
+    assert!(
+        chunks > 10,
+        "{chunks} chunks: small chunks, as the layout is meant to have"
+    );
     #[allow(clippy::cast_precision_loss)]
     let missing = (chunks + 1) as f64;
     for (name, problem, count) in [

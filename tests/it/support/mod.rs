@@ -80,8 +80,17 @@ impl Seek for FailingWriter {
 /// A resolved scene's `[run]` holds the settings its integrator uses and none it ignores: rtol and atol
 /// for an adaptive method, the step for a fixed-step one (docs/format.md: Metadata records).
 pub fn assert_uses_its_settings(name: &str, text: &str) {
-    let adaptive = text.contains("integrator = \"dop853\"") || text.contains("integrator = \"dopri5\"");
-    for (key, used) in [("rtol =", adaptive), ("atol =", adaptive), ("step =", !adaptive)] {
-        assert_eq!(text.contains(key), used, "{name}: `{key}` present iff used in\n{text}");
+    let adaptive =
+        text.contains("integrator = \"dop853\"") || text.contains("integrator = \"dopri5\"");
+    for (key, used) in [
+        ("rtol =", adaptive),
+        ("atol =", adaptive),
+        ("step =", !adaptive),
+    ] {
+        assert_eq!(
+            text.contains(key),
+            used,
+            "{name}: `{key}` present iff used in\n{text}"
+        );
     }
 }

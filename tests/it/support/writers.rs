@@ -18,8 +18,8 @@ use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, Rk4, RunSettings, Termination,
 };
 use coin_log::model::{
-    centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams,
-    Dynamics, State, Steady, SteadyKind, STATE_LEN,
+    centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams, Dynamics,
+    State, Steady, SteadyKind, STATE_LEN,
 };
 use coin_log::record::{Foxglove3d, FoxgloveBatch};
 use coin_log::simulation::{simulate, CoinEvents};
