@@ -321,6 +321,9 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
         .with_context(|| format!("creating the output folder `{}`", args.out.display()))?;
     let csv_path = args.out.join("stability-map.csv");
     let svg_path = args.out.join("stability-map.svg");
+    // Both checked before either is written, so a refusal leaves the folder as it was.
+    super::destination::refuse_special(&csv_path)?;
+    super::destination::refuse_special(&svg_path)?;
     write_replacing(&csv_path, &csv)?;
     write_replacing(&svg_path, &svg)?;
     let branches = match options.branches {
@@ -360,6 +363,7 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
 /// file (or none), never half of the new one.
 fn write_replacing(path: &Path, text: &str) -> anyhow::Result<()> {
     use std::io::Write;
+    super::destination::refuse_special(path)?;
     let folder = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())

@@ -99,6 +99,37 @@ pub fn check_target(
     Ok(Some(meta))
 }
 
+/// For the other commands that write files (`plot`, `export`, `analyse map`): an existing `target` must be
+/// a regular file, since they too move a finished temporary file into place, which would replace a link,
+/// a device, a pipe or a socket with a plain file, even with `--overwrite`. Looks without following links.
+///
+/// # Errors
+/// `target` exists and is not a regular file.
+pub fn refuse_special(target: &Path) -> anyhow::Result<()> {
+    let shown = target.display();
+    let Ok(meta) = fs::symlink_metadata(target) else {
+        return Ok(());
+    };
+    let kind = meta.file_type();
+    if kind.is_symlink() {
+        let to = fs::read_link(target).map_or_else(|_| "?".into(), |p| p.display().to_string());
+        bail!(
+            "`{shown}` is a symbolic link (to `{to}`), not a regular file; the new file is moved into place, \
+             which would replace the link itself with a plain file: give the path it points to, or choose \
+             another path"
+        );
+    }
+    if !kind.is_file() && !kind.is_dir() {
+        let what = kind_of(&meta);
+        bail!(
+            "`{shown}` is {what}, not a regular file; the new file is moved into place, which would \
+             replace {}: choose a file path",
+            what.replacen("a ", "the ", 1)
+        );
+    }
+    Ok(())
+}
+
 /// The target's folder must exist (a clearer message than the temporary file's ENOENT).
 fn check_folder(target: &Path) -> anyhow::Result<()> {
     let folder = folder_of(target);

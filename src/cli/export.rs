@@ -116,6 +116,9 @@ fn out_dir(args: &ExportArgs) -> anyhow::Result<PathBuf> {
 /// Moves every finished table into place: first checks that none would replace a file (unless
 /// `overwrite`), so that either all tables land or none does.
 fn persist(temps: Vec<(String, NamedTempFile)>, dir: &Path, overwrite: bool) -> anyhow::Result<()> {
+    for (name, _) in &temps {
+        super::destination::refuse_special(&dir.join(name))?;
+    }
     if !overwrite {
         let existing: Vec<String> = temps
             .iter()

@@ -41,6 +41,7 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
             target.join("plot.svg").display()
         );
     }
+    super::destination::refuse_special(&target)?;
     if target.exists() && !args.overwrite {
         bail!("`{}` already exists; pass --overwrite to replace it, or choose another file with --out", target.display());
     }

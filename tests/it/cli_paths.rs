@@ -311,3 +311,79 @@ fn a_second_signal_abandons_the_recording_and_leaves_nothing() {
         "a finished file or nothing, never a temporary file: {files:?}"
     );
 }
+
+/// `plot`, `export` and `analyse map` also move finished files into place: with `--overwrite` (or, for
+/// the map, always replacing its own files) they must still refuse a named pipe and a symbolic link,
+/// leave both intact, and leave no temporary file (negative control: a regular file is replaced).
+#[test]
+fn plot_export_and_the_map_never_replace_a_pipe_or_a_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = coin_log(d, &["record", "topple", "-o", "topple.mcap"]);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    std::fs::create_dir(d.join("tables")).unwrap();
+    std::fs::write(d.join("real"), "precious").unwrap();
+    for name in ["pipe.svg", "tables/omega.csv", "stability-map.csv"] {
+        let status = Command::new("mkfifo").arg(d.join(name)).status().unwrap();
+        assert!(status.success(), "mkfifo {name}");
+    }
+    std::os::unix::fs::symlink("real", d.join("link.svg")).unwrap();
+    let runs: [(&[&str], &str); 4] = [
+        (
+            &["plot", "topple.mcap", "--out", "pipe.svg", "--overwrite"],
+            "`pipe.svg` is a named pipe",
+        ),
+        (
+            &["plot", "topple.mcap", "--out", "link.svg", "--overwrite"],
+            "`link.svg` is a symbolic link (to `real`)",
+        ),
+        (
+            &["export", "topple.mcap", "--out", "tables", "--overwrite"],
+            "omega.csv` is a named pipe",
+        ),
+        (
+            &[
+                "analyse",
+                "map",
+                "--theta",
+                "0.1:0.2:3",
+                "--omega-z",
+                "0.1:0.2:3",
+                "--out",
+                ".",
+            ],
+            "stability-map.csv` is a named pipe",
+        ),
+    ];
+    let before = listing(d);
+    for (args, needle) in runs {
+        let out = coin_log(d, args);
+        assert_eq!(code(&out), 1, "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        assert_eq!(listing(d), before, "{args:?}: the folder is as it was");
+    }
+    for name in ["pipe.svg", "tables/omega.csv", "stability-map.csv"] {
+        let meta = std::fs::symlink_metadata(d.join(name)).unwrap();
+        assert!(meta.file_type().is_fifo(), "{name} is intact");
+    }
+    assert!(std::fs::symlink_metadata(d.join("link.svg"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read(d.join("real")).unwrap(), b"precious");
+    assert_eq!(
+        listing(&d.join("tables")),
+        ["omega.csv"],
+        "no table, no temporary file"
+    );
+    // Negative control: a regular file in the way is replaced with --overwrite.
+    std::fs::write(d.join("plain.svg"), "old").unwrap();
+    let out = coin_log(
+        d,
+        &["plot", "topple.mcap", "--out", "plain.svg", "--overwrite"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(std::fs::read_to_string(d.join("plain.svg"))
+        .unwrap()
+        .contains("<svg"));
+}
