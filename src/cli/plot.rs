@@ -50,10 +50,7 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
         |n| n.to_string_lossy().into_owned(),
     );
     let svg = plot::plot(&args.file, &name).map_err(|e| anyhow!("{}: {e}", args.file.display()))?;
-    let folder = match target.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let folder = super::destination::folder_of(&target);
     let mut temp = tempfile::Builder::new()
         .prefix(".coin-log-")
         .suffix(".svg.tmp")
@@ -62,13 +59,7 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
     temp.write_all(svg.as_bytes())
         .and_then(|()| temp.as_file().sync_all())
         .with_context(|| format!("writing `{}`", target.display()))?;
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = temp
-            .as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
+    super::make_readable(temp.as_file());
     let moved = if args.overwrite {
         temp.persist(&target).map(|_| ()).map_err(|e| e.error)
     } else {

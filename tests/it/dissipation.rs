@@ -15,7 +15,7 @@ use crate::support::writers::{nudge, rewrite};
 use coin_log::format::metadata::DISSIPATION_KEYS;
 use coin_log::format::{Channel, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use coin_log::model::{
-    energy, Coin, CoinParams, Dissipation, DissipationModel, DissipativeCoin, Inertia,
+    energy, Coin, CoinParams, Dissipation, DissipationModel, DissipativeCoin,
     DISSIPATIVE_STATE_LEN, STATE_LEN, WORK_INDEX,
 };
 use coin_log::record::{record, RecordOptions, RecordSummary};
@@ -36,25 +36,6 @@ fn config() -> Config {
         failure_persistence: None,
         ..Config::default()
     }
-}
-
-/// A random body (as in `properties`): M, a, g over decades, inertias a tenth to twice M a².
-fn body() -> impl Strategy<Value = CoinParams> {
-    (0.1..10.0, 0.1..5.0, 0.5..20.0, 0.1..1.0, 0.1..2.0).prop_map(
-        |(m, a, g, kx, kz): (f64, f64, f64, f64, f64)| {
-            let ma2 = m * a * a;
-            CoinParams::new(
-                m,
-                a,
-                g,
-                Inertia::Explicit {
-                    inertia_x: kx * ma2,
-                    inertia_z: kz * ma2,
-                },
-            )
-            .unwrap()
-        },
-    )
 }
 
 /// A random law for body `p`: m in [1, 3], k in [−2, 2], κ up to 2 Mga (g/a)^((1−m)/2), the size that
@@ -85,7 +66,7 @@ proptest! {
     /// cancel to round-off and the couple removes exactly P.
     #[test]
     fn the_energy_falls_at_exactly_the_dissipated_power(
-        p in body(),
+        p in physics::random_body(),
         (theta, wx, wy, wz) in (-1.4..1.4, -5.0..5.0, -5.0..5.0, -5.0..5.0),
         (c, m, k) in (0.0..2.0, 1.0..3.0, -2.0..2.0),
     ) {

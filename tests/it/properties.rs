@@ -12,7 +12,7 @@ use crate::support::newton_euler::NewtonEuler;
 use crate::support::physics::{self, rate_unit};
 use crate::support::vectors::{self, V3};
 use coin_log::model::{
-    centre, contact_point, orientation, reaction, Branch, Coin, CoinParams, Inertia, State, Steady,
+    centre, contact_point, orientation, reaction, Branch, Coin, CoinParams, State, Steady,
     SteadyKind, STATE_LEN,
 };
 use proptest::prelude::*;
@@ -28,25 +28,6 @@ fn config() -> Config {
         failure_persistence: None,
         ..Config::default()
     }
-}
-
-/// A random body: M, a, g over two decades, inertias between a tenth and twice M a² (any shape).
-fn body() -> impl Strategy<Value = CoinParams> {
-    (0.1..10.0, 0.1..5.0, 0.5..20.0, 0.1..1.0, 0.1..2.0).prop_map(
-        |(m, a, g, kx, kz): (f64, f64, f64, f64, f64)| {
-            let ma2 = m * a * a;
-            CoinParams::new(
-                m,
-                a,
-                g,
-                Inertia::Explicit {
-                    inertia_x: kx * ma2,
-                    inertia_z: kz * ma2,
-                },
-            )
-            .unwrap()
-        },
-    )
 }
 
 /// A random state for `p`: |θ| ≤ 1.4, any heading and spin, |ω_i| ≤ 5 √(g/a), centre within 10 a.
@@ -101,7 +82,7 @@ proptest! {
     /// ∂E/∂ω_Y = I_X ω_Y, ∂E/∂ω_Z = (I_Z + Ma²) ω_Z (physics §3), must vanish for the RHS of eqs (14)–(17).
     /// Scale: the sum of the absolute values of every product that enters.
     #[test]
-    fn the_exact_flow_conserves_energy(p in body(), u in state()) {
+    fn the_exact_flow_conserves_energy(p in physics::random_body(), u in state()) {
         let coin = Coin::new(p);
         let s = scaled(&p, &u);
         let f = rhs(&coin, &s);
@@ -128,7 +109,7 @@ proptest! {
     /// The centre's velocity from the RHS, (ẋ, −a sin θ θ̇, ż), equals −ω × ρ with ρ = −a e_Y and
     /// ω = ω_X e_X + ω_Y e_Y + ω_Z e_Z from the lean frame built independently (physics §1).
     #[test]
-    fn the_centre_moves_with_the_no_slip_velocity(p in body(), u in state()) {
+    fn the_centre_moves_with_the_no_slip_velocity(p in physics::random_body(), u in state()) {
         let coin = Coin::new(p);
         let s = scaled(&p, &u);
         let f = rhs(&coin, &s);
@@ -144,7 +125,7 @@ proptest! {
     /// third row, derived from the rotations of physics §1); and the contact point is centre − a e_Y with
     /// e_Y = e_Z × (e_y × e_Z)/|e_y × e_Z| built from that rotated normal.
     #[test]
-    fn the_quaternion_carries_the_normal_and_places_the_contact_point(p in body(), u in state()) {
+    fn the_quaternion_carries_the_normal_and_places_the_contact_point(p in physics::random_body(), u in state()) {
         let coin = Coin::new(p);
         let s = scaled(&p, &u);
         let q = orientation(&s);
@@ -163,7 +144,7 @@ proptest! {
     /// solves for, and its angular acceleration, carried to the world frame
     /// (ω̇ = Σ ω̇_i e_i + Ω × ω with the lean frame's rate Ω = θ̇ e_X + φ̇ e_y), equals the Newton–Euler ω̇.
     #[test]
-    fn the_library_and_the_newton_euler_model_agree_at_every_state(p in body(), u in state()) {
+    fn the_library_and_the_newton_euler_model_agree_at_every_state(p in physics::random_body(), u in state()) {
         let coin = Coin::new(p);
         let s = scaled(&p, &u);
         let ne = NewtonEuler::from_params(&p);
@@ -187,7 +168,7 @@ proptest! {
     /// the largest term of eq (14)), and the analytic φ̇, ψ̇ equal eqs (18)–(19).
     #[test]
     fn steady_constructors_give_fixed_points_of_the_equations(
-        p in body(),
+        p in physics::random_body(),
         theta_magnitude in 0.01..1.5_f64,
         theta_negative in any::<bool>(),
         omega_z_natural in -5.0..5.0_f64,

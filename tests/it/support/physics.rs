@@ -7,6 +7,7 @@
 
 use coin_log::integrate::{OdeSystem, Rk4, Stepper};
 use coin_log::model::{CoinParams, Inertia, State};
+use proptest::prelude::*;
 
 /// Unit thin disk M = a = g = 1 (the note's section 5).
 pub fn unit_disk() -> CoinParams {
@@ -112,4 +113,24 @@ pub fn zero_crossings(samples: &[(f64, f64)]) -> Vec<f64> {
         .filter(|w| w[0].1 != 0.0 && w[0].1.signum() != w[1].1.signum())
         .map(|w| w[0].0 - w[0].1 * (w[1].0 - w[0].0) / (w[1].1 - w[0].1))
         .collect()
+}
+
+/// A random body for property tests: M, a, g over two decades, inertias between a tenth and twice M a²
+/// (any shape, not only the thin disk or the hoop).
+pub fn random_body() -> impl Strategy<Value = CoinParams> {
+    (0.1..10.0, 0.1..5.0, 0.5..20.0, 0.1..1.0, 0.1..2.0).prop_map(
+        |(m, a, g, kx, kz): (f64, f64, f64, f64, f64)| {
+            let ma2 = m * a * a;
+            CoinParams::new(
+                m,
+                a,
+                g,
+                Inertia::Explicit {
+                    inertia_x: kx * ma2,
+                    inertia_z: kz * ma2,
+                },
+            )
+            .unwrap()
+        },
+    )
 }
