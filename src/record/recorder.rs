@@ -182,16 +182,53 @@ impl From<TimeError> for SampleError {
     }
 }
 
+/// A topic's channel as the file declares it: what a [`Tap`] needs to announce it elsewhere.
+#[derive(Debug, Clone, Copy)]
+pub struct ChannelInfo<'a> {
+    /// The topic.
+    pub topic: Topic,
+    /// Schema name (e.g. `coin_log.Energy`).
+    pub schema_name: &'static str,
+    /// Schema encoding (`jsonschema` or `protobuf`).
+    pub schema_encoding: &'static str,
+    /// The schema's bytes, as written to the file.
+    pub schema: &'a [u8],
+    /// Message encoding (`json` or `protobuf`).
+    pub message_encoding: &'static str,
+}
+
+/// Sees the recording as it is written (e.g. `coin-log live` serves it to a viewer): each topic's channel
+/// before its first message, then every message with its log time, in the file's order. Called on the
+/// simulation's thread, so a tap that blocks (to pace the run in real time) slows the run.
+pub trait Tap {
+    /// A topic's channel, once, before its first message.
+    fn channel(&mut self, info: &ChannelInfo<'_>);
+    /// A message, after it went to the file.
+    fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]);
+}
+
+/// The tap of a plain recording: sees nothing (and costs nothing: it is inlined away).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoTap;
+
+impl Tap for NoTap {
+    #[inline]
+    fn channel(&mut self, _: &ChannelInfo<'_>) {}
+    #[inline]
+    fn message(&mut self, _: Topic, _: u64, _: &[u8]) {}
+}
+
 /// The writer with its topics: registers a topic's MCAP channel at its first message, numbers messages per
-/// topic.
-struct Output<W: Write + Seek> {
+/// topic, and shows both to the tap.
+struct Output<W: Write + Seek, T: Tap> {
     writer: McapWriter<W>,
+    tap: T,
     ids: [Option<u16>; Topic::COUNT],
     sequence: [u32; Topic::COUNT],
     messages: u64,
 }
 
-impl<W: Write + Seek> Output<W> {
+impl<W: Write + Seek, T: Tap> Output<W, T> {
     #[inline]
     fn write(&mut self, topic: Topic, log_time: u64, data: &[u8]) -> Result<(), SampleError> {
         let index = topic.index();
@@ -204,6 +241,7 @@ impl<W: Write + Seek> Output<W> {
         self.writer
             .write_message(channel_id, sequence, log_time, log_time, data)?;
         self.messages += 1;
+        self.tap.message(topic, log_time, data);
         Ok(())
     }
 
@@ -217,6 +255,13 @@ impl<W: Write + Seek> Output<W> {
             self.writer
                 .add_channel(schema_id, topic.name(), MESSAGE_ENCODING, &BTreeMap::new())?;
         self.ids[topic.index()] = Some(id);
+        self.tap.channel(&ChannelInfo {
+            topic,
+            schema_name,
+            schema_encoding: SCHEMA_ENCODING,
+            schema: data,
+            message_encoding: MESSAGE_ENCODING,
+        });
         Ok(id)
     }
 }
@@ -264,8 +309,8 @@ impl Drift {
 }
 
 /// Everything a sample needs, built once.
-struct Sampler<W: Write + Seek> {
-    out: Output<W>,
+struct Sampler<W: Write + Seek, T: Tap> {
+    out: Output<W, T>,
     coin: Coin,
     /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
     dynamics: Dynamics,
@@ -285,7 +330,7 @@ struct Sampler<W: Write + Seek> {
     samples: u64,
 }
 
-impl<W: Write + Seek> Sampler<W> {
+impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     #[inline]
     fn on(&self, channel: Channel) -> bool {
         self.on[channel as usize]
@@ -505,7 +550,22 @@ pub fn record<W: Write + Seek>(
     stop: &AtomicBool,
     progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
-    let mut sampler = Sampler::start(scene, options, writer)?;
+    record_with_tap(scene, options, writer, NoTap, stop, progress)
+}
+
+/// [`record`], showing every channel and message to `tap` as it is written.
+///
+/// # Errors
+/// As [`record`].
+pub fn record_with_tap<W: Write + Seek, T: Tap>(
+    scene: &Scene,
+    options: &RecordOptions,
+    writer: W,
+    tap: T,
+    stop: &AtomicBool,
+    progress: impl FnMut(f64),
+) -> Result<RecordSummary, RecordError> {
+    let mut sampler = Sampler::start(scene, options, writer, tap)?;
     let (outcome, error) = integrate_into(scene, &mut sampler, stop, progress);
     let (termination, termination_time, failure) = match error {
         Some(SampleError::Write(e)) => return Err(e.into()),
@@ -560,9 +620,9 @@ fn ending(end: &integrate::Termination, t_last: f64) -> (Termination, f64, Optio
 /// Runs the scene's integrator, writing each sample one sample late (so that the last one can be flagged
 /// as last), reporting progress and honouring `stop`. Returns the integrator's outcome and the error that
 /// stopped writing, if one did.
-fn integrate_into<W: Write + Seek>(
+fn integrate_into<W: Write + Seek, T: Tap>(
     scene: &Scene,
-    sampler: &mut Sampler<W>,
+    sampler: &mut Sampler<W, T>,
     stop: &AtomicBool,
     mut progress: impl FnMut(f64),
 ) -> (RunOutcome, Option<SampleError>) {
@@ -609,10 +669,15 @@ fn integrate_into<W: Write + Seek>(
     (outcome, error)
 }
 
-impl<W: Write + Seek> Sampler<W> {
+impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// Opens the file: writer, `coin-log` metadata, and what each sample will compute. A body whose C1, C2
     /// cannot be evaluated fails here, before the first byte, so no half-written file is left.
-    fn start(scene: &Scene, options: &RecordOptions, writer: W) -> Result<Self, RecordError> {
+    fn start(
+        scene: &Scene,
+        options: &RecordOptions,
+        writer: W,
+        tap: T,
+    ) -> Result<Self, RecordError> {
         let dynamics = scene.dynamics();
         let coin = *dynamics.coin();
         let mut on = [false; Channel::ALL.len()];
@@ -636,6 +701,7 @@ impl<W: Write + Seek> Sampler<W> {
         Ok(Self {
             out: Output {
                 writer,
+                tap,
                 ids: [None; Topic::COUNT],
                 sequence: [0; Topic::COUNT],
                 messages: 0,
