@@ -136,12 +136,12 @@ impl Path2 {
         if self.stride == 0 {
             self.stride = 1;
         }
-        if self.seen % self.stride == 0 {
+        if self.seen.is_multiple_of(self.stride) {
             if self.points.len() == 2 * POINTS {
                 self.points = self.points.iter().step_by(2).copied().collect();
                 self.stride *= 2;
             }
-            if self.seen % self.stride == 0 {
+            if self.seen.is_multiple_of(self.stride) {
                 self.points.push(p);
             }
         }

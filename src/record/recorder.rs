@@ -650,7 +650,7 @@ fn integrate_into<W: Write + Seek, T: Tap>(
                 }
             }
             observed += 1;
-            if observed % PROGRESS_INTERVAL == 0 {
+            if observed.is_multiple_of(PROGRESS_INTERVAL) {
                 progress(t);
             }
             if stop.load(Ordering::Relaxed) {
