@@ -25,7 +25,7 @@
 use super::precision::rtol_for;
 use super::presets::bench_case;
 use super::{reference_trajectory, run_sampled, state_error, BenchCase, BenchError, Trajectory};
-use crate::format::Channel;
+use crate::format::{Channel, Encoding};
 use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Stats};
 use crate::mcap_io::{
     self, ChunkCompression, ChunkCompressor, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
@@ -408,6 +408,8 @@ fn median_peak(peaks: impl Iterator<Item = Option<u64>>) -> f64 {
 pub struct DurationRuns {
     /// The workloads' duration \[time units\].
     pub duration: f64,
+    /// The recordings' message encoding.
+    pub encoding: Encoding,
     /// The record runs, one per repeat.
     pub records: Vec<RecordRun>,
     /// The compression bounds of their recordings.
@@ -481,8 +483,17 @@ impl DurationRuns {
     fn record_rows(&self, last: &RecordRun, bound: &Bound, record_s: f64) -> Vec<ThroughputRow> {
         let duration = self.duration;
         let messages = last.messages;
-        let workload = format!("record {SCENE} {duration} u @ 1 kHz, 7 channels, zstd");
-        let counts = format!("{messages} messages, {} JSON bytes", bound.json_bytes);
+        let (workload, what) = match self.encoding {
+            Encoding::Json => (
+                format!("record {SCENE} {duration} u @ 1 kHz, 7 channels, zstd"),
+                "JSON",
+            ),
+            Encoding::Protobuf => (
+                format!("record {SCENE} {duration} u @ 1 kHz, 7 channels, zstd, protobuf"),
+                "Protobuf",
+            ),
+        };
+        let counts = format!("{messages} messages, {} {what} bytes", bound.json_bytes);
         vec![
             row(
                 &workload,
@@ -494,7 +505,7 @@ impl DurationRuns {
             ),
             row(
                 &workload,
-                "JSON MB/s",
+                &format!("{what} MB/s"),
                 as_f64(bound.json_bytes) / record_s / 1e6,
                 "MB/s",
                 None,
@@ -515,7 +526,7 @@ impl DurationRuns {
                 "B",
                 None,
                 &format!(
-                    "{:.1} B/message, JSON/file {:.2}",
+                    "{:.1} B/message, {what}/file {:.2}",
                     as_f64(last.bytes) / as_f64(messages),
                     as_f64(bound.json_bytes) / as_f64(last.bytes)
                 ),

@@ -258,6 +258,15 @@ fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
     };
     let scene = scene::resolve(&source.file, &flags)
         .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
+    let max = record::foxglove::PROTOBUF_MAX_SECONDS;
+    if args.encoding == EncodingArg::Protobuf && scene.run.duration > max {
+        return Err(anyhow!(
+            "scene `{}`: run.duration = {} is longer than {max} time units, the most Foxglove's Protobuf \
+             timestamps hold (32-bit seconds); record it with --encoding json, or shorten it with --duration",
+            source.label,
+            scene.run.duration
+        ));
+    }
     let (file, provenance) = flags.apply(&source.file);
     let method = scene.run.method.method;
     for (key, value) in limits::ignored_settings(file.run.as_ref(), method) {

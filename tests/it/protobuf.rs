@@ -2,6 +2,8 @@
 //! verdict, same check values to the last bit), the bytes are reproducible, the Foxglove messages carry the
 //! same frames and drawing as the JSON ones, export gives the same tables, and verify names what is wrong
 //! with a damaged Protobuf file (negative controls).
+// The helpers outside #[test] functions read files they just wrote: a failure there is a failed test.
+#![allow(clippy::unwrap_used)]
 
 use crate::support::record::{coin_log_text, read_back, record_scene, scene_names};
 use coin_log::format::protobuf::put_double;
@@ -118,12 +120,12 @@ fn color(c: Option<&foxglove::messages::Color>) -> Value {
 }
 
 fn cube(c: &CubePrimitive) -> Value {
-    let s = c.size.clone().unwrap_or_default();
+    let s = c.size.unwrap_or_default();
     json!({"pose": pose(c.pose.as_ref()), "size": vector(s.x, s.y, s.z), "color": color(c.color.as_ref())})
 }
 
 fn cylinder(c: &CylinderPrimitive) -> Value {
-    let s = c.size.clone().unwrap_or_default();
+    let s = c.size.unwrap_or_default();
     json!({"pose": pose(c.pose.as_ref()), "size": vector(s.x, s.y, s.z), "bottom_scale": c.bottom_scale,
            "top_scale": c.top_scale, "color": color(c.color.as_ref())})
 }
@@ -428,10 +430,9 @@ fn verify_names_what_is_wrong_with_a_damaged_protobuf_file() {
     // The physics checks read the Protobuf values: E one part in a million off fails `energy`.
     rewrite(&src, &out, keep, protobuf, |topic, i, data| {
         if topic == "/coin/energy" && i == 100 {
-            let mut v = [0.0; 6];
+            // Field 1 (t) is bytes 0..9; field 2's value (`total`) follows its key at byte 9.
             let total = f64::from_le_bytes(data[10..18].try_into().unwrap());
-            v[1] = total * (1.0 + 1e-6);
-            put_double(data, 2, v[1]);
+            put_double(data, 2, total * (1.0 + 1e-6));
         }
     });
     let r = verify_file(&out, &Options::default());

@@ -4,6 +4,7 @@
 //! bound and the integration cost, turn the runs into rows and format them.
 
 use super::{create_dir, write};
+use crate::cli::record::EncodingArg;
 use crate::cli::Outcome;
 use anyhow::{anyhow, bail, Context};
 use coin_log::bench::throughput::{
@@ -34,6 +35,9 @@ pub struct ThroughputArgs {
     /// Keep the recordings in the output folder.
     #[arg(long)]
     keep: bool,
+    /// Message encoding of the recordings.
+    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
+    encoding: EncodingArg,
 }
 
 /// Runs `coin-log bench throughput`: measure, clean up, print the table, write the CSV.
@@ -41,7 +45,13 @@ pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
     let durations = durations(args)?;
     create_dir(&args.out)?;
     let exe = std::env::current_exe().context("locating the coin-log binary")?;
-    let result = measure(&exe, &args.out, &durations, args.repeats as usize);
+    let result = measure(
+        &exe,
+        &args.out,
+        &durations,
+        args.repeats as usize,
+        args.encoding,
+    );
     if !args.keep {
         for d in &durations {
             let _ = fs::remove_file(recording_path(&args.out, *d));
@@ -75,10 +85,11 @@ fn measure(
     dir: &Path,
     durations: &[f64],
     repeats: usize,
+    encoding: EncodingArg,
 ) -> anyhow::Result<ThroughputReport> {
     let mut rows = Vec::new();
     for &duration in durations {
-        rows.extend(record_and_verify(exe, dir, duration, repeats)?);
+        rows.extend(record_and_verify(exe, dir, duration, repeats, encoding)?);
     }
     rows.extend(throughput::integration_cost(repeats)?);
     Ok(ThroughputReport::new(rows))
@@ -90,11 +101,16 @@ fn record_and_verify(
     dir: &Path,
     duration: f64,
     repeats: usize,
+    encoding: EncodingArg,
 ) -> anyhow::Result<Vec<ThroughputRow>> {
     let path = recording_path(dir, duration);
-    let mut runs = DurationRuns::new(duration);
+    let mut runs = DurationRuns {
+        encoding: encoding.into(),
+        ..DurationRuns::new(duration)
+    };
     for _ in 0..repeats.max(1) {
-        runs.records.push(record_run(exe, &path, duration)?);
+        runs.records
+            .push(record_run(exe, &path, duration, encoding)?);
         runs.bounds.push(compression_bound(&path)?);
         runs.verifies.push(verify_run(exe, &path)?);
         runs.exports.push(export_run(exe, &path)?);
@@ -121,7 +137,16 @@ fn child_json(exe: &Path, args: &[String]) -> anyhow::Result<(serde_json::Value,
 }
 
 /// Records the workload for `duration` time units into `path` in a child process.
-fn record_run(exe: &Path, path: &Path, duration: f64) -> anyhow::Result<RecordRun> {
+fn record_run(
+    exe: &Path,
+    path: &Path,
+    duration: f64,
+    encoding: EncodingArg,
+) -> anyhow::Result<RecordRun> {
+    let encoding = match encoding {
+        EncodingArg::Json => "json",
+        EncodingArg::Protobuf => "protobuf",
+    };
     let args: Vec<String> = [
         "record",
         SCENE,
@@ -133,6 +158,8 @@ fn record_run(exe: &Path, path: &Path, duration: f64) -> anyhow::Result<RecordRu
         &channel_list(),
         "--compression",
         "zstd",
+        "--encoding",
+        encoding,
         "-o",
         &path.display().to_string(),
         "--overwrite",
