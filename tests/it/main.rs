@@ -33,6 +33,7 @@ mod linearisation;
 mod other_writers;
 mod params;
 mod properties;
+mod protobuf_readers;
 mod readme;
 mod record_roundtrip;
 mod rk4_order;
