@@ -3,8 +3,11 @@
 
 usage: .venv/bin/python scripts/readers/rerun_check.py FILE.mcap OUT.rrd
 
-1. `rerun mcap convert FILE.mcap -o OUT.rrd` (the CLI of the `rerun-sdk` package, from this venv): Rerun's
-   MCAP importer with all its decoders, as the viewer runs it when it opens the .mcap.
+1. `rerun mcap check --full FILE.mcap` (Rerun's structure and timeline check, payloads decoded);
+   `rerun mcap convert FILE.mcap --timeline-type duration -o OUT.rrd` (the CLI of the `rerun-sdk` package,
+   from this venv): Rerun's MCAP importer with all its decoders, as the viewer runs it when it opens the
+   .mcap; `--timeline-type duration` because coin-log's log times are simulation time from t = 0, not Unix
+   time; then `rerun rrd verify OUT.rrd` (every column deserializes as its Rerun type).
 2. Reads OUT.rrd back with the SDK (`rerun.chunk.RrdReader`) and prints one JSON document on stdout:
    - "rerun": the rerun-sdk version; "command": the conversion command;
    - "entities": {entity path: [component, ...]} for every entity with time-indexed data, and
@@ -42,12 +45,14 @@ def main(argv):
         print("usage: rerun_check.py FILE.mcap OUT.rrd", file=sys.stderr)
         return 2
     mcap, rrd = argv[1], argv[2]
-    cli = Path(sys.executable).parent / "rerun"
-    command = [str(cli), "mcap", "convert", mcap, "-o", rrd]
-    done = subprocess.run(command, capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        print(f"rerun_check.py: `{' '.join(command)}` failed ({done.returncode}):\n{done.stderr}", file=sys.stderr)
-        return 1
+    cli = str(Path(sys.executable).parent / "rerun")
+    command = [cli, "mcap", "convert", mcap, "--timeline-type", "duration", "-o", rrd]
+    for step in ([cli, "mcap", "check", "--full", mcap], command, [cli, "rrd", "verify", rrd]):
+        done = subprocess.run(step, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            shown = " ".join(["rerun", *step[1:]])
+            print(f"rerun_check.py: `{shown}` failed ({done.returncode}):\n{done.stdout}{done.stderr}", file=sys.stderr)
+            return 1
 
     entities, timelines, transforms, messages = {}, {}, {}, {}
     for chunk in rr.chunk.RrdReader(rrd).stream():
