@@ -50,10 +50,10 @@ class FileReadable {
 }
 
 /** The IEEE-754 binary64 bit pattern of `value`, 16 hex digits. */
+const view = new DataView(new ArrayBuffer(8));
 function bits(value) {
-  const view = new DataView(new ArrayBuffer(8));
   view.setFloat64(0, value);
-  return view.getBigUint64(0).toString(16).padStart(16, "0");
+  return (view.getUint32(0).toString(16).padStart(8, "0") + view.getUint32(4).toString(16).padStart(8, "0"));
 }
 
 function scalar(field, value) {
@@ -131,7 +131,7 @@ function foxgloveTimestamps(schemaName, message) {
   return [];
 }
 
-async function checkFile(file, published, dumpDir) {
+async function checkFile(file, published, roots, dumpDir) {
   const failures = [];
   const fail = (msg) => {
     if (failures.length < MAX_REPORTED) failures.push(msg);
@@ -169,8 +169,13 @@ async function checkFile(file, published, dumpDir) {
       }
       let type;
       try {
-        const set = descriptor.FileDescriptorSet.decode(schema.data);
-        const root = protobuf.Root.fromDescriptor(set, { keepCase: true });
+        // One root per distinct descriptor (protobufjs generates code for every type of a root).
+        const key = `${schema.name}\n${Buffer.from(schema.data).toString("base64")}`;
+        let root = roots.get(key);
+        if (root === undefined) {
+          root = protobuf.Root.fromDescriptor(descriptor.FileDescriptorSet.decode(schema.data), { keepCase: true });
+          roots.set(key, root);
+        }
         type = root.lookupType(schema.name);
         for (const t of messageTypes(root)) {
           const name = t.fullName.replace(/^\./, "");
@@ -268,11 +273,12 @@ async function main() {
   await zstd.isLoaded;
   await lz4.isLoaded;
   const published = publishedFoxglove();
+  const roots = new Map();
   let bad = 0;
   for (const file of args) {
     let result;
     try {
-      result = await checkFile(file, published, dumpDir);
+      result = await checkFile(file, published, roots, dumpDir);
     } catch (e) {
       result = { failures: [`unreadable: ${e.message}`], summary: "" };
     }

@@ -19,7 +19,7 @@ use crate::support::repo;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
 
 /// Simulated time of each recording: every channel and topic is written at t = 0 and then at the scene's
 /// rate, so one time unit gives tens to a thousand messages per channel and keeps the test to seconds.
@@ -48,37 +48,45 @@ fn record_both(dir: &Path, scene: &str) -> (PathBuf, PathBuf) {
     (pb, json)
 }
 
-/// What one reader said: success, its output, and its dump (file name → messages).
+/// What one reader said: success, and its output (its dump is in the dump folder).
 struct ReaderRun {
     ok: bool,
     text: String,
 }
 
-/// Runs the Python and the Node Protobuf readers on `files`, dumping into `dump`.
+/// Runs the Python and the Node Protobuf readers on `files` (at once), dumping into `dump`.
 fn run_readers(files: &[PathBuf], dump: &Path) -> [ReaderRun; 2] {
-    let py = Command::new(python())
-        .arg(repo().join("scripts/readers/protobuf_check.py"))
-        .arg("--dump")
-        .arg(dump)
-        .args(files)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
-    let node = Command::new("node")
-        .arg(node_readers().join("protobuf_check.mjs"))
-        .arg("--dump")
-        .arg(dump)
-        .args(files)
-        .output()
-        .unwrap_or_else(|e| {
-            panic!("cannot run `node` ({e}): install Node.js 20 and run scripts/test")
-        });
-    [py, node].map(|o| ReaderRun {
-        ok: o.status.success(),
-        text: format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        ),
+    let spawn = |program: PathBuf, script: PathBuf, what: &str| {
+        Command::new(program)
+            .arg(script)
+            .arg("--dump")
+            .arg(dump)
+            .args(files)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot run {what} ({e}): run scripts/test"))
+    };
+    let py = spawn(
+        python(),
+        repo().join("scripts/readers/protobuf_check.py"),
+        "the venv's python",
+    );
+    let node = spawn(
+        PathBuf::from("node"),
+        node_readers().join("protobuf_check.mjs"),
+        "`node` (install Node.js 20)",
+    );
+    [py, node].map(|child| {
+        let o = child.wait_with_output().unwrap();
+        ReaderRun {
+            ok: o.status.success(),
+            text: format!(
+                "{}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            ),
+        }
     })
 }
 
