@@ -135,6 +135,12 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
             size(packed)
         ),
     )];
+    let schemas = match i.encoding().as_str() {
+        "json" => "json (JSON Schemas)".to_string(),
+        "protobuf" => "protobuf (FileDescriptorSet schemas)".to_string(),
+        other => other.to_string(),
+    };
+    rows.push(("encoding", schemas));
     let version = i.run.as_ref().map_or_else(
         |_| String::new(),
         |r| format!(", format {}", r.format_version),

@@ -12,6 +12,7 @@
 
 pub mod channels;
 mod encoding;
+pub mod fields;
 pub mod json;
 pub mod messages;
 pub mod metadata;

@@ -16,7 +16,9 @@
 //! written as the exact decimal of their nanoseconds.
 
 use super::seconds_text;
+use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
+use crate::format::Encoding;
 use crate::format::Channel;
 use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
 use serde::Deserialize;
@@ -124,9 +126,11 @@ enum Target {
         channel: Channel,
         fields: &'static [&'static str],
         table: Option<usize>,
+        /// Index of its reader in `Exporter::readers`.
+        reader: usize,
     },
-    /// `/tf`, flattened into its table.
-    Tf { table: usize },
+    /// `/tf`, flattened into its table; Protobuf or JSON.
+    Tf { table: usize, protobuf: bool },
     /// Not exported.
     Skip,
 }
@@ -155,7 +159,10 @@ struct Wide {
 struct Exporter<'a, W: Write> {
     layout: Layout,
     open: &'a mut dyn FnMut(&str) -> io::Result<W>,
-    schemas: BTreeMap<u16, String>,
+    /// Each schema's name, encoding and bytes.
+    schemas: BTreeMap<u16, (String, String, Vec<u8>)>,
+    /// The field readers of the flat channels.
+    readers: Vec<FieldReader>,
     targets: BTreeMap<u16, (String, Target)>,
     tables: Vec<Open<W>>,
     skipped: Vec<Skipped>,
@@ -183,6 +190,7 @@ pub fn export<W: Write>(
         layout,
         open,
         schemas: BTreeMap::new(),
+        readers: Vec::new(),
         targets: BTreeMap::new(),
         tables: Vec::new(),
         skipped: Vec::new(),
@@ -258,8 +266,9 @@ impl<W: Write> Exporter<'_, W> {
         Target::Skip
     }
 
-    /// What a channel with this topic and schema becomes.
-    fn target(&mut self, topic: &str, schema: &str) -> Target {
+    /// What a channel with this topic and schema (name, encoding, bytes) becomes.
+    fn target(&mut self, topic: &str, (schema, encoding, data): &(String, String, Vec<u8>)) -> Target {
+        let schema = schema.as_str();
         let Some(channel) = Channel::from_topic(topic) else {
             return self.skip(topic, "not a coin-log channel");
         };
@@ -270,8 +279,9 @@ impl<W: Write> Exporter<'_, W> {
                 Layout::PerChannel => {
                     let columns = TF_COLUMNS.iter().map(ToString::to_string).collect();
                     let name = format!("{}.csv", topic.trim_start_matches('/').replace('/', "_"));
+                    let protobuf = Encoding::from_schema_encoding(encoding) == Some(Encoding::Protobuf);
                     match self.open_table(&name, topic, columns) {
-                        Some(table) => Target::Tf { table },
+                        Some(table) => Target::Tf { table, protobuf },
                         None => Target::Skip,
                     }
                 }
@@ -291,6 +301,14 @@ impl<W: Write> Exporter<'_, W> {
             );
         }
         let fields = channel.fields().filter(|f| f.first() == Some(&"t"));
+        let reader = match fields.map(|f| FieldReader::new(encoding, schema, data, f)) {
+            Some(Ok(r)) => {
+                self.readers.push(r);
+                self.readers.len() - 1
+            }
+            Some(Err(e)) => return self.skip(topic, &e.to_string()),
+            None => 0,
+        };
         match (fields, channel, self.layout) {
             (Some(fields), _, Layout::PerChannel) => {
                 let columns = fields.iter().map(ToString::to_string).collect();
@@ -300,6 +318,7 @@ impl<W: Write> Exporter<'_, W> {
                         channel,
                         fields,
                         table: Some(table),
+                        reader,
                     },
                     None => Target::Skip,
                 }
@@ -308,6 +327,7 @@ impl<W: Write> Exporter<'_, W> {
                 channel,
                 fields,
                 table: None,
+                reader,
             },
             (None, _, _) => self.skip(
                 topic,
@@ -343,13 +363,15 @@ impl<W: Write> Exporter<'_, W> {
         &mut self,
         h: &MessageHeader,
         data: &[u8],
-        channel: Channel,
-        fields: &'static [&'static str],
-        table: Option<usize>,
+        (channel, fields, table, reader): (Channel, &'static [&'static str], Option<usize>, usize),
     ) {
         self.values.clear();
         self.values.resize(fields.len(), 0.0);
-        if let Err(e) = read_fields(data, fields, &mut self.values) {
+        let read = match self.readers.get(reader) {
+            Some(r) => r.read(data, fields, &mut self.values),
+            None => read_fields(data, fields, &mut self.values),
+        };
+        if let Err(e) = read {
             return self.fail(ExportError::Message {
                 topic: channel.topic().to_string(),
                 log_time: h.log_time,
@@ -362,8 +384,13 @@ impl<W: Write> Exporter<'_, W> {
         }
     }
 
-    fn tf(&mut self, h: &MessageHeader, data: &[u8], table: usize) {
-        let m: FrameTransform = match serde_json::from_slice(data) {
+    fn tf(&mut self, h: &MessageHeader, data: &[u8], table: usize, protobuf: bool) {
+        let m = if protobuf {
+            decode_transform(data)
+        } else {
+            serde_json::from_slice(data).map_err(|e| e.to_string())
+        };
+        let m: FrameTransform = match m {
             Ok(m) => m,
             Err(e) => {
                 return self.fail(ExportError::Message {
@@ -528,8 +555,9 @@ impl<W: Write> Exporter<'_, W> {
 }
 
 impl<W: Write> Visitor for Exporter<'_, W> {
-    fn schema(&mut self, id: u16, name: &str, _: &str, _: &[u8]) {
-        self.schemas.insert(id, name.to_string());
+    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
+        self.schemas
+            .insert(id, (name.to_string(), encoding.to_string(), data.to_vec()));
     }
     fn channel(&mut self, id: u16, schema_id: u16, topic: &str, _: &str) {
         let schema = self.schemas.get(&schema_id).cloned().unwrap_or_default();
@@ -547,14 +575,15 @@ impl<W: Write> Visitor for Exporter<'_, W> {
                     channel,
                     fields,
                     table,
+                    reader,
                 },
             )) => {
-                let (channel, fields, table) = (*channel, *fields, *table);
-                self.flat(h, data, channel, fields, table);
+                let flat = (*channel, *fields, *table, *reader);
+                self.flat(h, data, flat);
             }
-            Some((_, Target::Tf { table })) => {
-                let table = *table;
-                self.tf(h, data, table);
+            Some((_, Target::Tf { table, protobuf })) => {
+                let (table, protobuf) = (*table, *protobuf);
+                self.tf(h, data, table, protobuf);
             }
             Some((_, Target::Skip)) => {}
             None => {
@@ -581,6 +610,35 @@ fn csv_text(s: &str) -> String {
     } else {
         s.to_string()
     }
+}
+
+/// A Protobuf `foxglove.FrameTransform` as the fields the table holds (absent sub-messages read as zeros,
+/// as proto3 defines them).
+fn decode_transform(data: &[u8]) -> Result<FrameTransform, String> {
+    use prost::Message;
+    let m = foxglove::messages::FrameTransform::decode(data).map_err(|e| e.to_string())?;
+    let time = m.timestamp.unwrap_or_default();
+    let tr = m.translation.unwrap_or_default();
+    let ro = m.rotation.unwrap_or_default();
+    Ok(FrameTransform {
+        timestamp: Time {
+            sec: u64::from(time.sec()),
+            nsec: time.nsec(),
+        },
+        parent_frame_id: m.parent_frame_id,
+        child_frame_id: m.child_frame_id,
+        translation: Vector3 {
+            x: tr.x,
+            y: tr.y,
+            z: tr.z,
+        },
+        rotation: Quaternion {
+            x: ro.x,
+            y: ro.y,
+            z: ro.z,
+            w: ro.w,
+        },
+    })
 }
 
 /// The fields of `foxglove.FrameTransform` that the table holds (others are ignored).

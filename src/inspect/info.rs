@@ -102,6 +102,23 @@ impl FileInfo {
         }
     }
 
+    /// The message encoding of the file's channels: `json`, `protobuf`, `mixed (json, protobuf)`, or `no
+    /// channels`.
+    #[must_use]
+    pub fn encoding(&self) -> String {
+        let set: std::collections::BTreeSet<&str> = self
+            .channels
+            .iter()
+            .map(|c| c.message_encoding.as_str())
+            .collect();
+        let list: Vec<&str> = set.into_iter().collect();
+        match list.as_slice() {
+            [] => "no channels".into(),
+            [one] => (*one).to_string(),
+            more => format!("mixed ({})", more.join(", ")),
+        }
+    }
+
     /// The stored scene's TOML text (the `scene` value of the `coin-log` record).
     #[must_use]
     pub fn scene_toml(&self) -> Option<&str> {
@@ -128,6 +145,7 @@ impl FileInfo {
             "end_time": self.time_range.map(|r| seconds(r.1)),
             "chunks": self.chunks,
             "compression": self.compression(),
+            "encoding": self.encoding(),
             "compressed_bytes": self.chunk_bytes.0,
             "uncompressed_bytes": self.chunk_bytes.1,
             "channels": self.channels.iter().map(|c| json!({

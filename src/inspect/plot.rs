@@ -9,6 +9,7 @@
 //! with the minimum and maximum of the samples in each (so no spike is lost), and the paths keep every
 //! k-th point with k doubling as needed.
 
+use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::{
     Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
@@ -178,7 +179,10 @@ impl Fields<'_> {
 /// Everything the page draws, gathered in one pass.
 #[derive(Default)]
 struct Collect {
-    schemas: BTreeMap<u16, String>,
+    /// Each schema's name, encoding and bytes.
+    schemas: BTreeMap<u16, (String, String, Vec<u8>)>,
+    /// The field reader of each plotted channel id.
+    readers: BTreeMap<u16, FieldReader>,
     channels: BTreeMap<u16, Channel>,
     run: Option<Result<RunMetadata, String>>,
     result: Option<ResultMetadata>,
@@ -275,13 +279,29 @@ impl Collect {
 }
 
 impl Visitor for Collect {
-    fn schema(&mut self, id: u16, name: &str, _: &str, _: &[u8]) {
-        self.schemas.insert(id, name.to_string());
+    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
+        self.schemas
+            .insert(id, (name.to_string(), encoding.to_string(), data.to_vec()));
     }
     fn channel(&mut self, id: u16, schema_id: u16, topic: &str, _: &str) {
-        let schema = self.schemas.get(&schema_id).map_or("", String::as_str);
-        if let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) {
-            self.channels.insert(id, c);
+        let Some((schema, encoding, data)) = self.schemas.get(&schema_id) else {
+            return;
+        };
+        let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) else {
+            return;
+        };
+        let Some(fields) = c.fields() else {
+            return;
+        };
+        match FieldReader::new(encoding, schema, data, fields) {
+            Ok(r) => {
+                self.readers.insert(id, r);
+                self.channels.insert(id, c);
+            }
+            Err(e) => {
+                self.problem
+                    .get_or_insert_with(|| format!("{topic}: {e}"));
+            }
         }
     }
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
@@ -305,7 +325,11 @@ impl Visitor for Collect {
         let mut values = std::mem::take(&mut self.values);
         values.clear();
         values.resize(names.len(), 0.0);
-        match read_fields(data, names, &mut values) {
+        let read = match self.readers.get(&h.channel_id) {
+            Some(r) => r.read(data, names, &mut values),
+            None => read_fields(data, names, &mut values),
+        };
+        match read {
             Ok(()) => self.observe(
                 channel,
                 &Fields {
