@@ -13,6 +13,9 @@
 //! changed by one unit in the last place makes the comparison with the JSON recording fail.
 //! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
 
+// Helpers outside #[test] functions (reading dumps, damaging files) fail the test by unwrap, as meant.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use crate::support::other_writers::{node_readers, python};
 use crate::support::record::{coin_log_text, read_messages, scene_names};
 use crate::support::repo;
@@ -248,10 +251,13 @@ struct Comparison {
     signed_zeros: usize,
 }
 
+/// The messages of one topic: (log time, message).
+type Timeline<'a> = Vec<(u64, &'a Value)>;
+
 /// Compares, topic by topic and in order, every message of the JSON recording with its Protobuf dump.
 fn compare_with_json(json: &[(String, u64, Value)], dump: &[Dumped]) -> Comparison {
     let mut c = Comparison::default();
-    let mut by_topic: BTreeMap<&str, (Vec<(u64, &Value)>, Vec<(u64, &Value)>)> = BTreeMap::new();
+    let mut by_topic: BTreeMap<&str, (Timeline<'_>, Timeline<'_>)> = BTreeMap::new();
     for (topic, t, v) in json {
         by_topic.entry(topic).or_default().0.push((*t, v));
     }
@@ -602,6 +608,11 @@ fn rerun(file: &Path, rrd: &Path) -> Value {
         .unwrap_or_else(|e| panic!("rerun_check.py printed no JSON ({e})"))
 }
 
+/// The log time of a row of `rerun_check.py`'s output (a decimal string).
+fn log_time_of(row: &Value) -> Option<u64> {
+    row["log_time"].as_str().and_then(|s| s.parse().ok())
+}
+
 /// `x` stored as Rerun stores transforms: a 32-bit float (round to nearest), read back as f64.
 fn as_f32(x: f64) -> f64 {
     f64::from(x as f32)
@@ -630,7 +641,7 @@ fn compare_rerun(doc: &Value, json: &[(String, u64, Value)]) -> Vec<String> {
             }
             for ((t, m), row) in messages.iter().zip(rows) {
                 let at = format!("{topic} at {t} ns");
-                if row["log_time"] != t.to_string() {
+                if log_time_of(row) != Some(*t) {
                     out.push(format!("{at}: Rerun row at {}", row["log_time"]));
                 }
                 let fields = m.as_object().unwrap();
@@ -662,7 +673,7 @@ fn compare_rerun(doc: &Value, json: &[(String, u64, Value)]) -> Vec<String> {
                     "{topic} at {t} ns ({} → {})",
                     m["parent_frame_id"], m["child_frame_id"]
                 );
-                if row["log_time"] != t.to_string()
+                if log_time_of(row) != Some(*t)
                     || row["parent"] != m["parent_frame_id"]
                     || row["child"] != m["child_frame_id"]
                 {
@@ -759,4 +770,41 @@ fn rerun_converts_a_recording_into_the_coins_transforms_and_numeric_series() {
         differences[1].contains("/tf") && differences[1].contains("translation.x"),
         "{differences:?}"
     );
+}
+
+/// `scripts/rerun_blueprint.py` writes a blueprint that Rerun's own check accepts (it checks its plotted
+/// fields against `schemas/` first); the same check refuses the file cut in half.
+#[test]
+fn the_rerun_blueprint_is_one_rerun_accepts() {
+    let dir = tempfile::tempdir().unwrap();
+    let rbl = dir.path().join("coin-log.rbl");
+    let o = Command::new(python())
+        .arg(repo().join("scripts/rerun_blueprint.py"))
+        .arg(&rbl)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rerun = python().with_file_name("rerun");
+    let verify = |path: &Path| {
+        let o = Command::new(&rerun)
+            .args(["rrd", "verify"])
+            .arg(path)
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run {} ({e}): run scripts/test", rerun.display()));
+        (
+            o.status.success(),
+            format!(
+                "{}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            ),
+        )
+    };
+    let (ok, text) = verify(&rbl);
+    assert!(ok, "rerun rrd verify refused the blueprint:\n{text}");
+    let bytes = std::fs::read(&rbl).unwrap();
+    let cut = dir.path().join("cut.rbl");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let (ok, text) = verify(&cut);
+    assert!(!ok, "rerun rrd verify accepted half a blueprint:\n{text}");
 }
