@@ -89,8 +89,13 @@ mod tests {
         let mut outs = Vec::new();
         for e in Encoding::ALL {
             let schema = schema_data(Position::SCHEMA, e).unwrap();
-            let r = FieldReader::new(e.schema_encoding(), Position::SCHEMA, schema, Position::FIELDS)
-                .unwrap();
+            let r = FieldReader::new(
+                e.schema_encoding(),
+                Position::SCHEMA,
+                schema,
+                Position::FIELDS,
+            )
+            .unwrap();
             assert_eq!(r.encoding(), e);
             let mut buf = Vec::new();
             m.write(e, &mut buf).unwrap();

@@ -18,8 +18,8 @@
 use super::seconds_text;
 use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
-use crate::format::Encoding;
 use crate::format::Channel;
+use crate::format::Encoding;
 use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -267,7 +267,11 @@ impl<W: Write> Exporter<'_, W> {
     }
 
     /// What a channel with this topic and schema (name, encoding, bytes) becomes.
-    fn target(&mut self, topic: &str, (schema, encoding, data): &(String, String, Vec<u8>)) -> Target {
+    fn target(
+        &mut self,
+        topic: &str,
+        (schema, encoding, data): &(String, String, Vec<u8>),
+    ) -> Target {
         let schema = schema.as_str();
         let Some(channel) = Channel::from_topic(topic) else {
             return self.skip(topic, "not a coin-log channel");
@@ -279,7 +283,8 @@ impl<W: Write> Exporter<'_, W> {
                 Layout::PerChannel => {
                     let columns = TF_COLUMNS.iter().map(ToString::to_string).collect();
                     let name = format!("{}.csv", topic.trim_start_matches('/').replace('/', "_"));
-                    let protobuf = Encoding::from_schema_encoding(encoding) == Some(Encoding::Protobuf);
+                    let protobuf =
+                        Encoding::from_schema_encoding(encoding) == Some(Encoding::Protobuf);
                     match self.open_table(&name, topic, columns) {
                         Some(table) => Target::Tf { table, protobuf },
                         None => Target::Skip,

@@ -299,8 +299,7 @@ impl Visitor for Collect {
                 self.channels.insert(id, c);
             }
             Err(e) => {
-                self.problem
-                    .get_or_insert_with(|| format!("{topic}: {e}"));
+                self.problem.get_or_insert_with(|| format!("{topic}: {e}"));
             }
         }
     }

@@ -103,8 +103,12 @@ fn the_estimate_holds_within_its_factor_on_real_recordings() {
     ];
     let mut worst: f64 = 1.0;
     for (name, extra) in cases {
-        for compression in ["zstd", "lz4", "none"] {
+        for (compression, encoding) in ["zstd", "lz4", "none"]
+            .into_iter()
+            .flat_map(|c| [(c, "json"), (c, "protobuf")])
+        {
             let mut args = vec!["record", name, "--compression", compression];
+            args.extend_from_slice(&["--encoding", encoding]);
             args.extend_from_slice(extra);
             let mut dry = args.clone();
             dry.extend(["--dry-run", "--json"]);
@@ -114,20 +118,24 @@ fn the_estimate_holds_within_its_factor_on_real_recordings() {
             let path = record_scene(
                 dir.path(),
                 name,
-                &[&["--compression", compression][..], extra].concat(),
+                &[
+                    &["--compression", compression, "--encoding", encoding][..],
+                    extra,
+                ]
+                .concat(),
             );
             let bytes = std::fs::metadata(&path).unwrap().len() as f64;
             let file = read_back(&std::fs::read(&path).unwrap());
             let messages = file.messages.len() as u64;
             let ratio = estimate["estimated_bytes"].as_f64().unwrap() / bytes;
             println!(
-                "{name:<17} {compression:<4} estimate {:>9} B, file {bytes:>9} B, ratio {ratio:.2}; messages {} vs {messages}",
+                "{name:<17} {compression:<4} {encoding:<8} estimate {:>9} B, file {bytes:>9} B, ratio {ratio:.2}; messages {} vs {messages}",
                 estimate["estimated_bytes"], estimate["messages"]
             );
             worst = worst.max(ratio).max(1.0 / ratio);
             assert!(
                 (1.0 / ACCURACY..=ACCURACY).contains(&ratio),
-                "{name} {compression}: estimate/file = {ratio:.3}, outside the factor {ACCURACY}"
+                "{name} {compression} {encoding}: estimate/file = {ratio:.3}, outside the factor {ACCURACY}"
             );
             // The coin_log channels' counts are exact for a completed run; the Foxglove display topics
             // (track levels, table moves) are estimated, so the total is held to the size's factor.

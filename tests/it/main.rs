@@ -33,6 +33,7 @@ mod linearisation;
 mod other_writers;
 mod params;
 mod properties;
+mod protobuf;
 mod protobuf_readers;
 mod readme;
 mod record_roundtrip;
