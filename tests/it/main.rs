@@ -34,6 +34,7 @@ mod other_writers;
 mod params;
 mod properties;
 mod protobuf;
+mod protobuf_readers;
 mod readme;
 mod record_roundtrip;
 mod rk4_order;
