@@ -7,6 +7,7 @@ use super::scene_arg::{load_source, SceneSource};
 use super::text::size;
 use super::{destination, make_readable, output, Outcome};
 use anyhow::{anyhow, bail, Context};
+use coin_log::format::Encoding;
 use coin_log::format::Termination;
 use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
 use coin_log::scene::{self, limits, FlagOverrides, Scene};
@@ -68,6 +69,10 @@ pub struct RecordArgs {
     /// Chunk compression.
     #[arg(long, value_enum, default_value_t = CompressionArg::Zstd)]
     compression: CompressionArg,
+    /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
+    /// about half the size, and Rerun reads it). Both carry the same f64 values (docs/format.md: Encodings).
+    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
+    pub encoding: EncodingArg,
     /// Set a scene key before the flags above apply: KEY is a dotted path (`initial.theta`, `run.rtol`,
     /// `body.shape`), VALUE a TOML value or a bare string. Repeatable.
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -82,6 +87,24 @@ pub struct RecordArgs {
     /// messages and file size, and exit without writing.
     #[arg(long)]
     dry_run: bool,
+}
+
+/// `--encoding`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EncodingArg {
+    /// JSON messages with JSON Schemas (the default).
+    Json,
+    /// Protobuf messages with FileDescriptorSet schemas.
+    Protobuf,
+}
+
+impl From<EncodingArg> for Encoding {
+    fn from(e: EncodingArg) -> Self {
+        match e {
+            EncodingArg::Json => Encoding::Json,
+            EncodingArg::Protobuf => Encoding::Protobuf,
+        }
+    }
 }
 
 /// `--compression`.
@@ -138,7 +161,7 @@ const LARGE: u64 = 1 << 30;
 /// `--dry-run`: the resolved scene as TOML after comment lines with the estimate (so the output is itself
 /// a scene file), or with `--json` one object; nothing is written.
 fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outcome> {
-    let e = record::estimate(scene, args.compression.into());
+    let e = record::estimate(scene, args.compression.into(), args.encoding.into());
     let toml = scene.to_toml();
     if args.json {
         let json = serde_json::json!({
@@ -154,13 +177,17 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
     }
     out!(
         "# `{label}` resolved, every default filled in (coin-log record --dry-run: nothing written).\n\
-         # Estimate for the full duration: {} samples, {} messages, about {} with {} chunks\n\
+         # Estimate for the full duration: {} samples, {} messages, about {} with {} chunks{}\n\
          # (within a factor of {} on typical scenes; a run ended by an event writes less).\n{toml}",
         e.samples,
         e.messages,
         size(e.bytes),
         clap::ValueEnum::to_possible_value(&args.compression)
             .map_or_else(String::new, |v| v.get_name().to_string()),
+        match args.encoding {
+            EncodingArg::Json => "",
+            EncodingArg::Protobuf => " of Protobuf messages",
+        },
         record::estimate::ACCURACY
     );
     Ok(Outcome::Success)
@@ -168,7 +195,7 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
 
 /// Warns on stderr before a recording estimated larger than [`LARGE`].
 fn warn_if_large(args: &RecordArgs, scene: &Scene) {
-    let e = record::estimate(scene, args.compression.into());
+    let e = record::estimate(scene, args.compression.into(), args.encoding.into());
     if e.bytes > LARGE {
         errln!(
             "warning: this recording is estimated at {} ({} messages); `--dry-run` shows the estimate, \
@@ -335,6 +362,7 @@ fn record_into(
 ) -> anyhow::Result<(RecordSummary, Duration)> {
     let options = RecordOptions {
         compression: args.compression.into(),
+        encoding: args.encoding.into(),
     };
     let bar = progress_bar();
     let started = Instant::now();

@@ -1,12 +1,13 @@
 //! The channels of the format (format.md: Channels and fields): name, topic, schema name and schema bytes.
 //! The schema bytes are the files in `schemas/`, embedded at build time, so a log's schema is the file.
 
+use super::Encoding;
 use std::fmt;
 use std::str::FromStr;
 
-/// Schema encoding of every channel.
+/// Schema encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
 pub const SCHEMA_ENCODING: &str = "jsonschema";
-/// Message encoding of every channel.
+/// Message encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
 pub const MESSAGE_ENCODING: &str = "json";
 
 /// A recordable channel.
@@ -277,6 +278,16 @@ impl fmt::Display for Topic {
     }
 }
 
+/// The schema bytes a file in `encoding` stores for a schema name this tool writes: the JSON Schema of
+/// `schemas/<name>.json`, or the serialized `FileDescriptorSet` ([`super::protobuf::descriptor_set`]).
+#[must_use]
+pub fn schema_data(schema_name: &str, encoding: Encoding) -> Option<&'static [u8]> {
+    match encoding {
+        Encoding::Json => schema_bytes(schema_name),
+        Encoding::Protobuf => super::protobuf::descriptor_set(schema_name),
+    }
+}
+
 /// The bytes of `schemas/<name>.json` for a schema name this tool writes.
 #[must_use]
 pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
@@ -327,7 +338,9 @@ mod tests {
         for (i, t) in all.iter().enumerate() {
             assert_eq!(t.index(), i, "{t}");
             assert_eq!(Topic::from_name(t.name()), Some(*t));
-            assert!(schema_bytes(t.schema_name()).is_some(), "{t}");
+            for e in Encoding::ALL {
+                assert!(schema_data(t.schema_name(), e).is_some(), "{t} {e}");
+            }
         }
         let names: std::collections::BTreeSet<&str> = all.iter().map(|t| t.name()).collect();
         assert_eq!(names.len(), all.len());

@@ -62,6 +62,9 @@ pub enum FieldsError {
     /// A field of the schema is absent.
     #[error("has no field `{0}`")]
     Missing(String),
+    /// Not a valid Protobuf message of its schema (cut short, or a field of another wire type).
+    #[error("is not a valid Protobuf message of its schema: {0}")]
+    NotProtobuf(String),
     /// A field the schema does not have.
     #[error("has a field `{0}` its schema does not declare")]
     Unknown(String),

@@ -5,13 +5,13 @@
 //! Hand-written rather than `serde_json::to_writer` because the recorder formats tens of millions of
 //! messages and must refuse non-finite numbers (JSON has no NaN) instead of writing `null`.
 
+use super::encoding::Encoding;
+use super::protobuf::put_double;
 use serde::Deserialize;
 
 /// A number that JSON cannot carry.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error(
-    "field `{field}` of a `{schema}` message is {value}; JSON messages carry finite numbers only"
-)]
+#[error("field `{field}` of a `{schema}` message is {value}; messages carry finite numbers only")]
 pub struct NonFiniteField {
     /// Schema name.
     pub schema: &'static str,
@@ -90,12 +90,8 @@ macro_rules! message {
             /// Field names of the schema's first version (before any `added` field).
             pub const FIRST_FIELDS: &'static [&'static str] = &[$(stringify!($field)),+];
 
-            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an added
-            /// field only when it is `Some`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
-            pub fn write_json(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+            /// `Err` naming the first field that is NaN or infinite.
+            fn check_finite(&self) -> Result<(), NonFiniteField> {
                 $(
                     if !self.$field.is_finite() {
                         return Err(NonFiniteField { schema: $schema, field: stringify!($field), value: self.$field });
@@ -106,6 +102,50 @@ macro_rules! message {
                         return Err(NonFiniteField { schema: $schema, field: stringify!($added), value: v });
                     }
                 )+)?
+                Ok(())
+            }
+
+            /// Appends this message to `buf` in `encoding`.
+            ///
+            /// # Errors
+            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+            #[inline]
+            pub fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+                match encoding {
+                    Encoding::Json => self.write_json(buf),
+                    Encoding::Protobuf => self.write_protobuf(buf),
+                }
+            }
+
+            /// Appends this message in Protobuf to `buf`: every field as a double numbered by its place in the
+            /// schema (t = 1), zeros included; an added field only when it is `Some`.
+            ///
+            /// # Errors
+            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+            pub fn write_protobuf(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+                self.check_finite()?;
+                let mut number = 0_u32;
+                $(
+                    number += 1;
+                    put_double(buf, number, self.$field);
+                )+
+                $($(
+                    number += 1;
+                    if let Some(v) = self.$added {
+                        put_double(buf, number, v);
+                    }
+                )+)?
+                let _ = number;
+                Ok(())
+            }
+
+            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an added
+            /// field only when it is `Some`.
+            ///
+            /// # Errors
+            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+            pub fn write_json(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+                self.check_finite()?;
                 let mut formatter = ryu::Buffer::new();
                 let mut first = true;
                 buf.push(b'{');

@@ -1,7 +1,7 @@
 //! The file format, typed: everything a coin-log MCAP file contains that `scene`, `record` and `verify` must
 //! agree on (docs/format.md). The channels with their topics, schema names and schema bytes
 //! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`], read back by
-//! [`json`]); the two metadata
+//! [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
 //! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
 //! recorded integrator settings ([`tolerances`]).
@@ -11,16 +11,20 @@
 //! nothing about scenes, the recorder or the checks, which all import it.
 
 pub mod channels;
+mod encoding;
 pub mod json;
 pub mod messages;
 pub mod metadata;
+pub mod protobuf;
 mod termination;
 mod time;
 pub mod tolerances;
 
 pub use channels::{
-    schema_bytes, Channel, Topic, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING, TRACK_LEVELS,
+    schema_bytes, schema_data, Channel, Topic, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING,
+    TRACK_LEVELS,
 };
+pub use encoding::{Encoding, UnknownEncoding};
 pub use metadata::{
     MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,

@@ -17,7 +17,7 @@
 
 use super::foxglove::SCENE_RATE;
 use super::recorder::Compression;
-use crate::format::{schema_bytes, Channel};
+use crate::format::{schema_data, Channel, Encoding};
 use crate::scene::Scene;
 
 /// Characters of a typical `t` value (`12.34`).
@@ -26,6 +26,12 @@ pub const TIME_CHARS: u64 = 5;
 pub const NUMBER_CHARS: u64 = 19;
 /// Bytes of a `/tf` message (measured: 283–289; 236 on `topple`, whose numbers are shorter).
 pub const TF_BYTES: u64 = 285;
+/// Bytes of a Protobuf `/tf` message (keys, two frame names, 7 doubles, a timestamp).
+pub const TF_PROTOBUF_BYTES: u64 = 100;
+/// Bytes of a Protobuf `/scene` update without its track points.
+pub const SCENE_PROTOBUF_BYTES: u64 = 900;
+/// Bytes of one track point in a Protobuf `/scene` update.
+pub const TRACK_POINT_PROTOBUF_BYTES: u64 = 20;
 /// Messages per display update on the `scene` channel's topics (follow frame, coin, ~2 track levels).
 pub const SCENE_MESSAGES_PER_UPDATE: u64 = 4;
 /// Bytes of a `/scene` update without its track points (measured: 1700–1760).
@@ -44,14 +50,16 @@ pub const CHUNK_INDEX_BYTES: u64 = 200;
 /// The estimate is within this factor of the real file size on the calibration recordings.
 pub const ACCURACY: f64 = 2.0;
 
-/// Compressed size over uncompressed size of the chunks (measured on the calibration recordings: zstd
-/// 0.15–0.30, lz4 0.23–0.39).
+/// Compressed size over uncompressed size of the chunks (measured on the calibration recordings: JSON zstd
+/// 0.15–0.30, lz4 0.23–0.39; Protobuf zstd PB_ZSTD, lz4 PB_LZ4: binary doubles compress less).
 #[must_use]
-pub fn compression_ratio(compression: Compression) -> f64 {
-    match compression {
-        Compression::Zstd => 0.25,
-        Compression::Lz4 => 0.35,
-        Compression::None => 1.0,
+pub fn compression_ratio(compression: Compression, encoding: Encoding) -> f64 {
+    match (compression, encoding) {
+        (Compression::Zstd, Encoding::Json) => 0.25,
+        (Compression::Lz4, Encoding::Json) => 0.35,
+        (Compression::Zstd, Encoding::Protobuf) => 0.6,
+        (Compression::Lz4, Encoding::Protobuf) => 0.8,
+        (Compression::None, _) => 1.0,
     }
 }
 
@@ -86,14 +94,21 @@ fn flat_bytes(fields: &[&str]) -> u64 {
     2 + keys + n.saturating_sub(1) + TIME_CHARS + n.saturating_sub(1) * NUMBER_CHARS
 }
 
-/// The estimate for `scene` written with `compression`.
+/// Bytes of one Protobuf message of a flat `coin_log.*` channel with `fields`: a one-byte key and 8 bytes per
+/// field.
+fn flat_protobuf_bytes(fields: &[&str]) -> u64 {
+    9 * fields.len() as u64
+}
+
+/// The estimate for `scene` written with `compression` in `encoding`.
 #[must_use]
 #[allow(
     clippy::cast_possible_truncation,
     clippy::cast_sign_loss,
     clippy::cast_precision_loss
 )]
-pub fn estimate(scene: &Scene, compression: Compression) -> Estimate {
+pub fn estimate(scene: &Scene, compression: Compression, encoding: Encoding) -> Estimate {
+    let protobuf = encoding == Encoding::Protobuf;
     let n = samples(scene.run.duration, scene.run.rate);
     let updates = n.min((scene.run.duration * SCENE_RATE).ceil() as u64 + 2);
     let mut per_channel = Vec::new();
@@ -102,27 +117,41 @@ pub fn estimate(scene: &Scene, compression: Compression) -> Estimate {
     for &c in &scene.channels {
         let (count, bytes) = match c {
             // /tf: world → table once, then table → coin per sample; /tf_static: world → table once.
-            Channel::Tf => (n + 2, TF_BYTES),
+            Channel::Tf => (
+                n + 2,
+                if protobuf {
+                    TF_PROTOBUF_BYTES
+                } else {
+                    TF_BYTES
+                },
+            ),
             // Per display update: the follow frame and the coin, and on average about two track levels
             // (level k changes every 2^k updates: a binary counter); the table once, then when it moves.
             // The bytes per message are averaged over these.
-            Channel::Scene => (
-                SCENE_MESSAGES_PER_UPDATE * updates + 1,
-                (SCENE_BYTES + TRACK_POINT_BYTES * n.div_ceil(updates.max(1)))
-                    / SCENE_MESSAGES_PER_UPDATE,
-            ),
+            Channel::Scene => {
+                let (update, point) = if protobuf {
+                    (SCENE_PROTOBUF_BYTES, TRACK_POINT_PROTOBUF_BYTES)
+                } else {
+                    (SCENE_BYTES, TRACK_POINT_BYTES)
+                };
+                (
+                    SCENE_MESSAGES_PER_UPDATE * updates + 1,
+                    (update + point * n.div_ceil(updates.max(1))) / SCENE_MESSAGES_PER_UPDATE,
+                )
+            }
+            _ if protobuf => (n, c.fields().map_or(100, flat_protobuf_bytes)),
             _ => (n, c.fields().map_or(100, flat_bytes)),
         };
         per_channel.push((c, count));
         payload += count * (bytes + RECORD_OVERHEAD);
         if !seen_schemas.contains(&c.schema_name()) {
             seen_schemas.push(c.schema_name());
-            schemas += schema_bytes(c.schema_name()).map_or(0, |s| s.len() as u64);
+            schemas += schema_data(c.schema_name(), encoding).map_or(0, |s| s.len() as u64);
         }
     }
     let messages: u64 = per_channel.iter().map(|(_, m)| m).sum();
     let chunks = payload.div_ceil(1 << 20);
-    let compressed = (payload as f64 * compression_ratio(compression)).ceil() as u64;
+    let compressed = (payload as f64 * compression_ratio(compression, encoding)).ceil() as u64;
     let bytes = FIXED_BYTES
         + 2 * schemas
         + 2 * scene.to_toml().len() as u64

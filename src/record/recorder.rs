@@ -11,7 +11,7 @@
 //! into one reused buffer and written with a precomputed channel id. Samples are written one sample late
 //! so that the last one can be flagged as last (the 3D scene then shows the final state).
 
-use super::foxglove::{Foxglove3d, FoxgloveBatch};
+use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
     drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
@@ -19,8 +19,8 @@ use crate::format::messages::{
 };
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Termination, TimeError, Topic,
-    FORMAT_VERSION, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Termination, TimeError,
+    Topic, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Flow, RunOutcome, RunSettings};
 use crate::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
@@ -100,6 +100,8 @@ impl FromStr for Compression {
 pub struct RecordOptions {
     /// Chunk compression.
     pub compression: Compression,
+    /// Message encoding: JSON (the default) or Protobuf.
+    pub encoding: Encoding,
 }
 
 /// The file could not be written; the caller should discard it. The cause (e.g. "No space left on
@@ -115,6 +117,17 @@ pub enum RecordError {
     /// C1, C2 cannot be evaluated for this body (μ too large; no validated scene has such a body).
     #[error("the `invariants` channel cannot be recorded for this body")]
     Invariants(#[from] InvariantsError),
+    /// The run is longer than Foxglove's Protobuf timestamps reach (u32 seconds).
+    #[error(
+        "the run lasts {duration} time units, longer than the {max} seconds a Protobuf timestamp of Foxglove's \
+         schemas holds; record it with --encoding json, or shorten run.duration"
+    )]
+    TooLongForProtobuf {
+        /// The scene's duration.
+        duration: f64,
+        /// The longest.
+        max: f64,
+    },
 }
 
 /// The writer options of every coin-log file (chunked, indexed, statistics, summary offsets and CRCs are
@@ -235,6 +248,7 @@ impl Tap for NoTap {
 struct Output<W: Write + Seek, T: Tap> {
     writer: McapWriter<W>,
     tap: T,
+    encoding: Encoding,
     ids: [Option<u16>; Topic::COUNT],
     sequence: [u32; Topic::COUNT],
     messages: u64,
@@ -260,19 +274,23 @@ impl<W: Write + Seek, T: Tap> Output<W, T> {
     #[cold]
     fn register(&mut self, topic: Topic) -> Result<u16, WriteError> {
         let schema_name = topic.schema_name();
-        // Every topic's schema is one of the embedded files (a test checks it).
-        let data = schema_bytes(schema_name).unwrap_or_default();
-        let schema_id = self.writer.add_schema(schema_name, SCHEMA_ENCODING, data)?;
+        // Every topic has a schema in each encoding (a test checks it).
+        let data = schema_data(schema_name, self.encoding).unwrap_or_default();
+        let (schema_encoding, message_encoding) = (
+            self.encoding.schema_encoding(),
+            self.encoding.message_encoding(),
+        );
+        let schema_id = self.writer.add_schema(schema_name, schema_encoding, data)?;
         let id =
             self.writer
-                .add_channel(schema_id, topic.name(), MESSAGE_ENCODING, &BTreeMap::new())?;
+                .add_channel(schema_id, topic.name(), message_encoding, &BTreeMap::new())?;
         self.ids[topic.index()] = Some(id);
         self.tap.channel(&ChannelInfo {
             topic,
             schema_name,
-            schema_encoding: SCHEMA_ENCODING,
+            schema_encoding,
             schema: data,
-            message_encoding: MESSAGE_ENCODING,
+            message_encoding,
         });
         Ok(id)
     }
@@ -404,6 +422,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// follows in place of E (physics §11).
     #[inline]
     fn stage_work(&mut self, t: f64, total: f64, work: f64) -> Result<f64, SampleError> {
+        let encoding = self.out.encoding;
         let balance = total + work;
         if self.on(Channel::Work) {
             let m = WorkMessage {
@@ -411,7 +430,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 dissipated: work,
                 balance,
             };
-            self.stage(Channel::Work, |b| m.write_json(b))?;
+            self.stage(Channel::Work, |b| m.write(encoding, b))?;
         }
         Ok(balance)
     }
@@ -419,6 +438,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
     #[inline]
     fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
+        let encoding = self.out.encoding;
         let coin = self.coin;
         if self.on(Channel::Omega) {
             let m = AngularVelocity {
@@ -427,7 +447,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 y: s.omega_y,
                 z: s.omega_z,
             };
-            self.stage(Channel::Omega, |b| m.write_json(b))?;
+            self.stage(Channel::Omega, |b| m.write(encoding, b))?;
         }
         if self.on(Channel::Angles) {
             let m = Angles {
@@ -437,7 +457,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 psi: s.psi,
                 phi_dot: Some(s.omega_y / s.theta.cos()),
             };
-            self.stage(Channel::Angles, |b| m.write_json(b))?;
+            self.stage(Channel::Angles, |b| m.write(encoding, b))?;
         }
         if self.on(Channel::Quaternion) {
             let q = orientation(s);
@@ -448,7 +468,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 z: q.k,
                 w: q.w,
             };
-            self.stage(Channel::Quaternion, |b| m.write_json(b))?;
+            self.stage(Channel::Quaternion, |b| m.write(encoding, b))?;
         }
         if self.on(Channel::Position) {
             let c = centre(&coin, s);
@@ -458,7 +478,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 y: c.y,
                 z: c.z,
             };
-            self.stage(Channel::Position, |b| m.write_json(b))?;
+            self.stage(Channel::Position, |b| m.write(encoding, b))?;
         }
         if self.on(Channel::Contact) {
             let c = contact_point(&coin, s);
@@ -468,7 +488,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 y: c.y,
                 z: c.z,
             };
-            self.stage(Channel::Contact, |b| m.write_json(b))?;
+            self.stage(Channel::Contact, |b| m.write(encoding, b))?;
         }
         Ok(())
     }
@@ -482,6 +502,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         s: &State,
     ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
         let coin = self.coin;
+        let encoding = self.out.encoding;
         if self.on(Channel::Reaction) {
             let r = self.dynamics.reaction(s);
             let p = coin.params();
@@ -494,7 +515,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 normal: r.normal,
                 friction_ratio: Some(friction_ratio(r.friction, r.normal, p.mass(), p.gravity())),
             };
-            self.stage(Channel::Reaction, |b| m.write_json(b))?;
+            self.stage(Channel::Reaction, |b| m.write(encoding, b))?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
         let e = energy(&coin, s);
@@ -508,7 +529,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 change: Some(e.total - e0),
                 drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
             };
-            self.stage(Channel::Energy, |b| m.write_json(b))?;
+            self.stage(Channel::Energy, |b| m.write(encoding, b))?;
         }
         let invariants = self.chaplygin.as_ref().map(|c| c.of_state(s));
         if let Some(c) = invariants {
@@ -517,7 +538,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 c1: c.c1,
                 c2: c.c2,
             };
-            self.stage(Channel::Invariants, |b| m.write_json(b))?;
+            self.stage(Channel::Invariants, |b| m.write(encoding, b))?;
         }
         Ok((e.total, invariants.map(|c| (c.c1, c.c2))))
     }
@@ -696,6 +717,12 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         for c in &scene.channels {
             on[*c as usize] = true;
         }
+        if options.encoding == Encoding::Protobuf && scene.run.duration > PROTOBUF_MAX_SECONDS {
+            return Err(RecordError::TooLongForProtobuf {
+                duration: scene.run.duration,
+                max: PROTOBUF_MAX_SECONDS,
+            });
+        }
         let chaplygin = if on[Channel::Invariants as usize] {
             Some(Chaplygin::new(&scene.params)?)
         } else {
@@ -706,7 +733,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
         let foxglove = (tf || scene_on).then(|| {
             (
-                Foxglove3d::new(&coin, scene.thickness, tf, scene_on),
+                Foxglove3d::with_encoding(&coin, scene.thickness, tf, scene_on, options.encoding),
                 FoxgloveBatch::default(),
             )
         });
@@ -714,6 +741,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             out: Output {
                 writer,
                 tap,
+                encoding: options.encoding,
                 ids: [None; Topic::COUNT],
                 sequence: [0; Topic::COUNT],
                 messages: 0,

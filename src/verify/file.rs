@@ -15,9 +15,10 @@ use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage, WorkMessage,
 };
+use crate::format::protobuf::{self, MessageDecoder};
 use crate::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
-    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
+    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::mcap_io::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
 use crate::model::invariants::Chaplygin;
@@ -25,6 +26,7 @@ use crate::model::{Coin, CoinParams, Dynamics, Inertia};
 use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
+use std::rc::Rc;
 
 /// What a channel id stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,6 +43,10 @@ struct ChannelState {
     last: Option<u64>,
     /// The channel's schema is the first version of its type (messages without the fields added since).
     first_version: bool,
+    /// The messages' encoding (its schema's), and for a Protobuf `coin_log.*` channel the decoder its
+    /// schema's descriptor gives.
+    encoding: Encoding,
+    decoder: Option<Rc<MessageDecoder>>,
 }
 
 /// The physics checks' running state.
@@ -135,6 +141,35 @@ fn validates(data: &[u8], fields: &[&str]) -> Result<(), String> {
     Ok(())
 }
 
+/// Whether a message of a Foxglove channel is valid in its encoding: JSON text, or a Protobuf message of
+/// its Foxglove type.
+fn foxglove_message(
+    encoding: Encoding,
+    channel_id: u16,
+    channels: &[Option<ChannelState>],
+    data: &[u8],
+) -> Result<(), String> {
+    use foxglove::messages::{FrameTransform, SceneUpdate};
+    use prost::Message;
+    match encoding {
+        Encoding::Json => serde_json::from_slice::<serde::de::IgnoredAny>(data)
+            .map(|_| ())
+            .map_err(|e| format!("is not JSON: {e}")),
+        Encoding::Protobuf => {
+            let topic = channels
+                .get(usize::from(channel_id))
+                .and_then(Option::as_ref)
+                .and_then(|c| Topic::from_name(&c.topic));
+            let decoded = match topic.map(Topic::schema_name) {
+                Some("foxglove.FrameTransform") => FrameTransform::decode(data).map(|_| ()),
+                Some(_) => SceneUpdate::decode(data).map(|_| ()),
+                None => Ok(()),
+            };
+            decoded.map_err(|e| format!("is not a valid Protobuf message of its type: {e}"))
+        }
+    }
+}
+
 /// The visitor that judges one log while it streams by.
 #[derive(Default)]
 struct Judge {
@@ -142,6 +177,10 @@ struct Judge {
     schemas: BTreeMap<u16, String>,
     /// Ids of schemas that are the first version of a `coin_log.*` type.
     first_versions: BTreeSet<u16>,
+    /// Each schema's encoding (absent for an encoding coin-log does not write).
+    encodings: BTreeMap<u16, Encoding>,
+    /// The decoder of each Protobuf `coin_log.*` schema.
+    decoders: BTreeMap<u16, Rc<MessageDecoder>>,
     ctx: Option<Context>,
     /// The `coin-log.result` record, kept until the end (it may come before or after `coin-log`).
     result: Option<ResultMetadata>,
@@ -163,10 +202,22 @@ impl Judge {
         slot: Slot,
         data: &[u8],
         first: bool,
-    ) -> Result<(f64, Value, bool), serde_json::Error> {
-        /// `$ty { fields in schema order } added { later fields }` read by the fast path, else by serde.
+        decoder: Option<&MessageDecoder>,
+    ) -> Result<(f64, Value, bool), String> {
+        /// `$ty { fields in schema order } added { later fields }` read by the Protobuf decoder, or the JSON
+        /// fast path, else by serde.
         macro_rules! typed {
             ($variant:ident, $ty:ident { $($f:ident),+ } $(added { $($g:ident),+ })?) => {{
+                if let Some(d) = decoder {
+                    let mut v = [0.0_f64; 8];
+                    let n = d.fields().len().min(v.len());
+                    d.read(data, &mut v[..n]).map_err(|e| format!("the message {e}"))?;
+                    let mut it = v.into_iter();
+                    $(let $f = it.next().unwrap_or(0.0);)+
+                    $($(let $g = (!first).then(|| it.next().unwrap_or(0.0));)+)?
+                    let m = $ty { $($f,)+ $($($g,)+)? };
+                    return Ok((m.t, Value::$variant(m), m.is_complete()));
+                }
                 let fast = if first {
                     json::parse_numbers(data, &[$(stringify!($f)),+])
                         .map(|[$($f),+]| $ty { $($f,)+ $($($g: None,)+)? })
@@ -176,7 +227,7 @@ impl Judge {
                 };
                 let m: $ty = match fast {
                     Some(m) => m,
-                    None => serde_json::from_slice(data)?,
+                    None => serde_json::from_slice(data).map_err(|e| e.to_string())?,
                 };
                 (m.t, Value::$variant(m), m.is_complete())
             }};
@@ -272,10 +323,25 @@ impl Visitor for Judge {
 
     fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
         self.schemas.insert(id, name.to_string());
-        if encoding != SCHEMA_ENCODING {
-            self.problems.push_with(|| {
-                format!("schema `{name}` has encoding {encoding:?}, not {SCHEMA_ENCODING:?}")
-            });
+        match Encoding::from_schema_encoding(encoding) {
+            Some(Encoding::Json) => {
+                self.encodings.insert(id, Encoding::Json);
+            }
+            Some(Encoding::Protobuf) => {
+                self.encodings.insert(id, Encoding::Protobuf);
+                self.protobuf_schema(id, name, data);
+                return;
+            }
+            None => {
+                self.problems.push_with(|| {
+                    format!(
+                        "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
+                        Encoding::Json.schema_encoding(),
+                        Encoding::Protobuf.schema_encoding()
+                    )
+                });
+                return;
+            }
         }
         match schema_bytes(name) {
             Some(ours) if ours == data => {}
@@ -323,9 +389,13 @@ impl Visitor for Judge {
                         )
                     });
                 }
-                if message_encoding != MESSAGE_ENCODING {
+                let expected = self
+                    .encodings
+                    .get(&schema_id)
+                    .map_or(MESSAGE_ENCODING, |e| e.message_encoding());
+                if message_encoding != expected {
                     self.problems.push_with(|| {
-                        format!("topic `{topic}` has message encoding {message_encoding:?}, not {MESSAGE_ENCODING:?}")
+                        format!("topic `{topic}` has message encoding {message_encoding:?}, not {expected:?} as its schema's encoding says")
                     });
                 }
                 match t.channel() {
@@ -349,11 +419,14 @@ impl Visitor for Judge {
         if self.channels.len() <= i {
             self.channels.resize(i + 1, None);
         }
+        let encoding = self.encodings.get(&schema_id).copied().unwrap_or_default();
         self.channels[i] = Some(ChannelState {
             kind,
             topic: topic.to_string(),
             last: None,
             first_version: self.first_versions.contains(&schema_id),
+            encoding,
+            decoder: self.decoders.get(&schema_id).cloned(),
         });
     }
 
@@ -409,10 +482,12 @@ impl Visitor for Judge {
             }
         }
         channel.last = Some(lt);
-        let (kind, first) = (channel.kind, channel.first_version);
+        let (kind, first, encoding) = (channel.kind, channel.first_version, channel.encoding);
+        let decoder = channel.decoder.clone();
         match kind {
             Kind::Coin(slot) => {
-                let Some((t, value)) = self.parse_checked(slot, first, h, data) else {
+                let Some((t, value)) = self.parse_checked(slot, first, decoder.as_deref(), h, data)
+                else {
                     return ControlFlow::Continue(());
                 };
                 match log_time(t) {
@@ -436,10 +511,10 @@ impl Visitor for Judge {
                     .push(slot, lt, t, value, &mut |s| checks.observe(s, ctx));
             }
             Kind::Foxglove => {
-                if let Err(e) = serde_json::from_slice::<serde::de::IgnoredAny>(data) {
+                if let Err(e) = foxglove_message(encoding, h.channel_id, &self.channels, data) {
                     let topic = self.topic(h.channel_id);
                     self.problems
-                        .push_with(|| format!("{topic}: message at {lt} ns is not JSON: {e}"));
+                        .push_with(|| format!("{topic}: message at {lt} ns {e}"));
                 }
             }
             Kind::Unknown => {}
@@ -455,11 +530,12 @@ impl Judge {
         &mut self,
         slot: Slot,
         first: bool,
+        decoder: Option<&MessageDecoder>,
         h: &MessageHeader,
         data: &[u8],
     ) -> Option<(f64, Value)> {
         let lt = h.log_time;
-        match Self::parse(slot, data, first) {
+        match Self::parse(slot, data, first, decoder) {
             Ok((_, _, complete)) if complete == first => {
                 let topic = self.topic(h.channel_id);
                 let what = if first {
@@ -479,6 +555,49 @@ impl Judge {
                 None
             }
         }
+    }
+
+    /// Checks a Protobuf schema: a `coin_log.*` type's descriptor must declare its fields (the current
+    /// version's, or the first's) as doubles, and gives the decoder of its messages; a Foxglove type's is
+    /// taken as it is.
+    fn protobuf_schema(&mut self, id: u16, name: &str, data: &[u8]) {
+        let ours = protobuf::descriptor_set(name);
+        let Some((fields, first)) = fields_of(name) else {
+            match ours {
+                Some(ours) if ours == data => {}
+                Some(_) => self.notes.push(format!(
+                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
+                )),
+                None => self
+                    .problems
+                    .push_with(|| format!("schema `{name}` is not one of coin-log's")),
+            }
+            return;
+        };
+        let decoder = match MessageDecoder::new(data, name, fields) {
+            Ok(d) => d,
+            Err(e) => match MessageDecoder::new(data, name, first) {
+                Ok(d) if fields != first => {
+                    self.first_versions.insert(id);
+                    self.notes.push(format!(
+                        "schema `{name}` is the first version of the type, without the fields added since ({})",
+                        fields[first.len()..].join(", ")
+                    ));
+                    d
+                }
+                _ => {
+                    self.problems
+                        .push_with(|| format!("schema `{name}` (protobuf) {e}"));
+                    return;
+                }
+            },
+        };
+        if ours != Some(data) && !self.first_versions.contains(&id) {
+            self.notes.push(format!(
+                "schema `{name}` is another version than this tool's; its messages are read by the field numbers it declares"
+            ));
+        }
+        self.decoders.insert(id, Rc::new(decoder));
     }
 
     fn topic(&self, id: u16) -> String {

@@ -39,10 +39,11 @@
 //! All timestamps `{sec, nsec}` are the log time of the sample ([`crate::format::log_time`]).
 
 mod json;
+mod proto;
 pub mod track;
 
 use crate::format::messages::NonFiniteField;
-use crate::format::{Channel, Topic, TRACK_LEVELS};
+use crate::format::{Channel, Encoding, Topic, TRACK_LEVELS};
 use crate::model::{contact_point, orientation, Coin, State};
 use json::{check, Writer};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -104,6 +105,53 @@ const GRID_COLORS: [&[u8]; 2] = [
 ];
 const TRACK_COLOR: &[u8] = br#"{"r":0.1,"g":0.35,"b":0.9,"a":1}"#;
 
+/// A colour (r, g, b, a) in 0..1: the Protobuf writer's form of the JSON literals above (a test checks
+/// they agree).
+type Rgba = [f64; 4];
+const COIN_RGBA: Rgba = [0.85, 0.65, 0.2, 1.0];
+const MARK_RGBA: [Rgba; 2] = [[0.6, 0.05, 0.05, 1.0], [0.05, 0.1, 0.55, 1.0]];
+const TABLE_RGBA: Rgba = [0.87, 0.86, 0.82, 1.0];
+const GRID_RGBA: [Rgba; 2] = [[0.66, 0.66, 0.63, 1.0], [0.45, 0.45, 0.43, 1.0]];
+const TRACK_RGBA: Rgba = [0.1, 0.35, 0.9, 1.0];
+
+pub use proto::MAX_SECONDS as PROTOBUF_MAX_SECONDS;
+
+/// The coin's two face marks, posed with the coin's orientation `r`: (centre in `coin_level`, size, colour),
+/// the top (+z) face's first. A bar 0.85 × 0.12 just outside each face, `0.2 · thickness` thick (at least
+/// 1e-3), so that spin and the face that is up both show.
+fn coin_marks(r: &UnitQuaternion<f64>, thickness: f64) -> [(Vector3<f64>, [f64; 3], Rgba); 2] {
+    let mark = (0.2 * thickness).max(1e-3);
+    [1.0, -1.0].map(|sign: f64| {
+        let colour = MARK_RGBA[usize::from(sign < 0.0)];
+        (
+            r * Vector3::new(0.45, 0.0, sign * 0.5 * (thickness + mark)),
+            [0.85, 0.12, mark],
+            colour,
+        )
+    })
+}
+
+/// The segments of the table's grid centred on `centre`: the minor lines (every 1) or the major ones (every
+/// [`GRID_MAJOR`]), across the slab in both directions, as (start, end) in display units.
+fn grid_segments(centre: [f64; 2], major: bool) -> impl Iterator<Item = ([f64; 2], [f64; 2])> {
+    (-GRID_HALF_COUNT..=GRID_HALF_COUNT)
+        // The centre is a multiple of TABLE_SNAP (10), itself a multiple of GRID_MAJOR.
+        .filter(move |k| (k % GRID_MAJOR == 0) == major)
+        .flat_map(move |k| {
+            let offset = f64::from(k);
+            [
+                (offset, -TABLE_HALF_SIDE, offset, TABLE_HALF_SIDE),
+                (-TABLE_HALF_SIDE, offset, TABLE_HALF_SIDE, offset),
+            ]
+            .map(|(x0, y0, x1, y1)| {
+                (
+                    [centre[0] + x0, centre[1] + y0],
+                    [centre[0] + x1, centre[1] + y1],
+                )
+            })
+        })
+}
+
 /// The Foxglove messages due at one sample, in one reused buffer.
 #[derive(Debug, Default)]
 pub struct FoxgloveBatch {
@@ -164,6 +212,7 @@ impl FoxgloveBatch {
 #[derive(Debug, Clone)]
 pub struct Foxglove3d {
     coin: Coin,
+    encoding: Encoding,
     /// 1/a: lengths → display units.
     inv_a: f64,
     thickness: f64,
@@ -188,8 +237,21 @@ impl Foxglove3d {
     /// Output for `coin` drawn `thickness` (fraction of a) thick; `tf` and `scene` say which channels are on.
     #[must_use]
     pub fn new(coin: &Coin, thickness: f64, tf: bool, scene: bool) -> Self {
+        Self::with_encoding(coin, thickness, tf, scene, Encoding::Json)
+    }
+
+    /// [`Self::new`] writing its messages in `encoding`.
+    #[must_use]
+    pub fn with_encoding(
+        coin: &Coin,
+        thickness: f64,
+        tf: bool,
+        scene: bool,
+        encoding: Encoding,
+    ) -> Self {
         Self {
             coin: *coin,
+            encoding,
             inv_a: 1.0 / coin.params().radius(),
             thickness,
             tf,
@@ -234,12 +296,16 @@ impl Foxglove3d {
         let first = !self.started;
         if self.tf {
             let tf = Topic::Main(Channel::Tf);
+            let table = match self.encoding {
+                Encoding::Json => write_table_transform,
+                Encoding::Protobuf => proto::table_transform,
+            };
             if first {
-                out.push(tf, |buf| write_table_transform(buf, log_time))?;
+                out.push(tf, |buf| table(buf, log_time))?;
             }
             out.push(tf, |buf| self.write_coin_transform(buf, log_time, s))?;
             if first {
-                out.push(Topic::TfStatic, |buf| write_table_transform(buf, log_time))?;
+                out.push(Topic::TfStatic, |buf| table(buf, log_time))?;
             }
         }
         self.last_had_scene = false;
@@ -283,19 +349,34 @@ impl Foxglove3d {
         out: &mut FoxgloveBatch,
     ) -> Result<(), NonFiniteField> {
         let centre = [s.x * self.inv_a, -s.z * self.inv_a, s.theta.cos()];
+        let protobuf = self.encoding == Encoding::Protobuf;
         out.push(Topic::SceneFollow, |buf| {
-            write_follow_transform(buf, log_time, centre)
+            if protobuf {
+                proto::follow_transform(buf, log_time, centre)
+            } else {
+                write_follow_transform(buf, log_time, centre)
+            }
         })?;
         let rotation = TABLE_ROTATION * orientation(s);
         out.push(Topic::Main(Channel::Scene), |buf| {
-            self.write_coin(buf, log_time, &rotation)
+            if protobuf {
+                proto::coin(buf, log_time, &rotation, self.thickness)
+            } else {
+                self.write_coin(buf, log_time, &rotation)
+            }
         })?;
         let moved = match self.table {
             Some(t) if (centre[0] - t[0]).abs().max((centre[1] - t[1]).abs()) <= TABLE_SNAP => None,
             _ => Some([snap(centre[0]), snap(centre[1])]),
         };
         if let Some(table) = moved {
-            out.push(Topic::SceneTable, |buf| write_table(buf, log_time, table))?;
+            out.push(Topic::SceneTable, |buf| {
+                if protobuf {
+                    proto::table(buf, log_time, table)
+                } else {
+                    write_table(buf, log_time, table)
+                }
+            })?;
             self.table = Some(table);
         }
         if let Some(change) = self.track.update() {
@@ -317,11 +398,22 @@ impl Foxglove3d {
         // level < TRACK_LEVELS = 16 fits in a u8.
         let topic = Topic::SceneTrack(u8::try_from(level).unwrap_or(u8::MAX));
         let points = self.track.level(level);
+        let protobuf = self.encoding == Encoding::Protobuf;
         if !points.is_empty() {
-            out.push(topic, |buf| write_track(buf, log_time, points))?;
+            out.push(topic, |buf| {
+                if protobuf {
+                    proto::track(buf, log_time, points)
+                } else {
+                    write_track(buf, log_time, points)
+                }
+            })?;
         } else if self.drawn[level] {
             out.push(topic, |buf| {
-                write_track_deletion(buf, log_time);
+                if protobuf {
+                    proto::track_deletion(buf, log_time);
+                } else {
+                    write_track_deletion(buf, log_time);
+                }
                 Ok(())
             })?;
         }
@@ -337,6 +429,9 @@ impl Foxglove3d {
     ) -> Result<(), NonFiniteField> {
         let a = self.coin.params().radius();
         let q = orientation(s);
+        if self.encoding == Encoding::Protobuf {
+            return proto::coin_transform(buf, log_time, [s.x, a * s.theta.cos(), s.z], &q);
+        }
         let mut w = Writer::new(buf, FRAME_TRANSFORM);
         w.raw(b"{\"timestamp\":");
         w.time(log_time);
@@ -367,18 +462,18 @@ impl Foxglove3d {
         let mut w = Writer::new(buf, SCENE_UPDATE);
         w.raw(b"{\"deletions\":[],\"entities\":[");
         w.entity_head(log_time, FOLLOW_FRAME, b"coin", None, true);
-        let mark = (0.2 * h).max(1e-3);
         w.raw(b"\"cubes\":[");
-        for (sign, color) in [(1.0, MARK_TOP_COLOR), (-1.0, MARK_BOTTOM_COLOR)] {
-            if sign < 0.0 {
+        let colors = [MARK_TOP_COLOR, MARK_BOTTOM_COLOR];
+        for (i, (position, size, _)) in coin_marks(r, h).iter().enumerate() {
+            if i > 0 {
                 w.raw(b",");
             }
             w.raw(b"{\"pose\":");
-            w.pose(&(r * Vector3::new(0.45, 0.0, sign * 0.5 * (h + mark))), r)?;
+            w.pose(position, r)?;
             w.raw(b",\"size\":");
-            w.vector3("cubes.size", 0.85, 0.12, mark)?;
+            w.vector3("cubes.size", size[0], size[1], size[2])?;
             w.raw(b",\"color\":");
-            w.raw(color);
+            w.raw(colors[i]);
             w.raw(b"}");
         }
         w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
@@ -458,25 +553,13 @@ fn write_grid(w: &mut Writer, centre: [f64; 2], major: bool) -> Result<(), NonFi
     w.raw(b"},\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"thickness\":");
     w.num("lines.thickness", GRID_WIDTHS[usize::from(major)])?;
     w.raw(b",\"scale_invariant\":true,\"points\":[");
-    let mut first = true;
-    for k in -GRID_HALF_COUNT..=GRID_HALF_COUNT {
-        // The centre is a multiple of TABLE_SNAP (10), itself a multiple of GRID_MAJOR.
-        if (k % GRID_MAJOR == 0) != major {
-            continue;
-        }
-        let offset = f64::from(k);
-        for (x0, y0, x1, y1) in [
-            (offset, -TABLE_HALF_SIDE, offset, TABLE_HALF_SIDE),
-            (-TABLE_HALF_SIDE, offset, TABLE_HALF_SIDE, offset),
-        ] {
-            if !first {
-                w.raw(b",");
-            }
-            first = false;
-            w.point(centre[0] + x0, centre[1] + y0)?;
+    for (i, (a, b)) in grid_segments(centre, major).enumerate() {
+        if i > 0 {
             w.raw(b",");
-            w.point(centre[0] + x1, centre[1] + y1)?;
         }
+        w.point(a[0], a[1])?;
+        w.raw(b",");
+        w.point(b[0], b[1])?;
     }
     w.raw(b"],\"color\":");
     w.raw(GRID_COLORS[usize::from(major)]);

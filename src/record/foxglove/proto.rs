@@ -1,0 +1,306 @@
+//! The Protobuf form of the Foxglove messages: the same frames and drawing as the JSON writers of
+//! [`super`], built as the `foxglove` crate's message types (Foxglove's published schemas) and encoded by
+//! prost. The geometry comes from the same helpers as the JSON ([`super::coin_marks`],
+//! [`super::grid_segments`], the colour constants), and a test decodes both encodings of a run and
+//! compares them field by field.
+
+use super::track::TrackPoint;
+use super::{
+    coin_marks, grid_segments, Rgba, COIN_RGBA, FOLLOW_FRAME, GRID_HEIGHT, GRID_RGBA, GRID_WIDTHS,
+    TABLE_HALF_SIDE, TABLE_RGBA, TABLE_ROTATION, TABLE_THICKNESS, TABLE_TOP, TRACK_RGBA,
+    TRACK_WIDTH, WORLD_FRAME,
+};
+use crate::format::messages::NonFiniteField;
+use foxglove::messages::{
+    line_primitive, scene_entity_deletion, Color, CubePrimitive, CylinderPrimitive, Duration,
+    FrameTransform, LinePrimitive, Point3, Pose, Quaternion, SceneEntity, SceneEntityDeletion,
+    SceneUpdate, Timestamp, Vector3,
+};
+use nalgebra::UnitQuaternion;
+use prost::Message;
+
+const FRAME_TRANSFORM: &str = "foxglove.FrameTransform";
+const SCENE_UPDATE: &str = "foxglove.SceneUpdate";
+
+/// The timestamp of a log time (ns). Foxglove's `Timestamp` counts seconds in a u32: up to 4.29e9 time
+/// units, beyond the longest run the recorder accepts in Protobuf ([`MAX_SECONDS`]).
+fn timestamp(log_time: u64) -> Timestamp {
+    let sec = u32::try_from(log_time / 1_000_000_000).unwrap_or(u32::MAX);
+    // log_time % 1e9 < 1e9 fits in a u32.
+    let nsec = u32::try_from(log_time % 1_000_000_000).unwrap_or(0);
+    Timestamp::new_checked(sec, nsec).unwrap_or(Timestamp::MAX)
+}
+
+/// The longest run, in time units (= seconds of log time), whose timestamps fit Foxglove's u32 seconds.
+pub const MAX_SECONDS: f64 = 4_294_967_295.0;
+
+/// Every number of a message must be finite (as in JSON): `Err` naming the first that is not.
+struct Finite {
+    schema: &'static str,
+}
+
+impl Finite {
+    fn check(&self, field: &'static str, values: &[f64]) -> Result<(), NonFiniteField> {
+        match values.iter().find(|v| !v.is_finite()) {
+            None => Ok(()),
+            Some(&value) => Err(NonFiniteField {
+                schema: self.schema,
+                field,
+                value,
+            }),
+        }
+    }
+}
+
+fn vector3(x: f64, y: f64, z: f64) -> Option<Vector3> {
+    Some(Vector3 { x, y, z })
+}
+
+fn quaternion(q: &UnitQuaternion<f64>) -> Option<Quaternion> {
+    Some(Quaternion {
+        x: q.i,
+        y: q.j,
+        z: q.k,
+        w: q.w,
+    })
+}
+
+fn color(c: Rgba) -> Option<Color> {
+    Some(Color {
+        r: c[0],
+        g: c[1],
+        b: c[2],
+        a: c[3],
+    })
+}
+
+fn identity() -> Option<Pose> {
+    Some(Pose {
+        position: vector3(0.0, 0.0, 0.0),
+        orientation: quaternion(&UnitQuaternion::identity()),
+    })
+}
+
+fn transform(
+    log_time: u64,
+    parent: &str,
+    child: &str,
+    translation: [f64; 3],
+    rotation: &UnitQuaternion<f64>,
+) -> Result<FrameTransform, NonFiniteField> {
+    let f = Finite {
+        schema: FRAME_TRANSFORM,
+    };
+    f.check("translation", &translation)?;
+    f.check("rotation", rotation.coords.as_slice())?;
+    Ok(FrameTransform {
+        timestamp: Some(timestamp(log_time)),
+        parent_frame_id: parent.to_string(),
+        child_frame_id: child.to_string(),
+        translation: vector3(translation[0], translation[1], translation[2]),
+        rotation: quaternion(rotation),
+    })
+}
+
+/// `/tf` and `/tf_static` world → table.
+pub(super) fn table_transform(buf: &mut Vec<u8>, log_time: u64) -> Result<(), NonFiniteField> {
+    transform(
+        log_time,
+        WORLD_FRAME,
+        super::TABLE_FRAME,
+        [0.0; 3],
+        &TABLE_ROTATION,
+    )?
+    .encode_raw(buf);
+    Ok(())
+}
+
+/// `/tf` table → coin: the centre `translation` and the orientation `q`.
+pub(super) fn coin_transform(
+    buf: &mut Vec<u8>,
+    log_time: u64,
+    translation: [f64; 3],
+    q: &UnitQuaternion<f64>,
+) -> Result<(), NonFiniteField> {
+    transform(
+        log_time,
+        super::TABLE_FRAME,
+        super::COIN_FRAME,
+        translation,
+        q,
+    )?
+    .encode_raw(buf);
+    Ok(())
+}
+
+/// `/scene/follow` world → coin_level.
+pub(super) fn follow_transform(
+    buf: &mut Vec<u8>,
+    log_time: u64,
+    centre: [f64; 3],
+) -> Result<(), NonFiniteField> {
+    transform(
+        log_time,
+        WORLD_FRAME,
+        FOLLOW_FRAME,
+        centre,
+        &UnitQuaternion::identity(),
+    )?
+    .encode_raw(buf);
+    Ok(())
+}
+
+/// An entity with the fields every drawn one shares (no lifetime: it stays until replaced).
+fn entity(log_time: u64, frame: &str, id: &str) -> SceneEntity {
+    SceneEntity {
+        timestamp: Some(timestamp(log_time)),
+        frame_id: frame.to_string(),
+        id: id.to_string(),
+        lifetime: Some(Duration::new(0, 0)),
+        frame_locked: true,
+        ..SceneEntity::default()
+    }
+}
+
+fn update(entity: SceneEntity) -> SceneUpdate {
+    SceneUpdate {
+        deletions: Vec::new(),
+        entities: vec![entity],
+    }
+}
+
+/// `/scene`: the coin posed with `r`, `thickness` thick, and its two face marks.
+pub(super) fn coin(
+    buf: &mut Vec<u8>,
+    log_time: u64,
+    r: &UnitQuaternion<f64>,
+    thickness: f64,
+) -> Result<(), NonFiniteField> {
+    let f = Finite {
+        schema: SCENE_UPDATE,
+    };
+    f.check("cylinders.size.z", &[thickness])?;
+    f.check("pose.orientation", r.coords.as_slice())?;
+    let mut e = entity(log_time, FOLLOW_FRAME, "coin");
+    for (position, size, rgba) in coin_marks(r, thickness) {
+        f.check("cubes.pose.position", position.as_slice())?;
+        e.cubes.push(CubePrimitive {
+            pose: Some(Pose {
+                position: vector3(position.x, position.y, position.z),
+                orientation: quaternion(r),
+            }),
+            size: vector3(size[0], size[1], size[2]),
+            color: color(rgba),
+        });
+    }
+    e.cylinders.push(CylinderPrimitive {
+        pose: Some(Pose {
+            position: vector3(0.0, 0.0, 0.0),
+            orientation: quaternion(r),
+        }),
+        size: vector3(2.0, 2.0, thickness),
+        bottom_scale: 1.0,
+        top_scale: 1.0,
+        color: color(COIN_RGBA),
+    });
+    update(e).encode_raw(buf);
+    Ok(())
+}
+
+/// `/scene/table`: the slab centred on `centre` and its grid.
+pub(super) fn table(
+    buf: &mut Vec<u8>,
+    log_time: u64,
+    centre: [f64; 2],
+) -> Result<(), NonFiniteField> {
+    let f = Finite {
+        schema: SCENE_UPDATE,
+    };
+    f.check("cubes.pose.position", &centre)?;
+    let mut e = entity(log_time, WORLD_FRAME, "table");
+    let side = 2.0 * TABLE_HALF_SIDE;
+    e.cubes.push(CubePrimitive {
+        pose: Some(Pose {
+            position: vector3(centre[0], centre[1], TABLE_TOP - 0.5 * TABLE_THICKNESS),
+            orientation: quaternion(&UnitQuaternion::identity()),
+        }),
+        size: vector3(side, side, TABLE_THICKNESS),
+        color: color(TABLE_RGBA),
+    });
+    for major in [false, true] {
+        let mut points = Vec::new();
+        for (a, b) in grid_segments(centre, major) {
+            points.push(Point3 {
+                x: a[0],
+                y: a[1],
+                z: 0.0,
+            });
+            points.push(Point3 {
+                x: b[0],
+                y: b[1],
+                z: 0.0,
+            });
+        }
+        e.lines.push(LinePrimitive {
+            r#type: line_primitive::Type::LineList as i32,
+            pose: Some(Pose {
+                position: vector3(0.0, 0.0, GRID_HEIGHT),
+                orientation: quaternion(&UnitQuaternion::identity()),
+            }),
+            thickness: GRID_WIDTHS[usize::from(major)],
+            scale_invariant: true,
+            points,
+            color: color(GRID_RGBA[usize::from(major)]),
+            colors: Vec::new(),
+            indices: Vec::new(),
+        });
+    }
+    update(e).encode_raw(buf);
+    Ok(())
+}
+
+/// `/scene/track/<L>`: the level's points as one line strip.
+pub(super) fn track(
+    buf: &mut Vec<u8>,
+    log_time: u64,
+    points: &[TrackPoint],
+) -> Result<(), NonFiniteField> {
+    let f = Finite {
+        schema: SCENE_UPDATE,
+    };
+    let mut line = Vec::with_capacity(points.len());
+    for p in points {
+        f.check("lines.points", &[p.x, p.y])?;
+        line.push(Point3 {
+            x: p.x,
+            y: p.y,
+            z: 0.0,
+        });
+    }
+    let mut e = entity(log_time, WORLD_FRAME, "track");
+    e.lines.push(LinePrimitive {
+        r#type: line_primitive::Type::LineStrip as i32,
+        pose: identity(),
+        thickness: TRACK_WIDTH,
+        scale_invariant: true,
+        points: line,
+        color: color(TRACK_RGBA),
+        colors: Vec::new(),
+        indices: Vec::new(),
+    });
+    update(e).encode_raw(buf);
+    Ok(())
+}
+
+/// `/scene/track/<L>` when the level is empty: the deletion of its line.
+pub(super) fn track_deletion(buf: &mut Vec<u8>, log_time: u64) {
+    SceneUpdate {
+        deletions: vec![SceneEntityDeletion {
+            timestamp: Some(timestamp(log_time)),
+            r#type: scene_entity_deletion::Type::MatchingId as i32,
+            id: "track".to_string(),
+        }],
+        entities: Vec::new(),
+    }
+    .encode_raw(buf);
+}
