@@ -3,7 +3,7 @@
 //! paces; this file does the address, signals, the optional file (as `record` does it), printing and exit
 //! codes.
 
-use super::record::{self, Signals};
+use super::record::{self, EncodingArg, Signals};
 use super::scene_arg::load_source;
 use super::{make_readable, output, Outcome};
 use anyhow::{anyhow, Context};
@@ -20,6 +20,8 @@ use tempfile::NamedTempFile;
 const WRITE_BUFFER: usize = 1 << 20;
 /// With `--exit`, time left to viewers to receive what is queued for them before the server closes.
 const DRAIN: Duration = Duration::from_millis(500);
+/// Falling further behind the pace than this gets a warning after the run.
+const LAG_WARNING: Duration = Duration::from_millis(500);
 /// How often the server, once the run is over, looks for Ctrl-C.
 const SERVE_POLL: Duration = Duration::from_millis(100);
 
@@ -74,6 +76,10 @@ pub struct LiveArgs {
     /// Comma-separated channels, as for `record` (overrides `record.channels`; default all).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     channels: Option<Vec<String>>,
+    /// Message encoding, as for `record`: json (JSON Schemas) or protobuf (FileDescriptorSet schemas);
+    /// Foxglove reads both live.
+    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
+    encoding: EncodingArg,
     /// Set a scene key before the flags above apply, as for `record`. Repeatable.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
@@ -129,7 +135,11 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     };
     let started = Instant::now();
     let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
-    let summary = run_scene(&scene, &mut tap, file.as_mut(), &signals)?;
+    let options = RecordOptions {
+        compression: Compression::default(),
+        encoding: args.encoding.into(),
+    };
+    let summary = run_scene(&scene, &options, &mut tap, file.as_mut(), &signals)?;
     let wall = started.elapsed();
     if let Some(e) = tap.error() {
         errln!("warning: a topic could not be served: {e}");
@@ -209,20 +219,18 @@ fn tell(event: LiveEvent, pacing: Pacing) {
 /// Records into the optional file (or nowhere) through the live tap; the file is synced and readable.
 fn run_scene<F: FnMut(LiveEvent)>(
     scene: &Scene,
+    options: &RecordOptions,
     tap: &mut LiveTap<'_, F>,
     file: Option<&mut (PathBuf, NamedTempFile)>,
     signals: &Signals,
 ) -> anyhow::Result<RecordSummary> {
-    let options = RecordOptions {
-        compression: Compression::default(),
-    };
     let stop = &signals.stop;
     let Some((target, temp)) = file else {
-        return record_with_tap(scene, &options, Discard::default(), tap, stop, |_| {})
+        return record_with_tap(scene, options, Discard::default(), tap, stop, |_| {})
             .context("running the scene");
     };
     let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());
-    let summary = record_with_tap(scene, &options, writer, tap, stop, |_| {})
+    let summary = record_with_tap(scene, options, writer, tap, stop, |_| {})
         .with_context(|| format!("recording `{}`", target.display()))?;
     temp.as_file()
         .sync_all()
@@ -305,6 +313,14 @@ fn print_summary(
     }
     if s.event_trusted == Some(false) {
         errln!("warning: {}", record::untrusted_event(s));
+    }
+    if live.max_lag > LAG_WARNING {
+        errln!(
+            "warning: the run fell up to {:.1} s behind {}× real time (the simulation and serving were \
+             slower than that); lower --speed, or --rate or --channels for fewer messages",
+            live.max_lag.as_secs_f64(),
+            args.speed
+        );
     }
     if output::stdout_failed() {
         errln!("note: only the summary was lost");

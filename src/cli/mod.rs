@@ -65,12 +65,24 @@ enum Command {
     /// authentication, no encryption).
     #[cfg(feature = "live")]
     Live(live::LiveArgs),
+    /// Not in this build: says how to get it.
+    #[cfg(not(feature = "live"))]
+    #[command(hide = true, disable_help_flag = true)]
+    Live(NoLive),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(completions::CompletionsArgs),
     /// Print the man page, or write one per command into a folder.
     Man(completions::ManArgs),
     /// What a scene's motion will do, without simulating it; `analyse map`: the stability map.
     Analyse(analyse::AnalyseArgs),
+}
+
+/// `live` in a build without the `live` feature: any arguments, to answer with how to get it.
+#[cfg(not(feature = "live"))]
+#[derive(Debug, clap::Args)]
+struct NoLive {
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    args: Vec<String>,
 }
 
 /// What a command ended with; the one place exit codes are decided (format.md: Exit codes).
@@ -118,6 +130,15 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Plot(args) => plot::run(&args),
         #[cfg(feature = "live")]
         Command::Live(args) => live::run(args),
+        #[cfg(not(feature = "live"))]
+        Command::Live(_) => {
+            output::errln!(
+                "error: this coin-log was built without the live view (cargo feature `live`): build it with \
+                 `cargo build --release --features live`, or install it with `cargo install --path . \
+                 --features live`"
+            );
+            Ok(Outcome::Unusable)
+        }
         Command::Completions(args) => completions::completions(&args),
         Command::Man(args) => completions::man(&args),
         Command::Analyse(args) => analyse::run(args),

@@ -97,6 +97,7 @@ fn the_throughput_command_records_the_library_workload_and_prints_sane_rows() {
         let mut recorded = Cursor::new(Vec::new());
         let options = RecordOptions {
             compression: Compression::Zstd,
+            ..RecordOptions::default()
         };
         let summary = record::record(
             &scene,

@@ -304,7 +304,11 @@ fn every_compression_gives_a_readable_file_with_the_same_messages() {
     );
     let mut all = Vec::new();
     for compression in Compression::ALL {
-        let (bytes, summary) = record_to_memory(&scene, &RecordOptions { compression });
+        let options = RecordOptions {
+            compression,
+            ..RecordOptions::default()
+        };
+        let (bytes, summary) = record_to_memory(&scene, &options);
         check_recording(compression.name(), &scene, &bytes, &summary);
         let messages: Vec<Vec<u8>> = read_back(&bytes)
             .messages

@@ -616,7 +616,10 @@ fn a_recording_passes_every_crc_check_for_every_compression() {
         let mut out = Cursor::new(Vec::new());
         let summary = record::record(
             &scene,
-            &RecordOptions { compression },
+            &RecordOptions {
+                compression,
+                ..RecordOptions::default()
+            },
             &mut out,
             &AtomicBool::new(false),
             |_| {},
