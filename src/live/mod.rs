@@ -76,15 +76,18 @@ impl Latest {
     }
 }
 
+/// The channels by id, each with its latest messages once it has some.
+type Channels = HashMap<ChannelId, (Arc<RawChannel>, Option<Latest>)>;
+
 /// Every channel and its latest messages. Logging and re-sending both hold the lock, so a viewer never gets
 /// a topic's messages out of time order.
 #[derive(Default)]
 struct Latch {
-    channels: Mutex<HashMap<ChannelId, (Arc<RawChannel>, Option<Latest>)>>,
+    channels: Mutex<Channels>,
 }
 
 impl Latch {
-    fn lock(&self) -> MutexGuard<'_, HashMap<ChannelId, (Arc<RawChannel>, Option<Latest>)>> {
+    fn lock(&self) -> MutexGuard<'_, Channels> {
         self.channels.lock().unwrap_or_else(PoisonError::into_inner)
     }
 

@@ -837,16 +837,16 @@ mod tests {
             ReactionMessage::FIELDS,
             ["t", "x", "y", "z", "friction", "normal", "friction_ratio"]
         );
-        let (t, v, complete) = Judge::parse(Slot::Reaction, &buf, false).unwrap();
+        let (t, v, complete) = Judge::parse(Slot::Reaction, &buf, false, None).unwrap();
         assert_eq!(t.to_bits(), 0.5_f64.to_bits());
         assert!(matches!(v, Value::Reaction(r) if r == m));
         assert!(complete);
         // The same message read as the first version (no friction_ratio in its schema) is not complete
         // only if it lacks the field: this one has it, so the caller flags it.
-        let (_, _, complete) = Judge::parse(Slot::Reaction, &buf, true).unwrap();
+        let (_, _, complete) = Judge::parse(Slot::Reaction, &buf, true, None).unwrap();
         assert!(complete);
         let old = br#"{"t":0.5,"x":0.1,"y":-0.2,"z":1e-17,"friction":3.0,"normal":0.75}"#;
-        let (_, v, complete) = Judge::parse(Slot::Reaction, old, true).unwrap();
+        let (_, v, complete) = Judge::parse(Slot::Reaction, old, true, None).unwrap();
         assert!(!complete);
         assert!(matches!(v, Value::Reaction(r) if r.friction_ratio.is_none()));
         for (slot, fields) in [
@@ -868,7 +868,10 @@ mod tests {
             };
             assert_eq!(fields, fields_fast, "{slot:?}");
             assert!(
-                matches!(Judge::parse(slot, text.as_bytes(), false), Ok((_, _, true))),
+                matches!(
+                    Judge::parse(slot, text.as_bytes(), false, None),
+                    Ok((_, _, true))
+                ),
                 "{text}"
             );
         }
