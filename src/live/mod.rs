@@ -152,7 +152,14 @@ impl LiveServer {
         let latch = Arc::new(Latch::default());
         let handle = WebSocketServer::new()
             .name(name)
-            .bind(host.to_string(), port)
+            // The server joins host and port as `host:port`: an IPv6 address needs its brackets.
+            .bind(
+                match host {
+                    IpAddr::V4(v4) => v4.to_string(),
+                    IpAddr::V6(v6) => format!("[{v6}]"),
+                },
+                port,
+            )
             .context(&context)
             .capabilities([foxglove::websocket::Capability::Time])
             .supported_encodings(["json", "protobuf"])

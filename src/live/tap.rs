@@ -159,9 +159,11 @@ impl<'a, F: FnMut(LiveEvent)> LiveTap<'a, F> {
             (self.on_event)(LiveEvent::Waiting);
             self.wait_for_viewer();
         }
-        (self.on_event)(LiveEvent::Started {
-            viewers: self.server.clients(),
-        });
+        if !self.stopped() {
+            (self.on_event)(LiveEvent::Started {
+                viewers: self.server.clients(),
+            });
+        }
         *self.clock.insert(Instant::now())
     }
 
