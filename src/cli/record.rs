@@ -211,6 +211,7 @@ fn warn_if_large(args: &RecordArgs, scene: &Scene) {
 pub(super) struct Signals {
     pub(super) stop: Arc<AtomicBool>,
     /// What the first signal says it does (`live` says more than "finishing the file").
+    #[cfg_attr(not(feature = "live"), allow(dead_code))]
     first: Arc<Mutex<&'static str>>,
     /// The temporary file while it exists (locked while it is created and moved into place).
     temp: Arc<Mutex<Option<PathBuf>>>,
@@ -241,6 +242,7 @@ impl Signals {
     }
 
     /// What the first signal will say it does from now on.
+    #[cfg_attr(not(feature = "live"), allow(dead_code))]
     pub(super) fn on_first_signal(&self, message: &'static str) {
         *self.first.lock().unwrap_or_else(PoisonError::into_inner) = message;
     }
