@@ -9,6 +9,8 @@ mod completions;
 mod destination;
 mod export;
 mod info;
+#[cfg(feature = "live")]
+mod live;
 mod plot;
 mod progress;
 mod record;
@@ -50,12 +52,37 @@ enum Command {
     Export(export::ExportArgs),
     /// Draw a one-page SVG overview of a file.
     Plot(plot::PlotArgs),
+    /// Simulate a scene in real time (or faster) and serve it live to Foxglove.
+    ///
+    /// Serves the run over the Foxglove WebSocket protocol at --speed times real time (one time unit of the
+    /// scene per second at 1): in Foxglove, Open connection → Foxglove WebSocket → the URL printed on stderr
+    /// (ws://127.0.0.1:8765 by default). The channels, schemas and messages are byte for byte those of
+    /// `record`; -o FILE records them at the same time. The first sample is shown at once and the clock
+    /// starts when a viewer subscribes (--no-wait: at once). When the run ends the server keeps serving its
+    /// final state until Ctrl-C (--exit: quits at once); Ctrl-C during the run stops it (the file is
+    /// finished, marked interrupted, exit 130). The server listens on 127.0.0.1, this machine only;
+    /// --host 0.0.0.0 listens on every interface, where anyone who can reach the machine can connect (no
+    /// authentication, no encryption).
+    #[cfg(feature = "live")]
+    Live(live::LiveArgs),
+    /// Not in this build: says how to get it.
+    #[cfg(not(feature = "live"))]
+    #[command(hide = true, disable_help_flag = true)]
+    Live(NoLive),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(completions::CompletionsArgs),
     /// Print the man page, or write one per command into a folder.
     Man(completions::ManArgs),
     /// What a scene's motion will do, without simulating it; `analyse map`: the stability map.
     Analyse(analyse::AnalyseArgs),
+}
+
+/// `live` in a build without the `live` feature: any arguments, to answer with how to get it.
+#[cfg(not(feature = "live"))]
+#[derive(Debug, clap::Args)]
+struct NoLive {
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    args: Vec<String>,
 }
 
 /// What a command ended with; the one place exit codes are decided (format.md: Exit codes).
@@ -101,6 +128,17 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Info(args) => info::run(&args),
         Command::Export(args) => export::run(&args),
         Command::Plot(args) => plot::run(&args),
+        #[cfg(feature = "live")]
+        Command::Live(args) => live::run(args),
+        #[cfg(not(feature = "live"))]
+        Command::Live(_) => {
+            output::errln!(
+                "error: this coin-log was built without the live view (cargo feature `live`): build it with \
+                 `cargo build --release --features live`, or install it with `cargo install --path . \
+                 --features live`"
+            );
+            Ok(Outcome::Unusable)
+        }
         Command::Completions(args) => completions::completions(&args),
         Command::Man(args) => completions::man(&args),
         Command::Analyse(args) => analyse::run(args),

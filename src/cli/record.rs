@@ -144,7 +144,7 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     }
     warn_if_large(&args, &scene);
     let target = output_path(&args, &source);
-    let mut temp = prepare_output(&target, &args, &source, &signals)?;
+    let mut temp = prepare_output(&target, args.overwrite, &source, &signals)?;
     if signals.stopped() {
         errln!("interrupted before recording began: nothing was written");
         return Ok(Outcome::Interrupted);
@@ -208,20 +208,26 @@ fn warn_if_large(args: &RecordArgs, scene: &Scene) {
 
 /// SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): the first finishes the file with what was
 /// recorded, marked `interrupted`; a second abandons the recording at once, deleting the temporary file.
-struct Signals {
-    stop: Arc<AtomicBool>,
+pub(super) struct Signals {
+    pub(super) stop: Arc<AtomicBool>,
+    /// What the first signal says it does (`live` says more than "finishing the file").
+    #[cfg_attr(not(feature = "live"), allow(dead_code))]
+    first: Arc<Mutex<&'static str>>,
     /// The temporary file while it exists (locked while it is created and moved into place).
     temp: Arc<Mutex<Option<PathBuf>>>,
 }
 
 impl Signals {
-    fn install() -> anyhow::Result<Self> {
+    pub(super) fn install() -> anyhow::Result<Self> {
         let stop = Arc::new(AtomicBool::new(false));
         let temp: Arc<Mutex<Option<PathBuf>>> = Arc::new(Mutex::new(None));
-        let (flag, slot) = (Arc::clone(&stop), Arc::clone(&temp));
+        let first = Arc::new(Mutex::new(
+            "stopping: finishing the file with what was recorded (signal again to abandon it)",
+        ));
+        let (flag, slot, said) = (Arc::clone(&stop), Arc::clone(&temp), Arc::clone(&first));
         ctrlc::set_handler(move || {
             if !flag.swap(true, Ordering::SeqCst) {
-                errln!("stopping: finishing the file with what was recorded (signal again to abandon it)");
+                errln!("{}", *said.lock().unwrap_or_else(PoisonError::into_inner));
                 return;
             }
             let slot = slot.lock().unwrap_or_else(PoisonError::into_inner);
@@ -232,10 +238,16 @@ impl Signals {
             std::process::exit(130);
         })
         .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;
-        Ok(Self { stop, temp })
+        Ok(Self { stop, temp, first })
     }
 
-    fn stopped(&self) -> bool {
+    /// What the first signal will say it does from now on.
+    #[cfg_attr(not(feature = "live"), allow(dead_code))]
+    pub(super) fn on_first_signal(&self, message: &'static str) {
+        *self.first.lock().unwrap_or_else(PoisonError::into_inner) = message;
+    }
+
+    pub(super) fn stopped(&self) -> bool {
         self.stop.load(Ordering::SeqCst)
     }
 
@@ -247,15 +259,22 @@ impl Signals {
 /// The scene with the command-line flags applied and validated; warns about settings the integrator does
 /// not use and notes a step rounded to the sampling grid.
 fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
-    let flags = FlagOverrides {
-        duration: args.duration,
-        rate: args.rate,
-        integrator: args.integrator.clone(),
-        rtol: args.rtol,
-        atol: args.atol,
-        step: args.step,
-        channels: args.channels.clone(),
-    };
+    resolve_flags(
+        FlagOverrides {
+            duration: args.duration,
+            rate: args.rate,
+            integrator: args.integrator.clone(),
+            rtol: args.rtol,
+            atol: args.atol,
+            step: args.step,
+            channels: args.channels.clone(),
+        },
+        source,
+    )
+}
+
+/// [`resolve`] with the flags given as scene overrides (shared with `live`).
+pub(super) fn resolve_flags(flags: FlagOverrides, source: &SceneSource) -> anyhow::Result<Scene> {
     let scene = scene::resolve(&source.file, &flags)
         .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
     let max = record::foxglove::PROTOBUF_MAX_SECONDS;
@@ -311,14 +330,14 @@ fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
 
 /// Checks the target and creates the temporary file beside it, all before simulating: the target must be
 /// absent or (with `--overwrite`) a regular file other than the scene, and its name must be creatable.
-fn prepare_output(
+pub(super) fn prepare_output(
     target: &Path,
-    args: &RecordArgs,
+    overwrite: bool,
     source: &SceneSource,
     signals: &Signals,
 ) -> anyhow::Result<NamedTempFile> {
     let existing =
-        destination::check_target(target, args.overwrite, source.path.as_deref(), &source.stem)?;
+        destination::check_target(target, overwrite, source.path.as_deref(), &source.stem)?;
     let mut slot = signals.slot();
     let temp = temp_file_beside(target)?;
     *slot = Some(temp.path().to_path_buf());
@@ -378,7 +397,7 @@ fn record_into(
 
 /// Moves the finished recording into place; without `--overwrite` a file that appeared meanwhile is left
 /// alone and the recording kept under its temporary name.
-fn persist(
+pub(super) fn persist(
     temp: NamedTempFile,
     target: &Path,
     overwrite: bool,
@@ -408,7 +427,7 @@ fn persist(
 }
 
 /// The exit code of a finished recording; a numerical failure says where the samples stop.
-fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
+pub(super) fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
     match &summary.failure {
         Some(f) => {
             errln!(
@@ -471,7 +490,7 @@ fn print_summary(
 }
 
 /// Why an event is not to be trusted, in one sentence.
-fn untrusted_event(s: &RecordSummary) -> String {
+pub(super) fn untrusted_event(s: &RecordSummary) -> String {
     format!(
         "the {} at t = {} is not to be trusted: the energy drift {:.3e} is above {:.3e}, the energy \
          tolerance verify derives from these integrator settings, so the integration had gone wrong \
@@ -514,7 +533,7 @@ fn messages_per_second(s: &RecordSummary, seconds: f64) -> f64 {
     }
 }
 
-fn json_summary(
+pub(super) fn json_summary(
     scene: &Scene,
     label: &str,
     target: &Path,
@@ -552,7 +571,7 @@ fn json_summary(
     })
 }
 
-fn summary_rows(
+pub(super) fn summary_rows(
     scene: &Scene,
     label: &str,
     target: &Path,

@@ -220,6 +220,18 @@ pub trait Tap {
     fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]);
 }
 
+/// A tap lent to a recording, so that the caller reads its state afterwards.
+impl<T: Tap + ?Sized> Tap for &mut T {
+    #[inline]
+    fn channel(&mut self, info: &ChannelInfo<'_>) {
+        (**self).channel(info);
+    }
+    #[inline]
+    fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]) {
+        (**self).message(topic, log_time, data);
+    }
+}
+
 /// The tap of a plain recording: sees nothing (and costs nothing: it is inlined away).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoTap;

@@ -21,6 +21,7 @@ const LAYERS: &[&[&str]] = &[
     &["format"],
     &["scene"],
     &["record", "verify", "analyse", "inspect"],
+    &["live"],
     &["bench"],
 ];
 

@@ -30,6 +30,8 @@ mod inspect;
 mod integrators;
 mod invariants;
 mod linearisation;
+#[cfg(feature = "live")]
+mod live;
 mod other_writers;
 mod params;
 mod properties;

@@ -1,0 +1,349 @@
+//! `coin-log live`: simulate a scene at a chosen pace and serve it to Foxglove over the Foxglove WebSocket
+//! protocol, optionally recording the same messages to a file. The library (`coin_log::live`) serves and
+//! paces; this file does the address, signals, the optional file (as `record` does it), printing and exit
+//! codes.
+
+use super::record::{self, EncodingArg, Signals};
+use super::scene_arg::load_source;
+use super::{make_readable, output, Outcome};
+use anyhow::{anyhow, Context};
+use coin_log::live::{Discard, LiveEvent, LiveServer, LiveTap, Pacing, DEFAULT_PORT};
+use coin_log::record::{record_with_tap, Compression, RecordOptions, RecordSummary};
+use coin_log::scene::{FlagOverrides, Scene};
+use std::io::BufWriter;
+use std::net::IpAddr;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+use tempfile::NamedTempFile;
+
+/// Write buffer in front of the optional file.
+const WRITE_BUFFER: usize = 1 << 20;
+/// With `--exit`, time left to viewers to receive what is queued for them before the server closes.
+const DRAIN: Duration = Duration::from_millis(500);
+/// Falling further behind the pace than this gets a warning after the run.
+const LAG_WARNING: Duration = Duration::from_millis(500);
+/// How often the server, once the run is over, looks for Ctrl-C.
+const SERVE_POLL: Duration = Duration::from_millis(100);
+
+/// Arguments of `coin-log live` (the command's description is on its variant in `cli/mod.rs`).
+#[derive(Debug, clap::Args)]
+pub struct LiveArgs {
+    /// A built-in scene (listed by `coin-log scenes`) or a scene file, as for `record`.
+    scene: String,
+    /// Simulated time units per second of wall time: 1 real time, 10 ten times faster, 0.1 slow motion
+    /// (finite, above 0).
+    #[arg(long, value_name = "X", default_value_t = 1.0, value_parser = parse_speed,
+          allow_negative_numbers = true)]
+    speed: f64,
+    /// TCP port to serve on; 0 picks a free one (the URL printed says which).
+    #[arg(long, value_name = "P", default_value_t = DEFAULT_PORT)]
+    port: u16,
+    /// IP address to listen on: 127.0.0.1 (this machine only), 0.0.0.0 or :: (every interface: anyone on
+    /// the network can connect), or one interface's address.
+    #[arg(long, value_name = "H", default_value = "127.0.0.1", value_parser = parse_host)]
+    host: IpAddr,
+    /// Start the clock at once instead of waiting for a viewer to subscribe.
+    #[arg(long)]
+    no_wait: bool,
+    /// Exit when the run ends instead of serving its final state until Ctrl-C.
+    #[arg(long)]
+    exit: bool,
+    /// Also record to FILE, exactly as `record -o FILE` would (temporary file, moved into place when
+    /// finished, never replacing a file without --overwrite).
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Replace FILE if it exists.
+    #[arg(long, requires = "output")]
+    overwrite: bool,
+    /// Duration in the scene's time unit (overrides `run.duration`).
+    #[arg(long, value_name = "T")]
+    duration: Option<f64>,
+    /// Samples per time unit (overrides `run.rate`; scene default 100).
+    #[arg(long, value_name = "R")]
+    rate: Option<f64>,
+    /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`).
+    #[arg(long, value_name = "NAME")]
+    integrator: Option<String>,
+    /// Relative tolerance of adaptive methods (overrides `run.rtol`).
+    #[arg(long, value_name = "X")]
+    rtol: Option<f64>,
+    /// Absolute tolerance of adaptive methods (overrides `run.atol`).
+    #[arg(long, value_name = "X")]
+    atol: Option<f64>,
+    /// Step of fixed-step methods (overrides `run.step`).
+    #[arg(long, value_name = "H")]
+    step: Option<f64>,
+    /// Comma-separated channels, as for `record` (overrides `record.channels`; default all).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    channels: Option<Vec<String>>,
+    /// Message encoding, as for `record`: json (JSON Schemas) or protobuf (FileDescriptorSet schemas);
+    /// Foxglove reads both live.
+    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
+    encoding: EncodingArg,
+    /// Set a scene key before the flags above apply, as for `record`. Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Print the end-of-run summary as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_speed(s: &str) -> Result<f64, String> {
+    let x: f64 = s.trim().parse().map_err(|_| {
+        format!("`{s}` is not a number; give simulated time units per wall second, e.g. 1 or 10")
+    })?;
+    Pacing::new(x, true).map(|p| p.speed()).ok_or_else(|| {
+        format!("the speed must be a finite number above 0 (got {s}); 1 is real time, 10 ten times faster")
+    })
+}
+
+fn parse_host(s: &str) -> Result<IpAddr, String> {
+    s.trim().parse().map_err(|_| {
+        format!(
+            "`{s}` is not an IP address; use 127.0.0.1 (this machine only), 0.0.0.0 (every interface) \
+             or one interface's address"
+        )
+    })
+}
+
+/// Runs `coin-log live`: load → resolve → serve → record and serve at the pace → summary → serve the final
+/// state until Ctrl-C (or `--exit`).
+pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
+    let signals = Signals::install()?;
+    if args.output.is_none() {
+        signals.on_first_signal("stopping the run (signal again to quit at once)");
+    }
+    let source = load_source(&args.scene, &args.set)?;
+    let scene = record::resolve_flags(flags(&args), &source)?;
+    let pacing = Pacing::new(args.speed, !args.no_wait)
+        .ok_or_else(|| anyhow!("the speed must be a finite number above 0"))?;
+    let server =
+        match LiveServer::start(args.host, args.port, &format!("coin-log {}", source.label)) {
+            Ok(server) => server,
+            Err(e) => {
+                errln!("error: {e:#}; {}", bind_hint(&e.to_string()));
+                return Ok(Outcome::Unusable);
+            }
+        };
+    announce(&args, &server, &source.label);
+    let mut file = match &args.output {
+        Some(target) => {
+            let temp = record::prepare_output(target, args.overwrite, &source, &signals)?;
+            Some((target.clone(), temp))
+        }
+        None => None,
+    };
+    let started = Instant::now();
+    let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
+    let options = RecordOptions {
+        compression: Compression::default(),
+        encoding: args.encoding.into(),
+    };
+    let summary = run_scene(&scene, &options, &mut tap, file.as_mut(), &signals)?;
+    let wall = started.elapsed();
+    if let Some(e) = tap.error() {
+        errln!("warning: a topic could not be served: {e}");
+    }
+    let stats = Stats {
+        served: tap.messages(),
+        max_lag: tap.max_lag(),
+        clock: tap.elapsed(),
+        url: server.url(),
+    };
+    if let Some((target, temp)) = file.take() {
+        record::persist(temp, &target, args.overwrite, &signals)?;
+    }
+    print_summary(&args, &scene, &source.label, &summary, wall, &stats)?;
+    let outcome = match &args.output {
+        Some(target) => record::outcome(&summary, target),
+        None => run_outcome(&summary),
+    };
+    serve_final_state(&args, server, &signals);
+    Ok(outcome)
+}
+
+fn flags(args: &LiveArgs) -> FlagOverrides {
+    FlagOverrides {
+        duration: args.duration,
+        rate: args.rate,
+        integrator: args.integrator.clone(),
+        rtol: args.rtol,
+        atol: args.atol,
+        step: args.step,
+        channels: args.channels.clone(),
+    }
+}
+
+/// What to do about an address that cannot be served.
+fn bind_hint(error: &str) -> &'static str {
+    if error.contains("in use") {
+        "another program (or another `coin-log live`) uses this port: pick another with --port, or --port 0 \
+         for any free one"
+    } else {
+        "check --host (an address of this machine) and --port"
+    }
+}
+
+/// The URL to connect to, on stderr in a line of its own (`serving ws://…`), and what the address exposes.
+fn announce(args: &LiveArgs, server: &LiveServer, label: &str) {
+    errln!("serving `{label}` live at {}", server.url());
+    errln!(
+        "  open it in Foxglove: Open connection → Foxglove WebSocket → {}",
+        server.url()
+    );
+    if args.host.is_loopback() {
+        errln!("  (this machine only; --host 0.0.0.0 exposes it to the network)");
+    } else {
+        errln!(
+            "  warning: listening on {}: anyone who can reach this machine on port {} can connect and watch \
+             (no authentication, no encryption)",
+            args.host,
+            server.port()
+        );
+    }
+}
+
+fn tell(event: LiveEvent, pacing: Pacing) {
+    match event {
+        LiveEvent::Waiting => errln!(
+            "waiting for a viewer: the clock starts when one subscribes (--no-wait starts it at once)"
+        ),
+        LiveEvent::Started { viewers } => errln!(
+            "running at {}× real time ({viewers} viewer{} connected)",
+            pacing.speed(),
+            if viewers == 1 { "" } else { "s" }
+        ),
+    }
+}
+
+/// Records into the optional file (or nowhere) through the live tap; the file is synced and readable.
+fn run_scene<F: FnMut(LiveEvent)>(
+    scene: &Scene,
+    options: &RecordOptions,
+    tap: &mut LiveTap<'_, F>,
+    file: Option<&mut (PathBuf, NamedTempFile)>,
+    signals: &Signals,
+) -> anyhow::Result<RecordSummary> {
+    let stop = &signals.stop;
+    let Some((target, temp)) = file else {
+        return record_with_tap(scene, options, Discard::default(), tap, stop, |_| {})
+            .context("running the scene");
+    };
+    let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());
+    let summary = record_with_tap(scene, options, writer, tap, stop, |_| {})
+        .with_context(|| format!("recording `{}`", target.display()))?;
+    temp.as_file()
+        .sync_all()
+        .with_context(|| format!("writing `{}`", target.display()))?;
+    make_readable(temp.as_file());
+    Ok(summary)
+}
+
+/// The exit code of a run without a file.
+fn run_outcome(summary: &RecordSummary) -> Outcome {
+    match &summary.failure {
+        Some(f) => {
+            errln!(
+                "error: the integration failed at t = {}: {f}",
+                summary.termination_time
+            );
+            Outcome::Failure
+        }
+        None if summary.termination == coin_log::format::Termination::Interrupted => {
+            Outcome::Interrupted
+        }
+        None => Outcome::Success,
+    }
+}
+
+/// What the live side of a run did.
+struct Stats {
+    /// Messages served.
+    served: u64,
+    /// At worst, how late a sample was served.
+    max_lag: Duration,
+    /// Wall time from the start of the clock to the end of the run.
+    clock: Duration,
+    url: String,
+}
+
+/// `record`'s summary (the file row says when there is none) with the live rows; or one JSON object.
+fn print_summary(
+    args: &LiveArgs,
+    scene: &Scene,
+    label: &str,
+    s: &RecordSummary,
+    wall: Duration,
+    live: &Stats,
+) -> anyhow::Result<()> {
+    let target = args.output.clone().unwrap_or_default();
+    if args.json {
+        let mut json = record::json_summary(scene, label, &target, s, wall);
+        json["file"] = args
+            .output
+            .as_ref()
+            .map_or(serde_json::Value::Null, |p| p.display().to_string().into());
+        json["url"] = live.url.clone().into();
+        json["speed"] = args.speed.into();
+        json["served_messages"] = live.served.into();
+        json["clock_s"] = live.clock.as_secs_f64().into();
+        json["max_lag_s"] = live.max_lag.as_secs_f64().into();
+        outln!("{}", serde_json::to_string(&json)?);
+    } else {
+        let mut rows = record::summary_rows(scene, label, &target, s, wall);
+        if args.output.is_none() {
+            for row in rows.iter_mut().filter(|r| r.0 == "file") {
+                row.1 = "none (-o FILE records one)".to_string();
+            }
+        }
+        rows.push((
+            "live",
+            format!(
+                "{} at {}× real time: {} messages served in {:.3} s, at worst {:.1} ms behind the clock",
+                live.url,
+                args.speed,
+                live.served,
+                live.clock.as_secs_f64(),
+                live.max_lag.as_secs_f64() * 1e3
+            ),
+        ));
+        for (key, value) in rows {
+            outln!("{key:<16} {value}");
+        }
+    }
+    if s.event_trusted == Some(false) {
+        errln!("warning: {}", record::untrusted_event(s));
+    }
+    if live.max_lag > LAG_WARNING {
+        errln!(
+            "warning: the run fell up to {:.1} s behind {}× real time (the simulation and serving were \
+             slower than that); lower --speed, or --rate or --channels for fewer messages",
+            live.max_lag.as_secs_f64(),
+            args.speed
+        );
+    }
+    if output::stdout_failed() {
+        errln!("note: only the summary was lost");
+    }
+    Ok(())
+}
+
+/// After the run: unless `--exit` or the run was stopped, keep serving the final state (a viewer that
+/// connects now gets every topic's latest message) until Ctrl-C; then close the server.
+fn serve_final_state(args: &LiveArgs, server: LiveServer, signals: &Signals) {
+    if args.exit || signals.stopped() {
+        if server.clients() > 0 {
+            std::thread::sleep(DRAIN);
+        }
+    } else {
+        signals.on_first_signal("stopping the server");
+        errln!(
+            "the run is over; still serving its final state at {} (Ctrl-C to stop)",
+            server.url()
+        );
+        while !signals.stopped() {
+            std::thread::sleep(SERVE_POLL);
+        }
+    }
+    server.stop();
+}
