@@ -114,7 +114,7 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
         signals.on_first_signal("stopping the run (signal again to quit at once)");
     }
     let source = load_source(&args.scene, &args.set)?;
-    let scene = record::resolve_flags(flags(&args), &source)?;
+    let scene = record::resolve_flags(flags(&args), args.encoding, &source)?;
     let pacing = Pacing::new(args.speed, !args.no_wait)
         .ok_or_else(|| anyhow!("the speed must be a finite number above 0"))?;
     let server =

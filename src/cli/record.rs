@@ -269,16 +269,22 @@ fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
             step: args.step,
             channels: args.channels.clone(),
         },
+        args.encoding,
         source,
     )
 }
 
-/// [`resolve`] with the flags given as scene overrides (shared with `live`).
-pub(super) fn resolve_flags(flags: FlagOverrides, source: &SceneSource) -> anyhow::Result<Scene> {
+/// [`resolve`] with the flags given as scene overrides (shared with `live`); a run too long for the
+/// Protobuf timestamps of `encoding` is refused.
+pub(super) fn resolve_flags(
+    flags: FlagOverrides,
+    encoding: EncodingArg,
+    source: &SceneSource,
+) -> anyhow::Result<Scene> {
     let scene = scene::resolve(&source.file, &flags)
         .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
     let max = record::foxglove::PROTOBUF_MAX_SECONDS;
-    if args.encoding == EncodingArg::Protobuf && scene.run.duration > max {
+    if encoding == EncodingArg::Protobuf && scene.run.duration > max {
         return Err(anyhow!(
             "scene `{}`: run.duration = {} is longer than {max} time units, the most Foxglove's Protobuf \
              timestamps hold (32-bit seconds); record it with --encoding json, or shorten it with --duration",

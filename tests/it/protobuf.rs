@@ -95,6 +95,24 @@ fn a_protobuf_recording_is_the_same_bytes_every_time_and_says_its_encoding() {
     assert_eq!(code, 0);
     let info: Value = serde_json::from_str(&out).unwrap();
     assert_eq!(info["files"][0]["encoding"], "protobuf");
+    // A run longer than Foxglove's 32-bit seconds is refused before anything is written, with the way out;
+    // the same run in JSON is fine (negative control).
+    let long = [
+        "record",
+        "wobble",
+        "--duration",
+        "5e9",
+        "--dry-run",
+        "--encoding",
+    ];
+    let (code, _, err) = coin_log_text(&[&long[..], &["protobuf"]].concat());
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("run.duration = 5000000000") && err.contains("--encoding json"),
+        "{err}"
+    );
+    let (code, _, err) = coin_log_text(&[&long[..], &["json"]].concat());
+    assert_eq!(code, 0, "{err}");
     // A bad value names the choices (clap), exit 2.
     let (code, _, err) = coin_log_text(&["record", "wobble", "--encoding", "cbor", "--dry-run"]);
     assert_eq!(code, 2);
