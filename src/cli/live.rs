@@ -3,13 +3,13 @@
 //! paces; this file does the address, signals, the optional file (as `record` does it), printing and exit
 //! codes.
 
-use super::record::{self, EncodingArg, Signals};
+use super::record::{self, SceneFlags, Signals};
 use super::scene_arg::load_source;
 use super::{make_readable, output, Outcome};
 use anyhow::{anyhow, Context};
 use coin_log::live::{Discard, LiveEvent, LiveServer, LiveTap, Pacing, DEFAULT_PORT};
 use coin_log::record::{record_with_tap, Compression, RecordOptions, RecordSummary};
-use coin_log::scene::{FlagOverrides, Scene};
+use coin_log::scene::Scene;
 use std::io::BufWriter;
 use std::net::IpAddr;
 use std::path::PathBuf;
@@ -55,34 +55,9 @@ pub struct LiveArgs {
     /// Replace FILE if it exists.
     #[arg(long, requires = "output")]
     overwrite: bool,
-    /// Duration in the scene's time unit (overrides `run.duration`).
-    #[arg(long, value_name = "T")]
-    duration: Option<f64>,
-    /// Samples per time unit (overrides `run.rate`; scene default 100).
-    #[arg(long, value_name = "R")]
-    rate: Option<f64>,
-    /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`).
-    #[arg(long, value_name = "NAME")]
-    integrator: Option<String>,
-    /// Relative tolerance of adaptive methods (overrides `run.rtol`).
-    #[arg(long, value_name = "X")]
-    rtol: Option<f64>,
-    /// Absolute tolerance of adaptive methods (overrides `run.atol`).
-    #[arg(long, value_name = "X")]
-    atol: Option<f64>,
-    /// Step of fixed-step methods (overrides `run.step`).
-    #[arg(long, value_name = "H")]
-    step: Option<f64>,
-    /// Comma-separated channels, as for `record` (overrides `record.channels`; default all).
-    #[arg(long, value_name = "LIST", value_delimiter = ',')]
-    channels: Option<Vec<String>>,
-    /// Message encoding, as for `record`: json (JSON Schemas) or protobuf (FileDescriptorSet schemas);
-    /// Foxglove reads both live.
-    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
-    encoding: EncodingArg,
-    /// Set a scene key before the flags above apply, as for `record`. Repeatable.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
+    /// The scene flags, as for `record`.
+    #[command(flatten)]
+    flags: SceneFlags,
     /// Print the end-of-run summary as one JSON object.
     #[arg(long)]
     json: bool,
@@ -113,8 +88,8 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     if args.output.is_none() {
         signals.on_first_signal("stopping the run (signal again to quit at once)");
     }
-    let source = load_source(&args.scene, &args.set)?;
-    let scene = record::resolve_flags(flags(&args), args.encoding, &source)?;
+    let source = load_source(&args.scene, &args.flags.set)?;
+    let scene = record::resolve_flags(args.flags.overrides(), args.flags.encoding, &source)?;
     let pacing = Pacing::new(args.speed, !args.no_wait)
         .ok_or_else(|| anyhow!("the speed must be a finite number above 0"))?;
     let server =
@@ -125,6 +100,8 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
                 return Ok(Outcome::Unusable);
             }
         };
+    let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
+    tap.announce_topics(&scene.channels, args.flags.encoding.into());
     announce(&args, &server, &source.label);
     let mut file = match &args.output {
         Some(target) => {
@@ -134,10 +111,9 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
         None => None,
     };
     let started = Instant::now();
-    let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
     let options = RecordOptions {
         compression: Compression::default(),
-        encoding: args.encoding.into(),
+        encoding: args.flags.encoding.into(),
     };
     let summary = run_scene(&scene, &options, &mut tap, file.as_mut(), &signals)?;
     let wall = started.elapsed();
@@ -160,18 +136,6 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     };
     serve_final_state(&args, server, &signals);
     Ok(outcome)
-}
-
-fn flags(args: &LiveArgs) -> FlagOverrides {
-    FlagOverrides {
-        duration: args.duration,
-        rate: args.rate,
-        integrator: args.integrator.clone(),
-        rtol: args.rtol,
-        atol: args.atol,
-        step: args.step,
-        channels: args.channels.clone(),
-    }
 }
 
 /// What to do about an address that cannot be served.

@@ -42,41 +42,12 @@ pub struct RecordArgs {
     /// Output file [default: <scene name or file stem>.mcap in the current folder].
     #[arg(short, long, value_name = "FILE")]
     output: Option<PathBuf>,
-    /// Duration in the scene's time unit (overrides `run.duration`).
-    #[arg(long, value_name = "T")]
-    duration: Option<f64>,
-    /// Samples per time unit (overrides `run.rate`; scene default 100).
-    #[arg(long, value_name = "R")]
-    rate: Option<f64>,
-    /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
-    #[arg(long, value_name = "NAME")]
-    integrator: Option<String>,
-    /// Relative tolerance of adaptive methods, 2.2e-15 to 1e-3 (overrides `run.rtol`; default 1e-10).
-    #[arg(long, value_name = "X")]
-    rtol: Option<f64>,
-    /// Absolute tolerance of adaptive methods, at most 1e-3·min(1, a, 1/τ) (overrides `run.atol`; default
-    /// 1e-12).
-    #[arg(long, value_name = "X")]
-    atol: Option<f64>,
-    /// Step of fixed-step methods, rounded down to divide 1/rate; step·W ≤ 0.178 with W the fastest rate at
-    /// t = 0 (overrides `run.step`; default 1e-3).
-    #[arg(long, value_name = "H")]
-    step: Option<f64>,
-    /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
-    /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
-    #[arg(long, value_name = "LIST", value_delimiter = ',')]
-    channels: Option<Vec<String>>,
+    /// The scene flags.
+    #[command(flatten)]
+    pub flags: SceneFlags,
     /// Chunk compression.
     #[arg(long, value_enum, default_value_t = CompressionArg::Zstd)]
     compression: CompressionArg,
-    /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
-    /// about half the size, and Rerun reads it). Both carry the same f64 values (docs/format.md: Encodings).
-    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
-    pub encoding: EncodingArg,
-    /// Set a scene key before the flags above apply: KEY is a dotted path (`initial.theta`, `run.rtol`,
-    /// `body.shape`), VALUE a TOML value or a bare string. Repeatable.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
     /// Replace FILE if it exists.
     #[arg(long)]
     overwrite: bool,
@@ -87,6 +58,58 @@ pub struct RecordArgs {
     /// messages and file size, and exit without writing.
     #[arg(long)]
     dry_run: bool,
+}
+
+/// The flags `record` and `live` share: scene overrides, edits and the message encoding.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SceneFlags {
+    /// Duration in the scene's time unit (overrides `run.duration`).
+    #[arg(long, value_name = "T")]
+    pub duration: Option<f64>,
+    /// Samples per time unit (overrides `run.rate`; scene default 100).
+    #[arg(long, value_name = "R")]
+    pub rate: Option<f64>,
+    /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
+    #[arg(long, value_name = "NAME")]
+    pub integrator: Option<String>,
+    /// Relative tolerance of adaptive methods, 2.2e-15 to 1e-3 (overrides `run.rtol`; default 1e-10).
+    #[arg(long, value_name = "X")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance of adaptive methods, at most 1e-3·min(1, a, 1/τ) (overrides `run.atol`; default
+    /// 1e-12).
+    #[arg(long, value_name = "X")]
+    pub atol: Option<f64>,
+    /// Step of fixed-step methods, rounded down to divide 1/rate; step·W ≤ 0.178 with W the fastest rate at
+    /// t = 0 (overrides `run.step`; default 1e-3).
+    #[arg(long, value_name = "H")]
+    pub step: Option<f64>,
+    /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
+    /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub channels: Option<Vec<String>>,
+    /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
+    /// about half the size, and Rerun reads it). Both carry the same f64 values (docs/format.md: Encodings).
+    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
+    pub encoding: EncodingArg,
+    /// Set a scene key before the flags above apply: KEY is a dotted path (`initial.theta`, `run.rtol`,
+    /// `body.shape`), VALUE a TOML value or a bare string. Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl SceneFlags {
+    /// The flags that override scene keys.
+    pub(super) fn overrides(&self) -> FlagOverrides {
+        FlagOverrides {
+            duration: self.duration,
+            rate: self.rate,
+            integrator: self.integrator.clone(),
+            rtol: self.rtol,
+            atol: self.atol,
+            step: self.step,
+            channels: self.channels.clone(),
+        }
+    }
 }
 
 /// `--encoding`.
@@ -133,7 +156,7 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     // First, so that a signal at any later stage finishes or abandons cleanly (never kills the process
     // with a temporary file behind).
     let signals = Signals::install()?;
-    let source = load_source(&args.scene, &args.set)?;
+    let source = load_source(&args.scene, &args.flags.set)?;
     let scene = resolve(&args, &source)?;
     if args.dry_run {
         return dry_run(&args, &scene, &source.label);
@@ -161,7 +184,7 @@ const LARGE: u64 = 1 << 30;
 /// `--dry-run`: the resolved scene as TOML after comment lines with the estimate (so the output is itself
 /// a scene file), or with `--json` one object; nothing is written.
 fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outcome> {
-    let e = record::estimate(scene, args.compression.into(), args.encoding.into());
+    let e = record::estimate(scene, args.compression.into(), args.flags.encoding.into());
     let toml = scene.to_toml();
     if args.json {
         let json = serde_json::json!({
@@ -184,7 +207,7 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
         size(e.bytes),
         clap::ValueEnum::to_possible_value(&args.compression)
             .map_or_else(String::new, |v| v.get_name().to_string()),
-        match args.encoding {
+        match args.flags.encoding {
             EncodingArg::Json => "",
             EncodingArg::Protobuf => " of Protobuf messages",
         },
@@ -195,7 +218,7 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
 
 /// Warns on stderr before a recording estimated larger than [`LARGE`].
 fn warn_if_large(args: &RecordArgs, scene: &Scene) {
-    let e = record::estimate(scene, args.compression.into(), args.encoding.into());
+    let e = record::estimate(scene, args.compression.into(), args.flags.encoding.into());
     if e.bytes > LARGE {
         errln!(
             "warning: this recording is estimated at {} ({} messages); `--dry-run` shows the estimate, \
@@ -259,19 +282,7 @@ impl Signals {
 /// The scene with the command-line flags applied and validated; warns about settings the integrator does
 /// not use and notes a step rounded to the sampling grid.
 fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
-    resolve_flags(
-        FlagOverrides {
-            duration: args.duration,
-            rate: args.rate,
-            integrator: args.integrator.clone(),
-            rtol: args.rtol,
-            atol: args.atol,
-            step: args.step,
-            channels: args.channels.clone(),
-        },
-        args.encoding,
-        source,
-    )
+    resolve_flags(args.flags.overrides(), args.flags.encoding, source)
 }
 
 /// [`resolve`] with the flags given as scene overrides (shared with `live`); a run too long for the
@@ -379,7 +390,7 @@ fn record_into(
 ) -> anyhow::Result<(RecordSummary, Duration)> {
     let options = RecordOptions {
         compression: args.compression.into(),
-        encoding: args.encoding.into(),
+        encoding: args.flags.encoding.into(),
     };
     let bar = progress_bar();
     let started = Instant::now();

@@ -163,6 +163,8 @@ struct Seen {
     subscriptions: BTreeMap<u32, u64>,
     messages: BTreeMap<String, Vec<(u64, Vec<u8>)>>,
     times: Vec<u64>,
+    /// The server's status messages (e.g. "Unknown channel ID" for a refused subscription).
+    statuses: Vec<Value>,
 }
 
 impl Seen {
@@ -174,6 +176,7 @@ impl Seen {
                 match v["op"].as_str() {
                     Some("serverInfo") => self.server_info = v,
                     Some("advertise") => self.advertise(ws, &v),
+                    Some("status") => self.statuses.push(v),
                     _ => {}
                 }
             }
@@ -259,12 +262,21 @@ fn disagreements(file: &ReadBack, seen: &Seen) -> Vec<String> {
         .values()
         .map(|a| (a.topic.as_str(), a))
         .collect();
+    // Every topic of the recorded channels is advertised before the run (`LiveTap::announce_topics`), so
+    // the served topics are the file's and those the run had no message for (higher track levels).
     let file_topics = file.topics();
     let served: Vec<String> = advertised.keys().map(|t| (*t).to_string()).collect();
-    if served != file_topics {
-        problems.push(format!(
-            "topics served {served:?}, file has {file_topics:?}"
-        ));
+    let missing: Vec<&String> = file_topics.iter().filter(|t| !served.contains(t)).collect();
+    if !missing.is_empty() {
+        problems.push(format!("topics {missing:?} of the file were not served"));
+    }
+    for extra in served.iter().filter(|t| !file_topics.contains(t)) {
+        if seen.messages.get(extra).is_some_and(|m| !m.is_empty()) {
+            problems.push(format!("{extra}: served messages, the file has none"));
+        }
+    }
+    for status in seen.statuses.iter().filter(|s| s["level"] == 2) {
+        problems.push(format!("the server reported an error: {status}"));
     }
     let first_time = file.messages.iter().map(|m| m.log_time).min().unwrap_or(0);
     for channel in file.summary.channels.values() {

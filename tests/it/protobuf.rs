@@ -102,6 +102,8 @@ fn a_protobuf_recording_is_the_same_bytes_every_time_and_says_its_encoding() {
         "wobble",
         "--duration",
         "5e9",
+        "--rate",
+        "0.01",
         "--dry-run",
         "--encoding",
     ];
