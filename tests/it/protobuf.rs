@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used)]
 
 use crate::support::record::{coin_log_text, read_back, record_scene, scene_names};
+use crate::support::writers::rewrite_protobuf;
 use coin_log::format::protobuf::put_double;
 use coin_log::verify::{verify_file, CheckId, Options, Status};
 use foxglove::messages::{
@@ -14,7 +15,6 @@ use foxglove::messages::{
 use prost::Message;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
-use std::io::BufWriter;
 use std::path::Path;
 
 /// Records `scene` in both encodings into `dir` (`<scene>.json.mcap`, `<scene>.protobuf.mcap`).
@@ -303,51 +303,6 @@ fn export_gives_the_same_tables_from_both_encodings() {
     }
 }
 
-/// Copies the Protobuf recording `src` to `dst` with the mcap crate, letting `schema` replace a schema's
-/// bytes, `encoding` a channel's message encoding, and `edit` a message (`index` counts per topic).
-fn rewrite(
-    src: &Path,
-    dst: &Path,
-    schema: impl Fn(&str, &[u8]) -> Vec<u8>,
-    encoding: impl Fn(&str) -> &'static str,
-    mut edit: impl FnMut(&str, usize, &mut Vec<u8>),
-) {
-    let bytes = std::fs::read(src).unwrap();
-    let file = read_back(&bytes);
-    let mut w = mcap::WriteOptions::new()
-        .library("coin-log/test")
-        .create(BufWriter::new(std::fs::File::create(dst).unwrap()))
-        .unwrap();
-    let (_, run) = &file.metadata["coin-log"];
-    w.write_metadata(&mcap::records::Metadata {
-        name: "coin-log".into(),
-        metadata: run.clone(),
-    })
-    .unwrap();
-    let mut ids: BTreeMap<String, u16> = BTreeMap::new();
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    for m in &file.messages {
-        let id = *ids.entry(m.topic.clone()).or_insert_with(|| {
-            let data = schema(&m.schema_name, &file.schemas[&m.schema_name]);
-            let s = w.add_schema(&m.schema_name, "protobuf", &data).unwrap();
-            w.add_channel(s, &m.topic, encoding(&m.topic), &BTreeMap::new())
-                .unwrap()
-        });
-        let index = counts.entry(m.topic.clone()).or_default();
-        let mut data = m.data.clone();
-        edit(&m.topic, *index, &mut data);
-        *index += 1;
-        crate::support::writers::write_message(&mut w, id, m.sequence, m.log_time, &data);
-    }
-    let (_, result) = &file.metadata["coin-log.result"];
-    w.write_metadata(&mcap::records::Metadata {
-        name: "coin-log.result".into(),
-        metadata: result.clone(),
-    })
-    .unwrap();
-    w.finish().unwrap();
-}
-
 /// The report of `path`: its exit code and the integrity check's reason.
 fn judged(path: &Path) -> (u8, Status, String) {
     let r = verify_file(path, &Options::default());
@@ -376,12 +331,12 @@ fn verify_names_what_is_wrong_with_a_damaged_protobuf_file() {
     let keep = |_: &str, d: &[u8]| d.to_vec();
     let protobuf = |_: &str| "protobuf";
     // The control: an untouched copy by another writer verifies.
-    rewrite(&src, &out, keep, protobuf, |_, _, _| {});
+    rewrite_protobuf(&src, &out, keep, protobuf, |_, _, _| {});
     let (code, status, reason) = judged(&out);
     assert_eq!((code, status), (0, Status::Pass), "{reason}");
 
     // A NaN in one energy message (field 2, `total`, appended: the last value wins).
-    rewrite(&src, &out, keep, protobuf, |topic, i, data| {
+    rewrite_protobuf(&src, &out, keep, protobuf, |topic, i, data| {
         if topic == "/coin/energy" && i == 7 {
             put_double(data, 2, f64::NAN);
         }
@@ -394,7 +349,7 @@ fn verify_names_what_is_wrong_with_a_damaged_protobuf_file() {
     );
 
     // A message cut short.
-    rewrite(&src, &out, keep, protobuf, |topic, i, data| {
+    rewrite_protobuf(&src, &out, keep, protobuf, |topic, i, data| {
         if topic == "/coin/omega" && i == 3 {
             data.truncate(data.len() - 3);
         }
@@ -404,7 +359,7 @@ fn verify_names_what_is_wrong_with_a_damaged_protobuf_file() {
     assert!(reason.contains("not a valid Protobuf message"), "{reason}");
 
     // A Foxglove message that is not one.
-    rewrite(&src, &out, keep, protobuf, |topic, i, data| {
+    rewrite_protobuf(&src, &out, keep, protobuf, |topic, i, data| {
         if topic == "/tf" && i == 2 {
             *data = vec![0xff; 5];
         }
@@ -424,7 +379,7 @@ fn verify_names_what_is_wrong_with_a_damaged_protobuf_file() {
             "protobuf"
         }
     };
-    rewrite(&src, &out, keep, json_omega, |_, _, _| {});
+    rewrite_protobuf(&src, &out, keep, json_omega, |_, _, _| {});
     let (_, status, reason) = judged(&out);
     assert_eq!(status, Status::Fail);
     assert!(
@@ -442,13 +397,13 @@ fn verify_names_what_is_wrong_with_a_damaged_protobuf_file() {
         }
         set.encode_to_vec()
     };
-    rewrite(&src, &out, no_psi, protobuf, |_, _, _| {});
+    rewrite_protobuf(&src, &out, no_psi, protobuf, |_, _, _| {});
     let (_, status, reason) = judged(&out);
     assert_eq!(status, Status::Fail);
     assert!(reason.contains("does not declare field `psi`"), "{reason}");
 
     // The physics checks read the Protobuf values: E one part in a million off fails `energy`.
-    rewrite(&src, &out, keep, protobuf, |topic, i, data| {
+    rewrite_protobuf(&src, &out, keep, protobuf, |topic, i, data| {
         if topic == "/coin/energy" && i == 100 {
             // Field 1 (t) is bytes 0..9; field 2's value (`total`) follows its key at byte 9.
             let total = f64::from_le_bytes(data[10..18].try_into().unwrap());

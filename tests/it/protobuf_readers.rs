@@ -19,6 +19,7 @@
 use crate::support::other_writers::{node_readers, python};
 use crate::support::record::{coin_log_text, read_messages, scene_names};
 use crate::support::repo;
+use crate::support::writers::rewrite_protobuf;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -432,84 +433,47 @@ enum Damage {
 }
 
 /// Copies the Protobuf recording `src` to `dst` (the mcap crate's writer, every schema, channel and message
-/// as they are) with one `damage`.
+/// as they are, through [`rewrite_protobuf`]) with one `damage`.
 fn damaged_copy(src: &Path, dst: &Path, damage: Damage) {
     use prost::Message as _;
-    let bytes = std::fs::read(src).unwrap();
-    let file = std::io::BufWriter::new(std::fs::File::create(dst).unwrap());
-    let mut w = mcap::WriteOptions::new()
-        .compression(Some(mcap::Compression::Zstd))
-        .library("coin-log/test")
-        .create(file)
-        .unwrap();
-    let mut channels: BTreeMap<String, u16> = BTreeMap::new();
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    let mut damaged = false;
-    for m in mcap::MessageStream::new(&bytes).unwrap() {
-        let m = m.unwrap();
-        let topic = m.channel.topic.clone();
-        let id = *channels.entry(topic.clone()).or_insert_with(|| {
-            let schema = m.channel.schema.as_ref().unwrap();
-            let mut data = schema.data.to_vec();
-            if matches!(damage, Damage::SwappedDescriptor)
-                && schema.name == "coin_log.AngularVelocity"
-            {
-                let mut set = prost_types::FileDescriptorSet::decode(data.as_slice()).unwrap();
-                let fields = &mut set.file[0].message_type[0].field;
-                assert_eq!(fields[1].name.as_deref(), Some("x"), "{fields:?}");
-                assert_eq!(fields[2].name.as_deref(), Some("y"), "{fields:?}");
-                fields[1].name = Some("y".into());
-                fields[1].json_name = Some("y".into());
-                fields[2].name = Some("x".into());
-                fields[2].json_name = Some("x".into());
-                data = set.encode_to_vec();
-                damaged = true;
-            }
-            let schema_id = w.add_schema(&schema.name, &schema.encoding, &data).unwrap();
-            w.add_channel(
-                schema_id,
-                &topic,
-                &m.channel.message_encoding,
-                &m.channel.metadata,
-            )
-            .unwrap()
-        });
-        let index = counts.entry(topic.clone()).or_insert(0);
-        let mut data = m.data.to_vec();
-        match damage {
-            Damage::TruncatedMessage if topic == "/coin/energy" && *index == 3 => {
-                data.truncate(data.len() - 3);
-                damaged = true;
-            }
-            Damage::OneUlp if topic == "/coin/energy" && *index == 2 => {
-                // Field 2 (a double: key 0x11, then 8 little-endian bytes) follows field 1 (9 bytes).
-                assert_eq!(
-                    data[9],
-                    (2 << 3) | 1,
-                    "field 2 of /coin/energy is a double after t: {data:?}"
-                );
-                let x = f64::from_le_bytes(data[10..18].try_into().unwrap());
-                let next = f64::from_bits(x.to_bits() + 1);
-                data[10..18].copy_from_slice(&next.to_le_bytes());
-                damaged = true;
-            }
-            _ => {}
+    let damaged = std::cell::Cell::new(false);
+    let schema = |name: &str, data: &[u8]| {
+        if !matches!(damage, Damage::SwappedDescriptor) || name != "coin_log.AngularVelocity" {
+            return data.to_vec();
         }
-        *index += 1;
-        w.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: id,
-                sequence: m.sequence,
-                log_time: m.log_time,
-                publish_time: m.publish_time,
-            },
-            &data,
-        )
-        .unwrap();
-    }
-    w.finish().unwrap();
+        let mut set = prost_types::FileDescriptorSet::decode(data).unwrap();
+        let fields = &mut set.file[0].message_type[0].field;
+        assert_eq!(fields[1].name.as_deref(), Some("x"), "{fields:?}");
+        assert_eq!(fields[2].name.as_deref(), Some("y"), "{fields:?}");
+        fields[1].name = Some("y".into());
+        fields[1].json_name = Some("y".into());
+        fields[2].name = Some("x".into());
+        fields[2].json_name = Some("x".into());
+        damaged.set(true);
+        set.encode_to_vec()
+    };
+    let edit = |topic: &str, index: usize, data: &mut Vec<u8>| match damage {
+        Damage::TruncatedMessage if topic == "/coin/energy" && index == 3 => {
+            data.truncate(data.len() - 3);
+            damaged.set(true);
+        }
+        Damage::OneUlp if topic == "/coin/energy" && index == 2 => {
+            // Field 2 (a double: key 0x11, then 8 little-endian bytes) follows field 1 (9 bytes).
+            assert_eq!(
+                data[9],
+                (2 << 3) | 1,
+                "field 2 of /coin/energy is a double after t: {data:?}"
+            );
+            let x = f64::from_le_bytes(data[10..18].try_into().unwrap());
+            let next = f64::from_bits(x.to_bits() + 1);
+            data[10..18].copy_from_slice(&next.to_le_bytes());
+            damaged.set(true);
+        }
+        _ => {}
+    };
+    rewrite_protobuf(src, dst, schema, |_| "protobuf", edit);
     assert!(
-        damaged,
+        damaged.get(),
         "{damage:?} found nothing to damage in {}",
         src.display()
     );

@@ -575,3 +575,48 @@ pub fn recorded(spec: &Spec, name: &str) -> (tempfile::TempDir, PathBuf) {
     record(spec, &path);
     (dir, path)
 }
+
+/// Copies the Protobuf recording `src` to `dst` with the mcap crate, letting `schema` replace a schema's
+/// bytes, `encoding` a channel's message encoding, and `edit` a message (`index` counts per topic).
+pub fn rewrite_protobuf(
+    src: &Path,
+    dst: &Path,
+    schema: impl Fn(&str, &[u8]) -> Vec<u8>,
+    encoding: impl Fn(&str) -> &'static str,
+    mut edit: impl FnMut(&str, usize, &mut Vec<u8>),
+) {
+    let bytes = std::fs::read(src).unwrap();
+    let file = super::record::read_back(&bytes);
+    let mut w = mcap::WriteOptions::new()
+        .library("coin-log/test")
+        .create(BufWriter::new(std::fs::File::create(dst).unwrap()))
+        .unwrap();
+    let (_, run) = &file.metadata["coin-log"];
+    w.write_metadata(&mcap::records::Metadata {
+        name: "coin-log".into(),
+        metadata: run.clone(),
+    })
+    .unwrap();
+    let mut ids: BTreeMap<String, u16> = BTreeMap::new();
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    for m in &file.messages {
+        let id = *ids.entry(m.topic.clone()).or_insert_with(|| {
+            let data = schema(&m.schema_name, &file.schemas[&m.schema_name]);
+            let s = w.add_schema(&m.schema_name, "protobuf", &data).unwrap();
+            w.add_channel(s, &m.topic, encoding(&m.topic), &BTreeMap::new())
+                .unwrap()
+        });
+        let index = counts.entry(m.topic.clone()).or_default();
+        let mut data = m.data.clone();
+        edit(&m.topic, *index, &mut data);
+        *index += 1;
+        write_message(&mut w, id, m.sequence, m.log_time, &data);
+    }
+    let (_, result) = &file.metadata["coin-log.result"];
+    w.write_metadata(&mcap::records::Metadata {
+        name: "coin-log.result".into(),
+        metadata: result.clone(),
+    })
+    .unwrap();
+    w.finish().unwrap();
+}
