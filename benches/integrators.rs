@@ -2,9 +2,9 @@
 //! ω = (0.3, 0.2, 1.5), 30 time units, sampled at 100 per unit) and of one C1/C2 evaluation, so that a
 //! speed regression shows next to the accuracy tests. CI only compiles them (`cargo bench --no-run`).
 
-use coin_log::bench::stability::wobble_state;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunSettings};
 use coin_log::model::{Chaplygin, Coin, CoinParams};
+use coin_log_bench::stability::wobble_state;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 

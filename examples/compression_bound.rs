@@ -1,12 +1,12 @@
 //! The compression bound: the time one thread takes to zstd-compress the bytes of a recording,
-//! chunk by chunk as `mcap_io::McapWriter` does, and the JSON payloads alone in pieces of the same size.
+//! chunk by chunk as `coin_log_mcap::McapWriter` does, and the JSON payloads alone in pieces of the same size.
 //!
 //! `cargo run --release --example compression_bound -- FILE.mcap [LEVEL...]`. Prints the median of 5 passes
 //! (seconds, MB/s, messages/s, compressed size) for the writer's own `ChunkCompressor` (zstd at its level,
 //! lz4, none: what a recording costs to compress), then for each zstd LEVEL given.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use coin_log::mcap_io::{ChunkCompression, ChunkCompressor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
+use coin_log_mcap::{ChunkCompression, ChunkCompressor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
 use mcap::records::Record;
 use std::io::Read;
 use std::time::Instant;

@@ -24,16 +24,16 @@ use crate::support::record::{coin_log, record_scene};
 use crate::support::writers::rewrite;
 use coin_log::analyse::map::{boundary, closures, edge_leans, sign_changes};
 use coin_log::analyse::Analysis;
-use coin_log::bench::nutation::{
-    displaced, generic_motions, growth_rate, kicked, turning_points, GROWTH_START,
-};
-use coin_log::bench::stability::suite_config;
 use coin_log::integrate::Method;
 use coin_log::model::nutation::Motion;
 use coin_log::model::{
     steady_sigma_squared, Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
 };
 use coin_log::verify::{verify_file, CheckId, Options, Status};
+use coin_log_bench::nutation::{
+    displaced, generic_motions, growth_rate, kicked, turning_points, GROWTH_START,
+};
+use coin_log_bench::stability::suite_config;
 use std::f64::consts::TAU;
 
 /// Flat margin of the scenes (format.md: scene keys, `run.flat_margin`).

@@ -4,13 +4,13 @@
 //! couple's direction), and the output formats are pinned. Also `bench precision` on the dissipative
 //! `euler-disk`: the energy error is that of E + W and there is no invariant error.
 
-use coin_log::bench::euler::{euler_bench, EulerOptions, EulerRow, SLIP_FRICTION};
-use coin_log::bench::plot::euler_svg;
-use coin_log::bench::precision::{precision_bench, PrecisionOptions};
-use coin_log::bench::presets::bench_case;
-use coin_log::bench::table::{euler_csv, EULER_CSV_HEADER};
 use coin_log::integrate::Method;
 use coin_log::model::DissipationModel;
+use coin_log_bench::euler::{euler_bench, EulerOptions, EulerRow, SLIP_FRICTION};
+use coin_log_bench::plot::euler_svg;
+use coin_log_bench::precision::{precision_bench, PrecisionOptions};
+use coin_log_bench::presets::bench_case;
+use coin_log_bench::table::{euler_csv, EULER_CSV_HEADER};
 use std::sync::OnceLock;
 
 /// The acceptance: fitted exponents within 2 % of 1/(1 − p).

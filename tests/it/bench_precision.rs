@@ -3,12 +3,12 @@
 //! deterministic cost; wall time is never asserted) matches its order within ±0.5. The output formats
 //! (CSV columns, SVG) are pinned too.
 
-use coin_log::bench::plot::work_precision_svg;
-use coin_log::bench::precision::{precision_bench, PrecisionOptions, PrecisionReport};
-use coin_log::bench::presets::bench_case;
-use coin_log::bench::table::{precision_csv, PRECISION_CSV_HEADER};
-use coin_log::bench::ReferenceKind;
 use coin_log::integrate::Method;
+use coin_log_bench::plot::work_precision_svg;
+use coin_log_bench::precision::{precision_bench, PrecisionOptions, PrecisionReport};
+use coin_log_bench::presets::bench_case;
+use coin_log_bench::table::{precision_csv, PRECISION_CSV_HEADER};
+use coin_log_bench::ReferenceKind;
 use std::sync::OnceLock;
 
 /// Slopes must match the orders within this.

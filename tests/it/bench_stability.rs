@@ -4,18 +4,18 @@
 //! rolling (bench: 30), a long horizon of 10³ (bench: 10⁴) and 5 time units of scale invariance (bench: 10).
 //! Every run of every case must end completed or at a physical event, never with NaN or a numerical failure.
 
-use coin_log::bench::stability::{dimensionless_difference, scaled_wobble};
-use coin_log::bench::stability::{
-    drift_history, fast_spin, long_horizon_config, marginal, near_flat, nutation_frequency,
-    release, scale_difference, straight_tilt_linear, StabilityRow, SuiteOptions,
-    RK4_STABILITY_LIMIT, SCALES,
-};
-use coin_log::bench::{default_config, run_sampled, Trajectory};
 use coin_log::integrate::Method;
 use coin_log::model::{
     centre_fixed_sigma_squared, straight_lambda_squared, Branch, Coin, CoinParams, Inertia, Steady,
     SteadyKind,
 };
+use coin_log_bench::stability::{dimensionless_difference, scaled_wobble};
+use coin_log_bench::stability::{
+    drift_history, fast_spin, long_horizon_config, marginal, near_flat, nutation_frequency,
+    release, scale_difference, straight_tilt_linear, StabilityRow, SuiteOptions,
+    RK4_STABILITY_LIMIT, SCALES,
+};
+use coin_log_bench::{default_config, run_sampled, Trajectory};
 
 fn assert_honest_ending(rows: &[StabilityRow], allowed: &[&str]) {
     for r in rows {
@@ -224,7 +224,7 @@ fn the_analyse_rows_confirm_sigma_growth_and_the_quadrature_with_every_integrato
     // The rows `bench stability` adds for `analyse` (bench::nutation), over 10 periods: σ of kicked
     // circles to 1e-6, growth rates to 1e-4, T and ΔΦ of generic motions to 1e-9 (the bounds),
     // with every integrator (rk4 and gauss4 at 2048 steps per period: (2π/2048)⁴ ≈ 1e-10).
-    use coin_log::bench::nutation::{generic_periods, stable_circles, unstable_circles};
+    use coin_log_bench::nutation::{generic_periods, stable_circles, unstable_circles};
     let mut rows = stable_circles(10.0).unwrap();
     rows.extend(unstable_circles().unwrap());
     rows.extend(generic_periods(10.0).unwrap());

@@ -3,12 +3,12 @@
 //! ([`release_time`], checked in its own unit tests), independently of the integrators. The flat landing (|θ| = π/2 − flat_margin) and the lift-off
 //! (N = 0, physics §3/§7) must be located at those times to 1e-9.
 
-use coin_log::bench::stability::release_time;
 use coin_log::integrate::{
     run_method, EventFunctions, Flow, Method, MethodConfig, RunSettings, Termination,
 };
 use coin_log::model::{Coin, CoinParams, State, STATE_LEN};
 use coin_log::simulation::{CoinEvents, PhysicalEvent};
+use coin_log_bench::stability::release_time;
 use std::f64::consts::FRAC_PI_2;
 
 /// Flat margin of the runs (the contract's default).

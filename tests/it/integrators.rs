@@ -3,12 +3,12 @@
 //! method (with rk4 as the drifting control), dense output and behaviour at a finite-time blow-up.
 
 use crate::support::vectors::max_diff;
-use coin_log::bench::stability::wobble_state;
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Stats, StepError,
     Termination,
 };
 use coin_log::model::{energy, Coin, CoinParams, State, STATE_LEN};
+use coin_log_bench::stability::wobble_state;
 
 const EPS: f64 = f64::EPSILON;
 

@@ -7,10 +7,10 @@
 //! only τ ≈ 8.8. Classical RK4 at h ≈ 2.5e-4 with compensated (Kahan) accumulation, run again at h/2 and
 //! Richardson-extrapolated; the difference between the two runs is printed as the reference's own error.
 
-use coin_log::bench::stability::wobble_state;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
 use coin_log::model::{energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
 use coin_log::simulation::{simulate, CoinEvents};
+use coin_log_bench::stability::wobble_state;
 
 use std::f64::consts::FRAC_PI_6;
 

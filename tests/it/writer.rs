@@ -1,4 +1,4 @@
-//! `mcap_io::McapWriter`: files read back through the `mcap` crate's linear and indexed
+//! `coin_log_mcap::McapWriter`: files read back through the `mcap` crate's linear and indexed
 //! paths for every compression, with many chunks; statistics, indexes and CRCs are right (and a flipped
 //! byte is caught); the bytes do not depend on the worker count; a failing output is an error, never a
 //! panic or a hang.
@@ -6,7 +6,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use crate::support::FailingWriter;
-use coin_log::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
+use coin_log_mcap::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::{McapError, MessageStream, Summary};

@@ -5,16 +5,16 @@ mod throughput;
 
 use super::Outcome;
 use anyhow::Context;
-use coin_log::bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
-use coin_log::bench::plot::{euler_svg, work_precision_svg};
-use coin_log::bench::precision::{precision_bench, PrecisionOptions};
-use coin_log::bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
-use coin_log::bench::stability;
-use coin_log::bench::table::{
+use coin_log::integrate::Method;
+use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
+use coin_log_bench::plot::{euler_svg, work_precision_svg};
+use coin_log_bench::precision::{precision_bench, PrecisionOptions};
+use coin_log_bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
+use coin_log_bench::stability;
+use coin_log_bench::table::{
     euler_csv, euler_table, precision_csv, precision_table, stability_csv, stability_table,
 };
-use coin_log::bench::BenchCase;
-use coin_log::integrate::Method;
+use coin_log_bench::BenchCase;
 use std::fs;
 use std::path::{Path, PathBuf};
 

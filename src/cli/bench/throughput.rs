@@ -1,5 +1,5 @@
 //! `coin-log bench throughput`: runs the record and verify workloads of
-//! [`coin_log::bench::throughput`] in child processes of this binary (each in its own process, so that its
+//! [`coin_log_bench::throughput`] in child processes of this binary (each in its own process, so that its
 //! peak RSS is its own), reads their `--json` summaries, and has the library measure the compression
 //! bound and the integration cost, turn the runs into rows and format them.
 
@@ -7,7 +7,7 @@ use super::{create_dir, write};
 use crate::cli::record::EncodingArg;
 use crate::cli::Outcome;
 use anyhow::{anyhow, bail, Context};
-use coin_log::bench::throughput::{
+use coin_log_bench::throughput::{
     self, channel_list, compression_bound, recording_path, DurationRuns, ExportRun, RecordRun,
     ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
 };

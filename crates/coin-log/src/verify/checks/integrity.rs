@@ -3,8 +3,8 @@
 //! message parsed strictly into its type, and log times monotonic per channel and equal to round(t·10⁹).
 //! The value is the number of problems found; the tolerance is 0.
 
-use crate::mcap_io::Problems;
 use crate::verify::report::{CheckId, CheckResult};
+use coin_log_mcap::Problems;
 
 /// The integrity result from the problems found and a description of what was read.
 #[must_use]

@@ -20,7 +20,7 @@ use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::Channel;
 use crate::format::Encoding;
-use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::io::{self, BufWriter, Write};
@@ -201,7 +201,7 @@ pub fn export<W: Write>(
         messages: 0,
         error: None,
     };
-    let (_, read_error) = mcap_io::read_with_progress(path, &mut e, progress);
+    let (_, read_error) = coin_log_mcap::read_with_progress(path, &mut e, progress);
     if let Some(err) = e.error.take() {
         return Err(err);
     }

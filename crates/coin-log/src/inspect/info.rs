@@ -2,14 +2,14 @@
 //! rate), the time range, the body and run settings and the stored scene from the `coin-log` metadata,
 //! the termination from `coin-log.result`, the file's size and compression and the version that wrote it.
 //!
-//! The summary section is read when the file has one ([`mcap_io::read_summary`]: a few seeks, instant on
+//! The summary section is read when the file has one ([`coin_log_mcap::read_summary`]: a few seeks, instant on
 //! a file of gigabytes); a file without one (an unfinished recording, another writer) is read in one
-//! streaming pass ([`mcap_io::read`]), and a file that breaks off part way is described up to the break.
+//! streaming pass ([`coin_log_mcap::read`]), and a file that breaks off part way is described up to the break.
 //! The summary is taken as the file states it: `verify` is what checks it.
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
-use crate::mcap_io::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
 use crate::scene::SceneFile;
+use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -212,7 +212,7 @@ pub struct InfoError(pub String);
 /// # Errors
 /// [`InfoError`] if the file cannot be opened, is not MCAP, or breaks off before anything is known.
 pub fn info(path: &Path) -> Result<FileInfo, InfoError> {
-    match mcap_io::read_summary(path) {
+    match coin_log_mcap::read_summary(path) {
         Ok(Some(summary)) => Ok(from_summary(summary)),
         Err(e) if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) => {
             Err(InfoError(e.detail))
@@ -264,7 +264,7 @@ fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
     (messages >= 2 && end > start).then(|| (messages - 1) as f64 / ((end - start) as f64 / 1e9))
 }
 
-fn from_summary(s: mcap_io::Summary) -> FileInfo {
+fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
     let (run, result) = records(&s.metadata);
     let scene = scene_of(&run);
     FileInfo {
@@ -337,7 +337,7 @@ impl Visitor for Scan {
 
 fn scan(path: &Path) -> Result<FileInfo, InfoError> {
     let mut v = Scan::default();
-    let (s, error) = mcap_io::read(path, &mut v);
+    let (s, error) = coin_log_mcap::read(path, &mut v);
     let problem = match error {
         Some(ReadError {
             kind: ReadErrorKind::Io | ReadErrorKind::NotMcap,

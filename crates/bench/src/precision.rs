@@ -9,7 +9,7 @@ use super::case::{run_sampled, termination_name, Reference, ReferenceKind, Traje
 use super::{
     balance_drift, invariant_drift, reference_trajectory, state_error, BenchCase, BenchError,
 };
-use crate::integrate::{Method, MethodConfig};
+use coin_log::integrate::{Method, MethodConfig};
 use std::time::Instant;
 
 /// The adaptive sweep's rtol is 1e3·atol ...

@@ -20,9 +20,9 @@ use crate::format::{
     log_time, schema_bytes, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
-use crate::mcap_io::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
+use coin_log_mcap::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
 use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -621,7 +621,7 @@ fn unusable(path: &str, problem: String) -> FileReport {
 /// Judges one file (see [`super::verify_file`]).
 pub fn verify_file(path: &Path, options: &Options) -> FileReport {
     let mut judge = Judge::default();
-    let (structure, error) = mcap_io::read(path, &mut judge);
+    let (structure, error) = coin_log_mcap::read(path, &mut judge);
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 
@@ -632,7 +632,7 @@ pub fn verify_file_with_progress(
     progress: &(dyn Fn(u64) + Sync),
 ) -> FileReport {
     let mut judge = Judge::default();
-    let (structure, error) = mcap_io::read_with_progress(path, &mut judge, progress);
+    let (structure, error) = coin_log_mcap::read_with_progress(path, &mut judge, progress);
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 
@@ -640,15 +640,15 @@ pub fn verify_file_with_progress(
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();
     let source = std::io::Cursor::new(bytes);
-    let (structure, error) = mcap_io::read_from(source, bytes.len() as u64, &mut judge);
+    let (structure, error) = coin_log_mcap::read_from(source, bytes.len() as u64, &mut judge);
     verdict(name.to_string(), judge, structure, error, options)
 }
 
 fn verdict(
     shown: String,
     mut judge: Judge,
-    structure: mcap_io::Structure,
-    error: Option<mcap_io::ReadError>,
+    structure: coin_log_mcap::Structure,
+    error: Option<coin_log_mcap::ReadError>,
     options: &Options,
 ) -> FileReport {
     if let Some(e) = &error {
@@ -727,7 +727,7 @@ impl Judge {
     /// Every integrity problem: the reader's, the judge's, the result record's, and the read error's.
     fn all_problems(
         &mut self,
-        structure: &mcap_io::Structure,
+        structure: &coin_log_mcap::Structure,
         ctx: &Context,
         read_whole: bool,
         read_problem: Option<&String>,

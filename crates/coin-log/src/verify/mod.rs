@@ -1,7 +1,7 @@
 //! `coin-log verify`: judge a stored log from the file alone (format.md: verify).
 //!
 //! The parameters come from the file's `coin-log` metadata; the physics is recomputed from the stored
-//! channels, never re-simulated. The file is read once, as a stream ([`crate::mcap_io::read`]), in memory
+//! channels, never re-simulated. The file is read once, as a stream ([`coin_log_mcap::read`]), in memory
 //! bounded by its largest record: messages are parsed into their strict types, grouped by log time into
 //! samples ([`samples`]), and each check keeps running maxima and a short window ([`checks`]). Tolerances
 //! follow from the recorded integrator settings ([`tolerances`]).

@@ -292,16 +292,20 @@ pub fn schema_data(schema_name: &str, encoding: Encoding) -> Option<&'static [u8
 #[must_use]
 pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
     Some(match schema_name {
-        "coin_log.AngularVelocity" => include_bytes!("../../schemas/coin_log.AngularVelocity.json"),
-        "coin_log.Angles" => include_bytes!("../../schemas/coin_log.Angles.json"),
-        "coin_log.Quaternion" => include_bytes!("../../schemas/coin_log.Quaternion.json"),
-        "coin_log.Position" => include_bytes!("../../schemas/coin_log.Position.json"),
-        "coin_log.Reaction" => include_bytes!("../../schemas/coin_log.Reaction.json"),
-        "coin_log.Energy" => include_bytes!("../../schemas/coin_log.Energy.json"),
-        "coin_log.Invariants" => include_bytes!("../../schemas/coin_log.Invariants.json"),
-        "coin_log.Work" => include_bytes!("../../schemas/coin_log.Work.json"),
-        "foxglove.FrameTransform" => include_bytes!("../../schemas/foxglove.FrameTransform.json"),
-        "foxglove.SceneUpdate" => include_bytes!("../../schemas/foxglove.SceneUpdate.json"),
+        "coin_log.AngularVelocity" => {
+            include_bytes!("../../../../schemas/coin_log.AngularVelocity.json")
+        }
+        "coin_log.Angles" => include_bytes!("../../../../schemas/coin_log.Angles.json"),
+        "coin_log.Quaternion" => include_bytes!("../../../../schemas/coin_log.Quaternion.json"),
+        "coin_log.Position" => include_bytes!("../../../../schemas/coin_log.Position.json"),
+        "coin_log.Reaction" => include_bytes!("../../../../schemas/coin_log.Reaction.json"),
+        "coin_log.Energy" => include_bytes!("../../../../schemas/coin_log.Energy.json"),
+        "coin_log.Invariants" => include_bytes!("../../../../schemas/coin_log.Invariants.json"),
+        "coin_log.Work" => include_bytes!("../../../../schemas/coin_log.Work.json"),
+        "foxglove.FrameTransform" => {
+            include_bytes!("../../../../schemas/foxglove.FrameTransform.json")
+        }
+        "foxglove.SceneUpdate" => include_bytes!("../../../../schemas/foxglove.SceneUpdate.json"),
         _ => return None,
     })
 }

@@ -349,7 +349,7 @@ mod tests {
             let json = schema_bytes(schema).unwrap();
             let expected = proto_text(json);
             let path = format!(
-                "{}/schemas/{}",
+                "{}/../../schemas/{}",
                 env!("CARGO_MANIFEST_DIR"),
                 proto_file_name(schema)
             );

@@ -23,9 +23,9 @@
 
 use super::case::{run_sampled_with, Trajectory};
 use super::{BenchCase, BenchError};
-use crate::integrate::RunSettings;
-use crate::model::{centre_fixed_sigma_squared, Coin, Dissipation, DissipationModel, State};
-use crate::scene::{defaults, presets, Scene};
+use coin_log::integrate::RunSettings;
+use coin_log::model::{centre_fixed_sigma_squared, Coin, Dissipation, DissipationModel, State};
+use coin_log::scene::{defaults, presets, Scene};
 use std::f64::consts::FRAC_PI_2;
 use std::time::Instant;
 

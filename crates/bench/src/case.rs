@@ -2,12 +2,12 @@
 //! is judged against, and the error measures shared by the precision and stability benches.
 
 use super::BenchError;
-use crate::integrate::{Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination};
-use crate::model::drift::{EnergyDrift, InvariantDrift};
-use crate::model::invariants::Chaplygin;
-use crate::model::{energy, Coin, Dissipation, Dynamics, State, Steady, STATE_LEN};
-use crate::scene::defaults;
-use crate::simulation::{run_dynamics, CoinEvents};
+use coin_log::integrate::{Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination};
+use coin_log::model::drift::{EnergyDrift, InvariantDrift};
+use coin_log::model::invariants::Chaplygin;
+use coin_log::model::{energy, Coin, Dissipation, Dynamics, State, Steady, STATE_LEN};
+use coin_log::scene::defaults;
+use coin_log::simulation::{run_dynamics, CoinEvents};
 
 /// Samples per natural time unit √(a/g) at which errors are measured ("100 per time unit").
 pub const SAMPLES_PER_TIME_UNIT: f64 = 100.0;
@@ -134,7 +134,7 @@ impl Trajectory {
 /// The format's name of a termination.
 #[must_use]
 pub fn termination_name(termination: &Termination) -> String {
-    crate::format::Termination::of_run(termination).to_string()
+    coin_log::format::Termination::of_run(termination).to_string()
 }
 
 /// Runs `config` on `case`, storing every sample in `out` (cleared first).

@@ -14,10 +14,10 @@ use crate::format::json::read_fields;
 use crate::format::{
     Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
-use crate::mcap_io::{self, MessageHeader, ReadErrorKind, Visitor};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
 use crate::scene::SceneFile;
+use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
@@ -357,7 +357,7 @@ impl Visitor for Collect {
 /// schema. A file that breaks off part way is drawn up to the break, and the title says so.
 pub fn plot(path: &Path, name: &str) -> Result<String, PlotError> {
     let mut c = Collect::default();
-    let (_, error) = mcap_io::read(path, &mut c);
+    let (_, error) = coin_log_mcap::read(path, &mut c);
     let mut broken = None;
     if let Some(e) = error {
         match e.kind {

@@ -23,7 +23,6 @@ use crate::format::{
     Topic, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Flow, RunOutcome, RunSettings};
-use crate::mcap_io::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{
     centre, contact_point, energy, orientation, Chaplygin, Coin, Dynamics, InvariantsError, State,
@@ -31,6 +30,7 @@ use crate::model::{
 };
 use crate::scene::Scene;
 use crate::simulation::run_dynamics;
+use coin_log_mcap::{ChunkCompression, McapWriter, WriteError, WriterOptions};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::io::{Seek, Write};
@@ -47,7 +47,7 @@ const PROGRESS_INTERVAL: u64 = 4096;
 /// Chunk compression (`--compression`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Compression {
-    /// zstd at [`crate::mcap_io::ZSTD_LEVEL`] (the default).
+    /// zstd at [`coin_log_mcap::ZSTD_LEVEL`] (the default).
     #[default]
     Zstd,
     /// lz4.

@@ -1,8 +1,8 @@
-//! Bench cases from scenes: the built-in scenes of [`crate::scene::presets`] by name, or any validated
+//! Bench cases from scenes: the built-in scenes of [`coin_log::scene::presets`] by name, or any validated
 //! [`Scene`] (a `.toml` file read by the CLI).
 
 use super::{BenchCase, BenchError};
-use crate::scene::{self, presets, Scene};
+use coin_log::scene::{self, presets, Scene};
 
 /// Scenes `bench precision` runs when none are given: a generic wobble, a steady circle (analytic
 /// reference) and a fast spin.

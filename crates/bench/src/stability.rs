@@ -21,8 +21,8 @@ use super::{
     default_config, energy_drift, reference_trajectory, state_error, BenchCase, BenchError,
     DEFAULT_FLAT_MARGIN,
 };
-use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
-use crate::model::{
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
+use coin_log::model::{
     energy, steady_sigma_squared, straight_lambda_squared, Branch, Coin, CoinParams, Inertia,
     State, Steady, SteadyKind, STATE_LEN,
 };
@@ -373,7 +373,7 @@ pub fn near_flat(theta: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>
 // Flat landing and lift-off
 
 /// Gauss–Legendre nodes and weights (kept here under their old path; the rule lives in the model).
-pub use crate::model::quadrature::gauss_legendre;
+pub use coin_log::model::quadrature::gauss_legendre;
 
 /// Time for a coin released at rest at lean θ₀ (no spin) to reach lean θ₁, from the energy integral
 /// (I_X + Ma²)θ̇²/2 = Mga(cos θ₀ − cos θ): t = ∫ dθ / √(2K(cos θ₀ − cos θ)), K = Mga/(I_X + Ma²). The
@@ -513,7 +513,7 @@ pub fn straight_tilt_linear(coin: &Coin, omega_z0: f64, theta0: f64, t: f64) -> 
 #[must_use]
 pub fn marginal(offset: f64, horizon: f64) -> Vec<StabilityRow> {
     let coin = unit_disk();
-    let omega = crate::model::critical_spin(&coin) * (1.0 + offset);
+    let omega = coin_log::model::critical_spin(&coin) * (1.0 + offset);
     let case = BenchCase {
         name: format!("marginal-wc{offset:+e}"),
         coin,
@@ -599,7 +599,7 @@ pub fn drift_history(config: &MethodConfig, horizon: f64) -> DriftHistory {
         t_end: horizon,
         sample_interval: 0.1,
     };
-    let events = crate::simulation::CoinEvents::new(coin, DEFAULT_FLAT_MARGIN, None);
+    let events = coin_log::simulation::CoinEvents::new(coin, DEFAULT_FLAT_MARGIN, None);
     let start = Instant::now();
     let outcome = run_method(
         config,
@@ -870,7 +870,7 @@ pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError
 #[cfg(test)]
 mod tests {
     use super::{release_time, CoinParams};
-    use crate::model::Coin;
+    use coin_log::model::Coin;
 
     /// K = Mga/(I_X + Ma²) of the unit thin disk: 1/(1/4 + 1).
     const UNIT_DISK_K: f64 = 0.8;

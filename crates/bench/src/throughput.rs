@@ -25,13 +25,13 @@
 use super::precision::rtol_for;
 use super::presets::bench_case;
 use super::{reference_trajectory, run_sampled, state_error, BenchCase, BenchError, Trajectory};
-use crate::format::{Channel, Encoding};
-use crate::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Stats};
-use crate::mcap_io::{
+use coin_log::format::{Channel, Encoding};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Stats};
+use coin_log::record::COMPRESSION_THREADS;
+use coin_log::scene::{self, presets, FlagOverrides, Scene};
+use coin_log_mcap::{
     self, ChunkCompression, ChunkCompressor, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
 };
-use crate::record::COMPRESSION_THREADS;
-use crate::scene::{self, presets, FlagOverrides, Scene};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::hint::black_box;
@@ -345,7 +345,7 @@ pub fn compression_bound(path: &Path) -> Result<Bound, ThroughputError> {
         bound: Bound::default(),
         error: None,
     };
-    let (_, error) = mcap_io::read(path, &mut visitor);
+    let (_, error) = coin_log_mcap::read(path, &mut visitor);
     visitor.flush();
     if let Some(e) = visitor.error {
         return Err(ThroughputError::Compress(e));
@@ -658,7 +658,7 @@ fn time_integration(config: &MethodConfig, case: &BenchCase, repeats: usize) -> 
 fn time_rhs(case: &BenchCase, repeats: usize) -> Vec<f64> {
     let y0 = case.initial.to_array();
     let mut per_rhs = Vec::new();
-    let mut dy = [0.0; crate::model::STATE_LEN];
+    let mut dy = [0.0; coin_log::model::STATE_LEN];
     for _ in 0..repeats.max(1) {
         let start = Instant::now();
         for _ in 0..RHS_EVALUATIONS {

@@ -13,10 +13,10 @@
 
 use super::stability::{suite_config, StabilityRow};
 use super::BenchError;
-use crate::analyse::Analysis;
-use crate::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunSettings};
-use crate::model::nutation::Motion;
-use crate::model::{
+use coin_log::analyse::Analysis;
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunSettings};
+use coin_log::model::nutation::Motion;
+use coin_log::model::{
     energy, steady_sigma_squared, Branch, Coin, CoinParams, Inertia, Linearisation, State, Steady,
     SteadyKind,
 };
@@ -436,7 +436,7 @@ pub fn generic_periods(periods: f64) -> Result<Vec<StabilityRow>, BenchError> {
         let analysis = Analysis::of_state(
             &coin,
             &state,
-            crate::scene::defaults::FLAT_MARGIN,
+            coin_log::scene::defaults::FLAT_MARGIN,
             None,
             None,
         )
