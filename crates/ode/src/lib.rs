@@ -17,6 +17,7 @@ mod hermite;
 mod method;
 mod rk4;
 
+pub use coin_log_names::UnknownName;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use driver::{
@@ -24,7 +25,7 @@ pub use driver::{
 };
 pub use gauss4::Gauss4;
 pub use hermite::hermite_interpolate;
-pub use method::{run_method, Method, MethodConfig, UnknownMethod};
+pub use method::{run_method, Method, MethodConfig};
 pub use rk4::Rk4;
 
 use thiserror::Error;

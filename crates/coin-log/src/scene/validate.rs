@@ -793,7 +793,10 @@ fn check_run(
             problems.push(
                 "run.integrator",
                 quoted(integrator),
-                format!("is not a known integrator: use one of {}", e.valid),
+                format!(
+                    "is not a known integrator: use one of {}",
+                    e.valid.join(", ")
+                ),
             );
             None
         }

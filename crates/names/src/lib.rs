@@ -1,0 +1,117 @@
+//! One declaration of an enum and its names: [`named_enum!`] gives the enum `ALL`, `NAMES`, `name()`,
+//! `Display` and `FromStr`, whose error, [`UnknownName`], lists the valid names. Every crate of the
+//! workspace that has such an enum (integrators, compressions, encodings, terminations, channels, steady
+//! families, …) declares it with this macro, so a name is written once and parsing and printing agree.
+
+/// A name that is none of an enum's names.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown {kind} `{given}`; valid: {}", .valid.join(", "))]
+pub struct UnknownName {
+    /// What the enum names ("integrator", "encoding", …).
+    pub kind: &'static str,
+    /// What was given.
+    pub given: String,
+    /// The valid names, in declaration order.
+    pub valid: &'static [&'static str],
+}
+
+/// Declares a fieldless enum whose variants each have a name:
+///
+/// ```
+/// coin_log_names::named_enum! {
+///     /// How chunks are compressed.
+///     #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+///     pub enum Compression: "compression" {
+///         /// zstd.
+///         #[default]
+///         Zstd = "zstd",
+///         /// Stored as they are.
+///         None = "none",
+///     }
+/// }
+/// assert_eq!(Compression::ALL, [Compression::Zstd, Compression::None]);
+/// assert_eq!("none".parse::<Compression>(), Ok(Compression::None));
+/// assert_eq!(Compression::Zstd.to_string(), "zstd");
+/// assert_eq!(
+///     "lz5".parse::<Compression>().unwrap_err().to_string(),
+///     "unknown compression `lz5`; valid: zstd, none"
+/// );
+/// ```
+///
+/// The enum must derive `Clone` and `Copy`. The string after the colon is what an unknown name is
+/// called in the error.
+#[macro_export]
+macro_rules! named_enum {
+    (
+        $(#[$meta:meta])*
+        $vis:vis enum $name:ident : $kind:literal {
+            $( $(#[$variant_meta:meta])* $variant:ident = $text:literal ),+ $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        $vis enum $name {
+            $( $(#[$variant_meta])* $variant ),+
+        }
+
+        impl $name {
+            /// Every variant, in declaration order.
+            pub const ALL: &'static [Self] = &[$(Self::$variant),+];
+            /// Every variant's name, in the order of `ALL`.
+            pub const NAMES: &'static [&'static str] = &[$($text),+];
+
+            /// The name in files and on the command line.
+            #[must_use]
+            pub const fn name(self) -> &'static str {
+                match self {
+                    $(Self::$variant => $text),+
+                }
+            }
+        }
+
+        impl ::core::fmt::Display for $name {
+            fn fmt(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl ::core::str::FromStr for $name {
+            type Err = $crate::UnknownName;
+            fn from_str(s: &str) -> ::core::result::Result<Self, Self::Err> {
+                Self::ALL
+                    .iter()
+                    .copied()
+                    .find(|v| v.name() == s)
+                    .ok_or_else(|| $crate::UnknownName {
+                        kind: $kind,
+                        given: s.to_string(),
+                        valid: Self::NAMES,
+                    })
+            }
+        }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    named_enum! {
+        /// A test enum.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        enum Branch: "branch" {
+            /// Plus.
+            Plus = "+",
+            /// Minus.
+            Minus = "-",
+        }
+    }
+
+    #[test]
+    fn every_name_round_trips_and_an_unknown_one_lists_the_valid_names() {
+        for b in Branch::ALL {
+            assert_eq!(b.name().parse::<Branch>(), Ok(*b));
+            assert_eq!(b.to_string(), b.name());
+        }
+        assert_eq!(Branch::NAMES, ["+", "-"]);
+        let e = "0".parse::<Branch>().unwrap_err();
+        assert_eq!(e.to_string(), "unknown branch `0`; valid: +, -");
+    }
+}
