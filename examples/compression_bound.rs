@@ -6,7 +6,7 @@
 //! lz4, none: what a recording costs to compress), then for each zstd LEVEL given.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use coin_log_mcap::{ChunkCompression, ChunkCompressor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
+use coin_log_mcap::{ChunkCompressor, Compression, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
 use mcap::records::Record;
 use std::io::Read;
 use std::time::Instant;
@@ -40,14 +40,10 @@ fn main() {
         );
         println!("{what}: {seconds:.3} s, {mb:.0} MB/s, {msgs:.2} M messages/s, {compressed} bytes ({ratio:.2}x)");
     };
-    for compression in [
-        ChunkCompression::Zstd,
-        ChunkCompression::Lz4,
-        ChunkCompression::None,
-    ] {
+    for compression in [Compression::Zstd, Compression::Lz4, Compression::None] {
         let (seconds, compressed) = writer_pass(compression, &chunk_refs);
         let name = match compression {
-            ChunkCompression::Zstd => format!("zstd level {ZSTD_LEVEL}"),
+            Compression::Zstd => format!("zstd level {ZSTD_LEVEL}"),
             other => format!("{other:?}").to_lowercase(),
         };
         report(
@@ -113,7 +109,7 @@ fn payloads(bytes: &[u8]) -> (Vec<u8>, u64) {
 }
 
 /// The writer's own compressor (and CRC) over the chunk records: median seconds and compressed size.
-fn writer_pass(compression: ChunkCompression, chunks: &[&[u8]]) -> (f64, usize) {
+fn writer_pass(compression: Compression, chunks: &[&[u8]]) -> (f64, usize) {
     let mut compressor = ChunkCompressor::new(compression);
     median_pass(chunks, |piece, out| {
         compressor.compress(piece, out).unwrap();

@@ -8,8 +8,9 @@ use super::scene_arg::load_source;
 use super::{make_readable, output, Outcome};
 use anyhow::{anyhow, Context};
 use coin_log::live::{Discard, LiveEvent, LiveServer, LiveTap, Pacing, DEFAULT_PORT};
-use coin_log::record::{record_with_tap, Compression, RecordOptions, RecordSummary};
+use coin_log::record::{record_with_tap, RecordOptions, RecordSummary};
 use coin_log::scene::Scene;
+use coin_log_mcap::Compression;
 use std::io::BufWriter;
 use std::net::IpAddr;
 use std::path::PathBuf;
@@ -101,7 +102,7 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
             }
         };
     let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
-    tap.announce_topics(&scene.channels, args.flags.encoding.into());
+    tap.announce_topics(&scene.channels, args.flags.encoding);
     announce(&args, &server, &source.label);
     let mut file = match &args.output {
         Some(target) => {
@@ -113,7 +114,7 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let options = RecordOptions {
         compression: Compression::default(),
-        encoding: args.flags.encoding.into(),
+        encoding: args.flags.encoding,
     };
     let summary = run_scene(&scene, &options, &mut tap, file.as_mut(), &signals)?;
     let wall = started.elapsed();

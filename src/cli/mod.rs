@@ -145,6 +145,15 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
     }
 }
 
+/// The clap value parser of an enum declared with `coin_log_names::named_enum!`: its names are the possible
+/// values (listed in `--help` and in the error), parsed by the enum's own `FromStr`.
+pub(crate) fn named<
+    T: coin_log_names::Named + std::str::FromStr<Err = coin_log_names::UnknownName>,
+>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(T::NAMES).try_map(|s| s.parse::<T>())
+}
+
 /// Temporary files are created owner-only; a finished output file is an ordinary file.
 pub(crate) fn make_readable(file: &std::fs::File) {
     #[cfg(unix)]

@@ -9,8 +9,9 @@ use super::{destination, make_readable, output, Outcome};
 use anyhow::{anyhow, bail, Context};
 use coin_log::format::Encoding;
 use coin_log::format::Termination;
-use coin_log::record::{self, Compression, RecordOptions, RecordSummary};
+use coin_log::record::{self, RecordOptions, RecordSummary};
 use coin_log::scene::{self, limits, FlagOverrides, Scene};
+use coin_log_mcap::Compression;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
@@ -46,8 +47,8 @@ pub struct RecordArgs {
     #[command(flatten)]
     pub flags: SceneFlags,
     /// Chunk compression.
-    #[arg(long, value_enum, default_value_t = CompressionArg::Zstd)]
-    compression: CompressionArg,
+    #[arg(long, default_value_t, value_parser = super::named::<Compression>())]
+    compression: Compression,
     /// Replace FILE if it exists.
     #[arg(long)]
     overwrite: bool,
@@ -89,8 +90,8 @@ pub struct SceneFlags {
     pub channels: Option<Vec<String>>,
     /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
     /// about half the size, and Rerun reads it). Both carry the same f64 values (docs/format.md: Encodings).
-    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
-    pub encoding: EncodingArg,
+    #[arg(long, default_value_t, value_parser = super::named::<Encoding>())]
+    pub encoding: Encoding,
     /// Set a scene key before the flags above apply: KEY is a dotted path (`initial.theta`, `run.rtol`,
     /// `body.shape`), VALUE a TOML value or a bare string. Repeatable.
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -108,45 +109,6 @@ impl SceneFlags {
             atol: self.atol,
             step: self.step,
             channels: self.channels.clone(),
-        }
-    }
-}
-
-/// `--encoding`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum EncodingArg {
-    /// JSON messages with JSON Schemas (the default).
-    Json,
-    /// Protobuf messages with FileDescriptorSet schemas.
-    Protobuf,
-}
-
-impl From<EncodingArg> for Encoding {
-    fn from(e: EncodingArg) -> Self {
-        match e {
-            EncodingArg::Json => Encoding::Json,
-            EncodingArg::Protobuf => Encoding::Protobuf,
-        }
-    }
-}
-
-/// `--compression`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum CompressionArg {
-    /// zstd, level 1 (faster and smaller than level 3 on these JSON chunks).
-    Zstd,
-    /// lz4.
-    Lz4,
-    /// No compression.
-    None,
-}
-
-impl From<CompressionArg> for Compression {
-    fn from(c: CompressionArg) -> Self {
-        match c {
-            CompressionArg::Zstd => Compression::Zstd,
-            CompressionArg::Lz4 => Compression::Lz4,
-            CompressionArg::None => Compression::None,
         }
     }
 }
@@ -184,7 +146,7 @@ const LARGE: u64 = 1 << 30;
 /// `--dry-run`: the resolved scene as TOML after comment lines with the estimate (so the output is itself
 /// a scene file), or with `--json` one object; nothing is written.
 fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outcome> {
-    let e = record::estimate(scene, args.compression.into(), args.flags.encoding.into());
+    let e = record::estimate(scene, args.compression, args.flags.encoding);
     let toml = scene.to_toml();
     if args.json {
         let json = serde_json::json!({
@@ -205,11 +167,10 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
         e.samples,
         e.messages,
         size(e.bytes),
-        clap::ValueEnum::to_possible_value(&args.compression)
-            .map_or_else(String::new, |v| v.get_name().to_string()),
+        args.compression,
         match args.flags.encoding {
-            EncodingArg::Json => "",
-            EncodingArg::Protobuf => " of Protobuf messages",
+            Encoding::Json => "",
+            Encoding::Protobuf => " of Protobuf messages",
         },
         record::estimate::ACCURACY
     );
@@ -218,7 +179,7 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
 
 /// Warns on stderr before a recording estimated larger than [`LARGE`].
 fn warn_if_large(args: &RecordArgs, scene: &Scene) {
-    let e = record::estimate(scene, args.compression.into(), args.flags.encoding.into());
+    let e = record::estimate(scene, args.compression, args.flags.encoding);
     if e.bytes > LARGE {
         errln!(
             "warning: this recording is estimated at {} ({} messages); `--dry-run` shows the estimate, \
@@ -289,13 +250,13 @@ fn resolve(args: &RecordArgs, source: &SceneSource) -> anyhow::Result<Scene> {
 /// Protobuf timestamps of `encoding` is refused.
 pub(super) fn resolve_flags(
     flags: FlagOverrides,
-    encoding: EncodingArg,
+    encoding: Encoding,
     source: &SceneSource,
 ) -> anyhow::Result<Scene> {
     let scene = scene::resolve(&source.file, &flags)
         .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
     let max = record::foxglove::PROTOBUF_MAX_SECONDS;
-    if encoding == EncodingArg::Protobuf && scene.run.duration > max {
+    if encoding == Encoding::Protobuf && scene.run.duration > max {
         return Err(anyhow!(
             "scene `{}`: run.duration = {} is longer than {max} time units, the most Foxglove's Protobuf \
              timestamps hold (32-bit seconds); record it with --encoding json, or shorten it with --duration",
@@ -389,8 +350,8 @@ fn record_into(
     signals: &Signals,
 ) -> anyhow::Result<(RecordSummary, Duration)> {
     let options = RecordOptions {
-        compression: args.compression.into(),
-        encoding: args.flags.encoding.into(),
+        compression: args.compression,
+        encoding: args.flags.encoding,
     };
     let bar = progress_bar();
     let started = Instant::now();

@@ -11,11 +11,12 @@
 
 use crate::support::record::{coin_log, exe};
 use crate::support::repo;
-use coin_log::record::{self, Compression, RecordOptions};
+use coin_log::record::{self, RecordOptions};
 use coin_log_bench::throughput::{
     self, compression_bound, recording_path, workload_scene, Bound, DurationRuns, ExportRun,
     RecordRun, ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, CSV_HEADER,
 };
+use coin_log_mcap::Compression;
 use std::io::Cursor;
 use std::process::Command;
 use std::sync::atomic::AtomicBool;

@@ -13,10 +13,11 @@ use coin_log::format::{
 use coin_log::integrate::{run_method, Flow, RunSettings};
 use coin_log::model::{energy, Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use coin_log::record::{
-    self, run_metadata, Compression, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
+    self, run_metadata, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
 };
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log::simulation::{CoinEvents, DissipativeEvents};
+use coin_log_mcap::Compression;
 use std::io::Cursor;
 use std::sync::atomic::AtomicBool;
 
@@ -303,7 +304,7 @@ fn every_compression_gives_a_readable_file_with_the_same_messages() {
         },
     );
     let mut all = Vec::new();
-    for compression in Compression::ALL {
+    for &compression in Compression::ALL {
         let (bytes, summary) = record_to_memory(
             &scene,
             &RecordOptions {

@@ -6,18 +6,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use crate::support::FailingWriter;
-use coin_log_mcap::{ChunkCompression, McapWriter, WriteError, WriterOptions};
+use coin_log_mcap::{Compression, McapWriter, WriteError, WriterOptions};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::{McapError, MessageStream, Summary};
 use std::collections::BTreeMap;
 use std::io::{Cursor, Write};
 
-const COMPRESSIONS: [ChunkCompression; 3] = [
-    ChunkCompression::Zstd,
-    ChunkCompression::Lz4,
-    ChunkCompression::None,
-];
+const COMPRESSIONS: [Compression; 3] = [Compression::Zstd, Compression::Lz4, Compression::None];
 
 /// A message as written: (topic, sequence, log time, publish time, data).
 type Written = (String, u32, u64, u64, Vec<u8>);
@@ -29,7 +25,7 @@ const CHANNELS: [(&str, &str); 3] = [
     ("/c", "test.Scalar"),
 ];
 
-fn options(compression: ChunkCompression, chunk_size: usize, workers: usize) -> WriterOptions {
+fn options(compression: Compression, chunk_size: usize, workers: usize) -> WriterOptions {
     WriterOptions {
         chunk_size,
         workers,
@@ -317,7 +313,7 @@ fn the_summary_indexes_every_chunk_message_and_metadata_record() {
 
 #[test]
 fn the_file_has_the_layout_of_the_spec_with_summary_offsets_for_every_group() {
-    let (bytes, _) = write_file(&options(ChunkCompression::Zstd, 4096, 1), 5_000).unwrap();
+    let (bytes, _) = write_file(&options(Compression::Zstd, 4096, 1), 5_000).unwrap();
     let records = validated_records(&bytes, true).unwrap();
     let opcode = |r: &Record| r.opcode();
     let data_end = records
@@ -391,7 +387,7 @@ fn find(haystack: &[u8], needle: &[u8]) -> usize {
 #[test]
 fn a_flipped_byte_fails_the_chunk_data_or_summary_crc() {
     // Uncompressed chunks so that a flipped byte is still a well-formed record: only a CRC can tell.
-    let (bytes, _) = write_file(&options(ChunkCompression::None, 4096, 1), 2_000).unwrap();
+    let (bytes, _) = write_file(&options(Compression::None, 4096, 1), 2_000).unwrap();
     assert!(
         validated_records(&bytes, false).is_ok(),
         "the unflipped file reads"
@@ -417,7 +413,7 @@ fn a_flipped_byte_fails_the_chunk_data_or_summary_crc() {
     assert!(matches!(summary_error, McapError::BadSummaryCrc { .. }));
 
     // A compressed chunk with a flipped byte does not read either (bad frame or bad CRC).
-    for compression in [ChunkCompression::Zstd, ChunkCompression::Lz4] {
+    for compression in [Compression::Zstd, Compression::Lz4] {
         let (bytes, _) = write_file(&options(compression, 4096, 1), 2_000).unwrap();
         let summary = Summary::read(&bytes).unwrap().unwrap();
         let chunk = &summary.chunk_indexes[3];
@@ -441,7 +437,7 @@ fn the_bytes_do_not_depend_on_the_worker_count_or_the_run() {
 
 #[test]
 fn a_message_larger_than_a_chunk_gets_a_chunk_of_its_own() {
-    let (bytes, written) = write_file(&options(ChunkCompression::Zstd, 64, 2), 3_000).unwrap();
+    let (bytes, written) = write_file(&options(Compression::Zstd, 64, 2), 3_000).unwrap();
     let summary = Summary::read(&bytes).unwrap().unwrap();
     println!(
         "{} messages in {} chunks of at least 64 bytes",
@@ -459,7 +455,7 @@ fn a_message_larger_than_a_chunk_gets_a_chunk_of_its_own() {
 fn a_file_without_messages_is_complete_and_readable() {
     let writer = McapWriter::new(
         Cursor::new(Vec::new()),
-        &options(ChunkCompression::Zstd, 4096, 1),
+        &options(Compression::Zstd, 4096, 1),
     )
     .unwrap();
     let (out, length) = writer.finish().unwrap();
@@ -473,11 +469,8 @@ fn a_file_without_messages_is_complete_and_readable() {
 
 #[test]
 fn unknown_channels_and_schemas_are_refused_and_equal_registrations_share_an_id() {
-    let mut writer = McapWriter::new(
-        Cursor::new(Vec::new()),
-        &options(ChunkCompression::Lz4, 4096, 1),
-    )
-    .unwrap();
+    let mut writer =
+        McapWriter::new(Cursor::new(Vec::new()), &options(Compression::Lz4, 4096, 1)).unwrap();
     assert!(matches!(
         writer.write_message(1, 0, 0, 0, b"x"),
         Err(WriteError::UnknownChannel { channel_id: 1 })
@@ -561,7 +554,7 @@ fn a_failing_output_is_an_error_from_a_write_or_from_finish_never_a_panic_or_a_h
 #[test]
 fn after_a_failure_every_call_fails_and_dropping_the_writer_returns() {
     let out = FailingWriter::new(200_000);
-    let mut writer = McapWriter::new(out, &options(ChunkCompression::Zstd, 4096, 2)).unwrap();
+    let mut writer = McapWriter::new(out, &options(Compression::Zstd, 4096, 2)).unwrap();
     let s = writer.add_schema("s", "jsonschema", b"{}").unwrap();
     let c = writer
         .add_channel(s, "/x", "json", &BTreeMap::new())
@@ -588,7 +581,7 @@ fn after_a_failure_every_call_fails_and_dropping_the_writer_returns() {
     assert!(matches!(writer.finish(), Err(WriteError::AlreadyFailed)));
 
     // A writer dropped with chunks in flight stops its workers and returns.
-    let mut writer = McapWriter::new(Vec::new(), &options(ChunkCompression::Zstd, 256, 2)).unwrap();
+    let mut writer = McapWriter::new(Vec::new(), &options(Compression::Zstd, 256, 2)).unwrap();
     let s = writer.add_schema("s", "jsonschema", b"{}").unwrap();
     let c = writer
         .add_channel(s, "/x", "json", &BTreeMap::new())
@@ -603,8 +596,9 @@ fn after_a_failure_every_call_fails_and_dropping_the_writer_returns() {
 
 #[test]
 fn a_recording_passes_every_crc_check_for_every_compression() {
-    use coin_log::record::{self, Compression, RecordOptions};
+    use coin_log::record::{self, RecordOptions};
     use coin_log::scene::{self, presets, FlagOverrides};
+    use coin_log_mcap::Compression;
     use std::sync::atomic::AtomicBool;
     let file = presets::preset("wobble").expect("built-in");
     let flags = FlagOverrides {
@@ -612,7 +606,7 @@ fn a_recording_passes_every_crc_check_for_every_compression() {
         ..FlagOverrides::default()
     };
     let scene = scene::resolve(&file, &flags).unwrap();
-    for compression in Compression::ALL {
+    for &compression in Compression::ALL {
         let mut out = Cursor::new(Vec::new());
         let summary = record::record(
             &scene,

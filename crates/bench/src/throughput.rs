@@ -30,7 +30,7 @@ use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, S
 use coin_log::record::COMPRESSION_THREADS;
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log_mcap::{
-    self, ChunkCompression, ChunkCompressor, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
+    self, ChunkCompressor, Compression, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
 };
 use std::collections::BTreeMap;
 use std::fmt;
@@ -339,7 +339,7 @@ impl Visitor for Compressing {
 /// [`ThroughputError`] if the file cannot be read back or zstd fails.
 pub fn compression_bound(path: &Path) -> Result<Bound, ThroughputError> {
     let mut visitor = Compressing {
-        compressor: ChunkCompressor::new(ChunkCompression::Zstd),
+        compressor: ChunkCompressor::new(Compression::Zstd),
         chunk: Vec::with_capacity(CHUNK_SIZE + (CHUNK_SIZE >> 2)),
         out: Vec::new(),
         bound: Bound::default(),

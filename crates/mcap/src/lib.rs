@@ -3,7 +3,7 @@
 //! put the coin-log contract on top of it. It depends on nothing else in the crate.
 //!
 //! **Writing**: [`McapWriter`] writes a chunked, indexed file with statistics, summary offsets and CRCs,
-//! compressing whole chunks on worker threads ([`WriterOptions`], [`ChunkCompression`]). The same bytes go
+//! compressing whole chunks on worker threads ([`WriterOptions`], [`Compression`]). The same bytes go
 //! out whatever the worker count or timing. [`ChunkCompressor`] is the code its workers compress a chunk
 //! with, public so that a benchmark can time compression alone; [`DEFAULT_CHUNK_SIZE`] and [`ZSTD_LEVEL`]
 //! are the writer's defaults.
@@ -35,6 +35,6 @@ pub use reader::{
 pub use summary::{read_summary, ChannelSummary, Summary};
 pub use wire::MessageHeader;
 pub use writer::{
-    ChunkCompression, ChunkCompressor, McapWriter, WriteError, WriterOptions, DEFAULT_CHUNK_SIZE,
+    ChunkCompressor, Compression, McapWriter, WriteError, WriterOptions, DEFAULT_CHUNK_SIZE,
     ZSTD_LEVEL,
 };

@@ -1088,7 +1088,7 @@ impl Book {
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
-    use super::super::writer::{ChunkCompression, McapWriter, WriterOptions};
+    use super::super::writer::{Compression, McapWriter, WriterOptions};
     use super::*;
     use std::io::Cursor as IoCursor;
     use std::time::Duration;
@@ -1099,7 +1099,7 @@ mod tests {
     /// An uncompressed file of `messages` 1 KiB messages in 64 KiB chunks (many more batches than the
     /// prefetch queue holds), with a metadata record `late` written after the first `late_after` messages.
     fn file(messages: u32, late_after: u32) -> Vec<u8> {
-        let mut options = WriterOptions::new(ChunkCompression::None, "test");
+        let mut options = WriterOptions::new(Compression::None, "test");
         options.chunk_size = 1 << 16;
         let mut w = McapWriter::new(IoCursor::new(Vec::new()), &options).unwrap();
         let schema = w.add_schema("s", "jsonschema", b"{}").unwrap();

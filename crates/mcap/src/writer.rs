@@ -40,7 +40,7 @@ mod op {
 /// to a time decompresses little.
 pub const DEFAULT_CHUNK_SIZE: usize = 1 << 20;
 
-/// The zstd level of [`ChunkCompression::Zstd`] chunks (fixed: the writer has no other). Level 1 is both
+/// The zstd level of [`Compression::Zstd`] chunks (fixed: the writer has no other). Level 1 is both
 /// faster and smaller than zstd's default level 3 on coin-log's JSON chunks (measured on the seven-channel
 /// wobble run: 3.9× vs 3.5× smaller, about 1.3× faster; the shortest round-trip digits leave little for
 /// level 3's longer matches to find).
@@ -64,19 +64,21 @@ const MESSAGE_HEADER_LEN: usize = 1 + 8 + 2 + 4 + 8 + 8;
 /// The Footer record's length: summary start, summary offset start, summary CRC.
 const FOOTER_LEN: u64 = 8 + 8 + 4;
 
-/// How chunks are compressed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ChunkCompression {
-    /// zstd at [`ZSTD_LEVEL`] (the default).
-    #[default]
-    Zstd,
-    /// An lz4 frame (fast level, linked blocks, content checksum, no block checksums).
-    Lz4,
-    /// Stored uncompressed.
-    None,
+coin_log_names::named_enum! {
+    /// How chunks are compressed; the name is the one of `--compression` and of the recording's metadata.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+    pub enum Compression: "compression" {
+        /// zstd at [`ZSTD_LEVEL`] (the default).
+        #[default]
+        Zstd = "zstd",
+        /// An lz4 frame (fast level, linked blocks, content checksum, no block checksums).
+        Lz4 = "lz4",
+        /// Stored uncompressed.
+        None = "none",
+    }
 }
 
-impl ChunkCompression {
+impl Compression {
     /// The `compression` string of the Chunk and ChunkIndex records.
     #[must_use]
     pub fn mcap_name(self) -> &'static str {
@@ -92,7 +94,7 @@ impl ChunkCompression {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct WriterOptions {
     /// Chunk compression.
-    pub compression: ChunkCompression,
+    pub compression: Compression,
     /// A chunk is closed once its uncompressed records reach this many bytes (at least 1).
     pub chunk_size: usize,
     /// Compression worker threads (at least 1). The bytes do not depend on it.
@@ -107,7 +109,7 @@ impl WriterOptions {
     /// Options with the given compression and library string, [`DEFAULT_CHUNK_SIZE`], one worker and
     /// no profile.
     #[must_use]
-    pub fn new(compression: ChunkCompression, library: impl Into<String>) -> Self {
+    pub fn new(compression: Compression, library: impl Into<String>) -> Self {
         Self {
             compression,
             chunk_size: DEFAULT_CHUNK_SIZE,
@@ -221,7 +223,7 @@ struct MetadataIndex {
 struct Job {
     /// The uncompressed records.
     records: Vec<u8>,
-    /// The compressed records (empty for [`ChunkCompression::None`]).
+    /// The compressed records (empty for [`Compression::None`]).
     compressed: Vec<u8>,
 }
 
@@ -244,7 +246,7 @@ struct Worker {
 struct Workers(Vec<Worker>);
 
 impl Workers {
-    fn spawn(count: usize, compression: ChunkCompression) -> Result<Self, WriteError> {
+    fn spawn(count: usize, compression: Compression) -> Result<Self, WriteError> {
         let mut workers = Self(Vec::with_capacity(count));
         for number in 0..count.max(1) {
             let (job_sender, job_receiver) = mpsc::channel::<Job>();
@@ -291,7 +293,7 @@ impl Drop for Workers {
 }
 
 /// A worker's loop: compress each chunk it is sent, send it back, until either channel closes.
-fn compress_chunks(compression: ChunkCompression, jobs: &Receiver<Job>, done: &Sender<Done>) {
+fn compress_chunks(compression: Compression, jobs: &Receiver<Job>, done: &Sender<Done>) {
     let mut compressor = ChunkCompressor::new(compression);
     while let Ok(mut job) = jobs.recv() {
         let crc = crc32fast::hash(&job.records);
@@ -305,7 +307,7 @@ fn compress_chunks(compression: ChunkCompression, jobs: &Receiver<Job>, done: &S
 /// Compresses whole chunks exactly as the writer's workers do (one call per chunk, one thread), so that
 /// a benchmark can time the compression bound on the same code.
 pub struct ChunkCompressor {
-    compression: ChunkCompression,
+    compression: Compression,
     /// Created at the first zstd chunk and kept: its context is reused from chunk to chunk.
     zstd: Option<zstd::bulk::Compressor<'static>>,
 }
@@ -313,22 +315,22 @@ pub struct ChunkCompressor {
 impl ChunkCompressor {
     /// A compressor for `compression`.
     #[must_use]
-    pub fn new(compression: ChunkCompression) -> Self {
+    pub fn new(compression: Compression) -> Self {
         Self {
             compression,
             zstd: None,
         }
     }
 
-    /// Replaces `out` with the compressed `records` (leaves it empty for [`ChunkCompression::None`]).
+    /// Replaces `out` with the compressed `records` (leaves it empty for [`Compression::None`]).
     ///
     /// # Errors
     /// The compressor's error (in practice only when out of memory).
     pub fn compress(&mut self, records: &[u8], out: &mut Vec<u8>) -> io::Result<()> {
         out.clear();
         match self.compression {
-            ChunkCompression::None => Ok(()),
-            ChunkCompression::Zstd => {
+            Compression::None => Ok(()),
+            Compression::Zstd => {
                 let compressor = match &mut self.zstd {
                     Some(c) => c,
                     None => self.zstd.insert(zstd::bulk::Compressor::new(ZSTD_LEVEL)?),
@@ -337,7 +339,7 @@ impl ChunkCompressor {
                 compressor.compress_to_buffer(records, out)?;
                 Ok(())
             }
-            ChunkCompression::Lz4 => {
+            Compression::Lz4 => {
                 // The same frame parameters as the `mcap` crate's lz4 chunks: no block checksums (the
                 // chunk CRC covers the data), lz4's defaults otherwise.
                 let mut encoder = lz4::EncoderBuilder::new()
@@ -407,7 +409,7 @@ impl<W: Write> Output<W> {
 #[must_use = "an MCAP file is complete only after `finish`"]
 pub struct McapWriter<W: Write> {
     out: Output<W>,
-    compression: ChunkCompression,
+    compression: Compression,
     chunk_size: usize,
     /// The open chunk's records and what is known about them.
     chunk: Vec<u8>,
@@ -749,8 +751,8 @@ impl<W: Write> McapWriter<W> {
         crc: u32,
     ) -> Result<(), WriteError> {
         let stored = match self.compression {
-            ChunkCompression::None => records,
-            ChunkCompression::Zstd | ChunkCompression::Lz4 => compressed,
+            Compression::None => records,
+            Compression::Zstd | Compression::Lz4 => compressed,
         };
         let bounds = meta.bounds.unwrap_or((0, 0));
         let name = self.compression.mcap_name();

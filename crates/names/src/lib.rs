@@ -15,6 +15,19 @@ pub struct UnknownName {
     pub valid: &'static [&'static str],
 }
 
+/// What [`named_enum!`] gives every enum it declares, for code generic over such enums (a command-line
+/// parser listing the possible values, say).
+pub trait Named: Copy + Send + Sync + 'static {
+    /// Every variant, in declaration order.
+    const ALL: &'static [Self];
+    /// Every variant's name, in the order of `ALL`.
+    const NAMES: &'static [&'static str];
+    /// What a name of the enum is called in an error ("integrator").
+    const KIND: &'static str;
+    /// The variant's name.
+    fn name(self) -> &'static str;
+}
+
 /// Declares a fieldless enum whose variants each have a name:
 ///
 /// ```
@@ -38,7 +51,7 @@ pub struct UnknownName {
 /// );
 /// ```
 ///
-/// The enum must derive `Clone` and `Copy`. The string after the colon is what an unknown name is
+/// It also implements [`Named`]. The enum must derive `Clone` and `Copy`. The string after the colon is what an unknown name is
 /// called in the error.
 #[macro_export]
 macro_rules! named_enum {
@@ -65,6 +78,15 @@ macro_rules! named_enum {
                 match self {
                     $(Self::$variant => $text),+
                 }
+            }
+        }
+
+        impl $crate::Named for $name {
+            const ALL: &'static [Self] = Self::ALL;
+            const NAMES: &'static [&'static str] = Self::NAMES;
+            const KIND: &'static str = $kind;
+            fn name(self) -> &'static str {
+                Self::name(self)
             }
         }
 

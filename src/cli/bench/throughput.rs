@@ -4,9 +4,9 @@
 //! bound and the integration cost, turn the runs into rows and format them.
 
 use super::{create_dir, write};
-use crate::cli::record::EncodingArg;
 use crate::cli::Outcome;
 use anyhow::{anyhow, bail, Context};
+use coin_log::format::Encoding;
 use coin_log_bench::throughput::{
     self, channel_list, compression_bound, recording_path, DurationRuns, ExportRun, RecordRun,
     ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
@@ -36,8 +36,8 @@ pub struct ThroughputArgs {
     #[arg(long)]
     keep: bool,
     /// Message encoding of the recordings.
-    #[arg(long, value_enum, default_value_t = EncodingArg::Json)]
-    encoding: EncodingArg,
+    #[arg(long, default_value_t, value_parser = crate::cli::named::<Encoding>())]
+    encoding: Encoding,
 }
 
 /// Runs `coin-log bench throughput`: measure, clean up, print the table, write the CSV.
@@ -85,7 +85,7 @@ fn measure(
     dir: &Path,
     durations: &[f64],
     repeats: usize,
-    encoding: EncodingArg,
+    encoding: Encoding,
 ) -> anyhow::Result<ThroughputReport> {
     let mut rows = Vec::new();
     for &duration in durations {
@@ -101,11 +101,11 @@ fn record_and_verify(
     dir: &Path,
     duration: f64,
     repeats: usize,
-    encoding: EncodingArg,
+    encoding: Encoding,
 ) -> anyhow::Result<Vec<ThroughputRow>> {
     let path = recording_path(dir, duration);
     let mut runs = DurationRuns {
-        encoding: encoding.into(),
+        encoding,
         ..DurationRuns::new(duration)
     };
     for _ in 0..repeats.max(1) {
@@ -141,12 +141,8 @@ fn record_run(
     exe: &Path,
     path: &Path,
     duration: f64,
-    encoding: EncodingArg,
+    encoding: Encoding,
 ) -> anyhow::Result<RecordRun> {
-    let encoding = match encoding {
-        EncodingArg::Json => "json",
-        EncodingArg::Protobuf => "protobuf",
-    };
     let args: Vec<String> = [
         "record",
         SCENE,
@@ -159,7 +155,7 @@ fn record_run(
         "--compression",
         "zstd",
         "--encoding",
-        encoding,
+        encoding.name(),
         "-o",
         &path.display().to_string(),
         "--overwrite",

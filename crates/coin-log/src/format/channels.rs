@@ -342,7 +342,7 @@ mod tests {
         for (i, t) in all.iter().enumerate() {
             assert_eq!(t.index(), i, "{t}");
             assert_eq!(Topic::from_name(t.name()), Some(*t));
-            for e in Encoding::ALL {
+            for &e in Encoding::ALL {
                 assert!(schema_data(t.schema_name(), e).is_some(), "{t} {e}");
             }
         }

@@ -1,33 +1,20 @@
 //! The two message encodings of a file (docs/format.md: Encodings): JSON with JSON Schemas (the default), and
 //! Protobuf with `FileDescriptorSet` schemas. Both carry the same fields with the same f64 values.
 
-use std::fmt;
-use std::str::FromStr;
-
-/// How the messages of a file are encoded.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum Encoding {
-    /// JSON messages, `jsonschema` schemas (`schemas/*.json`).
-    #[default]
-    Json,
-    /// Protobuf messages, `protobuf` schemas: a serialized `FileDescriptorSet` (`schemas/*.proto` for the
-    /// `coin_log.*` types, Foxglove's own descriptors for `foxglove.*`).
-    Protobuf,
+coin_log_names::named_enum! {
+    /// How the messages of a file are encoded; the name is the one of `--encoding`.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+    pub enum Encoding: "encoding" {
+        /// JSON messages, `jsonschema` schemas (`schemas/*.json`).
+        #[default]
+        Json = "json",
+        /// Protobuf messages, `protobuf` schemas: a serialized `FileDescriptorSet` (`schemas/*.proto` for the
+        /// `coin_log.*` types, Foxglove's own descriptors for `foxglove.*`).
+        Protobuf = "protobuf",
+    }
 }
 
 impl Encoding {
-    /// Every encoding.
-    pub const ALL: [Encoding; 2] = [Self::Json, Self::Protobuf];
-
-    /// The name on the command line (`--encoding`).
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Json => "json",
-            Self::Protobuf => "protobuf",
-        }
-    }
-
     /// The MCAP schema encoding of its schemas.
     #[must_use]
     pub fn schema_encoding(self) -> &'static str {
@@ -49,34 +36,19 @@ impl Encoding {
     /// The encoding whose MCAP schema encoding is `name`.
     #[must_use]
     pub fn from_schema_encoding(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|e| e.schema_encoding() == name)
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|e| e.schema_encoding() == name)
     }
 
     /// The encoding whose MCAP message encoding is `name`.
     #[must_use]
     pub fn from_message_encoding(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|e| e.message_encoding() == name)
-    }
-}
-
-impl fmt::Display for Encoding {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// An encoding name that is not `json` or `protobuf`.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown encoding `{0}`; use json or protobuf")]
-pub struct UnknownEncoding(pub String);
-
-impl FromStr for Encoding {
-    type Err = UnknownEncoding;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
         Self::ALL
-            .into_iter()
-            .find(|e| e.name() == s)
-            .ok_or_else(|| UnknownEncoding(s.to_string()))
+            .iter()
+            .copied()
+            .find(|e| e.message_encoding() == name)
     }
 }
 
@@ -86,7 +58,7 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_unknown_names_are_refused() {
-        for e in Encoding::ALL {
+        for &e in Encoding::ALL {
             assert_eq!(e.name().parse::<Encoding>(), Ok(e));
             assert_eq!(Encoding::from_schema_encoding(e.schema_encoding()), Some(e));
             assert_eq!(
@@ -96,7 +68,7 @@ mod tests {
         }
         assert_eq!(
             "cbor".parse::<Encoding>().unwrap_err().to_string(),
-            "unknown encoding `cbor`; use json or protobuf"
+            "unknown encoding `cbor`; valid: json, protobuf"
         );
         assert_eq!(Encoding::from_schema_encoding("ros2msg"), None);
     }

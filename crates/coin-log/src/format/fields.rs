@@ -87,7 +87,7 @@ mod tests {
             z: -0.0,
         };
         let mut outs = Vec::new();
-        for e in Encoding::ALL {
+        for &e in Encoding::ALL {
             let schema = schema_data(Position::SCHEMA, e).unwrap();
             let r = FieldReader::new(
                 e.schema_encoding(),

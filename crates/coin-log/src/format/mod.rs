@@ -25,7 +25,7 @@ pub use channels::{
     schema_bytes, schema_data, Channel, Topic, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING,
     TRACK_LEVELS,
 };
-pub use encoding::{Encoding, UnknownEncoding};
+pub use encoding::Encoding;
 pub use metadata::{
     MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,

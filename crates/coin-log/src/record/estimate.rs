@@ -16,9 +16,9 @@
 //! [`ACCURACY`] of the file's size (a test keeps it so).
 
 use super::foxglove::SCENE_RATE;
-use super::recorder::Compression;
 use crate::format::{schema_data, Channel, Encoding};
 use crate::scene::Scene;
+use coin_log_mcap::Compression;
 
 /// Characters of a typical `t` value (`12.34`).
 pub const TIME_CHARS: u64 = 5;

@@ -30,11 +30,9 @@ use crate::model::{
 };
 use crate::scene::Scene;
 use crate::simulation::run_dynamics;
-use coin_log_mcap::{ChunkCompression, McapWriter, WriteError, WriterOptions};
+use coin_log_mcap::{Compression, McapWriter, WriteError, WriterOptions};
 use std::collections::BTreeMap;
-use std::fmt;
 use std::io::{Seek, Write};
-use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Chunk compression worker threads. One worker lets compression of a chunk overlap with the simulation
@@ -43,57 +41,6 @@ pub const COMPRESSION_THREADS: usize = 1;
 
 /// How often (in samples) `progress` is called: rare enough to cost nothing, often enough for a bar.
 const PROGRESS_INTERVAL: u64 = 4096;
-
-/// Chunk compression (`--compression`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Compression {
-    /// zstd at [`coin_log_mcap::ZSTD_LEVEL`] (the default).
-    #[default]
-    Zstd,
-    /// lz4.
-    Lz4,
-    /// Uncompressed chunks.
-    None,
-}
-
-impl Compression {
-    /// Every choice.
-    pub const ALL: [Compression; 3] = [Self::Zstd, Self::Lz4, Self::None];
-
-    /// Name on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Zstd => "zstd",
-            Self::Lz4 => "lz4",
-            Self::None => "none",
-        }
-    }
-
-    fn to_chunk(self) -> ChunkCompression {
-        match self {
-            Self::Zstd => ChunkCompression::Zstd,
-            Self::Lz4 => ChunkCompression::Lz4,
-            Self::None => ChunkCompression::None,
-        }
-    }
-}
-
-impl fmt::Display for Compression {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Compression {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|c| c.name() == s)
-            .ok_or_else(|| format!("unknown compression `{s}`; use zstd, lz4 or none"))
-    }
-}
 
 /// How to write the file (what to simulate is the [`Scene`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -137,7 +84,7 @@ pub fn write_options(options: &RecordOptions) -> WriterOptions {
     WriterOptions {
         workers: COMPRESSION_THREADS,
         ..WriterOptions::new(
-            options.compression.to_chunk(),
+            options.compression,
             format!("coin-log/{}", env!("CARGO_PKG_VERSION")),
         )
     }
