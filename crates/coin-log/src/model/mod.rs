@@ -5,6 +5,7 @@ mod derived;
 mod dissipation;
 pub mod drift;
 mod equations;
+pub mod fit;
 pub mod invariants;
 pub mod nutation;
 mod params;
