@@ -3,14 +3,16 @@
 //! speed regression shows next to the accuracy tests. CI only compiles them (`cargo bench --no-run`).
 
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunSettings};
-use coin_log::model::{Chaplygin, Coin, CoinParams};
-use coin_log_bench::stability::wobble_state;
+use coin_log::model::{Chaplygin, CoinParams};
+use coin_log_bench::presets::bench_case;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
 fn integrators(c: &mut Criterion) {
-    let coin = Coin::new(CoinParams::unit_disk());
-    let y0 = wobble_state().to_array();
+    let Ok(case) = bench_case("wobble") else {
+        return;
+    };
+    let (coin, y0) = (case.coin, case.initial.to_array());
     let settings = RunSettings {
         t0: 0.0,
         t_end: 30.0,

@@ -24,7 +24,9 @@
 
 use super::precision::rtol_for;
 use super::presets::bench_case;
-use super::{reference_trajectory, run_sampled, state_error, BenchCase, BenchError, Trajectory};
+use super::{
+    median, reference_trajectory, run_sampled, state_error, BenchCase, BenchError, Trajectory,
+};
 use coin_log::format::{Channel, Encoding};
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Stats};
 use coin_log::record::COMPRESSION_THREADS;
@@ -197,22 +199,6 @@ pub enum ThroughputError {
         /// The smallest error reached.
         best: f64,
     },
-}
-
-/// The median of `values` (the mean of the middle two for an even count); NaN when empty.
-#[must_use]
-pub fn median(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 /// The `--channels` value of the workload.
@@ -790,13 +776,6 @@ pub fn table(report: &ThroughputReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn medians_of_odd_and_even_counts() {
-        assert!((median(&[3.0, 1.0, 2.0]) - 2.0).abs() < 1e-15);
-        assert!((median(&[4.0, 1.0, 2.0, 3.0]) - 2.5).abs() < 1e-15);
-        assert!(median(&[]).is_nan());
-    }
 
     #[test]
     fn targets_say_which_side_is_good() {

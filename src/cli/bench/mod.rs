@@ -10,11 +10,11 @@ use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP
 use coin_log_bench::plot::{euler_svg, work_precision_svg};
 use coin_log_bench::precision::{precision_bench, PrecisionOptions};
 use coin_log_bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
-use coin_log_bench::stability;
 use coin_log_bench::table::{
     euler_csv, euler_table, precision_csv, precision_table, stability_csv, stability_table,
 };
 use coin_log_bench::BenchCase;
+use coin_log_bench::{stability, suite};
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -164,7 +164,7 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
 
 fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     create_dir(&args.out)?;
-    let rows = stability::run_suite(&stability::SuiteOptions::full())?;
+    let rows = suite::run_suite(&stability::SuiteOptions::full())?;
     out!("{}", stability_table(&rows));
     let csv_path = args.out.join("stability.csv");
     write(&csv_path, &stability_csv(&rows))?;
