@@ -25,6 +25,7 @@ pub use case::{
     ReferenceKind, Trajectory, DEFAULT_FLAT_MARGIN, SAMPLES_PER_TIME_UNIT,
 };
 
+use coin_log::integrate::Method;
 use thiserror::Error;
 
 /// Why a benchmark could not run.
@@ -55,6 +56,18 @@ pub enum BenchError {
         reference: String,
         /// How it ended.
         termination: String,
+    },
+    /// No setting of a method reaches the state error asked for.
+    #[error("scene `{scene}`: {method} does not reach a state error of {error:e} (best {best:e})")]
+    Inaccurate {
+        /// Scene name.
+        scene: String,
+        /// The method.
+        method: Method,
+        /// The state error asked for.
+        error: f64,
+        /// The smallest it reached.
+        best: f64,
     },
     /// Drawing the SVG failed.
     #[error("drawing the work-precision diagram of `{scene}`: {reason}")]

@@ -342,6 +342,44 @@ pub fn precision_bench(
     })
 }
 
+/// The loosest adaptive setting of `method` among `atols` (loosest first; rtol = min(1e3·atol, 1e-3)) whose
+/// state error on `case` against its reference is at most `error`, with that error: the setting at which
+/// the criterion benchmarks time an integrator.
+///
+/// # Errors
+/// [`BenchError::ReferenceFailed`] when the reference cannot be computed; [`BenchError::Inaccurate`] when
+/// no setting reaches `error`.
+pub fn loosest_accurate(
+    case: &BenchCase,
+    method: Method,
+    atols: &[f64],
+    error: f64,
+) -> Result<(MethodConfig, f64), BenchError> {
+    let reference = reference_trajectory(case)?;
+    let mut run = Trajectory::default();
+    let mut best = f64::INFINITY;
+    for &atol in atols {
+        let config = MethodConfig {
+            method,
+            rtol: rtol_for(atol),
+            atol,
+            step: 0.0,
+        };
+        run_sampled(&config, case, &mut run);
+        let reached = state_error(case, &run, &reference);
+        best = best.min(reached);
+        if run.completed() && reached <= error {
+            return Ok((config, reached));
+        }
+    }
+    Err(BenchError::Inaccurate {
+        scene: case.name.clone(),
+        method,
+        error,
+        best,
+    })
+}
+
 #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 fn reference_samples(case: &BenchCase) -> usize {
     let n = case.duration / case.settings().sample_interval;

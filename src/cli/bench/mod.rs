@@ -37,14 +37,14 @@ enum BenchCommand {
     /// The hard-case suite: fast spin, near flat, landing and lift-off, marginal stability, long horizon,
     /// scale invariance; every case with every integrator.
     Stability(StabilityArgs),
-    /// Record and verify speed and memory on the real channel set, against the zstd bound, and the cost of
-    /// integration.
+    /// Record, verify and export speed and memory on the real channel set, against the zstd bound.
     ///
     /// Records `wobble` with the seven channels omega, angles, quaternion, position, contact, reaction,
     /// energy at 1 kHz with zstd, each run in a child `coin-log record` process; times zstd alone on the
-    /// same JSON bytes (the bound); verifies the file in a child `coin-log verify`; reports messages/s,
-    /// MB/s, file size and peak RSS at two durations (100 and 1000 time units; 1000 and 10000 with
-    /// --long), then dop853 on wobble and one RHS evaluation. Medians of --repeats runs.
+    /// same JSON bytes (the bound); verifies and exports the file in a child `coin-log verify` and `coin-log
+    /// export`; reports messages/s, MB/s, file size and peak RSS at two durations (100 and 1000 time units;
+    /// 1000 and 10000 with --long). Medians of --repeats runs. (The integration and one RHS evaluation are
+    /// criterion benchmarks: `cargo bench -p coin-log-bench`.)
     Throughput(throughput::ThroughputArgs),
     /// Euler's disk: the time law α = A (t0 − t)^n of each dissipation preset against n = 1/(1 − p).
     ///
