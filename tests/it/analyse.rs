@@ -1,5 +1,7 @@
 //! `analyse` proven by simulation and by values it does not compute itself (physics §9, §10):
 //!
+//! - the linear theory in closed form: σ of the centre-fixed motion and of straight rolling (physics §5),
+//!   the tilt of straight rolling at ω_c growing like 1 + 2t²/5;
 //! - kicked stable circles nutate at σ (eq (21)), measured from a simulation to 1e-6;
 //! - displaced unstable circles grow at √(−σ²), to 1e-4 in the linear regime;
 //! - the period T and heading advance ΔΦ of generic motions (disk, hoop, explicit inertias) by quadrature
@@ -12,8 +14,9 @@
 //! - `verify`'s `nutation` check: it judges a wobble, skips a steady circle, and fails a recording whose
 //!   time axis is stretched by 1e-6 (negative control).
 //!
-//! The simulations sample 1/2048 of a nutation period apart, so the cubic Hermite location of the turning
-//! points (`bench::nutation`) errs by ~(2π/2048)⁴/384/2π ≈ 4e-14 of a period: far below the tolerances.
+//! The simulations (the benchmarks' runners) sample 1/2048 of a nutation period apart, so the quintic
+//! Hermite location of the turning points (`model::turning_points`) errs by ~(2π/2048)⁶/46080/2π ≈ 3e-21 of
+//! a period: far below the tolerances.
 
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
@@ -22,17 +25,17 @@ use crate::linearisation;
 use crate::support::physics::check_relative;
 use crate::support::record::{coin_log, record_scene};
 use crate::support::writers::rewrite;
+use coin_log::analyse::linear::{displaced, kicked, nutation_frequency, straight_tilt_linear};
 use coin_log::analyse::map::{boundary, closures, edge_leans, sign_changes};
 use coin_log::analyse::Analysis;
 use coin_log::integrate::Method;
 use coin_log::model::nutation::Motion;
 use coin_log::model::{
-    steady_sigma_squared, Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
+    centre_fixed_sigma_squared, critical_spin, steady_sigma_squared, straight_lambda_squared,
+    Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
 };
 use coin_log::verify::{verify_file, CheckId, Options, Status};
-use coin_log_bench::nutation::{
-    displaced, generic_motions, growth_rate, kicked, turning_points, GROWTH_START,
-};
+use coin_log_bench::nutation::{generic_motions, growth_rate, turning_points, GROWTH_START};
 use coin_log_bench::stability::suite_config;
 use std::f64::consts::TAU;
 
@@ -57,7 +60,46 @@ fn circle(coin: &Coin, theta: f64, omega_z: f64, branch: Branch) -> State {
 fn simulated_period(coin: &Coin, state: &State, period: f64, periods: f64) -> (f64, f64) {
     let config = suite_config(Method::Dop853, period / 2048.0);
     let (points, _) = turning_points(coin, state, &config, periods * period, period / 2048.0);
-    points.period().unwrap()
+    let measured = points.measure().unwrap();
+    (measured.period, measured.precession)
+}
+
+#[test]
+fn nutation_frequency_matches_the_closed_forms_of_notes_section_5() {
+    let coin = Coin::new(CoinParams::unit_disk());
+    let theta = 0.7;
+    let steady = Steady::new(
+        &coin,
+        SteadyKind::CentreFixed {
+            theta,
+            branch: Branch::Plus,
+        },
+    )
+    .unwrap();
+    let sigma = nutation_frequency(&coin, &steady).unwrap();
+    let expected = centre_fixed_sigma_squared(&coin, theta).sqrt();
+    println!("centre-fixed σ: measured {sigma}, expected {expected}, tolerance 1e-12");
+    assert!((sigma - expected).abs() <= 1e-12 * expected);
+    // Straight rolling above ω_c: σ² = −λ².
+    let steady = Steady::new(&coin, SteadyKind::Straight { omega_z: 1.0 }).unwrap();
+    let sigma = nutation_frequency(&coin, &steady).unwrap();
+    let expected = (-straight_lambda_squared(&coin, 1.0)).sqrt();
+    println!("straight σ: measured {sigma}, expected {expected} (1.2649), tolerance 1e-12");
+    assert!((sigma - expected).abs() <= 1e-12 * expected);
+}
+
+#[test]
+fn the_linear_tilt_of_straight_rolling_at_the_critical_spin_grows_like_t_squared() {
+    // The linear theory at ω_c is the thin disk's δθ₀(1 + 2t²/5) (physics §5).
+    let coin = Coin::new(CoinParams::unit_disk());
+    let wc = critical_spin(&coin);
+    for t in [1.0, 7.0, 20.0] {
+        let linear = straight_tilt_linear(&coin, wc, 1.0, t);
+        assert!(
+            (linear - (1.0 + 0.4 * t * t)).abs() <= 1e-7 * linear,
+            "t = {t}: {linear}"
+        );
+    }
 }
 
 #[test]
@@ -124,7 +166,7 @@ fn displaced_unstable_circles_grow_at_the_root_of_minus_sigma_squared() {
 fn the_quadratures_period_and_heading_advance_agree_with_a_tight_simulation() {
     // The "Done when" bound, 1e-10 relative: measured ~1e-15 on the disk (dop853 at rtol 1e-12 keeps the
     // phase to ~1e-13 over 20 periods).
-    for (name, coin, state) in generic_motions() {
+    for (name, coin, state) in generic_motions().unwrap() {
         let orbit = Analysis::of_state(&coin, &state, FLAT_MARGIN, None, None)
             .unwrap()
             .orbit;

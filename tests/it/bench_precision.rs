@@ -5,9 +5,12 @@
 
 use coin_log::integrate::Method;
 use coin_log_bench::plot::work_precision_svg;
-use coin_log_bench::precision::{precision_bench, PrecisionOptions, PrecisionReport};
+use coin_log_bench::precision::{
+    loosest_accurate, precision_bench, rtol_for, PrecisionOptions, PrecisionReport,
+};
 use coin_log_bench::presets::bench_case;
 use coin_log_bench::table::{precision_csv, PRECISION_CSV_HEADER};
+use coin_log_bench::BenchError;
 use coin_log_bench::ReferenceKind;
 use std::sync::OnceLock;
 
@@ -159,4 +162,23 @@ fn steady_scenes_are_measured_against_the_analytic_trajectory() {
         tight.state_error
     );
     assert!(tight.state_error <= 1e-8);
+}
+
+#[test]
+fn the_timed_dop853_setting_is_the_loosest_that_reaches_1e_10_on_wobble() {
+    // The setting criterion times dop853 at (benches/integrators.rs): the loosest atol of the list whose
+    // state error is ≤ 1e-10; the next looser one does not reach it, and an unreachable target is an error.
+    let case = bench_case("wobble").unwrap();
+    let atols = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14];
+    let (config, error) = loosest_accurate(&case, Method::Dop853, &atols, DOP853_TARGET).unwrap();
+    println!(
+        "dop853 on wobble: atol {:e}, rtol {:e}, state error {error:e} (≤ {DOP853_TARGET:e})",
+        config.atol, config.rtol
+    );
+    assert!(error <= DOP853_TARGET);
+    assert!((config.rtol - rtol_for(config.atol)).abs() <= 1e-3 * config.rtol);
+    let looser: Vec<f64> = atols.iter().copied().filter(|&a| a > config.atol).collect();
+    let missed = loosest_accurate(&case, Method::Dop853, &looser, DOP853_TARGET);
+    println!("looser atols {looser:?}: {missed:?}");
+    assert!(matches!(missed, Err(BenchError::Inaccurate { best, .. }) if best > DOP853_TARGET));
 }

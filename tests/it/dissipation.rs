@@ -520,7 +520,7 @@ fn the_euler_disk_coefficient_is_moffatts() {
         std::f64::consts::FRAC_PI_4 * mu * a.powi(3),
         1e-15,
     );
-    let t0 = coin_log_bench::euler::slow_change_time_scale(&scene.coin(), &law, 0.2);
+    let t0 = coin_log::analyse::slow_change::slow_change_time_scale(&scene.coin(), &law, 0.2);
     let moffatt = 0.2_f64.powi(3) * 0.45 / (2.0 * std::f64::consts::PI * mu * a);
     // sin^3 α₀ / α₀³ = 1 − α₀²/2 + …: 2 % at α₀ = 0.2.
     physics::check_relative(

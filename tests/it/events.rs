@@ -1,14 +1,18 @@
 //! Events end a run at the right time: a coin released from rest falls about its contact point, and the
 //! energy integral (I_X + Ma²)·θ̇²/2 = Mga(cos θ₀ − cos θ) gives the time to reach any tilt by quadrature
-//! ([`release_time`], checked in its own unit tests), independently of the integrators. The flat landing (|θ| = π/2 − flat_margin) and the lift-off
+//! (`analyse`'s [`Orbit`], [`release_time`]; checked here against a closed form and Simpson's rule),
+//! independently of the integrators. The flat landing (|θ| = π/2 − flat_margin) and the lift-off
 //! (N = 0, physics §3/§7) must be located at those times to 1e-9.
+
+// Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
+#![allow(clippy::unwrap_used)]
 
 use coin_log::integrate::{
     run_method, EventFunctions, Flow, Method, MethodConfig, RunSettings, Termination,
 };
-use coin_log::model::{Coin, CoinParams, State, STATE_LEN};
+use coin_log::model::nutation::{Motion, Orbit};
+use coin_log::model::{Chaplygin, Coin, CoinParams, State, STATE_LEN};
 use coin_log::simulation::{CoinEvents, PhysicalEvent};
-use coin_log_bench::stability::release_time;
 use std::f64::consts::FRAC_PI_2;
 
 /// Flat margin of the runs (the contract's default).
@@ -27,6 +31,70 @@ fn lift_off_tilt(coin: &Coin, theta0: f64) -> Option<f64> {
     let (qa, qb, qc) = (1.5 * k, -k * c0, p.gravity() / p.radius() - 0.5 * k);
     let discriminant = qb * qb - 4.0 * qa * qc;
     (discriminant >= 0.0).then(|| ((-qb + discriminant.sqrt()) / (2.0 * qa)).acos())
+}
+
+/// Time for a coin released at rest at lean θ₀ to reach lean θ₁ > θ₀: the quadrature's flat-landing time
+/// with the flat margin at θ₁ (the landing time does not stop at a lift-off on the way).
+fn release_time(coin: &Coin, theta0: f64, theta1: f64) -> f64 {
+    let chaplygin = Chaplygin::new(coin.params()).unwrap();
+    let at_rest = State {
+        theta: theta0,
+        ..State::default()
+    };
+    let orbit = Orbit::new(coin, &chaplygin, &at_rest, FRAC_PI_2 - theta1).unwrap();
+    let Motion::FlatLanding { time, .. } = orbit.motion else {
+        panic!("released at {theta0}: {:?}", orbit.motion);
+    };
+    time
+}
+
+/// K = Mga/(I_X + Ma²) of the unit thin disk: 1/(1/4 + 1).
+const UNIT_DISK_K: f64 = 0.8;
+
+#[test]
+fn the_release_time_agrees_with_the_closed_form_near_the_release_point() {
+    // For small θ − θ₀ the motion is θ ≈ θ₀ + (K sin θ₀/2) t², so t ≈ √(2(θ − θ₀)/(K sin θ₀)).
+    let coin = Coin::new(CoinParams::unit_disk());
+    let (theta0, dtheta) = (0.6, 1e-8);
+    let expected = (2.0 * dtheta / (UNIT_DISK_K * f64::sin(theta0))).sqrt();
+    let measured = release_time(&coin, theta0, theta0 + dtheta);
+    println!("quadrature {measured:.15e} vs small-angle closed form {expected:.15e}");
+    assert!((measured / expected - 1.0).abs() < 1e-7);
+}
+
+/// The same integral by another rule and another form of the integrand: composite Simpson on
+/// t = ∫₀^√(θ₁−θ₀) 2v dv / √(2K(cos θ₀ − cos(θ₀ + v²))), whose value at v = 0 is its limit
+/// 2/√(2K sin θ₀).
+fn simpson_release_time(theta0: f64, theta1: f64, intervals: u32) -> f64 {
+    let k = UNIT_DISK_K;
+    let integrand = |v: f64| {
+        if v == 0.0 {
+            2.0 / (2.0 * k * theta0.sin()).sqrt()
+        } else {
+            2.0 * v / (2.0 * k * (theta0.cos() - (theta0 + v * v).cos())).sqrt()
+        }
+    };
+    let width = (theta1 - theta0).sqrt() / f64::from(intervals);
+    let mut sum = integrand(0.0) + integrand(width * f64::from(intervals));
+    for j in 1..intervals {
+        let weight = if j % 2 == 1 { 4.0 } else { 2.0 };
+        sum += weight * integrand(width * f64::from(j));
+    }
+    sum * width / 3.0
+}
+
+#[test]
+fn the_release_time_agrees_with_simpsons_rule_on_the_direct_integrand() {
+    let coin = Coin::new(CoinParams::unit_disk());
+    for (theta0, theta1) in [(0.6, FRAC_PI_2 - 1e-4), (0.2, 1.07), (1.0, 1.3)] {
+        let measured = release_time(&coin, theta0, theta1);
+        let expected = simpson_release_time(theta0, theta1, 20_000);
+        let relative = (measured / expected - 1.0).abs();
+        println!(
+            "θ₀ = {theta0}, θ₁ = {theta1}: quadrature {measured:.15} vs Simpson {expected:.15}, relative difference {relative:.1e} (tolerance 1e-10)"
+        );
+        assert!(relative < 1e-10);
+    }
 }
 
 struct Ended {

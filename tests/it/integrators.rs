@@ -2,13 +2,13 @@
 //! of convergence, energy conservation on the wobbling coin, bounded energy error of the symmetric
 //! method (with rk4 as the drifting control), dense output and behaviour at a finite-time blow-up.
 
+use crate::support::physics::wobble;
 use crate::support::vectors::max_diff;
 use coin_log::integrate::{
     run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Stats, StepError,
     Termination,
 };
 use coin_log::model::{energy, Coin, CoinParams, State, STATE_LEN};
-use coin_log_bench::stability::wobble_state;
 
 const EPS: f64 = f64::EPSILON;
 
@@ -283,7 +283,7 @@ fn every_method_shows_its_order_on_the_kepler_problem() {
 /// The wobbling unit thin disk of the issue: θ₀ = 0.5, ω = (0.3, 0.2, 1.5).
 fn wobbling_coin() -> (Coin, [f64; STATE_LEN]) {
     let coin = Coin::new(CoinParams::unit_disk());
-    (coin, wobble_state().to_array())
+    (coin, wobble().to_array())
 }
 
 /// Samples of a run on a grid of `SAMPLES` points.

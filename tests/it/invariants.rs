@@ -7,10 +7,10 @@
 //! only τ ≈ 8.8. Classical RK4 at h ≈ 2.5e-4 with compensated (Kahan) accumulation, run again at h/2 and
 //! Richardson-extrapolated; the difference between the two runs is printed as the reference's own error.
 
+use crate::support::physics::wobble;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
 use coin_log::model::{energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
 use coin_log::simulation::{simulate, CoinEvents};
-use coin_log_bench::stability::wobble_state;
 
 use std::f64::consts::FRAC_PI_6;
 
@@ -344,7 +344,7 @@ const RK4_DRIFT_TOLERANCE: f64 = 1e-11;
 fn c1_and_c2_stay_constant_along_rk4_trajectories() {
     for (name, p) in cases() {
         let ch = Chaplygin::new(&p).unwrap();
-        for (motion, initial) in [("wobble", wobble_state()), ("deep lean", deep_lean())] {
+        for (motion, initial) in [("wobble", wobble()), ("deep lean", deep_lean())] {
             let (drift, termination, t_last) =
                 drift_along(&p, &initial, 20.0, |y| ch.evaluate(y[0], y[4], y[5]));
             println!(
@@ -367,7 +367,7 @@ fn a_mixed_up_or_wrong_mu_formula_drifts_visibly() {
         assert!(drift > 1e-3, "{name} did not drift: {drift:.2e}");
     };
     // y_e in the ω_Z term, y_o in the ω_Y term.
-    let (drift, ..) = drift_along(&disk, &wobble_state(), 20.0, |y| {
+    let (drift, ..) = drift_along(&disk, &wobble(), 20.0, |y| {
         let b = ch.basis(y[0]);
         let cos = y[0].cos();
         let c1 = cos * cos * b.dy_even * y[5] - cos * b.y_odd * y[4] / k;
@@ -375,12 +375,10 @@ fn a_mixed_up_or_wrong_mu_formula_drifts_visibly() {
     });
     control("C1 with y_e′ in place of y_o′", drift);
     // The hoop's μ = 1 basis on a disk's motion.
-    let (drift, ..) = drift_along(&disk, &wobble_state(), 20.0, |y| {
-        hoop.evaluate(y[0], y[4], y[5])
-    });
+    let (drift, ..) = drift_along(&disk, &wobble(), 20.0, |y| hoop.evaluate(y[0], y[4], y[5]));
     control("disk motion, hoop's μ", drift);
     // Swapping y_e and y_o *everywhere* in C1 gives −C2, which is conserved: not a negative control.
-    let (drift, ..) = drift_along(&disk, &wobble_state(), 20.0, |y| {
+    let (drift, ..) = drift_along(&disk, &wobble(), 20.0, |y| {
         let b = ch.basis(y[0]);
         let cos = y[0].cos();
         let c1 = cos * cos * b.dy_even * y[5] - cos * b.y_even * y[4] / k;
@@ -538,25 +536,25 @@ fn energy_c1_and_c2_drift_below_1e_11_over_100_time_units_with_dop853_at_rtol_1e
         (
             "thin disk",
             params(Inertia::ThinDisk),
-            wobble_state(),
+            wobble(),
             DOP853_DRIFT_TOLERANCE,
         ),
         (
             "hoop",
             params(Inertia::Hoop),
-            wobble_state(),
+            wobble(),
             DOP853_DRIFT_TOLERANCE,
         ),
         (
             "μ = 0.1",
             params_with_mu(0.1),
-            wobble_state(),
+            wobble(),
             DOP853_DRIFT_TOLERANCE,
         ),
         (
             "μ = 2.7",
             params_with_mu(2.7),
-            wobble_state(),
+            wobble(),
             DOP853_DRIFT_TOLERANCE,
         ),
         (

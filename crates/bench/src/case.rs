@@ -1,7 +1,8 @@
 //! What a benchmark runs (a coin, an initial state, a duration), how a run is sampled, the references it
-//! is judged against, and the error measures shared by the precision and stability benches.
+//! is judged against, and the error measures and the median shared by the benches.
 
 use super::BenchError;
+use coin_log::analyse::steady_path::steady_state_at;
 use coin_log::integrate::{Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination};
 use coin_log::model::drift::{EnergyDrift, InvariantDrift};
 use coin_log::model::invariants::Chaplygin;
@@ -44,6 +45,22 @@ pub struct BenchCase {
 }
 
 impl BenchCase {
+    /// A case of the conservative `coin` from `initial` for `duration`: no steady reference, no friction
+    /// limit, the default flat margin.
+    #[must_use]
+    pub fn conservative(name: &str, coin: Coin, initial: State, duration: f64) -> Self {
+        Self {
+            name: name.to_string(),
+            coin,
+            initial,
+            steady: None,
+            duration,
+            flat_margin: DEFAULT_FLAT_MARGIN,
+            friction: None,
+            dissipation: None,
+        }
+    }
+
     /// The natural time unit √(a/g) \[time\].
     #[must_use]
     pub fn time_unit(&self) -> f64 {
@@ -226,46 +243,12 @@ impl Reference {
     #[must_use]
     pub fn state_at(&self, coin: &Coin, index: usize, t: f64) -> Option<[f64; STATE_LEN]> {
         match self {
-            Self::Analytic { steady, start } => Some(analytic_steady_state(coin, steady, start, t)),
+            Self::Analytic { steady, start } => {
+                Some(steady_state_at(coin, steady, start, t).to_array())
+            }
             Self::Numerical { trajectory, .. } => trajectory.states.get(index).copied(),
         }
     }
-}
-
-/// The state at time `t` of a steady motion started from `start` (physics §4): θ and ω constant,
-/// φ = φ₀ + φ̇t, ψ = ψ₀ + ψ̇t, the centre on its circle about C = p₀ + r(sin φ₀, cos φ₀), r = aω_Z/φ̇:
-/// x = C_x − r sin φ, z = C_z − r cos φ (from ẋ = −aω_Z cos φ, ż = aω_Z sin φ at ω_X = 0); a straight
-/// line x = x₀ − aω_Z cos φ₀ t, z = z₀ + aω_Z sin φ₀ t when φ̇ = 0.
-#[must_use]
-pub fn analytic_steady_state(coin: &Coin, steady: &Steady, start: &State, t: f64) -> [f64; 8] {
-    let a = coin.params().radius();
-    let phi = start.phi + steady.phi_dot * t;
-    let psi = start.psi + steady.psi_dot * t;
-    let (x, z) = if steady.phi_dot == 0.0 {
-        let (s0, c0) = start.phi.sin_cos();
-        (
-            start.x - a * start.omega_z * c0 * t,
-            start.z + a * start.omega_z * s0 * t,
-        )
-    } else {
-        // x − x₀ = −r(sin φ − sin φ₀) = −2r cos(φ̄) sin(φ̇t/2), z − z₀ = 2r sin(φ̄) sin(φ̇t/2), φ̄ the mean
-        // angle: no cancellation for small t.
-        let r = a * start.omega_z / steady.phi_dot;
-        let half = 0.5 * steady.phi_dot * t;
-        let mean = start.phi + half;
-        let chord = 2.0 * r * half.sin();
-        (start.x - chord * mean.cos(), start.z + chord * mean.sin())
-    };
-    [
-        start.theta,
-        phi,
-        psi,
-        start.omega_x,
-        start.omega_y,
-        start.omega_z,
-        x,
-        z,
-    ]
 }
 
 /// The reference of a case: analytic when the case is an unperturbed steady motion, otherwise dop853 at
@@ -315,13 +298,19 @@ pub fn reference_trajectory_with(
     Ok(Reference::Numerical { config, trajectory })
 }
 
-/// The dimensionless difference of two states: the largest of |Δθ|, |Δφ|, |Δψ|, |Δω_i|·T (T = √(a/g)),
-/// |Δx|/a, |Δz|/a.
+/// The factors that make a state dimensionless: angles as they are, ω·T (T = √(a/g)), x/a, z/a.
 #[must_use]
-pub fn state_difference(coin: &Coin, y: &[f64; STATE_LEN], r: &[f64; STATE_LEN]) -> f64 {
+pub fn natural_scales(coin: &Coin) -> [f64; STATE_LEN] {
     let p = coin.params();
     let (t_unit, a) = (p.time_unit(), p.radius());
-    let scale = [1.0, 1.0, 1.0, t_unit, t_unit, t_unit, 1.0 / a, 1.0 / a];
+    [1.0, 1.0, 1.0, t_unit, t_unit, t_unit, 1.0 / a, 1.0 / a]
+}
+
+/// The dimensionless difference of two states: the largest of |Δθ|, |Δφ|, |Δψ|, |Δω_i|·T (T = √(a/g)),
+/// |Δx|/a, |Δz|/a ([`natural_scales`]).
+#[must_use]
+pub fn state_difference(coin: &Coin, y: &[f64; STATE_LEN], r: &[f64; STATE_LEN]) -> f64 {
+    let scale = natural_scales(coin);
     let mut worst = 0.0_f64;
     for i in 0..STATE_LEN {
         let d = (y[i] - r[i]).abs() * scale[i];
@@ -398,4 +387,32 @@ pub fn invariant_drift(coin: &Coin, states: &[[f64; STATE_LEN]]) -> Option<f64> 
         drift.observe(0.0, c.c1, c.c2);
     }
     Some(drift.value())
+}
+
+/// The median of `values` (the mean of the middle two for an even count); NaN when empty.
+#[must_use]
+pub fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn medians_of_odd_and_even_counts() {
+        assert!((median(&[3.0, 1.0, 2.0]) - 2.0).abs() < 1e-15);
+        assert!((median(&[4.0, 1.0, 2.0, 3.0]) - 2.5).abs() < 1e-15);
+        assert!(median(&[]).is_nan());
+    }
 }

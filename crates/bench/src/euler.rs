@@ -15,18 +15,21 @@
 //! ε = [`EulerOptions::epsilon`] (for p < 1/2, where ε grows as α falls), or to 1.5 times the smallest α
 //! the run reached. Samples are thinned to be evenly spaced in ln α.
 //!
-//! **t₀.** Fitted: for each trial t₀, n and ln A follow by linear least squares in (ln |t₀ − t|, ln α);
-//! t₀ minimises the residual, on a geometric scan of |t₀ − t_window end| refined by golden section. Both
-//! sides are tried: t₀ after the window (a finite-time singularity, n > 0) and before it (a power-law
-//! decay, n < 0); the better fit wins. Extrapolating t₀ from the run's end instead would bias n, since the
-//! event comes a finite time before t₀.
+//! **t₀.** Fitted with n and A ([`power_law`]), on both sides of the window: after it (a finite-time
+//! singularity, n > 0) and before it (a power-law decay, n < 0). Extrapolating t₀ from the run's end
+//! instead would bias n, since the event comes a finite time before t₀.
+//!
+//! The slow-change laws themselves are the library's ([`coin_log::analyse::slow_change`]).
 
 use super::case::{run_sampled_with, Trajectory};
 use super::{BenchCase, BenchError};
+use coin_log::analyse::slow_change::{
+    alpha_of, breakdown_alpha, coefficient_for, slow_change_time_scale,
+};
 use coin_log::integrate::RunSettings;
-use coin_log::model::{centre_fixed_sigma_squared, Coin, Dissipation, DissipationModel, State};
-use coin_log::scene::{defaults, presets, Scene};
-use std::f64::consts::FRAC_PI_2;
+use coin_log::model::fit::{power_law, PowerLaw};
+use coin_log::model::{Dissipation, DissipationModel, State};
+use coin_log::scene::{presets, Scene};
 use std::time::Instant;
 
 /// The scene whose body, start, μ and Moffatt coefficient the bench uses.
@@ -39,10 +42,6 @@ const END_MARGIN: f64 = 1.5;
 const WINDOW_POINTS: usize = 400;
 /// Samples per run (the window's end needs a fine grid in time).
 const SAMPLES: f64 = 2e5;
-/// Geometric scan of |t₀ − t_end of window| for the fit, in units of the window's span.
-const SCAN: (f64, f64, usize) = (1e-7, 1e4, 221);
-/// Golden-section refinement steps of the t₀ fit.
-const REFINE_STEPS: usize = 100;
 
 /// How the bench runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,50 +72,17 @@ impl EulerOptions {
     }
 }
 
-/// The fitted law α = A |t₀ − t|^n.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PowerLawFit {
-    /// n.
-    pub exponent: f64,
-    /// A.
-    pub amplitude: f64,
-    /// t₀.
-    pub t0: f64,
-    /// True when t₀ lies after the window (a finite-time singularity), false before it (a decay).
-    pub singular: bool,
-    /// Root-mean-square residual of ln α.
-    pub rms: f64,
-}
-
-impl PowerLawFit {
-    /// α of the fitted law at time t.
-    #[must_use]
-    pub fn alpha(&self, t: f64) -> f64 {
-        self.amplitude * (self.t0 - t).abs().powf(self.exponent)
-    }
-}
-
-/// What ends the fit window at small α.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum WindowLimit {
-    /// ε = |α̇|/(α σ) reached [`EulerOptions::epsilon`]: the slow-change approximation starts to fail.
-    SlowChange,
-    /// ω_Z²/|ω|² reached [`EulerOptions::spin_share`]: the motion has drifted off the centre-fixed family
-    /// on which the prediction is made (the spin ω_Z picked up on the way takes a share of P).
-    SpinShare,
-    /// 1.5 times the smallest α of the run.
-    RunEnd,
-}
-
-impl WindowLimit {
-    /// A short name for tables.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::SlowChange => "slow-change",
-            Self::SpinShare => "spin-share",
-            Self::RunEnd => "run-end",
-        }
+coin_log_names::named_enum! {
+    /// What ends the fit window at small α; its name is the one in the table and the CSV.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum WindowLimit: "window limit" {
+        /// ε = |α̇|/(α σ) reached [`EulerOptions::epsilon`]: the slow-change approximation starts to fail.
+        SlowChange = "slow-change",
+        /// ω_Z²/|ω|² reached [`EulerOptions::spin_share`]: the motion has drifted off the centre-fixed
+        /// family on which the prediction is made (the spin ω_Z picked up on the way takes a share of P).
+        SpinShare = "spin-share",
+        /// 1.5 times the smallest α of the run.
+        RunEnd = "run-end",
     }
 }
 
@@ -130,7 +96,7 @@ pub struct EulerRow {
     /// 1/(1 − p).
     pub predicted: f64,
     /// The fit; `None` when the window holds fewer than 10 points.
-    pub fit: Option<PowerLawFit>,
+    pub fit: Option<PowerLaw>,
     /// The window: α from `alpha_window.0` to `alpha_window.1`.
     pub alpha_window: (f64, f64),
     /// What set the window's lower end.
@@ -195,82 +161,6 @@ impl EulerSetting {
     pub fn alpha0(&self) -> f64 {
         alpha_of(&self.scene.initial)
     }
-}
-
-/// α = π/2 − |θ|.
-#[must_use]
-pub fn alpha_of(s: &State) -> f64 {
-    FRAC_PI_2 - s.theta.abs()
-}
-
-/// C of the slow-change law d(sin α)/dt = −C sin^p α on the centre-fixed family (eqs (35)–(37)):
-/// E = (3/2) Mga sin α and P = κ (Mga/I_X)^(m/2) sin^p α, so C = κ (Mga/I_X)^(m/2) / ((3/2) Mga).
-#[must_use]
-pub fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
-    let p = coin.params();
-    let mga = p.mass() * p.gravity() * p.radius();
-    law.coefficient() * (mga / p.inertia_x()).powf(0.5 * law.m()) / (1.5 * mga)
-}
-
-/// T = sin^(1−p) α₀ / (|1 − p| C): the collapse time t₀ for p < 1, the decay time of α₀(1 + t/T)^(1/(1−p))
-/// for p > 1 (eq (37)).
-#[must_use]
-pub fn slow_change_time_scale(coin: &Coin, law: &Dissipation, alpha0: f64) -> f64 {
-    let q = 1.0 - law.angle_exponent();
-    alpha0.sin().powf(q) / (q.abs() * slow_change_rate(coin, law))
-}
-
-/// The κ that gives `model` the time scale `time_scale` from `alpha0` (inverse of
-/// [`slow_change_time_scale`]).
-///
-/// # Errors
-/// [`BenchError::InvalidScene`] for `power-law` (no fixed exponents) or a κ that does not validate.
-pub fn coefficient_for(
-    coin: &Coin,
-    model: DissipationModel,
-    alpha0: f64,
-    time_scale: f64,
-) -> Result<Dissipation, BenchError> {
-    let invalid = |reason: String| BenchError::InvalidScene {
-        scene: SCENE.into(),
-        reason,
-    };
-    let unit = Dissipation::preset(model, 1.0).map_err(|e| invalid(e.to_string()))?;
-    let kappa = slow_change_time_scale(coin, &unit, alpha0) / time_scale;
-    Dissipation::preset(model, kappa).map_err(|e| invalid(e.to_string()))
-}
-
-/// ε(α) = |α̇| / (α σ): the slow-change rate α̇ = −C sin^p α / cos α against the nutation frequency σ of the
-/// centre-fixed motion at α (physics §5). The slow-change approximation needs ε ≪ 1.
-#[must_use]
-pub fn slow_change_ratio(coin: &Coin, law: &Dissipation, alpha: f64) -> f64 {
-    let rate = slow_change_rate(coin, law) * alpha.sin().powf(law.angle_exponent()) / alpha.cos();
-    let sigma = centre_fixed_sigma_squared(coin, FRAC_PI_2 - alpha).sqrt();
-    rate / (alpha * sigma)
-}
-
-/// The α below which ε exceeds `epsilon` (bisection in ln α between the flat margin and `alpha0`); 0 when
-/// ε stays below `epsilon` all the way (p ≥ 1/2, where the slow-change approximation improves as α falls).
-#[must_use]
-pub fn breakdown_alpha(coin: &Coin, law: &Dissipation, alpha0: f64, epsilon: f64) -> f64 {
-    let ratio = |a: f64| slow_change_ratio(coin, law, a);
-    let mut lo = defaults::FLAT_MARGIN;
-    let mut hi = alpha0;
-    if ratio(lo) <= epsilon {
-        return 0.0;
-    }
-    if ratio(hi) >= epsilon {
-        return hi;
-    }
-    for _ in 0..200 {
-        let mid = (lo * hi).sqrt();
-        if ratio(mid) > epsilon {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
 }
 
 /// The friction coefficient at which the bench reports where rolling without slipping breaks down first.
@@ -390,7 +280,12 @@ pub fn run_model(
 ) -> Result<EulerRow, BenchError> {
     let coin = setting.scene.coin();
     let alpha0 = setting.alpha0();
-    let law = coefficient_for(&coin, model, alpha0, setting.time_scale)?;
+    let law = coefficient_for(&coin, model, alpha0, setting.time_scale).map_err(|e| {
+        BenchError::InvalidScene {
+            scene: SCENE.into(),
+            reason: e.to_string(),
+        }
+    })?;
     let p = law.angle_exponent();
     let factor = if p < 1.0 { 2.0 } else { options.decay_duration };
     let duration = setting.time_scale * factor;
@@ -420,9 +315,7 @@ pub fn run_model(
         .max_by(|a, b| a.0.total_cmp(&b.0))
         .unwrap_or((0.0, WindowLimit::RunEnd));
     let window = thin(&series, options.top, bottom);
-    let fit = (window.len() >= 10)
-        .then(|| fit_power_law(&window))
-        .flatten();
+    let fit = (window.len() >= 10).then(|| power_law(&window)).flatten();
     Ok(EulerRow {
         dissipation: law,
         p,
@@ -474,82 +367,6 @@ pub fn thin(series: &[(f64, f64)], top: f64, bottom: f64) -> Vec<(f64, f64)> {
     kept
 }
 
-/// Least squares of ln α = ln A + n ln |t₀ − t| for a fixed t₀: (n, ln A, sum of squared residuals).
-fn linear_fit(points: &[(f64, f64)], t0: f64) -> Option<(f64, f64, f64)> {
-    #[allow(clippy::cast_precision_loss)]
-    let count = points.len() as f64;
-    let xy: Vec<(f64, f64)> = points
-        .iter()
-        .map(|(t, a)| ((t0 - t).abs().ln(), a.ln()))
-        .collect();
-    let mx = xy.iter().map(|p| p.0).sum::<f64>() / count;
-    let my = xy.iter().map(|p| p.1).sum::<f64>() / count;
-    let sxx: f64 = xy.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
-    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    if sxx.is_nan() || sxx <= 0.0 {
-        return None;
-    }
-    let n = sxy / sxx;
-    let b = my - n * mx;
-    let rss: f64 = xy.iter().map(|p| (p.1 - b - n * p.0).powi(2)).sum();
-    rss.is_finite().then_some((n, b, rss))
-}
-
-/// The best fit with t₀ on one side of the window: t₀ = anchor + side·d, d scanned geometrically over
-/// [`SCAN`] (in units of the window's span) and refined by golden section in ln d around the best.
-fn fit_side(points: &[(f64, f64)], anchor: f64, side: f64, span: f64) -> Option<PowerLawFit> {
-    let rss_at =
-        |ln_d: f64| linear_fit(points, anchor + side * ln_d.exp()).map_or(f64::INFINITY, |f| f.2);
-    let (lo, hi, steps) = SCAN;
-    let (ln_lo, ln_hi) = ((lo * span).ln(), (hi * span).ln());
-    #[allow(clippy::cast_precision_loss)]
-    let grid: Vec<f64> = (0..steps)
-        .map(|i| ln_lo + (ln_hi - ln_lo) * i as f64 / (steps - 1) as f64)
-        .collect();
-    let best = (0..steps).min_by(|&i, &j| rss_at(grid[i]).total_cmp(&rss_at(grid[j])))?;
-    let (mut a, mut b) = (
-        grid[best.saturating_sub(1)],
-        grid[(best + 1).min(steps - 1)],
-    );
-    let golden = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..REFINE_STEPS {
-        let (x1, x2) = (b - golden * (b - a), a + golden * (b - a));
-        if rss_at(x1) < rss_at(x2) {
-            b = x2;
-        } else {
-            a = x1;
-        }
-    }
-    let t0 = anchor + side * (0.5 * (a + b)).exp();
-    let (n, ln_a, rss) = linear_fit(points, t0)?;
-    #[allow(clippy::cast_precision_loss)]
-    let rms = (rss / points.len() as f64).sqrt();
-    Some(PowerLawFit {
-        exponent: n,
-        amplitude: ln_a.exp(),
-        t0,
-        singular: side > 0.0,
-        rms,
-    })
-}
-
-/// The 3-parameter fit α = A |t₀ − t|^n to (t, α) points in time order (module doc): t₀ after the last
-/// point (finite-time singularity) or before the first (decay), whichever fits better.
-#[must_use]
-pub fn fit_power_law(points: &[(f64, f64)]) -> Option<PowerLawFit> {
-    let (first, last) = (points.first()?.0, points.last()?.0);
-    let span = last - first;
-    if span.is_nan() || span <= 0.0 {
-        return None;
-    }
-    let after = fit_side(points, last, 1.0, span);
-    let before = fit_side(points, first, -1.0, span);
-    match (after, before) {
-        (Some(a), Some(b)) => Some(if a.rms <= b.rms { a } else { b }),
-        (a, b) => a.or(b),
-    }
-}
-
 /// Every preset of `options`, in order.
 ///
 /// # Errors
@@ -566,29 +383,6 @@ pub fn euler_bench(options: &EulerOptions) -> Result<Vec<EulerRow>, BenchError> 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn an_exact_power_law_is_fitted_with_its_t0_on_either_side() {
-        let law = |t0: f64, n: f64| -> Vec<(f64, f64)> {
-            (0..300)
-                .map(|i| {
-                    let t = f64::from(i) * 0.3;
-                    (t, 0.7 * (t0 - t).abs().powf(n))
-                })
-                .collect()
-        };
-        let fit = fit_power_law(&law(100.0, 1.0 / 3.0)).unwrap();
-        assert!(
-            fit.singular && (fit.exponent - 1.0 / 3.0).abs() < 1e-6,
-            "{fit:?}"
-        );
-        assert!((fit.t0 - 100.0).abs() < 1e-3, "{fit:?}");
-        let fit = fit_power_law(&law(-40.0, -2.0)).unwrap();
-        assert!(
-            !fit.singular && (fit.exponent + 2.0).abs() < 1e-6,
-            "{fit:?}"
-        );
-    }
 
     #[test]
     fn thinning_keeps_evenly_spaced_logs() {

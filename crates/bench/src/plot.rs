@@ -4,6 +4,7 @@
 use super::euler::EulerRow;
 use super::precision::PrecisionReport;
 use super::BenchError;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Line colours, one per integrator in order.
@@ -18,28 +19,32 @@ const PALETTE: [RGBColor; 6] = [
 /// Size of the diagram \[px\].
 const SIZE: (u32, u32) = (800, 560);
 
-/// The work-precision diagram of one scene: log10 state error against log10 wall time, one line per
-/// integrator, its measured slope in the legend. Returns the SVG document.
-///
-/// # Errors
-/// [`BenchError::Plot`] if drawing fails (it does not for finite data).
-pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError> {
-    let fail = |e: &dyn std::fmt::Display| BenchError::Plot {
-        scene: report.scene.clone(),
+/// A diagram's axes, as the series are drawn on them.
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+/// What drawing on the SVG backend can fail with.
+type DrawError = DrawingAreaErrorKind<std::io::Error>;
+
+/// The frame both diagrams share: a white page of [`SIZE`] with `caption` (text, font size), the axes
+/// over `(x0, x1, y0, y1)` labelled `(x, y)`, the series `draw` puts on them, and their legend at
+/// `legend`. Returns the SVG document; a drawing error is reported as [`BenchError::Plot`] of `scene`.
+fn diagram(
+    scene: &str,
+    caption: (&str, u32),
+    (x_desc, y_desc): (&str, &str),
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    legend: SeriesLabelPosition,
+    draw: impl FnOnce(&mut Chart<'_, '_>) -> Result<(), DrawError>,
+) -> Result<String, BenchError> {
+    let fail = |e: &DrawError| BenchError::Plot {
+        scene: scene.to_string(),
         reason: e.to_string(),
     };
-    let series = series(report);
-    let (x0, x1, y0, y1) = bounds(&series);
-
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(&e))?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!("{}: work-precision ({})", report.scene, report.reference),
-                ("sans-serif", 18),
-            )
+            .caption(caption.0, ("sans-serif", caption.1))
             .margin(16)
             .x_label_area_size(44)
             .y_label_area_size(56)
@@ -47,29 +52,14 @@ pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError
             .map_err(|e| fail(&e))?;
         chart
             .configure_mesh()
-            .x_desc("log10 wall time [s]")
-            .y_desc("log10 state error")
+            .x_desc(x_desc)
+            .y_desc(y_desc)
             .draw()
             .map_err(|e| fail(&e))?;
-        for (i, (label, points)) in series.iter().enumerate() {
-            let colour = PALETTE[i % PALETTE.len()];
-            chart
-                .draw_series(LineSeries::new(
-                    points.iter().copied(),
-                    colour.stroke_width(2),
-                ))
-                .map_err(|e| fail(&e))?
-                .label(label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                .map_err(|e| fail(&e))?;
-        }
+        draw(&mut chart).map_err(|e| fail(&e))?;
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(legend)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -77,6 +67,41 @@ pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError
         root.present().map_err(|e| fail(&e))?;
     }
     Ok(svg)
+}
+
+/// The work-precision diagram of one scene: log10 state error against log10 wall time, one line per
+/// integrator, its measured slope in the legend. Returns the SVG document.
+///
+/// # Errors
+/// [`BenchError::Plot`] if drawing fails (it does not for finite data).
+pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError> {
+    let series = series(report);
+    diagram(
+        &report.scene,
+        (
+            &format!("{}: work-precision ({})", report.scene, report.reference),
+            18,
+        ),
+        ("log10 wall time [s]", "log10 state error"),
+        bounds(&series),
+        SeriesLabelPosition::UpperRight,
+        |chart| {
+            for (i, (label, points)) in series.iter().enumerate() {
+                let colour = PALETTE[i % PALETTE.len()];
+                chart
+                    .draw_series(LineSeries::new(
+                        points.iter().copied(),
+                        colour.stroke_width(2),
+                    ))?
+                    .label(label.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                    });
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+            }
+            Ok(())
+        },
+    )
 }
 
 /// One (label, points) series per integrator: (log10 wall time, log10 state error), sorted by time; the
@@ -136,62 +161,37 @@ const FIT_LINE_POINTS: usize = 50;
 /// # Errors
 /// [`BenchError::Plot`] if drawing fails (it does not for finite data).
 pub fn euler_svg(rows: &[EulerRow]) -> Result<String, BenchError> {
-    let fail = |e: &dyn std::fmt::Display| BenchError::Plot {
-        scene: "euler".into(),
-        reason: e.to_string(),
-    };
     let curves = euler_curves(rows);
     let all: Vec<(String, Vec<(f64, f64)>)> = curves
         .iter()
         .flat_map(|(label, run, fit)| [(label.clone(), run.clone()), (label.clone(), fit.clone())])
         .collect();
-    let (x0, x1, y0, y1) = bounds(&all);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "Euler's disk: α = A |t0 − t|^n, fitted on the window (thick) of each run (thin)",
-                ("sans-serif", 16),
-            )
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(56)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("log10 |t0 − t| [s]")
-            .y_desc("log10 α [rad]")
-            .draw()
-            .map_err(|e| fail(&e))?;
-        for (i, (label, run, fit)) in curves.iter().enumerate() {
-            let colour = PALETTE[i % PALETTE.len()];
-            chart
-                .draw_series(LineSeries::new(
+    diagram(
+        "euler",
+        (
+            "Euler's disk: α = A |t0 − t|^n, fitted on the window (thick) of each run (thin)",
+            16,
+        ),
+        ("log10 |t0 − t| [s]", "log10 α [rad]"),
+        bounds(&all),
+        SeriesLabelPosition::LowerRight,
+        |chart| {
+            for (i, (label, run, fit)) in curves.iter().enumerate() {
+                let colour = PALETTE[i % PALETTE.len()];
+                chart.draw_series(LineSeries::new(
                     run.iter().copied(),
                     colour.mix(0.5).stroke_width(1),
-                ))
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(LineSeries::new(fit.iter().copied(), colour.stroke_width(4)))
-                .map_err(|e| fail(&e))?
-                .label(label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(4))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))?;
-    }
-    Ok(svg)
+                ))?;
+                chart
+                    .draw_series(LineSeries::new(fit.iter().copied(), colour.stroke_width(4)))?
+                    .label(label.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(4))
+                    });
+            }
+            Ok(())
+        },
+    )
 }
 
 /// One law in the Euler's disk diagram: its label, the run's (log10 |t₀ − t|, log10 α) and the fitted

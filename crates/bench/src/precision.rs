@@ -7,9 +7,11 @@
 
 use super::case::{run_sampled, termination_name, Reference, ReferenceKind, Trajectory};
 use super::{
-    balance_drift, invariant_drift, reference_trajectory, state_error, BenchCase, BenchError,
+    balance_drift, invariant_drift, median, reference_trajectory, state_error, BenchCase,
+    BenchError,
 };
 use coin_log::integrate::{Method, MethodConfig};
+use coin_log::model::fit::log_log_slope;
 use std::time::Instant;
 
 /// The adaptive sweep's rtol is 1e3·atol ...
@@ -152,29 +154,6 @@ pub fn round_to_grid(step: f64, interval: f64) -> f64 {
     }
 }
 
-/// Least-squares slope of log10(y) against log10(x); `None` with fewer than two points or no spread.
-#[must_use]
-#[allow(clippy::cast_precision_loss)]
-pub fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
-    let logs: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
-        .map(|(x, y)| (x.log10(), y.log10()))
-        .collect();
-    if logs.len() < 2 {
-        return None;
-    }
-    let n = logs.len() as f64;
-    let mx = logs.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = logs.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = logs.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
-    let sxy: f64 = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    if sxx <= 0.0 {
-        return None;
-    }
-    Some(sxy / sxx)
-}
-
 /// Slopes of one integrator's rows, fitted on the points whose error is inside [`SLOPE_FIT_RANGE`] (all
 /// finite points if fewer than three are inside).
 #[must_use]
@@ -200,8 +179,8 @@ pub fn slopes_of(integrator: Method, rows: &[PrecisionRow]) -> Slope {
         .collect();
     Slope {
         integrator,
-        time: fit_slope(&time),
-        work: fit_slope(&work),
+        time: log_log_slope(&time),
+        work: log_log_slope(&work),
         points: used.len(),
     }
 }
@@ -215,20 +194,14 @@ fn timed_runs(
     out: &mut Trajectory,
 ) -> f64 {
     run_sampled(config, case, out);
-    let mut times: Vec<f64> = (0..repeats.max(1))
+    let times: Vec<f64> = (0..repeats.max(1))
         .map(|_| {
             let start = Instant::now();
             run_sampled(config, case, out);
             start.elapsed().as_secs_f64()
         })
         .collect();
-    times.sort_by(f64::total_cmp);
-    let mid = times.len() / 2;
-    if times.len() % 2 == 1 {
-        times[mid]
-    } else {
-        0.5 * (times[mid - 1] + times[mid])
-    }
+    median(&times)
 }
 
 /// Measures one sweep point.
@@ -369,6 +342,44 @@ pub fn precision_bench(
     })
 }
 
+/// The loosest adaptive setting of `method` among `atols` (loosest first; rtol = min(1e3·atol, 1e-3)) whose
+/// state error on `case` against its reference is at most `error`, with that error: the setting at which
+/// the criterion benchmarks time an integrator.
+///
+/// # Errors
+/// [`BenchError::ReferenceFailed`] when the reference cannot be computed; [`BenchError::Inaccurate`] when
+/// no setting reaches `error`.
+pub fn loosest_accurate(
+    case: &BenchCase,
+    method: Method,
+    atols: &[f64],
+    error: f64,
+) -> Result<(MethodConfig, f64), BenchError> {
+    let reference = reference_trajectory(case)?;
+    let mut run = Trajectory::default();
+    let mut best = f64::INFINITY;
+    for &atol in atols {
+        let config = MethodConfig {
+            method,
+            rtol: rtol_for(atol),
+            atol,
+            step: 0.0,
+        };
+        run_sampled(&config, case, &mut run);
+        let reached = state_error(case, &run, &reference);
+        best = best.min(reached);
+        if run.completed() && reached <= error {
+            return Ok((config, reached));
+        }
+    }
+    Err(BenchError::Inaccurate {
+        scene: case.name.clone(),
+        method,
+        error,
+        best,
+    })
+}
+
 #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 fn reference_samples(case: &BenchCase) -> usize {
     let n = case.duration / case.settings().sample_interval;
@@ -382,15 +393,6 @@ fn reference_samples(case: &BenchCase) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn slope_of_a_power_law_is_its_exponent() {
-        let points: Vec<(f64, f64)> = (1..6)
-            .map(|k| (f64::from(k), f64::from(k).powi(-4)))
-            .collect();
-        let s = fit_slope(&points).unwrap();
-        assert!((s + 4.0).abs() < 1e-12, "slope {s}, expected -4");
-    }
 
     #[test]
     fn steps_are_rounded_onto_the_sample_grid() {

@@ -11,20 +11,26 @@
 //!   at ω_c);
 //! - long horizon on a wobbling motion: energy drift against time;
 //! - scale invariance: M, a, g over 1e-3 … 1e3, disk and hoop, against the unit-scale run;
-//! - the predictions of `analyse` ([`super::nutation`]): kicked stable circles nutate at σ, displaced
-//!   unstable circles grow at √(−σ²), generic motions have the quadrature's period and heading advance.
 //!
-//! Horizons are options ([`SuiteOptions`]) so that the tests run the same cases shorter.
+//! The suite's rows, horizons and settings are here too; [`super::nutation`] adds the cases that prove
+//! `analyse` and [`super::suite`] runs them all. Horizons are options ([`SuiteOptions`]) so that the tests
+//! run the same cases shorter.
 
-use super::case::{reference_trajectory_with, run_sampled_with, termination_name, Trajectory};
+use super::case::{
+    natural_scales, reference_trajectory_with, run_sampled_with, termination_name, Trajectory,
+};
+use super::presets::bench_case;
 use super::{
     default_config, energy_drift, reference_trajectory, state_error, BenchCase, BenchError,
     DEFAULT_FLAT_MARGIN,
 };
+use coin_log::analyse::linear::{nutation_frequency, straight_tilt_linear};
+use coin_log::analyse::Analysis;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
+use coin_log::model::fit::log_log_slope;
+use coin_log::model::nutation::Motion;
 use coin_log::model::{
-    energy, steady_sigma_squared, straight_lambda_squared, Branch, Coin, CoinParams, Inertia,
-    State, Steady, SteadyKind, STATE_LEN,
+    energy, Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind, STATE_LEN,
 };
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::time::Instant;
@@ -42,7 +48,7 @@ const FAST_SPIN_NUDGE: f64 = 1e-3;
 /// Kick of the near-flat cases: the nutation amplitude as a fraction of the distance to the flat event.
 const NEAR_FLAT_KICK: f64 = 0.5;
 /// Relative perturbation of the spin in the marginal-stability cases.
-const MARGINAL_OFFSET: f64 = 1e-3;
+pub const MARGINAL_OFFSET: f64 = 1e-3;
 /// Initial tilt of the marginal-stability cases \[rad\]: small enough for the linear theory (relative
 /// nonlinear terms ~ δθ² ≈ 1e-7 at t = 30), large enough to be far above the integration error.
 const MARGINAL_TILT: f64 = 1e-6;
@@ -123,6 +129,27 @@ pub struct StabilityRow {
     pub expected: Option<f64>,
 }
 
+impl StabilityRow {
+    /// The row of `case` run with `config`, measuring `quantity`; the run's figures are filled in by the
+    /// caller (until then: completed at t = 0, nothing measured).
+    #[must_use]
+    pub fn new(case: &str, config: &MethodConfig, quantity: &str) -> Self {
+        Self {
+            case: case.to_string(),
+            integrator: config.method,
+            setting: describe(config),
+            termination: "completed".into(),
+            end_time: 0.0,
+            max_error: None,
+            energy_drift: 0.0,
+            wall_seconds: 0.0,
+            quantity: quantity.to_string(),
+            measured: None,
+            expected: None,
+        }
+    }
+}
+
 /// Settings of a method in the suite: tight tolerances for adaptive methods, `step` for fixed ones.
 #[must_use]
 pub fn suite_config(method: Method, step: f64) -> MethodConfig {
@@ -159,32 +186,18 @@ fn row_for(
     run_sampled_with(config, case, settings, &mut run);
     let wall_seconds = start.elapsed().as_secs_f64();
     let row = StabilityRow {
-        case: case_name.to_string(),
-        integrator: config.method,
-        setting: describe(config),
         termination: run.termination_name(),
         end_time: run.outcome.as_ref().map_or(0.0, |o| o.t_last),
         max_error: reference.map(|r| state_error(case, &run, r)),
         energy_drift: energy_drift(&case.coin, &run.states),
         wall_seconds,
-        quantity: String::new(),
-        measured: None,
-        expected: None,
+        ..StabilityRow::new(case_name, config, "")
     };
     (row, run)
 }
 
 // ---------------------------------------------------------------------------------------------------------
 // Fast spin
-
-/// Nutation frequency σ of a steady motion: σ² of physics §9, eq (21) (the linearisation of eqs
-/// (14)–(17) about ω_X = 0 has eigenvalues 0, 0, ±iσ). `None` when σ² ≤ 0 (an unstable steady motion).
-#[must_use]
-pub fn nutation_frequency(coin: &Coin, steady: &Steady) -> Option<f64> {
-    let s = &steady.state;
-    let sigma2 = steady_sigma_squared(coin, s.theta, s.omega_y, s.omega_z);
-    (sigma2 > 0.0).then(|| sigma2.sqrt())
-}
 
 /// The fast-spin case: the steady circle at tilt 0.2 and spin `omega_z`, nudged to a nutation of
 /// peak angular acceleration 1e-3 g/a, for `periods` nutation periods, and its σ.
@@ -214,16 +227,7 @@ pub fn fast_spin_case(omega_z: f64, periods: f64) -> Result<(BenchCase, f64), Be
     // δθ = nudge·(g/a)/σ², so δω_X = σ δθ.
     initial.omega_x += FAST_SPIN_NUDGE * p.gravity() / p.radius() / sigma;
     Ok((
-        BenchCase {
-            name,
-            coin,
-            initial,
-            steady: None,
-            duration: periods * TAU / sigma,
-            flat_margin: DEFAULT_FLAT_MARGIN,
-            friction: None,
-            dissipation: None,
-        },
+        BenchCase::conservative(&name, coin, initial, periods * TAU / sigma),
         sigma,
     ))
 }
@@ -332,14 +336,13 @@ pub fn near_flat(theta: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>
     let sigma = nutation_frequency(&coin, &steady).unwrap_or(1.0);
     let gap = FRAC_PI_2 - DEFAULT_FLAT_MARGIN - theta;
     let steady_case = BenchCase {
-        name: format!("near-flat-{theta}-steady"),
-        coin,
-        initial: steady.state,
         steady: Some(steady),
-        duration: options.near_flat_periods * TAU / sigma,
-        flat_margin: DEFAULT_FLAT_MARGIN,
-        friction: None,
-        dissipation: None,
+        ..BenchCase::conservative(
+            &format!("near-flat-{theta}-steady"),
+            coin,
+            steady.state,
+            options.near_flat_periods * TAU / sigma,
+        )
     };
     let mut kicked = steady_case.clone();
     kicked.name = format!("near-flat-{theta}-kicked");
@@ -372,99 +375,32 @@ pub fn near_flat(theta: f64, options: &SuiteOptions) -> Result<Vec<StabilityRow>
 // ---------------------------------------------------------------------------------------------------------
 // Flat landing and lift-off
 
-/// Gauss–Legendre nodes and weights (kept here under their old path; the rule lives in the model).
-pub use coin_log::model::quadrature::gauss_legendre;
-
-/// Time for a coin released at rest at lean θ₀ (no spin) to reach lean θ₁, from the energy integral
-/// (I_X + Ma²)θ̇²/2 = Mga(cos θ₀ − cos θ): t = ∫ dθ / √(2K(cos θ₀ − cos θ)), K = Mga/(I_X + Ma²). The
-/// 1/√ singularity at θ₀ is removed by θ = θ₀ + u²: t = ∫₀^√(θ₁−θ₀) u du / √(K sin(θ₀ + u²/2) sin(u²/2)),
-/// a smooth integrand, by composite 20-point Gauss–Legendre on 64 panels (converged to round-off).
-#[must_use]
-#[allow(clippy::cast_precision_loss)]
-pub fn release_time(coin: &Coin, theta0: f64, theta1: f64) -> f64 {
-    let p = coin.params();
-    let k = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
-    let u_end = (theta1 - theta0).max(0.0).sqrt();
-    let integrand = |u: f64| {
-        let half = 0.5 * u * u;
-        u / (k * (theta0 + half).sin() * half.sin()).sqrt()
-    };
-    let rule = gauss_legendre(20);
-    let panels = 64;
-    let width = u_end / f64::from(panels);
-    let mut total = 0.0;
-    for j in 0..panels {
-        let centre = (f64::from(j) + 0.5) * width;
-        for &(x, w) in &rule {
-            total += 0.5 * width * w * integrand(centre + 0.5 * width * x);
-        }
-    }
-    total
-}
-
-/// The lean at which a coin released at rest at θ₀ leaves the table, if it does before `theta_max`:
-/// N/(Mg) = 1 − (a/g)(θ̇² cos θ + θ̈ sin θ) with θ̇² = 2K(cos θ₀ − cos θ), θ̈ = K sin θ (physics §3), first
-/// zero by bisection to round-off.
-#[must_use]
-pub fn lift_off_lean(coin: &Coin, theta0: f64, theta_max: f64) -> Option<f64> {
-    let p = coin.params();
-    let k = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
-    let ratio = p.radius() / p.gravity();
-    let normal = |t: f64| {
-        let (s, c) = t.sin_cos();
-        1.0 - ratio * (2.0 * k * (theta0.cos() - c) * c + k * s * s)
-    };
-    // Scan for the first sign change, then bisect.
-    let scan = 2000;
-    let mut lo = theta0;
-    for i in 1..=scan {
-        let hi = theta0 + (theta_max - theta0) * f64::from(i) / f64::from(scan);
-        if normal(hi) <= 0.0 {
-            let mut hi = hi;
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if mid <= lo || mid >= hi {
-                    break;
-                }
-                if normal(mid) <= 0.0 {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return Some(hi);
-        }
-        lo = hi;
-    }
-    None
-}
-
-/// A coin released at rest at lean `theta0`: the expected event (flat landing at π/2 − flat_margin or
-/// lift-off, whichever comes first) and its time by [`release_time`]; every integrator locates it
+/// A coin released at rest at lean `theta0`: the event the quadrature of `analyse` expects (lift-off if N
+/// reaches 0 first, else the flat landing at π/2 − flat_margin) and its time; every integrator locates it
 /// (fixed step 1e-3).
-#[must_use]
-pub fn release(theta0: f64, case_name: &str) -> Vec<StabilityRow> {
+///
+/// # Errors
+/// [`BenchError::InvalidScene`] if the quadrature fails or expects neither event (never for these).
+pub fn release(theta0: f64, case_name: &str) -> Result<Vec<StabilityRow>, BenchError> {
     let coin = unit_disk();
-    let flat = FRAC_PI_2 - DEFAULT_FLAT_MARGIN;
-    let (expected_event, theta1) = match lift_off_lean(&coin, theta0, flat) {
-        Some(t) => ("lift-off", t),
-        None => ("flat-landing", flat),
+    let initial = State {
+        theta: theta0,
+        ..State::default()
     };
-    let expected_time = release_time(&coin, theta0, theta1);
-    let case = BenchCase {
-        name: case_name.to_string(),
-        coin,
-        initial: State {
-            theta: theta0,
-            ..State::default()
-        },
-        steady: None,
-        duration: 4.0 * expected_time + 1.0,
-        flat_margin: DEFAULT_FLAT_MARGIN,
-        friction: None,
-        dissipation: None,
+    let invalid = |reason: String| BenchError::InvalidScene {
+        scene: case_name.to_string(),
+        reason,
     };
-    Method::ALL
+    let orbit = Analysis::of_state(&coin, &initial, DEFAULT_FLAT_MARGIN, None, None)
+        .map_err(|e| invalid(e.to_string()))?
+        .orbit;
+    let (expected_event, expected_time) = match (orbit.lift_off, orbit.motion) {
+        (Some(lift_off), _) => ("lift-off", lift_off.time),
+        (None, Motion::FlatLanding { time, .. }) => ("flat-landing", time),
+        (None, motion) => return Err(invalid(format!("the quadrature expects {motion:?}"))),
+    };
+    let case = BenchCase::conservative(case_name, coin, initial, 4.0 * expected_time + 1.0);
+    Ok(Method::ALL
         .iter()
         .map(|&method| {
             let config = suite_config(method, 1e-3);
@@ -479,33 +415,11 @@ pub fn release(theta0: f64, case_name: &str) -> Vec<StabilityRow> {
             row.max_error = Some(located.map_or(f64::INFINITY, |t| (t - expected_time).abs()));
             row
         })
-        .collect()
+        .collect())
 }
 
 // ---------------------------------------------------------------------------------------------------------
 // Marginal stability
-
-/// Linear theory of straight rolling at spin Ω from a tilt δθ₀ at rest (physics §5): with
-/// G = Mga/(I_X + Ma²) and λ² = [`straight_lambda_squared`], θ̈ = λ²θ + (G − λ²)θ₀, so
-/// θ(t) = θ₀(1 + G(cosh λt − 1)/λ²) (with (1 − cos σt)/σ² for λ² = −σ² < 0 and t²/2 at λ² = 0: the
-/// thin disk's δθ₀(1 + 2t²/5) at ω_c).
-#[must_use]
-pub fn straight_tilt_linear(coin: &Coin, omega_z0: f64, theta0: f64, t: f64) -> f64 {
-    let p = coin.params();
-    let g = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
-    let l2 = straight_lambda_squared(coin, omega_z0);
-    let growth = if l2.abs() * t * t < 1e-8 {
-        // Series: t²/2 + λ²t⁴/24 (the closed forms cancel here).
-        0.5 * t * t + l2 * t.powi(4) / 24.0
-    } else if l2 > 0.0 {
-        let l = l2.sqrt();
-        ((l * t).cosh() - 1.0) / l2
-    } else {
-        let s = (-l2).sqrt();
-        (1.0 - (s * t).cos()) / (-l2)
-    };
-    theta0 * (1.0 + g * growth)
-}
 
 /// Straight rolling at ω_c(1 + `offset`) from a tilt of 1e-6 for `horizon` time units: the largest
 /// relative deviation of θ from [`straight_tilt_linear`] over the samples, every integrator (fixed step
@@ -514,20 +428,12 @@ pub fn straight_tilt_linear(coin: &Coin, omega_z0: f64, theta0: f64, t: f64) -> 
 pub fn marginal(offset: f64, horizon: f64) -> Vec<StabilityRow> {
     let coin = unit_disk();
     let omega = coin_log::model::critical_spin(&coin) * (1.0 + offset);
-    let case = BenchCase {
-        name: format!("marginal-wc{offset:+e}"),
-        coin,
-        initial: State {
-            theta: MARGINAL_TILT,
-            omega_z: omega,
-            ..State::default()
-        },
-        steady: None,
-        duration: horizon,
-        flat_margin: DEFAULT_FLAT_MARGIN,
-        friction: None,
-        dissipation: None,
+    let initial = State {
+        theta: MARGINAL_TILT,
+        omega_z: omega,
+        ..State::default()
     };
+    let case = BenchCase::conservative(&format!("marginal-wc{offset:+e}"), coin, initial, horizon);
     Method::ALL
         .iter()
         .map(|&method| {
@@ -570,25 +476,14 @@ pub struct DriftHistory {
     pub wall_seconds: f64,
 }
 
-/// The wobbling motion of the built-in `wobble` scene (θ₀ = 0.5, ω = (0.3, 0.2, 1.5), unit
-/// thin disk): the long-horizon case here, and the motion of the integrator tests and benchmarks.
-#[must_use]
-pub fn wobble_state() -> State {
-    State {
-        theta: 0.5,
-        omega_x: 0.3,
-        omega_y: 0.2,
-        omega_z: 1.5,
-        ..State::default()
-    }
-}
-
-/// Runs `config` on the wobble to `horizon`, streaming the energy error (samples every 0.1 time units,
-/// nothing stored) and recording its running maximum at t = 10, 100, 1000, ... and at the horizon.
-#[must_use]
-pub fn drift_history(config: &MethodConfig, horizon: f64) -> DriftHistory {
-    let coin = unit_disk();
-    let initial = wobble_state();
+/// Runs `config` on the `wobble` scene's motion to `horizon`, streaming the energy error (samples every
+/// 0.1 time units, nothing stored) and recording its running maximum at t = 10, 100, 1000, ... and at the
+/// horizon.
+///
+/// # Errors
+/// [`BenchError`] if the `wobble` scene does not validate (a bug).
+pub fn drift_history(config: &MethodConfig, horizon: f64) -> Result<DriftHistory, BenchError> {
+    let BenchCase { coin, initial, .. } = bench_case("wobble")?;
     let e0 = energy(&coin, &initial).total;
     let scale = e0.abs().max(coin.params().energy_scale());
     let mut checkpoints = Vec::new();
@@ -620,12 +515,12 @@ pub fn drift_history(config: &MethodConfig, horizon: f64) -> DriftHistory {
             Flow::Continue
         },
     );
-    DriftHistory {
+    Ok(DriftHistory {
         config: *config,
         checkpoints,
         termination: termination_name(&outcome.termination),
         wall_seconds: start.elapsed().as_secs_f64(),
-    }
+    })
 }
 
 /// Fixed step of the long-horizon runs: large enough that the truncation error of the energy (≈ 1e-8 for
@@ -644,29 +539,26 @@ pub fn long_horizon_config(method: Method) -> MethodConfig {
 
 /// The long-horizon case: every integrator on the wobble to `horizon`, one row per checkpoint, and the
 /// growth exponent of the drift (slope of log drift against log t: ≈ 1 for a linear drift, ≈ 0 bounded).
-#[must_use]
-pub fn long_horizon(horizon: f64) -> Vec<StabilityRow> {
+///
+/// # Errors
+/// As [`drift_history`].
+pub fn long_horizon(horizon: f64) -> Result<Vec<StabilityRow>, BenchError> {
     let mut rows = Vec::new();
     for &method in Method::ALL {
-        let history = drift_history(&long_horizon_config(method), horizon);
-        let growth = super::precision::fit_slope(&history.checkpoints);
+        let history = drift_history(&long_horizon_config(method), horizon)?;
+        let growth = log_log_slope(&history.checkpoints);
         for &(t, drift) in &history.checkpoints {
             rows.push(StabilityRow {
-                case: "long-horizon".into(),
-                integrator: method,
-                setting: describe(&history.config),
                 termination: history.termination.clone(),
                 end_time: t,
-                max_error: None,
                 energy_drift: drift,
                 wall_seconds: history.wall_seconds,
-                quantity: "drift growth exponent".into(),
                 measured: growth,
-                expected: None,
+                ..StabilityRow::new("long-horizon", &history.config, "drift growth exponent")
             });
         }
     }
-    rows
+    Ok(rows)
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -684,24 +576,14 @@ pub const SCALES: &[(f64, f64, f64)] = &[
     (1e-3, 1e3, 1e-3),
 ];
 
-/// The state made dimensionless: angles as they are, ω·√(a/g), x/a, z/a.
+/// The state made dimensionless ([`natural_scales`]): angles as they are, ω·√(a/g), x/a, z/a.
 #[must_use]
 pub fn dimensionless(coin: &Coin, y: &[f64; STATE_LEN]) -> [f64; STATE_LEN] {
-    let p = coin.params();
-    let (t, a) = (p.time_unit(), p.radius());
-    [
-        y[0],
-        y[1],
-        y[2],
-        y[3] * t,
-        y[4] * t,
-        y[5] * t,
-        y[6] / a,
-        y[7] / a,
-    ]
+    let scale = natural_scales(coin);
+    std::array::from_fn(|i| y[i] * scale[i])
 }
 
-/// The wobble on a coin of (M, a, g, shape), scaled: ω by √(g/a), horizon and step by √(a/g).
+/// The `wobble` scene's motion on a coin of (M, a, g, shape), scaled: ω by √(g/a), horizon and step by √(a/g).
 ///
 /// # Errors
 /// [`BenchError::InvalidScene`] for non-positive parameters.
@@ -715,22 +597,17 @@ pub fn scaled_wobble(
             scene: "scale".into(),
             reason: format!("{e:?}"),
         })?;
-    let coin = Coin::new(params);
     let t = params.time_unit();
-    let mut initial = wobble_state();
+    let mut initial = bench_case("wobble")?.initial;
     initial.omega_x /= t;
     initial.omega_y /= t;
     initial.omega_z /= t;
-    Ok(BenchCase {
-        name: format!("scale-M{mass:e}-a{radius:e}-g{gravity:e}"),
-        coin,
+    Ok(BenchCase::conservative(
+        &format!("scale-M{mass:e}-a{radius:e}-g{gravity:e}"),
+        Coin::new(params),
         initial,
-        steady: None,
-        duration: horizon * t,
-        flat_margin: DEFAULT_FLAT_MARGIN,
-        friction: None,
-        dissipation: None,
-    })
+        horizon * t,
+    ))
 }
 
 /// Largest dimensionless difference between the wobble at scale `scale` and at unit scale, same shape,
@@ -838,90 +715,4 @@ pub fn scale_invariance(horizon: f64) -> Result<Vec<StabilityRow>, BenchError> {
         }
     }
     Ok(rows)
-}
-
-// ---------------------------------------------------------------------------------------------------------
-
-/// The whole suite.
-///
-/// # Errors
-/// [`BenchError`] if a case cannot be built (never for the built-in cases).
-pub fn run_suite(options: &SuiteOptions) -> Result<Vec<StabilityRow>, BenchError> {
-    let mut rows = Vec::new();
-    for omega_z in [50.0, 500.0] {
-        rows.extend(fast_spin(omega_z, options)?);
-    }
-    for theta in [1.5, 1.56, 1.5705] {
-        rows.extend(near_flat(theta, options)?);
-    }
-    rows.extend(release(0.6, "flat-landing"));
-    rows.extend(release(0.2, "lift-off"));
-    for offset in [MARGINAL_OFFSET, 0.0, -MARGINAL_OFFSET] {
-        rows.extend(marginal(offset, options.marginal_horizon));
-    }
-    rows.extend(long_horizon(options.long_horizon));
-    rows.extend(scale_invariance(options.scale_horizon)?);
-    rows.extend(super::nutation::stable_circles(options.analyse_periods)?);
-    rows.extend(super::nutation::unstable_circles()?);
-    rows.extend(super::nutation::generic_periods(options.analyse_periods)?);
-    Ok(rows)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{release_time, CoinParams};
-    use coin_log::model::Coin;
-
-    /// K = Mga/(I_X + Ma²) of the unit thin disk: 1/(1/4 + 1).
-    const UNIT_DISK_K: f64 = 0.8;
-
-    #[test]
-    fn the_release_time_agrees_with_the_closed_form_near_the_release_point() {
-        // For small θ − θ₀ the motion is θ ≈ θ₀ + (K sin θ₀/2) t², so t ≈ √(2(θ − θ₀)/(K sin θ₀)).
-        let coin = Coin::new(CoinParams::unit_disk());
-        let (theta0, dtheta) = (0.6, 1e-8);
-        let expected = (2.0 * dtheta / (UNIT_DISK_K * f64::sin(theta0))).sqrt();
-        let measured = release_time(&coin, theta0, theta0 + dtheta);
-        println!("quadrature {measured:.15e} vs small-angle closed form {expected:.15e}");
-        assert!((measured / expected - 1.0).abs() < 1e-7);
-    }
-
-    /// The same integral by another rule and another form of the integrand: composite Simpson on
-    /// t = ∫₀^√(θ₁−θ₀) 2v dv / √(2K(cos θ₀ − cos(θ₀ + v²))), whose value at v = 0 is its limit
-    /// 2/√(2K sin θ₀).
-    fn simpson_release_time(theta0: f64, theta1: f64, intervals: u32) -> f64 {
-        let k = UNIT_DISK_K;
-        let integrand = |v: f64| {
-            if v == 0.0 {
-                2.0 / (2.0 * k * theta0.sin()).sqrt()
-            } else {
-                2.0 * v / (2.0 * k * (theta0.cos() - (theta0 + v * v).cos())).sqrt()
-            }
-        };
-        let width = (theta1 - theta0).sqrt() / f64::from(intervals);
-        let mut sum = integrand(0.0) + integrand(width * f64::from(intervals));
-        for j in 1..intervals {
-            let weight = if j % 2 == 1 { 4.0 } else { 2.0 };
-            sum += weight * integrand(width * f64::from(j));
-        }
-        sum * width / 3.0
-    }
-
-    #[test]
-    fn the_release_time_agrees_with_simpsons_rule_on_the_direct_integrand() {
-        let coin = Coin::new(CoinParams::unit_disk());
-        for (theta0, theta1) in [
-            (0.6, std::f64::consts::FRAC_PI_2 - 1e-4),
-            (0.2, 1.07),
-            (1.0, 1.3),
-        ] {
-            let measured = release_time(&coin, theta0, theta1);
-            let expected = simpson_release_time(theta0, theta1, 20_000);
-            let relative = (measured / expected - 1.0).abs();
-            println!(
-                "θ₀ = {theta0}, θ₁ = {theta1}: Gauss–Legendre {measured:.15} vs Simpson {expected:.15}, relative difference {relative:.1e} (tolerance 1e-10)"
-            );
-            assert!(relative < 1e-10);
-        }
-    }
 }

@@ -1,6 +1,7 @@
-//! The throughput bench (`bench throughput`): how fast `record` and `verify` run on the real
-//! channel set and code paths, in how much memory, against the bound the machine sets, and what the
-//! integration itself costs.
+//! The throughput bench (`bench throughput`): how fast `record`, `verify` and `export` run on the real
+//! channel set and code paths, in how much memory, against the bound the machine sets. (What the
+//! integration itself costs, and one RHS evaluation, are criterion's micro-benchmarks: `cargo bench -p
+//! coin-log-bench`.)
 //!
 //! Workloads, each repeated and reported as the median:
 //! - **record**: `coin-log record wobble` with the seven channels omega, angles, quaternion, position,
@@ -11,22 +12,16 @@
 //!   as each compression worker does ([`compression_bound`]); the ratio record time / bound says how close
 //!   recording is to what compression alone costs;
 //! - **verify**: `coin-log verify --json` of that file, every check on ([`VerifyRun`]);
-//! - **export**: `coin-log export --json` of that file, one CSV table per channel ([`ExportRun`]);
-//! - **integration**: dop853 on `wobble` (30 time units) at the loosest tolerance whose state error against
-//!   the dop853 reference (atol 1e-16) is ≤ 1e-10, and one RHS evaluation (`Coin::derivative`)
-//!   ([`integration_cost`]).
+//! - **export**: `coin-log export --json` of that file, one CSV table per channel ([`ExportRun`]).
 //!
 //! Record and verify run at two durations, so that their peak RSS shows whether memory grows with the
 //! length of the run. Each runs in its own process so that its peak RSS is its own: the `coin-log bench
 //! throughput` command starts them and fills in [`RecordRun`] and [`VerifyRun`]; this module defines the
-//! workloads, measures what runs in-process (the bound, the integration), turns the runs into rows
+//! workloads, measures what runs in-process (the bound), turns the runs into rows
 //! ([`DurationRuns::rows`]) and formats them ([`table`], [`csv`]).
 
-use super::precision::rtol_for;
-use super::presets::bench_case;
-use super::{reference_trajectory, run_sampled, state_error, BenchCase, BenchError, Trajectory};
+use super::median;
 use coin_log::format::{Channel, Encoding};
-use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Stats};
 use coin_log::record::COMPRESSION_THREADS;
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log_mcap::{
@@ -34,7 +29,6 @@ use coin_log_mcap::{
 };
 use std::collections::BTreeMap;
 use std::fmt;
-use std::hint::black_box;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -55,17 +49,6 @@ pub const CHANNELS: [Channel; 7] = [
 pub const RATE: f64 = 1000.0;
 /// Uncompressed bytes per chunk: the recorder's ([`DEFAULT_CHUNK_SIZE`]).
 pub const CHUNK_SIZE: usize = DEFAULT_CHUNK_SIZE;
-/// Duration of the integration workload (the `wobble` scene's) \[time units\].
-pub const INTEGRATION_DURATION: f64 = 30.0;
-/// Largest state error of the integration workload against the reference.
-pub const INTEGRATION_ERROR: f64 = 1e-10;
-/// atol values tried for the integration workload, loosest first (rtol = min(1e3·atol, 1e-3)).
-const INTEGRATION_ATOLS: [f64; 7] = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14];
-/// RHS evaluations per timed repeat.
-pub const RHS_EVALUATIONS: u32 = 2_000_000;
-/// Timed integration runs per repeat (one run lasts well under a millisecond).
-pub const INTEGRATION_RUNS: u32 = 200;
-
 /// The throughput targets.
 pub mod targets {
     /// Recording, messages per second.
@@ -76,10 +59,6 @@ pub mod targets {
     pub const VERIFY_MESSAGES_PER_SECOND: f64 = 2e6;
     /// Peak RSS of record, verify and export \[bytes\].
     pub const PEAK_RSS_BYTES: f64 = 64.0 * 1024.0 * 1024.0;
-    /// dop853 on wobble \[s\].
-    pub const INTEGRATION_SECONDS: f64 = 0.5e-3;
-    /// One RHS evaluation \[s\].
-    pub const RHS_SECONDS: f64 = 50e-9;
 }
 
 /// A target and which side of it is good.
@@ -188,31 +167,6 @@ pub enum ThroughputError {
         /// The duration \[time units\].
         duration: f64,
     },
-    /// The integration workload could not be set up.
-    #[error(transparent)]
-    Bench(#[from] BenchError),
-    /// No tolerance reached the required state error.
-    #[error("dop853 on wobble does not reach a state error of {INTEGRATION_ERROR:e} at atol down to 1e-14 (best {best:e})")]
-    Accuracy {
-        /// The smallest error reached.
-        best: f64,
-    },
-}
-
-/// The median of `values` (the mean of the middle two for an even count); NaN when empty.
-#[must_use]
-pub fn median(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 /// The `--channels` value of the workload.
@@ -598,113 +552,6 @@ impl DurationRuns {
     }
 }
 
-/// The loosest dop853 setting in [`INTEGRATION_ATOLS`] whose state error on `case` is at most
-/// [`INTEGRATION_ERROR`], with that error.
-fn accurate_dop853(case: &BenchCase) -> Result<(MethodConfig, f64), ThroughputError> {
-    let reference = reference_trajectory(case)?;
-    let mut run = Trajectory::default();
-    let mut best = f64::INFINITY;
-    for atol in INTEGRATION_ATOLS {
-        let config = MethodConfig {
-            method: Method::Dop853,
-            rtol: rtol_for(atol),
-            atol,
-            step: 0.0,
-        };
-        run_sampled(&config, case, &mut run);
-        let error = state_error(case, &run, &reference);
-        best = best.min(error);
-        if run.completed() && error <= INTEGRATION_ERROR {
-            return Ok((config, error));
-        }
-    }
-    Err(ThroughputError::Accuracy { best })
-}
-
-/// Wall time of one run of `config` on `case` (no sampling) over [`INTEGRATION_RUNS`] runs per repeat,
-/// and the last run's counters.
-fn time_integration(config: &MethodConfig, case: &BenchCase, repeats: usize) -> (Vec<f64>, Stats) {
-    let settings = RunSettings {
-        t0: 0.0,
-        t_end: case.duration,
-        sample_interval: case.duration,
-    };
-    let events = case.events();
-    let y0 = case.initial.to_array();
-    let mut stats = None;
-    let mut per_run = Vec::new();
-    for _ in 0..repeats.max(1) {
-        let start = Instant::now();
-        for _ in 0..INTEGRATION_RUNS {
-            let outcome = run_method(
-                config,
-                &case.coin,
-                black_box(&y0),
-                &settings,
-                &events,
-                |_, y| {
-                    black_box(y);
-                    Flow::Continue
-                },
-            );
-            stats = Some(outcome.stats);
-        }
-        per_run.push(start.elapsed().as_secs_f64() / f64::from(INTEGRATION_RUNS));
-    }
-    (per_run, stats.unwrap_or_default())
-}
-
-/// Time per RHS evaluation at the case's initial state, one value per repeat.
-fn time_rhs(case: &BenchCase, repeats: usize) -> Vec<f64> {
-    let y0 = case.initial.to_array();
-    let mut per_rhs = Vec::new();
-    let mut dy = [0.0; coin_log::model::STATE_LEN];
-    for _ in 0..repeats.max(1) {
-        let start = Instant::now();
-        for _ in 0..RHS_EVALUATIONS {
-            case.coin.derivative(black_box(&y0), black_box(&mut dy));
-        }
-        per_rhs.push(start.elapsed().as_secs_f64() / f64::from(RHS_EVALUATIONS));
-    }
-    per_rhs
-}
-
-/// dop853 on `wobble` at the loosest tolerance meeting [`INTEGRATION_ERROR`], timed over
-/// [`INTEGRATION_RUNS`] runs per repeat, and one RHS evaluation.
-///
-/// # Errors
-/// [`ThroughputError`] if the reference cannot be built or no tolerance is accurate enough.
-pub fn integration_cost(repeats: usize) -> Result<Vec<ThroughputRow>, ThroughputError> {
-    let case = bench_case(SCENE)?;
-    let (config, error) = accurate_dop853(&case)?;
-    let (per_run, stats) = time_integration(&config, &case, repeats);
-    let per_rhs = time_rhs(&case, repeats);
-    Ok(vec![
-        ThroughputRow {
-            workload: format!(
-                "integrate dop853 {SCENE} {} u, atol {:e} rtol {:e}",
-                case.duration, config.atol, config.rtol
-            ),
-            quantity: "wall time".into(),
-            value: median(&per_run),
-            unit: "s".into(),
-            target: Some(Target::Below(targets::INTEGRATION_SECONDS)),
-            note: format!(
-                "state error {error:.2e} ≤ {INTEGRATION_ERROR:e} vs dop853 atol 1e-16; {} steps, {} RHS evaluations",
-                stats.steps, stats.rhs_evaluations
-            ),
-        },
-        ThroughputRow {
-            workload: "Coin::derivative".into(),
-            quantity: "time per RHS evaluation".into(),
-            value: median(&per_rhs),
-            unit: "s".into(),
-            target: Some(Target::Below(targets::RHS_SECONDS)),
-            note: format!("{RHS_EVALUATIONS} evaluations per repeat"),
-        },
-    ])
-}
-
 /// The CSV header of `bench throughput`.
 pub const CSV_HEADER: &str = "workload,quantity,value,unit,target,met,note";
 
@@ -790,13 +637,6 @@ pub fn table(report: &ThroughputReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn medians_of_odd_and_even_counts() {
-        assert!((median(&[3.0, 1.0, 2.0]) - 2.0).abs() < 1e-15);
-        assert!((median(&[4.0, 1.0, 2.0, 3.0]) - 2.5).abs() < 1e-15);
-        assert!(median(&[]).is_nan());
-    }
 
     #[test]
     fn targets_say_which_side_is_good() {

@@ -10,11 +10,11 @@ use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP
 use coin_log_bench::plot::{euler_svg, work_precision_svg};
 use coin_log_bench::precision::{precision_bench, PrecisionOptions};
 use coin_log_bench::presets::{bench_case, bench_case_from_toml, DEFAULT_PRECISION_SCENES};
-use coin_log_bench::stability;
 use coin_log_bench::table::{
     euler_csv, euler_table, precision_csv, precision_table, stability_csv, stability_table,
 };
 use coin_log_bench::BenchCase;
+use coin_log_bench::{stability, suite};
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -37,14 +37,14 @@ enum BenchCommand {
     /// The hard-case suite: fast spin, near flat, landing and lift-off, marginal stability, long horizon,
     /// scale invariance; every case with every integrator.
     Stability(StabilityArgs),
-    /// Record and verify speed and memory on the real channel set, against the zstd bound, and the cost of
-    /// integration.
+    /// Record, verify and export speed and memory on the real channel set, against the zstd bound.
     ///
     /// Records `wobble` with the seven channels omega, angles, quaternion, position, contact, reaction,
     /// energy at 1 kHz with zstd, each run in a child `coin-log record` process; times zstd alone on the
-    /// same JSON bytes (the bound); verifies the file in a child `coin-log verify`; reports messages/s,
-    /// MB/s, file size and peak RSS at two durations (100 and 1000 time units; 1000 and 10000 with
-    /// --long), then dop853 on wobble and one RHS evaluation. Medians of --repeats runs.
+    /// same JSON bytes (the bound); verifies and exports the file in a child `coin-log verify` and `coin-log
+    /// export`; reports messages/s, MB/s, file size and peak RSS at two durations (100 and 1000 time units;
+    /// 1000 and 10000 with --long). Medians of --repeats runs. (The integration and one RHS evaluation are
+    /// criterion benchmarks: `cargo bench -p coin-log-bench`.)
     Throughput(throughput::ThroughputArgs),
     /// Euler's disk: the time law α = A (t0 − t)^n of each dissipation preset against n = 1/(1 − p).
     ///
@@ -164,7 +164,7 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
 
 fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     create_dir(&args.out)?;
-    let rows = stability::run_suite(&stability::SuiteOptions::full())?;
+    let rows = suite::run_suite(&stability::SuiteOptions::full())?;
     out!("{}", stability_table(&rows));
     let csv_path = args.out.join("stability.csv");
     write(&csv_path, &stability_csv(&rows))?;

@@ -1,7 +1,7 @@
 //! `coin-log bench throughput`: runs the record and verify workloads of
 //! [`coin_log_bench::throughput`] in child processes of this binary (each in its own process, so that its
 //! peak RSS is its own), reads their `--json` summaries, and has the library measure the compression
-//! bound and the integration cost, turn the runs into rows and format them.
+//! bound, turn the runs into rows and format them.
 
 use super::{create_dir, write};
 use crate::cli::Outcome;
@@ -79,7 +79,7 @@ fn durations(args: &ThroughputArgs) -> anyhow::Result<Vec<f64>> {
     Ok(durations)
 }
 
-/// Record, bound and verify at every duration, then the integration cost.
+/// Record, bound, verify and export at every duration.
 fn measure(
     exe: &Path,
     dir: &Path,
@@ -91,7 +91,6 @@ fn measure(
     for &duration in durations {
         rows.extend(record_and_verify(exe, dir, duration, repeats, encoding)?);
     }
-    rows.extend(throughput::integration_cost(repeats)?);
     Ok(ThroughputReport::new(rows))
 }
 

@@ -1,12 +1,13 @@
-//! Helpers of the model tests: parameter sets, a generic wobbling state, fixed-step rk4 trajectories,
-//! zero crossings of a sampled signal, and the reporting check that prints measured vs expected vs
-//! tolerance.
+//! Helpers of the model tests: parameter sets, a generic wobbling state and the `wobble` scene's state,
+//! fixed-step rk4 trajectories, zero crossings of a sampled signal, and the reporting check that prints
+//! measured vs expected vs tolerance.
 // Test helpers are not #[test] functions, so clippy.toml's allow-unwrap-in-tests does not reach them; a
 // failed unwrap here is a failed test, which is what we want.
 #![allow(clippy::unwrap_used)]
 
 use coin_log::integrate::{OdeSystem, Rk4, Stepper};
 use coin_log::model::{CoinParams, Inertia, State};
+use coin_log::scene::{presets, Scene};
 use proptest::prelude::*;
 
 /// Unit thin disk M = a = g = 1 (the note's section 5).
@@ -49,6 +50,12 @@ pub fn wobbling(p: &CoinParams) -> State {
         x: 0.1 * p.radius(),
         z: -0.2 * p.radius(),
     }
+}
+
+/// The initial state of the built-in `wobble` scene (θ0 = 0.5, ω = (0.3, 0.2, 1.5), unit thin disk).
+pub fn wobble() -> State {
+    let file = presets::preset("wobble").unwrap();
+    Scene::from_file(&file).unwrap().initial
 }
 
 /// Integrates with the library's fixed-step rk4 for `steps` steps of `h`, keeping every `every`-th state

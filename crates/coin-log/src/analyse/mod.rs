@@ -4,9 +4,12 @@
 //!
 //! The library returns values; `coin-log analyse` prints them and writes the map's files.
 
+pub mod linear;
 pub mod map;
 mod plot;
+pub mod slow_change;
 mod steady;
+pub mod steady_path;
 
 pub use steady::{SteadyAnalysis, Verdict};
 

@@ -5,6 +5,7 @@ mod derived;
 mod dissipation;
 pub mod drift;
 mod equations;
+pub mod fit;
 pub mod invariants;
 pub mod nutation;
 mod params;
@@ -12,6 +13,7 @@ pub mod quadrature;
 mod stability;
 mod state;
 mod steady;
+pub mod turning_points;
 
 pub use derived::{centre, contact_point, energy, orientation, reaction, Energy, Reaction};
 pub use dissipation::{
@@ -30,3 +32,4 @@ pub use steady::{
     steady_omega_y, Branch, Steady, SteadyError, SteadyFamily, SteadyKind, UnknownBranch,
     UnknownSteadyFamily,
 };
+pub use turning_points::{MeasuredNutation, TurningPoints};

@@ -2,7 +2,7 @@
 //! plus ẋ, ż), for the thin disk and general parameters, at a generic wobbling state; and of the
 //! dissipative coin (`DissipativeCoin::derivative`, eqs (30)–(34) of physics §11, with Moffatt's law), a
 //! separate system, so that the conservative evaluation is exactly what it is without dissipation.
-//! CI only compiles it (`cargo bench --no-run`); run with `cargo bench --bench rhs`.
+//! The target of issue 9 is 50 ns per evaluation. CI only compiles it; run with `cargo bench --bench rhs`.
 
 use coin_log::model::{
     Coin, CoinParams, Dissipation, DissipationModel, DissipativeCoin, Inertia, State,
