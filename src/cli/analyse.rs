@@ -3,16 +3,18 @@
 //! scene, prints, and writes the map's files.
 
 use super::scene_arg::load_source;
-use super::{make_readable, Outcome};
+use super::Outcome;
 use anyhow::{anyhow, Context};
 use coin_log::analyse::map::{
     band_report, stability_map, Branches, Grid, MapOptions, DEFAULT_OMEGA_Z, DEFAULT_THETA,
 };
 use coin_log::analyse::{motion_name, Analysis, SteadyAnalysis, Verdict};
+use coin_log::files::{shown, OutputFolder};
 use coin_log::model::nutation::Motion;
 use coin_log::model::{Coin, CoinParams, SteadyFamily};
 use coin_log::scene::{RunFile, Scene};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `coin-log analyse`.
@@ -298,6 +300,10 @@ fn force_rows(a: &Analysis) -> Vec<(&'static str, String)> {
     vec![("normal force", normal), ("friction", friction)]
 }
 
+/// The map's files.
+const CSV: &str = "stability-map.csv";
+const SVG: &str = "stability-map.svg";
+
 fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     let options = MapOptions {
         theta: Grid::parse("--theta", &args.theta)?,
@@ -317,15 +323,16 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     let csv = map.csv();
     let svg = map.svg()?;
     let elapsed = started.elapsed().as_secs_f64();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating the output folder `{}`", args.out.display()))?;
-    let csv_path = args.out.join("stability-map.csv");
-    let svg_path = args.out.join("stability-map.svg");
-    // Both checked before either is written, so a refusal leaves the folder as it was.
-    super::destination::refuse_special(&csv_path)?;
-    super::destination::refuse_special(&svg_path)?;
-    write_replacing(&csv_path, &csv)?;
-    write_replacing(&svg_path, &svg)?;
+    // The map replaces its own files; both are checked before either is moved into place.
+    let mut folder = OutputFolder::create(&args.out, true)?;
+    for (name, text) in [(CSV, &csv), (SVG, &svg)] {
+        let shown_name = shown(&args.out.join(name));
+        let mut file = folder.file(name)?;
+        file.write_all(text.as_bytes())
+            .with_context(|| format!("writing `{shown_name}`"))?;
+    }
+    folder.commit()?;
+    let (csv_path, svg_path) = (args.out.join(CSV), args.out.join(SVG));
     let branches = match options.branches {
         Branches::Plus => "the + branch",
         Branches::Minus => "the − branch",
@@ -353,29 +360,8 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     outln!(
         "{:<16} {}, {} ({elapsed:.3} s)",
         "wrote",
-        csv_path.display(),
-        svg_path.display()
+        shown(&csv_path),
+        shown(&svg_path)
     );
     Ok(Outcome::Success)
-}
-
-/// Writes `text` to `path` through a temporary file in the same folder, so that a failure leaves the old
-/// file (or none), never half of the new one.
-fn write_replacing(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    super::destination::refuse_special(path)?;
-    let folder = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut temp = tempfile::Builder::new()
-        .prefix(".coin-log-")
-        .tempfile_in(folder)
-        .with_context(|| format!("cannot write in `{}`", folder.display()))?;
-    temp.write_all(text.as_bytes())
-        .with_context(|| format!("writing `{}`", path.display()))?;
-    make_readable(temp.as_file());
-    temp.persist(path)
-        .map_err(|e| anyhow!("cannot write `{}`: {}", path.display(), e.error))?;
-    Ok(())
 }

@@ -6,7 +6,6 @@ mod output;
 mod analyse;
 mod bench;
 mod completions;
-mod destination;
 mod export;
 mod info;
 #[cfg(feature = "live")]
@@ -152,17 +151,6 @@ pub(crate) fn named<
 >() -> impl clap::builder::TypedValueParser<Value = T> {
     use clap::builder::TypedValueParser;
     clap::builder::PossibleValuesParser::new(T::NAMES).try_map(|s| s.parse::<T>())
-}
-
-/// Temporary files are created owner-only; a finished output file is an ordinary file.
-pub(crate) fn make_readable(file: &std::fs::File) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = file;
 }
 
 #[cfg(test)]

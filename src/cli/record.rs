@@ -5,8 +5,9 @@
 use super::rss::peak_rss_bytes;
 use super::scene_arg::{load_source, SceneSource};
 use super::text::size;
-use super::{destination, make_readable, output, Outcome};
-use anyhow::{anyhow, bail, Context};
+use super::{output, Outcome};
+use anyhow::{anyhow, Context};
+use coin_log::files::{shown, Output, Policy};
 use coin_log::format::Encoding;
 use coin_log::format::Termination;
 use coin_log::record::{self, RecordOptions, RecordSummary};
@@ -18,7 +19,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
-use tempfile::NamedTempFile;
 
 /// Runs shorter than this show no progress bar.
 const PROGRESS_DELAY: Duration = Duration::from_secs(1);
@@ -129,13 +129,13 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     }
     warn_if_large(&args, &scene);
     let target = output_path(&args, &source);
-    let mut temp = prepare_output(&target, args.overwrite, &source, &signals)?;
+    let mut output = prepare_output(&target, args.overwrite, &source, &signals)?;
     if signals.stopped() {
         errln!("interrupted before recording began: nothing was written");
         return Ok(Outcome::Interrupted);
     }
-    let (summary, wall) = record_into(&args, &scene, &target, &mut temp, &signals)?;
-    persist(temp, &target, args.overwrite, &signals)?;
+    let (summary, wall) = record_into(&args, &scene, &mut output, &signals)?;
+    persist(output, &signals)?;
     print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
     Ok(outcome(&summary, &target))
 }
@@ -306,47 +306,37 @@ fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)))
 }
 
-/// Checks the target and creates the temporary file beside it, all before simulating: the target must be
-/// absent or (with `--overwrite`) a regular file other than the scene, and its name must be creatable.
+/// Checks the target and creates the temporary file beside it, all before simulating (files::output):
+/// the target must be absent or (with `--overwrite`) a regular file other than the scene.
 pub(super) fn prepare_output(
     target: &Path,
     overwrite: bool,
     source: &SceneSource,
     signals: &Signals,
-) -> anyhow::Result<NamedTempFile> {
-    let existing =
-        destination::check_target(target, overwrite, source.path.as_deref(), &source.stem)?;
+) -> anyhow::Result<Output> {
+    let example = format!("{}.mcap", source.stem);
+    let policy = Policy {
+        overwrite,
+        flag: "-o",
+        example: &example,
+        protect: source
+            .path
+            .as_deref()
+            .map(|p| (p, "the scene file being recorded")),
+    };
+    // Locked while the temporary file is created, so that a second signal finds it to delete.
     let mut slot = signals.slot();
-    let temp = temp_file_beside(target)?;
-    *slot = Some(temp.path().to_path_buf());
-    drop(slot);
-    destination::probe_target(target, existing.as_ref(), &temp)?;
-    Ok(temp)
+    let output = Output::create(target, &policy)?;
+    *slot = Some(output.temp_path().to_path_buf());
+    Ok(output)
 }
 
-/// A temporary file in the target's folder, so that the finished recording is moved, not copied.
-fn temp_file_beside(target: &Path) -> anyhow::Result<NamedTempFile> {
-    let folder = destination::folder_of(target);
-    tempfile::Builder::new()
-        .prefix(".coin-log-")
-        .suffix(".mcap.tmp")
-        .tempfile_in(&folder)
-        .with_context(|| {
-            format!(
-                "cannot write in `{}` (for `{}`)",
-                folder.display(),
-                target.display()
-            )
-        })
-}
-
-/// Records the scene into `temp` with a signal finishing the file early and a progress bar on long runs;
-/// returns the summary and the wall time, the file synced to disk and readable.
+/// Records the scene into `output` with a signal finishing the file early and a progress bar on long runs;
+/// returns the summary and the wall time.
 fn record_into(
     args: &RecordArgs,
     scene: &Scene,
-    target: &Path,
-    temp: &mut NamedTempFile,
+    output: &mut Output,
     signals: &Signals,
 ) -> anyhow::Result<(RecordSummary, Duration)> {
     let options = RecordOptions {
@@ -359,49 +349,21 @@ fn record_into(
     let result = record::record(
         scene,
         &options,
-        BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut()),
+        BufWriter::with_capacity(WRITE_BUFFER, output.file()),
         &signals.stop,
         |t| update_progress(&bar, started, t / duration),
     );
     bar.finish_and_clear();
-    let summary = result.with_context(|| format!("recording `{}`", target.display()))?;
-    temp.as_file()
-        .sync_all()
-        .with_context(|| format!("writing `{}`", target.display()))?;
-    let wall = started.elapsed();
-    make_readable(temp.as_file());
-    Ok((summary, wall))
+    let summary = result.with_context(|| format!("recording `{}`", shown(output.target())))?;
+    Ok((summary, started.elapsed()))
 }
 
-/// Moves the finished recording into place; without `--overwrite` a file that appeared meanwhile is left
-/// alone and the recording kept under its temporary name.
-pub(super) fn persist(
-    temp: NamedTempFile,
-    target: &Path,
-    overwrite: bool,
-    signals: &Signals,
-) -> anyhow::Result<()> {
+/// Moves the finished recording into place (synced; kept under the name the error gives if the move fails).
+pub(super) fn persist(output: Output, signals: &Signals) -> anyhow::Result<()> {
     // Held until the move is done, so that a second signal cannot delete a file being moved.
     let mut slot = signals.slot();
     *slot = None;
-    if overwrite {
-        temp.persist(target).map_err(|e| {
-            anyhow!(
-                "cannot move the recording to `{}`: {}",
-                target.display(),
-                e.error
-            )
-        })?;
-    } else if let Err(e) = temp.persist_noclobber(target) {
-        // The target appeared while we were recording: keep our file rather than lose it.
-        let kept = e.file.keep().map(|(_, p)| p);
-        let kept = kept.map_or_else(|_| "(lost)".to_string(), |p| p.display().to_string());
-        bail!(
-            "`{}` appeared while recording and was left alone; the recording is kept at `{kept}`",
-            target.display()
-        );
-    }
-    Ok(())
+    Ok(output.commit()?)
 }
 
 /// The exit code of a finished recording; a numerical failure says where the samples stop.
@@ -411,7 +373,7 @@ pub(super) fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
             errln!(
                 "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
                 summary.termination_time,
-                target.display()
+                shown(target)
             );
             Outcome::Failure
         }
@@ -461,7 +423,7 @@ fn print_summary(
     if output::stdout_failed() {
         errln!(
             "note: the recording `{}` is complete; only its summary was lost",
-            target.display()
+            shown(target)
         );
     }
     Ok(())
@@ -559,7 +521,7 @@ pub(super) fn summary_rows(
     let seconds = wall.as_secs_f64();
     let mut rows: Vec<(&str, String)> = vec![
         ("scene", label.to_string()),
-        ("file", format!("{} ({})", target.display(), size(s.bytes))),
+        ("file", format!("{} ({})", shown(target), size(s.bytes))),
         ("samples", s.samples.to_string()),
         ("messages", s.messages.to_string()),
         (

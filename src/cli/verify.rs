@@ -1,9 +1,11 @@
 //! `coin-log verify`: prints each file's checks as a table (or the contract's JSON) and maps the worst
 //! verdict to the exit code.
 
-use super::progress::{file_len, FileProgress};
+use super::progress::FileProgress;
 use super::rss::peak_rss_bytes;
 use super::Outcome;
+use coin_log::files::input::check;
+use coin_log::files::{escaped, shown, InputKind};
 use coin_log::verify::{self, FileReport, Options, Report, Verdict};
 use std::path::{Path, PathBuf};
 
@@ -76,7 +78,7 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     // like every other command's errors.
     for file in &report.files {
         if let Some(problem) = &file.problem {
-            errln!("error: {}: {problem}", file.path);
+            errln!("error: {}: {problem}", escaped(&file.path));
         }
     }
     if args.json {
@@ -97,9 +99,22 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     })
 }
 
-/// Judges one file with a progress bar on stderr (a terminal only, after a second).
+/// Judges one file with a progress bar on stderr (a terminal only, after a second); a path that is not a
+/// regular file is unusable without being opened (files::input).
 fn verify_with_progress(path: &Path, options: &Options) -> FileReport {
-    let progress = FileProgress::new(&path.display().to_string(), file_len(path));
+    let len = match check(path, InputKind::Mcap) {
+        Ok(meta) => meta.len(),
+        Err(e) => {
+            return FileReport {
+                path: path.display().to_string(),
+                exit_code: Verdict::Unusable.exit_code(),
+                verdict: Verdict::Unusable,
+                problem: Some(e.to_string()),
+                checks: Vec::new(),
+            }
+        }
+    };
+    let progress = FileProgress::new(&shown(path), len);
     let report = verify::verify_file_with_progress(path, options, &|b| progress.update(b));
     progress.finish();
     report
@@ -142,7 +157,7 @@ fn number(x: Option<f64>) -> String {
 fn file_table(f: &FileReport, out: &mut String) {
     out.push_str(&format!(
         "{}: {} (exit {})\n",
-        f.path,
+        escaped(&f.path),
         f.verdict.label(),
         f.exit_code
     ));

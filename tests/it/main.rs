@@ -15,6 +15,7 @@ mod bench_euler;
 mod bench_precision;
 mod bench_stability;
 mod bench_throughput;
+mod cli_files;
 mod cli_inspect;
 mod cli_paths;
 mod cli_pipes;

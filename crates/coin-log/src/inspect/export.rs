@@ -110,6 +110,9 @@ pub enum ExportError {
     /// The messages cannot be joined into one row per sample.
     #[error("cannot join the channels into one table: {0}; export one table per channel instead (without --wide)")]
     Join(String),
+    /// No channel of the file makes a table.
+    #[error("nothing to export: {0}")]
+    Nothing(String),
     /// A table could not be written.
     #[error("writing `{table}`: {source}")]
     Write {
@@ -526,6 +529,22 @@ impl<W: Write> Exporter<'_, W> {
         self.flush_row();
         if let Some(e) = self.error.take() {
             return Err(e);
+        }
+        if self.tables.is_empty() {
+            let why = if self.skipped.is_empty() {
+                "the file has no coin-log channel with messages".to_string()
+            } else {
+                let skipped: Vec<String> = self
+                    .skipped
+                    .iter()
+                    .map(|k| format!("{}: {}", k.topic, k.reason))
+                    .collect();
+                format!(
+                    "no channel of the file makes a table ({})",
+                    skipped.join("; ")
+                )
+            };
+            return Err(ExportError::Nothing(why));
         }
         let mut tables = Vec::new();
         for open in self.tables {
