@@ -110,7 +110,7 @@ fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> 
         );
     }
     if json {
-        outln!("{}", serde_json::to_string(&analysis.json())?);
+        super::output::json(&analysis.json())?;
     } else {
         for (key, value) in summary(arg, &scene, &analysis) {
             outln!("{key:<16} {value}");

@@ -96,20 +96,20 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<Outcome> {
 
 fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()> {
     if args.json {
-        let json = serde_json::json!({
-            "file": args.file.display().to_string(),
-            "out": dir.display().to_string(),
-            "messages": s.messages,
-            "tables": s.tables.iter().map(|t| serde_json::json!({
-                "name": t.name, "topics": t.topics, "columns": t.columns, "rows": t.rows,
-            })).collect::<Vec<_>>(),
-            "skipped": s.skipped.iter().map(|k| serde_json::json!({
-                "topic": k.topic, "reason": k.reason,
-            })).collect::<Vec<_>>(),
-            "peak_rss_bytes": peak_rss_bytes(),
-        });
-        outln!("{}", serde_json::to_string(&json)?);
-        return Ok(());
+        #[derive(serde::Serialize)]
+        struct Json<'a> {
+            file: String,
+            out: String,
+            #[serde(flatten)]
+            summary: &'a ExportSummary,
+            peak_rss_bytes: Option<u64>,
+        }
+        return Ok(super::output::json(&Json {
+            file: args.file.display().to_string(),
+            out: dir.display().to_string(),
+            summary: s,
+            peak_rss_bytes: peak_rss_bytes(),
+        })?);
     }
     for t in &s.tables {
         outln!(

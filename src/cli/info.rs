@@ -33,6 +33,19 @@ pub struct InfoArgs {
     scene: bool,
 }
 
+/// `info --json`: `{"files": [...]}`, each a file's object or, for a file that could not be read, its path
+/// and problem.
+#[derive(serde::Serialize)]
+struct Files {
+    files: Vec<serde_json::Value>,
+}
+
+#[derive(serde::Serialize)]
+struct Unreadable<'a> {
+    path: &'a str,
+    problem: &'a str,
+}
+
 /// Runs `coin-log info`: exit 0 when every file was described, 1 otherwise.
 pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
     if args.scene {
@@ -47,7 +60,7 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
             Ok(i) => {
                 failed |= i.problem.is_some();
                 if args.json {
-                    json_files.push(i.to_json(&given));
+                    json_files.push(serde_json::to_value(i.json(&given))?);
                 } else {
                     out!("{}", text(&shown(path), &i));
                 }
@@ -56,16 +69,16 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
                 failed = true;
                 errln!("error: {}: {e}", shown(path));
                 if args.json {
-                    json_files.push(serde_json::json!({"path": given, "problem": e}));
+                    json_files.push(serde_json::to_value(Unreadable {
+                        path: &given,
+                        problem: &e,
+                    })?);
                 }
             }
         }
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string(&serde_json::json!({ "files": json_files }))?
-        );
+        super::output::json(&Files { files: json_files })?;
     }
     Ok(if failed {
         Outcome::Failure

@@ -226,6 +226,16 @@ struct Stats {
     url: String,
 }
 
+/// What `live --json` adds to `record`'s summary.
+#[derive(serde::Serialize)]
+struct LiveJson<'a> {
+    url: &'a str,
+    speed: f64,
+    served_messages: u64,
+    clock_s: f64,
+    max_lag_s: f64,
+}
+
 /// `record`'s summary (the file row says when there is none) with the live rows; or one JSON object.
 fn print_summary(
     args: &LiveArgs,
@@ -238,16 +248,15 @@ fn print_summary(
     let target = args.output.clone().unwrap_or_default();
     if args.json {
         let mut json = record::json_summary(scene, label, &target, s, wall);
-        json["file"] = args
-            .output
-            .as_ref()
-            .map_or(serde_json::Value::Null, |p| p.display().to_string().into());
-        json["url"] = live.url.clone().into();
-        json["speed"] = args.speed.into();
-        json["served_messages"] = live.served.into();
-        json["clock_s"] = live.clock.as_secs_f64().into();
-        json["max_lag_s"] = live.max_lag.as_secs_f64().into();
-        outln!("{}", serde_json::to_string(&json)?);
+        json.file = args.output.as_ref().map(|p| p.display().to_string());
+        json.live = Some(LiveJson {
+            url: &live.url,
+            speed: args.speed,
+            served_messages: live.served,
+            clock_s: live.clock.as_secs_f64(),
+            max_lag_s: live.max_lag.as_secs_f64(),
+        });
+        output::json(&json)?;
     } else {
         let mut rows = record::summary_rows(scene, label, &target, s, wall);
         if args.output.is_none() {

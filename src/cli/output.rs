@@ -87,6 +87,16 @@ pub fn settle(outcome: Outcome) -> Outcome {
     }
 }
 
+/// Prints `value` as one line of JSON. Through `serde_json::Value`, whose objects (without serde_json's
+/// `preserve_order`) hold their keys in alphabetical order: the order every JSON output of coin-log has.
+///
+/// # Errors
+/// `value` cannot be represented as JSON (a map with keys that are not strings).
+pub fn json(value: &impl serde::Serialize) -> serde_json::Result<()> {
+    write_stdout(format_args!("{}\n", serde_json::to_value(value)?));
+    Ok(())
+}
+
 /// `print!` that survives a closed or full stdout.
 macro_rules! out {
     ($($arg:tt)*) => { $crate::cli::output::write_stdout(format_args!($($arg)*)) };

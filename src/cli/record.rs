@@ -14,6 +14,7 @@ use coin_log::record::{self, RecordOptions, RecordSummary};
 use coin_log::scene::{self, limits, FlagOverrides, Scene};
 use coin_log_mcap::Compression;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -149,15 +150,23 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
     let e = record::estimate(scene, args.compression, args.flags.encoding);
     let toml = scene.to_toml();
     if args.json {
-        let json = serde_json::json!({
-            "scene": label,
-            "resolved": toml,
-            "samples": e.samples,
-            "messages": e.messages,
-            "channels": e.per_channel.iter().map(|(c, n)| (c.name().to_string(), *n)).collect::<std::collections::BTreeMap<_, _>>(),
-            "estimated_bytes": e.bytes,
-        });
-        outln!("{}", serde_json::to_string(&json)?);
+        #[derive(Serialize)]
+        struct DryRun<'a> {
+            scene: &'a str,
+            resolved: &'a str,
+            samples: u64,
+            messages: u64,
+            channels: std::collections::BTreeMap<&'static str, u64>,
+            estimated_bytes: u64,
+        }
+        output::json(&DryRun {
+            scene: label,
+            resolved: &toml,
+            samples: e.samples,
+            messages: e.messages,
+            channels: e.per_channel.iter().map(|(c, n)| (c.name(), *n)).collect(),
+            estimated_bytes: e.bytes,
+        })?;
         return Ok(Outcome::Success);
     }
     out!(
@@ -410,8 +419,7 @@ fn print_summary(
     wall: Duration,
 ) -> anyhow::Result<()> {
     if args.json {
-        let json = json_summary(scene, label, target, s, wall);
-        outln!("{}", serde_json::to_string(&json)?);
+        output::json(&json_summary::<()>(scene, label, target, s, wall))?;
     } else {
         for (key, value) in summary_rows(scene, label, target, s, wall) {
             outln!("{key:<16} {value}");
@@ -473,42 +481,49 @@ fn messages_per_second(s: &RecordSummary, seconds: f64) -> f64 {
     }
 }
 
-pub(super) fn json_summary(
+/// The object `record --json` prints: the library's summary with what the command adds (format.md:
+/// record, Summary); `live` adds its own fields.
+#[derive(Serialize)]
+pub(super) struct SummaryJson<'a, Live: Serialize> {
+    scene: &'a str,
+    /// The output file; `null` for `live` without `-o`.
+    pub(super) file: Option<String>,
+    #[serde(flatten)]
+    summary: &'a RecordSummary,
+    wall_time_s: f64,
+    messages_per_second: f64,
+    integrator: &'static str,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    step: Option<f64>,
+    peak_rss_bytes: Option<u64>,
+    #[serde(flatten)]
+    pub(super) live: Option<Live>,
+}
+
+pub(super) fn json_summary<'a, Live: Serialize>(
     scene: &Scene,
-    label: &str,
+    label: &'a str,
     target: &Path,
-    s: &RecordSummary,
+    s: &'a RecordSummary,
     wall: Duration,
-) -> serde_json::Value {
+) -> SummaryJson<'a, Live> {
     let seconds = wall.as_secs_f64();
     let m = &scene.run.method;
     let adaptive = m.method.is_adaptive();
-    serde_json::json!({
-        "scene": label,
-        "file": target.display().to_string(),
-        "samples": s.samples,
-        "messages": s.messages,
-        "bytes": s.bytes,
-        "wall_time_s": seconds,
-        "messages_per_second": messages_per_second(s, seconds),
-        "integrator": m.method.name(),
-        "rtol": adaptive.then_some(m.rtol),
-        "atol": adaptive.then_some(m.atol),
-        "step": (!adaptive).then_some(m.step),
-        "steps": s.stats.steps,
-        "rhs_evaluations": s.stats.rhs_evaluations,
-        "rejected_steps": s.stats.rejected_steps,
-        "energy_drift": s.energy_drift,
-        "energy_tolerance": s.energy_tolerance,
-        "invariant_drift": s.invariant_drift,
-        "steady_residual": s.steady_residual,
-        "termination": s.termination.name(),
-        "termination_time": s.termination_time,
-        "event_trusted": s.event_trusted,
-        "dissipated_work": s.dissipated_work,
-        "termination_alpha": s.termination_alpha,
-        "peak_rss_bytes": peak_rss_bytes(),
-    })
+    SummaryJson {
+        scene: label,
+        file: Some(target.display().to_string()),
+        summary: s,
+        wall_time_s: seconds,
+        messages_per_second: messages_per_second(s, seconds),
+        integrator: m.method.name(),
+        rtol: adaptive.then_some(m.rtol),
+        atol: adaptive.then_some(m.atol),
+        step: (!adaptive).then_some(m.step),
+        peak_rss_bytes: peak_rss_bytes(),
+        live: None,
+    }
 }
 
 pub(super) fn summary_rows(

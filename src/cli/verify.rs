@@ -7,6 +7,7 @@ use super::Outcome;
 use coin_log::files::input::check;
 use coin_log::files::{escaped, shown, InputKind};
 use coin_log::verify::{self, FileReport, Options, Report, Verdict};
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// What `coin-log verify --help` adds after the options: the checks, the tolerance formula, exit codes.
@@ -82,10 +83,14 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
         }
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string(&with_peak_rss(&report, &peaks)?)?
-        );
+        let files = report.files.iter().zip(peaks);
+        let files = files.map(|(report, peak_rss_bytes)| FileJson {
+            report,
+            peak_rss_bytes,
+        });
+        super::output::json(&Json {
+            files: files.collect(),
+        })?;
     } else {
         out!("{}", table(&report));
         if report.files.len() > 1 {
@@ -135,19 +140,16 @@ fn total(report: &Report) -> String {
 
 /// The contract's JSON plus `peak_rss_bytes` in each file object: the process's peak resident set size
 /// (VmHWM) once that file was judged, `null` where the system does not report it.
-fn with_peak_rss(report: &Report, peaks: &[Option<u64>]) -> anyhow::Result<serde_json::Value> {
-    let mut json = serde_json::to_value(report)?;
-    if let Some(files) = json
-        .get_mut("files")
-        .and_then(serde_json::Value::as_array_mut)
-    {
-        for (file, peak) in files.iter_mut().zip(peaks) {
-            if let Some(object) = file.as_object_mut() {
-                object.insert("peak_rss_bytes".into(), serde_json::json!(peak));
-            }
-        }
-    }
-    Ok(json)
+#[derive(Serialize)]
+struct Json<'a> {
+    files: Vec<FileJson<'a>>,
+}
+
+#[derive(Serialize)]
+struct FileJson<'a> {
+    #[serde(flatten)]
+    report: &'a FileReport,
+    peak_rss_bytes: Option<u64>,
 }
 
 fn number(x: Option<f64>) -> String {

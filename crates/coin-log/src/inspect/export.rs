@@ -22,7 +22,7 @@ use crate::format::json::read_fields;
 use crate::format::Channel;
 use crate::format::Encoding;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{self, BufWriter, Write};
 use std::ops::ControlFlow;
@@ -59,7 +59,7 @@ pub const TF_COLUMNS: [&str; 10] = [
 ];
 
 /// One table written.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Table {
     /// File name (`omega.csv`).
     pub name: String,
@@ -72,7 +72,7 @@ pub struct Table {
 }
 
 /// A channel not exported, and why.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Skipped {
     /// Topic.
     pub topic: String,
@@ -80,8 +80,8 @@ pub struct Skipped {
     pub reason: String,
 }
 
-/// What an export wrote.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+/// What an export wrote (`export --json` prints it).
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
 pub struct ExportSummary {
     /// The tables, in the order they were opened.
     pub tables: Vec<Table>,
