@@ -330,11 +330,16 @@ fn a_recording_whose_move_fails_is_kept_under_the_name_the_error_gives() {
         .spawn()
         .unwrap();
     let started = Instant::now();
-    while !listing(dir.path())
-        .iter()
-        .any(|n| n.starts_with(".coin-log-"))
-    {
-        assert!(started.elapsed() < DEADLINE, "no temporary file appeared");
+    // Until the recording holds a few chunks (so that verify can judge it), not just the temporary file.
+    let written = || {
+        listing(dir.path())
+            .iter()
+            .filter(|n| n.starts_with(".coin-log-"))
+            .filter_map(|n| std::fs::metadata(dir.path().join(n)).ok())
+            .any(|m| m.len() > 4 << 20)
+    };
+    while !written() {
+        assert!(started.elapsed() < DEADLINE, "no recording was written");
         std::thread::sleep(Duration::from_millis(10));
     }
     std::fs::remove_file(&target).unwrap();
