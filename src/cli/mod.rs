@@ -110,7 +110,11 @@ impl From<Outcome> for ExitCode {
 
 /// Parses the command line, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help, --version and usage errors, printed so that a failed write is seen (`--help > /dev/full`).
+        Err(e) => return output::settle(output::clap_message(&e)).into(),
+    };
     let outcome = run(cli).unwrap_or_else(|e| {
         output::errln!("error: {e:#}");
         Outcome::Failure

@@ -15,14 +15,17 @@ const AFTER_HELP: &str = "\
 Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata
 (found through the summary's metadata index wherever it sits, so files rewritten by other MCAP writers
 verify too), the physics is recomputed from the stored channels (never re-simulated). Checks: integrity,
-energy, invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance
-and pass/fail, or skip with the reason it could not run.
+energy, invariants, steady, constraint, consistency, validity, nutation (period and heading advance per
+nutation period against the quadrature); each reports its measured value, tolerance and pass/fail, or skip
+with the reason it could not run.
 
 Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
 W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a) for adaptive methods, or for fixed-step methods
 of order p with step h (rk4, gauss4: p = 4) eps = (h W)^p (only the settings the method uses count):
   energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
   constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
+  nutation period and advance:    min(1e-6, max(1e-11, 100 eps)), plus the quadrature's and the
+                                  interpolation's error estimates
 Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
 reaction) must agree to 1e-12 relative; N >= 0 and |F| <= mu N are held to 1e-12 Mg.
 

@@ -21,6 +21,7 @@ mod cli_paths;
 mod cli_pipes;
 mod cli_record;
 mod cli_scene_limits;
+mod cli_words;
 mod datasets;
 mod dissipation;
 mod events;
