@@ -3,16 +3,19 @@
 //! scene, prints, and writes the map's files.
 
 use super::scene_arg::load_source;
-use super::{make_readable, Outcome};
+use super::text::number as n;
+use super::Outcome;
 use anyhow::{anyhow, Context};
 use coin_log::analyse::map::{
     band_report, stability_map, Branches, Grid, MapOptions, DEFAULT_OMEGA_Z, DEFAULT_THETA,
 };
 use coin_log::analyse::{motion_name, Analysis, SteadyAnalysis, Verdict};
+use coin_log::files::{shown, OutputFolder};
 use coin_log::model::nutation::Motion;
 use coin_log::model::{Coin, CoinParams, SteadyFamily};
 use coin_log::scene::{RunFile, Scene};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `coin-log analyse`.
@@ -108,7 +111,7 @@ fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> 
         );
     }
     if json {
-        outln!("{}", serde_json::to_string(&analysis.json())?);
+        super::output::json(&analysis.json())?;
     } else {
         for (key, value) in summary(arg, &scene, &analysis) {
             outln!("{key:<16} {value}");
@@ -120,11 +123,11 @@ fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> 
 fn body(p: &CoinParams) -> String {
     format!(
         "M = {}, a = {}, g = {}, I_X = {}, I_Z = {}",
-        p.mass(),
-        p.radius(),
-        p.gravity(),
-        p.inertia_x(),
-        p.inertia_z()
+        n(p.mass()),
+        n(p.radius()),
+        n(p.gravity()),
+        n(p.inertia_x()),
+        n(p.inertia_z())
     )
 }
 
@@ -139,11 +142,14 @@ fn summary(label: &str, scene: &Scene, a: &Analysis) -> Vec<(&'static str, Strin
             "state",
             format!(
                 "θ = {}, ω = ({}, {}, {})",
-                s.theta, s.omega_x, s.omega_y, s.omega_z
+                n(s.theta),
+                n(s.omega_x),
+                n(s.omega_y),
+                n(s.omega_z)
             ),
         ),
-        ("energy", format!("E = {}", o.energy)),
-        ("invariants", format!("C1 = {}, C2 = {}", o.c1, o.c2)),
+        ("energy", format!("E = {}", n(o.energy))),
+        ("invariants", format!("C1 = {}, C2 = {}", n(o.c1), n(o.c2))),
     ];
     match (&a.steady, o.motion) {
         (Some(steady), _) => rows.extend(steady_rows(steady)),
@@ -155,7 +161,7 @@ fn summary(label: &str, scene: &Scene, a: &Analysis) -> Vec<(&'static str, Strin
             format!(
                 "{}; σ² = {}, {}",
                 family(base),
-                base.sigma_squared,
+                n(base.sigma_squared),
                 verdict(base)
             ),
         ));
@@ -181,11 +187,11 @@ fn verdict(s: &SteadyAnalysis) -> String {
     match s.verdict {
         Verdict::Stable => format!(
             "stable: small perturbations nutate with period 2π/σ = {}",
-            s.nutation_period().unwrap_or(f64::NAN)
+            n(s.nutation_period().unwrap_or(f64::NAN))
         ),
         Verdict::Unstable => format!(
             "unstable: small perturbations grow like e^(t/τ), τ = 1/√(−σ²) = {}",
-            s.e_folding_time().unwrap_or(f64::NAN)
+            n(s.e_folding_time().unwrap_or(f64::NAN))
         ),
         Verdict::Marginal => {
             "marginal: σ² = 0 to rounding, the linearisation does not decide".to_string()
@@ -194,27 +200,35 @@ fn verdict(s: &SteadyAnalysis) -> String {
 }
 
 fn steady_rows(s: &SteadyAnalysis) -> Vec<(&'static str, String)> {
-    let radius = |r: Option<f64>| r.map_or_else(|| "∞".to_string(), |r| r.to_string());
+    let radius = |r: Option<f64>| r.map_or_else(|| "∞".to_string(), n);
     let root = s.eigenvalues[2];
     let pair = if root.1 != 0.0 {
-        format!("±{} i", root.1)
+        format!("±{} i", n(root.1))
     } else {
-        format!("±{}", root.0)
+        format!("±{}", n(root.0))
     };
     vec![
         ("motion", family(s)),
         (
             "rates",
-            format!("ω_Y = {}, φ̇ = {}, ψ̇ = {}", s.omega_y, s.phi_dot, s.psi_dot),
+            format!(
+                "ω_Y = {}, φ̇ = {}, ψ̇ = {}",
+                n(s.omega_y),
+                n(s.phi_dot),
+                n(s.psi_dot)
+            ),
         ),
         (
             "radii",
             format!("R_G = {}, R_C = {}", radius(s.r_g), radius(s.r_c)),
         ),
-        ("forces", format!("N = {}, |F| = {}", s.normal, s.friction)),
+        (
+            "forces",
+            format!("N = {}, |F| = {}", n(s.normal), n(s.friction)),
+        ),
         (
             "σ²",
-            format!("{} (docs/physics.md §9, eq (21))", s.sigma_squared),
+            format!("{} (docs/physics.md §9, eq (21))", n(s.sigma_squared)),
         ),
         ("eigenvalues", format!("0, 0, {pair}")),
         ("verdict", verdict(s)),
@@ -235,33 +249,42 @@ fn motion_rows(a: &Analysis, motion: Motion, flat_margin: f64) -> Vec<(&'static 
                 format!(
                     "{}: θ between {} and {}",
                     motion_name(&motion),
-                    o.theta_min,
-                    o.theta_max
+                    n(o.theta_min),
+                    n(o.theta_max)
                 ),
             ));
-            rows.push(("period", format!("T = {period}")));
+            rows.push(("period", format!("T = {}", n(period))));
             rows.push((
                 "heading",
                 format!(
-                    "ΔΦ = {precession} rad per period (mean φ̇ = {})",
-                    precession / period
+                    "ΔΦ = {} rad per period (mean φ̇ = {})",
+                    n(precession),
+                    n(precession / period)
                 ),
             ));
-            rows.push(("spin", format!("ΔΨ = {spin_advance} rad per period")));
+            rows.push(("spin", format!("ΔΨ = {} rad per period", n(spin_advance))));
         }
         Motion::FlatLanding { theta, time } => {
             let first = match o.lift_off {
                 Some(e) if e.time < time => format!(
                     "lifts off at t = {} (N reaches 0, θ = {}) before it would land flat: ",
-                    e.time, e.theta
+                    n(e.time),
+                    n(e.theta)
                 ),
                 _ => String::new(),
             };
             rows.push((
                 "motion",
                 format!(
-                    "{first}lands flat: θ reaches {theta} (flat margin {flat_margin}) at t = {time}, from θ = {}",
-                    if theta > 0.0 { o.theta_min } else { o.theta_max }
+                    "{first}lands flat: θ reaches {} (flat margin {}) at t = {}, from θ = {}",
+                    n(theta),
+                    n(flat_margin),
+                    n(time),
+                    n(if theta > 0.0 {
+                        o.theta_min
+                    } else {
+                        o.theta_max
+                    })
                 ),
             ));
         }
@@ -279,24 +302,38 @@ fn force_rows(a: &Analysis) -> Vec<(&'static str, String)> {
     let normal = match o.lift_off {
         Some(event) => format!(
             "min N = {} at θ = {}: N reaches 0 at θ = {}, t = {}, where the coin lifts off",
-            o.min_normal.value, o.min_normal.theta, event.theta, event.time
+            n(o.min_normal.value),
+            n(o.min_normal.theta),
+            n(event.theta),
+            n(event.time)
         ),
         None => format!(
             "min N = {} at θ = {}: stays positive",
-            o.min_normal.value, o.min_normal.theta
+            n(o.min_normal.value),
+            n(o.min_normal.theta)
         ),
     };
     let need = o.max_friction_ratio.map_or_else(
         || "|F|/N grows without bound as N reaches 0: no μ keeps it rolling".to_string(),
-        |e| format!("needs μ ≥ max |F|/N = {} (at θ = {})", e.value, e.theta),
+        |e| {
+            format!(
+                "needs μ ≥ max |F|/N = {} (at θ = {})",
+                n(e.value),
+                n(e.theta)
+            )
+        },
     );
     let friction = match (a.friction, a.slips()) {
-        (Some(mu), Some(true)) => format!("{need}; the scene's μ = {mu}: it slips"),
-        (Some(mu), _) => format!("{need}; the scene's μ = {mu} holds"),
+        (Some(mu), Some(true)) => format!("{need}; the scene's μ = {}: it slips", n(mu)),
+        (Some(mu), _) => format!("{need}; the scene's μ = {} holds", n(mu)),
         (None, _) => need,
     };
     vec![("normal force", normal), ("friction", friction)]
 }
+
+/// The map's files.
+const CSV: &str = "stability-map.csv";
+const SVG: &str = "stability-map.svg";
 
 fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     let options = MapOptions {
@@ -317,15 +354,16 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     let csv = map.csv();
     let svg = map.svg()?;
     let elapsed = started.elapsed().as_secs_f64();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating the output folder `{}`", args.out.display()))?;
-    let csv_path = args.out.join("stability-map.csv");
-    let svg_path = args.out.join("stability-map.svg");
-    // Both checked before either is written, so a refusal leaves the folder as it was.
-    super::destination::refuse_special(&csv_path)?;
-    super::destination::refuse_special(&svg_path)?;
-    write_replacing(&csv_path, &csv)?;
-    write_replacing(&svg_path, &svg)?;
+    // The map replaces its own files; both are checked before either is moved into place.
+    let mut folder = OutputFolder::create(&args.out, true)?;
+    for (name, text) in [(CSV, &csv), (SVG, &svg)] {
+        let shown_name = shown(&args.out.join(name));
+        let mut file = folder.file(name)?;
+        file.write_all(text.as_bytes())
+            .with_context(|| format!("writing `{shown_name}`"))?;
+    }
+    folder.commit()?;
+    let (csv_path, svg_path) = (args.out.join(CSV), args.out.join(SVG));
     let branches = match options.branches {
         Branches::Plus => "the + branch",
         Branches::Minus => "the − branch",
@@ -343,7 +381,7 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     outln!(
         "{:<16} {} (straight rolling is unstable below it, docs/physics.md §5)",
         "ω_c",
-        map.critical_spin
+        n(map.critical_spin)
     );
     let report = band_report(&coin);
     if !report.is_empty() {
@@ -353,29 +391,8 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     outln!(
         "{:<16} {}, {} ({elapsed:.3} s)",
         "wrote",
-        csv_path.display(),
-        svg_path.display()
+        shown(&csv_path),
+        shown(&svg_path)
     );
     Ok(Outcome::Success)
-}
-
-/// Writes `text` to `path` through a temporary file in the same folder, so that a failure leaves the old
-/// file (or none), never half of the new one.
-fn write_replacing(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    super::destination::refuse_special(path)?;
-    let folder = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut temp = tempfile::Builder::new()
-        .prefix(".coin-log-")
-        .tempfile_in(folder)
-        .with_context(|| format!("cannot write in `{}`", folder.display()))?;
-    temp.write_all(text.as_bytes())
-        .with_context(|| format!("writing `{}`", path.display()))?;
-    make_readable(temp.as_file());
-    temp.persist(path)
-        .map_err(|e| anyhow!("cannot write `{}`: {}", path.display(), e.error))?;
-    Ok(())
 }

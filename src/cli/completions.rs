@@ -4,6 +4,8 @@
 use super::{Cli, Outcome};
 use anyhow::Context;
 use clap::CommandFactory;
+use coin_log::files::{shown, OutputFolder};
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `coin-log completions`.
@@ -26,7 +28,8 @@ pub struct CompletionsArgs {
 /// ...) into DIR.
 #[derive(Debug, clap::Args)]
 pub struct ManArgs {
-    /// Folder for the man pages (created if missing).
+    /// Folder for the man pages (created if missing; pages already there are replaced, but never a link,
+    /// pipe or device in their place).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
@@ -44,22 +47,36 @@ pub fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
 
 /// Runs `coin-log man`.
 pub fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
-    let cmd = Cli::command();
-    match &args.out {
-        None => {
-            let mut page = Vec::new();
-            clap_mangen::Man::new(cmd)
-                .render(&mut page)
-                .context("writing the man page")?;
-            out!("{}", String::from_utf8_lossy(&page));
-        }
-        Some(dir) => {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create the folder `{}`", dir.display()))?;
-            clap_mangen::generate_to(cmd, dir)
-                .with_context(|| format!("writing man pages into `{}`", dir.display()))?;
-            outln!("{}", dir.display());
-        }
-    }
+    let Some(dir) = &args.out else {
+        let mut page = Vec::new();
+        clap_mangen::Man::new(Cli::command())
+            .render(&mut page)
+            .context("writing the man page")?;
+        out!("{}", String::from_utf8_lossy(&page));
+        return Ok(Outcome::Success);
+    };
+    // The pages replace earlier ones (regular files only), all moved into place once every page is written.
+    let mut folder = OutputFolder::create(dir, true)?;
+    let mut cmd = Cli::command().disable_help_subcommand(true);
+    cmd.build();
+    write_pages(cmd, &mut folder)?;
+    folder.commit()?;
+    outln!("{}", shown(dir));
     Ok(Outcome::Success)
+}
+
+/// The page of `cmd` and of each visible subcommand, as `clap_mangen::generate_to` names them, written
+/// through `folder` (generate_to itself would follow a link and block on a named pipe).
+fn write_pages(cmd: clap::Command, folder: &mut OutputFolder) -> anyhow::Result<()> {
+    for sub in cmd.get_subcommands().filter(|s| !s.is_hide_set()) {
+        write_pages(sub.clone(), folder)?;
+    }
+    let man = clap_mangen::Man::new(cmd);
+    let name = man.get_filename();
+    let mut page = Vec::new();
+    man.render(&mut page)?;
+    folder
+        .file(&name)?
+        .write_all(&page)
+        .with_context(|| format!("writing `{}`", shown(&folder.path().join(&name))))
 }

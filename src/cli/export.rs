@@ -1,15 +1,16 @@
 //! `coin-log export`: a file's channels as CSV tables in a folder. Every table is written to a temporary
 //! file in the folder and moved into place only when the whole file has been exported, so an error leaves
-//! the folder as it was; an existing table is never replaced without `--overwrite`.
+//! the folder as it was (and removes it if export created it); an existing table is never replaced
+//! without `--overwrite` (files::output).
 
-use super::progress::{file_len, FileProgress};
+use super::progress::FileProgress;
 use super::rss::peak_rss_bytes;
-use super::{make_readable, Outcome};
-use anyhow::{anyhow, bail, Context};
+use super::Outcome;
+use anyhow::{anyhow, bail};
+use coin_log::files::input::check;
+use coin_log::files::{shown, InputKind, OutputFolder};
 use coin_log::inspect::export::{self, ExportSummary, Layout};
-use std::fs::File;
 use std::path::{Path, PathBuf};
-use tempfile::NamedTempFile;
 
 /// The one-liners that turn the CSV tables into Parquet (pandas' default float parser is not exact; its
 /// `round_trip` parser and polars' are).
@@ -65,36 +66,10 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<Outcome> {
              the CSV tables, which hold the same numbers exactly; {PARQUET_HINT}"
         );
     }
-    let dir = out_dir(args)?;
-    let shown = args.file.display().to_string();
-    let progress = FileProgress::new(&shown, file_len(&args.file));
-    let mut temps: Vec<(String, NamedTempFile)> = Vec::new();
-    let result = {
-        let mut open = |name: &str| -> std::io::Result<File> {
-            let temp = tempfile::Builder::new()
-                .prefix(".coin-log-")
-                .suffix(".csv.tmp")
-                .tempfile_in(&dir)?;
-            let file = temp.reopen()?;
-            temps.push((name.to_string(), temp));
-            Ok(file)
-        };
-        let layout = if args.wide {
-            Layout::Wide
-        } else {
-            Layout::PerChannel
-        };
-        export::export(&args.file, layout, &mut open, &|b| progress.update(b))
-    };
-    progress.finish();
-    let summary = result.map_err(|e| anyhow!("{shown}: {e}"))?;
-    persist(temps, &dir, args.overwrite)?;
-    report(args, &dir, &summary)?;
-    Ok(Outcome::Success)
-}
-
-/// The output folder: `--out`, or `<stem>-csv`; created if missing, never a file.
-fn out_dir(args: &ExportArgs) -> anyhow::Result<PathBuf> {
+    let shown_file = shown(&args.file);
+    let len = check(&args.file, InputKind::Mcap)
+        .map_err(|e| anyhow!("{shown_file}: {e}"))?
+        .len();
     let dir = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .file
@@ -102,75 +77,44 @@ fn out_dir(args: &ExportArgs) -> anyhow::Result<PathBuf> {
             .map_or_else(|| "export".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from(format!("{stem}-csv"))
     });
-    if dir.exists() && !dir.is_dir() {
-        bail!(
-            "`{}` is a file; --out takes a folder for the tables",
-            dir.display()
-        );
-    }
-    std::fs::create_dir_all(&dir)
-        .with_context(|| format!("cannot create the folder `{}`", dir.display()))?;
-    Ok(dir)
-}
-
-/// Moves every finished table into place: first checks that none would replace a file (unless
-/// `overwrite`), so that either all tables land or none does.
-fn persist(temps: Vec<(String, NamedTempFile)>, dir: &Path, overwrite: bool) -> anyhow::Result<()> {
-    for (name, _) in &temps {
-        super::destination::refuse_special(&dir.join(name))?;
-    }
-    if !overwrite {
-        let existing: Vec<String> = temps
-            .iter()
-            .map(|(name, _)| dir.join(name))
-            .filter(|p| p.exists())
-            .map(|p| p.display().to_string())
-            .collect();
-        if !existing.is_empty() {
-            bail!(
-                "{} already exist(s); pass --overwrite to replace, or choose another folder with --out",
-                existing.join(", ")
-            );
-        }
-    }
-    for (name, temp) in temps {
-        let target = dir.join(&name);
-        temp.as_file()
-            .sync_all()
-            .with_context(|| format!("writing `{}`", target.display()))?;
-        make_readable(temp.as_file());
-        temp.persist(&target).map_err(|e| {
-            anyhow!(
-                "cannot move the table to `{}`: {}",
-                target.display(),
-                e.error
-            )
-        })?;
-    }
-    Ok(())
+    // Dropped on an error: every table and the folders it created go with it.
+    let mut folder = OutputFolder::create(&dir, args.overwrite)?;
+    let progress = FileProgress::new(&shown_file, len);
+    let layout = if args.wide {
+        Layout::Wide
+    } else {
+        Layout::PerChannel
+    };
+    let mut open = |name: &str| folder.file(name).map_err(std::io::Error::other);
+    let result = export::export(&args.file, layout, &mut open, &|b| progress.update(b));
+    progress.finish();
+    let summary = result.map_err(|e| anyhow!("{shown_file}: {e}"))?;
+    folder.commit()?;
+    report(args, &dir, &summary)?;
+    Ok(Outcome::Success)
 }
 
 fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()> {
     if args.json {
-        let json = serde_json::json!({
-            "file": args.file.display().to_string(),
-            "out": dir.display().to_string(),
-            "messages": s.messages,
-            "tables": s.tables.iter().map(|t| serde_json::json!({
-                "name": t.name, "topics": t.topics, "columns": t.columns, "rows": t.rows,
-            })).collect::<Vec<_>>(),
-            "skipped": s.skipped.iter().map(|k| serde_json::json!({
-                "topic": k.topic, "reason": k.reason,
-            })).collect::<Vec<_>>(),
-            "peak_rss_bytes": peak_rss_bytes(),
-        });
-        outln!("{}", serde_json::to_string(&json)?);
-        return Ok(());
+        #[derive(serde::Serialize)]
+        struct Json<'a> {
+            file: String,
+            out: String,
+            #[serde(flatten)]
+            summary: &'a ExportSummary,
+            peak_rss_bytes: Option<u64>,
+        }
+        return Ok(super::output::json(&Json {
+            file: args.file.display().to_string(),
+            out: dir.display().to_string(),
+            summary: s,
+            peak_rss_bytes: peak_rss_bytes(),
+        })?);
     }
     for t in &s.tables {
         outln!(
             "{}: {} rows × {} columns ({})",
-            dir.join(&t.name).display(),
+            shown(&dir.join(&t.name)),
             t.rows,
             t.columns.len(),
             t.topics.join(", ")

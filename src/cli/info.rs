@@ -3,11 +3,13 @@
 use super::text::size;
 use super::Outcome;
 use anyhow::bail;
+use coin_log::files::input::check;
+use coin_log::files::{shown, InputKind};
 use coin_log::format::metadata::number_string as n;
 use coin_log::inspect::info::{self, FileInfo};
 use coin_log::inspect::seconds_text;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `coin-log info`.
 ///
@@ -31,6 +33,19 @@ pub struct InfoArgs {
     scene: bool,
 }
 
+/// `info --json`: `{"files": [...]}`, each a file's object or, for a file that could not be read, its path
+/// and problem.
+#[derive(serde::Serialize)]
+struct Files {
+    files: Vec<serde_json::Value>,
+}
+
+#[derive(serde::Serialize)]
+struct Unreadable<'a> {
+    path: &'a str,
+    problem: &'a str,
+}
+
 /// Runs `coin-log info`: exit 0 when every file was described, 1 otherwise.
 pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
     if args.scene {
@@ -39,36 +54,44 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
     let mut failed = false;
     let mut json_files = Vec::new();
     for path in &args.files {
-        let shown = path.display().to_string();
-        match info::info(path) {
+        // As given in JSON (which escapes what it must), escaped in text.
+        let given = path.display().to_string();
+        match read(path) {
             Ok(i) => {
                 failed |= i.problem.is_some();
                 if args.json {
-                    json_files.push(i.to_json(&shown));
+                    json_files.push(serde_json::to_value(i.json(&given))?);
                 } else {
-                    out!("{}", text(&shown, &i));
+                    out!("{}", text(&shown(path), &i));
                 }
             }
             Err(e) => {
                 failed = true;
-                errln!("error: {shown}: {e}");
+                errln!("error: {}: {e}", shown(path));
                 if args.json {
-                    json_files.push(serde_json::json!({"path": shown, "problem": e.to_string()}));
+                    json_files.push(serde_json::to_value(Unreadable {
+                        path: &given,
+                        problem: &e,
+                    })?);
                 }
             }
         }
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string(&serde_json::json!({ "files": json_files }))?
-        );
+        super::output::json(&Files { files: json_files })?;
     }
     Ok(if failed {
         Outcome::Failure
     } else {
         Outcome::Success
     })
+}
+
+/// What the file at `path` holds; a path that is not a regular file is refused without being opened (a
+/// named pipe would block: files::input).
+fn read(path: &Path) -> Result<FileInfo, String> {
+    check(path, InputKind::Mcap).map_err(|e| e.to_string())?;
+    info::info(path).map_err(|e| e.to_string())
 }
 
 /// `--scene`: the stored scene, after comment lines saying where it comes from and how to reproduce it.
@@ -79,8 +102,8 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
             args.files.len()
         );
     };
-    let shown = path.display().to_string();
-    let i = info::info(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+    let shown = shown(path);
+    let i = read(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
     let run = match &i.run {
         Ok(run) => run,
         Err(e) => bail!("{shown}: {e}"),

@@ -5,8 +5,9 @@
 
 use super::record::{self, SceneFlags, Signals};
 use super::scene_arg::load_source;
-use super::{make_readable, output, Outcome};
+use super::{output, Outcome};
 use anyhow::{anyhow, Context};
+use coin_log::files::{shown, Output};
 use coin_log::live::{Discard, LiveEvent, LiveServer, LiveTap, Pacing, DEFAULT_PORT};
 use coin_log::record::{record_with_tap, RecordOptions, RecordSummary};
 use coin_log::scene::Scene;
@@ -15,7 +16,6 @@ use std::io::BufWriter;
 use std::net::IpAddr;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-use tempfile::NamedTempFile;
 
 /// Write buffer in front of the optional file.
 const WRITE_BUFFER: usize = 1 << 20;
@@ -104,13 +104,11 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
     tap.announce_topics(&scene.channels, args.flags.encoding);
     announce(&args, &server, &source.label);
-    let mut file = match &args.output {
-        Some(target) => {
-            let temp = record::prepare_output(target, args.overwrite, &source, &signals)?;
-            Some((target.clone(), temp))
-        }
-        None => None,
-    };
+    let mut file = args
+        .output
+        .as_ref()
+        .map(|target| record::prepare_output(target, args.overwrite, &source, &signals))
+        .transpose()?;
     let started = Instant::now();
     let options = RecordOptions {
         compression: Compression::default(),
@@ -127,8 +125,8 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
         clock: tap.elapsed(),
         url: server.url(),
     };
-    if let Some((target, temp)) = file.take() {
-        record::persist(temp, &target, args.overwrite, &signals)?;
+    if let Some(output) = file.take() {
+        record::persist(output, &signals)?;
     }
     print_summary(&args, &scene, &source.label, &summary, wall, &stats)?;
     let outcome = match &args.output {
@@ -181,27 +179,23 @@ fn tell(event: LiveEvent, pacing: Pacing) {
     }
 }
 
-/// Records into the optional file (or nowhere) through the live tap; the file is synced and readable.
+/// Records into the optional file (or nowhere) through the live tap.
 fn run_scene<F: FnMut(LiveEvent)>(
     scene: &Scene,
     options: &RecordOptions,
     tap: &mut LiveTap<'_, F>,
-    file: Option<&mut (PathBuf, NamedTempFile)>,
+    file: Option<&mut Output>,
     signals: &Signals,
 ) -> anyhow::Result<RecordSummary> {
     let stop = &signals.stop;
-    let Some((target, temp)) = file else {
+    let Some(output) = file else {
         return record_with_tap(scene, options, Discard::default(), tap, stop, |_| {})
             .context("running the scene");
     };
-    let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());
-    let summary = record_with_tap(scene, options, writer, tap, stop, |_| {})
-        .with_context(|| format!("recording `{}`", target.display()))?;
-    temp.as_file()
-        .sync_all()
-        .with_context(|| format!("writing `{}`", target.display()))?;
-    make_readable(temp.as_file());
-    Ok(summary)
+    let shown = shown(output.target());
+    let writer = BufWriter::with_capacity(WRITE_BUFFER, output.file());
+    record_with_tap(scene, options, writer, tap, stop, |_| {})
+        .with_context(|| format!("recording `{shown}`"))
 }
 
 /// The exit code of a run without a file.
@@ -232,6 +226,16 @@ struct Stats {
     url: String,
 }
 
+/// What `live --json` adds to `record`'s summary.
+#[derive(serde::Serialize)]
+struct LiveJson<'a> {
+    url: &'a str,
+    speed: f64,
+    served_messages: u64,
+    clock_s: f64,
+    max_lag_s: f64,
+}
+
 /// `record`'s summary (the file row says when there is none) with the live rows; or one JSON object.
 fn print_summary(
     args: &LiveArgs,
@@ -244,16 +248,15 @@ fn print_summary(
     let target = args.output.clone().unwrap_or_default();
     if args.json {
         let mut json = record::json_summary(scene, label, &target, s, wall);
-        json["file"] = args
-            .output
-            .as_ref()
-            .map_or(serde_json::Value::Null, |p| p.display().to_string().into());
-        json["url"] = live.url.clone().into();
-        json["speed"] = args.speed.into();
-        json["served_messages"] = live.served.into();
-        json["clock_s"] = live.clock.as_secs_f64().into();
-        json["max_lag_s"] = live.max_lag.as_secs_f64().into();
-        outln!("{}", serde_json::to_string(&json)?);
+        json.file = args.output.as_ref().map(|p| p.display().to_string());
+        json.live = Some(LiveJson {
+            url: &live.url,
+            speed: args.speed,
+            served_messages: live.served,
+            clock_s: live.clock.as_secs_f64(),
+            max_lag_s: live.max_lag.as_secs_f64(),
+        });
+        output::json(&json)?;
     } else {
         let mut rows = record::summary_rows(scene, label, &target, s, wall);
         if args.output.is_none() {

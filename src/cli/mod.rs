@@ -6,7 +6,6 @@ mod output;
 mod analyse;
 mod bench;
 mod completions;
-mod destination;
 mod export;
 mod info;
 #[cfg(feature = "live")]
@@ -111,7 +110,11 @@ impl From<Outcome> for ExitCode {
 
 /// Parses the command line, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help, --version and usage errors, printed so that a failed write is seen (`--help > /dev/full`).
+        Err(e) => return output::settle(output::clap_message(&e)).into(),
+    };
     let outcome = run(cli).unwrap_or_else(|e| {
         output::errln!("error: {e:#}");
         Outcome::Failure
@@ -152,17 +155,6 @@ pub(crate) fn named<
 >() -> impl clap::builder::TypedValueParser<Value = T> {
     use clap::builder::TypedValueParser;
     clap::builder::PossibleValuesParser::new(T::NAMES).try_map(|s| s.parse::<T>())
-}
-
-/// Temporary files are created owner-only; a finished output file is an ordinary file.
-pub(crate) fn make_readable(file: &std::fs::File) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = file;
 }
 
 #[cfg(test)]

@@ -87,6 +87,30 @@ pub fn settle(outcome: Outcome) -> Outcome {
     }
 }
 
+/// Prints clap's help, version or usage error (`Cli::try_parse`'s error) with its colours, as
+/// `Error::exit` would, but a failed write to stdout counts like every other (`--help > /dev/full`);
+/// returns clap's exit code: 0 for help and version, 2 for a usage error.
+pub fn clap_message(e: &clap::Error) -> Outcome {
+    if e.use_stderr() {
+        let _ = e.print();
+        return Outcome::Unusable;
+    }
+    if let Err(error) = e.print().and_then(|()| io::stdout().lock().flush()) {
+        note_error(&mut state(), error);
+    }
+    Outcome::Success
+}
+
+/// Prints `value` as one line of JSON. Through `serde_json::Value`, whose objects (without serde_json's
+/// `preserve_order`) hold their keys in alphabetical order: the order every JSON output of coin-log has.
+///
+/// # Errors
+/// `value` cannot be represented as JSON (a map with keys that are not strings).
+pub fn json(value: &impl serde::Serialize) -> serde_json::Result<()> {
+    write_stdout(format_args!("{}\n", serde_json::to_value(value)?));
+    Ok(())
+}
+
 /// `print!` that survives a closed or full stdout.
 macro_rules! out {
     ($($arg:tt)*) => { $crate::cli::output::write_stdout(format_args!($($arg)*)) };

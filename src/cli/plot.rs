@@ -2,10 +2,12 @@
 //! never over an existing file without `--overwrite`.
 
 use super::Outcome;
-use anyhow::{anyhow, bail, Context};
+use anyhow::anyhow;
+use coin_log::files::input::check;
+use coin_log::files::{shown, InputKind, Output, Policy};
 use coin_log::inspect::plot;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `coin-log plot`.
 ///
@@ -25,8 +27,10 @@ pub struct PlotArgs {
     overwrite: bool,
 }
 
-/// Runs `coin-log plot`.
+/// Runs `coin-log plot`: exit 0 for a picture of the whole file; a file that breaks off part way is drawn
+/// up to the break, and the problem is an error (exit 1).
 pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
+    let shown_file = shown(&args.file);
     let target = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .file
@@ -34,40 +38,34 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
             .map_or_else(|| "plot".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from(format!("{stem}.svg"))
     });
-    if target.is_dir() {
-        bail!(
-            "`{}` is a folder; give the picture a file name, e.g. --out {}",
-            target.display(),
-            target.join("plot.svg").display()
-        );
-    }
-    super::destination::refuse_special(&target)?;
-    if target.exists() && !args.overwrite {
-        bail!("`{}` already exists; pass --overwrite to replace it, or choose another file with --out", target.display());
-    }
-    let name = args.file.file_name().map_or_else(
-        || args.file.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
-    let svg = plot::plot(&args.file, &name).map_err(|e| anyhow!("{}: {e}", args.file.display()))?;
-    let folder = super::destination::folder_of(&target);
-    let mut temp = tempfile::Builder::new()
-        .prefix(".coin-log-")
-        .suffix(".svg.tmp")
-        .tempfile_in(&folder)
-        .with_context(|| format!("cannot write in `{}`", folder.display()))?;
-    temp.write_all(svg.as_bytes())
-        .and_then(|()| temp.as_file().sync_all())
-        .with_context(|| format!("writing `{}`", target.display()))?;
-    super::make_readable(temp.as_file());
-    let moved = if args.overwrite {
-        temp.persist(&target).map(|_| ()).map_err(|e| e.error)
-    } else {
-        temp.persist_noclobber(&target)
-            .map(|_| ())
-            .map_err(|e| e.error)
+    let policy = Policy {
+        overwrite: args.overwrite,
+        flag: "--out",
+        example: "plot.svg",
+        protect: None,
     };
-    moved.map_err(|e| anyhow!("cannot move the picture to `{}`: {e}", target.display()))?;
-    outln!("{}", target.display());
-    Ok(Outcome::Success)
+    // Before reading: a bad target costs nothing.
+    let mut output = Output::create(&target, &policy)?;
+    check(&args.file, InputKind::Mcap).map_err(|e| anyhow!("{shown_file}: {e}"))?;
+    let name = args
+        .file
+        .file_name()
+        .map_or_else(|| shown_file.clone(), |n| shown(Path::new(n)));
+    let picture = plot::plot(&args.file, &name).map_err(|e| anyhow!("{shown_file}: {e}"))?;
+    output
+        .file()
+        .write_all(picture.svg.as_bytes())
+        .map_err(|e| output.write_error(e))?;
+    output.commit()?;
+    outln!("{}", shown(&target));
+    Ok(match picture.broken {
+        Some(broken) => {
+            errln!(
+                "error: {shown_file}: {broken}; `{}` shows the file up to the break",
+                shown(&target)
+            );
+            Outcome::Failure
+        }
+        None => Outcome::Success,
+    })
 }

@@ -46,8 +46,3 @@ impl FileProgress {
         self.bar.finish_and_clear();
     }
 }
-
-/// The size of a file in bytes, 0 when it cannot be read (the reader then reports why).
-pub fn file_len(path: &std::path::Path) -> u64 {
-    std::fs::metadata(path).map_or(0, |m| m.len())
-}

@@ -4,21 +4,22 @@
 
 use super::rss::peak_rss_bytes;
 use super::scene_arg::{load_source, SceneSource};
-use super::text::size;
-use super::{destination, make_readable, output, Outcome};
-use anyhow::{anyhow, bail, Context};
+use super::text::{number, size};
+use super::{output, Outcome};
+use anyhow::{anyhow, Context};
+use coin_log::files::{shown, Output, Policy};
 use coin_log::format::Encoding;
 use coin_log::format::Termination;
 use coin_log::record::{self, RecordOptions, RecordSummary};
 use coin_log::scene::{self, limits, FlagOverrides, Scene};
 use coin_log_mcap::Compression;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
-use tempfile::NamedTempFile;
 
 /// Runs shorter than this show no progress bar.
 const PROGRESS_DELAY: Duration = Duration::from_secs(1);
@@ -64,24 +65,27 @@ pub struct RecordArgs {
 /// The flags `record` and `live` share: scene overrides, edits and the message encoding.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SceneFlags {
-    /// Duration in the scene's time unit (overrides `run.duration`).
+    /// Duration in the scene's time unit, > 0, with T·W ≤ 1e10 radians of the fastest motion W =
+    /// max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0 (overrides `run.duration`).
     #[arg(long, value_name = "T")]
     pub duration: Option<f64>,
-    /// Samples per time unit (overrides `run.rate`; scene default 100).
+    /// Samples per time unit, > 0, at most 1/(1e-9 + 3·2⁻⁵²·T) (just under 1e9: samples stay ≥ 1 ns apart)
+    /// (overrides `run.rate`; scene default 100).
     #[arg(long, value_name = "R")]
     pub rate: Option<f64>,
     /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
     #[arg(long, value_name = "NAME")]
     pub integrator: Option<String>,
-    /// Relative tolerance of adaptive methods, 2.2e-15 to 1e-3 (overrides `run.rtol`; default 1e-10).
+    /// Relative tolerance of adaptive methods, 2.221e-15 (ten units of rounding, 10·2⁻⁵²) to 1e-3 (overrides
+    /// `run.rtol`; default 1e-10).
     #[arg(long, value_name = "X")]
     pub rtol: Option<f64>,
     /// Absolute tolerance of adaptive methods, at most 1e-3·min(1, a, 1/τ) (overrides `run.atol`; default
     /// 1e-12).
     #[arg(long, value_name = "X")]
     pub atol: Option<f64>,
-    /// Step of fixed-step methods, rounded down to divide 1/rate; step·W ≤ 0.178 with W the fastest rate at
-    /// t = 0 (overrides `run.step`; default 1e-3).
+    /// Step of fixed-step methods, rounded down to divide 1/rate; then step·W ≤ 0.1778 with W the fastest
+    /// rate at t = 0, as for --duration (overrides `run.step`; default 1e-3).
     #[arg(long, value_name = "H")]
     pub step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
@@ -89,7 +93,9 @@ pub struct SceneFlags {
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub channels: Option<Vec<String>>,
     /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
-    /// about half the size, and Rerun reads it). Both carry the same f64 values (docs/format.md: Encodings).
+    /// records about twice as fast, and Rerun reads it; the file is about 0.9× JSON's size with zstd, 0.6×
+    /// with lz4 or uncompressed: README, Performance). Both carry the same f64 values (docs/format.md:
+    /// Encodings).
     #[arg(long, default_value_t, value_parser = super::named::<Encoding>())]
     pub encoding: Encoding,
     /// Set a scene key before the flags above apply: KEY is a dotted path (`initial.theta`, `run.rtol`,
@@ -129,13 +135,13 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     }
     warn_if_large(&args, &scene);
     let target = output_path(&args, &source);
-    let mut temp = prepare_output(&target, args.overwrite, &source, &signals)?;
+    let mut output = prepare_output(&target, args.overwrite, &source, &signals)?;
     if signals.stopped() {
         errln!("interrupted before recording began: nothing was written");
         return Ok(Outcome::Interrupted);
     }
-    let (summary, wall) = record_into(&args, &scene, &target, &mut temp, &signals)?;
-    persist(temp, &target, args.overwrite, &signals)?;
+    let (summary, wall) = record_into(&args, &scene, &mut output, &signals)?;
+    persist(output, &signals)?;
     print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
     Ok(outcome(&summary, &target))
 }
@@ -149,15 +155,23 @@ fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outc
     let e = record::estimate(scene, args.compression, args.flags.encoding);
     let toml = scene.to_toml();
     if args.json {
-        let json = serde_json::json!({
-            "scene": label,
-            "resolved": toml,
-            "samples": e.samples,
-            "messages": e.messages,
-            "channels": e.per_channel.iter().map(|(c, n)| (c.name().to_string(), *n)).collect::<std::collections::BTreeMap<_, _>>(),
-            "estimated_bytes": e.bytes,
-        });
-        outln!("{}", serde_json::to_string(&json)?);
+        #[derive(Serialize)]
+        struct DryRun<'a> {
+            scene: &'a str,
+            resolved: &'a str,
+            samples: u64,
+            messages: u64,
+            channels: std::collections::BTreeMap<&'static str, u64>,
+            estimated_bytes: u64,
+        }
+        output::json(&DryRun {
+            scene: label,
+            resolved: &toml,
+            samples: e.samples,
+            messages: e.messages,
+            channels: e.per_channel.iter().map(|(c, n)| (c.name(), *n)).collect(),
+            estimated_bytes: e.bytes,
+        })?;
         return Ok(Outcome::Success);
     }
     out!(
@@ -306,47 +320,37 @@ fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)))
 }
 
-/// Checks the target and creates the temporary file beside it, all before simulating: the target must be
-/// absent or (with `--overwrite`) a regular file other than the scene, and its name must be creatable.
+/// Checks the target and creates the temporary file beside it, all before simulating (files::output):
+/// the target must be absent or (with `--overwrite`) a regular file other than the scene.
 pub(super) fn prepare_output(
     target: &Path,
     overwrite: bool,
     source: &SceneSource,
     signals: &Signals,
-) -> anyhow::Result<NamedTempFile> {
-    let existing =
-        destination::check_target(target, overwrite, source.path.as_deref(), &source.stem)?;
+) -> anyhow::Result<Output> {
+    let example = format!("{}.mcap", source.stem);
+    let policy = Policy {
+        overwrite,
+        flag: "-o",
+        example: &example,
+        protect: source
+            .path
+            .as_deref()
+            .map(|p| (p, "the scene file being recorded")),
+    };
+    // Locked while the temporary file is created, so that a second signal finds it to delete.
     let mut slot = signals.slot();
-    let temp = temp_file_beside(target)?;
-    *slot = Some(temp.path().to_path_buf());
-    drop(slot);
-    destination::probe_target(target, existing.as_ref(), &temp)?;
-    Ok(temp)
+    let output = Output::create(target, &policy)?;
+    *slot = Some(output.temp_path().to_path_buf());
+    Ok(output)
 }
 
-/// A temporary file in the target's folder, so that the finished recording is moved, not copied.
-fn temp_file_beside(target: &Path) -> anyhow::Result<NamedTempFile> {
-    let folder = destination::folder_of(target);
-    tempfile::Builder::new()
-        .prefix(".coin-log-")
-        .suffix(".mcap.tmp")
-        .tempfile_in(&folder)
-        .with_context(|| {
-            format!(
-                "cannot write in `{}` (for `{}`)",
-                folder.display(),
-                target.display()
-            )
-        })
-}
-
-/// Records the scene into `temp` with a signal finishing the file early and a progress bar on long runs;
-/// returns the summary and the wall time, the file synced to disk and readable.
+/// Records the scene into `output` with a signal finishing the file early and a progress bar on long runs;
+/// returns the summary and the wall time.
 fn record_into(
     args: &RecordArgs,
     scene: &Scene,
-    target: &Path,
-    temp: &mut NamedTempFile,
+    output: &mut Output,
     signals: &Signals,
 ) -> anyhow::Result<(RecordSummary, Duration)> {
     let options = RecordOptions {
@@ -359,49 +363,21 @@ fn record_into(
     let result = record::record(
         scene,
         &options,
-        BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut()),
+        BufWriter::with_capacity(WRITE_BUFFER, output.file()),
         &signals.stop,
         |t| update_progress(&bar, started, t / duration),
     );
     bar.finish_and_clear();
-    let summary = result.with_context(|| format!("recording `{}`", target.display()))?;
-    temp.as_file()
-        .sync_all()
-        .with_context(|| format!("writing `{}`", target.display()))?;
-    let wall = started.elapsed();
-    make_readable(temp.as_file());
-    Ok((summary, wall))
+    let summary = result.with_context(|| format!("recording `{}`", shown(output.target())))?;
+    Ok((summary, started.elapsed()))
 }
 
-/// Moves the finished recording into place; without `--overwrite` a file that appeared meanwhile is left
-/// alone and the recording kept under its temporary name.
-pub(super) fn persist(
-    temp: NamedTempFile,
-    target: &Path,
-    overwrite: bool,
-    signals: &Signals,
-) -> anyhow::Result<()> {
+/// Moves the finished recording into place (synced; kept under the name the error gives if the move fails).
+pub(super) fn persist(output: Output, signals: &Signals) -> anyhow::Result<()> {
     // Held until the move is done, so that a second signal cannot delete a file being moved.
     let mut slot = signals.slot();
     *slot = None;
-    if overwrite {
-        temp.persist(target).map_err(|e| {
-            anyhow!(
-                "cannot move the recording to `{}`: {}",
-                target.display(),
-                e.error
-            )
-        })?;
-    } else if let Err(e) = temp.persist_noclobber(target) {
-        // The target appeared while we were recording: keep our file rather than lose it.
-        let kept = e.file.keep().map(|(_, p)| p);
-        let kept = kept.map_or_else(|_| "(lost)".to_string(), |p| p.display().to_string());
-        bail!(
-            "`{}` appeared while recording and was left alone; the recording is kept at `{kept}`",
-            target.display()
-        );
-    }
-    Ok(())
+    Ok(output.commit()?)
 }
 
 /// The exit code of a finished recording; a numerical failure says where the samples stop.
@@ -410,8 +386,8 @@ pub(super) fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
         Some(f) => {
             errln!(
                 "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
-                summary.termination_time,
-                target.display()
+                number(summary.termination_time),
+                shown(target)
             );
             Outcome::Failure
         }
@@ -448,8 +424,7 @@ fn print_summary(
     wall: Duration,
 ) -> anyhow::Result<()> {
     if args.json {
-        let json = json_summary(scene, label, target, s, wall);
-        outln!("{}", serde_json::to_string(&json)?);
+        output::json(&json_summary::<()>(scene, label, target, s, wall))?;
     } else {
         for (key, value) in summary_rows(scene, label, target, s, wall) {
             outln!("{key:<16} {value}");
@@ -461,7 +436,7 @@ fn print_summary(
     if output::stdout_failed() {
         errln!(
             "note: the recording `{}` is complete; only its summary was lost",
-            target.display()
+            shown(target)
         );
     }
     Ok(())
@@ -475,7 +450,7 @@ pub(super) fn untrusted_event(s: &RecordSummary) -> String {
          before the event, which may be an artefact of it; tighten --rtol/--atol (dopri5, dop853) or \
          --step (rk4, gauss4)",
         s.termination.name(),
-        s.termination_time,
+        number(s.termination_time),
         s.energy_drift,
         s.energy_tolerance
     )
@@ -511,42 +486,49 @@ fn messages_per_second(s: &RecordSummary, seconds: f64) -> f64 {
     }
 }
 
-pub(super) fn json_summary(
+/// The object `record --json` prints: the library's summary with what the command adds (format.md:
+/// record, Summary); `live` adds its own fields.
+#[derive(Serialize)]
+pub(super) struct SummaryJson<'a, Live: Serialize> {
+    scene: &'a str,
+    /// The output file; `null` for `live` without `-o`.
+    pub(super) file: Option<String>,
+    #[serde(flatten)]
+    summary: &'a RecordSummary,
+    wall_time_s: f64,
+    messages_per_second: f64,
+    integrator: &'static str,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    step: Option<f64>,
+    peak_rss_bytes: Option<u64>,
+    #[serde(flatten)]
+    pub(super) live: Option<Live>,
+}
+
+pub(super) fn json_summary<'a, Live: Serialize>(
     scene: &Scene,
-    label: &str,
+    label: &'a str,
     target: &Path,
-    s: &RecordSummary,
+    s: &'a RecordSummary,
     wall: Duration,
-) -> serde_json::Value {
+) -> SummaryJson<'a, Live> {
     let seconds = wall.as_secs_f64();
     let m = &scene.run.method;
     let adaptive = m.method.is_adaptive();
-    serde_json::json!({
-        "scene": label,
-        "file": target.display().to_string(),
-        "samples": s.samples,
-        "messages": s.messages,
-        "bytes": s.bytes,
-        "wall_time_s": seconds,
-        "messages_per_second": messages_per_second(s, seconds),
-        "integrator": m.method.name(),
-        "rtol": adaptive.then_some(m.rtol),
-        "atol": adaptive.then_some(m.atol),
-        "step": (!adaptive).then_some(m.step),
-        "steps": s.stats.steps,
-        "rhs_evaluations": s.stats.rhs_evaluations,
-        "rejected_steps": s.stats.rejected_steps,
-        "energy_drift": s.energy_drift,
-        "energy_tolerance": s.energy_tolerance,
-        "invariant_drift": s.invariant_drift,
-        "steady_residual": s.steady_residual,
-        "termination": s.termination.name(),
-        "termination_time": s.termination_time,
-        "event_trusted": s.event_trusted,
-        "dissipated_work": s.dissipated_work,
-        "termination_alpha": s.termination_alpha,
-        "peak_rss_bytes": peak_rss_bytes(),
-    })
+    SummaryJson {
+        scene: label,
+        file: Some(target.display().to_string()),
+        summary: s,
+        wall_time_s: seconds,
+        messages_per_second: messages_per_second(s, seconds),
+        integrator: m.method.name(),
+        rtol: adaptive.then_some(m.rtol),
+        atol: adaptive.then_some(m.atol),
+        step: (!adaptive).then_some(m.step),
+        peak_rss_bytes: peak_rss_bytes(),
+        live: None,
+    }
 }
 
 pub(super) fn summary_rows(
@@ -559,7 +541,7 @@ pub(super) fn summary_rows(
     let seconds = wall.as_secs_f64();
     let mut rows: Vec<(&str, String)> = vec![
         ("scene", label.to_string()),
-        ("file", format!("{} ({})", target.display(), size(s.bytes))),
+        ("file", format!("{} ({})", shown(target), size(s.bytes))),
         ("samples", s.samples.to_string()),
         ("messages", s.messages.to_string()),
         (
@@ -605,7 +587,11 @@ fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
     if let Some(r) = s.steady_residual {
         rows.push(("steady residual", format!("{r:.3e}")));
     }
-    let mut termination = format!("{} at t = {}", s.termination.name(), s.termination_time);
+    let mut termination = format!(
+        "{} at t = {}",
+        s.termination.name(),
+        number(s.termination_time)
+    );
     if let Some(a) = s.termination_alpha {
         termination.push_str(&format!(" (α = {a:.4e} rad from the table)"));
     }

@@ -5,7 +5,8 @@
 //! is a file if one exists. [`load_source`] is the one loader of `record` and `analyse`: the scene, with
 //! the `--set KEY=VALUE` edits applied (format.md: Scene edits).
 
-use anyhow::{anyhow, Context};
+use anyhow::anyhow;
+use coin_log::files::{escaped, read_scene, shown};
 use coin_log::scene::{self, presets, SceneFile};
 use std::path::{Path, PathBuf};
 
@@ -28,7 +29,7 @@ fn looks_like_a_path(arg: &str) -> bool {
 /// No built-in scene of that name and no such file.
 pub fn classify(arg: &str) -> anyhow::Result<SceneArg<'_>> {
     let path = Path::new(arg);
-    if looks_like_a_path(arg) {
+    if looks_like_a_path(arg) || arg == "-" {
         return Ok(SceneArg::File(path));
     }
     if presets::preset(arg).is_some() {
@@ -45,14 +46,24 @@ pub fn classify(arg: &str) -> anyhow::Result<SceneArg<'_>> {
         return Ok(SceneArg::File(path));
     }
     anyhow::bail!(
-        "no built-in scene `{arg}` and no such file; built-in scenes: {}",
+        "no built-in scene `{}` and no such file; built-in scenes: {}",
+        escaped(arg),
         presets::NAMES.join(", ")
     )
 }
 
+/// The text of the scene file at `path`, read by the rules of files::input (a regular file, at most
+/// [`SCENE_MAX_BYTES`](coin_log::files::input::SCENE_MAX_BYTES)).
+///
+/// # Errors
+/// The path is not such a file, or cannot be read.
+pub fn read_scene_file(path: &Path) -> anyhow::Result<String> {
+    read_scene(path).map_err(|e| anyhow!("cannot read scene file `{}`: {e}", shown(path)))
+}
+
 /// Where a scene came from: its name in messages, its default output stem, and its file if it is one.
 pub struct SceneSource {
-    /// SCENE as given.
+    /// SCENE as given, its control characters escaped (it names the scene in messages and summaries).
     pub label: String,
     /// The built-in name or the file's stem.
     pub stem: String,
@@ -81,14 +92,14 @@ pub fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
         }
         SceneArg::File(path) => path,
     };
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
-    let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
+    let text = read_scene_file(path)?;
+    let label = escaped(arg).into_owned();
+    let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{label}`: {e}"))?;
     let stem = path
         .file_stem()
         .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
     Ok(SceneSource {
-        label: arg.to_string(),
+        label,
         stem,
         file,
         path: Some(path.to_path_buf()),

@@ -23,16 +23,23 @@ pub struct ScenesArgs {
 /// Runs `coin-log scenes`.
 pub fn run(args: ScenesArgs) -> anyhow::Result<Outcome> {
     if args.json {
+        #[derive(serde::Serialize)]
+        struct Entry {
+            name: &'static str,
+            description: String,
+            scene: SceneFile,
+        }
         let mut all = Vec::new();
         for name in presets::NAMES {
-            let file = resolved(name)?;
-            all.push(serde_json::json!({
-                "name": name,
-                "description": file.description.clone().unwrap_or_default(),
-                "scene": file,
-            }));
+            let scene = resolved(name)?;
+            let description = scene.description.clone().unwrap_or_default();
+            all.push(Entry {
+                name,
+                description,
+                scene,
+            });
         }
-        outln!("{}", serde_json::to_string(&all)?);
+        super::output::json(&all)?;
         return Ok(Outcome::Success);
     }
     match args.show {

@@ -1,10 +1,13 @@
 //! `coin-log verify`: prints each file's checks as a table (or the contract's JSON) and maps the worst
 //! verdict to the exit code.
 
-use super::progress::{file_len, FileProgress};
+use super::progress::FileProgress;
 use super::rss::peak_rss_bytes;
 use super::Outcome;
+use coin_log::files::input::check;
+use coin_log::files::{escaped, shown, InputKind};
 use coin_log::verify::{self, FileReport, Options, Report, Verdict};
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// What `coin-log verify --help` adds after the options: the checks, the tolerance formula, exit codes.
@@ -12,14 +15,17 @@ const AFTER_HELP: &str = "\
 Re-reads each log knowing nothing but the file: the body parameters come from its `coin-log` metadata
 (found through the summary's metadata index wherever it sits, so files rewritten by other MCAP writers
 verify too), the physics is recomputed from the stored channels (never re-simulated). Checks: integrity,
-energy, invariants, steady, constraint, consistency, validity; each reports its measured value, tolerance
-and pass/fail, or skip with the reason it could not run.
+energy, invariants, steady, constraint, consistency, validity, nutation (period and heading advance per
+nutation period against the quadrature); each reports its measured value, tolerance and pass/fail, or skip
+with the reason it could not run.
 
 Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
 W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a) for adaptive methods, or for fixed-step methods
 of order p with step h (rk4, gauss4: p = 4) eps = (h W)^p (only the settings the method uses count):
   energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
   constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
+  nutation period and advance:    min(1e-6, max(1e-11, 100 eps)), plus the quadrature's and the
+                                  interpolation's error estimates
 Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
 reaction) must agree to 1e-12 relative; N >= 0 and |F| <= mu N are held to 1e-12 Mg.
 
@@ -76,14 +82,18 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     // like every other command's errors.
     for file in &report.files {
         if let Some(problem) = &file.problem {
-            errln!("error: {}: {problem}", file.path);
+            errln!("error: {}: {problem}", escaped(&file.path));
         }
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string(&with_peak_rss(&report, &peaks)?)?
-        );
+        let files = report.files.iter().zip(peaks);
+        let files = files.map(|(report, peak_rss_bytes)| FileJson {
+            report,
+            peak_rss_bytes,
+        });
+        super::output::json(&Json {
+            files: files.collect(),
+        })?;
     } else {
         out!("{}", table(&report));
         if report.files.len() > 1 {
@@ -97,9 +107,22 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
     })
 }
 
-/// Judges one file with a progress bar on stderr (a terminal only, after a second).
+/// Judges one file with a progress bar on stderr (a terminal only, after a second); a path that is not a
+/// regular file is unusable without being opened (files::input).
 fn verify_with_progress(path: &Path, options: &Options) -> FileReport {
-    let progress = FileProgress::new(&path.display().to_string(), file_len(path));
+    let len = match check(path, InputKind::Mcap) {
+        Ok(meta) => meta.len(),
+        Err(e) => {
+            return FileReport {
+                path: path.display().to_string(),
+                exit_code: Verdict::Unusable.exit_code(),
+                verdict: Verdict::Unusable,
+                problem: Some(e.to_string()),
+                checks: Vec::new(),
+            }
+        }
+    };
+    let progress = FileProgress::new(&shown(path), len);
     let report = verify::verify_file_with_progress(path, options, &|b| progress.update(b));
     progress.finish();
     report
@@ -120,19 +143,16 @@ fn total(report: &Report) -> String {
 
 /// The contract's JSON plus `peak_rss_bytes` in each file object: the process's peak resident set size
 /// (VmHWM) once that file was judged, `null` where the system does not report it.
-fn with_peak_rss(report: &Report, peaks: &[Option<u64>]) -> anyhow::Result<serde_json::Value> {
-    let mut json = serde_json::to_value(report)?;
-    if let Some(files) = json
-        .get_mut("files")
-        .and_then(serde_json::Value::as_array_mut)
-    {
-        for (file, peak) in files.iter_mut().zip(peaks) {
-            if let Some(object) = file.as_object_mut() {
-                object.insert("peak_rss_bytes".into(), serde_json::json!(peak));
-            }
-        }
-    }
-    Ok(json)
+#[derive(Serialize)]
+struct Json<'a> {
+    files: Vec<FileJson<'a>>,
+}
+
+#[derive(Serialize)]
+struct FileJson<'a> {
+    #[serde(flatten)]
+    report: &'a FileReport,
+    peak_rss_bytes: Option<u64>,
 }
 
 fn number(x: Option<f64>) -> String {
@@ -142,7 +162,7 @@ fn number(x: Option<f64>) -> String {
 fn file_table(f: &FileReport, out: &mut String) {
     out.push_str(&format!(
         "{}: {} (exit {})\n",
-        f.path,
+        escaped(&f.path),
         f.verdict.label(),
         f.exit_code
     ));

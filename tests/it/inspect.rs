@@ -508,7 +508,8 @@ fn parquet_is_refused_with_the_way_to_convert() {
     assert!(!dir.path().join("circle-plus-csv").exists());
 }
 
-/// An export that stops part way (a truncated file) leaves no table and no temporary file behind.
+/// An export that stops part way (a truncated file) leaves no table, no temporary file, and not the
+/// folder it created.
 #[test]
 fn a_failed_export_leaves_nothing_behind() {
     let dir = tempfile::tempdir().unwrap();
@@ -522,7 +523,12 @@ fn a_failed_export_leaves_nothing_behind() {
         err.contains("truncated") && err.contains("nothing exported"),
         "{err}"
     );
-    assert_eq!(std::fs::read_dir(dir.path().join("t")).unwrap().count(), 0);
+    assert!(!dir.path().join("t").exists(), "the folder it made is gone");
+    // Into a folder that was there, the folder stays, empty.
+    std::fs::create_dir(dir.path().join("u")).unwrap();
+    let out = coin_log(dir.path(), &["export", "half.mcap", "--out", "u"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(std::fs::read_dir(dir.path().join("u")).unwrap().count(), 0);
 }
 
 fn svg_texts(svg: &str) -> Vec<String> {

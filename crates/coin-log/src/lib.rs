@@ -6,11 +6,14 @@
 //! (docs/architecture.md): [`model`] → [`integrate`] → [`simulation`] → [`format`](mod@format) → [`scene`] →
 //! [`record`] / [`verify`] / [`analyse`] / [`inspect`] → `live` (cargo feature `live`); files are read and
 //! written through the `coin-log-mcap` crate below them all, and the `coin-log-bench` crate and the `coin-log`
-//! binary sit on top.
+//! binary sit on top. [`files`] (what an input path may be, how an output is written) and [`csv`] use
+//! nothing of the crate.
 
 pub use coin_log_ode as integrate;
 
 pub mod analyse;
+pub mod csv;
+pub mod files;
 pub mod format;
 pub mod inspect;
 #[cfg(feature = "live")]

@@ -5,6 +5,7 @@ mod throughput;
 
 use super::Outcome;
 use anyhow::Context;
+use coin_log::files::{shown, Output, Policy};
 use coin_log::integrate::Method;
 use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
 use coin_log_bench::plot::{euler_svg, work_precision_svg};
@@ -98,11 +99,18 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
 }
 
 fn create_dir(out: &Path) -> anyhow::Result<()> {
-    fs::create_dir_all(out).with_context(|| format!("creating the output folder {}", out.display()))
+    fs::create_dir_all(out).with_context(|| format!("creating the output folder `{}`", shown(out)))
 }
 
+/// Writes a result file, replacing an earlier run's (never a link, pipe or device: files::output).
 fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
-    fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+    let policy = Policy {
+        overwrite: true,
+        flag: "--out",
+        example: "bench-results",
+        protect: None,
+    };
+    Ok(Output::write(path, &policy, contents.as_bytes())?)
 }
 
 /// A built-in scene by name, or a scene file by path (named by its stem), by the rule of
@@ -112,8 +120,7 @@ fn load_case(arg: &str) -> anyhow::Result<BenchCase> {
         super::scene_arg::SceneArg::Builtin(name) => return Ok(bench_case(name)?),
         super::scene_arg::SceneArg::File(path) => path,
     };
-    let text = fs::read_to_string(path)
-        .with_context(|| format!("cannot read scene file `{}`", path.display()))?;
+    let text = super::scene_arg::read_scene_file(path)?;
     let stem = path
         .file_stem()
         .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
@@ -153,12 +160,12 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         }
         let svg_path = args.out.join(format!("precision-{}.svg", report.scene));
         write(&svg_path, &work_precision_svg(&report)?)?;
-        outln!("  diagram: {}\n", svg_path.display());
+        outln!("  diagram: {}\n", shown(&svg_path));
         all_rows.extend(report.rows);
     }
     let csv_path = args.out.join("precision.csv");
     write(&csv_path, &precision_csv(&all_rows))?;
-    outln!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", shown(&csv_path));
     Ok(Outcome::Success)
 }
 
@@ -168,7 +175,7 @@ fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
     out!("{}", stability_table(&rows));
     let csv_path = args.out.join("stability.csv");
     write(&csv_path, &stability_csv(&rows))?;
-    outln!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", shown(&csv_path));
     Ok(Outcome::Success)
 }
 
@@ -187,10 +194,6 @@ fn euler(args: &EulerArgs) -> anyhow::Result<Outcome> {
     write(&csv_path, &euler_csv(&rows))?;
     let svg_path = args.out.join("euler.svg");
     write(&svg_path, &euler_svg(&rows)?)?;
-    outln!(
-        "CSV: {}\ndiagram: {}",
-        csv_path.display(),
-        svg_path.display()
-    );
+    outln!("CSV: {}\ndiagram: {}", shown(&csv_path), shown(&svg_path));
     Ok(Outcome::Success)
 }

@@ -62,7 +62,7 @@ pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
     out!("{}", throughput::table(&report));
     let csv_path = args.out.join("throughput.csv");
     write(&csv_path, &throughput::csv(&report))?;
-    outln!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", coin_log::files::shown(&csv_path));
     Ok(Outcome::Success)
 }
 

@@ -340,24 +340,19 @@ impl StabilityMap {
     /// line per point, numbers as shortest round-trip decimals.
     #[must_use]
     pub fn csv(&self) -> String {
-        let mut out = String::with_capacity(64 * (self.points.len() + 1));
-        out.push_str("theta0,omega_z0,branch,omega_y0,sigma_squared,verdict\n");
-        let mut buffer = ryu::Buffer::new();
+        let mut line = crate::csv::Line::default();
+        line.text("theta0").text("omega_z0").text("branch");
+        line.text("omega_y0").text("sigma_squared").text("verdict");
         for p in &self.points {
-            for value in [p.theta0, p.omega_z0] {
-                out.push_str(buffer.format(value));
-                out.push(',');
-            }
-            out.push_str(p.branch.name());
-            for value in [p.omega_y0, p.sigma_squared] {
-                out.push(',');
-                out.push_str(buffer.format(value));
-            }
-            out.push(',');
-            out.push_str(p.verdict.name());
-            out.push('\n');
+            line.finish();
+            line.number(p.theta0)
+                .number(p.omega_z0)
+                .text(p.branch.name());
+            line.number(p.omega_y0)
+                .number(p.sigma_squared)
+                .text(p.verdict.name());
         }
-        out
+        line.finish().to_string()
     }
 
     /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes.

@@ -16,12 +16,13 @@
 //! written as the exact decimal of their nanoseconds.
 
 use super::seconds_text;
+use crate::csv;
 use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::Channel;
 use crate::format::Encoding;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{self, BufWriter, Write};
 use std::ops::ControlFlow;
@@ -58,7 +59,7 @@ pub const TF_COLUMNS: [&str; 10] = [
 ];
 
 /// One table written.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Table {
     /// File name (`omega.csv`).
     pub name: String,
@@ -71,7 +72,7 @@ pub struct Table {
 }
 
 /// A channel not exported, and why.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Skipped {
     /// Topic.
     pub topic: String,
@@ -79,8 +80,8 @@ pub struct Skipped {
     pub reason: String,
 }
 
-/// What an export wrote.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+/// What an export wrote (`export --json` prints it).
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
 pub struct ExportSummary {
     /// The tables, in the order they were opened.
     pub tables: Vec<Table>,
@@ -109,6 +110,9 @@ pub enum ExportError {
     /// The messages cannot be joined into one row per sample.
     #[error("cannot join the channels into one table: {0}; export one table per channel instead (without --wide)")]
     Join(String),
+    /// No channel of the file makes a table.
+    #[error("nothing to export: {0}")]
+    Nothing(String),
     /// A table could not be written.
     #[error("writing `{table}`: {source}")]
     Write {
@@ -168,8 +172,7 @@ struct Exporter<'a, W: Write> {
     skipped: Vec<Skipped>,
     wide: Wide,
     values: Vec<f64>,
-    number: ryu::Buffer,
-    line: Vec<u8>,
+    line: csv::Line,
     messages: u64,
     error: Option<ExportError>,
 }
@@ -196,8 +199,7 @@ pub fn export<W: Write>(
         skipped: Vec::new(),
         wide: Wide::default(),
         values: Vec::new(),
-        number: ryu::Buffer::new(),
-        line: Vec::new(),
+        line: csv::Line::default(),
         messages: 0,
         error: None,
     };
@@ -232,8 +234,7 @@ impl<W: Write> Exporter<'_, W> {
             }
         };
         let mut out = BufWriter::with_capacity(BUFFER, writer);
-        let header: Vec<String> = columns.iter().map(|c| csv_text(c)).collect();
-        if let Err(source) = writeln!(out, "{}", header.join(",")) {
+        if let Err(source) = out.write_all(csv::record(&columns).as_bytes()) {
             self.fail(ExportError::Write {
                 table: name.to_string(),
                 source,
@@ -344,21 +345,17 @@ impl<W: Write> Exporter<'_, W> {
     /// Writes the numbers in `self.values` as one CSV row of table `table`.
     fn write_numbers(&mut self, table: usize) {
         self.line.clear();
-        for (i, v) in self.values.iter().enumerate() {
-            if i > 0 {
-                self.line.push(b',');
-            }
-            self.line
-                .extend_from_slice(self.number.format_finite(*v).as_bytes());
+        for v in &self.values {
+            self.line.number(*v);
         }
-        self.line.push(b'\n');
         self.write_line(table);
     }
 
+    /// Ends `self.line` and writes it as a row of table `table`.
     fn write_line(&mut self, table: usize) {
         let open = &mut self.tables[table];
         open.table.rows += 1;
-        if let Err(source) = open.out.write_all(&self.line) {
+        if let Err(source) = open.out.write_all(self.line.finish().as_bytes()) {
             let table = open.table.name.clone();
             self.fail(ExportError::Write { table, source });
         }
@@ -411,18 +408,12 @@ impl<W: Write> Exporter<'_, W> {
             .saturating_mul(1_000_000_000)
             .saturating_add(u64::from(m.timestamp.nsec));
         self.line.clear();
-        self.line.extend_from_slice(seconds_text(ns).as_bytes());
-        for id in [&m.parent_frame_id, &m.child_frame_id] {
-            self.line.push(b',');
-            self.line.extend_from_slice(csv_text(id).as_bytes());
-        }
+        self.line.text(&seconds_text(ns));
+        self.line.text(&m.parent_frame_id).text(&m.child_frame_id);
         let (tr, ro) = (&m.translation, &m.rotation);
         for v in [tr.x, tr.y, tr.z, ro.x, ro.y, ro.z, ro.w] {
-            self.line.push(b',');
-            self.line
-                .extend_from_slice(self.number.format_finite(v).as_bytes());
+            self.line.number(v);
         }
-        self.line.push(b'\n');
         self.write_line(table);
     }
 }
@@ -518,19 +509,16 @@ impl<W: Write> Exporter<'_, W> {
             return self.fail(ExportError::Join(e));
         }
         self.line.clear();
-        self.line
-            .extend_from_slice(self.number.format_finite(row.t).as_bytes());
+        self.line.number(row.t);
         for (c, fields) in channels {
             let found = row.values.iter().find(|(k, _)| k == c);
             for i in 0..fields.len() - 1 {
-                self.line.push(b',');
-                if let Some((_, v)) = found {
-                    self.line
-                        .extend_from_slice(self.number.format_finite(v[i]).as_bytes());
-                }
+                match found {
+                    Some((_, v)) => self.line.number(v[i]),
+                    None => self.line.empty(),
+                };
             }
         }
-        self.line.push(b'\n');
         if !self.tables.is_empty() {
             self.write_line(0);
         }
@@ -541,6 +529,22 @@ impl<W: Write> Exporter<'_, W> {
         self.flush_row();
         if let Some(e) = self.error.take() {
             return Err(e);
+        }
+        if self.tables.is_empty() {
+            let why = if self.skipped.is_empty() {
+                "the file has no coin-log channel with messages".to_string()
+            } else {
+                let skipped: Vec<String> = self
+                    .skipped
+                    .iter()
+                    .map(|k| format!("{}: {}", k.topic, k.reason))
+                    .collect();
+                format!(
+                    "no channel of the file makes a table ({})",
+                    skipped.join("; ")
+                )
+            };
+            return Err(ExportError::Nothing(why));
         }
         let mut tables = Vec::new();
         for open in self.tables {
@@ -608,15 +612,6 @@ impl<W: Write> Visitor for Exporter<'_, W> {
     }
 }
 
-/// A CSV field: quoted (with quotes doubled) when it holds a comma, a quote or a line break.
-fn csv_text(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 /// A Protobuf `foxglove.FrameTransform` as the fields the table holds (absent sub-messages read as zeros,
 /// as proto3 defines them).
 fn decode_transform(data: &[u8]) -> Result<FrameTransform, String> {
@@ -675,16 +670,4 @@ struct Quaternion {
     y: f64,
     z: f64,
     w: f64,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::csv_text;
-
-    #[test]
-    fn csv_fields_are_quoted_only_when_needed() {
-        assert_eq!(csv_text("coin"), "coin");
-        assert_eq!(csv_text("a,b"), "\"a,b\"");
-        assert_eq!(csv_text("say \"hi\""), "\"say \"\"hi\"\"\"");
-    }
 }

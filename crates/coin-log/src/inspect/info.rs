@@ -10,13 +10,13 @@
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
 use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
-use serde_json::{json, Value};
+use serde::Serialize;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::Path;
 
-/// One channel of a file.
-#[derive(Debug, Clone, PartialEq)]
+/// One channel of a file (an entry of `info --json`'s `channels`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChannelInfo {
     /// Topic.
     pub topic: String,
@@ -127,79 +127,130 @@ impl FileInfo {
 
     /// The contract's JSON object of this file (format.md: info --json), `path` as given.
     #[must_use]
-    #[allow(clippy::cast_precision_loss)]
-    pub fn to_json(&self, path: &str) -> Value {
-        let seconds = |ns: u64| ns as f64 / 1e9;
+    pub fn json<'a>(&'a self, path: &'a str) -> impl Serialize + 'a {
         let run = self.run.as_ref().ok();
-        json!({
-            "path": path,
-            "file_size": self.file_size,
-            "library": self.library,
-            "read_from": self.source.name(),
-            "coin_log": run.is_some(),
-            "format_version": run.map(|r| r.format_version.clone()),
-            "tool_version": run.map(|r| r.tool_version.clone()),
-            "description": self.scene.as_ref().and_then(|s| s.description.clone()),
-            "messages": self.messages,
-            "start_time": self.time_range.map(|r| seconds(r.0)),
-            "end_time": self.time_range.map(|r| seconds(r.1)),
-            "chunks": self.chunks,
-            "compression": self.compression(),
-            "encoding": self.encoding(),
-            "compressed_bytes": self.chunk_bytes.0,
-            "uncompressed_bytes": self.chunk_bytes.1,
-            "channels": self.channels.iter().map(|c| json!({
-                "topic": c.topic,
-                "schema": c.schema,
-                "message_encoding": c.message_encoding,
-                "messages": c.messages,
-                "rate": c.rate,
-            })).collect::<Vec<_>>(),
-            "body": run.map(body_json),
-            "run": run.map(|r| run_json(r, self.scene.as_ref())),
-            "result": self.result.as_ref().ok().map(result_json),
-            "scene": self.scene_toml(),
-            "problem": self.problem,
-        })
+        FileJson {
+            path,
+            file_size: self.file_size,
+            library: &self.library,
+            read_from: self.source.name(),
+            coin_log: run.is_some(),
+            format_version: run.map(|r| r.format_version.as_str()),
+            tool_version: run.map(|r| r.tool_version.as_str()),
+            description: self.scene.as_ref().and_then(|s| s.description.as_deref()),
+            messages: self.messages,
+            start_time: self.time_range.map(|r| seconds(r.0)),
+            end_time: self.time_range.map(|r| seconds(r.1)),
+            chunks: self.chunks,
+            compression: self.compression(),
+            encoding: self.encoding(),
+            compressed_bytes: self.chunk_bytes.0,
+            uncompressed_bytes: self.chunk_bytes.1,
+            channels: &self.channels,
+            body: run.map(|r| BodyJson {
+                mass: r.mass,
+                radius: r.radius,
+                gravity: r.gravity,
+                inertia_x: r.inertia_x,
+                inertia_z: r.inertia_z,
+                friction: r.friction,
+                time_unit: r.time_unit,
+            }),
+            run: run.map(|r| RunJson {
+                duration: self.scene.as_ref().and_then(|s| s.run.as_ref()?.duration),
+                rate: r.rate,
+                integrator: r.integrator.name(),
+                rtol: r.rtol,
+                atol: r.atol,
+                step: r.step,
+                steady_kind: r.steady_kind.map(|k| k.to_string()),
+                phi_dot: r.phi_dot,
+                psi_dot: r.psi_dot,
+                r_g: r.r_g,
+                r_c: r.r_c,
+            }),
+            result: self.result.as_ref().ok().map(|r| ResultJson {
+                termination: r.termination.name(),
+                termination_time: r.termination_time,
+                steps: r.steps,
+                rhs_evaluations: r.rhs_evaluations,
+                rejected_steps: r.rejected_steps,
+            }),
+            scene: self.scene_toml(),
+            problem: self.problem.as_deref(),
+        }
     }
 }
 
-fn body_json(r: &RunMetadata) -> Value {
-    json!({
-        "mass": r.mass,
-        "radius": r.radius,
-        "gravity": r.gravity,
-        "inertia_x": r.inertia_x,
-        "inertia_z": r.inertia_z,
-        "friction": r.friction,
-        "time_unit": r.time_unit,
-    })
+/// Log time \[ns\] as seconds.
+#[allow(clippy::cast_precision_loss)]
+fn seconds(ns: u64) -> f64 {
+    ns as f64 / 1e9
 }
 
-fn run_json(r: &RunMetadata, scene: Option<&SceneFile>) -> Value {
-    json!({
-        "duration": scene.and_then(|s| s.run.as_ref()).and_then(|r| r.duration),
-        "rate": r.rate,
-        "integrator": r.integrator.name(),
-        "rtol": r.rtol,
-        "atol": r.atol,
-        "step": r.step,
-        "steady_kind": r.steady_kind.map(|k| k.to_string()),
-        "phi_dot": r.phi_dot,
-        "psi_dot": r.psi_dot,
-        "r_g": r.r_g,
-        "r_c": r.r_c,
-    })
+/// The `info --json` object of one file; its keys are format.md's (info --json).
+#[derive(Debug, Serialize)]
+struct FileJson<'a> {
+    path: &'a str,
+    file_size: u64,
+    library: &'a str,
+    read_from: &'static str,
+    coin_log: bool,
+    format_version: Option<&'a str>,
+    tool_version: Option<&'a str>,
+    description: Option<&'a str>,
+    messages: u64,
+    start_time: Option<f64>,
+    end_time: Option<f64>,
+    chunks: u64,
+    compression: String,
+    encoding: String,
+    compressed_bytes: u64,
+    uncompressed_bytes: u64,
+    channels: &'a [ChannelInfo],
+    body: Option<BodyJson>,
+    run: Option<RunJson>,
+    result: Option<ResultJson>,
+    scene: Option<&'a str>,
+    problem: Option<&'a str>,
 }
 
-fn result_json(r: &ResultMetadata) -> Value {
-    json!({
-        "termination": r.termination.name(),
-        "termination_time": r.termination_time,
-        "steps": r.steps,
-        "rhs_evaluations": r.rhs_evaluations,
-        "rejected_steps": r.rejected_steps,
-    })
+/// `body` of [`FileJson`]: the stored body parameters.
+#[derive(Debug, Serialize)]
+struct BodyJson {
+    mass: f64,
+    radius: f64,
+    gravity: f64,
+    inertia_x: f64,
+    inertia_z: f64,
+    friction: Option<f64>,
+    time_unit: f64,
+}
+
+/// `run` of [`FileJson`]: the stored run settings.
+#[derive(Debug, Serialize)]
+struct RunJson {
+    duration: Option<f64>,
+    rate: f64,
+    integrator: &'static str,
+    rtol: f64,
+    atol: f64,
+    step: f64,
+    steady_kind: Option<String>,
+    phi_dot: Option<f64>,
+    psi_dot: Option<f64>,
+    r_g: Option<f64>,
+    r_c: Option<f64>,
+}
+
+/// `result` of [`FileJson`]: how the run ended.
+#[derive(Debug, Serialize)]
+struct ResultJson {
+    termination: &'static str,
+    termination_time: f64,
+    steps: u64,
+    rhs_evaluations: u64,
+    rejected_steps: u64,
 }
 
 /// Why a file could not be described at all.

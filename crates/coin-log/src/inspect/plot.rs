@@ -350,12 +350,23 @@ impl Visitor for Collect {
     }
 }
 
+/// A drawn overview.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Plot {
+    /// The SVG document.
+    pub svg: String,
+    /// Why the file breaks off (truncated or corrupt part way): the picture shows it up to there, and
+    /// says so in its title.
+    pub broken: Option<String>,
+}
+
 /// The one-page overview of the file at `path` as an SVG document; `name` is shown in the title.
 ///
 /// # Errors
-/// [`PlotError`] if the file cannot be read, is not a coin-log file, or a message does not fit its
-/// schema. A file that breaks off part way is drawn up to the break, and the title says so.
-pub fn plot(path: &Path, name: &str) -> Result<String, PlotError> {
+/// [`PlotError`] if the file cannot be read, is not a coin-log file, breaks off before its `coin-log`
+/// metadata, or a message does not fit its schema. A file that breaks off later is drawn up to the break
+/// ([`Plot::broken`]).
+pub fn plot(path: &Path, name: &str) -> Result<Plot, PlotError> {
     let mut c = Collect::default();
     let (_, error) = coin_log_mcap::read(path, &mut c);
     let mut broken = None;
@@ -369,19 +380,23 @@ pub fn plot(path: &Path, name: &str) -> Result<String, PlotError> {
     if let Some(p) = c.problem.take() {
         return Err(PlotError(p));
     }
-    let run = match c.run.take() {
-        Some(Ok(run)) => run,
-        Some(Err(e)) => {
+    let run = match (c.run.take(), broken.as_deref()) {
+        (Some(Ok(run)), _) => run,
+        (Some(Err(e)), _) => {
             return Err(PlotError(format!(
                 "its `coin-log` metadata is unusable: {e}"
             )))
         }
-        None => return Err(PlotError(
+        (None, Some(broken)) => return Err(PlotError(format!(
+            "{broken}; the file breaks off before its `coin-log` metadata record, so there is nothing to draw"
+        ))),
+        (None, None) => return Err(PlotError(
             "not a coin-log file: it has no `coin-log` metadata record before its first message"
                 .into(),
         )),
     };
-    draw(&c, &run, name, broken.as_deref()).map_err(PlotError)
+    let svg = draw(&c, &run, name, broken.as_deref()).map_err(PlotError)?;
+    Ok(Plot { svg, broken })
 }
 
 /// The page's title: the file, the scene's description, how the run ended.

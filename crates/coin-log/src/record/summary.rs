@@ -3,6 +3,7 @@
 use crate::format::messages::NonFiniteField;
 use crate::format::{Termination, TimeError};
 use crate::integrate::{Stats, StepError};
+use serde::{Serialize, Serializer};
 use std::fmt;
 
 /// A numerical failure that ended a run early; the file holds the samples up to it.
@@ -37,8 +38,10 @@ impl fmt::Display for Failure {
     }
 }
 
-/// What a finished recording reports.
-#[derive(Debug, Clone, PartialEq)]
+/// What a finished recording reports. Serialized flat, as `record --json` prints it (format.md: record,
+/// Summary): the integrator's counters beside the other fields, the termination by name, no failure (its
+/// termination says what it was).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RecordSummary {
     /// Samples written (time points).
     pub samples: u64,
@@ -47,12 +50,15 @@ pub struct RecordSummary {
     /// Size of the finished file \[bytes\].
     pub bytes: u64,
     /// Integrator work.
+    #[serde(flatten, with = "StatsFields")]
     pub stats: Stats,
     /// Why the run ended.
+    #[serde(serialize_with = "by_name")]
     pub termination: Termination,
     /// When it ended (the last sample's time, or the failure's).
     pub termination_time: f64,
     /// The numerical failure that ended the run, when one did (its detail for the user).
+    #[serde(skip)]
     pub failure: Option<Failure>,
     /// Energy drift over the samples ([`EnergyDrift`](crate::model::drift::EnergyDrift)); with
     /// dissipation, the drift of E + W.
@@ -75,4 +81,17 @@ pub struct RecordSummary {
     pub dissipated_work: Option<f64>,
     /// With dissipation: α = π/2 − |θ| at the last sample, how flat the coin was when the run ended.
     pub termination_alpha: Option<f64>,
+}
+
+/// [`Stats`]'s fields, for the summary's JSON (the stepper crate knows no serde).
+#[derive(Serialize)]
+#[serde(remote = "Stats")]
+struct StatsFields {
+    steps: u64,
+    rhs_evaluations: u64,
+    rejected_steps: u64,
+}
+
+fn by_name<S: Serializer>(termination: &Termination, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(termination)
 }

@@ -16,7 +16,7 @@ pub use file::{
     SteadyFile,
 };
 pub use overrides::{apply_set, FlagOverrides};
-pub use validate::UNEXPLAINED;
+pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
 
 use crate::format::Channel;
 use crate::integrate::MethodConfig;

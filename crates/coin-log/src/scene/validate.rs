@@ -114,6 +114,38 @@ fn quoted(s: &str) -> String {
     format!("{s:?}")
 }
 
+/// Longest scene description [characters]: one line of `coin-log scenes` and `info` (the longest
+/// built-in has 379).
+pub const DESCRIPTION_MAX_CHARS: usize = 1000;
+
+/// The description is one line (format.md: Scene files): no line break or other control character, and
+/// at most [`DESCRIPTION_MAX_CHARS`], so that it cannot break the layouts that print it.
+fn check_description(description: Option<&str>, problems: &mut Problems) {
+    let Some(text) = description else {
+        return;
+    };
+    let chars = text.chars().count();
+    let head: String = text.chars().take(40).collect();
+    let value = format!("{}{}", quoted(&head), if chars > 40 { "…" } else { "" });
+    if text.chars().any(char::is_control) {
+        problems.push(
+            "description",
+            value,
+            "holds a line break or another control character: a description is one line of text (`coin-log \
+             scenes` and `info` print it as one); write it on one line",
+        );
+    } else if chars > DESCRIPTION_MAX_CHARS {
+        problems.push(
+            "description",
+            value,
+            format!(
+                "is {chars} characters long, more than the {DESCRIPTION_MAX_CHARS} of a description (one line \
+                 of `coin-log scenes` and `info`); shorten it"
+            ),
+        );
+    }
+}
+
 /// The lean range allowed by a flat margin, in words.
 fn lean_range(margin: f64) -> String {
     format!("is outside (−π/2 + {margin}, π/2 − {margin}) (run.flat_margin = {margin}): a rolling coin must lean less than flat")
@@ -148,6 +180,7 @@ pub(super) fn scene_from_file(
         );
     }
     let dissipation = check_dissipation(file.body.dissipation.as_ref(), &mut problems);
+    check_description(file.description.as_deref(), &mut problems);
     let run = check_run(&run_file, flat_margin, margin_ok, &mut problems);
     let channels = check_channels(
         file.record.as_ref(),

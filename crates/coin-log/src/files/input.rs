@@ -1,0 +1,173 @@
+//! What a path given as an input may be (format.md: Commands, Inputs and outputs). Every input is a regular
+//! file, looked at before it is opened, so a named pipe, a device (`/dev/zero`, `/dev/urandom`), a socket
+//! or a folder is refused with the reason instead of blocking or being read without end; a symbolic link
+//! is followed to what it names. A scene is read whole and must be at most [`SCENE_MAX_BYTES`]; an MCAP
+//! file is read in bounded memory by its reader, which seeks (to the summary and metadata), so it cannot
+//! be a stream. Standard input is offered nowhere: `-` is refused with that reason.
+
+use super::output::kind_of;
+use std::fs::{self, File, Metadata};
+use std::io::{self, Read};
+use std::path::Path;
+
+/// The largest scene file read \[bytes\]: scenes are a few kB of TOML (the built-ins are under 2 kB), so
+/// 1 MiB leaves room for any hand-written scene while bounding what a wrong path can make the tool read.
+pub const SCENE_MAX_BYTES: u64 = 1 << 20;
+
+/// What an input is read as, for the rules and the words of a refusal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputKind {
+    /// A TOML scene file, read whole.
+    Scene,
+    /// An MCAP file, read by seeking.
+    Mcap,
+}
+
+/// Why an input path is refused. The message does not name the path: the caller puts it first.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    /// `-`.
+    #[error(
+        "reading standard input is not offered (`-`): save the input to a file and give its path (a file \
+         named `-` is `./-`)"
+    )]
+    Stdin,
+    /// The path cannot be looked at or read (for an MCAP file in the words of its reader).
+    #[error("{}{source}", if *kind == InputKind::Mcap { "cannot read: " } else { "" })]
+    Io {
+        /// What is read.
+        kind: InputKind,
+        /// The system's reason.
+        source: io::Error,
+    },
+    /// A folder.
+    #[error("is a directory, not {}", what(*.0))]
+    Folder(InputKind),
+    /// A pipe, device or socket.
+    #[error("{}", special(*kind, what, *stdin))]
+    Special {
+        /// What is read.
+        kind: InputKind,
+        /// What the path is ("a named pipe").
+        what: &'static str,
+        /// The path is standard input (`/dev/stdin`).
+        stdin: bool,
+    },
+    /// A scene file above [`SCENE_MAX_BYTES`].
+    #[error(
+        "holds more than {limit} bytes (at least {bytes}), more than a scene file may (scenes are a few kB of \
+         TOML): is this the scene you meant?"
+    )]
+    TooLarge {
+        /// What it holds, as far as it was read.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
+}
+
+fn what(kind: InputKind) -> &'static str {
+    match kind {
+        InputKind::Scene => "a scene file",
+        InputKind::Mcap => "an MCAP file",
+    }
+}
+
+fn special(kind: InputKind, what: &str, stdin: bool) -> String {
+    match kind {
+        // The words of coin_log_mcap's reader, which refuses the same for `verify`.
+        InputKind::Mcap => format!(
+            "is {}not a regular file (a pipe, socket or device): an MCAP file is read by seeking to its \
+             summary and metadata, which a stream cannot do; save it to a file first",
+            if stdin { "standard input, " } else { "" }
+        ),
+        InputKind::Scene => format!(
+            "is {}{what}, not a regular file: a scene file is read whole, and a pipe or device may never end; \
+             save the scene to a file and give its path",
+            if stdin { "standard input, " } else { "" }
+        ),
+    }
+}
+
+/// The names of standard input as a file.
+const STDIN_PATHS: [&str; 3] = ["/dev/stdin", "/dev/fd/0", "/proc/self/fd/0"];
+
+/// Checks that `path` names a regular file (following links), without opening it; returns its metadata.
+///
+/// # Errors
+/// [`InputError`]: `-`, a path that cannot be looked at, a folder, a pipe, a device or a socket.
+pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
+    if path.as_os_str() == "-" {
+        return Err(InputError::Stdin);
+    }
+    let meta = fs::metadata(path).map_err(|source| InputError::Io { kind, source })?;
+    if meta.is_dir() {
+        return Err(InputError::Folder(kind));
+    }
+    if !meta.is_file() {
+        let stdin = STDIN_PATHS.iter().any(|s| path == Path::new(s));
+        return Err(InputError::Special {
+            kind,
+            what: kind_of(&meta),
+            stdin,
+        });
+    }
+    Ok(meta)
+}
+
+/// Reads the scene file at `path` as text: a regular file of at most [`SCENE_MAX_BYTES`] (the bound holds
+/// while reading too, for files that grow or whose size the system does not report, like `/proc` files).
+///
+/// # Errors
+/// As [`check`]; a file above the limit, one that cannot be read, or that is not UTF-8.
+pub fn read_scene(path: &Path) -> Result<String, InputError> {
+    check(path, InputKind::Scene)?;
+    let mut text = String::new();
+    let read = File::open(path)
+        .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_string(&mut text))
+        .map_err(|source| InputError::Io {
+            kind: InputKind::Scene,
+            source,
+        })?;
+    if read as u64 > SCENE_MAX_BYTES {
+        let bytes = fs::metadata(path).map_or(read as u64, |m| m.len().max(read as u64));
+        return Err(InputError::TooLarge {
+            bytes,
+            limit: SCENE_MAX_BYTES,
+        });
+    }
+    Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{check, read_scene, InputKind, SCENE_MAX_BYTES};
+    use std::path::Path;
+
+    #[test]
+    fn devices_folders_and_stdin_are_refused_with_the_reason() {
+        for (path, needle) in [
+            ("/dev/zero", "is a character device, not a regular file"),
+            ("/dev/urandom", "is a character device"),
+            ("/", "is a directory, not a scene file"),
+            ("-", "reading standard input is not offered"),
+        ] {
+            let e = read_scene(Path::new(path)).unwrap_err().to_string();
+            assert!(e.contains(needle), "{path}: {e}");
+        }
+        let e = check(Path::new("/dev/null"), InputKind::Mcap).unwrap_err();
+        assert!(e.to_string().starts_with("is not a regular file"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_above_the_limit_is_refused_and_one_at_it_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.toml");
+        let at = usize::try_from(SCENE_MAX_BYTES).unwrap();
+        std::fs::write(&path, "#".repeat(at)).unwrap();
+        assert_eq!(read_scene(&path).unwrap().len(), at);
+        std::fs::write(&path, "#".repeat(at + 1)).unwrap();
+        let e = read_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("more than 1048576 bytes"), "{e}");
+    }
+}

@@ -1,0 +1,57 @@
+//! The files coin-log reads and writes, by one policy for every command (format.md: Commands, Inputs and
+//! outputs).
+//!
+//! - [`input`]: what a path given as an input may be: a regular file (never a pipe, device, socket or
+//!   folder, whose reads may block or never end), and for a scene no larger than [`input::SCENE_MAX_BYTES`].
+//!   Standard input is not offered, and `-` says so.
+//! - [`output`]: how an output is written: into an owner-only temporary file beside the target, moved into
+//!   place by rename once finished and synced, never over anything but a regular file, never over an
+//!   existing one unless the command allows it; a finished file whose move fails is kept, and named.
+//! - [`shown`]: a path as every message prints it, its control characters escaped.
+
+pub mod input;
+pub mod output;
+
+pub use input::{read_scene, InputError, InputKind};
+pub use output::{Output, OutputError, OutputFolder, Policy};
+
+use std::borrow::Cow;
+use std::path::Path;
+
+/// A path for a message: its text (lossy for bytes that are not UTF-8) with control characters escaped
+/// (`\n`, `\u{1b}`), so that a crafted name cannot break a line or drive the terminal.
+#[must_use]
+pub fn shown(path: &Path) -> String {
+    escaped(&path.to_string_lossy()).into_owned()
+}
+
+/// `text` with its control characters escaped as [`shown`] does (for paths already held as text).
+#[must_use]
+pub fn escaped(text: &str) -> Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return Cow::Borrowed(text);
+    }
+    Cow::Owned(
+        text.chars()
+            .map(|c| {
+                if c.is_control() {
+                    c.escape_default().to_string()
+                } else {
+                    c.to_string()
+                }
+            })
+            .collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown;
+    use std::path::Path;
+
+    #[test]
+    fn control_characters_in_paths_are_escaped_and_the_rest_kept() {
+        assert_eq!(shown(Path::new("a/b c é.mcap")), "a/b c é.mcap");
+        assert_eq!(shown(Path::new("x\ny\r\u{1b}[31m")), "x\\ny\\r\\u{1b}[31m");
+    }
+}

@@ -1,0 +1,682 @@
+//! How every output is written (format.md: Commands, Inputs and outputs). A file is written to a temporary
+//! file beside its target (owner-only while it is written) and moved into place by rename once finished
+//! and synced, so a reader never sees half a file and a failure leaves the old file (or none). A rename replaces whatever has the
+//! target's name, so the target must be absent or, when the command allows replacing (`--overwrite`), a
+//! regular file: never a symbolic link (the link itself would become a plain file), a named pipe, a device
+//! (`/dev/null`), a socket or a folder, and never a file the command protects (the scene being recorded).
+//! Targets are looked at with `symlink_metadata` (lstat), which never follows a link, and never opened, so
+//! a pipe cannot block. Everything is checked before any work is done, and again just before the move; if
+//! the move fails, the finished file is kept under its temporary name, which the error gives.
+//!
+//! [`OutputFolder`] does the same for several files in one folder (`export`, `man`): every file is checked
+//! before any is moved, and an output that is dropped unfinished removes its temporary files and the
+//! folders it created.
+
+use super::shown;
+use std::fs::{self, File, Metadata, OpenOptions};
+use std::io::{self, ErrorKind, Write};
+use std::path::{Path, PathBuf};
+use tempfile::NamedTempFile;
+
+/// What may be at a target, and how messages tell the user to name another.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Policy<'a> {
+    /// An existing regular file may be replaced (`--overwrite`, or a command that always replaces its own
+    /// files).
+    pub overwrite: bool,
+    /// The flag that names the target (`-o`, `--out`), for the fixes messages suggest.
+    pub flag: &'a str,
+    /// A file name to suggest instead of a folder or a special file (`wobble.mcap`).
+    pub example: &'a str,
+    /// A file the output must never replace, however reached (another path, a hard or symbolic link),
+    /// and what it is: `(scene, "the scene file being recorded")`.
+    pub protect: Option<(&'a Path, &'a str)>,
+}
+
+/// Why an output cannot be written, or was not moved into place. `fix` says what to do instead.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The target is a folder.
+    #[error("`{path}` is a folder; {fix}")]
+    Folder {
+        /// The target.
+        path: String,
+        /// What to do instead.
+        fix: String,
+    },
+    /// The target is a symbolic link.
+    #[error(
+        "`{path}` is a symbolic link (to `{to}`), not a regular file; coin-log writes a new file and moves it \
+         into place, which would replace the link itself with a plain file: give the path it points to, or \
+         choose another path"
+    )]
+    Link {
+        /// The target.
+        path: String,
+        /// Where the link points.
+        to: String,
+    },
+    /// The target is a device, a named pipe or a socket.
+    #[error(
+        "`{path}` is {what}, not a regular file; coin-log writes a new file and moves it into place, which \
+         would replace {the}: {fix}"
+    )]
+    Special {
+        /// The target.
+        path: String,
+        /// What it is ("a named pipe").
+        what: &'static str,
+        /// The same with "the" ("the named pipe").
+        the: String,
+        /// What to do instead.
+        fix: String,
+    },
+    /// The target is the protected file.
+    #[error("`{path}` is {what}; writing there would replace it: {fix}")]
+    Protected {
+        /// The target.
+        path: String,
+        /// What the protected file is.
+        what: String,
+        /// What to do instead.
+        fix: String,
+    },
+    /// The target exists and may not be replaced.
+    #[error("`{path}` already exists; {fix}")]
+    Exists {
+        /// The target.
+        path: String,
+        /// What to do instead.
+        fix: String,
+    },
+    /// The target's folder does not exist.
+    #[error("the folder `{folder}` does not exist (for `{path}`): create it first, or choose another path")]
+    NoFolder {
+        /// The target.
+        path: String,
+        /// Its folder.
+        folder: String,
+    },
+    /// The folder given for several outputs is a file (or a device, ...).
+    #[error("`{path}` is not a folder; {flag} takes a folder (created if missing) for the files")]
+    FileAsFolder {
+        /// The folder given.
+        path: String,
+        /// The flag that gave it.
+        flag: &'static str,
+    },
+    /// Something on the way to the target is not a folder.
+    #[error("`{folder}` is not a folder, so `{path}` cannot be created in it")]
+    NotAFolder {
+        /// The target.
+        path: String,
+        /// The part that is not a folder.
+        folder: String,
+    },
+    /// The system refuses the target or its folder: the name, the permissions, the file system.
+    #[error("cannot {doing} `{path}`{target}: {source}")]
+    System {
+        /// What was being done ("create", "write in", "use").
+        doing: &'static str,
+        /// The path.
+        path: String,
+        /// For a folder, the target it was for (` (for `x.mcap`)`), or empty.
+        target: String,
+        /// The system's reason.
+        source: io::Error,
+    },
+    /// An existing file in a sticky folder that belongs to another user.
+    #[error(
+        "cannot replace `{path}`: it belongs to another user (uid {uid}) in a folder with the sticky bit (like \
+         /tmp), where only its owner may replace it: choose another path"
+    )]
+    Sticky {
+        /// The target.
+        path: String,
+        /// Its owner.
+        uid: u32,
+    },
+    /// The finished file could not be moved into place; it is kept.
+    #[error("the finished file was not moved into place: {reason}; it is kept as `{kept}`")]
+    Kept {
+        /// Why it was not moved.
+        reason: String,
+        /// Where it is, or why it could not be kept.
+        kept: String,
+    },
+}
+
+impl OutputError {
+    fn system(doing: &'static str, path: &Path, source: io::Error) -> Self {
+        Self::System {
+            doing,
+            path: shown(path),
+            target: String::new(),
+            source,
+        }
+    }
+}
+
+/// What a refused target is, for the fix a message suggests.
+#[derive(Clone, Copy)]
+enum Refused {
+    Folder,
+    Special,
+    Protected,
+    Exists,
+}
+
+impl Policy<'_> {
+    /// What to do instead of writing to `target`, refused as `refused`. Without an example the target is a
+    /// file of an output folder (`export`, `man`): the fix is another folder.
+    fn fix(&self, refused: Refused, target: &Path) -> String {
+        let flag = self.flag;
+        if self.example.is_empty() {
+            return match refused {
+                Refused::Exists => {
+                    format!("pass --overwrite to replace it, or choose another folder with {flag}")
+                }
+                _ => format!("move it away, or choose another folder with {flag}"),
+            };
+        }
+        match refused {
+            Refused::Folder => format!(
+                "give a file name, e.g. {flag} {}",
+                shown(&target.join(self.example))
+            ),
+            Refused::Special => format!("choose a file path, e.g. {flag} {}", self.example),
+            Refused::Protected => format!("choose another output, e.g. {flag} {}", self.example),
+            Refused::Exists => {
+                format!("pass --overwrite to replace it, or choose another file with {flag}")
+            }
+        }
+    }
+}
+
+/// What a file that is neither regular, a folder nor a link is, in words.
+pub(super) fn kind_of(meta: &Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_fifo() {
+            return "a named pipe";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = meta;
+    "a special file"
+}
+
+/// The folder a target lives in (`.` for a bare file name).
+fn folder_of(target: &Path) -> PathBuf {
+    match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Checks `target` against `policy`; returns its metadata when it is a regular file that may be replaced,
+/// `None` when it does not exist (its folder then does).
+fn check_target(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
+    let path = shown(target);
+    let meta = match fs::symlink_metadata(target) {
+        Ok(meta) => meta,
+        Err(e) if e.kind() == ErrorKind::NotFound => return check_folder(target).map(|()| None),
+        Err(source) => return Err(OutputError::system("use", target, source)),
+    };
+    let kind = meta.file_type();
+    if kind.is_dir() {
+        let fix = policy.fix(Refused::Folder, target);
+        return Err(OutputError::Folder { path, fix });
+    }
+    if kind.is_symlink() {
+        let to = fs::read_link(target).map_or_else(|_| "?".into(), |p| shown(&p));
+        return Err(OutputError::Link { path, to });
+    }
+    if !kind.is_file() {
+        let what = kind_of(&meta);
+        let the = what.replacen("a ", "the ", 1);
+        let fix = policy.fix(Refused::Special, target);
+        return Err(OutputError::Special {
+            path,
+            what,
+            the,
+            fix,
+        });
+    }
+    if let Some((_, what)) = policy.protect.filter(|(file, _)| same_file(&meta, file)) {
+        let (what, fix) = (what.to_string(), policy.fix(Refused::Protected, target));
+        return Err(OutputError::Protected { path, what, fix });
+    }
+    if !policy.overwrite {
+        let fix = policy.fix(Refused::Exists, target);
+        return Err(OutputError::Exists { path, fix });
+    }
+    Ok(Some(meta))
+}
+
+/// The target's folder must exist (a clearer message than the temporary file's ENOENT).
+fn check_folder(target: &Path) -> Result<(), OutputError> {
+    let folder = folder_of(target);
+    let (path, shown_folder) = (shown(target), shown(&folder));
+    match fs::metadata(&folder) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => Err(OutputError::NotAFolder {
+            path,
+            folder: shown_folder,
+        }),
+        Err(e) if e.kind() == ErrorKind::NotFound => Err(OutputError::NoFolder {
+            path,
+            folder: shown_folder,
+        }),
+        Err(source) => Err(OutputError::system("use the folder", &folder, source)),
+    }
+}
+
+/// True when `meta` (of the target) and the file at `other` are the same file, however reached.
+fn same_file(meta: &Metadata, other: &Path) -> bool {
+    let Ok(other) = fs::metadata(other) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        meta.dev() == other.dev() && meta.ino() == other.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (meta, other);
+        false
+    }
+}
+
+/// Proves before any work that the move into place will work: a name that does not exist yet is created
+/// and removed at once (the system then names any cause: "File name too long", "Read-only file system");
+/// an existing file must be replaceable by us (in a folder with the sticky bit, only its owner may).
+fn probe_target(
+    target: &Path,
+    existing: Option<&Metadata>,
+    temp: &NamedTempFile,
+    policy: &Policy,
+) -> Result<(), OutputError> {
+    let Some(meta) = existing else {
+        return match OpenOptions::new().write(true).create_new(true).open(target) {
+            Ok(file) => {
+                drop(file);
+                fs::remove_file(target)
+                    .map_err(|source| OutputError::system("remove the probe", target, source))
+            }
+            Err(e) if e.kind() == ErrorKind::AlreadyExists => Err(OutputError::Exists {
+                path: shown(target),
+                fix: policy.fix(Refused::Exists, target),
+            }),
+            Err(source) => Err(OutputError::system("create", target, source)),
+        };
+    };
+    match sticky_owner(target, meta, temp) {
+        Some(uid) => Err(OutputError::Sticky {
+            path: shown(target),
+            uid,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The owner of an existing file in a sticky folder when we may not replace it.
+fn sticky_owner(target: &Path, meta: &Metadata, temp: &NamedTempFile) -> Option<u32> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{MetadataExt, PermissionsExt};
+        let folder = fs::metadata(folder_of(target)).ok()?;
+        // The temporary file was just created by this process: its owner is our effective user.
+        let me = temp.as_file().metadata().ok()?.uid();
+        let sticky = folder.permissions().mode() & 0o1000 != 0;
+        (sticky && me != 0 && meta.uid() != me && folder.uid() != me).then_some(meta.uid())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (target, meta, temp);
+        None
+    }
+}
+
+/// A finished output file is an ordinary file (the temporary file is created owner-only).
+fn make_readable(file: &File) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = file.set_permissions(fs::Permissions::from_mode(0o644));
+    }
+    #[cfg(not(unix))]
+    let _ = file;
+}
+
+/// One output file being written: a temporary file beside its target until [`Output::commit`].
+#[derive(Debug)]
+pub struct Output {
+    target: PathBuf,
+    temp: NamedTempFile,
+    overwrite: bool,
+    flag: String,
+    example: String,
+    protect: Option<(PathBuf, String)>,
+}
+
+impl Output {
+    /// Checks `target` against `policy` and creates the temporary file beside it; nothing is left behind
+    /// if this fails.
+    ///
+    /// # Errors
+    /// [`OutputError`]: the target is not a file that may be written or replaced, its folder is missing,
+    /// or the system refuses the name or the folder.
+    pub fn create(target: &Path, policy: &Policy) -> Result<Self, OutputError> {
+        let existing = check_target(target, policy)?;
+        let folder = folder_of(target);
+        let suffix = target.extension().map_or_else(
+            || ".tmp".to_string(),
+            |e| format!(".{}.tmp", e.to_string_lossy()),
+        );
+        let temp = tempfile::Builder::new()
+            .prefix(".coin-log-")
+            .suffix(&suffix)
+            .tempfile_in(&folder)
+            .map_err(|source| OutputError::System {
+                doing: "write in",
+                path: shown(&folder),
+                target: format!(" (for `{}`)", shown(target)),
+                source,
+            })?;
+        probe_target(target, existing.as_ref(), &temp, policy)?;
+        Ok(Self {
+            target: target.to_path_buf(),
+            temp,
+            overwrite: policy.overwrite,
+            flag: policy.flag.to_string(),
+            example: policy.example.to_string(),
+            protect: policy
+                .protect
+                .map(|(p, w)| (p.to_path_buf(), w.to_string())),
+        })
+    }
+
+    /// Writes `bytes` to `target` by [`Output::create`] and [`Output::commit`].
+    ///
+    /// # Errors
+    /// As [`Output::create`], writing, and [`Output::commit`].
+    pub fn write(target: &Path, policy: &Policy, bytes: &[u8]) -> Result<(), OutputError> {
+        let mut output = Self::create(target, policy)?;
+        output
+            .file()
+            .write_all(bytes)
+            .map_err(|source| output.write_error(source))?;
+        output.commit()
+    }
+
+    /// The temporary file, to write the output into.
+    pub fn file(&mut self) -> &mut File {
+        self.temp.as_file_mut()
+    }
+
+    /// Where the output is written until it is finished.
+    #[must_use]
+    pub fn temp_path(&self) -> &Path {
+        self.temp.path()
+    }
+
+    /// Where the output goes.
+    #[must_use]
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// The error of a failed write into the output.
+    #[must_use]
+    pub fn write_error(&self, source: io::Error) -> OutputError {
+        OutputError::system("write", &self.target, source)
+    }
+
+    fn policy(&self) -> Policy<'_> {
+        Policy {
+            overwrite: self.overwrite,
+            flag: &self.flag,
+            example: &self.example,
+            protect: self
+                .protect
+                .as_ref()
+                .map(|(p, w)| (p.as_path(), w.as_str())),
+        }
+    }
+
+    /// Checks the target again (something may have appeared there meanwhile).
+    fn recheck(&self) -> Result<(), OutputError> {
+        check_target(&self.target, &self.policy()).map(|_| ())
+    }
+
+    /// Syncs the finished file, makes it readable and moves it into place. If the target no longer takes
+    /// it or the move fails, the file is kept under its temporary name and the error says where.
+    ///
+    /// # Errors
+    /// [`OutputError::System`] if the file cannot be synced (it is then removed: it is not finished);
+    /// [`OutputError::Kept`] if it was not moved into place.
+    pub fn commit(self) -> Result<(), OutputError> {
+        self.temp
+            .as_file()
+            .sync_all()
+            .map_err(|source| self.write_error(source))?;
+        make_readable(self.temp.as_file());
+        let reason = match self.recheck() {
+            Err(e @ OutputError::Exists { .. }) => {
+                format!("{e} (it appeared while the file was written, and was left alone)")
+            }
+            Err(e) => e.to_string(),
+            Ok(()) => {
+                let moved = if self.overwrite {
+                    self.temp.persist(&self.target).map(drop)
+                } else {
+                    self.temp.persist_noclobber(&self.target).map(drop)
+                };
+                let Err(e) = moved else {
+                    return Ok(());
+                };
+                let reason = format!("cannot move it to `{}`: {}", shown(&self.target), e.error);
+                return Err(keep(e.file, reason));
+            }
+        };
+        Err(keep(self.temp, reason))
+    }
+}
+
+/// Keeps a finished temporary file that could not be moved into place.
+fn keep(temp: NamedTempFile, reason: String) -> OutputError {
+    let kept = match temp.keep() {
+        Ok((_, path)) => shown(&path),
+        Err(e) => format!("nowhere: it could not be kept either ({})", e.error),
+    };
+    OutputError::Kept { reason, kept }
+}
+
+/// Several output files in one folder, each an [`Output`]: created if missing (and removed again, with
+/// every temporary file, if the outputs are dropped before [`OutputFolder::commit`]).
+#[derive(Debug)]
+pub struct OutputFolder {
+    dir: PathBuf,
+    overwrite: bool,
+    outputs: Vec<Output>,
+    /// The folders this created, deepest first.
+    created: Vec<PathBuf>,
+}
+
+impl OutputFolder {
+    /// Opens `dir` for outputs, creating it (and missing parents) if needed; `overwrite` lets the files
+    /// replace regular files of the same names.
+    ///
+    /// # Errors
+    /// [`OutputError`] if `dir` (or a parent) is not a folder or cannot be created.
+    pub fn create(dir: &Path, overwrite: bool) -> Result<Self, OutputError> {
+        let mut created = Vec::new();
+        let mut missing = Some(dir);
+        while let Some(d) = missing.filter(|d| !d.as_os_str().is_empty()) {
+            match fs::metadata(d) {
+                Ok(m) if m.is_dir() => break,
+                Ok(_) if d == dir => {
+                    return Err(OutputError::FileAsFolder {
+                        path: shown(dir),
+                        flag: "--out",
+                    })
+                }
+                Ok(_) => {
+                    return Err(OutputError::NotAFolder {
+                        path: shown(dir),
+                        folder: shown(d),
+                    })
+                }
+                Err(_) => created.push(d.to_path_buf()),
+            }
+            missing = d.parent();
+        }
+        // Created from the top down; on failure, what was created is removed (by `Drop`).
+        let mut folder = Self {
+            dir: dir.to_path_buf(),
+            overwrite,
+            outputs: Vec::new(),
+            created: Vec::new(),
+        };
+        while let Some(d) = created.pop() {
+            fs::create_dir(&d)
+                .map_err(|source| OutputError::system("create the folder", &d, source))?;
+            folder.created.insert(0, d);
+        }
+        Ok(folder)
+    }
+
+    /// The folder.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Starts the file `name` in the folder; returns a handle to write it through.
+    ///
+    /// # Errors
+    /// As [`Output::create`].
+    pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
+        let policy = Policy {
+            overwrite: self.overwrite,
+            flag: "--out",
+            example: "",
+            protect: None,
+        };
+        let mut output = Output::create(&self.dir.join(name), &policy)?;
+        let file = output
+            .file()
+            .try_clone()
+            .map_err(|source| output.write_error(source))?;
+        self.outputs.push(output);
+        Ok(file)
+    }
+
+    /// Checks every target again, then moves every file into place: either all land, or (unless a move
+    /// itself fails) none does.
+    ///
+    /// # Errors
+    /// [`OutputError`] as for [`Output::commit`].
+    pub fn commit(mut self) -> Result<(), OutputError> {
+        for output in &self.outputs {
+            output.recheck()?;
+        }
+        for output in std::mem::take(&mut self.outputs) {
+            output.commit()?;
+        }
+        self.created.clear();
+        Ok(())
+    }
+}
+
+impl Drop for OutputFolder {
+    fn drop(&mut self) {
+        self.outputs.clear();
+        for d in &self.created {
+            let _ = fs::remove_dir(d);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Output, OutputFolder, Policy};
+    use std::io::Write;
+
+    fn policy(overwrite: bool) -> Policy<'static> {
+        Policy {
+            overwrite,
+            flag: "-o",
+            example: "x.txt",
+            protect: None,
+        }
+    }
+
+    fn listing(dir: &std::path::Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_file_lands_whole_and_replaces_only_with_overwrite() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("a.txt");
+        Output::write(&target, &policy(false), b"one").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"one");
+        let e = Output::write(&target, &policy(false), b"two").unwrap_err();
+        assert!(e.to_string().contains("already exists"), "{e}");
+        Output::write(&target, &policy(true), b"two").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"two");
+        assert_eq!(listing(dir.path()), ["a.txt"]);
+    }
+
+    #[test]
+    fn a_target_replaced_by_a_folder_keeps_the_finished_file_and_names_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("a.txt");
+        std::fs::write(&target, "old").unwrap();
+        let mut output = Output::create(&target, &policy(true)).unwrap();
+        output.file().write_all(b"finished").unwrap();
+        std::fs::remove_file(&target).unwrap();
+        std::fs::create_dir(&target).unwrap();
+        let e = output.commit().unwrap_err().to_string();
+        println!("{e}");
+        let kept = e.split("kept as `").nth(1).unwrap().trim_end_matches('`');
+        assert!(e.contains("is a folder"), "{e}");
+        assert_eq!(std::fs::read(kept).unwrap(), b"finished");
+    }
+
+    #[test]
+    fn a_dropped_folder_output_leaves_nothing_not_even_its_folders() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut folder = OutputFolder::create(&dir.path().join("a/b"), false).unwrap();
+        folder.file("t.csv").unwrap().write_all(b"x").unwrap();
+        assert_eq!(
+            listing(&dir.path().join("a/b")).len(),
+            1,
+            "the temporary file"
+        );
+        drop(folder);
+        assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+        let mut folder = OutputFolder::create(&dir.path().join("c"), false).unwrap();
+        folder.file("t.csv").unwrap().write_all(b"x").unwrap();
+        folder.commit().unwrap();
+        assert_eq!(listing(&dir.path().join("c")), ["t.csv"]);
+    }
+}
