@@ -47,8 +47,7 @@ pub fn precision_csv(rows: &[PrecisionRow]) -> String {
             r.steps.to_string(),
             r.rejected.to_string(),
         ];
-        out.push_str(&fields.join(","));
-        out.push('\n');
+        out.push_str(&coin_log::csv::record(&fields));
     }
     out
 }
@@ -137,8 +136,7 @@ pub fn stability_csv(rows: &[StabilityRow]) -> String {
             number(r.measured),
             number(r.expected),
         ];
-        out.push_str(&fields.join(","));
-        out.push('\n');
+        out.push_str(&coin_log::csv::record(&fields));
     }
     out
 }
@@ -220,8 +218,7 @@ pub fn euler_csv(rows: &[EulerRow]) -> String {
             number(Some(r.with_friction.alpha)),
             number(Some(r.wall_seconds)),
         ];
-        out.push_str(&fields.join(","));
-        out.push('\n');
+        out.push_str(&coin_log::csv::record(&fields));
     }
     out
 }

@@ -555,15 +555,6 @@ impl DurationRuns {
 /// The CSV header of `bench throughput`.
 pub const CSV_HEADER: &str = "workload,quantity,value,unit,target,met,note";
 
-/// A CSV field, quoted when it holds a comma or a quote.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 /// The rows as CSV with [`CSV_HEADER`]; values as shortest round-trip numbers.
 #[must_use]
 pub fn csv(report: &ThroughputReport) -> String {
@@ -571,17 +562,15 @@ pub fn csv(report: &ThroughputReport) -> String {
     out.push('\n');
     for r in &report.rows {
         let fields = [
-            csv_field(&r.workload),
-            csv_field(&r.quantity),
+            r.workload.clone(),
+            r.quantity.clone(),
             super::table::number(Some(r.value)),
-            csv_field(&r.unit),
-            r.target
-                .map_or_else(String::new, |t| csv_field(&t.to_string())),
+            r.unit.clone(),
+            r.target.map_or_else(String::new, |t| t.to_string()),
             r.met().map_or_else(String::new, |m| m.to_string()),
-            csv_field(&r.note),
+            r.note.clone(),
         ];
-        out.push_str(&fields.join(","));
-        out.push('\n');
+        out.push_str(&coin_log::csv::record(&fields));
     }
     out
 }
