@@ -162,7 +162,7 @@ fn show(r: &FileReport) -> String {
         .map(|c| {
             format!(
                 "{:<12} {:<5} {:?} {}",
-                c.id.as_str(),
+                c.id.name(),
                 c.status.to_string(),
                 c.value,
                 c.reason

@@ -21,7 +21,7 @@ use super::{
     default_config, energy_drift, reference_trajectory, state_error, BenchCase, BenchError,
     DEFAULT_FLAT_MARGIN,
 };
-use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunEnd, RunSettings};
 use coin_log::model::{
     energy, steady_sigma_squared, straight_lambda_squared, Branch, Coin, CoinParams, Inertia,
     State, Steady, SteadyKind, STATE_LEN,
@@ -470,7 +470,7 @@ pub fn release(theta0: f64, case_name: &str) -> Vec<StabilityRow> {
             let config = suite_config(method, 1e-3);
             let (mut row, run) = row_for(case_name, &config, &case, &case.settings(), None);
             let located = match run.outcome.as_ref().map(|o| &o.termination) {
-                Some(Termination::Event { t, .. }) => Some(*t),
+                Some(RunEnd::Event { t, .. }) => Some(*t),
                 _ => None,
             };
             row.quantity = format!("{expected_event} time");

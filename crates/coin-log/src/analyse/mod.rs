@@ -8,7 +8,7 @@ pub mod map;
 mod plot;
 mod steady;
 
-pub use steady::{SteadyAnalysis, Verdict};
+pub use steady::{Stability, SteadyAnalysis};
 
 use crate::model::invariants::Chaplygin;
 use crate::model::nutation::{Motion, NutationError, Orbit};

@@ -6,7 +6,7 @@
 //! (a 200 × 200 map of the thin disk on both branches is about 2,000 rectangles, not 80,000).
 
 use super::map::{boundary, BoundaryPoint, MapError, MapPoint, StabilityMap};
-use super::steady::Verdict;
+use super::steady::Stability;
 use crate::model::Branch;
 use plotters::prelude::*;
 
@@ -27,25 +27,30 @@ const MARGINAL: RGBColor = RGBColor(150, 150, 150);
 /// θ₀ samples of the boundary curve per panel.
 const CURVE_SAMPLES: usize = 1200;
 
-/// The SVG document of `map`.
-pub fn map_svg(map: &StabilityMap) -> Result<String, MapError> {
-    let fail = |e: &dyn std::fmt::Display| MapError::Plot(e.to_string());
-    let branches = map.options.branches.list();
-    let panels = u32::try_from(branches.len()).unwrap_or(1);
-    let size = (PANEL.0 * panels, PANEL.1 + LEGEND);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let (top, bottom) = root.split_vertically(PANEL.1);
-        let areas = top.split_evenly((1, branches.len()));
-        for (area, &branch) in areas.iter().zip(branches) {
-            panel(map, area, branch).map_err(|e| fail(&e))?;
+impl StabilityMap {
+    /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes.
+    ///
+    /// # Errors
+    /// [`MapError::Plot`] if drawing fails (it does not for a validated grid).
+    pub fn svg(&self) -> Result<String, MapError> {
+        let fail = |e: &dyn std::fmt::Display| MapError::Plot(e.to_string());
+        let branches = self.options.branches.list();
+        let panels = u32::try_from(branches.len()).unwrap_or(1);
+        let size = (PANEL.0 * panels, PANEL.1 + LEGEND);
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| fail(&e))?;
+            let (top, bottom) = root.split_vertically(PANEL.1);
+            let areas = top.split_evenly((1, branches.len()));
+            for (area, &branch) in areas.iter().zip(branches) {
+                panel(self, area, branch).map_err(|e| fail(&e))?;
+            }
+            legend(self, &bottom).map_err(|e| fail(&e))?;
+            root.present().map_err(|e| fail(&e))?;
         }
-        legend(map, &bottom).map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))?;
+        Ok(svg)
     }
-    Ok(svg)
 }
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
@@ -124,9 +129,9 @@ fn panel(map: &StabilityMap, area: &Area<'_>, branch: Branch) -> DrawResult {
 /// Mga/(I_X + Ma²)); grey when marginal.
 fn colour(p: &MapPoint, unit: f64) -> RGBColor {
     let (light, dark) = match p.verdict {
-        Verdict::Marginal => return MARGINAL,
-        Verdict::Stable => STABLE,
-        Verdict::Unstable => UNSTABLE,
+        Stability::Marginal => return MARGINAL,
+        Stability::Stable => STABLE,
+        Stability::Unstable => UNSTABLE,
     };
     shade(light, dark, (p.sigma_squared.abs() / unit).log10())
 }

@@ -21,14 +21,12 @@ mod termination;
 mod time;
 pub mod tolerances;
 
-pub use channels::{
-    schema_bytes, schema_data, Channel, Topic, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING,
-    TRACK_LEVELS,
-};
+pub use channels::{schema_data, Channel, Topic, MESSAGE_ENCODING, SCHEMA_ENCODING, TRACK_LEVELS};
 pub use encoding::Encoding;
+pub use messages::{schema_bytes, FRAME_TRANSFORM, SCENE_UPDATE};
 pub use metadata::{
     MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,
 };
-pub use termination::{Termination, UnknownTermination};
+pub use termination::Termination;
 pub use time::{log_time, TimeError};

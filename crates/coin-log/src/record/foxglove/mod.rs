@@ -43,7 +43,7 @@ mod proto;
 pub mod track;
 
 use crate::format::messages::NonFiniteField;
-use crate::format::{Channel, Encoding, Topic, TRACK_LEVELS};
+use crate::format::{Channel, Encoding, Topic, FRAME_TRANSFORM, SCENE_UPDATE, TRACK_LEVELS};
 use crate::model::{contact_point, orientation, Coin, State};
 use json::{check, Writer};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -89,9 +89,6 @@ const GRID_WIDTHS: [f64; 2] = [1.0, 2.0];
 const TRACK_WIDTH: f64 = 3.0;
 /// Every GRID_MAJOR-th grid line is a major one.
 const GRID_MAJOR: i32 = 5;
-
-const FRAME_TRANSFORM: &str = "foxglove.FrameTransform";
-const SCENE_UPDATE: &str = "foxglove.SceneUpdate";
 
 const IDENTITY_POSE: &[u8] =
     br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
@@ -1233,7 +1230,7 @@ mod tests {
             .sample(0.01, 10_000_000, &bad, false, &mut batch)
             .unwrap_err();
         println!("{err}");
-        assert_eq!(err.schema, "foxglove.FrameTransform");
+        assert_eq!(err.schema, FRAME_TRANSFORM);
         assert_eq!(batch.len(), before);
         let bad = State {
             x: f64::INFINITY,
@@ -1255,7 +1252,7 @@ mod tests {
                 &mut batch,
             )
             .unwrap_err();
-        assert_eq!(err.schema, "foxglove.SceneUpdate");
+        assert_eq!(err.schema, SCENE_UPDATE);
     }
 
     #[test]
