@@ -774,17 +774,22 @@ pub(super) fn fitted_step(step: f64, interval: f64) -> f64 {
     interval / steps
 }
 
+/// The channels of a scene that lists none: all ten, and `work` with dissipation (format.md: Channels).
+pub(super) fn default_channels(dissipative: bool) -> Vec<Channel> {
+    let mut channels = Channel::DEFAULT.to_vec();
+    if dissipative {
+        channels.push(Channel::Work);
+    }
+    channels
+}
+
 fn check_channels(
     record: Option<&RecordFile>,
     dissipative: bool,
     problems: &mut ProblemCollector,
 ) -> Option<Vec<Channel>> {
     let Some(names) = record.and_then(|r| r.channels.as_ref()) else {
-        let mut channels = Channel::DEFAULT.to_vec();
-        if dissipative {
-            channels.push(Channel::Work);
-        }
-        return Some(channels);
+        return Some(default_channels(dissipative));
     };
     let before = problems.list.len();
     let mut channels = Vec::new();
