@@ -4,7 +4,7 @@
 //! NaN, a repeated log time, a run that never reaches its next sample, or numerical trouble that the
 //! summary would report as physics.
 
-use super::file::{RunFile, SceneFile};
+use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::integrate::Method;
@@ -400,25 +400,6 @@ fn describe_state(s: &State) -> String {
         number(s.omega_y),
         number(s.omega_z)
     )
-}
-
-/// Settings given that the integrator does not use: `run.step` for adaptive methods, `run.rtol` and
-/// `run.atol` for fixed-step ones (format.md: record). They are ignored (and stored as 0), never used to
-/// loosen `verify`'s tolerances; the caller warns about each.
-#[must_use]
-pub fn ignored_settings(run: Option<&RunFile>, method: Method) -> Vec<(&'static str, f64)> {
-    let Some(run) = run else {
-        return Vec::new();
-    };
-    let candidates: [(&'static str, Option<f64>, bool); 3] = [
-        ("run.rtol", run.rtol, !method.is_adaptive()),
-        ("run.atol", run.atol, !method.is_adaptive()),
-        ("run.step", run.step, method.is_adaptive()),
-    ];
-    candidates
-        .into_iter()
-        .filter_map(|(key, value, ignored)| value.filter(|_| ignored).map(|v| (key, v)))
-        .collect()
 }
 
 #[cfg(test)]

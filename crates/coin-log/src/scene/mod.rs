@@ -7,6 +7,7 @@
 
 mod file;
 pub mod limits;
+mod notes;
 mod overrides;
 pub mod presets;
 mod problems;
@@ -16,6 +17,7 @@ pub use file::{
     BodyFile, DissipationFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile,
     SteadyFile,
 };
+pub use notes::{compact, Note};
 pub use overrides::{apply_set, FlagOverrides};
 pub use problems::{Problem, SceneProblems};
 pub use validate::UNEXPLAINED;
@@ -242,6 +244,20 @@ fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
 /// # Errors
 /// [`SceneError::Invalid`] listing every problem.
 pub fn resolve(file: &SceneFile, flags: &FlagOverrides) -> Result<Scene, SceneError> {
+    resolve_with_notes(file, flags).map(|(scene, _)| scene)
+}
+
+/// [`resolve`], with what resolving did to what was asked: the settings the integrator ignores and a
+/// fixed step rounded to the sampling grid, for the user to be told.
+///
+/// # Errors
+/// [`SceneError::Invalid`] listing every problem.
+pub fn resolve_with_notes(
+    file: &SceneFile,
+    flags: &FlagOverrides,
+) -> Result<(Scene, Vec<Note>), SceneError> {
     let (file, provenance) = flags.apply(file);
-    validate::scene_from_file(&file, &provenance)
+    let scene = validate::scene_from_file(&file, &provenance)?;
+    let notes = notes::notes(&scene, &file, &provenance);
+    Ok((scene, notes))
 }
