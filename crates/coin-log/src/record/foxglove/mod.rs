@@ -92,18 +92,7 @@ const GRID_MAJOR: i32 = 5;
 
 const IDENTITY_POSE: &[u8] =
     br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
-const COIN_COLOR: &[u8] = br#"{"r":0.85,"g":0.65,"b":0.2,"a":1}"#;
-const MARK_TOP_COLOR: &[u8] = br#"{"r":0.6,"g":0.05,"b":0.05,"a":1}"#;
-const MARK_BOTTOM_COLOR: &[u8] = br#"{"r":0.05,"g":0.1,"b":0.55,"a":1}"#;
-const TABLE_COLOR: &[u8] = br#"{"r":0.87,"g":0.86,"b":0.82,"a":1}"#;
-const GRID_COLORS: [&[u8]; 2] = [
-    br#"{"r":0.66,"g":0.66,"b":0.63,"a":1}"#,
-    br#"{"r":0.45,"g":0.45,"b":0.43,"a":1}"#,
-];
-const TRACK_COLOR: &[u8] = br#"{"r":0.1,"g":0.35,"b":0.9,"a":1}"#;
-
-/// A colour (r, g, b, a) in 0..1: the Protobuf writer's form of the JSON literals above (a test checks
-/// they agree).
+/// A colour (r, g, b, a) in 0..1, as both encodings write it.
 type Rgba = [f64; 4];
 const COIN_RGBA: Rgba = [0.85, 0.65, 0.2, 1.0];
 const MARK_RGBA: [Rgba; 2] = [[0.6, 0.05, 0.05, 1.0], [0.05, 0.1, 0.55, 1.0]];
@@ -460,8 +449,7 @@ impl Foxglove3d {
         w.raw(b"{\"deletions\":[],\"entities\":[");
         w.entity_head(log_time, FOLLOW_FRAME, b"coin", None, true);
         w.raw(b"\"cubes\":[");
-        let colors = [MARK_TOP_COLOR, MARK_BOTTOM_COLOR];
-        for (i, (position, size, _)) in coin_marks(r, h).iter().enumerate() {
+        for (i, (position, size, colour)) in coin_marks(r, h).iter().enumerate() {
             if i > 0 {
                 w.raw(b",");
             }
@@ -470,7 +458,7 @@ impl Foxglove3d {
             w.raw(b",\"size\":");
             w.vector3("cubes.size", size[0], size[1], size[2])?;
             w.raw(b",\"color\":");
-            w.raw(colors[i]);
+            w.color(*colour);
             w.raw(b"}");
         }
         w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
@@ -478,7 +466,7 @@ impl Foxglove3d {
         w.raw(b",\"size\":");
         w.vector3("cylinders.size", 2.0, 2.0, h)?;
         w.raw(b",\"bottom_scale\":1,\"top_scale\":1,\"color\":");
-        w.raw(COIN_COLOR);
+        w.color(COIN_RGBA);
         w.raw(b"}],\"lines\":[],");
         w.entity_tail();
         w.raw(b"]}");
@@ -528,7 +516,7 @@ fn write_table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) -> Result<(),
     let side = 2.0 * TABLE_HALF_SIDE;
     w.vector3("cubes.size", side, side, TABLE_THICKNESS)?;
     w.raw(b",\"color\":");
-    w.raw(TABLE_COLOR);
+    w.color(TABLE_RGBA);
     w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
     for major in [false, true] {
         if major {
@@ -559,7 +547,7 @@ fn write_grid(w: &mut Writer, centre: [f64; 2], major: bool) -> Result<(), NonFi
         w.point(b[0], b[1])?;
     }
     w.raw(b"],\"color\":");
-    w.raw(GRID_COLORS[usize::from(major)]);
+    w.color(GRID_RGBA[usize::from(major)]);
     w.raw(b",\"colors\":[],\"indices\":[]}");
     Ok(())
 }
@@ -585,7 +573,7 @@ fn write_track(
         w.point(p.x, p.y)?;
     }
     w.raw(b"],\"color\":");
-    w.raw(TRACK_COLOR);
+    w.color(TRACK_RGBA);
     w.raw(b",\"colors\":[],\"indices\":[]}],");
     w.entity_tail();
     w.raw(b"]}");
