@@ -8,6 +8,7 @@
 use super::map::{boundary, BoundaryPoint, MapError, MapPoint, StabilityMap};
 use super::steady::Stability;
 use crate::model::Branch;
+use crate::palette::{MARGINAL, STABLE, UNSTABLE};
 use plotters::prelude::*;
 
 /// Size of one panel and of the legend strip \[px\].
@@ -18,12 +19,6 @@ const LEGEND: u32 = 70;
 const SHADES: usize = 12;
 /// Decades of |σ²|, in units of Mga/(I_X + Ma²), from light to dark.
 const DECADES: (f64, f64) = (-4.0, 2.0);
-/// Light and dark ends of the stable (blue) and unstable (red) scales.
-const STABLE: (RGBColor, RGBColor) = (RGBColor(222, 235, 247), RGBColor(8, 48, 107));
-/// See [`STABLE`].
-const UNSTABLE: (RGBColor, RGBColor) = (RGBColor(254, 224, 210), RGBColor(165, 15, 21));
-/// Cells with σ² = 0 to rounding.
-const MARGINAL: RGBColor = RGBColor(150, 150, 150);
 /// θ₀ samples of the boundary curve per panel.
 const CURVE_SAMPLES: usize = 1200;
 
@@ -153,8 +148,7 @@ fn shade(light: RGBColor, dark: RGBColor, decade: f64) -> RGBColor {
 
 /// The cells of one branch, runs of one colour along ω_Z0 merged.
 fn cells(map: &StabilityMap, branch: Branch) -> Vec<Rectangle<(f64, f64)>> {
-    let p = map.coin.params();
-    let unit = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
+    let unit = map.coin.params().topple_rate_squared();
     let (half_t, half_w) = (
         0.5 * map.options.theta.step(),
         0.5 * map.options.omega_z.step(),

@@ -16,6 +16,7 @@ use crate::format::{
 };
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
+use crate::palette::{BLUE, GREEN, GREY, ORANGE, RED};
 use crate::scene::SceneFile;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
 use plotters::coord::Shift;
@@ -37,12 +38,6 @@ pub const PANELS: [&str; 6] = [
     "normal force N / (Mg)",
     "friction ratio |F| / N",
 ];
-
-const BLUE: RGBColor = RGBColor(31, 119, 180);
-const ORANGE: RGBColor = RGBColor(255, 127, 14);
-const GREEN: RGBColor = RGBColor(44, 160, 44);
-const RED: RGBColor = RGBColor(214, 39, 40);
-const GREY: RGBColor = RGBColor(120, 120, 120);
 
 /// Why a file could not be plotted.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
