@@ -610,7 +610,7 @@ mod tests {
     // Unit tests of the Foxglove output: schemas, frames, the drawing's geometry against the model, rates,
     // the table, the track's levels, scale invariance, non-finite values.
 
-    use super::track::{MAX_TOLERANCE, QUANTUM};
+    use super::track::{segment_distance, MAX_TOLERANCE, QUANTUM};
     use super::*;
     use crate::format::log_time;
     use crate::format::schema_bytes;
@@ -1135,17 +1135,6 @@ mod tests {
         println!(
             "{checked} cut times: the latest track messages cover the path to the latest update"
         );
-    }
-
-    fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let len2 = dx * dx + dy * dy;
-        let s = if len2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p[0] - a[0] - s * dx).hypot(p[1] - a[1] - s * dy)
     }
 
     #[test]
