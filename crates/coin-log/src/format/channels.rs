@@ -9,9 +9,9 @@ use super::Encoding;
 use std::fmt;
 
 /// Schema encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const SCHEMA_ENCODING: &str = "jsonschema";
+pub const SCHEMA_ENCODING: &str = Encoding::Json.schema_encoding();
 /// Message encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const MESSAGE_ENCODING: &str = "json";
+pub const MESSAGE_ENCODING: &str = Encoding::Json.message_encoding();
 
 coin_log_names::named_enum! {
     /// A recordable channel; the name is the one of scene files and `--channels`. `work` is last here, but

@@ -17,7 +17,7 @@ coin_log_names::named_enum! {
 impl Encoding {
     /// The MCAP schema encoding of its schemas.
     #[must_use]
-    pub fn schema_encoding(self) -> &'static str {
+    pub const fn schema_encoding(self) -> &'static str {
         match self {
             Self::Json => "jsonschema",
             Self::Protobuf => "protobuf",
@@ -26,7 +26,7 @@ impl Encoding {
 
     /// The MCAP message encoding of its channels.
     #[must_use]
-    pub fn message_encoding(self) -> &'static str {
+    pub const fn message_encoding(self) -> &'static str {
         match self {
             Self::Json => "json",
             Self::Protobuf => "protobuf",
