@@ -18,7 +18,7 @@ fn problems(text: &str, sets: &[&str], flags: FlagOverrides) -> Vec<Problem> {
     let sets: Vec<String> = sets.iter().map(|s| (*s).to_string()).collect();
     let file = scene::parse_with_sets(text, &sets).expect("parses");
     match scene::resolve(&file, &flags) {
-        Err(SceneError::Invalid(p)) => p.into_vec(),
+        Err(SceneError::Invalid(p)) => p.iter().cloned().collect(),
         other => panic!("expected problems, got {other:?}"),
     }
 }

@@ -287,7 +287,7 @@ pub struct StabilityMap {
 
 /// σ² and its verdict for the circle (θ₀, ω_Z0) on `branch`.
 #[must_use]
-pub fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> MapPoint {
+fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> MapPoint {
     let omega_y0 = steady_omega_y(coin, theta0, omega_z0, branch);
     let sigma_squared = steady_sigma_squared(coin, theta0, omega_y0, omega_z0);
     let scale = Linearisation::at(coin, theta0, omega_y0, omega_z0).scale();

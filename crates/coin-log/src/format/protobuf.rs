@@ -62,7 +62,7 @@ fn foxglove_descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
 
 /// The file name of a `coin_log.*` type's `.proto` (in `schemas/` and in its descriptor).
 #[must_use]
-pub fn proto_file_name(schema_name: &str) -> String {
+fn proto_file_name(schema_name: &str) -> String {
     format!("{schema_name}.proto")
 }
 

@@ -80,7 +80,7 @@ pub enum RecordError {
 /// The writer options of every coin-log file (chunked, indexed, statistics, summary offsets and CRCs are
 /// always on in [`McapWriter`]).
 #[must_use]
-pub fn write_options(options: &RecordOptions) -> WriterOptions {
+fn write_options(options: &RecordOptions) -> WriterOptions {
     WriterOptions {
         workers: COMPRESSION_THREADS,
         ..WriterOptions::new(

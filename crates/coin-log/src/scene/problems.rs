@@ -59,11 +59,6 @@ impl SceneProblems {
         })
     }
 
-    /// Adds a problem.
-    pub fn push(&mut self, problem: Problem) {
-        self.rest.push(problem);
-    }
-
     /// How many problems (at least one).
     #[must_use]
     pub fn count(&self) -> usize {
@@ -73,14 +68,6 @@ impl SceneProblems {
     /// The problems, in the order found.
     pub fn iter(&self) -> impl Iterator<Item = &Problem> {
         std::iter::once(&self.first).chain(&self.rest)
-    }
-
-    /// The problems as a vector (never empty).
-    #[must_use]
-    pub fn into_vec(self) -> Vec<Problem> {
-        let mut all = vec![self.first];
-        all.extend(self.rest);
-        all
     }
 }
 
