@@ -1,5 +1,5 @@
-//! The channels of the format (format.md: Channels and fields): name, topic, schema name and schema bytes.
-//! The schema bytes are the files in `schemas/`, embedded at build time, so a log's schema is the file.
+//! The channels of the format (format.md: Channels and fields): name, topic, schema name and fields, and the
+//! schema bytes a file stores in either encoding.
 
 use super::messages::{
     message_type, schema_bytes, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,

@@ -1,7 +1,6 @@
 //! The file format, typed: everything a coin-log MCAP file contains that `scene`, `record` and `verify` must
-//! agree on (docs/format.md). The channels with their topics, schema names and schema bytes
-//! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`], read back by
-//! [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
+//! agree on (docs/format.md). The channels with their topics and schemas ([`channels`]); the schemas and
+//! the `coin_log.*` message types with their JSON form ([`messages`], read back by [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
 //! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
 //! recorded integrator settings ([`tolerances`]).
