@@ -2,8 +2,8 @@
 //! schema bytes a file stores in either encoding.
 
 use super::messages::{
-    message_type, schema_bytes, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
-    Position, QuaternionMessage, ReactionMessage, WorkMessage, FRAME_TRANSFORM, SCENE_UPDATE,
+    schema_bytes, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, MessageType, Position,
+    QuaternionMessage, ReactionMessage, WorkMessage, FRAME_TRANSFORM, SCENE_UPDATE,
 };
 use super::Encoding;
 use std::fmt;
@@ -70,20 +70,29 @@ impl Channel {
         }
     }
 
+    /// The `coin_log.*` message type of the channel; `None` for Foxglove's `/tf` and `/scene`.
+    #[must_use]
+    pub fn message_type(self) -> Option<&'static MessageType> {
+        Some(match self {
+            Self::Omega => &AngularVelocity::TYPE,
+            Self::Angles => &Angles::TYPE,
+            Self::Quaternion => &QuaternionMessage::TYPE,
+            Self::Position | Self::Contact => &Position::TYPE,
+            Self::Reaction => &ReactionMessage::TYPE,
+            Self::Energy => &EnergyMessage::TYPE,
+            Self::Invariants => &InvariantsMessage::TYPE,
+            Self::Work => &WorkMessage::TYPE,
+            Self::Tf | Self::Scene => return None,
+        })
+    }
+
     /// Schema name.
     #[must_use]
     pub fn schema_name(self) -> &'static str {
-        match self {
-            Self::Omega => AngularVelocity::SCHEMA,
-            Self::Angles => Angles::SCHEMA,
-            Self::Quaternion => QuaternionMessage::SCHEMA,
-            Self::Position | Self::Contact => Position::SCHEMA,
-            Self::Reaction => ReactionMessage::SCHEMA,
-            Self::Energy => EnergyMessage::SCHEMA,
-            Self::Invariants => InvariantsMessage::SCHEMA,
-            Self::Work => WorkMessage::SCHEMA,
-            Self::Tf => FRAME_TRANSFORM,
-            Self::Scene => SCENE_UPDATE,
+        match self.message_type() {
+            Some(t) => t.schema,
+            None if self == Self::Tf => FRAME_TRANSFORM,
+            None => SCENE_UPDATE,
         }
     }
 
@@ -91,7 +100,7 @@ impl Channel {
     /// `coin_log.*` channels; `None` for Foxglove's `/tf` and `/scene`, whose messages are nested.
     #[must_use]
     pub fn fields(self) -> Option<&'static [&'static str]> {
-        message_type(self.schema_name()).map(|t| t.fields)
+        self.message_type().map(|t| t.fields)
     }
 
     /// Every channel's name, comma-separated, for messages.
