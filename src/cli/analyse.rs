@@ -9,7 +9,7 @@ use anyhow::{anyhow, Context};
 use coin_log::analyse::map::{
     band_report, stability_map, Branches, Grid, MapOptions, DEFAULT_OMEGA_Z, DEFAULT_THETA,
 };
-use coin_log::analyse::{motion_name, Analysis, SteadyAnalysis, Verdict};
+use coin_log::analyse::{motion_name, Analysis, Stability, SteadyAnalysis};
 use coin_log::files::{shown, OutputFolder};
 use coin_log::model::nutation::Motion;
 use coin_log::model::{Coin, CoinParams, SteadyFamily};
@@ -185,15 +185,15 @@ fn family(s: &SteadyAnalysis) -> String {
 
 fn verdict(s: &SteadyAnalysis) -> String {
     match s.verdict {
-        Verdict::Stable => format!(
+        Stability::Stable => format!(
             "stable: small perturbations nutate with period 2π/σ = {}",
             n(s.nutation_period().unwrap_or(f64::NAN))
         ),
-        Verdict::Unstable => format!(
+        Stability::Unstable => format!(
             "unstable: small perturbations grow like e^(t/τ), τ = 1/√(−σ²) = {}",
             n(s.e_folding_time().unwrap_or(f64::NAN))
         ),
-        Verdict::Marginal => {
+        Stability::Marginal => {
             "marginal: σ² = 0 to rounding, the linearisation does not decide".to_string()
         }
     }

@@ -11,7 +11,7 @@ use coin_log::files::{shown, Output, Policy};
 use coin_log::format::Encoding;
 use coin_log::format::Termination;
 use coin_log::record::{self, RecordOptions, RecordSummary};
-use coin_log::scene::{self, limits, FlagOverrides, Scene};
+use coin_log::scene::{self, compact, FlagOverrides, Scene};
 use coin_log_mcap::Compression;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -267,7 +267,7 @@ pub(super) fn resolve_flags(
     encoding: Encoding,
     source: &SceneSource,
 ) -> anyhow::Result<Scene> {
-    let scene = scene::resolve(&source.file, &flags)
+    let (scene, notes) = scene::resolve_with_notes(&source.file, &flags)
         .map_err(|e| anyhow!("scene `{}`: {e}", source.label))?;
     let max = record::foxglove::PROTOBUF_MAX_SECONDS;
     if encoding == Encoding::Protobuf && scene.run.duration > max {
@@ -278,37 +278,9 @@ pub(super) fn resolve_flags(
             scene.run.duration
         ));
     }
-    let (file, provenance) = flags.apply(&source.file);
-    let method = scene.run.method.method;
-    for (key, value) in limits::ignored_settings(file.run.as_ref(), method) {
-        let by = provenance
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map_or_else(String::new, |(_, flag)| format!(" (set by `{flag}`)"));
-        let uses = if method.is_adaptive() {
-            "an adaptive method: it uses rtol and atol"
-        } else {
-            "a fixed-step method: it uses the step"
-        };
-        errln!(
-            "warning: `{key}` = {value}{by} does not apply to {method}, {uses}; ignored (stored as 0)"
-        );
-    }
-    if !method.is_adaptive() {
-        let asked = file
-            .run
-            .as_ref()
-            .and_then(|r| r.step)
-            .unwrap_or(scene::defaults::STEP);
-        let used = scene.run.method.step;
-        if (asked - used).abs() > 1e-12 * asked {
-            errln!(
-                "note: step {asked} rounded down to {} so that a whole number of steps ({}) fits between samples (1/rate = {})",
-                compact(used),
-                (scene.run.sample_interval() / used).round(),
-                compact(scene.run.sample_interval())
-            );
-        }
+    for note in notes {
+        let kind = if note.is_warning() { "warning" } else { "note" };
+        errln!("{kind}: {note}");
     }
     Ok(scene)
 }
@@ -463,17 +435,6 @@ fn integrator_settings(scene: &Scene) -> String {
         format!("{} (rtol {:e}, atol {:e})", m.method, m.rtol, m.atol)
     } else {
         format!("{} (step {})", m.method, compact(m.step))
-    }
-}
-
-/// A number in its shortest form when that is short (`0.001`, `0.0025`), else to 5 digits (`8.3333e-4`).
-fn compact(x: f64) -> String {
-    let shortest = x.to_string();
-    let digits = shortest.trim_start_matches(['-', '0', '.']).len();
-    if digits <= 6 {
-        shortest
-    } else {
-        format!("{x:.4e}")
     }
 }
 

@@ -176,7 +176,7 @@ fn file_table(f: &FileReport, out: &mut String) {
     for c in &f.checks {
         out.push_str(&format!(
             "  {:<12} {:<6} {:>10} {:>10}  {}\n",
-            c.id.as_str(),
+            c.id.name(),
             c.status.to_string(),
             number(c.value),
             number(c.tolerance),

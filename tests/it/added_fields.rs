@@ -15,7 +15,7 @@ fn show(r: &FileReport) -> String {
         .map(|c| {
             format!(
                 "{:<12} {} {:?}  {}",
-                c.id.as_str(),
+                c.id.name(),
                 c.status,
                 c.value,
                 c.reason

@@ -122,11 +122,7 @@ fn every_bound_record_help_states_is_accepted_and_the_next_value_refused() {
 fn verify_help_names_every_check() {
     let (_, help, _) = coin_log_text(&["verify", "--help"]);
     for id in CheckId::ALL {
-        assert!(
-            help.contains(id.as_str()),
-            "`{}` in verify --help",
-            id.as_str()
-        );
+        assert!(help.contains(id.name()), "`{}` in verify --help", id.name());
     }
 }
 

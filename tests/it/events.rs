@@ -8,7 +8,7 @@
 #![allow(clippy::unwrap_used)]
 
 use coin_log::integrate::{
-    run_method, EventFunctions, Flow, Method, MethodConfig, RunSettings, Termination,
+    run_method, EventFunctions, Flow, Method, MethodConfig, RunEnd, RunSettings,
 };
 use coin_log::model::nutation::{Motion, Orbit};
 use coin_log::model::{Chaplygin, Coin, CoinParams, State, STATE_LEN};
@@ -122,7 +122,7 @@ fn release(config: &MethodConfig, theta0: f64) -> Ended {
         last_sample = (t, *y);
         Flow::Continue
     });
-    let Termination::Event { index, t } = outcome.termination else {
+    let RunEnd::Event { index, t } = outcome.termination else {
         panic!(
             "{}: expected an event, got {:?}",
             config.method, outcome.termination
@@ -282,7 +282,7 @@ fn samples_fall_on_the_grid_and_the_last_one_is_exactly_t_end() {
                 times.last(),
                 outcome.termination
             );
-            assert_eq!(outcome.termination, Termination::Completed);
+            assert_eq!(outcome.termination, RunEnd::Completed);
             assert_eq!(times.len(), expected, "{method}: sample times {times:?}");
             assert!(
                 times.last().is_some_and(|&t| t == 1.0),
@@ -326,7 +326,7 @@ fn an_observer_asking_to_stop_ends_the_run_at_that_sample() {
         },
     );
     println!("{:?} after {count} samples", outcome.termination);
-    assert_eq!(outcome.termination, Termination::Stopped { t: 1.0 });
+    assert_eq!(outcome.termination, RunEnd::Stopped { t: 1.0 });
     assert_eq!(count, 5);
 }
 
@@ -362,7 +362,7 @@ fn an_event_just_after_a_grid_sample_never_repeats_a_nanosecond_of_log_time() {
             times.push(coin_log::format::log_time(t).unwrap());
             Flow::Continue
         });
-        let Termination::Event { t, .. } = outcome.termination else {
+        let RunEnd::Event { t, .. } = outcome.termination else {
             panic!(
                 "{method}: expected the event, got {:?}",
                 outcome.termination

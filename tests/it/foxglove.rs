@@ -15,7 +15,7 @@
 use crate::support::record::read_back;
 use crate::support::{dataset_files, repo};
 use coin_log::format::{schema_bytes, Topic};
-use coin_log::record::foxglove::track::{MAX_TOLERANCE, QUANTUM};
+use coin_log::record::foxglove::track::{segment_distance, MAX_TOLERANCE, QUANTUM};
 use coin_log::record::foxglove::{
     FOLLOW_FRAME, SCENE_RATE, TABLE_HALF_SIDE, TABLE_SNAP, WORLD_FRAME,
 };
@@ -333,17 +333,6 @@ fn track_chain(latest: &BTreeMap<&str, &Message>) -> Result<Vec<[f64; 2]>, Strin
         }
     }
     Ok(chain)
-}
-
-fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let s = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p[0] - a[0] - s * dx).hypot(p[1] - a[1] - s * dy)
 }
 
 /// Checks that `chain` draws the contact points `path` (in time order, display units) from the first to the

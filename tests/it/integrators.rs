@@ -5,8 +5,8 @@
 use crate::support::physics::wobble;
 use crate::support::vectors::max_diff;
 use coin_log::integrate::{
-    run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Stats, StepError,
-    Termination,
+    run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunEnd, RunSettings, Stats,
+    StepError,
 };
 use coin_log::model::{energy, Coin, CoinParams, State, STATE_LEN};
 
@@ -85,7 +85,7 @@ fn final_state<const N: usize, S: OdeSystem<N>>(
     });
     assert_eq!(
         outcome.termination,
-        Termination::Completed,
+        RunEnd::Completed,
         "{} did not complete",
         config.method
     );
@@ -155,7 +155,7 @@ fn max_sampled_error<const N: usize, S: OdeSystem<N>>(
         error = error.max(max_diff(y, &exact(t)));
         Flow::Continue
     });
-    assert_eq!(outcome.termination, Termination::Completed);
+    assert_eq!(outcome.termination, RunEnd::Completed);
     (error, outcome.stats)
 }
 
@@ -303,7 +303,7 @@ fn sampled<const N: usize, S: OdeSystem<N>>(
         samples.push((t, *y));
         Flow::Continue
     });
-    assert_eq!(outcome.termination, Termination::Completed);
+    assert_eq!(outcome.termination, RunEnd::Completed);
     (samples, outcome.stats)
 }
 
@@ -387,7 +387,7 @@ fn dop853_conserves_the_energy_of_a_wobbling_coin_to_1e_11() {
         samples.push((t, *y));
         Flow::Continue
     });
-    assert_eq!(outcome.termination, Termination::Completed);
+    assert_eq!(outcome.termination, RunEnd::Completed);
     let drift = relative_energy_error(&coin, &samples, 100.0);
     println!(
         "dop853 rtol 1e-12 over [0, 100]: relative energy drift {drift:.3e} (expected ≤ 1e-11), {:?}",
@@ -447,12 +447,7 @@ fn sampled_every<const N: usize, S: OdeSystem<N>>(
         samples.push((t, *y));
         Flow::Continue
     });
-    assert_eq!(
-        outcome.termination,
-        Termination::Completed,
-        "{}",
-        config.method
-    );
+    assert_eq!(outcome.termination, RunEnd::Completed, "{}", config.method);
     (samples, outcome.stats)
 }
 
@@ -509,12 +504,10 @@ fn a_finite_time_blow_up_ends_in_a_step_error_near_t_1_without_nan_samples() {
             "{method} passed non-finite samples on"
         );
         let t = match outcome.termination {
-            Termination::Failed(
-                StepError::StepSizeUnderflow { t, .. } | StepError::NonFinite { t },
-            ) => t,
-            Termination::Failed(StepError::NewtonFailure { t, .. }) if method == Method::Gauss4 => {
+            RunEnd::Failed(StepError::StepSizeUnderflow { t, .. } | StepError::NonFinite { t }) => {
                 t
             }
+            RunEnd::Failed(StepError::NewtonFailure { t, .. }) if method == Method::Gauss4 => t,
             other => panic!("{method}: expected a step failure, got {other:?}"),
         };
         assert!(

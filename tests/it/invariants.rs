@@ -8,7 +8,7 @@
 //! Richardson-extrapolated; the difference between the two runs is printed as the reference's own error.
 
 use crate::support::physics::wobble;
-use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunSettings, Termination};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunEnd, RunSettings};
 use coin_log::model::{energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
 use coin_log::simulation::{simulate, CoinEvents};
 
@@ -295,12 +295,7 @@ fn wronskian_is_one_over_cos_squared() {
 }
 
 /// C1, C2 on a trajectory; `variant` lets the negative controls break the formula.
-fn drift_along<F>(
-    p: &CoinParams,
-    initial: &State,
-    t_end: f64,
-    mut value: F,
-) -> (f64, Termination, f64)
+fn drift_along<F>(p: &CoinParams, initial: &State, t_end: f64, mut value: F) -> (f64, RunEnd, f64)
 where
     F: FnMut(&[f64; 8]) -> Invariants,
 {
@@ -605,7 +600,7 @@ fn energy_c1_and_c2_drift_below_1e_11_over_100_time_units_with_dop853_at_rtol_1e
             outcome.t_last, outcome.termination, outcome.stats.steps
         );
         assert!(
-            matches!(outcome.termination, Termination::Completed),
+            matches!(outcome.termination, RunEnd::Completed),
             "{name} did not complete"
         );
         for (quantity, drift) in [("E", energy_drift), ("C1", c1_drift), ("C2", c2_drift)] {

@@ -7,7 +7,7 @@
 
 use crate::support::record::{coin_log_text, read_back, record_scene, scene_names};
 use crate::support::writers::rewrite_protobuf;
-use coin_log::format::protobuf::put_double;
+use coin_log::format::messages::put_double;
 use coin_log::verify::{verify_file, CheckId, Options, Status};
 use foxglove::messages::{
     CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Pose, SceneEntity, SceneUpdate,

@@ -7,7 +7,7 @@ use crate::support::newton_euler::{NewtonEuler, NE_LEN};
 use crate::support::physics::{self, rate_unit, wobbling};
 use crate::support::vectors::{quat_distance, world_omega};
 use coin_log::integrate::{
-    run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunSettings, Termination,
+    run_method, Flow, Method, MethodConfig, NoEvents, OdeSystem, RunEnd, RunSettings,
 };
 use coin_log::model::{centre, contact_point, orientation, Coin, CoinParams, State, STATE_LEN};
 
@@ -61,7 +61,7 @@ fn disagreement<S: OdeSystem<STATE_LEN>>(
                     Flow::Continue
                 },
             );
-            assert_eq!(outcome.termination, Termination::Completed);
+            assert_eq!(outcome.termination, RunEnd::Completed);
             out
         }
     };

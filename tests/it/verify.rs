@@ -14,7 +14,7 @@ fn show(r: &FileReport) -> String {
         .map(|c| {
             format!(
                 "{:<12} {:<5} value {:?} tol {:?}  {}",
-                c.id.as_str(),
+                c.id.name(),
                 c.status.to_string(),
                 c.value,
                 c.tolerance,
@@ -428,7 +428,7 @@ fn assert_only_failure(r: &FileReport, clean: &FileReport, id: CheckId, expected
         (value - expected).abs() <= rel * expected,
         "{id}: measured {value:e}, expected {expected:e} ± {rel:e} relative"
     );
-    for other in CheckId::ALL.into_iter().filter(|o| *o != id) {
+    for &other in CheckId::ALL.iter().filter(|o| **o != id) {
         assert_eq!(
             status(r, other),
             status(clean, other),

@@ -3,7 +3,7 @@
 
 use super::BenchError;
 use coin_log::analyse::steady_path::steady_state_at;
-use coin_log::integrate::{Flow, Method, MethodConfig, RunOutcome, RunSettings, Termination};
+use coin_log::integrate::{Flow, Method, MethodConfig, RunEnd, RunOutcome, RunSettings};
 use coin_log::model::drift::{EnergyDrift, InvariantDrift};
 use coin_log::model::invariants::Chaplygin;
 use coin_log::model::{energy, Coin, Dissipation, Dynamics, State, Steady, STATE_LEN};
@@ -143,14 +143,14 @@ impl Trajectory {
     pub fn completed(&self) -> bool {
         matches!(
             self.outcome.as_ref().map(|o| &o.termination),
-            Some(Termination::Completed)
+            Some(RunEnd::Completed)
         )
     }
 }
 
 /// The format's name of a termination.
 #[must_use]
-pub fn termination_name(termination: &Termination) -> String {
+pub fn termination_name(termination: &RunEnd) -> String {
     coin_log::format::Termination::of_run(termination).to_string()
 }
 
@@ -286,7 +286,7 @@ pub fn reference_trajectory_with(
         // An event ends the reference and the runs alike: judge the common samples.
         if !matches!(
             trajectory.outcome.as_ref().map(|o| &o.termination),
-            Some(Termination::Event { .. })
+            Some(RunEnd::Event { .. })
         ) {
             return Err(BenchError::ReferenceFailed {
                 scene: case.name.clone(),

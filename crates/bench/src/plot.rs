@@ -4,18 +4,10 @@
 use super::euler::EulerRow;
 use super::precision::PrecisionReport;
 use super::BenchError;
+use coin_log::palette::LINES as PALETTE;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-/// Line colours, one per integrator in order.
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
 /// Size of the diagram \[px\].
 const SIZE: (u32, u32) = (800, 560);
 

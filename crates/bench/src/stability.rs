@@ -26,7 +26,7 @@ use super::{
 };
 use coin_log::analyse::linear::{nutation_frequency, straight_tilt_linear};
 use coin_log::analyse::Analysis;
-use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunSettings, Termination};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunEnd, RunSettings};
 use coin_log::model::fit::log_log_slope;
 use coin_log::model::nutation::Motion;
 use coin_log::model::{
@@ -406,7 +406,7 @@ pub fn release(theta0: f64, case_name: &str) -> Result<Vec<StabilityRow>, BenchE
             let config = suite_config(method, 1e-3);
             let (mut row, run) = row_for(case_name, &config, &case, &case.settings(), None);
             let located = match run.outcome.as_ref().map(|o| &o.termination) {
-                Some(Termination::Event { t, .. }) => Some(*t),
+                Some(RunEnd::Event { t, .. }) => Some(*t),
                 _ => None,
             };
             row.quantity = format!("{expected_event} time");

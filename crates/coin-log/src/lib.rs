@@ -19,6 +19,7 @@ pub mod inspect;
 #[cfg(feature = "live")]
 pub mod live;
 pub mod model;
+pub mod palette;
 pub mod record;
 pub mod scene;
 pub mod simulation;

@@ -56,7 +56,7 @@ pub struct RunSettings {
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Termination {
+pub enum RunEnd {
     /// Reached t_end.
     Completed,
     /// Event function `index` crossed zero at `t`; the last sample is at `t`.
@@ -79,7 +79,7 @@ pub enum Termination {
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutcome {
     /// Why it ended.
-    pub termination: Termination,
+    pub termination: RunEnd,
     /// Work done.
     pub stats: Stats,
     /// Time of the last sample.
@@ -160,28 +160,28 @@ where
 {
     /// Initialises the stepper and emits the first sample; `Err` holds the termination when the run ends
     /// right there (failure, an event already true at t0, or a stop).
-    fn start(&mut self, y0: &[f64; N]) -> Result<(), Termination> {
+    fn start(&mut self, y0: &[f64; N]) -> Result<(), RunEnd> {
         let t0 = self.settings.t0;
         self.stepper
             .init(self.sys, t0, y0, self.settings.t_end)
-            .map_err(Termination::Failed)?;
+            .map_err(RunEnd::Failed)?;
         let flow = (self.observe)(t0, y0);
         let n = self.n_events;
         self.events.evaluate(t0, y0, &mut self.g_old[..n]);
         if let Some(index) = self.g_old[..n].iter().position(|&g| g <= 0.0) {
-            return Err(Termination::Event { index, t: t0 });
+            return Err(RunEnd::Event { index, t: t0 });
         }
         if flow == Flow::Stop {
-            return Err(Termination::Stopped { t: t0 });
+            return Err(RunEnd::Stopped { t: t0 });
         }
         Ok(())
     }
 
     /// Steps until the run ends; returns how it ended.
-    fn steps(&mut self) -> Termination {
+    fn steps(&mut self) -> RunEnd {
         loop {
             if let Err(e) = self.stepper.step(self.sys, self.settings.t_end) {
-                return Termination::Failed(e);
+                return RunEnd::Failed(e);
             }
             self.dense_ready = false;
             let t_new = self.stepper.t();
@@ -191,7 +191,7 @@ where
             }
             if let Some((index, t)) = event {
                 self.sample_event(t);
-                return Termination::Event { index, t };
+                return RunEnd::Event { index, t };
             }
             if t_new >= self.settings.t_end {
                 // Unreachable in practice (the grid loop emits t_end); kept so t_end is always sampled.
@@ -199,7 +199,7 @@ where
                     let _ = (self.observe)(self.settings.t_end, self.stepper.y());
                     self.t_last = self.settings.t_end;
                 }
-                return Termination::Completed;
+                return RunEnd::Completed;
             }
             let n = self.n_events;
             self.g_old[..n].copy_from_slice(&self.g_new[..n]);
@@ -233,7 +233,7 @@ where
 
     /// Emits the grid samples up to the step's end, or strictly before the event; `Some` when the run
     /// ends on one of them (t_end reached, or the observer stopped).
-    fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<Termination> {
+    fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<RunEnd> {
         // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly), and
         // so is one within EVENT_SAMPLE_GAP of it: two samples that close would share a log time.
         let grid_slack = (1e-9 * self.settings.sample_interval).max(EVENT_SAMPLE_GAP);
@@ -259,10 +259,10 @@ where
             self.t_last = t_k;
             self.k += 1;
             if t_k >= self.settings.t_end {
-                return Some(Termination::Completed);
+                return Some(RunEnd::Completed);
             }
             if flow == Flow::Stop {
-                return Some(Termination::Stopped { t: t_k });
+                return Some(RunEnd::Stopped { t: t_k });
             }
         }
     }

@@ -21,7 +21,7 @@ pub use coin_log_names::UnknownName;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use driver::{
-    run, EventFunctions, Flow, NoEvents, RunOutcome, RunSettings, Termination, MAX_EVENTS,
+    run, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings, MAX_EVENTS,
 };
 pub use gauss4::Gauss4;
 pub use hermite::hermite_interpolate;

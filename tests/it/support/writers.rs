@@ -15,7 +15,7 @@ use coin_log::format::{
     MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use coin_log::integrate::{
-    run_method, Flow, Method, MethodConfig, NoEvents, Rk4, RunSettings, Termination,
+    run_method, Flow, Method, MethodConfig, NoEvents, Rk4, RunEnd, RunSettings,
 };
 use coin_log::model::{
     centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams, Dynamics,
@@ -470,7 +470,7 @@ pub fn record(spec: &Spec, path: &Path) {
         run_method(&config, &coin, &y0, &settings, &NoEvents, &mut observe)
     };
     let termination = match outcome.termination {
-        Termination::Completed | Termination::Event { .. } => {
+        RunEnd::Completed | RunEnd::Event { .. } => {
             coin_log::format::Termination::of_run(&outcome.termination)
         }
         other => panic!("test run failed: {other:?}"),

@@ -8,8 +8,7 @@
 //! and the family then fixes ω_Z0² = Mga sin θ₀ / (r (I_X tan θ₀ r + I_Z + Ma²)). The two roots of P meet,
 //! and the band closes, where its discriminant vanishes: a quadratic in tan²θ₀.
 
-use super::plot;
-use super::steady::{SteadyAnalysis, Verdict};
+use super::steady::{Stability, SteadyAnalysis};
 use crate::model::{
     critical_spin, steady_omega_y, steady_sigma_squared, Branch, Coin, Linearisation,
 };
@@ -148,7 +147,7 @@ impl Branches {
         match self {
             Self::Plus => &[Branch::Plus],
             Self::Minus => &[Branch::Minus],
-            Self::Both => &Branch::ALL,
+            Self::Both => Branch::ALL,
         }
     }
 }
@@ -238,7 +237,7 @@ pub struct MapPoint {
     /// σ², eq (21) [1/time²].
     pub sigma_squared: f64,
     /// Stable, unstable or marginal.
-    pub verdict: Verdict,
+    pub verdict: Stability,
 }
 
 /// A steady circle with σ² = 0.
@@ -266,7 +265,7 @@ pub struct ScenePoint {
     /// The branch whose panel shows it (straight rolling: the root it continues).
     pub branch: Branch,
     /// Its verdict.
-    pub verdict: Verdict,
+    pub verdict: Stability,
 }
 
 /// The stability map: the grid's points, the boundary and the band's closing points, ω_c and the scenes.
@@ -288,7 +287,7 @@ pub struct StabilityMap {
 
 /// σ² and its verdict for the circle (θ₀, ω_Z0) on `branch`.
 #[must_use]
-pub fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> MapPoint {
+fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> MapPoint {
     let omega_y0 = steady_omega_y(coin, theta0, omega_z0, branch);
     let sigma_squared = steady_sigma_squared(coin, theta0, omega_y0, omega_z0);
     let scale = Linearisation::at(coin, theta0, omega_y0, omega_z0).scale();
@@ -298,7 +297,7 @@ pub fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> Map
         branch,
         omega_y0,
         sigma_squared,
-        verdict: Verdict::of(sigma_squared, scale),
+        verdict: Stability::of(sigma_squared, scale),
     }
 }
 
@@ -355,20 +354,12 @@ impl StabilityMap {
         line.finish().to_string()
     }
 
-    /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes.
-    ///
-    /// # Errors
-    /// [`MapError::Plot`] if drawing fails (it does not for a validated grid).
-    pub fn svg(&self) -> Result<String, MapError> {
-        plot::map_svg(self)
-    }
-
     /// Points of the grid that are unstable.
     #[must_use]
     pub fn unstable_count(&self) -> usize {
         self.points
             .iter()
-            .filter(|p| p.verdict == Verdict::Unstable)
+            .filter(|p| p.verdict == Stability::Unstable)
             .count()
     }
 

@@ -11,7 +11,7 @@ pub mod slow_change;
 mod steady;
 pub mod steady_path;
 
-pub use steady::{SteadyAnalysis, Verdict};
+pub use steady::{Stability, SteadyAnalysis};
 
 use crate::model::invariants::Chaplygin;
 use crate::model::nutation::{Motion, NutationError, Orbit};

@@ -6,8 +6,9 @@
 //! (a 200 × 200 map of the thin disk on both branches is about 2,000 rectangles, not 80,000).
 
 use super::map::{boundary, BoundaryPoint, MapError, MapPoint, StabilityMap};
-use super::steady::Verdict;
+use super::steady::Stability;
 use crate::model::Branch;
+use crate::palette::{MARGINAL, STABLE, UNSTABLE};
 use plotters::prelude::*;
 
 /// Size of one panel and of the legend strip \[px\].
@@ -18,34 +19,33 @@ const LEGEND: u32 = 70;
 const SHADES: usize = 12;
 /// Decades of |σ²|, in units of Mga/(I_X + Ma²), from light to dark.
 const DECADES: (f64, f64) = (-4.0, 2.0);
-/// Light and dark ends of the stable (blue) and unstable (red) scales.
-const STABLE: (RGBColor, RGBColor) = (RGBColor(222, 235, 247), RGBColor(8, 48, 107));
-/// See [`STABLE`].
-const UNSTABLE: (RGBColor, RGBColor) = (RGBColor(254, 224, 210), RGBColor(165, 15, 21));
-/// Cells with σ² = 0 to rounding.
-const MARGINAL: RGBColor = RGBColor(150, 150, 150);
 /// θ₀ samples of the boundary curve per panel.
 const CURVE_SAMPLES: usize = 1200;
 
-/// The SVG document of `map`.
-pub fn map_svg(map: &StabilityMap) -> Result<String, MapError> {
-    let fail = |e: &dyn std::fmt::Display| MapError::Plot(e.to_string());
-    let branches = map.options.branches.list();
-    let panels = u32::try_from(branches.len()).unwrap_or(1);
-    let size = (PANEL.0 * panels, PANEL.1 + LEGEND);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let (top, bottom) = root.split_vertically(PANEL.1);
-        let areas = top.split_evenly((1, branches.len()));
-        for (area, &branch) in areas.iter().zip(branches) {
-            panel(map, area, branch).map_err(|e| fail(&e))?;
+impl StabilityMap {
+    /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes.
+    ///
+    /// # Errors
+    /// [`MapError::Plot`] if drawing fails (it does not for a validated grid).
+    pub fn svg(&self) -> Result<String, MapError> {
+        let fail = |e: &dyn std::fmt::Display| MapError::Plot(e.to_string());
+        let branches = self.options.branches.list();
+        let panels = u32::try_from(branches.len()).unwrap_or(1);
+        let size = (PANEL.0 * panels, PANEL.1 + LEGEND);
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| fail(&e))?;
+            let (top, bottom) = root.split_vertically(PANEL.1);
+            let areas = top.split_evenly((1, branches.len()));
+            for (area, &branch) in areas.iter().zip(branches) {
+                panel(self, area, branch).map_err(|e| fail(&e))?;
+            }
+            legend(self, &bottom).map_err(|e| fail(&e))?;
+            root.present().map_err(|e| fail(&e))?;
         }
-        legend(map, &bottom).map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))?;
+        Ok(svg)
     }
-    Ok(svg)
 }
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
@@ -124,9 +124,9 @@ fn panel(map: &StabilityMap, area: &Area<'_>, branch: Branch) -> DrawResult {
 /// Mga/(I_X + Ma²)); grey when marginal.
 fn colour(p: &MapPoint, unit: f64) -> RGBColor {
     let (light, dark) = match p.verdict {
-        Verdict::Marginal => return MARGINAL,
-        Verdict::Stable => STABLE,
-        Verdict::Unstable => UNSTABLE,
+        Stability::Marginal => return MARGINAL,
+        Stability::Stable => STABLE,
+        Stability::Unstable => UNSTABLE,
     };
     shade(light, dark, (p.sigma_squared.abs() / unit).log10())
 }
@@ -148,8 +148,7 @@ fn shade(light: RGBColor, dark: RGBColor, decade: f64) -> RGBColor {
 
 /// The cells of one branch, runs of one colour along ω_Z0 merged.
 fn cells(map: &StabilityMap, branch: Branch) -> Vec<Rectangle<(f64, f64)>> {
-    let p = map.coin.params();
-    let unit = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
+    let unit = map.coin.params().topple_rate_squared();
     let (half_t, half_w) = (
         0.5 * map.options.theta.step(),
         0.5 * map.options.omega_z.step(),

@@ -9,18 +9,21 @@ use crate::model::{
 /// |σ²| within this many ulp of the size of its terms is zero to rounding: the verdict is marginal.
 const MARGINAL_ULPS: f64 = 64.0;
 
-/// The linear stability of a steady motion (physics §9).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Verdict {
-    /// σ² > 0: small perturbations nutate at σ.
-    Stable,
-    /// σ² < 0: small perturbations grow like e^{√(−σ²) t}.
-    Unstable,
-    /// σ² = 0 to rounding: the linear analysis does not decide (straight rolling at ω_c grows like t²).
-    Marginal,
+coin_log_names::named_enum! {
+    /// The linear stability of a steady motion (physics §9); the name is the `verdict` of format.md's
+    /// analyse --json and of the stability map.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Stability: "stability" {
+        /// σ² > 0: small perturbations nutate at σ.
+        Stable = "stable",
+        /// σ² < 0: small perturbations grow like e^{√(−σ²) t}.
+        Unstable = "unstable",
+        /// σ² = 0 to rounding: the linear analysis does not decide (straight rolling at ω_c grows like t²).
+        Marginal = "marginal",
+    }
 }
 
-impl Verdict {
+impl Stability {
     /// The verdict of σ², given the size of the terms it is the sum of.
     #[must_use]
     pub fn of(sigma_squared: f64, scale: f64) -> Self {
@@ -30,16 +33,6 @@ impl Verdict {
             Self::Stable
         } else {
             Self::Unstable
-        }
-    }
-
-    /// `stable`, `unstable` or `marginal` (format.md: analyse --json).
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Stable => "stable",
-            Self::Unstable => "unstable",
-            Self::Marginal => "marginal",
         }
     }
 }
@@ -72,7 +65,7 @@ pub struct SteadyAnalysis {
     /// The eigenvalues of the linearisation, (re, im) [1/time].
     pub eigenvalues: [(f64, f64); 4],
     /// Stable, unstable or marginal.
-    pub verdict: Verdict,
+    pub verdict: Stability,
 }
 
 impl SteadyAnalysis {
@@ -108,20 +101,21 @@ impl SteadyAnalysis {
             sigma_squared,
             sigma_scale,
             eigenvalues: eigenvalues(sigma_squared),
-            verdict: Verdict::of(sigma_squared, sigma_scale),
+            verdict: Stability::of(sigma_squared, sigma_scale),
         }
     }
 
     /// The nutation period 2π/σ of small perturbations, when stable.
     #[must_use]
     pub fn nutation_period(&self) -> Option<f64> {
-        (self.verdict == Verdict::Stable).then(|| std::f64::consts::TAU / self.sigma_squared.sqrt())
+        (self.verdict == Stability::Stable)
+            .then(|| std::f64::consts::TAU / self.sigma_squared.sqrt())
     }
 
     /// The e-folding time 1/√(−σ²) of small perturbations, when unstable.
     #[must_use]
     pub fn e_folding_time(&self) -> Option<f64> {
-        (self.verdict == Verdict::Unstable).then(|| 1.0 / (-self.sigma_squared).sqrt())
+        (self.verdict == Stability::Unstable).then(|| 1.0 / (-self.sigma_squared).sqrt())
     }
 }
 

@@ -1,91 +1,56 @@
-//! The channels of the format (format.md: Channels and fields): name, topic, schema name and schema bytes.
-//! The schema bytes are the files in `schemas/`, embedded at build time, so a log's schema is the file.
+//! The channels of the format (format.md: Channels and fields): name, topic, schema name and fields, and the
+//! schema bytes a file stores in either encoding.
 
+use super::messages::{
+    schema_bytes, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, MessageType, Position,
+    QuaternionMessage, ReactionMessage, WorkMessage, FRAME_TRANSFORM, SCENE_UPDATE,
+};
 use super::Encoding;
 use std::fmt;
-use std::str::FromStr;
 
 /// Schema encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const SCHEMA_ENCODING: &str = "jsonschema";
+pub const SCHEMA_ENCODING: &str = Encoding::Json.schema_encoding();
 /// Message encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const MESSAGE_ENCODING: &str = "json";
+pub const MESSAGE_ENCODING: &str = Encoding::Json.message_encoding();
 
-/// A recordable channel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Channel {
-    /// ω in the lean frame.
-    Omega,
-    /// θ, φ, ψ.
-    Angles,
-    /// Orientation quaternion.
-    Quaternion,
-    /// Centre position.
-    Position,
-    /// Contact point.
-    Contact,
-    /// Reaction of the table.
-    Reaction,
-    /// Energy.
-    Energy,
-    /// Chaplygin integrals C1, C2.
-    Invariants,
-    /// Foxglove frame transforms.
-    Tf,
-    /// Foxglove scene (coin and track).
-    Scene,
-    /// Dissipated work W and the balance E + W (only with dissipation, physics §11).
-    Work,
+coin_log_names::named_enum! {
+    /// A recordable channel; the name is the one of scene files and `--channels`. `work` is last here, but
+    /// in a file it is written, and registered, with the other `coin_log.*` channels before `/tf` and
+    /// `/scene` (format.md's channel table).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+    pub enum Channel: "channel" {
+        /// ω in the lean frame.
+        Omega = "omega",
+        /// θ, φ, ψ.
+        Angles = "angles",
+        /// Orientation quaternion.
+        Quaternion = "quaternion",
+        /// Centre position.
+        Position = "position",
+        /// Contact point.
+        Contact = "contact",
+        /// Reaction of the table.
+        Reaction = "reaction",
+        /// Energy.
+        Energy = "energy",
+        /// Chaplygin integrals C1, C2.
+        Invariants = "invariants",
+        /// Foxglove frame transforms.
+        Tf = "tf",
+        /// Foxglove scene (coin and track).
+        Scene = "scene",
+        /// Dissipated work W and the balance E + W (only with dissipation, physics §11).
+        Work = "work",
+    }
 }
 
 impl Channel {
-    /// Every channel. `work` is last here, but in a file it is written, and registered, with the other
-    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table).
-    pub const ALL: [Channel; 11] = [
-        Self::Omega,
-        Self::Angles,
-        Self::Quaternion,
-        Self::Position,
-        Self::Contact,
-        Self::Reaction,
-        Self::Energy,
-        Self::Invariants,
-        Self::Tf,
-        Self::Scene,
-        Self::Work,
-    ];
-
-    /// The channels a scene records when it lists none and has no dissipation (format.md: all ten); with
-    /// dissipation, `work` is added.
-    pub const DEFAULT: [Channel; 10] = [
-        Self::Omega,
-        Self::Angles,
-        Self::Quaternion,
-        Self::Position,
-        Self::Contact,
-        Self::Reaction,
-        Self::Energy,
-        Self::Invariants,
-        Self::Tf,
-        Self::Scene,
-    ];
-
-    /// The channel's name in scene files and `--channels`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Omega => "omega",
-            Self::Angles => "angles",
-            Self::Quaternion => "quaternion",
-            Self::Position => "position",
-            Self::Contact => "contact",
-            Self::Reaction => "reaction",
-            Self::Energy => "energy",
-            Self::Invariants => "invariants",
-            Self::Tf => "tf",
-            Self::Scene => "scene",
-            Self::Work => "work",
-        }
-    }
+    /// The channels a scene records when it lists none and has no dissipation (format.md: all ten, every
+    /// channel but the last, `work`, which dissipation adds).
+    pub const DEFAULT: &'static [Channel] = match Self::ALL.split_last() {
+        Some((_, default)) => default,
+        None => &[],
+    };
 
     /// MCAP topic.
     #[must_use]
@@ -105,20 +70,29 @@ impl Channel {
         }
     }
 
+    /// The `coin_log.*` message type of the channel; `None` for Foxglove's `/tf` and `/scene`.
+    #[must_use]
+    pub fn message_type(self) -> Option<&'static MessageType> {
+        Some(match self {
+            Self::Omega => &AngularVelocity::TYPE,
+            Self::Angles => &Angles::TYPE,
+            Self::Quaternion => &QuaternionMessage::TYPE,
+            Self::Position | Self::Contact => &Position::TYPE,
+            Self::Reaction => &ReactionMessage::TYPE,
+            Self::Energy => &EnergyMessage::TYPE,
+            Self::Invariants => &InvariantsMessage::TYPE,
+            Self::Work => &WorkMessage::TYPE,
+            Self::Tf | Self::Scene => return None,
+        })
+    }
+
     /// Schema name.
     #[must_use]
     pub fn schema_name(self) -> &'static str {
-        match self {
-            Self::Omega => "coin_log.AngularVelocity",
-            Self::Angles => "coin_log.Angles",
-            Self::Quaternion => "coin_log.Quaternion",
-            Self::Position | Self::Contact => "coin_log.Position",
-            Self::Reaction => "coin_log.Reaction",
-            Self::Energy => "coin_log.Energy",
-            Self::Invariants => "coin_log.Invariants",
-            Self::Tf => "foxglove.FrameTransform",
-            Self::Scene => "foxglove.SceneUpdate",
-            Self::Work => "coin_log.Work",
+        match self.message_type() {
+            Some(t) => t.schema,
+            None if self == Self::Tf => FRAME_TRANSFORM,
+            None => SCENE_UPDATE,
         }
     }
 
@@ -126,27 +100,13 @@ impl Channel {
     /// `coin_log.*` channels; `None` for Foxglove's `/tf` and `/scene`, whose messages are nested.
     #[must_use]
     pub fn fields(self) -> Option<&'static [&'static str]> {
-        use super::messages::{
-            Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-            ReactionMessage, WorkMessage,
-        };
-        Some(match self {
-            Self::Omega => AngularVelocity::FIELDS,
-            Self::Angles => Angles::FIELDS,
-            Self::Quaternion => QuaternionMessage::FIELDS,
-            Self::Position | Self::Contact => Position::FIELDS,
-            Self::Reaction => ReactionMessage::FIELDS,
-            Self::Energy => EnergyMessage::FIELDS,
-            Self::Invariants => InvariantsMessage::FIELDS,
-            Self::Work => WorkMessage::FIELDS,
-            Self::Tf | Self::Scene => return None,
-        })
+        self.message_type().map(|t| t.fields)
     }
 
     /// Every channel's name, comma-separated, for messages.
     #[must_use]
     pub fn names() -> String {
-        Self::ALL.map(Self::name).join(", ")
+        Self::NAMES.join(", ")
     }
 
     /// The channel a topic belongs to: its main topic, or one of the extra Foxglove topics ([`Topic`]).
@@ -208,8 +168,8 @@ impl Topic {
         // TRACK_LEVELS (16) fits in a u8.
         let levels = (0..TRACK_LEVELS).map(|l| Self::SceneTrack(u8::try_from(l).unwrap_or(0)));
         Channel::ALL
-            .into_iter()
-            .map(Self::Main)
+            .iter()
+            .map(|&c| Self::Main(c))
             .chain(extras)
             .chain(levels)
     }
@@ -285,49 +245,6 @@ pub fn schema_data(schema_name: &str, encoding: Encoding) -> Option<&'static [u8
     match encoding {
         Encoding::Json => schema_bytes(schema_name),
         Encoding::Protobuf => super::protobuf::descriptor_set(schema_name),
-    }
-}
-
-/// The bytes of `schemas/<name>.json` for a schema name this tool writes.
-#[must_use]
-pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
-    Some(match schema_name {
-        "coin_log.AngularVelocity" => {
-            include_bytes!("../../../../schemas/coin_log.AngularVelocity.json")
-        }
-        "coin_log.Angles" => include_bytes!("../../../../schemas/coin_log.Angles.json"),
-        "coin_log.Quaternion" => include_bytes!("../../../../schemas/coin_log.Quaternion.json"),
-        "coin_log.Position" => include_bytes!("../../../../schemas/coin_log.Position.json"),
-        "coin_log.Reaction" => include_bytes!("../../../../schemas/coin_log.Reaction.json"),
-        "coin_log.Energy" => include_bytes!("../../../../schemas/coin_log.Energy.json"),
-        "coin_log.Invariants" => include_bytes!("../../../../schemas/coin_log.Invariants.json"),
-        "coin_log.Work" => include_bytes!("../../../../schemas/coin_log.Work.json"),
-        "foxglove.FrameTransform" => {
-            include_bytes!("../../../../schemas/foxglove.FrameTransform.json")
-        }
-        "foxglove.SceneUpdate" => include_bytes!("../../../../schemas/foxglove.SceneUpdate.json"),
-        _ => return None,
-    })
-}
-
-impl fmt::Display for Channel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// An unknown channel name, with the list of valid ones.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown channel `{name}`; valid channels: {valid}", name = .0, valid = Channel::names())]
-pub struct UnknownChannel(pub String);
-
-impl FromStr for Channel {
-    type Err = UnknownChannel;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|c| c.name() == s)
-            .ok_or_else(|| UnknownChannel(s.to_string()))
     }
 }
 

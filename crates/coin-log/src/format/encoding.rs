@@ -17,7 +17,7 @@ coin_log_names::named_enum! {
 impl Encoding {
     /// The MCAP schema encoding of its schemas.
     #[must_use]
-    pub fn schema_encoding(self) -> &'static str {
+    pub const fn schema_encoding(self) -> &'static str {
         match self {
             Self::Json => "jsonschema",
             Self::Protobuf => "protobuf",
@@ -26,7 +26,7 @@ impl Encoding {
 
     /// The MCAP message encoding of its channels.
     #[must_use]
-    pub fn message_encoding(self) -> &'static str {
+    pub const fn message_encoding(self) -> &'static str {
         match self {
             Self::Json => "json",
             Self::Protobuf => "protobuf",
@@ -41,15 +41,6 @@ impl Encoding {
             .copied()
             .find(|e| e.schema_encoding() == name)
     }
-
-    /// The encoding whose MCAP message encoding is `name`.
-    #[must_use]
-    pub fn from_message_encoding(name: &str) -> Option<Self> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|e| e.message_encoding() == name)
-    }
 }
 
 #[cfg(test)]
@@ -61,10 +52,6 @@ mod tests {
         for &e in Encoding::ALL {
             assert_eq!(e.name().parse::<Encoding>(), Ok(e));
             assert_eq!(Encoding::from_schema_encoding(e.schema_encoding()), Some(e));
-            assert_eq!(
-                Encoding::from_message_encoding(e.message_encoding()),
-                Some(e)
-            );
         }
         assert_eq!(
             "cbor".parse::<Encoding>().unwrap_err().to_string(),

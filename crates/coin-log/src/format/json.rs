@@ -24,7 +24,7 @@ pub fn parse_numbers<const N: usize>(data: &[u8], fields: &[&str; N]) -> Option<
 /// [`parse_numbers`] for a field list of any length: fills `out` (`out.len() == fields.len()`) and
 /// returns true, or returns false (with `out` partly written) if `data` has any other form.
 #[must_use]
-pub fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool {
+fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool {
     if out.len() != fields.len() {
         return false;
     }

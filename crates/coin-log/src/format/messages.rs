@@ -1,12 +1,13 @@
-//! The `coin_log.*` message types (format.md: Channels and fields). Each type deserialises strictly (unknown or missing
-//! fields rejected) for `verify`, and writes itself as compact JSON straight into a reused buffer for the
-//! recorder's hot path: shortest round-trip floats (ryu), fields in the schema's order, no allocation.
+//! The schemas of the format (format.md: Channels and fields): the names and JSON Schemas of Foxglove's two
+//! schemas and of the `coin_log.*` message types, which are declared here. Each type deserialises strictly
+//! (unknown or missing fields rejected) for `verify`, and writes itself as compact JSON straight into a
+//! reused buffer for the recorder's hot path: shortest round-trip floats (ryu), fields in the schema's
+//! order, no allocation.
 //!
 //! Hand-written rather than `serde_json::to_writer` because the recorder formats tens of millions of
 //! messages and must refuse non-finite numbers (JSON has no NaN) instead of writing `null`.
 
 use super::encoding::Encoding;
-use super::protobuf::put_double;
 use serde::Deserialize;
 
 /// A number that JSON cannot carry.
@@ -52,6 +53,12 @@ pub fn drift_eps(total: f64, e0: f64, energy_scale: f64) -> f64 {
     (total - e0) / (f64::EPSILON * e0.abs().max(energy_scale))
 }
 
+/// Appends Protobuf field `number` = `value` (wire type 64-bit) to `buf`.
+#[inline]
+pub fn put_double(buf: &mut Vec<u8>, number: u32, value: f64) {
+    prost::encoding::double::encode(number, &value, buf);
+}
+
 /// Appends the shortest round-trip decimal form of a finite `value` to `buf`.
 #[inline]
 pub fn push_number(buf: &mut Vec<u8>, value: f64, formatter: &mut ryu::Buffer) {
@@ -62,6 +69,63 @@ pub fn push_number(buf: &mut Vec<u8>, value: f64, formatter: &mut ryu::Buffer) {
 /// through `#[serde(default)]`).
 fn added_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
     f64::deserialize(d).map(Some)
+}
+
+/// A `coin_log.*` message type as the format declares it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MessageType {
+    /// Schema name.
+    pub schema: &'static str,
+    /// Field names in schema order (the JSON keys, `t` first; Protobuf field number = position + 1).
+    pub fields: &'static [&'static str],
+    /// The JSON Schema, the bytes of `schemas/<schema>.json` embedded at build time.
+    pub json_schema: &'static [u8],
+}
+
+/// Every `coin_log.*` message type.
+pub const MESSAGE_TYPES: [MessageType; 8] = [
+    AngularVelocity::TYPE,
+    Angles::TYPE,
+    QuaternionMessage::TYPE,
+    Position::TYPE,
+    ReactionMessage::TYPE,
+    EnergyMessage::TYPE,
+    InvariantsMessage::TYPE,
+    WorkMessage::TYPE,
+];
+
+/// The `coin_log.*` type of schema name `schema`.
+#[must_use]
+pub fn message_type(schema: &str) -> Option<&'static MessageType> {
+    MESSAGE_TYPES.iter().find(|t| t.schema == schema)
+}
+
+/// Declares the name of a Foxglove schema this tool writes, with the bytes of its file `schemas/<name>.json`.
+macro_rules! foxglove_schema {
+    ($(#[$doc:meta])* $name:ident, $json:ident = $schema:literal) => {
+        $(#[$doc])*
+        pub const $name: &str = $schema;
+        const $json: &[u8] = include_bytes!(concat!("../../../../schemas/", $schema, ".json"));
+    };
+}
+
+foxglove_schema!(
+    /// Foxglove's frame transform (`/tf`, `/tf_static`, `/scene/follow`).
+    FRAME_TRANSFORM, FRAME_TRANSFORM_JSON = "foxglove.FrameTransform"
+);
+foxglove_schema!(
+    /// Foxglove's scene update (`/scene`, `/scene/table`, `/scene/track/<level>`).
+    SCENE_UPDATE, SCENE_UPDATE_JSON = "foxglove.SceneUpdate"
+);
+
+/// The bytes of `schemas/<name>.json` for a schema name this tool writes.
+#[must_use]
+pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
+    match schema_name {
+        FRAME_TRANSFORM => Some(FRAME_TRANSFORM_JSON),
+        SCENE_UPDATE => Some(SCENE_UPDATE_JSON),
+        name => message_type(name).map(|t| t.json_schema),
+    }
 }
 
 /// Defines a message type. Fields listed under `added` came with a later version of the schema (docs/format.md
@@ -89,6 +153,12 @@ macro_rules! message {
             pub const FIELDS: &'static [&'static str] = &[$(stringify!($field)),+ $($(, stringify!($added))+)?];
             /// Field names of the schema's first version (before any `added` field).
             pub const FIRST_FIELDS: &'static [&'static str] = &[$(stringify!($field)),+];
+            /// What the format says of the type.
+            pub const TYPE: MessageType = MessageType {
+                schema: $schema,
+                fields: Self::FIELDS,
+                json_schema: include_bytes!(concat!("../../../../schemas/", $schema, ".json")),
+            };
 
             /// `Err` naming the first field that is NaN or infinite.
             fn check_finite(&self) -> Result<(), NonFiniteField> {

@@ -1,7 +1,6 @@
 //! The file format, typed: everything a coin-log MCAP file contains that `scene`, `record` and `verify` must
-//! agree on (docs/format.md). The channels with their topics, schema names and schema bytes
-//! ([`channels`]); the `coin_log.*` message types with their JSON form ([`messages`], read back by
-//! [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
+//! agree on (docs/format.md). The channels with their topics and schemas ([`channels`]); the schemas and
+//! the `coin_log.*` message types with their JSON form ([`messages`], read back by [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
 //! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
 //! recorded integrator settings ([`tolerances`]).
@@ -21,14 +20,12 @@ mod termination;
 mod time;
 pub mod tolerances;
 
-pub use channels::{
-    schema_bytes, schema_data, Channel, Topic, UnknownChannel, MESSAGE_ENCODING, SCHEMA_ENCODING,
-    TRACK_LEVELS,
-};
+pub use channels::{schema_data, Channel, Topic, MESSAGE_ENCODING, SCHEMA_ENCODING, TRACK_LEVELS};
 pub use encoding::Encoding;
+pub use messages::{schema_bytes, FRAME_TRANSFORM, SCENE_UPDATE};
 pub use metadata::{
     MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,
 };
-pub use termination::{Termination, UnknownTermination};
+pub use termination::Termination;
 pub use time::{log_time, TimeError};

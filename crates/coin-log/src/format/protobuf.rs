@@ -14,27 +14,12 @@
 //! f64, like the JSON fast path ([`super::json`]): a generated message struct per type would add nothing.
 
 use super::json::FieldsError;
-use super::messages::{
-    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage, WorkMessage,
-};
+use super::messages::{FRAME_TRANSFORM, MESSAGE_TYPES, SCENE_UPDATE};
 use prost::encoding::{decode_key, decode_varint, WireType};
 use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
 use prost_types::{DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet};
 use std::sync::OnceLock;
-
-/// The `coin_log.*` types: schema name and fields in schema order (field number = position + 1).
-pub const COIN_TYPES: [(&str, &[&str]); 8] = [
-    (AngularVelocity::SCHEMA, AngularVelocity::FIELDS),
-    (Angles::SCHEMA, Angles::FIELDS),
-    (QuaternionMessage::SCHEMA, QuaternionMessage::FIELDS),
-    (Position::SCHEMA, Position::FIELDS),
-    (ReactionMessage::SCHEMA, ReactionMessage::FIELDS),
-    (EnergyMessage::SCHEMA, EnergyMessage::FIELDS),
-    (InvariantsMessage::SCHEMA, InvariantsMessage::FIELDS),
-    (WorkMessage::SCHEMA, WorkMessage::FIELDS),
-];
 
 /// The Protobuf package of the `coin_log.*` types.
 pub const PACKAGE: &str = "coin_log";
@@ -44,11 +29,11 @@ pub const PACKAGE: &str = "coin_log";
 #[must_use]
 pub fn descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
     static COIN: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
-    if let Some(i) = COIN_TYPES.iter().position(|(s, _)| *s == schema_name) {
+    if let Some(i) = MESSAGE_TYPES.iter().position(|t| t.schema == schema_name) {
         let all = COIN.get_or_init(|| {
-            COIN_TYPES
+            MESSAGE_TYPES
                 .iter()
-                .map(|(s, f)| coin_descriptor_set(s, f).encode_to_vec())
+                .map(|t| coin_descriptor_set(t.schema, t.fields).encode_to_vec())
                 .collect()
         });
         return all.get(i).map(Vec::as_slice);
@@ -69,15 +54,15 @@ fn foxglove_descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
         ]
     });
     match schema_name {
-        "foxglove.FrameTransform" => Some(tf),
-        "foxglove.SceneUpdate" => Some(scene),
+        FRAME_TRANSFORM => Some(tf),
+        SCENE_UPDATE => Some(scene),
         _ => None,
     }
 }
 
 /// The file name of a `coin_log.*` type's `.proto` (in `schemas/` and in its descriptor).
 #[must_use]
-pub fn proto_file_name(schema_name: &str) -> String {
+fn proto_file_name(schema_name: &str) -> String {
     format!("{schema_name}.proto")
 }
 
@@ -130,12 +115,6 @@ fn coin_descriptor_set(schema_name: &str, fields: &[&str]) -> FileDescriptorSet 
             ..FileDescriptorProto::default()
         }],
     }
-}
-
-/// Appends field `number` = `value` (wire type 64-bit) to `buf`.
-#[inline]
-pub fn put_double(buf: &mut Vec<u8>, number: u32, value: f64) {
-    prost::encoding::double::encode(number, &value, buf);
 }
 
 /// A stored descriptor that cannot describe a `coin_log.*` type's messages.
@@ -314,7 +293,7 @@ fn skip(wire: WireType, buf: &mut &[u8]) -> Result<(), String> {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-    use crate::format::schema_bytes;
+    use crate::format::messages::{put_double, Angles, EnergyMessage};
 
     /// The `.proto` text of a `coin_log.*` type from its JSON Schema: its title, description and fields in
     /// order, each a double numbered from 1.
@@ -345,9 +324,9 @@ mod tests {
 
     #[test]
     fn the_proto_files_in_schemas_declare_the_json_schemas_fields_in_order() {
-        for (schema, fields) in COIN_TYPES {
-            let json = schema_bytes(schema).unwrap();
-            let expected = proto_text(json);
+        for t in MESSAGE_TYPES {
+            let (schema, fields) = (t.schema, t.fields);
+            let expected = proto_text(t.json_schema);
             let path = format!(
                 "{}/../../schemas/{}",
                 env!("CARGO_MANIFEST_DIR"),
@@ -372,7 +351,8 @@ mod tests {
 
     #[test]
     fn descriptors_decode_and_describe_every_field_as_a_numbered_double() {
-        for (schema, fields) in COIN_TYPES {
+        for t in MESSAGE_TYPES {
+            let (schema, fields) = (t.schema, t.fields);
             let set = FileDescriptorSet::decode(descriptor_set(schema).unwrap()).unwrap();
             let file = &set.file[0];
             assert_eq!(file.syntax(), "proto3");
@@ -387,7 +367,7 @@ mod tests {
         }
         assert_eq!(json_name("drift_eps"), "driftEps");
         assert_eq!(json_name("t"), "t");
-        for name in ["foxglove.FrameTransform", "foxglove.SceneUpdate"] {
+        for name in [FRAME_TRANSFORM, SCENE_UPDATE] {
             let set = FileDescriptorSet::decode(descriptor_set(name).unwrap()).unwrap();
             let declared = set.file.iter().any(|f| {
                 f.message_type

@@ -3,71 +3,35 @@
 
 use crate::integrate::{self, StepError};
 use crate::simulation::{CoinEvents, PhysicalEvent};
-use std::fmt;
-use std::str::FromStr;
 
-/// How a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Termination {
-    /// The duration was reached.
-    Completed,
-    /// |θ| reached π/2 − flat_margin: the coin lands flat (physics §7).
-    FlatLanding,
-    /// N reached 0: the coin would leave the table.
-    LiftOff,
-    /// |F| reached μN: the coin would slip.
-    Slip,
-    /// The user stopped the run (SIGINT, SIGTERM, SIGHUP).
-    Interrupted,
-    /// The adaptive step size fell below what floating point resolves.
-    StepSizeUnderflow,
-    /// The state or a derived quantity became NaN or infinite.
-    NonFinite,
-    /// The implicit stage equations did not converge.
-    NewtonFailure,
+coin_log_names::named_enum! {
+    /// How a run ended; the name is the one written in the metadata, in the order of the format's table.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum Termination: "termination" {
+        /// The duration was reached.
+        Completed = "completed",
+        /// |θ| reached π/2 − flat_margin: the coin lands flat (physics §7).
+        FlatLanding = "flat-landing",
+        /// N reached 0: the coin would leave the table.
+        LiftOff = "lift-off",
+        /// |F| reached μN: the coin would slip.
+        Slip = "slip",
+        /// The user stopped the run (SIGINT, SIGTERM, SIGHUP).
+        Interrupted = "interrupted",
+        /// The adaptive step size fell below what floating point resolves.
+        StepSizeUnderflow = "step-size-underflow",
+        /// The state or a derived quantity became NaN or infinite.
+        NonFinite = "non-finite",
+        /// The implicit stage equations did not converge.
+        NewtonFailure = "newton-failure",
+    }
 }
 
 impl Termination {
-    /// Every value, in the order of the format's table.
-    pub const ALL: [Termination; 8] = [
-        Self::Completed,
-        Self::FlatLanding,
-        Self::LiftOff,
-        Self::Slip,
-        Self::Interrupted,
-        Self::StepSizeUnderflow,
-        Self::NonFinite,
-        Self::NewtonFailure,
-    ];
-
-    /// The name written in the metadata.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Completed => "completed",
-            Self::FlatLanding => "flat-landing",
-            Self::LiftOff => "lift-off",
-            Self::Slip => "slip",
-            Self::Interrupted => "interrupted",
-            Self::StepSizeUnderflow => "step-size-underflow",
-            Self::NonFinite => "non-finite",
-            Self::NewtonFailure => "newton-failure",
-        }
-    }
-
     /// True for the physical events that end the model's validity (a normal end of a run).
     #[must_use]
     pub fn is_event(self) -> bool {
         matches!(self, Self::FlatLanding | Self::LiftOff | Self::Slip)
-    }
-
-    /// True for numerical failures (the file holds the samples up to the failure).
-    #[must_use]
-    pub fn is_failure(self) -> bool {
-        matches!(
-            self,
-            Self::StepSizeUnderflow | Self::NonFinite | Self::NewtonFailure
-        )
     }
 
     /// The termination of a numerical failure of the integrator.
@@ -82,12 +46,12 @@ impl Termination {
 
     /// The termination of an integration of the coin (events numbered as [`CoinEvents`] numbers them).
     #[must_use]
-    pub fn of_run(end: &integrate::Termination) -> Self {
+    pub fn of_run(end: &integrate::RunEnd) -> Self {
         match end {
-            integrate::Termination::Completed => Self::Completed,
-            integrate::Termination::Event { index, .. } => CoinEvents::event(*index).into(),
-            integrate::Termination::Stopped { .. } => Self::Interrupted,
-            integrate::Termination::Failed(e) => Self::of_step_error(e),
+            integrate::RunEnd::Completed => Self::Completed,
+            integrate::RunEnd::Event { index, .. } => CoinEvents::event(*index).into(),
+            integrate::RunEnd::Stopped { .. } => Self::Interrupted,
+            integrate::RunEnd::Failed(e) => Self::of_step_error(e),
         }
     }
 }
@@ -102,34 +66,13 @@ impl From<PhysicalEvent> for Termination {
     }
 }
 
-impl fmt::Display for Termination {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A `termination` value this tool does not know.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown termination `{0}`; known: completed, flat-landing, lift-off, slip, interrupted, step-size-underflow, non-finite, newton-failure")]
-pub struct UnknownTermination(pub String);
-
-impl FromStr for Termination {
-    type Err = UnknownTermination;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| UnknownTermination(s.to_string()))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn names_round_trip_and_unknown_names_are_refused() {
-        for t in Termination::ALL {
+        for &t in Termination::ALL {
             assert_eq!(t.name().parse::<Termination>(), Ok(t));
             assert_eq!(t.to_string(), t.name());
         }
@@ -144,7 +87,7 @@ mod tests {
             (1, Termination::LiftOff),
             (2, Termination::Slip),
         ] {
-            let end = integrate::Termination::Event { index, t: 1.0 };
+            let end = integrate::RunEnd::Event { index, t: 1.0 };
             assert_eq!(Termination::of_run(&end), expected);
         }
     }

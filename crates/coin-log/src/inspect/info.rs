@@ -17,7 +17,7 @@ use std::path::Path;
 
 /// One channel of a file (an entry of `info --json`'s `channels`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ChannelInfo {
+pub struct ChannelSummary {
     /// Topic.
     pub topic: String,
     /// Schema name (`""` without a schema).
@@ -31,23 +31,14 @@ pub struct ChannelInfo {
     pub rate: Option<f64>,
 }
 
-/// Where [`FileInfo`] was read from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Source {
-    /// The summary section (statistics, chunk indexes, metadata index).
-    Summary,
-    /// A streaming pass over the whole file (it has no usable summary).
-    Scan,
-}
-
-impl Source {
-    /// `summary` or `scan`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Summary => "summary",
-            Self::Scan => "scan",
-        }
+coin_log_names::named_enum! {
+    /// Where [`FileInfo`] was read from.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Source: "source" {
+        /// The summary section (statistics, chunk indexes, metadata index).
+        Summary = "summary",
+        /// A streaming pass over the whole file (it has no usable summary).
+        Scan = "scan",
     }
 }
 
@@ -71,7 +62,7 @@ pub struct FileInfo {
     /// The chunks' records compressed and uncompressed \[bytes\].
     pub chunk_bytes: (u64, u64),
     /// Channels, by id.
-    pub channels: Vec<ChannelInfo>,
+    pub channels: Vec<ChannelSummary>,
     /// The `coin-log` record, or why it is missing or unusable.
     pub run: Result<RunMetadata, String>,
     /// The `coin-log.result` record, or why it is missing or unusable.
@@ -207,7 +198,7 @@ struct FileJson<'a> {
     encoding: String,
     compressed_bytes: u64,
     uncompressed_bytes: u64,
-    channels: &'a [ChannelInfo],
+    channels: &'a [ChannelSummary],
     body: Option<BodyJson>,
     run: Option<RunJson>,
     result: Option<ResultJson>,
@@ -330,7 +321,7 @@ fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
         channels: s
             .channels
             .iter()
-            .map(|c| ChannelInfo {
+            .map(|c| ChannelSummary {
                 topic: c.topic.clone(),
                 schema: c.schema_name.clone(),
                 message_encoding: c.message_encoding.clone(),
@@ -349,7 +340,7 @@ fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
 #[derive(Default)]
 struct Scan {
     schemas: BTreeMap<u16, String>,
-    channels: BTreeMap<u16, ChannelInfo>,
+    channels: BTreeMap<u16, ChannelSummary>,
     metadata: Vec<(String, BTreeMap<String, String>)>,
     counts: BTreeMap<u16, u64>,
     time_range: Option<(u64, u64)>,
@@ -362,7 +353,7 @@ impl Visitor for Scan {
     fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
         self.channels.insert(
             id,
-            ChannelInfo {
+            ChannelSummary {
                 topic: topic.to_string(),
                 schema: self.schemas.get(&schema_id).cloned().unwrap_or_default(),
                 message_encoding: message_encoding.to_string(),

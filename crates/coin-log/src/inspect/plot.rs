@@ -16,6 +16,7 @@ use crate::format::{
 };
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
+use crate::palette::{BLUE, GREEN, GREY, ORANGE, RED};
 use crate::scene::SceneFile;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
 use plotters::coord::Shift;
@@ -37,12 +38,6 @@ pub const PANELS: [&str; 6] = [
     "normal force N / (Mg)",
     "friction ratio |F| / N",
 ];
-
-const BLUE: RGBColor = RGBColor(31, 119, 180);
-const ORANGE: RGBColor = RGBColor(255, 127, 14);
-const GREEN: RGBColor = RGBColor(44, 160, 44);
-const RED: RGBColor = RGBColor(214, 39, 40);
-const GREY: RGBColor = RGBColor(120, 120, 120);
 
 /// Why a file could not be plotted.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -601,6 +596,29 @@ fn legend<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
         .map_err(|e| e.to_string())
 }
 
+/// Each of `series` as a line through its `points` (values mapped by `value`), with its legend entry.
+fn draw_series<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
+    series: &[(&str, &Envelope, RGBColor)],
+    points: &[Vec<(f64, f64)>],
+    value: impl Fn(f64) -> f64,
+) -> Result<(), String> {
+    for ((label, _, colour), points) in series.iter().zip(points) {
+        let colour = *colour;
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().map(|&(t, v)| (t, value(v))),
+                colour.stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?
+            .label(*label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
+    Ok(())
+}
+
 /// The common time axis of the time panels, with the termination marked.
 struct TimeAxis<'a> {
     t_max: f64,
@@ -640,19 +658,7 @@ impl TimeAxis<'_> {
             .y_desc(y_desc)
             .draw()
             .map_err(|e| err(&e))?;
-        for ((label, _, colour), points) in series.iter().zip(&points) {
-            let colour = *colour;
-            chart
-                .draw_series(LineSeries::new(
-                    points.iter().copied(),
-                    colour.stroke_width(1),
-                ))
-                .map_err(|e| err(&e))?
-                .label(*label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-        }
+        draw_series(&mut chart, series, &points, |v| v)?;
         if let Some((label, v)) = line {
             chart
                 .draw_series(DashedLineSeries::new(
@@ -711,19 +717,7 @@ impl TimeAxis<'_> {
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(|e| err(&e))?;
-        for ((label, _, colour), points) in series.iter().zip(&points) {
-            let colour = *colour;
-            chart
-                .draw_series(LineSeries::new(
-                    points.iter().map(|&(t, v)| (t, v.max(floor))),
-                    colour.stroke_width(1),
-                ))
-                .map_err(|e| err(&e))?
-                .label(*label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-        }
+        draw_series(&mut chart, series, &points, |v| v.max(floor))?;
         self.mark_end(&mut chart, floor, top)?;
         legend(&mut chart)
     }

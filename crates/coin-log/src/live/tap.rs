@@ -2,7 +2,7 @@
 
 use super::LiveServer;
 use crate::format::{schema_data, Channel, Encoding, Topic};
-use crate::record::{ChannelInfo, Tap};
+use crate::record::{ChannelDeclaration, Tap};
 use foxglove::{ChannelBuilder, RawChannel, Schema};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -218,7 +218,7 @@ impl<F: FnMut(LiveEvent)> LiveTap<'_, F> {
             let Some(schema) = schema_data(schema_name, encoding) else {
                 continue;
             };
-            self.channel(&ChannelInfo {
+            self.channel(&ChannelDeclaration {
                 topic,
                 schema_name,
                 schema_encoding: encoding.schema_encoding(),
@@ -230,7 +230,7 @@ impl<F: FnMut(LiveEvent)> LiveTap<'_, F> {
 }
 
 impl<F: FnMut(LiveEvent)> Tap for LiveTap<'_, F> {
-    fn channel(&mut self, info: &ChannelInfo<'_>) {
+    fn channel(&mut self, info: &ChannelDeclaration<'_>) {
         if self.channels[info.topic.index()].is_some() {
             return;
         }

@@ -8,8 +8,6 @@
 use super::derived::{reaction_with, Reaction};
 use super::equations::{AngularAcceleration, Coin};
 use super::state::{State, STATE_LEN};
-use std::fmt;
-use std::str::FromStr;
 use thiserror::Error;
 
 /// Number of state components of the dissipative coin: the eight of [`State`] and the dissipated work W.
@@ -18,36 +16,29 @@ pub const DISSIPATIVE_STATE_LEN: usize = STATE_LEN + 1;
 /// Index of W in the dissipative state.
 pub const WORK_INDEX: usize = STATE_LEN;
 
-/// A dissipation law by name (format.md: `body.dissipation.model`): the exponents m, k of
-/// P = κ |φ̇|^m (sin α)^(−k) (physics §11).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum DissipationModel {
-    /// Moffatt's viscous air film under the coin: m = 2, k = 1 (α ∝ (t₀ − t)^{1/3}).
-    Moffatt,
-    /// Air drag in a viscous boundary layer (Bildsten): m = 2.5, k = 0 (α ∝ (t₀ − t)^{4/9}).
-    AirDrag,
-    /// A couple linear in the rate, P ∝ φ̇²: m = 2, k = 0 (α ∝ (t₀ − t)^{1/2}).
-    Viscous,
-    /// Rolling resistance, a constant resisting force at the rim: m = 1, k = 0 (α ∝ (t₀ − t)^{2/3}).
-    Rolling,
-    /// Pivoting (drilling) friction of Le Saux, Leine & Glocker (2005), a Coulomb torque about the table
-    /// normal, in the form it takes on the centre-fixed motion: m = 1, k = −2 (no finite-time singularity).
-    Pivoting,
-    /// Any exponents: `m` and `k` given in the scene.
-    PowerLaw,
+coin_log_names::named_enum! {
+    /// A dissipation law by name (format.md: `body.dissipation.model`, in the order of its table): the
+    /// exponents m, k of P = κ |φ̇|^m (sin α)^(−k) (physics §11).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum DissipationModel: "dissipation model" {
+        /// Moffatt's viscous air film under the coin: m = 2, k = 1 (α ∝ (t₀ − t)^{1/3}).
+        Moffatt = "moffatt",
+        /// Air drag in a viscous boundary layer (Bildsten): m = 2.5, k = 0 (α ∝ (t₀ − t)^{4/9}).
+        AirDrag = "air-drag",
+        /// A couple linear in the rate, P ∝ φ̇²: m = 2, k = 0 (α ∝ (t₀ − t)^{1/2}).
+        Viscous = "viscous",
+        /// Rolling resistance, a constant resisting force at the rim: m = 1, k = 0 (α ∝ (t₀ − t)^{2/3}).
+        Rolling = "rolling",
+        /// Pivoting (drilling) friction of Le Saux, Leine & Glocker (2005), a Coulomb torque about the
+        /// table normal, in the form it takes on the centre-fixed motion: m = 1, k = −2 (no finite-time
+        /// singularity).
+        Pivoting = "pivoting",
+        /// Any exponents: `m` and `k` given in the scene.
+        PowerLaw = "power-law",
+    }
 }
 
 impl DissipationModel {
-    /// Every model, in the order of format.md's table.
-    pub const ALL: [DissipationModel; 6] = [
-        Self::Moffatt,
-        Self::AirDrag,
-        Self::Viscous,
-        Self::Rolling,
-        Self::Pivoting,
-        Self::PowerLaw,
-    ];
-
     /// The models with fixed exponents (every one but `power-law`).
     pub const PRESETS: [DissipationModel; 5] = [
         Self::Moffatt,
@@ -56,19 +47,6 @@ impl DissipationModel {
         Self::Rolling,
         Self::Pivoting,
     ];
-
-    /// The name in scene files and metadata.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Moffatt => "moffatt",
-            Self::AirDrag => "air-drag",
-            Self::Viscous => "viscous",
-            Self::Rolling => "rolling",
-            Self::Pivoting => "pivoting",
-            Self::PowerLaw => "power-law",
-        }
-    }
 
     /// The fixed exponents (m, k) of a preset; `None` for `power-law`.
     #[must_use]
@@ -81,33 +59,6 @@ impl DissipationModel {
             Self::Pivoting => Some((1.0, -2.0)),
             Self::PowerLaw => None,
         }
-    }
-
-    /// Every name, quoted and comma-separated, for messages.
-    #[must_use]
-    pub fn names() -> String {
-        Self::ALL.map(|m| format!("\"{}\"", m.name())).join(", ")
-    }
-}
-
-impl fmt::Display for DissipationModel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A dissipation model name this tool does not know.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-#[error("`{0}` is not a dissipation model: use one of {names}", names = DissipationModel::names())]
-pub struct UnknownDissipationModel(pub String);
-
-impl FromStr for DissipationModel {
-    type Err = UnknownDissipationModel;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| UnknownDissipationModel(s.to_string()))
     }
 }
 
@@ -405,7 +356,7 @@ mod tests {
 
     #[test]
     fn presets_have_the_documented_exponents_and_names_round_trip() {
-        for m in DissipationModel::ALL {
+        for &m in DissipationModel::ALL {
             assert_eq!(m.name().parse::<DissipationModel>(), Ok(m));
         }
         assert!("stokes".parse::<DissipationModel>().is_err());

@@ -42,7 +42,7 @@ impl Coin {
             params,
             gyro_x: (iz + ma2) / (ix + ma2),
             centrifugal_x: ix / (ix + ma2),
-            gravity_x: params.mass() * params.gravity() * params.radius() / (ix + ma2),
+            gravity_x: params.topple_rate_squared(),
             ratio_zx: iz / ix,
             rolling_z: ma2 / (iz + ma2),
         }

@@ -18,7 +18,7 @@ pub mod turning_points;
 pub use derived::{centre, contact_point, energy, orientation, reaction, Energy, Reaction};
 pub use dissipation::{
     Dissipation, DissipationError, DissipationModel, DissipativeCoin, DissipativeRates, Dynamics,
-    UnknownDissipationModel, DISSIPATIVE_STATE_LEN, MIN_RATE_EXPONENT, WORK_INDEX,
+    DISSIPATIVE_STATE_LEN, MIN_RATE_EXPONENT, WORK_INDEX,
 };
 pub use equations::{AngularAcceleration, Coin};
 pub use invariants::{Chaplygin, Invariants, InvariantsError, LegendreBasis};
@@ -28,8 +28,5 @@ pub use stability::{
     steady_sigma_squared, straight_lambda_squared, Linearisation,
 };
 pub use state::{State, StateRate, STATE_LEN};
-pub use steady::{
-    steady_omega_y, Branch, Steady, SteadyError, SteadyFamily, SteadyKind, UnknownBranch,
-    UnknownSteadyFamily,
-};
+pub use steady::{steady_omega_y, Branch, Steady, SteadyError, SteadyFamily, SteadyKind};
 pub use turning_points::{MeasuredNutation, TurningPoints};

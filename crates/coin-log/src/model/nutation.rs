@@ -228,7 +228,7 @@ pub fn steady_residual(coin: &Coin, theta: f64, omega_y: f64, omega_z: f64) -> (
 /// Whether `state` is a steady motion to rounding: ω_X = 0 and the steady family holds, each to
 /// [`STEADY_TOLERANCE`] of its natural scale (|ω| + √(g/a) for ω_X, the size of S's terms for S).
 #[must_use]
-pub fn is_steady(coin: &Coin, state: &State) -> bool {
+fn is_steady(coin: &Coin, state: &State) -> bool {
     let p = coin.params();
     let rate = (state.omega_x.powi(2) + state.omega_y.powi(2) + state.omega_z.powi(2)).sqrt()
         + 1.0 / p.time_unit();

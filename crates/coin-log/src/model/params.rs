@@ -159,4 +159,15 @@ impl CoinParams {
     pub fn energy_scale(&self) -> f64 {
         self.mass * self.gravity * self.radius
     }
+    /// K = Mga/(I_X + Ma²) [1/time²]: a coin without spin topples as θ̈ = K sin θ (eq (14) with
+    /// ω_Y = ω_Z = 0), and the upright spin is stable above Ω_c² = K (physics §5).
+    ///
+    /// ```
+    /// // Thin disk, unit scales: I_X + Ma² = 5/4.
+    /// assert_eq!(coin_log::model::CoinParams::unit_disk().topple_rate_squared(), 0.8);
+    /// ```
+    #[must_use]
+    pub fn topple_rate_squared(&self) -> f64 {
+        self.energy_scale() / (self.inertia_x + self.ma2())
+    }
 }

@@ -36,8 +36,7 @@ pub fn critical_spin(coin: &Coin) -> f64 {
 /// Stable iff σ² > 0; σ is the small-oscillation frequency.
 #[must_use]
 pub fn spin_upright_sigma_squared(coin: &Coin, omega: f64) -> f64 {
-    let p = coin.params();
-    omega * omega - p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2())
+    omega * omega - coin.params().topple_rate_squared()
 }
 
 /// σ² of the nutation about solution 2, centre at rest at lean θ₀ (physics §5):

@@ -5,107 +5,32 @@
 
 use super::equations::Coin;
 use super::state::State;
-use std::fmt;
-use std::str::FromStr;
 use thiserror::Error;
 
-/// Which root of the steady family's quadratic in ω_Y (physics §4.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Branch {
-    /// ω_Y = (−B + √D) / (2A): for θ, ω_Z > 0 the large, outer circle of the note.
-    Plus,
-    /// ω_Y = (−B − √D) / (2A).
-    Minus,
-}
-
-impl Branch {
-    /// Both branches.
-    pub const ALL: [Branch; 2] = [Self::Plus, Self::Minus];
-
-    /// The name in scene files: `+` or `-`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Plus => "+",
-            Self::Minus => "-",
-        }
+coin_log_names::named_enum! {
+    /// Which root of the steady family's quadratic in ω_Y (physics §4.3); the name is the one of scene files.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum Branch: "branch" {
+        /// ω_Y = (−B + √D) / (2A): for θ, ω_Z > 0 the large, outer circle of the note.
+        Plus = "+",
+        /// ω_Y = (−B − √D) / (2A).
+        Minus = "-",
     }
 }
 
-impl fmt::Display for Branch {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A name that is neither `+` nor `-`.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-#[error("`{0}` is not a branch: use \"+\" or \"-\"")]
-pub struct UnknownBranch(pub String);
-
-impl FromStr for Branch {
-    type Err = UnknownBranch;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|b| b.name() == s)
-            .ok_or_else(|| UnknownBranch(s.to_string()))
-    }
-}
-
-/// The four families of steady motion by name: the `kind` of a scene's `initial.steady` and the
-/// `steady_kind` of a recording's metadata (physics §4, §5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum SteadyFamily {
-    /// Upright, rolling straight.
-    Straight,
-    /// Centre at rest, the coin rolling round it.
-    CentreFixed,
-    /// Circular rolling.
-    Circle,
-    /// Spinning upright in place about the vertical diameter.
-    SpinUpright,
-}
-
-impl SteadyFamily {
-    /// Every family.
-    pub const ALL: [SteadyFamily; 4] = [
-        Self::Straight,
-        Self::CentreFixed,
-        Self::Circle,
-        Self::SpinUpright,
-    ];
-
-    /// The name in scene files and metadata.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Straight => "straight",
-            Self::CentreFixed => "centre-fixed",
-            Self::Circle => "circle",
-            Self::SpinUpright => "spin-upright",
-        }
-    }
-}
-
-impl fmt::Display for SteadyFamily {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A name that is not a steady family.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-#[error("`{0}` is not a steady motion: use \"straight\", \"centre-fixed\", \"circle\" or \"spin-upright\"")]
-pub struct UnknownSteadyFamily(pub String);
-
-impl FromStr for SteadyFamily {
-    type Err = UnknownSteadyFamily;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|f| f.name() == s)
-            .ok_or_else(|| UnknownSteadyFamily(s.to_string()))
+coin_log_names::named_enum! {
+    /// The four families of steady motion by name: the `kind` of a scene's `initial.steady` and the
+    /// `steady_kind` of a recording's metadata (physics §4, §5).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum SteadyFamily: "steady kind" {
+        /// Upright, rolling straight.
+        Straight = "straight",
+        /// Centre at rest, the coin rolling round it.
+        CentreFixed = "centre-fixed",
+        /// Circular rolling.
+        Circle = "circle",
+        /// Spinning upright in place about the vertical diameter.
+        SpinUpright = "spin-upright",
     }
 }
 

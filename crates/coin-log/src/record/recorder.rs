@@ -80,7 +80,7 @@ pub enum RecordError {
 /// The writer options of every coin-log file (chunked, indexed, statistics, summary offsets and CRCs are
 /// always on in [`McapWriter`]).
 #[must_use]
-pub fn write_options(options: &RecordOptions) -> WriterOptions {
+fn write_options(options: &RecordOptions) -> WriterOptions {
     WriterOptions {
         workers: COMPRESSION_THREADS,
         ..WriterOptions::new(
@@ -144,7 +144,7 @@ impl From<TimeError> for SampleError {
 
 /// A topic's channel as the file declares it: what a [`Tap`] needs to announce it elsewhere.
 #[derive(Debug, Clone, Copy)]
-pub struct ChannelInfo<'a> {
+pub struct ChannelDeclaration<'a> {
     /// The topic.
     pub topic: Topic,
     /// Schema name (e.g. `coin_log.Energy`).
@@ -162,7 +162,7 @@ pub struct ChannelInfo<'a> {
 /// simulation's thread, so a tap that blocks (to pace the run in real time) slows the run.
 pub trait Tap {
     /// A topic's channel, once, before its first message.
-    fn channel(&mut self, info: &ChannelInfo<'_>);
+    fn channel(&mut self, info: &ChannelDeclaration<'_>);
     /// A message, after it went to the file.
     fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]);
 }
@@ -170,7 +170,7 @@ pub trait Tap {
 /// A tap lent to a recording, so that the caller reads its state afterwards.
 impl<T: Tap + ?Sized> Tap for &mut T {
     #[inline]
-    fn channel(&mut self, info: &ChannelInfo<'_>) {
+    fn channel(&mut self, info: &ChannelDeclaration<'_>) {
         (**self).channel(info);
     }
     #[inline]
@@ -185,7 +185,7 @@ pub struct NoTap;
 
 impl Tap for NoTap {
     #[inline]
-    fn channel(&mut self, _: &ChannelInfo<'_>) {}
+    fn channel(&mut self, _: &ChannelDeclaration<'_>) {}
     #[inline]
     fn message(&mut self, _: Topic, _: u64, _: &[u8]) {}
 }
@@ -232,7 +232,7 @@ impl<W: Write + Seek, T: Tap> Output<W, T> {
             self.writer
                 .add_channel(schema_id, topic.name(), message_encoding, &BTreeMap::new())?;
         self.ids[topic.index()] = Some(id);
-        self.tap.channel(&ChannelInfo {
+        self.tap.channel(&ChannelDeclaration {
             topic,
             schema_name,
             schema_encoding,
@@ -579,14 +579,14 @@ fn energy_tolerance(scene: &Scene, max_omega: f64, span: f64) -> f64 {
 }
 
 /// How the integration ended, as the file records it: termination, its time, and the failure if any.
-fn ending(end: &integrate::Termination, t_last: f64) -> (Termination, f64, Option<Failure>) {
+fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Failure>) {
     let termination = Termination::of_run(end);
     match end {
-        integrate::Termination::Completed => (termination, t_last, None),
-        integrate::Termination::Event { t, .. } | integrate::Termination::Stopped { t } => {
+        integrate::RunEnd::Completed => (termination, t_last, None),
+        integrate::RunEnd::Event { t, .. } | integrate::RunEnd::Stopped { t } => {
             (termination, *t, None)
         }
-        integrate::Termination::Failed(e) => {
+        integrate::RunEnd::Failed(e) => {
             let t = match e {
                 integrate::StepError::NonFinite { t }
                 | integrate::StepError::StepSizeUnderflow { t, .. }

@@ -4,8 +4,8 @@
 //! NaN, a repeated log time, a run that never reaches its next sample, or numerical trouble that the
 //! summary would report as physics.
 
-use super::file::{RunFile, SceneFile};
-use super::validate::{number, Problems};
+use super::file::SceneFile;
+use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::integrate::Method;
 use crate::model::{energy, reaction, CoinParams, Inertia, State};
@@ -124,7 +124,7 @@ fn in_scale_range(log10: f64) -> bool {
 pub(super) fn check_scales(
     body: &super::file::BodyFile,
     inertia: Inertia,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> bool {
     let mut inputs = vec![
         ("body.mass", body.mass),
@@ -162,7 +162,7 @@ const DERIVED_SCALES: [(&str, [f64; 3]); 5] = [
     ("the squared speed scale a·g", [0.0, 1.0, 1.0]),
 ];
 
-fn check_derived_scales(body: &super::file::BodyFile, problems: &mut Problems) -> bool {
+fn check_derived_scales(body: &super::file::BodyFile, problems: &mut ProblemCollector) -> bool {
     let keys = ["body.mass", "body.radius", "body.gravity"];
     let values = [body.mass, body.radius, body.gravity];
     let logs = values.map(f64::log10);
@@ -203,7 +203,7 @@ fn check_derived_scales(body: &super::file::BodyFile, problems: &mut Problems) -
 
 /// rtol and atol ranges that need no body (atol's ceiling needs the body: [`check_resolved`]); only for
 /// adaptive methods, which use them.
-pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Problems) {
+pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut ProblemCollector) {
     if !(method.is_some_and(Method::is_adaptive) && rtol.is_finite() && rtol > 0.0) {
         return;
     }
@@ -227,7 +227,7 @@ pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Probl
 }
 
 /// The sample rate against the 1 ns log-time base ([`max_rate`]).
-pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut Problems) {
+pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollector) {
     if !(rate.is_finite() && rate > 0.0 && duration.is_finite() && duration > 0.0) {
         return;
     }
@@ -260,7 +260,7 @@ fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
 
 /// Checks that need the whole scene: the initial state inside the model (finite energy and reaction,
 /// N > 0, |F| < μN), atol's ceiling, the fixed step against the fastest motion, and the work.
-pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Problems) {
+pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut ProblemCollector) {
     let before = problems.list.len();
     check_start(scene, problems);
     if problems.list.len() != before {
@@ -309,7 +309,7 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
 }
 
 /// atol ≤ 1e-3 × the smallest natural scale of the state: 1 rad, a, 1/τ.
-fn check_atol(scene: &Scene, problems: &mut Problems) {
+fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
     let p = &scene.params;
     let atol = scene.run.method.atol;
     let smallest = 1f64.min(p.radius()).min(1.0 / p.time_unit());
@@ -339,7 +339,7 @@ fn initial_key(scene: &Scene) -> &'static str {
 
 /// The initial state must be inside the model: finite energy and reaction, the table pushing (N > 0)
 /// and, with μ, friction within the cone (|F| < μN). Otherwise the run would end at t = 0 with one sample.
-fn check_start(scene: &Scene, problems: &mut Problems) {
+fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
     let coin = scene.coin();
     let s = &scene.initial;
     let e = energy(&coin, s).total;
@@ -400,25 +400,6 @@ fn describe_state(s: &State) -> String {
         number(s.omega_y),
         number(s.omega_z)
     )
-}
-
-/// Settings given that the integrator does not use: `run.step` for adaptive methods, `run.rtol` and
-/// `run.atol` for fixed-step ones (format.md: record). They are ignored (and stored as 0), never used to
-/// loosen `verify`'s tolerances; the caller warns about each.
-#[must_use]
-pub fn ignored_settings(run: Option<&RunFile>, method: Method) -> Vec<(&'static str, f64)> {
-    let Some(run) = run else {
-        return Vec::new();
-    };
-    let candidates: [(&'static str, Option<f64>, bool); 3] = [
-        ("run.rtol", run.rtol, !method.is_adaptive()),
-        ("run.atol", run.atol, !method.is_adaptive()),
-        ("run.step", run.step, method.is_adaptive()),
-    ];
-    candidates
-        .into_iter()
-        .filter_map(|(key, value, ignored)| value.filter(|_| ignored).map(|v| (key, v)))
-        .collect()
 }
 
 #[cfg(test)]

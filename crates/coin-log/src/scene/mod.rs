@@ -7,21 +7,24 @@
 
 mod file;
 pub mod limits;
+mod notes;
 mod overrides;
 pub mod presets;
+mod problems;
 mod validate;
 
 pub use file::{
     BodyFile, DissipationFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile,
     SteadyFile,
 };
+pub use notes::{compact, Note};
 pub use overrides::{apply_set, FlagOverrides};
+pub use problems::{Problem, SceneProblems};
 pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
 
 use crate::format::Channel;
 use crate::integrate::MethodConfig;
 use crate::model::{Coin, CoinParams, Dissipation, Dynamics, Inertia, State, Steady};
-use std::fmt;
 
 /// Defaults of the optional scene keys (format.md: Scene files).
 pub mod defaults {
@@ -45,100 +48,6 @@ pub mod defaults {
 
 /// Largest number of samples a scene may ask for (duration × rate): 10¹¹, far beyond any disk.
 pub const MAX_SAMPLES: f64 = 1e11;
-
-/// One thing wrong with a scene: the key, the value found and what is allowed.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Problem {
-    /// Dotted key (`body.mass`).
-    pub key: String,
-    /// The value found, TOML-like (`-1`, `"dop854"`, `NaN`), or empty when the key is missing.
-    pub value: String,
-    /// What is wrong and what is allowed (`is outside (0, ∞)`).
-    pub reason: String,
-    /// The command-line flag that set the value, if any (`--rate`).
-    pub flag: Option<String>,
-}
-
-impl fmt::Display for Problem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.value.is_empty() {
-            write!(f, "`{}` {}", self.key, self.reason)?;
-        } else {
-            write!(f, "`{}` = {} {}", self.key, self.value, self.reason)?;
-        }
-        if let Some(flag) = &self.flag {
-            write!(f, " (set by `{flag}`)")?;
-        }
-        Ok(())
-    }
-}
-
-/// Every problem found in a scene: never empty, by construction (a first problem is required), so that an
-/// invalid scene always says what is wrong.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ProblemList {
-    first: Problem,
-    rest: Vec<Problem>,
-}
-
-impl ProblemList {
-    /// A list of one problem.
-    #[must_use]
-    pub fn new(first: Problem) -> Self {
-        Self {
-            first,
-            rest: Vec::new(),
-        }
-    }
-
-    /// The problems of `list`, or `None` when it is empty.
-    #[must_use]
-    pub fn from_vec(list: Vec<Problem>) -> Option<Self> {
-        let mut list = list.into_iter();
-        let first = list.next()?;
-        Some(Self {
-            first,
-            rest: list.collect(),
-        })
-    }
-
-    /// Adds a problem.
-    pub fn push(&mut self, problem: Problem) {
-        self.rest.push(problem);
-    }
-
-    /// How many problems (at least one).
-    #[must_use]
-    pub fn count(&self) -> usize {
-        1 + self.rest.len()
-    }
-
-    /// The problems, in the order found.
-    pub fn iter(&self) -> impl Iterator<Item = &Problem> {
-        std::iter::once(&self.first).chain(&self.rest)
-    }
-
-    /// The problems as a vector (never empty).
-    #[must_use]
-    pub fn into_vec(self) -> Vec<Problem> {
-        let mut all = vec![self.first];
-        all.extend(self.rest);
-        all
-    }
-}
-
-impl fmt::Display for ProblemList {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.rest.is_empty() {
-            return self.first.fmt(f);
-        }
-        write!(f, "{} problems:", self.count())?;
-        for p in self.iter() {
-            write!(f, "\n  {p}")?;
-        }
-        Ok(())
-    }
-}
 
 /// Why a scene could not be loaded.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -164,7 +73,7 @@ pub enum SceneError {
     },
     /// Values out of range, missing or contradictory; every problem found (at least one).
     #[error("{0}")]
-    Invalid(ProblemList),
+    Invalid(SceneProblems),
 }
 
 /// How the initial state was specified.
@@ -335,6 +244,20 @@ fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
 /// # Errors
 /// [`SceneError::Invalid`] listing every problem.
 pub fn resolve(file: &SceneFile, flags: &FlagOverrides) -> Result<Scene, SceneError> {
+    resolve_with_notes(file, flags).map(|(scene, _)| scene)
+}
+
+/// [`resolve`], with what resolving did to what was asked: the settings the integrator ignores and a
+/// fixed step rounded to the sampling grid, for the user to be told.
+///
+/// # Errors
+/// [`SceneError::Invalid`] listing every problem.
+pub fn resolve_with_notes(
+    file: &SceneFile,
+    flags: &FlagOverrides,
+) -> Result<(Scene, Vec<Note>), SceneError> {
     let (file, provenance) = flags.apply(file);
-    validate::scene_from_file(&file, &provenance)
+    let scene = validate::scene_from_file(&file, &provenance)?;
+    let notes = notes::notes(&scene, &file, &provenance);
+    Ok((scene, notes))
 }

@@ -6,8 +6,9 @@ use super::file::{
     SteadyFile,
 };
 use super::limits;
+use super::problems::{number, numbers, ProblemCollector};
 use super::{
-    defaults, InitialSpec, Problem, ProblemList, RunConfig, Scene, SceneError, MAX_SAMPLES,
+    defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, SceneProblems, MAX_SAMPLES,
 };
 use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
@@ -16,99 +17,6 @@ use crate::model::{
     SteadyKind, MIN_RATE_EXPONENT,
 };
 use std::f64::consts::FRAC_PI_2;
-
-/// Collects problems, naming the flag that set a key when one did.
-pub(super) struct Problems<'a> {
-    pub(super) list: Vec<Problem>,
-    provenance: &'a [(&'static str, &'static str)],
-}
-
-impl Problems<'_> {
-    pub(super) fn push(&mut self, key: &str, value: String, reason: impl Into<String>) {
-        let flag = self
-            .provenance
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map(|(_, f)| (*f).to_string());
-        self.list.push(Problem {
-            key: key.to_string(),
-            value,
-            reason: reason.into(),
-            flag,
-        });
-    }
-
-    fn missing(&mut self, key: &str, reason: impl Into<String>) {
-        self.push(key, String::new(), reason);
-    }
-
-    /// A required number that must be finite and > 0.
-    fn positive(&mut self, key: &str, value: f64) -> bool {
-        let ok = value.is_finite() && value > 0.0;
-        if !ok {
-            self.push(
-                key,
-                number(value),
-                "is outside (0, ∞): give a finite number > 0",
-            );
-        }
-        ok
-    }
-
-    /// Any finite number.
-    fn finite(&mut self, key: &str, value: f64) -> bool {
-        let ok = value.is_finite();
-        if !ok {
-            self.push(key, number(value), "is not a finite number");
-        }
-        ok
-    }
-
-    /// A vector of three finite numbers.
-    fn vector3(&mut self, key: &str, value: &[f64]) -> Option<[f64; 3]> {
-        match value {
-            [x, y, z] => {
-                let ok = [*x, *y, *z].iter().all(|v| v.is_finite());
-                if ok {
-                    Some([*x, *y, *z])
-                } else {
-                    self.push(
-                        key,
-                        numbers(value),
-                        "has a non-finite component: give three finite numbers",
-                    );
-                    None
-                }
-            }
-            _ => {
-                self.push(
-                    key,
-                    numbers(value),
-                    format!(
-                        "has {} components: give three, [ω_X, ω_Y, ω_Z]",
-                        value.len()
-                    ),
-                );
-                None
-            }
-        }
-    }
-}
-
-/// A number as the user would write it (`-1`, `0.5`, `1e-9`, `NaN`, `inf`).
-pub(super) fn number(value: f64) -> String {
-    let magnitude = value.abs();
-    if value.is_finite() && value != 0.0 && !(1e-4..1e16).contains(&magnitude) {
-        ryu::Buffer::new().format_finite(value).to_string()
-    } else {
-        format!("{value}")
-    }
-}
-
-fn numbers(values: &[f64]) -> String {
-    let parts: Vec<String> = values.iter().map(|v| number(*v)).collect();
-    format!("[{}]", parts.join(", "))
-}
 
 fn quoted(s: &str) -> String {
     format!("{s:?}")
@@ -120,7 +28,7 @@ pub const DESCRIPTION_MAX_CHARS: usize = 1000;
 
 /// The description is one line (format.md: Scene files): no line break or other control character, and
 /// at most [`DESCRIPTION_MAX_CHARS`], so that it cannot break the layouts that print it.
-fn check_description(description: Option<&str>, problems: &mut Problems) {
+fn check_description(description: Option<&str>, problems: &mut ProblemCollector) {
     let Some(text) = description else {
         return;
     };
@@ -155,10 +63,7 @@ pub(super) fn scene_from_file(
     file: &SceneFile,
     provenance: &[(&'static str, &'static str)],
 ) -> Result<Scene, SceneError> {
-    let mut problems = Problems {
-        list: Vec::new(),
-        provenance,
-    };
+    let mut problems = ProblemCollector::new(provenance);
     let run_file = file.run.clone().unwrap_or_default();
     let flat_margin = run_file.flat_margin.unwrap_or(defaults::FLAT_MARGIN);
     let margin_ok = flat_margin.is_finite() && flat_margin > 0.0 && flat_margin < FRAC_PI_2;
@@ -213,11 +118,11 @@ pub(super) fn scene_from_file(
     if let Some(scene) = &scene {
         limits::check_resolved(scene, file, &mut problems);
     }
-    match (scene, ProblemList::from_vec(problems.list)) {
+    match (scene, SceneProblems::from_vec(problems.list)) {
         (Some(scene), None) => Ok(scene),
         (_, Some(list)) => Err(SceneError::Invalid(list)),
         // Every check that rejects a part reports why; should one ever fail to, still say something.
-        (None, None) => Err(SceneError::Invalid(ProblemList::new(Problem {
+        (None, None) => Err(SceneError::Invalid(SceneProblems::new(Problem {
             key: "scene".into(),
             value: String::new(),
             reason: UNEXPLAINED.into(),
@@ -232,7 +137,7 @@ pub const UNEXPLAINED: &str =
 
 type Body = (CoinParams, Inertia, Option<f64>, f64);
 
-fn check_body(body: &BodyFile, problems: &mut Problems) -> Option<Body> {
+fn check_body(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Body> {
     let mut ok = problems.positive("body.mass", body.mass);
     ok &= problems.positive("body.radius", body.radius);
     ok &= problems.positive("body.gravity", body.gravity);
@@ -260,7 +165,7 @@ fn check_body(body: &BodyFile, problems: &mut Problems) -> Option<Body> {
 }
 
 /// The inertia: a shape, or both moments (I_Z ≤ 2 I_X).
-fn check_inertia(body: &BodyFile, problems: &mut Problems) -> Option<Inertia> {
+fn check_inertia(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Inertia> {
     match (&body.shape, body.inertia_x, body.inertia_z) {
         (Some(shape), None, None) => match shape.as_str() {
             "thin-disk" => Some(Inertia::ThinDisk),
@@ -332,7 +237,7 @@ type Initial = (State, InitialSpec, [f64; 4]);
 /// when something is wrong (reported).
 fn check_dissipation(
     file: Option<&DissipationFile>,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<Option<Dissipation>> {
     let Some(d) = file else {
         return Some(None);
@@ -341,7 +246,14 @@ fn check_dissipation(
     let model = match d.model.parse::<DissipationModel>() {
         Ok(m) => Some(m),
         Err(e) => {
-            problems.push("body.dissipation.model", quoted(&d.model), format!("{e}"));
+            problems.push(
+                "body.dissipation.model",
+                quoted(&d.model),
+                format!(
+                    "is not a dissipation model: use one of {}",
+                    e.valid.join(", ")
+                ),
+            );
             None
         }
     };
@@ -392,7 +304,7 @@ fn check_dissipation(
 fn preset_exponent_given(
     d: &DissipationFile,
     model: Option<DissipationModel>,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) {
     let Some(model) = model else { return };
     let Some((m, k)) = model.exponents() else {
@@ -412,7 +324,7 @@ fn preset_exponent_given(
 }
 
 /// `power-law`'s m ≥ 1 and k, both required.
-fn power_law_exponents(d: &DissipationFile, problems: &mut Problems) -> (f64, f64) {
+fn power_law_exponents(d: &DissipationFile, problems: &mut ProblemCollector) -> (f64, f64) {
     let m = match d.m {
         Some(m) if m.is_finite() && m >= MIN_RATE_EXPONENT => m,
         Some(m) => {
@@ -449,7 +361,11 @@ fn power_law_exponents(d: &DissipationFile, problems: &mut Problems) -> (f64, f6
 }
 
 /// Checks of `[initial]` that need no body (used when the body is invalid).
-fn check_initial_alone(initial: &InitialFile, flat_margin: Option<f64>, problems: &mut Problems) {
+fn check_initial_alone(
+    initial: &InitialFile,
+    flat_margin: Option<f64>,
+    problems: &mut ProblemCollector,
+) {
     if let Some(theta) = initial.theta {
         if problems.finite("initial.theta", theta) {
             let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
@@ -477,7 +393,7 @@ fn check_initial(
     initial: &InitialFile,
     params: &CoinParams,
     flat_margin: Option<f64>,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<Initial> {
     let before = problems.list.len();
     let mut offsets = [0.0; 4]; // φ, ψ, x, z
@@ -528,7 +444,7 @@ fn initial_base(
     coin: &Coin,
     margin_text: f64,
     in_lean_range: &dyn Fn(f64) -> bool,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<(State, InitialSpec)> {
     const EITHER: &str = "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion";
     match (&initial.steady, initial.theta, &initial.omega) {
@@ -591,7 +507,7 @@ pub(super) fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
     }
 }
 
-fn check_perturbation(p: &PerturbationFile, problems: &mut Problems) -> Option<[f64; 4]> {
+fn check_perturbation(p: &PerturbationFile, problems: &mut ProblemCollector) -> Option<[f64; 4]> {
     let theta = p.theta.unwrap_or(0.0);
     let theta_ok = problems.finite("initial.perturbation.theta", theta);
     let omega = match &p.omega {
@@ -618,7 +534,7 @@ fn check_steady(
     coin: &Coin,
     margin: f64,
     in_lean_range: &dyn Fn(f64) -> bool,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<Steady> {
     let before = problems.list.len();
     let family = match steady.kind.parse::<SteadyFamily>() {
@@ -641,7 +557,7 @@ fn check_steady(
 }
 
 /// Reports the keys given that `family` does not take.
-fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut Problems) {
+fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut ProblemCollector) {
     let allowed = steady_keys(family);
     let given = [
         ("theta", steady.theta.map(number)),
@@ -672,7 +588,7 @@ fn steady_kind(
     family: SteadyFamily,
     margin: f64,
     in_lean_range: &dyn Fn(f64) -> bool,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> SteadyKind {
     let allowed = steady_keys(family);
     let mut required = |name: &str, value: Option<f64>| -> f64 {
@@ -735,7 +651,7 @@ fn steady_kind(
 }
 
 /// `initial.steady.branch` (default `+`).
-fn steady_branch(steady: &SteadyFile, problems: &mut Problems) -> Branch {
+fn steady_branch(steady: &SteadyFile, problems: &mut ProblemCollector) -> Branch {
     match steady.branch.as_deref() {
         None => defaults::BRANCH,
         Some(name) => name.parse().unwrap_or_else(|_| {
@@ -754,7 +670,7 @@ fn solve_steady(
     coin: &Coin,
     kind: SteadyKind,
     family: SteadyFamily,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<Steady> {
     match Steady::new(coin, kind) {
         Ok(s) if s.state.is_finite() => Some(s),
@@ -784,7 +700,7 @@ fn check_run(
     run: &RunFile,
     flat_margin: f64,
     margin_ok: bool,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<RunConfig> {
     let before = problems.list.len();
     let duration = match run.duration {
@@ -891,17 +807,22 @@ pub(super) fn fitted_step(step: f64, interval: f64) -> f64 {
     interval / steps
 }
 
+/// The channels of a scene that lists none: all ten, and `work` with dissipation (format.md: Channels).
+pub(super) fn default_channels(dissipative: bool) -> Vec<Channel> {
+    let mut channels = Channel::DEFAULT.to_vec();
+    if dissipative {
+        channels.push(Channel::Work);
+    }
+    channels
+}
+
 fn check_channels(
     record: Option<&RecordFile>,
     dissipative: bool,
-    problems: &mut Problems,
+    problems: &mut ProblemCollector,
 ) -> Option<Vec<Channel>> {
     let Some(names) = record.and_then(|r| r.channels.as_ref()) else {
-        let mut channels = Channel::DEFAULT.to_vec();
-        if dissipative {
-            channels.push(Channel::Work);
-        }
-        return Some(channels);
+        return Some(default_channels(dissipative));
     };
     let before = problems.list.len();
     let mut channels = Vec::new();

@@ -18,7 +18,7 @@ use crate::format::messages::{
 use crate::format::protobuf::{self, MessageDecoder};
 use crate::format::{
     log_time, schema_bytes, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
-    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+    FRAME_TRANSFORM, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
@@ -161,7 +161,7 @@ fn foxglove_message(
                 .and_then(Option::as_ref)
                 .and_then(|c| Topic::from_name(&c.topic));
             let decoded = match topic.map(Topic::schema_name) {
-                Some("foxglove.FrameTransform") => FrameTransform::decode(data).map(|_| ()),
+                Some(FRAME_TRANSFORM) => FrameTransform::decode(data).map(|_| ()),
                 Some(_) => SceneUpdate::decode(data).map(|_| ()),
                 None => Ok(()),
             };
@@ -799,7 +799,7 @@ fn missing_required(results: &[CheckResult]) -> Option<String> {
     let mut missing: Vec<&str> = [CheckId::Integrity, CheckId::Energy]
         .into_iter()
         .filter(|id| skipped(*id))
-        .map(CheckId::as_str)
+        .map(CheckId::name)
         .collect();
     if skipped(CheckId::Constraint) && skipped(CheckId::Steady) {
         missing.push("constraint or steady (the motion)");

@@ -50,14 +50,3 @@ pub fn verify_file_with_progress(
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     file::verify_bytes(name, bytes, options)
 }
-
-/// Judges several files.
-#[must_use]
-pub fn verify_files(paths: &[impl AsRef<Path>], options: &Options) -> Report {
-    Report {
-        files: paths
-            .iter()
-            .map(|p| verify_file(p.as_ref(), options))
-            .collect(),
-    }
-}

@@ -3,84 +3,42 @@
 //! "value", "tolerance", "reason"}]}]}`).
 
 use serde::Serialize;
-use std::fmt;
 
-/// The checks, with the contract's ids (format.md: verify).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum CheckId {
-    /// File structure, indexes, CRCs, statistics, schemas, message shapes and times.
-    Integrity,
-    /// Energy recomputed from the stored state; its drift and agreement with `/coin/energy`.
-    Energy,
-    /// Chaplygin–Appell integrals C1, C2 (physics §6).
-    Invariants,
-    /// Steady motions stay steady (physics §4).
-    Steady,
-    /// The rolling constraint: centre velocity from positions against a(−ω_Z e_X + ω_X e_Z).
-    Constraint,
-    /// Channels agree with each other (quaternion, contact, height, reaction).
-    Consistency,
-    /// The model is valid: N ≥ 0 and |F| ≤ μN.
-    Validity,
-    /// The nutation period and heading advance per period against the quadrature (physics §10).
-    Nutation,
-}
-
-impl CheckId {
-    /// Every check, in report order.
-    pub const ALL: [CheckId; 8] = [
-        Self::Integrity,
-        Self::Energy,
-        Self::Invariants,
-        Self::Steady,
-        Self::Constraint,
-        Self::Consistency,
-        Self::Validity,
-        Self::Nutation,
-    ];
-
-    /// The contract's id.
-    #[must_use]
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Integrity => "integrity",
-            Self::Energy => "energy",
-            Self::Invariants => "invariants",
-            Self::Steady => "steady",
-            Self::Constraint => "constraint",
-            Self::Consistency => "consistency",
-            Self::Validity => "validity",
-            Self::Nutation => "nutation",
-        }
+coin_log_names::named_enum! {
+    /// The checks, with the contract's ids (format.md: verify), in report order.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+    #[serde(rename_all = "lowercase")]
+    pub enum CheckId: "check" {
+        /// File structure, indexes, CRCs, statistics, schemas, message shapes and times.
+        Integrity = "integrity",
+        /// Energy recomputed from the stored state; its drift and agreement with `/coin/energy`.
+        Energy = "energy",
+        /// Chaplygin–Appell integrals C1, C2 (physics §6).
+        Invariants = "invariants",
+        /// Steady motions stay steady (physics §4).
+        Steady = "steady",
+        /// The rolling constraint: centre velocity from positions against a(−ω_Z e_X + ω_X e_Z).
+        Constraint = "constraint",
+        /// Channels agree with each other (quaternion, contact, height, reaction).
+        Consistency = "consistency",
+        /// The model is valid: N ≥ 0 and |F| ≤ μN.
+        Validity = "validity",
+        /// The nutation period and heading advance per period against the quadrature (physics §10).
+        Nutation = "nutation",
     }
 }
 
-impl fmt::Display for CheckId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-/// Outcome of one check.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Status {
-    /// Ran and the value is within tolerance.
-    Pass,
-    /// Ran and the value is outside tolerance (or the file cannot support it).
-    Fail,
-    /// Could not run; the reason says why.
-    Skip,
-}
-
-impl fmt::Display for Status {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::Pass => "pass",
-            Self::Fail => "fail",
-            Self::Skip => "skip",
-        })
+coin_log_names::named_enum! {
+    /// Outcome of one check.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+    #[serde(rename_all = "lowercase")]
+    pub enum Status: "status" {
+        /// Ran and the value is within tolerance.
+        Pass = "pass",
+        /// Ran and the value is outside tolerance (or the file cannot support it).
+        Fail = "fail",
+        /// Could not run; the reason says why.
+        Skip = "skip",
     }
 }
 

@@ -49,6 +49,18 @@ impl<'a> Writer<'a> {
         Ok(())
     }
 
+    /// A `Color` {r, g, b, a}, each component's shortest decimal, whole ones without `.0` (`"a":1`).
+    pub(super) fn color(&mut self, rgba: super::Rgba) {
+        let keys: [&[u8]; 4] = [b"{\"r\":", b",\"g\":", b",\"b\":", b",\"a\":"];
+        for (key, v) in keys.into_iter().zip(rgba) {
+            self.buf.extend_from_slice(key);
+            let text = self.ryu.format(v);
+            self.buf
+                .extend_from_slice(text.strip_suffix(".0").unwrap_or(text).as_bytes());
+        }
+        self.buf.push(b'}');
+    }
+
     pub(super) fn uint(&mut self, mut n: u64) {
         let mut digits = [0u8; 20];
         let mut i = digits.len();

@@ -43,7 +43,7 @@ mod proto;
 pub mod track;
 
 use crate::format::messages::NonFiniteField;
-use crate::format::{Channel, Encoding, Topic, TRACK_LEVELS};
+use crate::format::{Channel, Encoding, Topic, FRAME_TRANSFORM, SCENE_UPDATE, TRACK_LEVELS};
 use crate::model::{contact_point, orientation, Coin, State};
 use json::{check, Writer};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -90,23 +90,9 @@ const TRACK_WIDTH: f64 = 3.0;
 /// Every GRID_MAJOR-th grid line is a major one.
 const GRID_MAJOR: i32 = 5;
 
-const FRAME_TRANSFORM: &str = "foxglove.FrameTransform";
-const SCENE_UPDATE: &str = "foxglove.SceneUpdate";
-
 const IDENTITY_POSE: &[u8] =
     br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
-const COIN_COLOR: &[u8] = br#"{"r":0.85,"g":0.65,"b":0.2,"a":1}"#;
-const MARK_TOP_COLOR: &[u8] = br#"{"r":0.6,"g":0.05,"b":0.05,"a":1}"#;
-const MARK_BOTTOM_COLOR: &[u8] = br#"{"r":0.05,"g":0.1,"b":0.55,"a":1}"#;
-const TABLE_COLOR: &[u8] = br#"{"r":0.87,"g":0.86,"b":0.82,"a":1}"#;
-const GRID_COLORS: [&[u8]; 2] = [
-    br#"{"r":0.66,"g":0.66,"b":0.63,"a":1}"#,
-    br#"{"r":0.45,"g":0.45,"b":0.43,"a":1}"#,
-];
-const TRACK_COLOR: &[u8] = br#"{"r":0.1,"g":0.35,"b":0.9,"a":1}"#;
-
-/// A colour (r, g, b, a) in 0..1: the Protobuf writer's form of the JSON literals above (a test checks
-/// they agree).
+/// A colour (r, g, b, a) in 0..1, as both encodings write it.
 type Rgba = [f64; 4];
 const COIN_RGBA: Rgba = [0.85, 0.65, 0.2, 1.0];
 const MARK_RGBA: [Rgba; 2] = [[0.6, 0.05, 0.05, 1.0], [0.05, 0.1, 0.55, 1.0]];
@@ -463,8 +449,7 @@ impl Foxglove3d {
         w.raw(b"{\"deletions\":[],\"entities\":[");
         w.entity_head(log_time, FOLLOW_FRAME, b"coin", None, true);
         w.raw(b"\"cubes\":[");
-        let colors = [MARK_TOP_COLOR, MARK_BOTTOM_COLOR];
-        for (i, (position, size, _)) in coin_marks(r, h).iter().enumerate() {
+        for (i, (position, size, colour)) in coin_marks(r, h).iter().enumerate() {
             if i > 0 {
                 w.raw(b",");
             }
@@ -473,7 +458,7 @@ impl Foxglove3d {
             w.raw(b",\"size\":");
             w.vector3("cubes.size", size[0], size[1], size[2])?;
             w.raw(b",\"color\":");
-            w.raw(colors[i]);
+            w.color(*colour);
             w.raw(b"}");
         }
         w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
@@ -481,7 +466,7 @@ impl Foxglove3d {
         w.raw(b",\"size\":");
         w.vector3("cylinders.size", 2.0, 2.0, h)?;
         w.raw(b",\"bottom_scale\":1,\"top_scale\":1,\"color\":");
-        w.raw(COIN_COLOR);
+        w.color(COIN_RGBA);
         w.raw(b"}],\"lines\":[],");
         w.entity_tail();
         w.raw(b"]}");
@@ -531,7 +516,7 @@ fn write_table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) -> Result<(),
     let side = 2.0 * TABLE_HALF_SIDE;
     w.vector3("cubes.size", side, side, TABLE_THICKNESS)?;
     w.raw(b",\"color\":");
-    w.raw(TABLE_COLOR);
+    w.color(TABLE_RGBA);
     w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
     for major in [false, true] {
         if major {
@@ -562,7 +547,7 @@ fn write_grid(w: &mut Writer, centre: [f64; 2], major: bool) -> Result<(), NonFi
         w.point(b[0], b[1])?;
     }
     w.raw(b"],\"color\":");
-    w.raw(GRID_COLORS[usize::from(major)]);
+    w.color(GRID_RGBA[usize::from(major)]);
     w.raw(b",\"colors\":[],\"indices\":[]}");
     Ok(())
 }
@@ -588,7 +573,7 @@ fn write_track(
         w.point(p.x, p.y)?;
     }
     w.raw(b"],\"color\":");
-    w.raw(TRACK_COLOR);
+    w.color(TRACK_RGBA);
     w.raw(b",\"colors\":[],\"indices\":[]}],");
     w.entity_tail();
     w.raw(b"]}");
@@ -625,7 +610,7 @@ mod tests {
     // Unit tests of the Foxglove output: schemas, frames, the drawing's geometry against the model, rates,
     // the table, the track's levels, scale invariance, non-finite values.
 
-    use super::track::{MAX_TOLERANCE, QUANTUM};
+    use super::track::{segment_distance, MAX_TOLERANCE, QUANTUM};
     use super::*;
     use crate::format::log_time;
     use crate::format::schema_bytes;
@@ -1152,17 +1137,6 @@ mod tests {
         );
     }
 
-    fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let len2 = dx * dx + dy * dy;
-        let s = if len2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p[0] - a[0] - s * dx).hypot(p[1] - a[1] - s * dy)
-    }
-
     #[test]
     fn the_drawing_is_the_same_for_any_radius_in_units_of_a() {
         // The same motion in units of a, for a = 1 and a = 0.01325: every drawing message carries the same
@@ -1233,7 +1207,7 @@ mod tests {
             .sample(0.01, 10_000_000, &bad, false, &mut batch)
             .unwrap_err();
         println!("{err}");
-        assert_eq!(err.schema, "foxglove.FrameTransform");
+        assert_eq!(err.schema, FRAME_TRANSFORM);
         assert_eq!(batch.len(), before);
         let bad = State {
             x: f64::INFINITY,
@@ -1255,7 +1229,7 @@ mod tests {
                 &mut batch,
             )
             .unwrap_err();
-        assert_eq!(err.schema, "foxglove.SceneUpdate");
+        assert_eq!(err.schema, SCENE_UPDATE);
     }
 
     #[test]

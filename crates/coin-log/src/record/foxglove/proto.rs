@@ -11,6 +11,7 @@ use super::{
     TRACK_WIDTH, WORLD_FRAME,
 };
 use crate::format::messages::NonFiniteField;
+use crate::format::{FRAME_TRANSFORM, SCENE_UPDATE};
 use foxglove::messages::{
     line_primitive, scene_entity_deletion, Color, CubePrimitive, CylinderPrimitive, Duration,
     FrameTransform, LinePrimitive, Point3, Pose, Quaternion, SceneEntity, SceneEntityDeletion,
@@ -18,9 +19,6 @@ use foxglove::messages::{
 };
 use nalgebra::UnitQuaternion;
 use prost::Message;
-
-const FRAME_TRANSFORM: &str = "foxglove.FrameTransform";
-const SCENE_UPDATE: &str = "foxglove.SceneUpdate";
 
 /// The timestamp of a log time (ns). Foxglove's `Timestamp` counts seconds in a u32: up to 4.29e9 time
 /// units, beyond the longest run the recorder accepts in Protobuf ([`MAX_SECONDS`]).

@@ -231,14 +231,20 @@ fn segment_bound(points: &[TrackPoint], a: usize, b: usize) -> (f64, Option<usiz
 
 /// Distance from p to the segment [a, b].
 fn distance(p: &TrackPoint, a: &TrackPoint, b: &TrackPoint) -> f64 {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
+    segment_distance([p.x, p.y], [a.x, a.y], [b.x, b.y])
+}
+
+/// Distance from the point `p` to the segment [`a`, `b`] of the plane.
+#[must_use]
+pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let len2 = dx * dx + dy * dy;
     let s = if len2 > 0.0 {
-        (((p.x - a.x) * dx + (p.y - a.y) * dy) / len2).clamp(0.0, 1.0)
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    (p.x - (a.x + s * dx)).hypot(p.y - (a.y + s * dy))
+    (p[0] - (a[0] + s * dx)).hypot(p[1] - (a[1] + s * dy))
 }
 
 #[cfg(test)]

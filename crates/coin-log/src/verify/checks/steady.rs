@@ -162,8 +162,7 @@ impl SteadyCheck {
         let p = ctx.coin.params();
         let a = p.radius();
         let omega_scale = self.max_omega.max(1.0 / p.time_unit());
-        let acc_scale =
-            self.max_omega * self.max_omega + p.energy_scale() / (p.inertia_x() + p.ma2());
+        let acc_scale = self.max_omega * self.max_omega + p.topple_rate_squared();
         let mut measures = vec![
             (self.acceleration.value / acc_scale, tol.residual, "rhs"),
             (self.theta.value, tol.residual, "theta"),
