@@ -5,6 +5,10 @@
 //!
 //! proptest keeps the failing cases of a property test in `tests/proptest-regressions/<module>.txt` (the
 //! folder beside the one holding this `main.rs`); commit such a file when it appears.
+//!
+//! The modules that read files with Python, Node or Rerun are built with the cargo feature
+//! `external-readers` only (`scripts/test` installs the tools and turns it on), so that `cargo test` needs
+//! nothing but cargo.
 
 mod support;
 
@@ -23,6 +27,7 @@ mod cli_scene_limits;
 mod datasets;
 mod dissipation;
 mod events;
+#[cfg(feature = "external-readers")]
 mod external_readers;
 mod formulas;
 mod foxglove;
@@ -32,10 +37,12 @@ mod invariants;
 mod linearisation;
 #[cfg(feature = "live")]
 mod live;
+#[cfg(feature = "external-readers")]
 mod other_writers;
 mod params;
 mod properties;
 mod protobuf;
+#[cfg(feature = "external-readers")]
 mod protobuf_readers;
 mod readme;
 mod record_roundtrip;
