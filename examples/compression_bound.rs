@@ -5,6 +5,7 @@
 //! (seconds, MB/s, messages/s, compressed size) for the writer's own `ChunkCompressor` (zstd at its level,
 //! lz4, none: what a recording costs to compress), then for each zstd LEVEL given.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::print_stdout, reason = "a measurement printed for the reader")]
 
 use coin_log_mcap::{ChunkCompressor, Compression, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL};
 use mcap::records::Record;

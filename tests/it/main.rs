@@ -9,6 +9,19 @@
 //! The modules that read files with Python, Node or Rerun are built with the cargo feature
 //! `external-readers` only (`scripts/test` installs the tools and turns it on), so that `cargo test` needs
 //! nothing but cargo.
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "a test prints its evidence (measured values beside their bounds)"
+)]
+#![allow(
+    clippy::disallowed_methods,
+    reason = "the tests run the binary and the independent readers as child processes"
+)]
+#![allow(
+    clippy::too_many_lines,
+    reason = "a test is one story: set-up, run, every assertion; the length rule is for the code it tests"
+)]
 
 mod support;
 
