@@ -34,16 +34,24 @@ fn documents() -> Vec<(String, String)> {
         .collect()
 }
 
-/// Writes each ```console block of `text` to `dir` as `<stem>-<line>.md`, every other line of the
-/// document left blank (so trycmd's line numbers are the document's), with its working folder
-/// `<stem>-<line>.in/`. Returns how many commands the blocks hold.
-fn write_blocks(stem: &str, text: &str, dir: &Path) -> usize {
+/// Writes each ```console block of the document `name` to `dir` as `<name>-<line>.md` (`/` and `.` of the
+/// name as `-`), every other line of the document left blank (so trycmd's line numbers are the
+/// document's), with its working folder `<name>-<line>.in/`. Returns how many commands the blocks hold.
+fn write_blocks(name: &str, text: &str, dir: &Path) -> usize {
     let lines: Vec<&str> = text.lines().collect();
     let (mut commands, mut open) = (0, None);
     for (n, line) in lines.iter().enumerate() {
         match (open, line.trim()) {
             (None, "```console") => open = Some(n),
-            (Some(_), l) if l.starts_with("$ ") => commands += 1,
+            (Some(_), l) if l.starts_with("$ ") => {
+                // trycmd would skip a program it does not know.
+                assert!(
+                    l.starts_with("$ coin-log "),
+                    "{name}:{}: example commands start with `coin-log`",
+                    n + 1
+                );
+                commands += 1;
+            }
             (Some(first), "```") => {
                 let indent = lines[first].len() - lines[first].trim_start().len();
                 let block: String = (0..lines.len())
@@ -52,9 +60,9 @@ fn write_blocks(stem: &str, text: &str, dir: &Path) -> usize {
                         _ => "\n".to_string(),
                     })
                     .collect();
-                let name = format!("{stem}-{}", first + 1);
-                fs::write(dir.join(format!("{name}.md")), block).unwrap();
-                let folder = dir.join(format!("{name}.in"));
+                let stem = format!("{}-{}", name.replace(['/', '.'], "-"), first + 1);
+                fs::write(dir.join(format!("{stem}.md")), block).unwrap();
+                let folder = dir.join(format!("{stem}.in"));
                 fs::create_dir(&folder).unwrap();
                 for shared in ["datasets", "schemas"] {
                     std::os::unix::fs::symlink(repo().join(shared), folder.join(shared)).unwrap();
@@ -67,7 +75,8 @@ fn write_blocks(stem: &str, text: &str, dir: &Path) -> usize {
     commands
 }
 
-/// Runs the blocks written in `dir` with trycmd; it panics on the first wrong output.
+/// Runs the blocks written in `dir` with trycmd: each wrong output is shown on stderr, and the run panics
+/// if there was one.
 fn run_blocks(dir: &Path) {
     trycmd::TestCases::new()
         .register_bin("coin-log", exe())
@@ -82,7 +91,7 @@ fn every_console_example_in_the_docs_prints_what_it_shows() {
     let dir = tempfile::tempdir().unwrap();
     let mut commands = 0;
     for (name, text) in documents() {
-        commands += write_blocks(&name.replace(['/', '.'], "-"), &text, dir.path());
+        commands += write_blocks(&name, &text, dir.path());
     }
     println!("{commands} documented commands");
     assert!(
