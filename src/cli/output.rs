@@ -1,5 +1,5 @@
 //! Standard output and standard error of every command (format.md: Exit codes). Every print of `src/cli`
-//! goes through the macros of this module (a test of tests/it/architecture.rs checks it), because
+//! goes through the macros of this module (clippy's `print_stdout` and `print_stderr` check it), because
 //! `println!` panics when a write fails, and writes do fail: Rust ignores SIGPIPE, so `coin-log scenes |
 //! head -1` gets EPIPE once `head` has gone, and `> /dev/full` gets ENOSPC.
 //!

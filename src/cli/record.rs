@@ -233,6 +233,10 @@ impl Signals {
                 let _ = std::fs::remove_file(path);
             }
             errln!("stopped again: the recording is abandoned and nothing is written");
+            #[allow(
+                clippy::disallowed_methods,
+                reason = "a second signal abandons the run at once; its temporary file is removed above"
+            )]
             std::process::exit(130);
         })
         .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;

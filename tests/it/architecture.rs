@@ -1,33 +1,25 @@
-//! The architecture as tests: the module graph has no arrow running back up (docs/architecture.md), the
-//! library never prints and never starts a process, and no function is longer than a screen
-//! ([`LONGEST_FUNCTION`] lines, tables of data excepted).
+//! The architecture as tests: docs/architecture.md draws exactly the workspace's crate graph and the module
+//! graph inside crates/coin-log, and no module arrow runs back up the layers the document lists. The other
+//! rules (no printing in the libraries, no process started, no function longer than a screen) are
+//! clippy's: `[workspace.lints.clippy]` in Cargo.toml and clippy.toml.
 //!
-//! The checks read the source text: every `crate::<module>` path (in `use` lines and inline) in a file of
-//! `src/<module>/` is an arrow from that module to `<module>`. `#[cfg(test)]` blocks are left out (unit
-//! tests may print their evidence).
+//! The crate graph is `cargo metadata`'s: the normal dependencies of each workspace crate on the others.
+//! The module graph is read from the source text: every `crate::<module>` path (in `use` trees and inline)
+//! in a file of `crates/coin-log/src/<module>` is an arrow from that module to `<module>`; comments and
+//! `#[cfg(test)]` items are left out (unit tests may reach anywhere).
 // Helpers outside #[test] functions read the repository's own files: a failure to read is a failed test.
 #![allow(clippy::unwrap_used)]
 
-use std::collections::BTreeMap;
+use crate::support::repo;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
-/// The library's modules, lowest first. A module may use modules of lower layers only; modules of one
-/// layer do not use each other.
-const LAYERS: &[&[&str]] = &[
-    &["model", "mcap_io"],
-    &["integrate"],
-    &["simulation"],
-    &["format"],
-    &["scene"],
-    &["record", "verify", "analyse", "inspect"],
-    &["live"],
-    &["bench"],
-];
+/// An arrow of a graph: (from, to).
+type Arrow = (String, String);
 
-fn layer_of(module: &str) -> Option<usize> {
-    LAYERS.iter().position(|l| l.contains(&module))
-}
+const DOC: &str = "docs/architecture.md";
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in fs::read_dir(dir).unwrap() {
@@ -40,28 +32,21 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The library's source files with the module each belongs to (`src/model/x.rs` → model,
-/// `src/simulation.rs` → simulation); `lib.rs`, `main.rs` and `cli/` are not library modules.
-fn library_files() -> Vec<(String, PathBuf)> {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    files.sort();
-    files
-        .into_iter()
-        .filter_map(|p| {
-            let rel = p.strip_prefix(&src).unwrap().to_path_buf();
-            let first = rel.components().next()?.as_os_str().to_str()?.to_string();
-            let module = first.trim_end_matches(".rs").to_string();
-            (!matches!(module.as_str(), "lib" | "main" | "cli")).then_some((module, p))
-        })
+/// The library's modules: the entries of `crates/coin-log/src` but `lib.rs`.
+fn modules() -> BTreeSet<String> {
+    fs::read_dir(repo().join("crates/coin-log/src"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name != "lib.rs")
+        .map(|name| name.trim_end_matches(".rs").to_string())
         .collect()
 }
 
-/// The file's text without its `#[cfg(test)]` items (from the attribute to the end of the item's block).
+/// The file's code without comments and without its `#[cfg(test)]` items (from the attribute to the end
+/// of the item's block, or to the `;` of a one-line item).
 fn without_tests(text: &str) -> String {
     let mut out = String::new();
-    let mut lines = text.lines();
+    let mut lines = text.lines().map(|l| l.split("//").next().unwrap_or(""));
     while let Some(line) = lines.next() {
         if line.trim_start().starts_with("#[cfg(test)]") {
             let mut depth = 0i32;
@@ -81,254 +66,251 @@ fn without_tests(text: &str) -> String {
     out
 }
 
-/// Every module named after `crate::` in the text, including grouped imports `use crate::{a, b::c}`.
+fn identifier(text: &str) -> String {
+    text.trim_start()
+        .chars()
+        .take_while(|c| c.is_alphanumeric() || *c == '_')
+        .collect()
+}
+
+/// Every name after `crate::` in the text; in a use tree `crate::{a, b::{c, d}}`, its top-level items.
 fn crate_references(text: &str) -> Vec<String> {
     let mut found = Vec::new();
     for (i, _) in text.match_indices("crate::") {
         let rest = &text[i + "crate::".len()..];
-        if let Some(group) = rest.strip_prefix('{') {
-            let end = group.find('}').unwrap_or(group.len());
-            for item in group[..end].split(',') {
-                let name: String = item
-                    .trim()
-                    .chars()
-                    .take_while(|c| c.is_alphanumeric() || *c == '_')
-                    .collect();
-                found.push(name);
+        let Some(group) = rest.strip_prefix('{') else {
+            found.push(identifier(rest));
+            continue;
+        };
+        let (mut depth, mut start) = (0, 0);
+        for (j, c) in group.char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' if depth == 0 => {
+                    found.push(identifier(&group[start..j]));
+                    break;
+                }
+                '}' => depth -= 1,
+                ',' if depth == 0 => {
+                    found.push(identifier(&group[start..j]));
+                    start = j + 1;
+                }
+                _ => {}
             }
-        } else {
-            found.push(
-                rest.chars()
-                    .take_while(|c| c.is_alphanumeric() || *c == '_')
-                    .collect(),
-            );
         }
     }
     found.retain(|m| !m.is_empty());
     found
 }
 
-#[test]
-fn every_module_is_in_a_layer() {
-    for (module, path) in library_files() {
-        assert!(
-            layer_of(&module).is_some(),
-            "{}: module `{module}` is in no layer of tests/it/architecture.rs (and docs/architecture.md)",
-            path.display()
-        );
-    }
-}
-
-#[test]
-fn no_arrow_runs_back_up_the_module_graph() {
-    let mut arrows: BTreeMap<(String, String), Vec<String>> = BTreeMap::new();
-    for (module, path) in library_files() {
+/// The arrows between the library's modules, each with the files that make it.
+fn module_arrows() -> BTreeMap<Arrow, Vec<String>> {
+    let modules = modules();
+    let src = repo().join("crates/coin-log/src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut arrows: BTreeMap<Arrow, Vec<String>> = BTreeMap::new();
+    for path in files {
+        let rel = path.strip_prefix(&src).unwrap();
+        let first = rel
+            .components()
+            .next()
+            .unwrap()
+            .as_os_str()
+            .to_string_lossy();
+        let module = first.trim_end_matches(".rs").to_string();
+        if module == "lib" {
+            continue;
+        }
         let text = without_tests(&fs::read_to_string(&path).unwrap());
         for target in crate_references(&text) {
-            if target != module && layer_of(&target).is_some() {
-                arrows
-                    .entry((module.clone(), target))
-                    .or_default()
-                    .push(path.display().to_string());
+            if target != module && modules.contains(&target) {
+                let files = arrows.entry((module.clone(), target)).or_default();
+                files.push(rel.display().to_string());
+                files.dedup();
             }
         }
     }
-    let mut wrong = Vec::new();
-    for ((from, to), files) in &arrows {
-        let (lf, lt) = (layer_of(from).unwrap(), layer_of(to).unwrap());
-        println!("{from} (layer {lf}) -> {to} (layer {lt})");
-        if lt >= lf {
-            wrong.push(format!("{from} -> {to} in {}", files.join(", ")));
+    arrows
+}
+
+/// A crate's node in the document: its package name with `_` for `-` (mermaid ids).
+fn node(package: &str) -> String {
+    package.replace('-', "_")
+}
+
+/// The dependencies between the workspace's crates (`[dependencies]`, not dev or build), by
+/// `cargo metadata`.
+fn crate_arrows() -> BTreeSet<Arrow> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = Command::new(cargo)
+        .args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--no-deps",
+            "--offline",
+        ])
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "cargo metadata: {err}");
+    let metadata: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let packages = metadata["packages"].as_array().unwrap();
+    let names: BTreeSet<&str> = packages
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    let mut arrows = BTreeSet::new();
+    for package in packages {
+        for dependency in package["dependencies"].as_array().unwrap() {
+            let name = dependency["name"].as_str().unwrap();
+            if dependency["kind"].is_null() && names.contains(name) {
+                arrows.insert((node(package["name"].as_str().unwrap()), node(name)));
+            }
         }
     }
+    arrows
+}
+
+/// The arrows the ```mermaid blocks of a Markdown text draw: `a --> b` and `a --> b & c`.
+fn drawn_arrows(text: &str) -> BTreeSet<Arrow> {
+    let mut arrows = BTreeSet::new();
+    let mut in_graph = false;
+    for line in text.lines() {
+        match line.trim() {
+            "```mermaid" => in_graph = true,
+            "```" => in_graph = false,
+            l if in_graph && l.contains("-->") => {
+                let (from, to) = l.split_once("-->").unwrap();
+                let ids = |side: &str| -> Vec<String> {
+                    side.split('&')
+                        .map(|id| {
+                            let id = id.trim();
+                            assert!(
+                                !id.is_empty() && identifier(id) == id,
+                                "{DOC}: `{l}`: draw arrows as `a --> b & c`, nodes declared apart"
+                            );
+                            id.to_string()
+                        })
+                        .collect()
+                };
+                for f in ids(from) {
+                    arrows.extend(ids(to).into_iter().map(|t| (f.clone(), t)));
+                }
+            }
+            _ => {}
+        }
+    }
+    arrows
+}
+
+/// What `drawn` gets wrong against `real`: arrows it lacks and arrows it has that do not exist.
+fn differences(real: &BTreeSet<Arrow>, drawn: &BTreeSet<Arrow>) -> Vec<String> {
+    let missing = real
+        .difference(drawn)
+        .map(|(f, t)| format!("missing: {f} --> {t}"));
+    let extra = drawn
+        .difference(real)
+        .map(|(f, t)| format!("does not exist: {f} --> {t}"));
+    missing.chain(extra).collect()
+}
+
+/// The layers of the document's table (`| 0 | `model` | … |`), lowest first, each a list of modules.
+fn layers(text: &str) -> Vec<Vec<String>> {
+    let mut layers = Vec::new();
+    for line in text.lines() {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        if cells.len() < 4 || cells[1].parse::<usize>() != Ok(layers.len()) {
+            continue;
+        }
+        let names = cells[2].split(',').map(|m| {
+            let name = m.trim().trim_matches('`');
+            assert_eq!(format!("`{name}`"), m.trim(), "{DOC}: `{line}`");
+            name.to_string()
+        });
+        layers.push(names.collect());
+    }
+    layers
+}
+
+/// Arrows that do not point to a lower layer (or whose ends are in no layer).
+fn upward(arrows: &BTreeSet<Arrow>, layers: &[Vec<String>]) -> Vec<String> {
+    let layer = |m: &str| layers.iter().position(|l| l.iter().any(|x| x == m));
+    let name =
+        |m: &str| layer(m).map_or(format!("{m} (in no layer)"), |l| format!("{m} (layer {l})"));
+    arrows
+        .iter()
+        .filter(|(from, to)| !matches!((layer(from), layer(to)), (Some(f), Some(t)) if t < f))
+        .map(|(from, to)| format!("{} -> {}", name(from), name(to)))
+        .collect()
+}
+
+#[test]
+fn the_document_draws_exactly_the_crate_and_module_graphs() {
+    let doc = fs::read_to_string(repo().join(DOC)).unwrap();
+    let crates = crate_arrows();
+    let modules = module_arrows();
+    for ((from, to), files) in &modules {
+        println!("{from} -> {to}: {}", files.join(", "));
+    }
+    let real: BTreeSet<Arrow> = crates.iter().cloned().chain(modules.into_keys()).collect();
+    println!("{} crate arrows, {} in all", crates.len(), real.len());
+    let wrong = differences(&real, &drawn_arrows(&doc));
     assert!(
         wrong.is_empty(),
-        "arrows that do not point down the layers:\n  {}",
+        "{DOC}'s graphs are not the code's (crate arrows from `cargo metadata`, module arrows from \
+         the `crate::` paths of crates/coin-log):\n  {}",
         wrong.join("\n  ")
     );
 }
 
 #[test]
-fn the_negative_control_catches_an_upward_arrow() {
-    let text = "use crate::model::State;\nuse crate::{record::x, format};\nlet y = crate::scene::defaults::RATE;\n#[cfg(test)]\nmod tests {\n    use crate::cli::x;\n}\n";
+fn every_module_is_in_one_layer_and_no_arrow_runs_back_up() {
+    let layers = layers(&fs::read_to_string(repo().join(DOC)).unwrap());
+    let listed: Vec<&String> = layers.iter().flatten().collect();
+    let unique: BTreeSet<String> = listed.iter().map(|m| m.to_string()).collect();
+    println!("layers: {layers:?}");
+    assert_eq!(listed.len(), unique.len(), "a module in two layers");
+    assert_eq!(unique, modules(), "{DOC}'s layers list exactly the modules");
+    let arrows = module_arrows();
+    let wrong = upward(&arrows.keys().cloned().collect(), &layers);
+    assert!(
+        wrong.is_empty(),
+        "arrows that do not point down the layers of {DOC}:\n  {}",
+        wrong.join("\n  ")
+    );
+}
+
+/// Negative controls of the readers above: grouped, nested and inline paths found, comments and tests
+/// left out; a missing, an extra and an upward arrow caught.
+#[test]
+fn the_checks_catch_a_hidden_a_missing_an_extra_and_an_upward_arrow() {
+    let text = "use crate::model::State; // crate::live\nuse crate::{\n    format::{A, B},\n    record::x,\n};\nlet y = crate::scene::defaults::RATE;\n#[cfg(test)]\nmod tests {\n    use crate::cli::x;\n}\n#[cfg(test)]\nuse crate::verify;\n";
     let refs = crate_references(&without_tests(text));
-    assert_eq!(refs, ["model", "record", "format", "scene"]);
-    // A file of `model` naming `record` would be an arrow from layer 0 to layer 5.
-    assert!(layer_of("record").unwrap() > layer_of("model").unwrap());
-}
-
-#[test]
-fn the_library_never_prints_nor_starts_a_process() {
-    let forbidden = [
-        "println!",
-        "eprintln!",
-        "print!(",
-        "eprint!(",
-        "dbg!(",
-        "std::process::Command",
-        "process::exit",
-    ];
-    let mut found = Vec::new();
-    for (_, path) in library_files() {
-        let text = without_tests(&fs::read_to_string(&path).unwrap());
-        for (n, line) in text.lines().enumerate() {
-            let code = line.split("//").next().unwrap_or("");
-            for f in forbidden {
-                if code.contains(f) {
-                    found.push(format!("{}:{}: `{f}`", path.display(), n + 1));
-                }
-            }
-        }
-    }
-    assert!(found.is_empty(), "{}", found.join("\n"));
-}
-
-/// `println!` panics when stdout is a closed pipe or a full disk; the command line prints only through
-/// `src/cli/output.rs`, whose macros handle both (format.md: Exit codes).
-#[test]
-fn the_command_line_prints_only_through_its_output_module() {
-    let cli = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/cli");
-    let mut files = Vec::new();
-    rust_files(&cli, &mut files);
-    files.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/main.rs"));
-    let mut found = Vec::new();
-    for path in files.iter().filter(|p| !p.ends_with("cli/output.rs")) {
-        let text = without_tests(&fs::read_to_string(path).unwrap());
-        for (n, line) in text.lines().enumerate() {
-            let code = line.split("//").next().unwrap_or("");
-            for f in ["println!", "eprintln!", "print!(", "eprint!("] {
-                // `outln!`/`errln!` do not contain these; `out!(` does not either.
-                if code.contains(f) {
-                    found.push(format!("{}:{}: `{f}`", path.display(), n + 1));
-                }
-            }
-        }
-    }
-    println!("{} files of src/cli checked", files.len());
-    assert!(
-        found.is_empty(),
-        "use out!/outln!/errln! of src/cli/output.rs:\n{}",
-        found.join("\n")
+    assert_eq!(refs, ["model", "format", "record", "scene"]);
+    let arrow = |f: &str, t: &str| (f.to_string(), t.to_string());
+    let real = BTreeSet::from([arrow("record", "format"), arrow("format", "model")]);
+    let drawn = drawn_arrows("```mermaid\nflowchart TD\n    record[\"record: scene → MCAP\"]\n    record --> format & scene\n```\n");
+    assert_eq!(
+        differences(&real, &drawn),
+        [
+            "missing: format --> model",
+            "does not exist: record --> scene"
+        ]
     );
-}
-
-/// Longest function body allowed, in lines (about a screen): longer functions mix stages.
-const LONGEST_FUNCTION: usize = 80;
-
-/// Functions that are tables of data, not logic, and may be longer (file suffix, function name, why).
-const DATA_TABLES: &[(&str, &str, &str)] = &[];
-
-/// (name, first line, length in lines) of every `fn` with a body in `text`, by brace matching outside
-/// strings, chars and comments.
-fn functions(text: &str) -> Vec<(String, usize, usize)> {
-    let lines: Vec<&str> = text.lines().collect();
-    let code: Vec<String> = lines.iter().map(|l| strip_literals(l)).collect();
-    let mut found = Vec::new();
-    let mut i = 0;
-    while i < code.len() {
-        let Some(name) = fn_name(&code[i]) else {
-            i += 1;
-            continue;
-        };
-        let (mut depth, mut opened, mut j) = (0i64, false, i);
-        while j < code.len() {
-            depth += code[j].matches('{').count() as i64 - code[j].matches('}').count() as i64;
-            opened |= code[j].contains('{');
-            if (opened && depth <= 0) || (!opened && code[j].trim_end().ends_with(';')) {
-                break;
-            }
-            j += 1;
-        }
-        if opened {
-            found.push((name, i + 1, j - i + 1));
-            i = j + 1;
-        } else {
-            i += 1;
-        }
-    }
-    found
-}
-
-/// The line without string and char literals and `//` comments (so braces inside them do not count).
-fn strip_literals(line: &str) -> String {
-    let mut out = String::new();
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' => {
-                while let Some(d) = chars.next() {
-                    match d {
-                        '\\' => {
-                            chars.next();
-                        }
-                        '"' => break,
-                        _ => {}
-                    }
-                }
-            }
-            '\'' if chars.peek() == Some(&'{') || chars.peek() == Some(&'}') => {
-                chars.next();
-            }
-            '/' if chars.peek() == Some(&'/') => break,
-            _ => out.push(c),
-        }
-    }
-    out
-}
-
-/// The name of the function a line declares, if it does.
-fn fn_name(line: &str) -> Option<String> {
-    let t = line.trim_start();
-    let t = t
-        .strip_prefix("pub(crate) ")
-        .or_else(|| t.strip_prefix("pub(super) "))
-        .or_else(|| t.strip_prefix("pub "))
-        .unwrap_or(t);
-    let t = t.strip_prefix("const ").unwrap_or(t);
-    let t = t.strip_prefix("unsafe ").unwrap_or(t);
-    let rest = t.strip_prefix("fn ")?;
-    Some(
-        rest.chars()
-            .take_while(|c| c.is_alphanumeric() || *c == '_')
-            .collect(),
-    )
-}
-
-#[test]
-fn no_function_is_longer_than_a_screen() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    let mut long = Vec::new();
-    for path in files {
-        let text = without_tests(&fs::read_to_string(&path).unwrap());
-        for (name, line, len) in functions(&text) {
-            let table = DATA_TABLES
-                .iter()
-                .any(|(file, f, _)| path.ends_with(file) && *f == name);
-            if len > LONGEST_FUNCTION && !table {
-                long.push(format!(
-                    "{}:{line} `{name}` has {len} lines",
-                    path.display()
-                ));
-            }
-        }
-    }
-    assert!(
-        long.is_empty(),
-        "functions over {LONGEST_FUNCTION} lines (split them by stage):\n  {}",
-        long.join("\n  ")
-    );
-}
-
-#[test]
-fn the_function_measure_counts_a_long_function_and_ignores_braces_in_strings() {
-    let body: String = (0..90)
-        .map(|i| format!("    let x{i} = \"{{\";\n"))
-        .collect();
     let text =
-        format!("fn short() {{\n}}\n\npub fn long() {{\n{body}}}\nconst fn c() -> u8 {{ 1 }}\n");
-    let found = functions(&text);
-    let names: Vec<(&str, usize)> = found.iter().map(|(n, _, l)| (n.as_str(), *l)).collect();
-    assert_eq!(names, [("short", 2), ("long", 92), ("c", 1)]);
+        "| layer | modules |\n| --- | --- |\n| 0 | `model` | x |\n| 1 | `format`, `record` | y |\n";
+    let layers = layers(text);
+    assert_eq!(layers, [vec!["model"], vec!["format", "record"]]);
+    assert!(upward(&BTreeSet::from([arrow("format", "model")]), &layers).is_empty());
+    let sideways = BTreeSet::from([arrow("record", "format"), arrow("model", "live")]);
+    assert_eq!(
+        upward(&sideways, &layers),
+        [
+            "model (layer 0) -> live (in no layer)",
+            "record (layer 1) -> format (layer 1)"
+        ]
+    );
 }

@@ -5,6 +5,7 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::process::Process;
 use crate::support::record::{coin_log, exe, listing, read_back};
 use coin_log::format::{ResultMetadata, Termination, RESULT_METADATA_NAME};
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
@@ -226,14 +227,12 @@ fn a_folder_without_write_permission_fails_before_simulating() {
 /// each after its delay; returns the exit code and the process's stderr. Only the first signal must be
 /// delivered: the process may be gone before a later one.
 fn record_and_signal(dir: &Path, signals: &[(&str, Duration)]) -> (Option<i32>, String) {
-    let mut child = Command::new(exe())
-        .args(["record", "long-horizon", "-o", "long.mcap"])
-        .args(LONG)
-        .current_dir(dir)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = Process::start(
+        Command::new(exe())
+            .args(["record", "long-horizon", "-o", "long.mcap"])
+            .args(LONG)
+            .current_dir(dir),
+    );
     let started = Instant::now();
     while listing(dir).is_empty() {
         assert!(
@@ -251,19 +250,9 @@ fn record_and_signal(dir: &Path, signals: &[(&str, Duration)]) -> (Option<i32>, 
             .unwrap();
         assert!(status.success() || i > 0, "kill {signal}");
     }
-    let deadline = Instant::now() + Duration::from_secs(60);
-    let exit = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("the recording did not stop within 60 s of {signals:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let out = child.wait_with_output().unwrap();
-    (exit.code(), stderr(&out))
+    // Within 60 s of the signals.
+    let out = child.wait_within(Duration::from_secs(60));
+    (out.status.code(), out.stderr)
 }
 
 /// SIGTERM (a service manager, `kill`) and SIGHUP (the terminal closed) finish the file like Ctrl-C:

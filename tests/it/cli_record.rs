@@ -3,10 +3,11 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::process::Process;
 use crate::support::record::{coin_log, exe, listing, read_back};
 use crate::support::repo;
 use coin_log::format::{ResultMetadata, RESULT_METADATA_NAME};
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 const VALID: &str = r#"description = "test"
@@ -371,24 +372,22 @@ fn the_scenes_command_lists_and_shows_every_built_in() {
 #[test]
 fn ctrl_c_finishes_the_file_marked_interrupted() {
     let dir = tempfile::tempdir().unwrap();
-    let mut child = Command::new(exe())
-        .args([
-            "record",
-            "long-horizon",
-            "--rate",
-            "1000",
-            "--duration",
-            "100000",
-            "--integrator",
-            "rk4",
-            "-o",
-            "long.mcap",
-        ])
-        .current_dir(dir.path())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = Process::start(
+        Command::new(exe())
+            .args([
+                "record",
+                "long-horizon",
+                "--rate",
+                "1000",
+                "--duration",
+                "100000",
+                "--integrator",
+                "rk4",
+                "-o",
+                "long.mcap",
+            ])
+            .current_dir(dir.path()),
+    );
     // Wait for the temporary file: the signal handler is installed right after it is created.
     let started = Instant::now();
     while listing(dir.path()).is_empty() {
@@ -404,23 +403,14 @@ fn ctrl_c_finishes_the_file_marked_interrupted() {
         .status()
         .unwrap();
     assert!(status.success());
-    let deadline = Instant::now() + Duration::from_secs(60);
-    let exit = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("the recording did not stop within 60 s of SIGINT");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let out = child.wait_with_output().unwrap();
+    // Within 60 s of SIGINT.
+    let out = child.wait_within(Duration::from_secs(60));
+    let exit = out.status;
     println!(
         "exit {:?}, stdout:\n{}stderr: {}",
         exit.code(),
-        String::from_utf8_lossy(&out.stdout),
-        stderr(&out)
+        out.stdout,
+        out.stderr
     );
     assert_eq!(exit.code(), Some(130));
     assert_eq!(listing(dir.path()), vec!["long.mcap".to_string()]);

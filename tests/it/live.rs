@@ -7,15 +7,14 @@
 // Helpers outside #[test] functions: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use super::support::process::Process;
 use super::support::record::{exe, read_back, ReadBack};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, Read};
 use std::net::TcpStream;
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc::{channel, Receiver};
-use std::sync::{Arc, Mutex};
+use std::process::Command;
+use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 use tungstenite::client::IntoClientRequest;
 use tungstenite::http::HeaderValue;
@@ -26,44 +25,16 @@ const DEADLINE: Duration = Duration::from_secs(60);
 
 /// A running `coin-log live` with its stderr lines as they come.
 struct LiveProcess {
-    child: Child,
+    process: Process,
     lines: Receiver<String>,
-    stderr: Arc<Mutex<String>>,
-    stdout: Option<std::thread::JoinHandle<String>>,
 }
 
 impl LiveProcess {
     fn start(dir: &Path, args: &[&str]) -> Self {
-        let mut child = Command::new(exe())
-            .arg("live")
-            .args(args)
-            .current_dir(dir)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("coin-log runs");
-        let (tx, lines) = channel();
-        let stderr = Arc::new(Mutex::new(String::new()));
-        let (pipe, all) = (child.stderr.take().unwrap(), Arc::clone(&stderr));
-        std::thread::spawn(move || {
-            for line in BufReader::new(pipe).lines() {
-                let line = line.unwrap_or_default();
-                all.lock().unwrap().push_str(&format!("{line}\n"));
-                let _ = tx.send(line);
-            }
-        });
-        let mut out = child.stdout.take().unwrap();
-        let stdout = std::thread::spawn(move || {
-            let mut text = String::new();
-            let _ = out.read_to_string(&mut text);
-            text
-        });
-        Self {
-            child,
-            lines,
-            stderr,
-            stdout: Some(stdout),
-        }
+        let (process, lines) = Process::start_with_stderr_lines(
+            Command::new(exe()).arg("live").args(args).current_dir(dir),
+        );
+        Self { process, lines }
     }
 
     /// Waits for a stderr line containing `needle`; returns it.
@@ -91,40 +62,19 @@ impl LiveProcess {
     }
 
     fn stderr(&self) -> String {
-        self.stderr.lock().unwrap().clone()
+        self.process.stderr()
     }
 
     /// Sends `signal` (INT, TERM) and waits for the exit code and stdout.
     fn signal_and_wait(&mut self, signal: &str) -> (i32, String) {
         let status = Command::new("kill")
             .arg(format!("-{signal}"))
-            .arg(self.child.id().to_string())
+            .arg(self.process.id().to_string())
             .status()
             .expect("kill runs");
         assert!(status.success(), "kill -{signal} failed");
-        self.wait()
-    }
-
-    fn wait(&mut self) -> (i32, String) {
-        let start = Instant::now();
-        loop {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                let out = self.stdout.take().unwrap().join().unwrap();
-                return (status.code().unwrap_or(-1), out);
-            }
-            if start.elapsed() > DEADLINE {
-                let _ = self.child.kill();
-                panic!("coin-log live did not exit; stderr:\n{}", self.stderr());
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-    }
-}
-
-impl Drop for LiveProcess {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        let out = self.process.wait_within(DEADLINE);
+        (out.code(), out.stdout)
     }
 }
 
@@ -417,9 +367,8 @@ fn viewer_round(encoding: &str) {
     );
     let mut ws = connect(&url, "foxglove.sdk.v1").unwrap();
     let mut seen = Seen::default();
-    let stderr = Arc::clone(&live.stderr);
     read_until(&mut ws, &mut seen, |_| {
-        stderr.lock().unwrap().contains("the run is over")
+        live.stderr().contains("the run is over")
     });
     // Drain what is still queued: the final messages of every topic.
     let quiet = Instant::now();

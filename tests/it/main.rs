@@ -5,6 +5,23 @@
 //!
 //! proptest keeps the failing cases of a property test in `tests/proptest-regressions/<module>.txt` (the
 //! folder beside the one holding this `main.rs`); commit such a file when it appears.
+//!
+//! The modules that read files with Python, Node or Rerun are built with the cargo feature
+//! `external-readers` only (`scripts/test` installs the tools and turns it on), so that `cargo test` needs
+//! nothing but cargo.
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "a test prints its evidence (measured values beside their bounds)"
+)]
+#![allow(
+    clippy::disallowed_methods,
+    reason = "the tests run the binary and the independent readers as child processes"
+)]
+#![allow(
+    clippy::too_many_lines,
+    reason = "a test is one story: set-up, run, every assertion; the length rule is for the code it tests"
+)]
 
 mod support;
 
@@ -25,6 +42,7 @@ mod cli_words;
 mod datasets;
 mod dissipation;
 mod events;
+#[cfg(feature = "external-readers")]
 mod external_readers;
 mod formulas;
 mod foxglove;
@@ -34,10 +52,12 @@ mod invariants;
 mod linearisation;
 #[cfg(feature = "live")]
 mod live;
+#[cfg(feature = "external-readers")]
 mod other_writers;
 mod params;
 mod properties;
 mod protobuf;
+#[cfg(feature = "external-readers")]
 mod protobuf_readers;
 mod readme;
 mod record_roundtrip;

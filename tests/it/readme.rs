@@ -1,11 +1,13 @@
 //! The documentation's example sessions are real: every ```console block of README.md and docs/*.md is run
-//! and its output compared with what the block shows, so the examples cannot drift from the tool.
+//! by trycmd, and what each command prints is compared with what the block shows, so the examples cannot
+//! drift from the tool.
 //!
-//! In a block, a line `$ coin-log ARGS` is a command (run in a fresh folder holding links to `datasets/` and
-//! `schemas/`, one folder per block so later commands see earlier commands' files); the lines up to the next
-//! command are its expected standard output, line for line. In an expected line, `…` stands for any text
-//! (an elision, or a value that depends on the machine such as the wall time); a line that is only `…`
-//! stands for any number of lines.
+//! In a block, a line `$ coin-log ARGS` is a command, run in a fresh folder per block (holding links to
+//! `datasets/` and `schemas/`; later commands of a block see earlier commands' files). The lines up to the
+//! next command are its standard output and error, line for line, and it must exit 0 (unless a line
+//! `? CODE` follows the command); they end with an empty line, trycmd's mark of the last line's newline.
+//! In an expected line `[..]` stands for any text (an elision, or a value that depends on the machine
+//! such as the wall time); a line `...` stands for any number of lines.
 // Helpers outside #[test] functions read the repository's own files: a failure to read is a failed test.
 #![allow(clippy::unwrap_used)]
 
@@ -13,173 +15,117 @@ use crate::support::record::exe;
 use crate::support::repo;
 use std::fs;
 use std::path::Path;
-use std::process::Command;
+use std::time::Duration;
 
-/// One command of a block and the output it should print.
-#[derive(Debug)]
-struct Example {
-    source: String,
-    args: Vec<String>,
-    expected: Vec<String>,
-}
-
-/// The ```console blocks of a Markdown text, each as its list of examples.
-fn console_blocks(source: &str, text: &str) -> Vec<Vec<Example>> {
-    let mut blocks = Vec::new();
-    let mut current: Option<Vec<Example>> = None;
-    for (n, line) in text.lines().enumerate() {
-        let fence = line.trim_start();
-        match &mut current {
-            None if fence == "```console" => current = Some(Vec::new()),
-            None => {}
-            Some(block) if fence == "```" => {
-                blocks.push(std::mem::take(block));
-                current = None;
-            }
-            Some(block) => match line.strip_prefix("$ ") {
-                Some(command) => {
-                    let mut words = command.split_whitespace().map(str::to_string);
-                    assert_eq!(
-                        words.next().as_deref(),
-                        Some("coin-log"),
-                        "{source}:{}: example commands start with `coin-log`",
-                        n + 1
-                    );
-                    block.push(Example {
-                        source: format!("{source}:{}", n + 1),
-                        args: words.collect(),
-                        expected: Vec::new(),
-                    });
-                }
-                None => match block.last_mut() {
-                    Some(example) => example.expected.push(line.to_string()),
-                    None => panic!("{source}:{}: output before any `$ coin-log` line", n + 1),
-                },
-            },
-        }
-    }
-    blocks
-}
-
-/// Whether `actual` matches `expected`, where `…` in `expected` stands for any text.
-fn line_matches(expected: &str, actual: &str) -> bool {
-    let parts: Vec<&str> = expected.trim_end().split('…').collect();
-    let actual = actual.trim_end();
-    let (first, rest) = (parts[0], &parts[1..]);
-    let Some(mut tail) = actual.strip_prefix(first) else {
-        return false;
-    };
-    for (i, part) in rest.iter().enumerate() {
-        let last = i + 1 == rest.len();
-        if last {
-            return tail.ends_with(part);
-        }
-        match tail.find(part) {
-            Some(at) => tail = &tail[at + part.len()..],
-            None => return false,
-        }
-    }
-    tail.is_empty()
-}
-
-/// Whether the lines match, a lone `…` line standing for any number of lines.
-fn lines_match(expected: &[String], actual: &[&str]) -> bool {
-    match expected.split_first() {
-        None => actual.is_empty(),
-        Some((e, rest)) if e.trim() == "…" => {
-            (0..=actual.len()).any(|skip| lines_match(rest, &actual[skip..]))
-        }
-        Some((e, rest)) => {
-            !actual.is_empty() && line_matches(e, actual[0]) && lines_match(rest, &actual[1..])
-        }
-    }
-}
-
+/// README.md, then docs/*.md sorted: (name, text).
 fn documents() -> Vec<(String, String)> {
-    let root = repo();
-    let mut docs = vec![("README.md".to_string(), root.join("README.md"))];
-    let mut extra: Vec<_> = fs::read_dir(root.join("docs"))
+    let mut names = vec!["README.md".to_string()];
+    let mut docs: Vec<String> = fs::read_dir(repo().join("docs"))
         .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".md"))
+        .map(|name| format!("docs/{name}"))
         .collect();
-    extra.sort();
-    for p in extra {
-        let name = format!("docs/{}", p.file_name().unwrap().to_string_lossy());
-        docs.push((name, p));
-    }
-    docs.into_iter()
-        .map(|(name, p)| (name, fs::read_to_string(p).unwrap()))
+    docs.sort();
+    names.extend(docs);
+    names
+        .into_iter()
+        .map(|name| (name.clone(), fs::read_to_string(repo().join(name)).unwrap()))
         .collect()
 }
 
-fn link(from: &Path, to: &Path) {
-    #[cfg(unix)]
-    std::os::unix::fs::symlink(from, to).unwrap();
-    #[cfg(not(unix))]
-    let _ = (from, to);
+/// Writes each ```console block of the document `name` to `dir` as `<name>-<line>.md` (`/` and `.` of the
+/// name as `-`), every other line of the document left blank (so trycmd's line numbers are the
+/// document's), with its working folder `<name>-<line>.in/`. Returns how many commands the blocks hold.
+fn write_blocks(name: &str, text: &str, dir: &Path) -> usize {
+    let lines: Vec<&str> = text.lines().collect();
+    let (mut commands, mut open) = (0, None);
+    for (n, line) in lines.iter().enumerate() {
+        match (open, line.trim()) {
+            (None, "```console") => open = Some(n),
+            (Some(_), l) if l.starts_with("$ ") => {
+                // trycmd would skip a program it does not know.
+                assert!(
+                    l.starts_with("$ coin-log "),
+                    "{name}:{}: example commands start with `coin-log`",
+                    n + 1
+                );
+                commands += 1;
+            }
+            (Some(first), "```") => {
+                let indent = lines[first].len() - lines[first].trim_start().len();
+                let block: String = (0..lines.len())
+                    .map(|i| match lines[i].get(indent..) {
+                        Some(l) if (first..=n).contains(&i) => format!("{l}\n"),
+                        _ => "\n".to_string(),
+                    })
+                    .collect();
+                let stem = format!("{}-{}", name.replace(['/', '.'], "-"), first + 1);
+                fs::write(dir.join(format!("{stem}.md")), block).unwrap();
+                let folder = dir.join(format!("{stem}.in"));
+                fs::create_dir(&folder).unwrap();
+                for shared in ["datasets", "schemas"] {
+                    std::os::unix::fs::symlink(repo().join(shared), folder.join(shared)).unwrap();
+                }
+                open = None;
+            }
+            _ => {}
+        }
+    }
+    commands
+}
+
+/// Runs the blocks written in `dir` with trycmd: each wrong output is shown on stderr, and the run panics
+/// if there was one.
+fn run_blocks(dir: &Path) {
+    trycmd::TestCases::new()
+        .register_bin("coin-log", exe())
+        // A hang detector for each command, never a speed test.
+        .timeout(Duration::from_secs(60))
+        .case(dir.join("*.md"))
+        .run();
 }
 
 #[test]
 fn every_console_example_in_the_docs_prints_what_it_shows() {
-    let mut run = 0;
+    let dir = tempfile::tempdir().unwrap();
+    let mut commands = 0;
     for (name, text) in documents() {
-        for block in console_blocks(&name, &text) {
-            let dir = tempfile::tempdir().unwrap();
-            link(&repo().join("datasets"), &dir.path().join("datasets"));
-            link(&repo().join("schemas"), &dir.path().join("schemas"));
-            for example in block {
-                let out = Command::new(exe())
-                    .args(&example.args)
-                    .current_dir(dir.path())
-                    .output()
-                    .unwrap();
-                let stdout = String::from_utf8_lossy(&out.stdout);
-                let actual: Vec<&str> = stdout.lines().collect();
-                assert!(
-                    lines_match(&example.expected, &actual),
-                    "{}: `coin-log {}` printed (exit {:?}):\n{stdout}\nstderr:\n{}\nbut the document shows:\n{}",
-                    example.source,
-                    example.args.join(" "),
-                    out.status.code(),
-                    String::from_utf8_lossy(&out.stderr),
-                    example.expected.join("\n")
-                );
-                run += 1;
-            }
-        }
+        commands += write_blocks(&name, &text, dir.path());
     }
-    println!("{run} documented commands run");
+    println!("{commands} documented commands");
     assert!(
-        run >= 2,
+        commands >= 2,
         "the README's record and verify examples are console blocks"
     );
+    run_blocks(dir.path());
 }
 
+/// The negative control: the README's first example with a value changed (the last digit of its first
+/// line with a digit), with its last line missing, and with a line added each fail.
 #[test]
-fn the_matcher_rejects_a_changed_value_and_a_missing_line() {
-    assert!(line_matches(
-        "file  x.mcap (1.1 MiB)",
-        "file  x.mcap (1.1 MiB)"
-    ));
-    assert!(line_matches(
-        "wall time  … s (… messages/s)",
-        "wall time  0.03 s (99 messages/s)"
-    ));
-    assert!(line_matches(
-        "energy  pass  1e-16  …",
-        "energy  pass  1e-16  drift is ..."
-    ));
-    // Negative controls: a value the tool does not print, a missing line, an extra line.
-    assert!(!line_matches(
-        "file  x.mcap (1.2 MiB)",
-        "file  x.mcap (1.1 MiB)"
-    ));
-    let expected = vec!["a".to_string(), "b".to_string()];
-    assert!(lines_match(&expected, &["a", "b"]));
-    assert!(!lines_match(&expected, &["a"]));
-    assert!(!lines_match(&expected, &["a", "b", "c"]));
-    let with_gap = vec!["a".to_string(), "…".to_string(), "c".to_string()];
-    assert!(lines_match(&with_gap, &["a", "x", "y", "c"]));
-    assert!(!lines_match(&with_gap, &["a", "x"]));
+fn an_example_with_a_changed_missing_or_extra_line_fails() {
+    let (_, readme) = &documents()[0];
+    let start = readme.find("```console\n").unwrap();
+    let end = start + readme[start..].find("\n\n```\n").unwrap();
+    let block: Vec<String> = readme[start..end].lines().map(str::to_string).collect();
+    let (command, output) = (&block[1], &block[2..]);
+    assert!(output.iter().all(|l| !l.starts_with("$ ")), "one command");
+    let mut changed = output.to_vec();
+    let line = changed
+        .iter_mut()
+        .find(|l| !l.contains("[..]") && l.contains(|c: char| c.is_ascii_digit()))
+        .unwrap();
+    let at = line.rfind(|c: char| c.is_ascii_digit()).unwrap();
+    let digit = (line.as_bytes()[at] - b'0' + 1) % 10;
+    line.replace_range(at..=at, &digit.to_string());
+    let missing = output[..output.len() - 1].to_vec();
+    let extra = [output, &["extra".to_string()]].concat();
+    let dir = tempfile::tempdir().unwrap();
+    for (i, lines) in [changed, missing, extra].iter().enumerate() {
+        let text = format!("```console\n{command}\n{}\n\n```\n", lines.join("\n"));
+        write_blocks(&format!("wrong-{i}"), &text, dir.path());
+    }
+    let failed = std::panic::catch_unwind(|| run_blocks(dir.path())).unwrap_err();
+    assert_eq!(*failed.downcast::<String>().unwrap(), "3 of 3 tests failed");
 }

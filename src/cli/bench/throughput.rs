@@ -118,6 +118,10 @@ fn record_and_verify(
 }
 
 /// Runs a child `coin-log` and returns its parsed JSON stdout and wall time; it must exit 0.
+#[allow(
+    clippy::disallowed_methods,
+    reason = "each measured run is its own process, for its own peak memory"
+)]
 fn child_json(exe: &Path, args: &[String]) -> anyhow::Result<(serde_json::Value, f64)> {
     let command = format!("{} {}", exe.display(), args.join(" "));
     let start = Instant::now();

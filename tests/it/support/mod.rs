@@ -1,12 +1,14 @@
 //! The helpers of the integration tests: [`vectors`] and [`physics`] for the model tests, [`newton_euler`]
 //! (a second, independent model), [`writers`] (MCAP files written straight from the model, and rewritten
-//! with a defect), [`record`] (reading files back, running the binary), [`other_writers`] (recordings
-//! rewritten by the Python and TypeScript MCAP writers); here the repository's paths and an output that
-//! fails like a full disk.
+//! with a defect), [`record`] (reading files back, running the binary), [`process`] (child processes
+//! under a deadline), `other_writers` (recordings rewritten by the Python and TypeScript MCAP writers;
+//! feature `external-readers`); here the repository's paths and an output that fails like a full disk.
 
 pub mod newton_euler;
+#[cfg(feature = "external-readers")]
 pub mod other_writers;
 pub mod physics;
+pub mod process;
 pub mod record;
 pub mod vectors;
 pub mod writers;

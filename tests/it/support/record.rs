@@ -3,13 +3,13 @@
 // do not reach them; a failed unwrap or expect here is a failed test, which is what we want.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use super::process::run_within;
 use super::repo;
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
-use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::{Command, Output};
+use std::time::Duration;
 
 /// One message as read back.
 #[derive(Debug, Clone)]
@@ -190,43 +190,8 @@ pub const HANG_DEADLINE: Duration = Duration::from_secs(20);
 /// Runs the binary with `args` in the repository root like [`coin_log_text`], but kills it and fails the
 /// test if it has not exited within `deadline`.
 pub fn coin_log_within(deadline: Duration, args: &[&str]) -> (i32, String, String) {
-    let mut child = Command::new(exe())
-        .args(args)
-        .current_dir(repo())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("coin-log runs");
-    // Drained on threads, so that a child filling a pipe cannot stall.
-    let drain = |mut pipe: Box<dyn Read + Send>| {
-        std::thread::spawn(move || {
-            let mut text = Vec::new();
-            pipe.read_to_end(&mut text).expect("pipe readable");
-            String::from_utf8_lossy(&text).into_owned()
-        })
-    };
-    let out = drain(Box::new(child.stdout.take().expect("stdout piped")));
-    let err = drain(Box::new(child.stderr.take().expect("stderr piped")));
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("child waitable") {
-            break status;
-        }
-        if start.elapsed() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!(
-                "`coin-log {}` still ran after {deadline:?}: it hangs",
-                args.join(" ")
-            );
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    (
-        status.code().unwrap_or(-1),
-        out.join().expect("stdout thread"),
-        err.join().expect("stderr thread"),
-    )
+    let done = run_within(Command::new(exe()).args(args).current_dir(repo()), deadline);
+    (done.code(), done.stdout, done.stderr)
 }
 
 /// The top-level records of the MCAP file `bytes`, in order: (opcode, offset, body length), up to the

@@ -14,15 +14,19 @@ use coin_log::format::{
     log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
-use coin_log::integrate::{
-    run_method, Flow, Method, MethodConfig, NoEvents, Rk4, RunEnd, RunSettings,
-};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunEnd, RunSettings};
 use coin_log::model::{
     centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams, Dynamics,
     State, Steady, SteadyKind, STATE_LEN,
 };
-use coin_log::record::{Foxglove3d, FoxgloveBatch};
-use coin_log::simulation::{simulate, CoinEvents};
+use coin_log::simulation::CoinEvents;
+// `record_circle`'s (the independent readers' tests).
+#[cfg(feature = "external-readers")]
+use coin_log::{
+    integrate::Rk4,
+    record::{Foxglove3d, FoxgloveBatch},
+    simulation::simulate,
+};
 use std::collections::BTreeMap;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
@@ -217,7 +221,8 @@ pub fn write_message<W: Write + Seek>(
     .unwrap();
 }
 
-/// How the helper damages a file, for negative controls.
+/// How the helper damages a file, for negative controls (the independent readers' tests).
+#[cfg(feature = "external-readers")]
 #[derive(Clone, Copy, PartialEq)]
 pub enum Damage {
     None,
@@ -229,6 +234,7 @@ pub enum Damage {
 
 /// Records a steady circle (θ₀ = 0.3, ω_Z = 1, + branch) for `duration` at 100 samples per time unit with
 /// the library's pieces (model, rk4, messages, Foxglove output) straight into an MCAP file.
+#[cfg(feature = "external-readers")]
 pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
     let coin = Coin::new(CoinParams::unit_disk());
     let steady = Steady::new(

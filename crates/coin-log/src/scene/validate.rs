@@ -22,7 +22,7 @@ fn quoted(s: &str) -> String {
     format!("{s:?}")
 }
 
-/// Longest scene description [characters]: one line of `coin-log scenes` and `info` (the longest
+/// Longest scene description, in characters: one line of `coin-log scenes` and `info` (the longest
 /// built-in has 379).
 pub const DESCRIPTION_MAX_CHARS: usize = 1000;
 
