@@ -37,6 +37,8 @@ mod params;
 mod properties;
 mod protobuf;
 mod protobuf_readers;
+#[cfg(target_os = "linux")]
+mod read_budget;
 mod readme;
 mod record_roundtrip;
 mod rk4_order;

@@ -1,13 +1,17 @@
 //! The helpers of the integration tests: [`vectors`] and [`physics`] for the model tests, [`newton_euler`]
 //! (a second, independent model), [`writers`] (MCAP files written straight from the model, and rewritten
 //! with a defect), [`record`] (reading files back, running the binary), [`other_writers`] (recordings
-//! rewritten by the Python and TypeScript MCAP writers); here the repository's paths and an output that
-//! fails like a full disk.
+//! rewritten by the Python and TypeScript MCAP writers), [`crafted`] (files crafted to cost a reader
+//! memory) and [`rss`] (a child's peak memory); here the repository's paths and an output that fails like
+//! a full disk.
 
+pub mod crafted;
 pub mod newton_euler;
 pub mod other_writers;
 pub mod physics;
 pub mod record;
+#[cfg(target_os = "linux")]
+pub mod rss;
 pub mod vectors;
 pub mod writers;
 
