@@ -343,8 +343,7 @@ pub trait Record<'a>: Sized {
     /// [`TooLong`] if a field does not fit its length prefix.
     fn encode_record(&self, out: &mut Vec<u8>) -> Result<(), TooLong> {
         let at = out.len();
-        out.push(Self::OPCODE);
-        out.extend_from_slice(&[0; 8]);
+        out.extend_from_slice(&[Self::OPCODE, 0, 0, 0, 0, 0, 0, 0, 0]);
         self.encode_body(out)?;
         let len = (out.len() - at) as u64 - PREFIX_LEN;
         out[at + 1..at + 9].copy_from_slice(&len.to_le_bytes());

@@ -102,7 +102,9 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     let mut out = records.summary;
     out.file_len = file_len;
     out.library = library;
-    out.channels.sort_by_key(|c| c.id);
+    out.channels = std::mem::take(&mut records.channels)
+        .into_values()
+        .collect();
     for c in &mut out.channels {
         c.messages = records.counts.get(&c.id).copied().unwrap_or(0);
         if let Some(name) = records.schemas.get(&c.schema_id_of) {
@@ -181,6 +183,8 @@ fn summary_section(file: &mut std::fs::File, file_len: u64) -> Result<Option<Sec
 struct SummaryRecords {
     summary: Summary,
     statistics: bool,
+    /// The first record of each channel id.
+    channels: BTreeMap<u16, ChannelSummary>,
     schemas: BTreeMap<u16, String>,
     counts: BTreeMap<u16, u64>,
     metadata_indexes: Vec<(u64, u64)>,
@@ -207,16 +211,14 @@ impl SummaryRecords {
             }
             op::CHANNEL => {
                 let c = Channel::parse_body(body)?;
-                if !self.summary.channels.iter().any(|ch| ch.id == c.id) {
-                    self.summary.channels.push(ChannelSummary {
-                        id: c.id,
-                        topic: c.topic,
-                        schema_name: String::new(),
-                        message_encoding: c.message_encoding,
-                        messages: 0,
-                        schema_id_of: c.schema_id,
-                    });
-                }
+                self.channels.entry(c.id).or_insert(ChannelSummary {
+                    id: c.id,
+                    topic: c.topic,
+                    schema_name: String::new(),
+                    message_encoding: c.message_encoding,
+                    messages: 0,
+                    schema_id_of: c.schema_id,
+                });
             }
             op::STATISTICS => {
                 let s = Statistics::parse_body(body)?;
