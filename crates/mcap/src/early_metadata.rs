@@ -306,55 +306,61 @@ mod tests {
     use super::*;
     use std::io::Cursor as IoCursor;
 
-    fn record(opcode: u8, body: &[u8]) -> Vec<u8> {
-        let mut r = vec![opcode];
-        r.extend_from_slice(&(body.len() as u64).to_le_bytes());
-        r.extend_from_slice(body);
-        r
+    use mcap::records::{DataEnd, Header};
+    use std::collections::BTreeMap;
+
+    fn encoded<'a>(r: &impl Record<'a>) -> Vec<u8> {
+        let mut out = Vec::new();
+        r.encode_record(&mut out).unwrap();
+        out
     }
 
-    fn string(s: &str) -> Vec<u8> {
-        let mut b = (s.len() as u32).to_le_bytes().to_vec();
-        b.extend_from_slice(s.as_bytes());
-        b
+    fn metadata() -> Vec<u8> {
+        encoded(&Metadata {
+            name: "coin-log".into(),
+            metadata: BTreeMap::from([("k".into(), "v".into())]),
+        })
     }
 
-    fn metadata(name: &str, key: &str, value: &str) -> Vec<u8> {
-        let mut entries = string(key);
-        entries.extend(string(value));
-        let mut body = string(name);
-        body.extend((entries.len() as u32).to_le_bytes());
-        body.extend(entries);
-        record(op::METADATA, &body)
+    fn index(offset: u64, length: u64) -> Vec<u8> {
+        let name = "coin-log".into();
+        encoded(&MetadataIndex {
+            offset,
+            length,
+            name,
+        })
+    }
+
+    fn footer(summary_start: u64) -> Vec<u8> {
+        let mut f = encoded(&Footer {
+            summary_start,
+            ..Footer::default()
+        });
+        f.extend(MAGIC);
+        f
     }
 
     /// Magic, header, a fake chunk of `chunk` bytes, a metadata record, DataEnd; with a summary holding a
     /// metadata index when `indexed`, then the footer and the end magic.
     fn file(chunk: usize, indexed: bool) -> (Vec<u8>, u64) {
         let mut f = MAGIC.to_vec();
-        let mut header = string("");
-        header.extend(string("test"));
-        f.extend(record(op::HEADER, &header));
-        f.extend(record(op::CHUNK, &vec![0u8; chunk]));
+        f.extend(encoded(&Header {
+            profile: String::new(),
+            library: "test".into(),
+        }));
+        f.push(op::CHUNK);
+        f.extend((chunk as u64).to_le_bytes());
+        f.extend(vec![0u8; chunk]);
         let at = f.len() as u64;
-        let m = metadata("coin-log", "k", "v");
+        let m = metadata();
         let m_len = m.len() as u64;
         f.extend(m);
-        f.extend(record(op::DATA_END, &[0; 4]));
+        f.extend(encoded(&DataEnd::default()));
         let summary_start = f.len() as u64;
         if indexed {
-            let mut idx = at.to_le_bytes().to_vec();
-            idx.extend(m_len.to_le_bytes());
-            idx.extend(string("coin-log"));
-            f.extend(record(op::METADATA_INDEX, &idx));
+            f.extend(index(at, m_len));
         }
-        let mut footer = if indexed { summary_start } else { 0 }
-            .to_le_bytes()
-            .to_vec();
-        footer.extend(0u64.to_le_bytes());
-        footer.extend(0u32.to_le_bytes());
-        f.extend(record(op::FOOTER, &footer));
-        f.extend(MAGIC);
+        f.extend(footer(if indexed { summary_start } else { 0 }));
         (f, at)
     }
 
@@ -411,17 +417,11 @@ mod tests {
         let tail = f.len() - 8 - FOOTER_LEN as usize;
         f.truncate(tail);
         let summary_start = f.len() as u64;
-        let m_len = metadata("coin-log", "k", "v").len() as u64;
+        let m_len = metadata().len() as u64;
         for _ in 0..1000 {
-            let mut idx = at.to_le_bytes().to_vec();
-            idx.extend(m_len.to_le_bytes());
-            idx.extend(string("coin-log"));
-            f.extend(record(op::METADATA_INDEX, &idx));
+            f.extend(index(at, m_len));
         }
-        let mut footer = summary_start.to_le_bytes().to_vec();
-        footer.extend([0u8; 12]);
-        f.extend(record(op::FOOTER, &footer));
-        f.extend(MAGIC);
+        f.extend(footer(summary_start));
         let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
         assert!(p.indexed);
         assert_eq!(p.metadata.len(), 1);

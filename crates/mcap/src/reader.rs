@@ -141,29 +141,6 @@ pub struct Structure {
     pub uncompressed_bytes: u64,
 }
 
-/// What a schema or channel record is, given the ones seen before with the same id.
-enum Definition {
-    /// The first record with this id.
-    New,
-    /// The same bytes again (summary or chunk repeats are allowed).
-    Repeated,
-    /// Different bytes under an id already defined.
-    Different,
-}
-
-/// Classifies the record `data` with `id` against `seen` (by digest), remembering it when new.
-fn definition(seen: &mut BTreeMap<u16, Digest>, id: u16, data: &[u8]) -> Definition {
-    let d = Digest::of(data);
-    match seen.get(&id) {
-        Some(earlier) if *earlier != d => Definition::Different,
-        Some(_) => Definition::Repeated,
-        None => {
-            seen.insert(id, d);
-            Definition::New
-        }
-    }
-}
-
 /// Per channel, the digest of the (log time, offset) entries its message index must list.
 #[derive(Debug, Default, Clone, Copy)]
 struct IndexDigest {
@@ -174,62 +151,35 @@ struct IndexDigest {
 /// One chunk while it and its message indexes are read.
 #[derive(Debug)]
 struct ChunkBook {
-    start: u64,
-    length: u64,
-    header: ChunkHeader,
+    /// The chunk index entry the chunk and its message indexes make, to compare with the summary's.
+    index: ChunkIndex,
     /// Offset of the next record in the decompressed records.
     offset: u64,
     min_time: Option<u64>,
     max_time: u64,
     per_channel: BTreeMap<u16, IndexDigest>,
-    index_offsets: BTreeMap<u16, u64>,
-    index_length: u64,
 }
 
-/// The digest a chunk and its chunk index must both give.
-#[allow(clippy::too_many_arguments)]
-fn chunk_digest(
-    start: u64,
-    length: u64,
-    (start_time, end_time): (u64, u64),
-    compression: &str,
-    (compressed, uncompressed): (u64, u64),
-    index_offsets: &BTreeMap<u16, u64>,
-    index_length: u64,
-) -> Digest {
+/// The digest of a chunk index entry (the chunk's own, or a chunk index record's).
+fn index_digest(i: &ChunkIndex) -> Digest {
     let mut d = Digest::default();
     for v in [
-        start,
-        length,
-        start_time,
-        end_time,
-        Digest::of(compression.as_bytes()).0,
-        compressed,
-        uncompressed,
+        i.chunk_start_offset,
+        i.chunk_length,
+        i.message_start_time,
+        i.message_end_time,
+        Digest::of(i.compression.as_bytes()).0,
+        i.compressed_size,
+        i.uncompressed_size,
     ] {
         d.push(v);
     }
-    for (c, o) in index_offsets {
+    for (c, o) in &i.message_index_offsets {
         d.push(u64::from(*c));
         d.push(*o);
     }
-    d.push(index_length);
+    d.push(i.message_index_length);
     d
-}
-
-impl ChunkBook {
-    fn index_digest(&self) -> Digest {
-        let h = &self.header;
-        chunk_digest(
-            self.start,
-            self.length,
-            (h.message_start_time, h.message_end_time),
-            &h.compression,
-            (h.compressed_size, h.uncompressed_size),
-            &self.index_offsets,
-            self.index_length,
-        )
-    }
 }
 
 #[derive(Debug, Default)]
@@ -643,33 +593,28 @@ impl Book {
         let Some(chunk) = self.chunk.take() else {
             return;
         };
-        let (s, e) = (
-            chunk.header.message_start_time,
-            chunk.header.message_end_time,
-        );
+        let (i, start) = (&chunk.index, chunk.index.chunk_start_offset);
+        let (s, e) = (i.message_start_time, i.message_end_time);
         if chunk.min_time.is_some_and(|t| t != s)
             || (chunk.min_time.is_some() && chunk.max_time != e)
         {
             let (a, b) = (chunk.min_time.unwrap_or(0), chunk.max_time);
             self.problem(|| {
-                format!("chunk at byte {}: header says messages span {s}..{e} ns, they span {a}..{b} ns", chunk.start)
+                format!("chunk at byte {start}: header says messages span {s}..{e} ns, they span {a}..{b} ns")
             });
         }
         let missing: Vec<u16> = chunk
             .per_channel
             .keys()
-            .filter(|c| !chunk.index_offsets.contains_key(c))
+            .filter(|c| !i.message_index_offsets.contains_key(c))
             .copied()
             .collect();
         if !missing.is_empty() {
             self.problem(|| {
-                format!(
-                    "chunk at byte {}: no message index for channel(s) {missing:?}",
-                    chunk.start
-                )
+                format!("chunk at byte {start}: no message index for channel(s) {missing:?}")
             });
         }
-        self.chunk_digest.push(chunk.index_digest().0);
+        self.chunk_digest.push(index_digest(&chunk.index).0);
         self.s.chunks += 1;
     }
 
@@ -706,15 +651,21 @@ impl Book {
         self.s.compressed_bytes += header.compressed_size;
         self.s.uncompressed_bytes += header.uncompressed_size;
         self.chunk = Some(ChunkBook {
-            start: at,
-            length: PREFIX_LEN + len,
-            header: header.clone(),
+            index: ChunkIndex {
+                message_start_time: header.message_start_time,
+                message_end_time: header.message_end_time,
+                chunk_start_offset: at,
+                chunk_length: PREFIX_LEN + len,
+                message_index_offsets: BTreeMap::new(),
+                message_index_length: 0,
+                compression: header.compression.clone(),
+                compressed_size: header.compressed_size,
+                uncompressed_size: header.uncompressed_size,
+            },
             offset: 0,
             min_time: None,
             max_time: 0,
             per_channel: BTreeMap::new(),
-            index_offsets: BTreeMap::new(),
-            index_length: 0,
         });
     }
 
@@ -727,13 +678,19 @@ impl Book {
         let mut c = Cursor::new(records);
         while !c.rest().is_empty() {
             let (opcode, data) = c.record().map_err(|e| {
-                let at = self.chunk.as_ref().map_or(0, |c| c.start);
+                let at = self
+                    .chunk
+                    .as_ref()
+                    .map_or(0, |c| c.index.chunk_start_offset);
                 corrupt(format!(
                     "corrupt chunk at byte {at}: a record inside it runs past its end ({e})"
                 ))
                 .after(format!("judged the {} messages read", self.s.messages))
             })?;
-            let (at, offset) = self.chunk.as_ref().map_or((0, 0), |c| (c.start, c.offset));
+            let (at, offset) = self
+                .chunk
+                .as_ref()
+                .map_or((0, 0), |c| (c.index.chunk_start_offset, c.offset));
             if let Some(c) = self.chunk.as_mut() {
                 c.offset += PREFIX_LEN + data.len() as u64;
             }
@@ -824,11 +781,11 @@ impl Book {
             self.problem(|| format!("message index at byte {at} follows no chunk"));
             return Ok(());
         };
-        chunk.index_offsets.insert(channel, at);
-        chunk.index_length += PREFIX_LEN + data.len() as u64;
+        chunk.index.message_index_offsets.insert(channel, at);
+        chunk.index.message_index_length += PREFIX_LEN + data.len() as u64;
         let expected = chunk.per_channel.get(&channel).copied().unwrap_or_default();
         if expected.count != found.count || expected.digest != found.digest {
-            let start = chunk.start;
+            let start = chunk.index.chunk_start_offset;
             self.problem(|| {
                 format!(
                     "message index of channel {channel} for the chunk at byte {start} lists {} \
@@ -885,7 +842,7 @@ impl Book {
     }
 
     /// A schema record: kept at its first definition (for the channels that name it), compared with it
-    /// afterwards.
+    /// afterwards (summary or chunk repeats are allowed; other bytes under its id are not).
     fn schema(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
         let schema: Schema<'_> = parse(data, at)?;
         let (id, d) = (schema.id, Digest::of(data));
@@ -919,8 +876,19 @@ impl Book {
         visitor: &mut impl Visitor,
     ) -> Result<(), ReadError> {
         let c: Channel = parse(data, at)?;
-        match definition(&mut self.channels, c.id, data) {
-            Definition::New => {
+        let d = Digest::of(data);
+        match self.channels.get(&c.id) {
+            Some(earlier) if *earlier != d => {
+                let (id, topic) = (c.id, c.topic);
+                self.problem(|| {
+                    format!(
+                        "channel {id} `{topic}` at byte {at} differs from its earlier definition"
+                    )
+                });
+            }
+            Some(_) => {}
+            None => {
+                self.channels.insert(c.id, d);
                 let schema = self
                     .schemas
                     .get(&c.schema_id)
@@ -931,15 +899,6 @@ impl Book {
                     PREFIX_LEN + data.len() as u64 + schema.map_or(0, |s| s.data.len() as u64);
                 self.kept.charge(size, c.metadata.len(), at)?;
                 visitor.channel(c.id, &c.topic, &c.message_encoding, schema);
-            }
-            Definition::Repeated => {}
-            Definition::Different => {
-                let (id, topic) = (c.id, c.topic);
-                self.problem(|| {
-                    format!(
-                        "channel {id} `{topic}` at byte {at} differs from its earlier definition"
-                    )
-                });
             }
         }
         Ok(())
@@ -982,15 +941,7 @@ impl Book {
     /// A chunk index record: folded into the digest that must match the chunks' own.
     fn chunk_index(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
         let i: ChunkIndex = parse(data, at)?;
-        let d = chunk_digest(
-            i.chunk_start_offset,
-            i.chunk_length,
-            (i.message_start_time, i.message_end_time),
-            &i.compression,
-            (i.compressed_size, i.uncompressed_size),
-            &i.message_index_offsets,
-            i.message_index_length,
-        );
+        let d = index_digest(&i);
         self.chunk_index_digest.push(d.0);
         self.chunk_indexes += 1;
         Ok(())
