@@ -12,9 +12,9 @@
 //!
 //! Ours rather than the `mcap` crate's readers: on the 7 M-message workload of `bench throughput`
 //! (`benches/crate_vs_ours.rs`, its "read" race, file in the page cache, medians of 3 alternating rounds
-//! at load 14 on 2 cores) this reader, every check included, took 2.18 s; the crate's sans-io
-//! `LinearReader` with `mcap::parse_record` on every record, checking nothing beyond CRCs, 3.45 s, and
-//! `mcap::MessageStream` over the file in memory 3.38 s. The crate's `LinearReader` still splits the file
+//! at load 7 on 2 cores) this reader, every check included, took 1.31 s; the crate's sans-io
+//! `LinearReader` with `mcap::parse_record` on every record, checking nothing beyond CRCs, 2.34 s, and
+//! `mcap::MessageStream` over the file in memory 2.33 s. The crate's `LinearReader` still splits the file
 //! into records here; the pipeline, the chunk decompression (bounded) and the record parsing are ours.
 
 use crate::budget::{self, Kept, MAX_RECORD_BYTES};

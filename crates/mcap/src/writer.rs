@@ -5,9 +5,9 @@
 //! Written here rather than taken from `mcap::Writer` (0.26), which streams every record through a
 //! streaming zstd context on the calling thread and cannot hand a finished chunk away and go on. On the
 //! 7 M-message workload of `bench throughput` (`benches/crate_vs_ours.rs`, its "write" race, in memory,
-//! zstd level 1, 1 MiB chunks, medians of 3 alternating rounds at load 14 on 2 cores), this writer took
-//! 7.03 s with 1 worker (6.81 s with 2), `mcap::Writer` 12.46 s with `compression_threads(0)`, 13.12 s
-//! with 1 and 10.90 s with 2: 1.55 to 1.87 times as long. It would also change every recording's bytes.
+//! zstd level 1, 1 MiB chunks, medians of 3 alternating rounds at load 7 on 2 cores), this writer took
+//! 3.81 s with 1 worker (2.94 s with 2), `mcap::Writer` 6.07 s with `compression_threads(0)`, 5.93 s with
+//! 1 and 7.72 s with 2: 1.56 to 2.03 times as long. It would also change every recording's bytes.
 //!
 //! [`McapWriter`]'s doc describes the pipeline, why the bytes are deterministic, and the file's layout.
 
