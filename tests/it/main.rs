@@ -59,6 +59,8 @@ mod properties;
 mod protobuf;
 #[cfg(feature = "external-readers")]
 mod protobuf_readers;
+#[cfg(target_os = "linux")]
+mod read_budget;
 mod readme;
 mod record_roundtrip;
 mod rk4_order;

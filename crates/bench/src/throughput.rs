@@ -25,7 +25,8 @@ use coin_log::format::{Channel, Encoding};
 use coin_log::record::COMPRESSION_THREADS;
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log_mcap::{
-    self, ChunkCompressor, Compression, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
+    self, ChunkCompressor, Compression, MessageHeader, Schema, Visitor, DEFAULT_CHUNK_SIZE,
+    ZSTD_LEVEL,
 };
 use std::collections::BTreeMap;
 use std::fmt;
@@ -266,8 +267,7 @@ impl Compressing {
 }
 
 impl Visitor for Compressing {
-    fn schema(&mut self, _: u16, _: &str, _: &str, _: &[u8]) {}
-    fn channel(&mut self, _: u16, _: u16, _: &str, _: &str) {}
+    fn channel(&mut self, _: u16, _: &str, _: &str, _: Option<&Schema<'_>>) {}
     fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
     fn library(&mut self, _: &str) {}
     fn message(&mut self, _: &MessageHeader, data: &[u8]) -> ControlFlow<()> {

@@ -9,10 +9,12 @@
 //! are the writer's defaults.
 //!
 //! **Reading**: [`read`] (a path) and [`read_from`] (any reader of known length) walk a file once, in
-//! file order, passing its schemas, channels, metadata and messages to a [`Visitor`]. Memory is bounded by
-//! the largest record, never by the length of the file; every claimed length is checked against the file
-//! size before anything is allocated for it. A worker thread reads and decompresses ahead and checks the
-//! data, summary and chunk CRCs. Along the way the reader checks the file's structure (message indexes,
+//! file order, passing its channels (each with its schema), metadata and messages to a [`Visitor`].
+//! Memory is bounded by [`READ_MEMORY_BOUND`] whatever the file says or holds, never by its length: no
+//! record, chunk or decompressed chunk larger than [`MAX_RECORD_BYTES`] is accepted, every claimed length
+//! is checked against the file size before anything is allocated for it, and a chunk is decompressed with
+//! a limit, never trusting the size it declares. A worker thread reads and decompresses ahead and checks
+//! the data, summary and chunk CRCs. Along the way the reader checks the file's structure (message indexes,
 //! chunk indexes, statistics, metadata indexes, summary offsets, footer) and returns what it found as a
 //! [`Structure`]; a file that cannot be read to its end is a [`ReadError`] whose [`ReadErrorKind`] says
 //! why. [`read_with_progress`] also reports the bytes read so far.
@@ -20,20 +22,24 @@
 //! **Summary**: [`read_summary`] reads what a file says about itself (statistics, channels, chunk
 //! indexes, metadata) from its summary section alone, in a few seeks, whatever the file's length.
 
+mod budget;
+mod digest;
+mod early_metadata;
+mod findings;
 mod prefetch;
-mod prelude;
-mod problems;
 mod reader;
+pub mod records;
 mod summary;
-mod wire;
 mod writer;
 
-pub use problems::Problems;
+pub use budget::{MAX_RECORD_BYTES, READ_MEMORY_BOUND};
+pub use findings::BoundedFindings;
+pub use mcap::records::MessageHeader;
+pub use mcap::Schema;
 pub use reader::{
     read, read_from, read_with_progress, ReadError, ReadErrorKind, Structure, Visitor,
 };
 pub use summary::{read_summary, ChannelSummary, Summary};
-pub use wire::MessageHeader;
 pub use writer::{
     ChunkCompressor, Compression, McapWriter, WriteError, WriterOptions, DEFAULT_CHUNK_SIZE,
     ZSTD_LEVEL,

@@ -1,62 +1,103 @@
-//! The reading half of the reader's pipeline: a worker thread reads the file, checks the data and
-//! summary CRCs, decompresses each chunk and checks its CRC, and hands the records over in batches through
-//! a bounded channel, while the calling thread walks the records and runs the visitor.
+//! The reading half of the reader's pipeline: a worker thread reads the file (the `mcap` crate's sans-io
+//! `LinearReader` splits it into records and checks the magic, the data and summary CRCs and the end),
+//! decompresses each chunk whole and checks its size and CRC, and hands the records over in batches
+//! through a bounded channel, while the calling thread walks them and runs the visitor.
 //!
-//! A batch holds copies of whole records back to back and a list of [`Event`]s pointing into them, in file
-//! order; errors travel as events in their place, so the consumer sees exactly the sequence a
-//! single-threaded reader would. Memory stays bounded: at most [`QUEUE`] + 2 batches exist, each about
-//! [`BATCH_BYTES`] plus one record, and spent batches are sent back to be refilled rather than reallocated.
-//! When the consumer stops (an error, or its visitor breaks) it drops its receiver and the worker ends at
-//! its next send.
+//! A batch holds copies of top-level records and decompressed chunks back to back, and a list of
+//! [`Event`]s pointing into them, in file order; errors travel as events in their place, so the consumer
+//! sees exactly the sequence a single-threaded reader would. Memory stays bounded (see `budget`): at most
+//! [`POOL`] batches exist, handed over once their bytes and events reach [`BATCH_BYTES`]; the producer
+//! fills a batch with a record or chunk larger than that only when every other batch is back, and
+//! shrinks it when it returns. When the consumer stops (an error, or its visitor breaks) it drops its
+//! receiver and the worker ends at its next send.
 
+use crate::budget::MAX_RECORD_BYTES;
+use crate::records::{ChunkRecord, Record, WireError};
+use mcap::records::{op, ChunkHeader};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
-use std::io::Read;
+use std::io::{self, Read};
 use std::ops::Range;
 use std::sync::mpsc::{Receiver, SyncSender};
 
-use mcap::records::op;
-
 /// Bytes asked of the file per read (larger reads than the reader's minimum requests).
 const READ_BLOCK: usize = 1 << 18;
-/// Smallest record-length limit inside chunks (a chunk's records may decompress beyond the file's size).
-const MIN_CHUNK_RECORD_LIMIT: usize = 1 << 24;
-/// A batch is handed over once it holds this many bytes (about one decompressed chunk).
-pub(crate) const BATCH_BYTES: usize = 1 << 20;
-/// Batches in flight between the threads: enough to keep both busy, few enough to bound memory.
+/// A batch is handed over once its bytes and events reach this (about one decompressed chunk).
+const BATCH_BYTES: usize = 1 << 20;
+/// What an event counts towards [`BATCH_BYTES`]: its size, so that a flood of empty records fills
+/// batches as surely as large ones.
+const EVENT_COST: usize = std::mem::size_of::<Event>();
+/// Batches in the channel between the threads: enough to keep both busy.
 pub(crate) const QUEUE: usize = 4;
+/// Batches in existence: the queue's, the one being filled and the one being walked.
+pub(crate) const POOL: usize = QUEUE + 2;
 
 /// One step of the read, in file order.
 #[derive(Debug)]
 pub(crate) enum Event {
-    /// A top-level record (chunks included, whole and compressed) and its bytes in the batch.
-    Outer {
+    /// A top-level record other than a chunk, and its body in the batch.
+    Record {
         /// Record opcode.
         opcode: u8,
         /// Its body in [`Batch::bytes`].
         body: Range<usize>,
     },
-    /// A record inside the current chunk, decompressed.
-    Inner {
-        /// Record opcode.
-        opcode: u8,
-        /// Its body in [`Batch::bytes`].
-        body: Range<usize>,
+    /// A chunk, its records decompressed (their size and CRC checked).
+    Chunk {
+        /// The chunk record's body length.
+        len: u64,
+        /// Its header.
+        header: ChunkHeader,
+        /// Its decompressed records in [`Batch::bytes`].
+        records: Range<usize>,
     },
-    /// The current chunk's records are all read (its CRC, if any, matched).
-    ChunkEnd,
-    /// The top-level reader failed (bad magic, truncation, data or summary CRC, lengths).
+    /// A chunk that cannot be read; nothing follows.
+    BadChunk {
+        /// The chunk record's body length.
+        len: u64,
+        /// Its header, when it could be parsed.
+        header: Option<ChunkHeader>,
+        /// What is wrong.
+        error: ChunkError,
+    },
+    /// The top-level reader failed (bad magic, truncation, data or summary CRC, lengths); nothing
+    /// follows.
     OuterError(McapError),
-    /// Reading inside the current chunk failed (decompression, chunk CRC, a malformed record).
-    InnerError(McapError),
-    /// The file could not be read; the message for the user.
+    /// The file could not be read: the message for the user; nothing follows.
     Io(String),
+}
+
+/// Why a chunk's records cannot be read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum ChunkError {
+    /// Its header runs past the record.
+    Malformed(WireError),
+    /// It declares more than [`MAX_RECORD_BYTES`] of records.
+    TooLarge(u64),
+    /// A compression this reader does not know.
+    Unsupported(String),
+    /// The compressed records are not a valid stream.
+    Decompress(String),
+    /// They decompress to another size than declared (`None`: to more).
+    Size {
+        /// What they decompress to, when not more than declared.
+        got: Option<u64>,
+        /// What the header declares.
+        declared: u64,
+    },
+    /// Their CRC is not the stored one.
+    Crc {
+        /// The header's.
+        saved: u32,
+        /// The records'.
+        calculated: u32,
+    },
 }
 
 /// Records and the events that point into them.
 #[derive(Debug, Default)]
 pub(crate) struct Batch {
-    /// Record bodies back to back.
+    /// Record bodies and decompressed chunks back to back.
     pub(crate) bytes: Vec<u8>,
     /// What happened, in order.
     pub(crate) events: Vec<Event>,
@@ -70,7 +111,7 @@ impl Batch {
     }
 
     fn full(&self) -> bool {
-        self.bytes.len() >= BATCH_BYTES
+        self.bytes.len() + self.events.len() * EVENT_COST >= BATCH_BYTES
     }
 }
 
@@ -82,32 +123,77 @@ pub(crate) struct Producer {
     pub(crate) recycled: Receiver<Batch>,
 }
 
-impl Producer {
-    fn fresh(&self) -> Batch {
-        match self.recycled.try_recv() {
-            Ok(mut b) => {
-                b.bytes.clear();
-                b.events.clear();
-                b
-            }
-            Err(_) => Batch {
-                bytes: Vec::with_capacity(BATCH_BYTES + (BATCH_BYTES >> 2)),
-                events: Vec::new(),
-            },
+/// The worker's batches: the one being filled, and the spent ones back from the consumer.
+struct Batches<'p> {
+    producer: &'p Producer,
+    current: Batch,
+    spare: Vec<Batch>,
+    /// Batches made so far (at most [`POOL`]).
+    made: usize,
+}
+
+impl<'p> Batches<'p> {
+    fn new(producer: &'p Producer) -> Self {
+        Self {
+            producer,
+            current: Batch::default(),
+            spare: Vec::new(),
+            made: 1,
         }
     }
 
-    /// Sends `batch` and returns an empty one; `None` when the consumer has gone.
-    fn hand_over(&self, batch: Batch) -> Option<Batch> {
-        self.to_consumer.send(batch).ok()?;
-        Some(self.fresh())
+    /// A batch to fill: a spare one, a new one while fewer than [`POOL`] exist, or the next to come
+    /// back; `None` when the consumer has gone.
+    fn fresh(&mut self) -> Option<Batch> {
+        while let Ok(b) = self.producer.recycled.try_recv() {
+            self.spare.push(b);
+        }
+        let mut b = match self.spare.pop() {
+            Some(b) => b,
+            None if self.made < POOL => {
+                self.made += 1;
+                Batch::default()
+            }
+            None => self.producer.recycled.recv().ok()?,
+        };
+        b.bytes.clear();
+        b.events.clear();
+        // A batch that held a large record gives its memory back.
+        if b.bytes.capacity() > 2 * BATCH_BYTES {
+            b.bytes.shrink_to(BATCH_BYTES + BATCH_BYTES / 4);
+        }
+        Some(b)
+    }
+
+    /// Sends the current batch and starts another; `None` when the consumer has gone.
+    fn hand_over(&mut self) -> Option<()> {
+        let next = self.fresh()?;
+        let full = std::mem::replace(&mut self.current, next);
+        self.producer.to_consumer.send(full).ok()
+    }
+
+    /// Makes room for `size` more bytes: hands the batch over when full, and before something larger
+    /// than a batch, waits until every other batch is back, so that one such exists at a time.
+    fn room_for(&mut self, size: u64) -> Option<()> {
+        if self.current.full() {
+            self.hand_over()?;
+        }
+        if size > BATCH_BYTES as u64 {
+            if !self.current.events.is_empty() {
+                self.hand_over()?;
+            }
+            while self.spare.len() + 1 < self.made {
+                self.spare.push(self.producer.recycled.recv().ok()?);
+            }
+        }
+        Some(())
     }
 }
 
 /// Reads an MCAP stream of `file_len` bytes from `source` and sends its records to the consumer, ending
 /// after the last record, the first error, or when the consumer hangs up.
 pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer) {
-    let limit = usize::try_from(file_len).unwrap_or(usize::MAX);
+    let limit = usize::try_from(file_len.min(MAX_RECORD_BYTES)).unwrap_or(usize::MAX);
     let mut outer = LinearReader::new_with_options(
         LinearReaderOptions::default()
             .with_emit_chunks(true)
@@ -116,14 +202,8 @@ pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer)
             .with_check_finishes_after_end_magic(true)
             .with_record_length_limit(limit),
     );
-    let mut inner = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_skip_start_magic(true)
-            .with_skip_end_magic(true)
-            .with_validate_chunk_crcs(true)
-            .with_record_length_limit(limit.max(MIN_CHUNK_RECORD_LIMIT)),
-    );
-    let mut batch = producer.fresh();
+    let mut batches = Batches::new(producer);
+    let mut decompressor = Decompressor::default();
     let mut read_so_far: u64 = 0;
     while let Some(event) = outer.next_event() {
         match event {
@@ -135,77 +215,147 @@ pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer)
                         outer.notify_read(n);
                     }
                     Err(e) => {
-                        batch
-                            .events
-                            .push(Event::Io(format!("read error at byte {read_so_far}: {e}")));
+                        let detail = format!("read error at byte {read_so_far}: {e}");
+                        batches.current.events.push(Event::Io(detail));
                         break;
                     }
                 }
             }
             Ok(LinearReadEvent::Record { opcode, data }) => {
-                let body = batch.push(data);
-                batch.events.push(Event::Outer { opcode, body });
-                if opcode == op::CHUNK {
-                    feed_chunk(&mut inner, opcode, data);
-                    match chunk_records(&mut inner, batch, producer) {
-                        Some((b, true)) => batch = b,
-                        Some((b, false)) => {
-                            batch = b;
-                            break;
-                        }
+                let event = if opcode == op::CHUNK {
+                    match chunk(data, &mut batches, &mut decompressor) {
+                        Some(event) => event,
                         None => return,
                     }
-                }
-                if batch.full() {
-                    match producer.hand_over(batch) {
-                        Some(b) => batch = b,
-                        None => return,
+                } else {
+                    if batches.room_for(data.len() as u64).is_none() {
+                        return;
                     }
+                    let body = batches.current.push(data);
+                    Event::Record { opcode, body }
+                };
+                let stop = matches!(event, Event::BadChunk { .. });
+                batches.current.events.push(event);
+                if stop {
+                    break;
                 }
             }
             Err(e) => {
-                batch.events.push(Event::OuterError(e));
+                batches.current.events.push(Event::OuterError(e));
                 break;
             }
         }
     }
-    let _ = producer.to_consumer.send(batch);
+    let _ = producer.to_consumer.send(batches.current);
 }
 
-/// Gives the chunk record to the inner reader, which decompresses it as a stream.
-fn feed_chunk(inner: &mut LinearReader, opcode: u8, data: &[u8]) {
-    let total = 9 + data.len();
-    let buf = inner.insert(total);
-    buf[0] = opcode;
-    buf[1..9].copy_from_slice(&(data.len() as u64).to_le_bytes());
-    buf[9..].copy_from_slice(data);
-    inner.notify_read(total);
+/// Decompresses the chunk record `data` into the current batch (making room first); `None` when the
+/// consumer has gone.
+fn chunk(data: &[u8], batches: &mut Batches<'_>, decompressor: &mut Decompressor) -> Option<Event> {
+    let len = data.len() as u64;
+    let chunk = match ChunkRecord::parse_body(data) {
+        Ok(chunk) => chunk,
+        Err(e) => {
+            let error = ChunkError::Malformed(e);
+            return Some(Event::BadChunk {
+                len,
+                header: None,
+                error,
+            });
+        }
+    };
+    let declared = chunk.header.uncompressed_size;
+    if declared > MAX_RECORD_BYTES {
+        let error = ChunkError::TooLarge(declared);
+        let header = Some(chunk.header);
+        return Some(Event::BadChunk { len, header, error });
+    }
+    batches.room_for(declared)?;
+    let bytes = &mut batches.current.bytes;
+    let start = bytes.len();
+    Some(match decompressor.run(&chunk, bytes) {
+        Ok(()) => Event::Chunk {
+            len,
+            header: chunk.header,
+            records: start..bytes.len(),
+        },
+        Err(error) => {
+            bytes.truncate(start);
+            let header = Some(chunk.header);
+            Event::BadChunk { len, header, error }
+        }
+    })
 }
 
-/// Copies the chunk's records into batches. Returns the batch being filled and whether reading goes on
-/// (false after an error), or `None` when the consumer has gone.
-fn chunk_records(
-    inner: &mut LinearReader,
-    mut batch: Batch,
-    producer: &Producer,
-) -> Option<(Batch, bool)> {
-    while let Some(event) = inner.next_event() {
-        match event {
-            // The chunk is used up: the reader wants the next one.
-            Ok(LinearReadEvent::ReadRequest(_)) => break,
-            Ok(LinearReadEvent::Record { opcode, data }) => {
-                let body = batch.push(data);
-                batch.events.push(Event::Inner { opcode, body });
-                if batch.full() {
-                    batch = producer.hand_over(batch)?;
+/// The chunk decompressors, kept from chunk to chunk.
+#[derive(Default)]
+struct Decompressor {
+    zstd: Option<zstd::bulk::Decompressor<'static>>,
+}
+
+impl Decompressor {
+    /// Appends the chunk's records to `out`, decompressed with a limit of one byte past the declared
+    /// size, and checks their size and CRC.
+    fn run(&mut self, chunk: &ChunkRecord<'_>, out: &mut Vec<u8>) -> Result<(), ChunkError> {
+        let h = &chunk.header;
+        let stored = chunk.records.0;
+        let declared = h.uncompressed_size;
+        let start = out.len();
+        // At most MAX_RECORD_BYTES + 1: checked by the caller.
+        let room = usize::try_from(declared)
+            .unwrap_or(usize::MAX)
+            .saturating_add(1);
+        out.reserve_exact(room);
+        let decompress = |e: io::Error| ChunkError::Decompress(e.to_string());
+        match h.compression.as_str() {
+            "" => out.extend_from_slice(&stored[..stored.len().min(room)]),
+            "zstd" => {
+                let zstd = match &mut self.zstd {
+                    Some(z) => z,
+                    None => self
+                        .zstd
+                        .insert(zstd::bulk::Decompressor::new().map_err(decompress)?),
+                };
+                let mut at = io::Cursor::new(&mut *out);
+                at.set_position(start as u64);
+                if let Err(e) = zstd.decompress_to_buffer(stored, &mut at) {
+                    let too_small = e
+                        .get_ref()
+                        .and_then(|e| e.downcast_ref::<zstd::Error>())
+                        .is_some_and(|e| {
+                            e.is(zstd::zstd_safe::zstd_sys::ZSTD_ErrorCode::ZSTD_error_dstSize_tooSmall)
+                        });
+                    return Err(if too_small {
+                        ChunkError::Size {
+                            got: None,
+                            declared,
+                        }
+                    } else {
+                        decompress(e)
+                    });
                 }
             }
-            Err(e) => {
-                batch.events.push(Event::InnerError(e));
-                return Some((batch, false));
+            "lz4" => {
+                let decoder = lz4::Decoder::new(stored).map_err(decompress)?;
+                decoder
+                    .take(room as u64)
+                    .read_to_end(out)
+                    .map_err(decompress)?;
             }
+            other => return Err(ChunkError::Unsupported(other.to_string())),
         }
+        let got = (out.len() - start) as u64;
+        if got != declared {
+            let got = (got < declared).then_some(got);
+            return Err(ChunkError::Size { got, declared });
+        }
+        let calculated = crc32fast::hash(&out[start..]);
+        if h.uncompressed_crc != 0 && calculated != h.uncompressed_crc {
+            return Err(ChunkError::Crc {
+                saved: h.uncompressed_crc,
+                calculated,
+            });
+        }
+        Ok(())
     }
-    batch.events.push(Event::ChunkEnd);
-    Some((batch, true))
 }

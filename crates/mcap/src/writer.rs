@@ -1,39 +1,27 @@
 //! A pipelined, deterministic, chunked MCAP writer: the calling thread appends messages to an
-//! uncompressed chunk while earlier chunks are compressed whole on a worker thread.
+//! uncompressed chunk while earlier chunks are compressed whole on a worker thread. Every record is
+//! encoded by the crate's one codec (`records`).
 //!
-//! Written by hand because `mcap::Writer` (0.26) cannot compress a whole chunk on another thread: it
-//! streams every record (its 9-byte header, then its body) through a streaming zstd context on the
-//! calling thread, one `ZSTD_compressStream` call per write (plus a mutex per write with zstd worker
-//! threads), and it cannot hand a finished chunk away and go on. Profiling showed that this, not the
-//! simulation and JSON formatting (~0.25 µs per message), bounded the recorder.
+//! Written here rather than taken from `mcap::Writer` (0.26), which streams every record through a
+//! streaming zstd context on the calling thread and cannot hand a finished chunk away and go on. On the
+//! 7 M-message workload of `bench throughput` (`benches/crate_vs_ours.rs`, its "write" race, in memory,
+//! zstd level 1, 1 MiB chunks, medians of 3 alternating rounds at load 7 on 2 cores), this writer took
+//! 3.81 s with 1 worker (2.94 s with 2), `mcap::Writer` 6.07 s with `compression_threads(0)`, 5.93 s with
+//! 1 and 7.72 s with 2: 1.56 to 2.03 times as long. It would also change every recording's bytes.
 //!
 //! [`McapWriter`]'s doc describes the pipeline, why the bytes are deterministic, and the file's layout.
 
+use crate::records::{ChunkRecord, MessageRecord, Record, Tail, TooLong, MAGIC};
+use mcap::records::{
+    op, Channel, ChunkHeader, ChunkIndex, DataEnd, Footer, Header, MessageHeader, MessageIndex,
+    MessageIndexEntry, Metadata, MetadataIndex, Statistics, SummaryOffset,
+};
+use mcap::Schema;
 use std::collections::{BTreeMap, VecDeque};
 use std::io::{self, BufWriter, Write};
 use std::mem;
-use std::ops::Range;
 use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
 use std::thread::JoinHandle;
-
-use super::wire::MAGIC;
-
-/// Record opcodes (MCAP spec, "Records").
-mod op {
-    pub const HEADER: u8 = 0x01;
-    pub const FOOTER: u8 = 0x02;
-    pub const SCHEMA: u8 = 0x03;
-    pub const CHANNEL: u8 = 0x04;
-    pub const MESSAGE: u8 = 0x05;
-    pub const CHUNK: u8 = 0x06;
-    pub const MESSAGE_INDEX: u8 = 0x07;
-    pub const CHUNK_INDEX: u8 = 0x08;
-    pub const STATISTICS: u8 = 0x0B;
-    pub const METADATA: u8 = 0x0C;
-    pub const METADATA_INDEX: u8 = 0x0D;
-    pub const SUMMARY_OFFSET: u8 = 0x0E;
-    pub const DATA_END: u8 = 0x0F;
-}
 
 /// The default of [`WriterOptions::chunk_size`] \[bytes of uncompressed records\]: the `mcap` crate's
 /// default, large enough for good compression and few index records, small enough that a reader seeking
@@ -56,13 +44,6 @@ const IN_FLIGHT_PER_WORKER: usize = 2;
 /// Buffer between the writer and the output, so that small records (indexes, headers) are not one
 /// system call each.
 const OUTPUT_BUFFER: usize = 1 << 16;
-
-/// Bytes of a Message record before its data: opcode, record length, channel id, sequence, log time,
-/// publish time.
-const MESSAGE_HEADER_LEN: usize = 1 + 8 + 2 + 4 + 8 + 8;
-
-/// The Footer record's length: summary start, summary offset start, summary CRC.
-const FOOTER_LEN: u64 = 8 + 8 + 4;
 
 coin_log_names::named_enum! {
     /// How chunks are compressed; the name is the one of `--compression` and of the recording's metadata.
@@ -163,21 +144,13 @@ pub enum WriteError {
     },
 }
 
-/// A schema as registered.
-#[derive(Debug, Clone, PartialEq, Eq)]
-struct Schema {
-    name: String,
-    encoding: String,
-    data: Vec<u8>,
-}
-
-/// A channel as registered.
-#[derive(Debug, Clone, PartialEq, Eq)]
-struct ChannelInfo {
-    schema_id: u16,
-    topic: String,
-    message_encoding: String,
-    metadata: BTreeMap<String, String>,
+impl From<TooLong> for WriteError {
+    fn from(e: TooLong) -> Self {
+        Self::TooLong {
+            what: e.field,
+            len: e.len,
+        }
+    }
 }
 
 /// What the calling thread knows about a chunk; reused from chunk to chunk.
@@ -185,38 +158,18 @@ struct ChannelInfo {
 struct ChunkMeta {
     /// (earliest, latest) log time, None before the first message.
     bounds: Option<(u64, u64)>,
-    /// Per channel (index = id − 1): (log time, offset of the Message record in the uncompressed chunk).
-    indexes: Vec<Vec<(u64, u64)>>,
+    /// Per channel (index = id − 1), the entries of its message index: (log time, offset of the Message
+    /// record in the uncompressed chunk).
+    indexes: Vec<MessageIndex>,
 }
 
 impl ChunkMeta {
     fn clear(&mut self) {
         self.bounds = None;
-        for entries in &mut self.indexes {
-            entries.clear();
+        for index in &mut self.indexes {
+            index.records.clear();
         }
     }
-}
-
-/// A written chunk, for its ChunkIndex record.
-#[derive(Debug)]
-struct ChunkIndex {
-    bounds: (u64, u64),
-    chunk_start: u64,
-    chunk_length: u64,
-    /// Range of (channel id, MessageIndex offset) in [`McapWriter::index_offsets`].
-    offsets: Range<usize>,
-    message_index_length: u64,
-    compressed_size: u64,
-    uncompressed_size: u64,
-}
-
-/// A written Metadata record, for its MetadataIndex record.
-#[derive(Debug)]
-struct MetadataIndex {
-    offset: u64,
-    length: u64,
-    name: String,
 }
 
 /// A chunk on its way to a worker and back.
@@ -426,14 +379,12 @@ pub struct McapWriter<W: Write> {
     /// Reused for records written outside chunks.
     scratch: Vec<u8>,
     /// Schema id n is `schemas[n − 1]`; channel id n is `channels[n − 1]`.
-    schemas: Vec<Schema>,
-    channels: Vec<ChannelInfo>,
+    schemas: Vec<Schema<'static>>,
+    channels: Vec<Channel>,
     /// Messages per channel (index = id − 1).
     message_counts: Vec<u64>,
     bounds: Option<(u64, u64)>,
     chunk_indexes: Vec<ChunkIndex>,
-    /// (channel id, offset of its MessageIndex record) of every chunk, back to back.
-    index_offsets: Vec<(u16, u64)>,
     metadata_indexes: Vec<MetadataIndex>,
     failed: bool,
 }
@@ -469,16 +420,15 @@ impl<W: Write> McapWriter<W> {
             message_counts: Vec::new(),
             bounds: None,
             chunk_indexes: Vec::new(),
-            index_offsets: Vec::new(),
             metadata_indexes: Vec::new(),
             failed: false,
         };
-        let mut header = Vec::new();
-        header.extend_from_slice(&MAGIC);
-        let at = begin_record(&mut header, op::HEADER);
-        put_str(&mut header, &options.profile)?;
-        put_str(&mut header, &options.library)?;
-        end_record(&mut header, at);
+        let mut header = MAGIC.to_vec();
+        Header {
+            profile: options.profile.clone(),
+            library: options.library.clone(),
+        }
+        .encode_record(&mut header)?;
         this.guard(|w| Ok(w.out.write_all(&header)?))?;
         Ok(this)
     }
@@ -495,19 +445,21 @@ impl<W: Write> McapWriter<W> {
         data: &[u8],
     ) -> Result<u16, WriteError> {
         self.check()?;
-        let schema = Schema {
-            name: name.to_string(),
-            encoding: encoding.to_string(),
-            data: data.to_vec(),
-        };
-        if let Some(i) = self.schemas.iter().position(|s| *s == schema) {
-            return Ok(id_of(i));
+        let same = |s: &Schema<'_>| s.name == name && s.encoding == encoding && *s.data == *data;
+        if let Some(s) = self.schemas.iter().find(|s| same(s)) {
+            return Ok(s.id);
         }
         let id = u16::try_from(self.schemas.len() + 1)
             .map_err(|_| WriteError::TooMany { what: "schemas" })?;
+        let schema = Schema {
+            id,
+            name: name.to_string(),
+            encoding: encoding.to_string(),
+            data: data.to_vec().into(),
+        };
         // Encoded aside first: a field too long must not leave half a record in the chunk.
         let mut record = Vec::new();
-        encode_schema(&mut record, id, &schema)?;
+        schema.encode_record(&mut record)?;
         self.chunk.extend_from_slice(&record);
         self.schemas.push(schema);
         Ok(id)
@@ -531,20 +483,33 @@ impl<W: Write> McapWriter<W> {
         if usize::from(schema_id) > self.schemas.len() {
             return Err(WriteError::UnknownSchema { schema_id });
         }
-        let channel = ChannelInfo {
+        let same = |c: &Channel| {
+            (
+                c.schema_id,
+                c.topic.as_str(),
+                c.message_encoding.as_str(),
+                &c.metadata,
+            ) == (schema_id, topic, message_encoding, metadata)
+        };
+        if let Some(c) = self.channels.iter().find(|c| same(c)) {
+            return Ok(c.id);
+        }
+        let id = u16::try_from(self.channels.len() + 1)
+            .map_err(|_| WriteError::TooMany { what: "channels" })?;
+        let channel = Channel {
+            id,
             schema_id,
             topic: topic.to_string(),
             message_encoding: message_encoding.to_string(),
             metadata: metadata.clone(),
         };
-        if let Some(i) = self.channels.iter().position(|c| *c == channel) {
-            return Ok(id_of(i));
-        }
-        let id = u16::try_from(self.channels.len() + 1)
-            .map_err(|_| WriteError::TooMany { what: "channels" })?;
         let mut record = Vec::new();
-        encode_channel(&mut record, id, &channel)?;
+        channel.encode_record(&mut record)?;
         self.chunk.extend_from_slice(&record);
+        self.meta.indexes.push(MessageIndex {
+            channel_id: id,
+            records: Vec::new(),
+        });
         self.channels.push(channel);
         self.message_counts.push(0);
         Ok(id)
@@ -572,22 +537,21 @@ impl<W: Write> McapWriter<W> {
         *count += 1;
         self.bounds = Some(widen(self.bounds, log_time));
         self.meta.bounds = Some(widen(self.meta.bounds, log_time));
-        if self.meta.indexes.len() <= index {
-            self.meta.indexes.resize_with(index + 1, Vec::new);
+        self.meta.indexes[index].records.push(MessageIndexEntry {
+            log_time,
+            offset: self.chunk.len() as u64,
+        });
+        let header = MessageHeader {
+            channel_id,
+            sequence,
+            log_time,
+            publish_time,
+        };
+        MessageRecord {
+            header,
+            data: Tail(data),
         }
-        let offset = self.chunk.len() as u64;
-        self.meta.indexes[index].push((log_time, offset));
-
-        let length = (MESSAGE_HEADER_LEN - 9 + data.len()) as u64;
-        let mut header = [0_u8; MESSAGE_HEADER_LEN];
-        header[0] = op::MESSAGE;
-        header[1..9].copy_from_slice(&length.to_le_bytes());
-        header[9..11].copy_from_slice(&channel_id.to_le_bytes());
-        header[11..15].copy_from_slice(&sequence.to_le_bytes());
-        header[15..23].copy_from_slice(&log_time.to_le_bytes());
-        header[23..31].copy_from_slice(&publish_time.to_le_bytes());
-        self.chunk.extend_from_slice(&header);
-        self.chunk.extend_from_slice(data);
+        .encode_record(&mut self.chunk)?;
         if self.chunk.len() >= self.chunk_size {
             self.guard(Self::dispatch)?;
         }
@@ -609,10 +573,11 @@ impl<W: Write> McapWriter<W> {
             w.drain()?;
             let mut record = mem::take(&mut w.scratch);
             record.clear();
-            let at = begin_record(&mut record, op::METADATA);
-            put_str(&mut record, name)?;
-            put_string_map(&mut record, metadata)?;
-            end_record(&mut record, at);
+            Metadata {
+                name: name.to_string(),
+                metadata: metadata.clone(),
+            }
+            .encode_record(&mut record)?;
             let offset = w.out.position;
             let written = w.out.write_all(&record);
             w.metadata_indexes.push(MetadataIndex {
@@ -680,7 +645,14 @@ impl<W: Write> McapWriter<W> {
             .pop()
             .unwrap_or_else(|| Vec::with_capacity(chunk_capacity(self.chunk_size)));
         let records = mem::replace(&mut self.chunk, fresh);
-        let meta = mem::replace(&mut self.meta, self.free_meta.pop().unwrap_or_default());
+        let mut next = self.free_meta.pop().unwrap_or_default();
+        for channel in &self.channels[next.indexes.len()..] {
+            next.indexes.push(MessageIndex {
+                channel_id: channel.id,
+                records: Vec::new(),
+            });
+        }
+        let meta = mem::replace(&mut self.meta, next);
         let compressed = self.free_compressed.pop().unwrap_or_default();
         let worker = &self.workers.0[self.dispatched % self.workers.len()];
         worker
@@ -754,52 +726,40 @@ impl<W: Write> McapWriter<W> {
             Compression::None => records,
             Compression::Zstd | Compression::Lz4 => compressed,
         };
-        let bounds = meta.bounds.unwrap_or((0, 0));
-        let name = self.compression.mcap_name();
+        let (message_start_time, message_end_time) = meta.bounds.unwrap_or((0, 0));
+        let compression = self.compression.mcap_name().to_string();
         let mut buffer = mem::take(&mut self.scratch);
         buffer.clear();
-        let at = begin_record(&mut buffer, op::CHUNK);
-        put_u64(&mut buffer, bounds.0);
-        put_u64(&mut buffer, bounds.1);
-        put_u64(&mut buffer, records.len() as u64);
-        put_u32(&mut buffer, crc);
-        put_str(&mut buffer, name)?;
-        put_u64(&mut buffer, stored.len() as u64);
-        // The record's length covers the stored records that follow the header.
-        let length = (buffer.len() - at - 8 + stored.len()) as u64;
-        buffer[at..at + 8].copy_from_slice(&length.to_le_bytes());
-        let chunk_start = self.out.position;
-        let written = self
-            .out
-            .write_all(&buffer)
-            .and_then(|()| self.out.write_all(stored));
-        let chunk_length = self.out.position - chunk_start;
-
-        buffer.clear();
-        let first_offset = self.index_offsets.len();
-        let indexes_start = self.out.position;
-        for (index, entries) in meta.indexes.iter().enumerate() {
-            if entries.is_empty() {
-                continue;
-            }
-            self.index_offsets
-                .push((id_of(index), indexes_start + buffer.len() as u64));
-            let at = begin_record(&mut buffer, op::MESSAGE_INDEX);
-            put_u16(&mut buffer, id_of(index));
-            put_u32(&mut buffer, len32("message index", entries.len() * 16)?);
-            for &(log_time, offset) in entries {
-                put_u64(&mut buffer, log_time);
-                put_u64(&mut buffer, offset);
-            }
-            end_record(&mut buffer, at);
+        ChunkRecord {
+            header: ChunkHeader {
+                message_start_time,
+                message_end_time,
+                uncompressed_size: records.len() as u64,
+                uncompressed_crc: crc,
+                compression: compression.clone(),
+                compressed_size: stored.len() as u64,
+            },
+            records: Tail(stored),
         }
-        let written = written.and_then(|()| self.out.write_all(&buffer));
+        .encode_record(&mut buffer)?;
+        let chunk_start_offset = self.out.position;
+        let chunk_length = buffer.len() as u64;
+        let indexes_start = chunk_start_offset + chunk_length;
+        let mut message_index_offsets = BTreeMap::new();
+        for index in meta.indexes.iter().filter(|i| !i.records.is_empty()) {
+            let offset = (buffer.len() as u64) - chunk_length;
+            message_index_offsets.insert(index.channel_id, indexes_start + offset);
+            index.encode_record(&mut buffer)?;
+        }
+        let written = self.out.write_all(&buffer);
         self.chunk_indexes.push(ChunkIndex {
-            bounds,
-            chunk_start,
+            message_start_time,
+            message_end_time,
+            chunk_start_offset,
             chunk_length,
-            offsets: first_offset..self.index_offsets.len(),
-            message_index_length: buffer.len() as u64,
+            message_index_offsets,
+            message_index_length: buffer.len() as u64 - chunk_length,
+            compression,
             compressed_size: stored.len() as u64,
             uncompressed_size: records.len() as u64,
         });
@@ -811,9 +771,7 @@ impl<W: Write> McapWriter<W> {
     fn write_summary(&mut self) -> Result<(), WriteError> {
         let data_section_crc = mem::take(&mut self.out.crc).finalize();
         let mut b = Vec::new();
-        let at = begin_record(&mut b, op::DATA_END);
-        put_u32(&mut b, data_section_crc);
-        end_record(&mut b, at);
+        DataEnd { data_section_crc }.encode_record(&mut b)?;
         self.out.write_all(&b)?;
 
         // The summary CRC starts at the summary's first byte, after DataEnd.
@@ -823,24 +781,28 @@ impl<W: Write> McapWriter<W> {
         self.write_footer(summary_start, &groups)
     }
 
-    /// The summary's groups, in the order of the layout; returns (opcode, start, length) of each group
-    /// written (an empty group is left out).
-    fn write_summary_groups(&mut self) -> Result<Vec<(u8, u64, u64)>, WriteError> {
+    /// The summary's groups, in the order of the layout; returns the offset of each group written (an
+    /// empty group is left out).
+    fn write_summary_groups(&mut self) -> Result<Vec<SummaryOffset>, WriteError> {
         let mut groups = Vec::new();
         let mut b = Vec::new();
-        for (i, schema) in self.schemas.iter().enumerate() {
-            encode_schema(&mut b, id_of(i), schema)?;
+        for schema in &self.schemas {
+            schema.encode_record(&mut b)?;
         }
         self.write_group(op::SCHEMA, &mut b, &mut groups)?;
-        for (i, channel) in self.channels.iter().enumerate() {
-            encode_channel(&mut b, id_of(i), channel)?;
+        for channel in &self.channels {
+            channel.encode_record(&mut b)?;
         }
         self.write_group(op::CHANNEL, &mut b, &mut groups)?;
-        self.encode_statistics(&mut b)?;
+        self.statistics()?.encode_record(&mut b)?;
         self.write_group(op::STATISTICS, &mut b, &mut groups)?;
-        self.encode_chunk_indexes(&mut b)?;
+        for index in &self.chunk_indexes {
+            index.encode_record(&mut b)?;
+        }
         self.write_group(op::CHUNK_INDEX, &mut b, &mut groups)?;
-        self.encode_metadata_indexes(&mut b)?;
+        for index in &self.metadata_indexes {
+            index.encode_record(&mut b)?;
+        }
         self.write_group(op::METADATA_INDEX, &mut b, &mut groups)?;
         Ok(groups)
     }
@@ -848,12 +810,16 @@ impl<W: Write> McapWriter<W> {
     /// Writes the records of one summary group (if any), notes where they went, and empties `records`.
     fn write_group(
         &mut self,
-        opcode: u8,
+        group_opcode: u8,
         records: &mut Vec<u8>,
-        groups: &mut Vec<(u8, u64, u64)>,
+        groups: &mut Vec<SummaryOffset>,
     ) -> io::Result<()> {
         if !records.is_empty() {
-            groups.push((opcode, self.out.position, records.len() as u64));
+            groups.push(SummaryOffset {
+                group_opcode,
+                group_start: self.out.position,
+                group_length: records.len() as u64,
+            });
             self.out.write_all(records)?;
         }
         records.clear();
@@ -864,93 +830,51 @@ impl<W: Write> McapWriter<W> {
     fn write_footer(
         &mut self,
         summary_start: u64,
-        groups: &[(u8, u64, u64)],
+        groups: &[SummaryOffset],
     ) -> Result<(), WriteError> {
         let summary_offset_start = self.out.position;
         let mut b = Vec::new();
-        for &(opcode, start, length) in groups {
-            let at = begin_record(&mut b, op::SUMMARY_OFFSET);
-            b.push(opcode);
-            put_u64(&mut b, start);
-            put_u64(&mut b, length);
-            end_record(&mut b, at);
+        for group in groups {
+            group.encode_record(&mut b)?;
         }
-        // The footer up to its CRC field is covered by the summary CRC.
-        b.push(op::FOOTER);
-        put_u64(&mut b, FOOTER_LEN);
-        put_u64(&mut b, summary_start);
-        put_u64(&mut b, summary_offset_start);
-        self.out.write_all(&b)?;
+        Footer {
+            summary_start,
+            summary_offset_start,
+            summary_crc: 0,
+        }
+        .encode_record(&mut b)?;
+        // The summary CRC covers the footer up to its CRC field.
+        let crc_at = b.len() - 4;
+        self.out.write_all(&b[..crc_at])?;
         let summary_crc = mem::take(&mut self.out.crc).finalize();
-        b.clear();
-        put_u32(&mut b, summary_crc);
-        b.extend_from_slice(&MAGIC);
-        self.out.write_all(&b)?;
+        b.truncate(crc_at);
+        b.extend_from_slice(&summary_crc.to_le_bytes());
+        b.extend_from_slice(MAGIC);
+        self.out.write_all(&b[crc_at..])?;
         Ok(())
     }
 
-    fn encode_chunk_indexes(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
-        for index in &self.chunk_indexes {
-            let at = begin_record(b, op::CHUNK_INDEX);
-            put_u64(b, index.bounds.0);
-            put_u64(b, index.bounds.1);
-            put_u64(b, index.chunk_start);
-            put_u64(b, index.chunk_length);
-            let offsets = &self.index_offsets[index.offsets.clone()];
-            put_u32(b, len32("message index offsets", offsets.len() * 10)?);
-            for &(channel_id, offset) in offsets {
-                put_u16(b, channel_id);
-                put_u64(b, offset);
-            }
-            put_u64(b, index.message_index_length);
-            put_str(b, self.compression.mcap_name())?;
-            put_u64(b, index.compressed_size);
-            put_u64(b, index.uncompressed_size);
-            end_record(b, at);
-        }
-        Ok(())
-    }
-
-    fn encode_metadata_indexes(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
-        for index in &self.metadata_indexes {
-            let at = begin_record(b, op::METADATA_INDEX);
-            put_u64(b, index.offset);
-            put_u64(b, index.length);
-            put_str(b, &index.name)?;
-            end_record(b, at);
-        }
-        Ok(())
-    }
-
-    fn encode_statistics(&self, b: &mut Vec<u8>) -> Result<(), WriteError> {
-        let (start, end) = self.bounds.unwrap_or((0, 0));
-        let at = begin_record(b, op::STATISTICS);
-        put_u64(b, self.message_counts.iter().sum());
-        put_u16(
-            b,
-            u16::try_from(self.schemas.len())
+    fn statistics(&self) -> Result<Statistics, WriteError> {
+        let count = |what: &'static str, len: usize| {
+            u32::try_from(len).map_err(|_| WriteError::TooLong { what, len })
+        };
+        let (message_start_time, message_end_time) = self.bounds.unwrap_or((0, 0));
+        Ok(Statistics {
+            message_count: self.message_counts.iter().sum(),
+            schema_count: u16::try_from(self.schemas.len())
                 .map_err(|_| WriteError::TooMany { what: "schemas" })?,
-        );
-        put_u32(b, len32("channel count", self.channels.len())?);
-        put_u32(b, 0); // attachments
-        put_u32(b, len32("metadata count", self.metadata_indexes.len())?);
-        put_u32(b, len32("chunk count", self.chunk_indexes.len())?);
-        put_u64(b, start);
-        put_u64(b, end);
-        let counts: Vec<(u16, u64)> = self
-            .message_counts
-            .iter()
-            .enumerate()
-            .filter(|(_, &n)| n > 0)
-            .map(|(i, &n)| (id_of(i), n))
-            .collect();
-        put_u32(b, len32("channel message counts", counts.len() * 10)?);
-        for (channel_id, count) in counts {
-            put_u16(b, channel_id);
-            put_u64(b, count);
-        }
-        end_record(b, at);
-        Ok(())
+            channel_count: count("channel count", self.channels.len())?,
+            attachment_count: 0,
+            metadata_count: count("metadata count", self.metadata_indexes.len())?,
+            chunk_count: count("chunk count", self.chunk_indexes.len())?,
+            message_start_time,
+            message_end_time,
+            channel_message_counts: (1..)
+                .zip(&self.message_counts)
+                .filter(|(_, &n)| n > 0)
+                .map(|(id, &n)| (id, n))
+                .collect(),
+        })
     }
 }
 
@@ -959,88 +883,9 @@ fn chunk_capacity(chunk_size: usize) -> usize {
     chunk_size.saturating_add(chunk_size / 8).min(1 << 30)
 }
 
-/// The id of the schema or channel at `index` (ids start at 1; fewer than 65536 exist, checked when
-/// they are added).
-#[allow(clippy::cast_possible_truncation)]
-fn id_of(index: usize) -> u16 {
-    (index + 1) as u16
-}
-
 fn widen(bounds: Option<(u64, u64)>, t: u64) -> (u64, u64) {
     match bounds {
         None => (t, t),
         Some((start, end)) => (start.min(t), end.max(t)),
     }
-}
-
-fn len32(what: &'static str, len: usize) -> Result<u32, WriteError> {
-    u32::try_from(len).map_err(|_| WriteError::TooLong { what, len })
-}
-
-fn put_u16(b: &mut Vec<u8>, v: u16) {
-    b.extend_from_slice(&v.to_le_bytes());
-}
-fn put_u32(b: &mut Vec<u8>, v: u32) {
-    b.extend_from_slice(&v.to_le_bytes());
-}
-fn put_u64(b: &mut Vec<u8>, v: u64) {
-    b.extend_from_slice(&v.to_le_bytes());
-}
-
-/// An MCAP String or Bytes: u32 length, then the bytes.
-fn put_bytes(b: &mut Vec<u8>, what: &'static str, bytes: &[u8]) -> Result<(), WriteError> {
-    put_u32(b, len32(what, bytes.len())?);
-    b.extend_from_slice(bytes);
-    Ok(())
-}
-
-fn put_str(b: &mut Vec<u8>, s: &str) -> Result<(), WriteError> {
-    put_bytes(b, "string", s.as_bytes())
-}
-
-/// An MCAP `Map<String, String>`: u32 byte length of the entries, then key, value, … (sorted by key).
-fn put_string_map(b: &mut Vec<u8>, map: &BTreeMap<String, String>) -> Result<(), WriteError> {
-    let length: usize = map.iter().map(|(k, v)| 8 + k.len() + v.len()).sum();
-    put_u32(b, len32("map", length)?);
-    for (key, value) in map {
-        put_str(b, key)?;
-        put_str(b, value)?;
-    }
-    Ok(())
-}
-
-/// Starts a record: its opcode and a length to be filled in by [`end_record`]; returns where the length
-/// goes.
-fn begin_record(b: &mut Vec<u8>, opcode: u8) -> usize {
-    b.push(opcode);
-    let at = b.len();
-    b.extend_from_slice(&[0; 8]);
-    at
-}
-
-/// Sets the length of the record begun at `at` to everything after its length field.
-fn end_record(b: &mut [u8], at: usize) {
-    let length = (b.len() - at - 8) as u64;
-    b[at..at + 8].copy_from_slice(&length.to_le_bytes());
-}
-
-fn encode_schema(b: &mut Vec<u8>, id: u16, schema: &Schema) -> Result<(), WriteError> {
-    let at = begin_record(b, op::SCHEMA);
-    put_u16(b, id);
-    put_str(b, &schema.name)?;
-    put_str(b, &schema.encoding)?;
-    put_bytes(b, "schema", &schema.data)?;
-    end_record(b, at);
-    Ok(())
-}
-
-fn encode_channel(b: &mut Vec<u8>, id: u16, channel: &ChannelInfo) -> Result<(), WriteError> {
-    let at = begin_record(b, op::CHANNEL);
-    put_u16(b, id);
-    put_u16(b, channel.schema_id);
-    put_str(b, &channel.topic)?;
-    put_str(b, &channel.message_encoding)?;
-    put_string_map(b, &channel.metadata)?;
-    end_record(b, at);
-    Ok(())
 }

@@ -2,14 +2,18 @@
 //! (a second, independent model), [`writers`] (MCAP files written straight from the model, and rewritten
 //! with a defect), [`record`] (reading files back, running the binary), [`process`] (child processes
 //! under a deadline), `other_writers` (recordings rewritten by the Python and TypeScript MCAP writers;
-//! feature `external-readers`); here the repository's paths and an output that fails like a full disk.
+//! feature `external-readers`), [`crafted`] (files crafted to cost a reader memory) and [`rss`] (a
+//! child's peak memory); here the repository's paths and an output that fails like a full disk.
 
+pub mod crafted;
 pub mod newton_euler;
 #[cfg(feature = "external-readers")]
 pub mod other_writers;
 pub mod physics;
 pub mod process;
 pub mod record;
+#[cfg(target_os = "linux")]
+pub mod rss;
 pub mod vectors;
 pub mod writers;
 

@@ -21,7 +21,7 @@ use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::Channel;
 use crate::format::Encoding;
-use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{self, BufWriter, Write};
@@ -163,8 +163,6 @@ struct Wide {
 struct Exporter<'a, W: Write> {
     layout: Layout,
     open: &'a mut dyn FnMut(&str) -> io::Result<W>,
-    /// Each schema's name, encoding and bytes.
-    schemas: BTreeMap<u16, (String, String, Vec<u8>)>,
     /// The field readers of the flat channels.
     readers: Vec<FieldReader>,
     targets: BTreeMap<u16, (String, Target)>,
@@ -192,7 +190,6 @@ pub fn export<W: Write>(
     let mut e = Exporter {
         layout,
         open,
-        schemas: BTreeMap::new(),
         readers: Vec::new(),
         targets: BTreeMap::new(),
         tables: Vec::new(),
@@ -209,7 +206,7 @@ pub fn export<W: Write>(
     }
     if let Some(err) = read_error {
         let detail = match err.kind {
-            ReadErrorKind::Truncated | ReadErrorKind::Corrupt => format!(
+            ReadErrorKind::Truncated | ReadErrorKind::Corrupt | ReadErrorKind::TooLarge => format!(
                 "{}; nothing exported (`coin-log verify` says more about the file)",
                 err.detail
             ),
@@ -268,12 +265,10 @@ impl<W: Write> Exporter<'_, W> {
     }
 
     /// What a channel with this topic and schema (name, encoding, bytes) becomes.
-    fn target(
-        &mut self,
-        topic: &str,
-        (schema, encoding, data): &(String, String, Vec<u8>),
-    ) -> Target {
-        let schema = schema.as_str();
+    fn target(&mut self, topic: &str, schema: Option<&Schema<'_>>) -> Target {
+        let (schema, encoding, data) = schema.map_or(("", "", &[][..]), |s| {
+            (s.name.as_str(), s.encoding.as_str(), &s.data[..])
+        });
         let Some(channel) = Channel::from_topic(topic) else {
             return self.skip(topic, "not a coin-log channel");
         };
@@ -564,13 +559,8 @@ impl<W: Write> Exporter<'_, W> {
 }
 
 impl<W: Write> Visitor for Exporter<'_, W> {
-    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
-        self.schemas
-            .insert(id, (name.to_string(), encoding.to_string(), data.to_vec()));
-    }
-    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, _: &str) {
-        let schema = self.schemas.get(&schema_id).cloned().unwrap_or_default();
-        let target = self.target(topic, &schema);
+    fn channel(&mut self, id: u16, topic: &str, _: &str, schema: Option<&Schema<'_>>) {
+        let target = self.target(topic, schema);
         self.targets.insert(id, (topic.to_string(), target));
     }
     fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}

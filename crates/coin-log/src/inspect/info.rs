@@ -9,7 +9,7 @@
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
-use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Schema, Visitor};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -339,7 +339,6 @@ fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
 /// What the streaming pass gathers.
 #[derive(Default)]
 struct Scan {
-    schemas: BTreeMap<u16, String>,
     channels: BTreeMap<u16, ChannelSummary>,
     metadata: Vec<(String, BTreeMap<String, String>)>,
     counts: BTreeMap<u16, u64>,
@@ -347,15 +346,18 @@ struct Scan {
 }
 
 impl Visitor for Scan {
-    fn schema(&mut self, id: u16, name: &str, _: &str, _: &[u8]) {
-        self.schemas.insert(id, name.to_string());
-    }
-    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
+    fn channel(
+        &mut self,
+        id: u16,
+        topic: &str,
+        message_encoding: &str,
+        schema: Option<&Schema<'_>>,
+    ) {
         self.channels.insert(
             id,
             ChannelSummary {
                 topic: topic.to_string(),
-                schema: self.schemas.get(&schema_id).cloned().unwrap_or_default(),
+                schema: schema.map(|s| s.name.clone()).unwrap_or_default(),
                 message_encoding: message_encoding.to_string(),
                 messages: 0,
                 rate: None,

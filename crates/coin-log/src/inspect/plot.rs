@@ -18,7 +18,7 @@ use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
 use crate::palette::{BLUE, GREEN, GREY, ORANGE, RED};
 use crate::scene::SceneFile;
-use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
@@ -174,8 +174,6 @@ impl Fields<'_> {
 /// Everything the page draws, gathered in one pass.
 #[derive(Default)]
 struct Collect {
-    /// Each schema's name, encoding and bytes.
-    schemas: BTreeMap<u16, (String, String, Vec<u8>)>,
     /// The field reader of each plotted channel id.
     readers: BTreeMap<u16, FieldReader>,
     channels: BTreeMap<u16, Channel>,
@@ -274,12 +272,14 @@ impl Collect {
 }
 
 impl Visitor for Collect {
-    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
-        self.schemas
-            .insert(id, (name.to_string(), encoding.to_string(), data.to_vec()));
-    }
-    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, _: &str) {
-        let Some((schema, encoding, data)) = self.schemas.get(&schema_id) else {
+    fn channel(&mut self, id: u16, topic: &str, _: &str, schema: Option<&Schema<'_>>) {
+        let Some(Schema {
+            name: schema,
+            encoding,
+            data,
+            ..
+        }) = schema
+        else {
             return;
         };
         let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) else {
@@ -369,7 +369,9 @@ pub fn plot(path: &Path, name: &str) -> Result<Plot, PlotError> {
         match e.kind {
             ReadErrorKind::Io | ReadErrorKind::NotMcap => return Err(PlotError(e.detail)),
             ReadErrorKind::Stopped => {}
-            ReadErrorKind::Truncated | ReadErrorKind::Corrupt => broken = Some(e.detail),
+            ReadErrorKind::Truncated | ReadErrorKind::Corrupt | ReadErrorKind::TooLarge => {
+                broken = Some(e.detail);
+            }
         }
     }
     if let Some(p) = c.problem.take() {

@@ -22,8 +22,8 @@ use crate::format::{
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
-use coin_log_mcap::{self, MessageHeader, Problems, ReadErrorKind, Visitor};
-use std::collections::{BTreeMap, BTreeSet};
+use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
+use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::rc::Rc;
@@ -170,24 +170,28 @@ fn foxglove_message(
     }
 }
 
+/// What a channel's schema says about its messages.
+#[derive(Default)]
+struct SchemaJudged {
+    /// The schema's encoding (absent for an encoding coin-log does not write).
+    encoding: Option<Encoding>,
+    /// It is the first version of a `coin_log.*` type.
+    first_version: bool,
+    /// The decoder of a Protobuf `coin_log.*` schema.
+    decoder: Option<Rc<MessageDecoder>>,
+}
+
 /// The visitor that judges one log while it streams by.
 #[derive(Default)]
 struct Judge {
     channels: Vec<Option<ChannelState>>,
-    schemas: BTreeMap<u16, String>,
-    /// Ids of schemas that are the first version of a `coin_log.*` type.
-    first_versions: BTreeSet<u16>,
-    /// Each schema's encoding (absent for an encoding coin-log does not write).
-    encodings: BTreeMap<u16, Encoding>,
-    /// The decoder of each Protobuf `coin_log.*` schema.
-    decoders: BTreeMap<u16, Rc<MessageDecoder>>,
     ctx: Option<Context>,
     /// The `coin-log.result` record, kept until the end (it may come before or after `coin-log`).
     result: Option<ResultMetadata>,
     run_error: Option<String>,
     result_error: Option<String>,
     library: String,
-    problems: Problems,
+    problems: BoundedFindings,
     notes: Vec<String>,
     assembler: Assembler,
     checks: Checks,
@@ -321,58 +325,14 @@ impl Visitor for Judge {
         self.library = library.to_string();
     }
 
-    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
-        self.schemas.insert(id, name.to_string());
-        match Encoding::from_schema_encoding(encoding) {
-            Some(Encoding::Json) => {
-                self.encodings.insert(id, Encoding::Json);
-            }
-            Some(Encoding::Protobuf) => {
-                self.encodings.insert(id, Encoding::Protobuf);
-                self.protobuf_schema(id, name, data);
-                return;
-            }
-            None => {
-                self.problems.push_with(|| {
-                    format!(
-                        "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
-                        Encoding::Json.schema_encoding(),
-                        Encoding::Protobuf.schema_encoding()
-                    )
-                });
-                return;
-            }
-        }
-        match schema_bytes(name) {
-            Some(ours) if ours == data => {}
-            Some(_) => match fields_of(name) {
-                Some((fields, first)) => match validates(data, fields) {
-                    Ok(()) => self.notes.push(format!(
-                        "schema `{name}` is another version than this tool's; the messages conform to it"
-                    )),
-                    Err(e) if fields != first && validates(data, first).is_ok() => {
-                        self.first_versions.insert(id);
-                        self.notes.push(format!(
-                            "schema `{name}` is the first version of the type, without the fields added since ({}); the messages conform to it",
-                            fields[first.len()..].join(", ")
-                        ));
-                        let _ = e;
-                    }
-                    Err(e) => self.problems.push_with(|| {
-                        format!("schema `{name}` is another version than this tool's and {e}")
-                    }),
-                },
-                None => self.notes.push(format!(
-                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
-                )),
-            },
-            None => self
-                .problems
-                .push_with(|| format!("schema `{name}` is not one of coin-log's")),
-        }
-    }
-
-    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
+    fn channel(
+        &mut self,
+        id: u16,
+        topic: &str,
+        message_encoding: &str,
+        schema: Option<&Schema<'_>>,
+    ) {
+        let judged = schema.map(|s| self.schema(s)).unwrap_or_default();
         let kind = match Topic::from_name(topic) {
             None => {
                 self.problems
@@ -380,7 +340,7 @@ impl Visitor for Judge {
                 Kind::Unknown
             }
             Some(t) => {
-                let schema = self.schemas.get(&schema_id).map_or("", String::as_str);
+                let schema = schema.map_or("", |s| s.name.as_str());
                 if schema != t.schema_name() {
                     self.problems.push_with(|| {
                         format!(
@@ -389,9 +349,8 @@ impl Visitor for Judge {
                         )
                     });
                 }
-                let expected = self
-                    .encodings
-                    .get(&schema_id)
+                let expected = judged
+                    .encoding
                     .map_or(MESSAGE_ENCODING, |e| e.message_encoding());
                 if message_encoding != expected {
                     self.problems.push_with(|| {
@@ -419,14 +378,13 @@ impl Visitor for Judge {
         if self.channels.len() <= i {
             self.channels.resize(i + 1, None);
         }
-        let encoding = self.encodings.get(&schema_id).copied().unwrap_or_default();
         self.channels[i] = Some(ChannelState {
             kind,
             topic: topic.to_string(),
             last: None,
-            first_version: self.first_versions.contains(&schema_id),
-            encoding,
-            decoder: self.decoders.get(&schema_id).cloned(),
+            first_version: judged.first_version,
+            encoding: judged.encoding.unwrap_or_default(),
+            decoder: judged.decoder,
         });
     }
 
@@ -560,7 +518,7 @@ impl Judge {
     /// Checks a Protobuf schema: a `coin_log.*` type's descriptor must declare its fields (the current
     /// version's, or the first's) as doubles, and gives the decoder of its messages; a Foxglove type's is
     /// taken as it is.
-    fn protobuf_schema(&mut self, id: u16, name: &str, data: &[u8]) {
+    fn protobuf_schema(&mut self, name: &str, data: &[u8], judged: &mut SchemaJudged) {
         let ours = protobuf::descriptor_set(name);
         let Some((fields, first)) = fields_of(name) else {
             match ours {
@@ -578,7 +536,7 @@ impl Judge {
             Ok(d) => d,
             Err(e) => match MessageDecoder::new(data, name, first) {
                 Ok(d) if fields != first => {
-                    self.first_versions.insert(id);
+                    judged.first_version = true;
                     self.notes.push(format!(
                         "schema `{name}` is the first version of the type, without the fields added since ({})",
                         fields[first.len()..].join(", ")
@@ -592,12 +550,69 @@ impl Judge {
                 }
             },
         };
-        if ours != Some(data) && !self.first_versions.contains(&id) {
+        if ours != Some(data) && !judged.first_version {
             self.notes.push(format!(
                 "schema `{name}` is another version than this tool's; its messages are read by the field numbers it declares"
             ));
         }
-        self.decoders.insert(id, Rc::new(decoder));
+        judged.decoder = Some(Rc::new(decoder));
+    }
+
+    /// Judges a channel's schema: its encoding, and its bytes against this tool's (or the versions its
+    /// messages may follow).
+    fn schema(&mut self, schema: &Schema<'_>) -> SchemaJudged {
+        let (name, encoding, data) = (
+            schema.name.as_str(),
+            schema.encoding.as_str(),
+            &schema.data[..],
+        );
+        let mut judged = SchemaJudged::default();
+        match Encoding::from_schema_encoding(encoding) {
+            Some(Encoding::Json) => judged.encoding = Some(Encoding::Json),
+            Some(Encoding::Protobuf) => {
+                judged.encoding = Some(Encoding::Protobuf);
+                self.protobuf_schema(name, data, &mut judged);
+                return judged;
+            }
+            None => {
+                self.problems.push_with(|| {
+                    format!(
+                        "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
+                        Encoding::Json.schema_encoding(),
+                        Encoding::Protobuf.schema_encoding()
+                    )
+                });
+                return judged;
+            }
+        }
+        match schema_bytes(name) {
+            Some(ours) if ours == data => {}
+            Some(_) => match fields_of(name) {
+                Some((fields, first)) => match validates(data, fields) {
+                    Ok(()) => self.notes.push(format!(
+                        "schema `{name}` is another version than this tool's; the messages conform to it"
+                    )),
+                    Err(e) if fields != first && validates(data, first).is_ok() => {
+                        judged.first_version = true;
+                        self.notes.push(format!(
+                            "schema `{name}` is the first version of the type, without the fields added since ({})",
+                            fields[first.len()..].join(", ")
+                        ));
+                        let _ = e;
+                    }
+                    Err(e) => self.problems.push_with(|| {
+                        format!("schema `{name}` is another version than this tool's and {e}")
+                    }),
+                },
+                None => self.notes.push(format!(
+                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
+                )),
+            },
+            None => self
+                .problems
+                .push_with(|| format!("schema `{name}` is not one of coin-log's")),
+        }
+        judged
     }
 
     fn topic(&self, id: u16) -> String {
@@ -657,9 +672,12 @@ fn verdict(
         }
     }
     // A truncated or corrupt file is judged on what could be read, and is unusable (exit 2).
-    let read_problem = error
-        .as_ref()
-        .filter(|e| matches!(e.kind, ReadErrorKind::Truncated | ReadErrorKind::Corrupt));
+    let read_problem = error.as_ref().filter(|e| {
+        matches!(
+            e.kind,
+            ReadErrorKind::Truncated | ReadErrorKind::Corrupt | ReadErrorKind::TooLarge
+        )
+    });
     let Some(mut ctx) = judge.ctx.take() else {
         let why = match (judge.run_error.take(), read_problem) {
             (Some(run), Some(e)) => format!("{run}; {e}"),
@@ -731,7 +749,7 @@ impl Judge {
         ctx: &Context,
         read_whole: bool,
         read_problem: Option<&String>,
-    ) -> Problems {
+    ) -> BoundedFindings {
         if let Some(e) = &self.result_error {
             self.problems
                 .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));

@@ -4,11 +4,11 @@
 //! The value is the number of problems found; the tolerance is 0.
 
 use crate::verify::report::{CheckId, CheckResult};
-use coin_log_mcap::Problems;
+use coin_log_mcap::BoundedFindings;
 
 /// The integrity result from the problems found and a description of what was read.
 #[must_use]
-pub fn finish(problems: &Problems, read: &str, notes: &[String]) -> CheckResult {
+pub fn finish(problems: &BoundedFindings, read: &str, notes: &[String]) -> CheckResult {
     let mut reason = if problems.is_empty() {
         format!("{read}: structure, indexes, CRCs, statistics, schemas, message shapes and times are consistent")
     } else {

@@ -13,7 +13,9 @@
 //!    channels and messages there), so chunks are skipped unread and the scan costs a few reads per chunk.
 //!
 //! Both are bounded by the file: the summary is read once, metadata records are read only where they do
-//! not overlap one already read, and the scan visits each byte at most once. The records found are passed
+//! not overlap one already read, and the scan visits each byte at most once. What they keep counts
+//! against the reader's budget (`budget`): a metadata record larger than the largest record the reader
+//! accepts, or more metadata than it keeps, ends the search with [`Lookahead::too_large`]. The records found are passed
 //! to the visitor before the first message; the stream then recognises them by offset and does not pass
 //! them again. A seekable source is required: a pipe cannot be read twice, and buffering the messages
 //! until a late metadata record arrives would hold the whole file in memory for a file whose metadata
@@ -22,29 +24,25 @@
 //! Nothing here is trusted: a record that is not what the index says is ignored (the stream's checks of
 //! the indexes against the records report it), an I/O error ends the search (the stream reports it).
 
-use super::wire::{self, Cursor, MAGIC};
-use mcap::records::op;
-use std::collections::BTreeMap;
+use crate::budget::{Kept, MAX_RECORD_BYTES};
+use crate::digest::Digest;
+use crate::reader::ReadError;
+use crate::records::{self, Record, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
+use mcap::records::{op, Footer, Metadata, MetadataIndex};
 use std::io::{self, Read, Seek, SeekFrom};
 
-/// Bytes of an opcode and a record length.
-const PREFIX: u64 = 9;
-/// Bytes of the footer record (prefix and three fields) before the end magic.
-const FOOTER_RECORD: u64 = PREFIX + 8 + 8 + 4;
 /// Most metadata records passed on ahead of the stream (further ones come with the stream).
 const MAX_EARLY: usize = 1024;
 
 /// One metadata record found ahead of the stream.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) struct EarlyMetadata {
+pub(crate) struct FoundMetadata {
     /// Offset of the record (its opcode) in the file.
     pub(crate) at: u64,
-    /// Its body, as the stream will see it.
-    pub(crate) body: Vec<u8>,
-    /// The record's name.
-    pub(crate) name: String,
-    /// Its entries.
-    pub(crate) entries: BTreeMap<String, String>,
+    /// The digest of its body, to recognise it in the stream.
+    pub(crate) digest: Digest,
+    /// The record.
+    pub(crate) record: Metadata,
 }
 
 /// How the search ended without reaching the end of the data section.
@@ -65,10 +63,10 @@ pub(crate) enum ScanEnd {
 }
 
 /// What was learned before the stream.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Prelude {
+#[derive(Debug, Default)]
+pub(crate) struct Lookahead {
     /// The metadata records found, in file order.
-    pub(crate) metadata: Vec<EarlyMetadata>,
+    pub(crate) metadata: Vec<FoundMetadata>,
     /// The first bytes of the file are the MCAP magic, or its beginning when the file is shorter.
     pub(crate) magic_prefix: bool,
     /// The file ends with the MCAP magic (its last 8 bytes, not those of the start).
@@ -77,40 +75,53 @@ pub(crate) struct Prelude {
     pub(crate) indexed: bool,
     /// Where the scan stopped early, when it ran and did.
     pub(crate) scan_end: Option<ScanEnd>,
+    /// The metadata found exceeds the reader's budget (the search stopped there).
+    pub(crate) too_large: Option<ReadError>,
 }
 
-/// Looks for the metadata records of the MCAP file of `len` bytes in `source` (see the module doc).
-/// Leaves the source at an unspecified position.
-pub(crate) fn find(source: &mut (impl Read + Seek), len: u64) -> Prelude {
-    let mut p = Prelude::default();
-    let mut head = [0u8; 8];
-    let n = usize::try_from(len.min(8)).unwrap_or(8);
+/// Looks for the metadata records of the MCAP file of `len` bytes in `source` (see the module doc),
+/// counting them in `kept`. Leaves the source at an unspecified position.
+pub(crate) fn find(source: &mut (impl Read + Seek), len: u64, kept: &mut Kept) -> Lookahead {
+    let mut p = Lookahead::default();
+    let mut head = [0u8; MAGIC_LEN as usize];
+    let n = usize::try_from(len.min(MAGIC_LEN)).unwrap_or(0);
     if read_at(source, 0, &mut head[..n]).is_err() {
         return p;
     }
     p.magic_prefix = head[..n] == MAGIC[..n];
-    if len < 8 || !p.magic_prefix {
+    if len < MAGIC_LEN || !p.magic_prefix {
         return p;
     }
     // The end magic is a second copy: a file of 8 to 15 bytes holds only the first.
-    let mut tail = [0u8; 8];
-    p.ends_with_magic = len >= 16 && read_at(source, len - 8, &mut tail).is_ok() && tail == MAGIC;
+    let mut tail = [0u8; MAGIC_LEN as usize];
+    p.ends_with_magic = len >= 2 * MAGIC_LEN
+        && read_at(source, len - MAGIC_LEN, &mut tail).is_ok()
+        && tail == MAGIC;
     if p.ends_with_magic {
         if let Some(indexes) = summary_metadata_indexes(source, len) {
             if !indexes.is_empty() {
-                let (metadata, all_valid) = read_indexed(source, len, indexes);
-                if all_valid {
-                    p.indexed = true;
-                    p.metadata = metadata;
-                    return p;
+                // Counted aside: if the index proves untrustworthy, the scan counts them again.
+                let mut found = kept.clone();
+                match read_indexed(source, len, indexes, &mut found) {
+                    Ok(Some(metadata)) => {
+                        p.indexed = true;
+                        p.metadata = metadata;
+                        *kept = found;
+                        return p;
+                    }
+                    Err(e) => {
+                        p.too_large = Some(e);
+                        return p;
+                    }
+                    // An index entry that points at no metadata record of its length (e.g. @mcap/core
+                    // 2.2's unchunked writer records the offset of the messages it still buffers): the
+                    // index cannot be trusted to list them all; the scan finds them where they are.
+                    Ok(None) => {}
                 }
-                // An index entry that points at no metadata record of its length (e.g. @mcap/core 2.2's
-                // unchunked writer records the offset of the messages it still buffers): the index
-                // cannot be trusted to list them all; the scan finds them where they are.
             }
         }
     }
-    scan(source, len, &mut p);
+    scan(source, len, &mut p, kept);
     p
 }
 
@@ -119,28 +130,42 @@ fn read_at(source: &mut (impl Read + Seek), at: u64, buf: &mut [u8]) -> io::Resu
     source.read_exact(buf)
 }
 
-/// Reads the 9-byte prefix at the reader's position: (opcode, length), or `None` at a short read.
+/// Reads the record prefix at the reader's position: (opcode, body length), or `None` at a short read.
 fn prefix(r: &mut impl Read) -> Option<(u8, u64)> {
-    let mut b = [0u8; 9];
+    let mut b = [0u8; PREFIX_LEN as usize];
     r.read_exact(&mut b).ok()?;
-    let mut len = [0u8; 8];
-    len.copy_from_slice(&b[1..]);
-    Some((b[0], u64::from_le_bytes(len)))
+    records::prefix(&b)
+}
+
+/// Reads a body of `len` bytes at the reader's position; `None` if it is larger than the reader
+/// accepts or cannot be read.
+fn body(r: &mut impl Read, len: u64) -> Option<Vec<u8>> {
+    if len > MAX_RECORD_BYTES {
+        return None;
+    }
+    let mut body = vec![0u8; usize::try_from(len).ok()?];
+    r.read_exact(&mut body).ok()?;
+    Some(body)
+}
+
+/// The footer of the MCAP file of `len` bytes and where it starts, if it has a readable one.
+pub(crate) fn footer(source: &mut (impl Read + Seek), len: u64) -> Option<(Footer, u64)> {
+    let at = len.checked_sub(MAGIC_LEN + FOOTER_LEN)?;
+    source.seek(SeekFrom::Start(at)).ok()?;
+    match prefix(source)? {
+        (op::FOOTER, n) if n == FOOTER_LEN - PREFIX_LEN => {
+            Some((Footer::parse_body(&body(source, n)?).ok()?, at))
+        }
+        _ => None,
+    }
 }
 
 /// The (offset, length) of every MetadataIndex record of the summary, or `None` when the file has no
 /// readable footer or summary.
 fn summary_metadata_indexes(source: &mut (impl Read + Seek), len: u64) -> Option<Vec<(u64, u64)>> {
-    let footer_at = len.checked_sub(8 + FOOTER_RECORD)?;
-    source.seek(SeekFrom::Start(footer_at)).ok()?;
-    let (opcode, body_len) = prefix(source)?;
-    if opcode != op::FOOTER || body_len != FOOTER_RECORD - PREFIX {
-        return None;
-    }
-    let mut summary_start = [0u8; 8];
-    source.read_exact(&mut summary_start).ok()?;
-    let summary_start = u64::from_le_bytes(summary_start);
-    if summary_start < 8 || summary_start >= footer_at {
+    let (footer, footer_at) = footer(source, len)?;
+    let summary_start = footer.summary_start;
+    if summary_start < MAGIC_LEN || summary_start >= footer_at {
         return None;
     }
     // Walk the summary's records up to the footer, reading only the metadata indexes.
@@ -150,16 +175,13 @@ fn summary_metadata_indexes(source: &mut (impl Read + Seek), len: u64) -> Option
     let mut found = Vec::new();
     while at < footer_at {
         let (opcode, body_len) = prefix(&mut r)?;
-        let end = (at + PREFIX).checked_add(body_len)?;
+        let end = (at + PREFIX_LEN).checked_add(body_len)?;
         if end > footer_at {
             return Some(found);
         }
         if opcode == op::METADATA_INDEX && found.len() < MAX_EARLY {
-            let mut body = vec![0u8; usize::try_from(body_len).ok()?];
-            r.read_exact(&mut body).ok()?;
-            let mut c = Cursor::new(&body);
-            if let (Ok(offset), Ok(length)) = (c.u64("offset"), c.u64("length")) {
-                found.push((offset, length));
+            if let Ok(i) = MetadataIndex::parse_body(&body(&mut r, body_len)?) {
+                found.push((i.offset, i.length));
             }
         } else {
             r.seek_relative(i64::try_from(body_len).ok()?).ok()?;
@@ -170,83 +192,70 @@ fn summary_metadata_indexes(source: &mut (impl Read + Seek), len: u64) -> Option
 }
 
 /// Reads the metadata records the index points at: in file order, each once, never two that overlap
-/// (so that no byte is read twice), each checked to be a metadata record of the indexed length. Also says
-/// whether every entry pointed at such a record (a repeated entry counts as valid).
-fn read_indexed(
+/// (so that no byte is read twice), each checked to be a metadata record of the indexed length, and
+/// counted in `kept`. `None` when an entry points at no such record (a repeated entry counts as valid).
+///
+/// # Errors
+/// [`ReadError`] (too large) when they exceed the budget.
+pub(crate) fn read_indexed(
     source: &mut (impl Read + Seek),
     len: u64,
     mut indexes: Vec<(u64, u64)>,
-) -> (Vec<EarlyMetadata>, bool) {
+    kept: &mut Kept,
+) -> Result<Option<Vec<FoundMetadata>>, ReadError> {
     indexes.sort_unstable();
     indexes.dedup();
-    let mut out: Vec<EarlyMetadata> = Vec::new();
-    let mut free_from = 8;
+    let mut out: Vec<FoundMetadata> = Vec::new();
+    let mut free_from = MAGIC_LEN;
     for (at, length) in indexes {
         let end = at.saturating_add(length);
-        if at < free_from || end > len || length < PREFIX {
-            return (out, false);
+        if at < free_from || end > len || length < PREFIX_LEN {
+            return Ok(None);
         }
         let record = source
             .seek(SeekFrom::Start(at))
             .ok()
             .and_then(|_| prefix(source))
-            .filter(|(opcode, body_len)| *opcode == op::METADATA && *body_len == length - PREFIX)
-            .and_then(|(_, body_len)| read_metadata_body(source, at, body_len));
-        match record {
-            Some(m) => {
-                out.push(m);
-                free_from = end;
-            }
-            None => return (out, false),
-        }
+            .filter(|(opcode, body_len)| {
+                *opcode == op::METADATA && *body_len == length - PREFIX_LEN
+            })
+            .and_then(|(_, body_len)| read_metadata(source, at, body_len));
+        let Some(m) = record else {
+            return Ok(None);
+        };
+        kept.charge(length, m.record.metadata.len(), at)?;
+        out.push(m);
+        free_from = end;
     }
-    (out, true)
+    Ok(Some(out))
 }
 
 /// Reads and parses the body of the metadata record at `at` from the reader's position.
-fn read_metadata_body(r: &mut impl Read, at: u64, body_len: u64) -> Option<EarlyMetadata> {
-    let mut body = vec![0u8; usize::try_from(body_len).ok()?];
-    r.read_exact(&mut body).ok()?;
-    let (name, entries) = parse_metadata(&body).ok()?;
-    Some(EarlyMetadata {
+fn read_metadata(r: &mut impl Read, at: u64, body_len: u64) -> Option<FoundMetadata> {
+    let body = body(r, body_len)?;
+    let record = Metadata::parse_body(&body).ok()?;
+    Some(FoundMetadata {
         at,
-        body,
-        name,
-        entries,
+        digest: Digest::of(&body),
+        record,
     })
-}
-
-/// A metadata record's name and entries (invalid UTF-8 read as empty, as the stream reads it).
-pub(crate) fn parse_metadata(
-    body: &[u8],
-) -> Result<(String, BTreeMap<String, String>), wire::WireError> {
-    let mut c = Cursor::new(body);
-    let name = c.string("name")?.unwrap_or("").to_string();
-    let mut entries = BTreeMap::new();
-    wire::for_each_entry(&mut c, "metadata", |e| {
-        let k = e.string("key")?.unwrap_or("");
-        let v = e.string("value")?.unwrap_or("");
-        entries.insert(k.to_string(), v.to_string());
-        Ok(())
-    })?;
-    Ok((name, entries))
 }
 
 /// Walks the top-level records from the header to DataEnd (or the footer), reading metadata records and
 /// skipping everything else; notes where it stopped if the file ends or a record is impossible first.
-fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Prelude) {
-    if source.seek(SeekFrom::Start(8)).is_err() {
+fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Lookahead, kept: &mut Kept) {
+    if source.seek(SeekFrom::Start(MAGIC_LEN)).is_err() {
         return;
     }
     let mut r = io::BufReader::new(source);
-    let mut at = 8;
+    let mut at = MAGIC_LEN;
     loop {
         if at == len {
             p.scan_end = Some(ScanEnd::Cut { at, claimed: None });
             return;
         }
         let Some((opcode, body_len)) = prefix(&mut r) else {
-            let end = if len - at < PREFIX {
+            let end = if len - at < PREFIX_LEN {
                 ScanEnd::Cut { at, claimed: None }
             } else {
                 ScanEnd::Malformed { at }
@@ -254,7 +263,7 @@ fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Prelude) {
             p.scan_end = Some(end);
             return;
         };
-        let end = (at + PREFIX).saturating_add(body_len);
+        let end = (at + PREFIX_LEN).saturating_add(body_len);
         if end > len {
             p.scan_end = Some(ScanEnd::Cut {
                 at,
@@ -264,14 +273,18 @@ fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Prelude) {
         }
         match opcode {
             op::DATA_END | op::FOOTER => return,
+            // One too large to read: the stream refuses it where it stands.
+            op::METADATA if body_len > MAX_RECORD_BYTES => return,
             op::METADATA if p.metadata.len() < MAX_EARLY => {
-                match read_metadata_body(&mut r, at, body_len) {
-                    Some(m) => p.metadata.push(m),
-                    None => {
-                        p.scan_end = Some(ScanEnd::Malformed { at });
-                        return;
-                    }
+                let Some(m) = read_metadata(&mut r, at, body_len) else {
+                    p.scan_end = Some(ScanEnd::Malformed { at });
+                    return;
+                };
+                if let Err(e) = kept.charge(PREFIX_LEN + body_len, m.record.metadata.len(), at) {
+                    p.too_large = Some(e);
+                    return;
                 }
+                p.metadata.push(m);
             }
             _ => {
                 let Ok(skip) = i64::try_from(body_len) else {
@@ -293,55 +306,61 @@ mod tests {
     use super::*;
     use std::io::Cursor as IoCursor;
 
-    fn record(opcode: u8, body: &[u8]) -> Vec<u8> {
-        let mut r = vec![opcode];
-        r.extend_from_slice(&(body.len() as u64).to_le_bytes());
-        r.extend_from_slice(body);
-        r
+    use mcap::records::{DataEnd, Header};
+    use std::collections::BTreeMap;
+
+    fn encoded<'a>(r: &impl Record<'a>) -> Vec<u8> {
+        let mut out = Vec::new();
+        r.encode_record(&mut out).unwrap();
+        out
     }
 
-    fn string(s: &str) -> Vec<u8> {
-        let mut b = (s.len() as u32).to_le_bytes().to_vec();
-        b.extend_from_slice(s.as_bytes());
-        b
+    fn metadata() -> Vec<u8> {
+        encoded(&Metadata {
+            name: "coin-log".into(),
+            metadata: BTreeMap::from([("k".into(), "v".into())]),
+        })
     }
 
-    fn metadata(name: &str, key: &str, value: &str) -> Vec<u8> {
-        let mut entries = string(key);
-        entries.extend(string(value));
-        let mut body = string(name);
-        body.extend((entries.len() as u32).to_le_bytes());
-        body.extend(entries);
-        record(op::METADATA, &body)
+    fn index(offset: u64, length: u64) -> Vec<u8> {
+        let name = "coin-log".into();
+        encoded(&MetadataIndex {
+            offset,
+            length,
+            name,
+        })
+    }
+
+    fn footer(summary_start: u64) -> Vec<u8> {
+        let mut f = encoded(&Footer {
+            summary_start,
+            ..Footer::default()
+        });
+        f.extend(MAGIC);
+        f
     }
 
     /// Magic, header, a fake chunk of `chunk` bytes, a metadata record, DataEnd; with a summary holding a
     /// metadata index when `indexed`, then the footer and the end magic.
     fn file(chunk: usize, indexed: bool) -> (Vec<u8>, u64) {
         let mut f = MAGIC.to_vec();
-        let mut header = string("");
-        header.extend(string("test"));
-        f.extend(record(op::HEADER, &header));
-        f.extend(record(op::CHUNK, &vec![0u8; chunk]));
+        f.extend(encoded(&Header {
+            profile: String::new(),
+            library: "test".into(),
+        }));
+        f.push(op::CHUNK);
+        f.extend((chunk as u64).to_le_bytes());
+        f.extend(vec![0u8; chunk]);
         let at = f.len() as u64;
-        let m = metadata("coin-log", "k", "v");
+        let m = metadata();
         let m_len = m.len() as u64;
         f.extend(m);
-        f.extend(record(op::DATA_END, &[0; 4]));
+        f.extend(encoded(&DataEnd::default()));
         let summary_start = f.len() as u64;
         if indexed {
-            let mut idx = at.to_le_bytes().to_vec();
-            idx.extend(m_len.to_le_bytes());
-            idx.extend(string("coin-log"));
-            f.extend(record(op::METADATA_INDEX, &idx));
+            f.extend(index(at, m_len));
         }
-        let mut footer = if indexed { summary_start } else { 0 }
-            .to_le_bytes()
-            .to_vec();
-        footer.extend(0u64.to_le_bytes());
-        footer.extend(0u32.to_le_bytes());
-        f.extend(record(op::FOOTER, &footer));
-        f.extend(MAGIC);
+        f.extend(footer(if indexed { summary_start } else { 0 }));
         (f, at)
     }
 
@@ -349,13 +368,13 @@ mod tests {
     fn a_late_metadata_record_is_found_through_the_index_and_by_the_scan() {
         for indexed in [true, false] {
             let (f, at) = file(5000, indexed);
-            let p = find(&mut IoCursor::new(&f), f.len() as u64);
+            let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
             assert_eq!(p.indexed, indexed);
             assert!(p.ends_with_magic && p.magic_prefix && p.scan_end.is_none());
             assert_eq!(p.metadata.len(), 1, "indexed {indexed}");
             assert_eq!(p.metadata[0].at, at);
-            assert_eq!(p.metadata[0].name, "coin-log");
-            assert_eq!(p.metadata[0].entries["k"], "v");
+            assert_eq!(p.metadata[0].record.name, "coin-log");
+            assert_eq!(p.metadata[0].record.metadata["k"], "v");
         }
     }
 
@@ -365,7 +384,11 @@ mod tests {
         // Cut inside the chunk (after the magic and the 21-byte header record): its claimed length runs
         // past the end.
         let cut = &f[..3000];
-        let p = find(&mut IoCursor::new(cut), cut.len() as u64);
+        let p = find(
+            &mut IoCursor::new(cut),
+            cut.len() as u64,
+            &mut Kept::default(),
+        );
         assert!(!p.ends_with_magic && p.metadata.is_empty());
         assert_eq!(
             p.scan_end,
@@ -375,7 +398,7 @@ mod tests {
             })
         );
         // Cut inside a record prefix, and inside the magic.
-        let p = find(&mut IoCursor::new(&f[..12]), 12);
+        let p = find(&mut IoCursor::new(&f[..12]), 12, &mut Kept::default());
         assert_eq!(
             p.scan_end,
             Some(ScanEnd::Cut {
@@ -383,7 +406,7 @@ mod tests {
                 claimed: None
             })
         );
-        let p = find(&mut IoCursor::new(&f[..5]), 5);
+        let p = find(&mut IoCursor::new(&f[..5]), 5, &mut Kept::default());
         assert!(p.magic_prefix && p.scan_end.is_none());
     }
 
@@ -391,21 +414,15 @@ mod tests {
     fn index_entries_pointing_at_the_same_bytes_are_read_once() {
         let (mut f, at) = file(10, false);
         // Rebuild the summary with 1000 index entries for the same record, and a footer pointing at it.
-        let tail = f.len() - 8 - FOOTER_RECORD as usize;
+        let tail = f.len() - 8 - FOOTER_LEN as usize;
         f.truncate(tail);
         let summary_start = f.len() as u64;
-        let m_len = metadata("coin-log", "k", "v").len() as u64;
+        let m_len = metadata().len() as u64;
         for _ in 0..1000 {
-            let mut idx = at.to_le_bytes().to_vec();
-            idx.extend(m_len.to_le_bytes());
-            idx.extend(string("coin-log"));
-            f.extend(record(op::METADATA_INDEX, &idx));
+            f.extend(index(at, m_len));
         }
-        let mut footer = summary_start.to_le_bytes().to_vec();
-        footer.extend([0u8; 12]);
-        f.extend(record(op::FOOTER, &footer));
-        f.extend(MAGIC);
-        let p = find(&mut IoCursor::new(&f), f.len() as u64);
+        f.extend(footer(summary_start));
+        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
         assert!(p.indexed);
         assert_eq!(p.metadata.len(), 1);
     }
@@ -414,10 +431,10 @@ mod tests {
     fn an_index_entry_pointing_elsewhere_sends_the_search_to_the_scan() {
         let (mut f, at) = file(64, true);
         // Point the index entry at the chunk instead of the metadata record.
-        let tail = f.len() - 8 - FOOTER_RECORD as usize;
+        let tail = f.len() - 8 - FOOTER_LEN as usize;
         let entry = (tail - 9 - 8 - 8 - 4 - 8) + 9;
         f[entry..entry + 8].copy_from_slice(&29u64.to_le_bytes());
-        let p = find(&mut IoCursor::new(&f), f.len() as u64);
+        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
         assert!(!p.indexed);
         assert_eq!(p.metadata.len(), 1);
         assert_eq!(p.metadata[0].at, at);

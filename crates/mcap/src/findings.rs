@@ -2,20 +2,31 @@
 
 /// How many findings are kept in full.
 const KEPT: usize = 8;
+/// Longest finding kept \[bytes\]: a finding may quote a name from the file, which may be megabytes.
+const LONGEST: usize = 1024;
 
 /// Findings of one check, bounded in memory whatever the file holds.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Problems {
+pub struct BoundedFindings {
     first: Vec<String>,
     total: u64,
 }
 
-impl Problems {
+impl BoundedFindings {
     /// Records a finding; `describe` runs only while the list has room.
     pub fn push_with(&mut self, describe: impl FnOnce() -> String) {
         self.total += 1;
         if self.first.len() < KEPT {
-            self.first.push(describe());
+            let mut finding = describe();
+            if finding.len() > LONGEST {
+                let mut end = LONGEST;
+                while !finding.is_char_boundary(end) {
+                    end -= 1;
+                }
+                finding.truncate(end);
+                finding.push('…');
+            }
+            self.first.push(finding);
         }
     }
 
@@ -32,7 +43,7 @@ impl Problems {
     }
 
     /// Appends the other list's findings.
-    pub fn extend(&mut self, other: &Problems) {
+    pub fn extend(&mut self, other: &BoundedFindings) {
         for p in &other.first {
             if self.first.len() < KEPT {
                 self.first.push(p.clone());
@@ -50,5 +61,21 @@ impl Problems {
             s.push_str(&format!("; and {more} more"));
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_finding_is_cut_and_the_rest_counted() {
+        let mut f = BoundedFindings::default();
+        for _ in 0..10 {
+            f.push_with(|| "é".repeat(LONGEST));
+        }
+        assert_eq!(f.total(), 10);
+        assert!(f.first.iter().all(|s| s.len() <= LONGEST + '…'.len_utf8()));
+        assert!(f.summary().ends_with("; and 2 more"));
     }
 }
