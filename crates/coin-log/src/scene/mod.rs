@@ -15,7 +15,7 @@ pub use file::{
     BodyFile, DissipationFile, InitialFile, PerturbationFile, RecordFile, RunFile, SceneFile,
     SteadyFile,
 };
-pub use overrides::{apply_set, FlagOverrides};
+pub use overrides::{apply_set, set_value, FlagOverrides};
 pub use validate::UNEXPLAINED;
 
 use crate::format::Channel;
@@ -323,7 +323,11 @@ pub fn file_with_sets(file: &SceneFile, sets: &[String]) -> Result<SceneFile, Sc
     file_from_table(table)
 }
 
-fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
+/// A scene table (after edits) as a raw scene file, not yet validated.
+///
+/// # Errors
+/// [`SceneError::Parse`] for a key or type that does not fit (serde's message, on one line).
+pub fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
     toml::Value::Table(table)
         .try_into::<SceneFile>()
         .map_err(|e| SceneError::Parse(e.to_string().trim().replace('\n', " ")))
