@@ -19,4 +19,5 @@ pub mod model;
 pub mod record;
 pub mod scene;
 pub mod simulation;
+pub mod sweep;
 pub mod verify;
