@@ -44,6 +44,7 @@ mod scenes;
 mod second_model;
 mod stability;
 mod steady_states;
+mod sweep;
 mod verify;
 mod verify_bad_input;
 mod writer;

@@ -22,10 +22,11 @@ pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, ProblemList
     let places = places(&file);
     let base_table = c.base(&file.base, folder);
     let set = c.set(&file.set);
-    let axes: Vec<Axis> = (file.axis.iter().enumerate())
-        .filter_map(|(i, a)| c.axis(i, a))
+    let parsed: Vec<Option<Axis>> = (file.axis.iter().enumerate())
+        .map(|(i, a)| c.axis(i, a))
         .collect();
-    let dimensions = c.dimensions(&file.axis, &axes);
+    let dimensions = c.dimensions(&parsed);
+    let axes: Vec<Axis> = parsed.into_iter().flatten().collect();
     let random = file.random.as_ref().and_then(|r| c.random(r));
     let settings = c.settings(&file.output.unwrap_or_default());
     let mut sweep = Sweep {
@@ -154,11 +155,20 @@ impl Checker {
                     value.to_string(),
                     "is not a dotted scene key like \"run.duration\"",
                 );
-            } else if value.is_table() && !key.contains('.') {
-                self.problem(format!("set.{key}"), value.to_string(), format!(
-                    "is a table: TOML reads an unquoted dotted key as nested tables, which would replace the \
-                     whole `{key}` table; quote the key so that it names one scene key, as in \
-                     set = {{ \"{key}.name\" = value }}"));
+            } else if let (Some(inner), false) = (value.as_table(), key.contains('.')) {
+                let example = inner.iter().next().map_or_else(
+                    || format!("\"{key}.name\" = value"),
+                    |(k, v)| format!("\"{key}.{k}\" = {v}"),
+                );
+                self.problem(
+                    format!("set.{key}"),
+                    value.to_string(),
+                    format!(
+                        "is a table: TOML reads an unquoted dotted key as nested tables, which would \
+                         replace the whole `{key}` table; quote the key so that it names one scene key: \
+                         set = {{ {example} }}"
+                    ),
+                );
             } else {
                 edits.push((key.clone(), value.clone()));
             }
@@ -279,30 +289,36 @@ impl Checker {
         Some(values.into_iter().map(toml::Value::Float).collect())
     }
 
-    /// The grid's dimensions: each axis alone, or with the axes sharing its zip name, placed at the first.
-    fn dimensions(&mut self, files: &[AxisFile], axes: &[Axis]) -> Vec<Vec<usize>> {
-        if axes.len() != files.len() {
-            return Vec::new(); // an axis had a problem; reported already
-        }
+    /// The grid's dimensions: each axis alone, or with the axes sharing its zip name, placed at the first
+    /// (indexes of the file's axes; those that had a problem are left out, and then the sweep is refused).
+    fn dimensions(&mut self, axes: &[Option<Axis>]) -> Vec<Vec<usize>> {
         let mut dimensions: Vec<Vec<usize>> = Vec::new();
         for (i, axis) in axes.iter().enumerate() {
-            let group = axis.zip.as_ref().and_then(|z| {
+            let Some(axis) = axis else { continue };
+            let zip = axis.zip.as_ref();
+            let group = zip.and_then(|z| {
                 dimensions
                     .iter_mut()
-                    .find(|d| axes[d[0]].zip.as_ref() == Some(z))
+                    .find(|d| axes[d[0]].as_ref().and_then(|a| a.zip.as_ref()) == Some(z))
             });
-            match group {
-                Some(d) => {
-                    let first = d[0];
-                    if axes[first].values.len() != axis.values.len() {
-                        self.problem(format!("axis[{i}].zip"), format!("\"{}\"", axis.zip.as_deref().unwrap_or_default()), format!(
-                            "zips axes of different lengths (axis[{first}] has {}, axis[{i}] has {} values): zipped axes vary \
-                             together, so give each as many values", axes[first].values.len(), axis.values.len()));
-                    }
-                    d.push(i);
-                }
-                None => dimensions.push(vec![i]),
+            let Some(group) = group else {
+                dimensions.push(vec![i]);
+                continue;
+            };
+            let first = group[0];
+            let len = axes[first].as_ref().map_or(0, |a| a.values.len());
+            if len != axis.values.len() {
+                self.problem(
+                    format!("axis[{i}].zip"),
+                    format!("\"{}\"", zip.map_or("", String::as_str)),
+                    format!(
+                        "zips axes of different lengths (axis[{first}] has {len}, axis[{i}] has {} values): \
+                         zipped axes vary together, so give each as many values",
+                        axis.values.len()
+                    ),
+                );
             }
+            group.push(i);
         }
         dimensions
     }
