@@ -106,6 +106,8 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     let Some(path) = &args.sweep else {
         anyhow::bail!("give a SWEEP.toml to run, or `collect DIR`");
     };
+    // First, so that a signal at any later stage stops the sweep cleanly rather than killing it.
+    let stop = install_signals()?;
     let sweep = match Sweep::load(path) {
         Ok(sweep) => sweep,
         Err(e) => return Ok(bad_sweep(&e)),
@@ -123,7 +125,6 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
         return dry_run(&args, &sweep, shard, jobs);
     }
     let dir = args.output.clone().unwrap_or_default();
-    let stop = install_signals()?;
     let options = RunOptions {
         jobs,
         shard,

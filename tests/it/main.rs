@@ -45,6 +45,8 @@ mod second_model;
 mod stability;
 mod steady_states;
 mod sweep;
+mod sweep_resume;
+mod sweep_shards;
 mod verify;
 mod verify_bad_input;
 mod writer;

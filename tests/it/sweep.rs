@@ -4,7 +4,7 @@
 // Helpers outside #[test] functions: a failed unwrap there is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use crate::support::record::{coin_log, exe, listing};
+use crate::support::record::{exe, listing};
 use coin_log::sweep::{linspace, Sweep};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -49,14 +49,36 @@ pub fn write_sweep(dir: &Path, name: &str, text: &str) -> PathBuf {
     path
 }
 
-/// Runs `coin-log ARGS` in `dir`: exit code, stdout, stderr.
-pub fn run_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = coin_log(dir, args);
+/// The schedulers' variables, which would make a sweep take one shard: kept from every child but the
+/// ones that set them on purpose.
+pub const SCHEDULER_VARIABLES: [&str; 5] = [
+    "SLURM_ARRAY_TASK_ID",
+    "SLURM_ARRAY_TASK_COUNT",
+    "SLURM_ARRAY_TASK_MIN",
+    "SLURM_ARRAY_TASK_MAX",
+    "JOB_COMPLETION_INDEX",
+];
+
+/// Runs `coin-log ARGS` in `dir` with `env` set (and no other scheduler variable): exit code, stdout,
+/// stderr.
+pub fn run_with_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
+    let mut command = std::process::Command::new(exe());
+    command.args(args).current_dir(dir);
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    command.envs(env.iter().copied());
+    let out = command.output().expect("coin-log runs");
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// Runs `coin-log ARGS` in `dir`: exit code, stdout, stderr.
+pub fn run_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    run_with_env(dir, args, &[])
 }
 
 /// Runs the sweep `sweep` into `out` (both relative to `dir`) with `extra` flags and `--json`; returns

@@ -259,12 +259,18 @@ impl Folder {
             .append(true)
             .open(&path)
             .map_err(SweepError::io("opening the journal", &path))?;
-        let new = file
+        let len = file
             .metadata()
             .map_err(SweepError::io("reading the journal", &path))?
-            .len()
-            == 0;
-        if new {
+            .len();
+        if len > 0 && !ends_with_line_break(&path)? {
+            // A line torn by a crash: end it, so that it stays one bad (ignored) line instead of
+            // swallowing the next row.
+            file.write_all(b"\n")
+                .and_then(|()| file.sync_data())
+                .map_err(SweepError::io("writing the journal", &path))?;
+        }
+        if len == 0 {
             let mut header = vec![MTIME_COLUMN.to_string()];
             header.extend(self.columns());
             let line = format!("{}\n", catalogue::csv_line(&header));
@@ -284,6 +290,16 @@ impl Folder {
         replace_atomically(&path, bytes).map_err(SweepError::io("writing", &path))?;
         Ok(path)
     }
+}
+
+fn ends_with_line_break(path: &Path) -> Result<bool, SweepError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = File::open(path).map_err(SweepError::io("reading the journal", path))?;
+    let mut last = [0u8];
+    file.seek(SeekFrom::End(-1))
+        .and_then(|_| file.read_exact(&mut last))
+        .map_err(SweepError::io("reading the journal", path))?;
+    Ok(last[0] == b'\n')
 }
 
 /// A journal line: the file's modification time when the row was written, and the row's fields.
