@@ -21,7 +21,7 @@ const LAYERS: &[&[&str]] = &[
     &["format"],
     &["scene"],
     &["record", "verify", "analyse", "inspect"],
-    &["live"],
+    &["live", "sweep"],
     &["bench"],
 ];
 

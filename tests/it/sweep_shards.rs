@@ -272,3 +272,51 @@ fn collect_names_a_missing_part_a_run_in_two_parts_and_changed_files_and_then_wr
     assert_eq!(code, 2);
     assert!(err.contains("holds no sweep"), "{err}");
 }
+
+#[test]
+fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "one", &["--jobs", "1"]).0,
+        0
+    );
+    let children: Vec<_> = (0..4)
+        .map(|k| {
+            let mut command = std::process::Command::new(crate::support::record::exe());
+            for v in crate::sweep::SCHEDULER_VARIABLES {
+                command.env_remove(v);
+            }
+            command
+                .args([
+                    "sweep",
+                    "s.toml",
+                    "-o",
+                    "together",
+                    "--jobs",
+                    "1",
+                    "--shard",
+                    &format!("{k}/4"),
+                ])
+                .current_dir(dir.path())
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    for child in children {
+        let out = child.wait_with_output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let (code, err) = collect(dir.path(), "together");
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        rows(&dir.path().join("together/catalogue.csv")),
+        rows(&dir.path().join("one/catalogue.csv"))
+    );
+}
