@@ -320,7 +320,7 @@ fn sweep_json_holds_the_resolved_sweep_and_the_counts() {
     );
     assert_eq!(
         s["output"],
-        serde_json::json!({"channels": null, "encoding": "json", "compression": "zstd", "verify": true})
+        serde_json::json!({"channels": null, "encoding": "json", "compression": "zstd", "verify": true, "predict": true})
     );
     // The identity is the SHA-256 of the compact `sweep` object (format.md: sweep.json).
     let identity = coin_log::sweep::sha256_hex(s.to_string().as_bytes());
@@ -644,7 +644,7 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
         "circle-plus is a stable steady circle"
     );
     assert!(row["steady_residual"].parse::<f64>().is_ok());
-    write_sweep(dir.path(), "off.toml", &format!("{base}verify = false\n"));
+    write_sweep(dir.path(), "off.toml", &format!("{base}verify = false\npredict = false\n"));
     let (code, json) = sweep_json(dir.path(), "off.toml", "off", &[]);
     assert_eq!(code, 0, "{json}");
     let row = &Csv::read(&dir.path().join("off/catalogue.csv")).records()[0];
@@ -652,6 +652,9 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
         (row["status"].as_str(), row["verify"].as_str()),
         ("finished", "off")
     );
+    for column in ["predicted_motion", "predicted_stability", "predicted_termination"] {
+        assert_eq!(row[column], "", "no prediction asked");
+    }
 }
 
 #[test]

@@ -6,7 +6,7 @@ use super::catalogue::{split_csv_line, RunStatus};
 use super::error::SweepError;
 use super::folder::{self, Folder};
 use super::hash::sha256_file;
-use super::run::{catalogue_text, summary_json};
+use super::run::summary_json;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -81,12 +81,8 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         .count() as u64;
     let finished = rows.len() as u64 - failed;
     let written = if problems.is_empty() {
-        let lines: Vec<String> = rows
-            .values()
-            .map(|f| super::catalogue::csv_line(&f.fields))
-            .collect();
-        let text = catalogue_text(&columns, lines.iter().map(String::as_str));
-        let catalogue = folder.write_atomically(folder::CATALOGUE_FILE, text.as_bytes())?;
+        let lines = rows.values().map(|f| super::catalogue::csv_line(&f.fields));
+        let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
         let json = summary_json(&folder.plan, finished, failed, 0);
         let summary =
             folder.write_atomically(folder::SWEEP_JSON_FILE, format!("{json}\n").as_bytes())?;

@@ -64,6 +64,8 @@ pub struct Settings {
     pub compression: Compression,
     /// Whether each file is verified after recording.
     pub verify: bool,
+    /// Whether the catalogue gets `analyse`'s prediction of each run.
+    pub predict: bool,
 }
 
 fn by_name<T: coin_log_names::Named, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {

@@ -1,7 +1,8 @@
 //! The sweep's folder (format.md: The sweep folder): the run files, the catalogue (or its parts), the
 //! sweep's JSON, and the private state beside them in `.coin-log-sweep/`: the plan (the sweep's identity,
-//! written once) and one append-only journal per shard, a line per finished row, synced to disk before
-//! the next run's row, so that a crash or SIGKILL loses at most the runs in progress.
+//! written once) and one append-only journal per shard, a line per finished row, synced to disk as the
+//! runs end (rows that end during a sync share the next one), so that a crash or SIGKILL loses at most
+//! the runs in progress and the rows still being synced.
 
 use super::catalogue::{self, split_csv_line};
 use super::definition::Sweep;
@@ -286,8 +287,40 @@ impl Folder {
     /// # Errors
     /// The file cannot be written.
     pub fn write_atomically(&self, name: &str, bytes: &[u8]) -> Result<PathBuf, SweepError> {
+        self.write_atomically_with(name, |w| w.write_all(bytes))
+    }
+
+    /// A catalogue (or part) `name`: the header, then `lines`, each ending in a line break, streamed
+    /// into place atomically.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn write_catalogue<S: AsRef<str>>(
+        &self,
+        name: &str,
+        lines: impl Iterator<Item = S>,
+    ) -> Result<PathBuf, SweepError> {
+        let header = catalogue::csv_line(&self.columns());
+        self.write_atomically_with(name, |w| {
+            writeln!(w, "{header}")?;
+            for line in lines {
+                writeln!(w, "{}", line.as_ref())?;
+            }
+            Ok(())
+        })
+    }
+
+    fn write_atomically_with(
+        &self,
+        name: &str,
+        write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+    ) -> Result<PathBuf, SweepError> {
         let path = self.path.join(name);
-        replace_atomically(&path, bytes).map_err(SweepError::io("writing", &path))?;
+        let persist =
+            |temp: tempfile::NamedTempFile| temp.persist(&path).map(drop).map_err(|e| e.error);
+        temp_beside(&path, write)
+            .and_then(persist)
+            .map_err(SweepError::io("writing", &path))?;
         Ok(path)
     }
 }
@@ -338,14 +371,20 @@ pub struct Journal {
 }
 
 impl Journal {
-    /// Appends a row and syncs it to disk before returning.
+    /// Appends rows (each with its file's modification time) and syncs them to disk before returning.
     ///
     /// # Errors
-    /// Writing or syncing failed (the row may be torn: it is ignored when read back).
-    pub fn append(&mut self, mtime_ns: u128, row_line: &str) -> Result<(), SweepError> {
-        let line = format!("{mtime_ns},{row_line}\n");
+    /// Writing or syncing failed (the last row may be torn: it is ignored when read back).
+    pub fn append(&mut self, rows: &[(u128, String)]) -> Result<(), SweepError> {
+        if rows.is_empty() {
+            return Ok(());
+        }
+        let text: String = rows
+            .iter()
+            .map(|(mtime, line)| format!("{mtime},{line}\n"))
+            .collect();
         self.file
-            .write_all(line.as_bytes())
+            .write_all(text.as_bytes())
             .and_then(|()| self.file.sync_data())
             .map_err(SweepError::io("writing the journal", &self.path))
     }
@@ -393,27 +432,29 @@ fn short(identity: &str) -> &str {
     identity.get(..12).unwrap_or(identity)
 }
 
-// A minimal private atomic output, for the sweep's own files; the library's shared atomic-output helper
-// replaces these two functions once it lands.
-/// Writes `path` through a synced temporary file beside it, then renames it over `path`.
-fn replace_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let temp = temp_beside(path, bytes)?;
-    temp.persist(path).map(drop).map_err(|e| e.error)
-}
-
+// A minimal private atomic output, for the sweep's own files (the catalogue, its parts, sweep.json, the
+// plan); the library's shared atomic-output helper replaces `temp_beside` and its two callers once it lands.
 /// Writes `path` through a synced temporary file beside it, unless `path` exists (`AlreadyExists`).
 fn publish_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let temp = temp_beside(path, bytes)?;
+    let temp = temp_beside(path, |w| w.write_all(bytes))?;
     temp.persist_noclobber(path).map(drop).map_err(|e| e.error)
 }
 
-fn temp_beside(path: &Path, bytes: &[u8]) -> io::Result<tempfile::NamedTempFile> {
+/// A temporary file beside `path` holding what `write` wrote, flushed, synced and readable.
+fn temp_beside(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<tempfile::NamedTempFile> {
     let folder = path.parent().unwrap_or_else(|| Path::new("."));
     let mut temp = tempfile::Builder::new()
         .prefix(".coin-log-")
         .suffix(".tmp")
         .tempfile_in(folder)?;
-    temp.write_all(bytes)?;
+    {
+        let mut buffered = io::BufWriter::new(temp.as_file_mut());
+        write(&mut buffered)?;
+        buffered.flush()?;
+    }
     temp.as_file().sync_all()?;
     make_readable(temp.as_file());
     Ok(temp)

@@ -114,8 +114,8 @@ struct Held {
 
 /// Runs `sweep` into the folder `dir` (or resumes it there). `stop` set (by a signal handler) stops
 /// starting runs and ends the running recordings early; their files are discarded and the runs redone on
-/// resume. The sweep sets `stop` itself when it cannot write its journal. `progress` is called after each
-/// run, on the calling thread.
+/// resume. The sweep sets `stop` itself when it cannot write its journal. `progress` is called as runs
+/// end, on the calling thread.
 ///
 /// # Errors
 /// [`SweepError`] for a folder that cannot hold the sweep or a catalogue or journal that cannot be
@@ -129,85 +129,111 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
     let Resumed {
-        mut held,
+        held,
         todo,
         refreshed,
     } = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
-    for (mtime, line) in refreshed {
-        journal.append(mtime, &line)?;
-    }
-    let kept = held.len() as u64;
-    let mut state = Progress {
-        runs: options.shard.len(sweep.runs()),
-        todo: todo.len() as u64,
-        done: 0,
-        failed: held
-            .values()
-            .filter(|h| h.status == RunStatus::Failed)
-            .count() as u64,
-    };
-    progress(&state);
-    let (mut record_seconds, mut verify_seconds) = (0.0, 0.0);
+    journal.append(&refreshed)?;
+    let mut tally = Tally::new(held, options.shard.len(sweep.runs()), todo.len() as u64);
+    progress(&tally.progress);
     let mut error = None;
-    pool(sweep, &folder, &todo, options.jobs, stop, |done| {
-        let Done {
-            row,
-            mtime_ns,
-            record,
-            verify,
-        } = done;
-        let line = row.line();
-        if let Err(e) = journal.append(mtime_ns, &line) {
+    pool(sweep, &folder, &todo, options.jobs, stop, |batch| {
+        let lines: Vec<(u128, String)> = batch.iter().map(|d| (d.mtime_ns, d.row.line())).collect();
+        if let Err(e) = journal.append(&lines) {
             stop.store(true, Ordering::SeqCst);
             error.get_or_insert(e);
             return;
         }
-        record_seconds += record;
-        verify_seconds += verify;
-        state.done += 1;
-        state.failed += u64::from(row.status == RunStatus::Failed);
-        held.insert(
-            row.index,
-            Held {
-                line,
-                status: row.status,
-            },
-        );
-        progress(&state);
+        for (done, (_, line)) in batch.into_iter().zip(lines) {
+            tally.add(&done, line);
+        }
+        progress(&tally.progress);
     });
     if let Some(e) = error {
         return Err(e);
     }
-    let (catalogue, summary) = write_catalogue(sweep, &folder, options.shard, &held)?;
-    let failed = held
-        .values()
-        .filter(|h| h.status == RunStatus::Failed)
-        .count() as u64;
-    Ok(SweepOutcome {
-        runs: state.runs,
-        finished: held.len() as u64 - failed,
-        failed,
-        pending: state.runs - held.len() as u64,
-        kept,
-        done: state.done,
-        interrupted: stop.load(Ordering::SeqCst),
-        catalogue,
-        summary,
-        record_seconds,
-        verify_seconds,
-    })
+    let (catalogue, summary) = write_catalogue(sweep, &folder, options.shard, &tally.held)?;
+    Ok(tally.outcome(catalogue, summary, stop.load(Ordering::SeqCst)))
 }
 
-/// Runs `todo` on `jobs` threads; `handle` sees each result on the calling thread, in the order they end.
+/// The rows held for the catalogue and the counts, as the runs come in.
+struct Tally {
+    held: BTreeMap<u64, Held>,
+    progress: Progress,
+    kept: u64,
+    record_seconds: f64,
+    verify_seconds: f64,
+}
+
+impl Tally {
+    fn new(held: BTreeMap<u64, Held>, runs: u64, todo: u64) -> Self {
+        let failed = held
+            .values()
+            .filter(|h| h.status == RunStatus::Failed)
+            .count() as u64;
+        Self {
+            kept: held.len() as u64,
+            held,
+            progress: Progress {
+                runs,
+                todo,
+                done: 0,
+                failed,
+            },
+            record_seconds: 0.0,
+            verify_seconds: 0.0,
+        }
+    }
+
+    fn add(&mut self, done: &Done, line: String) {
+        let status = done.row.status;
+        self.record_seconds += done.record;
+        self.verify_seconds += done.verify;
+        self.progress.done += 1;
+        self.progress.failed += u64::from(status == RunStatus::Failed);
+        self.held.insert(done.row.index, Held { line, status });
+    }
+
+    fn outcome(
+        self,
+        catalogue: PathBuf,
+        summary: Option<PathBuf>,
+        interrupted: bool,
+    ) -> SweepOutcome {
+        let rows = self.held.len() as u64;
+        let failed = self
+            .held
+            .values()
+            .filter(|h| h.status == RunStatus::Failed)
+            .count() as u64;
+        SweepOutcome {
+            runs: self.progress.runs,
+            finished: rows - failed,
+            failed,
+            pending: self.progress.runs - rows,
+            kept: self.kept,
+            done: self.progress.done,
+            interrupted,
+            catalogue,
+            summary,
+            record_seconds: self.record_seconds,
+            verify_seconds: self.verify_seconds,
+        }
+    }
+}
+
+/// Runs `todo` on `jobs` threads; `handle` sees the results on the calling thread, in the order they end,
+/// in batches of those that ended while it handled the previous batch (so that one journal sync serves
+/// them all: the sweep is never slower than the disk syncs one row).
 fn pool(
     sweep: &Sweep,
     folder: &Folder,
     todo: &[u64],
     jobs: usize,
     stop: &AtomicBool,
-    mut handle: impl FnMut(Done),
+    mut handle: impl FnMut(Vec<Done>),
 ) {
     let next = AtomicUsize::new(0);
     let (sender, receiver) = mpsc::channel();
@@ -230,8 +256,10 @@ fn pool(
             });
         }
         drop(sender);
-        for done in receiver {
-            handle(done);
+        for first in &receiver {
+            let mut batch = vec![first];
+            batch.extend(receiver.try_iter());
+            handle(batch);
         }
     });
 }
@@ -311,14 +339,14 @@ fn write_catalogue(
     shard: Shard,
     held: &BTreeMap<u64, Held>,
 ) -> Result<(PathBuf, Option<PathBuf>), SweepError> {
-    let text = catalogue_text(&folder.columns(), held.values().map(|h| h.line.as_str()));
+    let lines = held.values().map(|h| h.line.as_str());
     if !shard.is_all() {
         return Ok((
-            folder.write_atomically(&folder::part_file_name(shard), text.as_bytes())?,
+            folder.write_catalogue(&folder::part_file_name(shard), lines)?,
             None,
         ));
     }
-    let catalogue = folder.write_atomically(folder::CATALOGUE_FILE, text.as_bytes())?;
+    let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
     let failed = held
         .values()
         .filter(|h| h.status == RunStatus::Failed)
@@ -332,20 +360,6 @@ fn write_catalogue(
     let summary =
         folder.write_atomically(folder::SWEEP_JSON_FILE, format!("{json}\n").as_bytes())?;
     Ok((catalogue, Some(summary)))
-}
-
-/// The header and the lines, each ending in a line break.
-pub(super) fn catalogue_text<'a>(
-    columns: &[String],
-    lines: impl Iterator<Item = &'a str>,
-) -> String {
-    let mut text = catalogue::csv_line(columns);
-    text.push('\n');
-    for line in lines {
-        text.push_str(line);
-        text.push('\n');
-    }
-    text
 }
 
 /// `sweep.json`: the plan with the counts (format.md: sweep.json).
@@ -391,7 +405,7 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
             )))
         }
     };
-    let prediction = predict(&scene);
+    let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
     match record_and_check(sweep, folder, index, &scene, stop) {
         Ok(None) => None,
         Ok(Some(checked)) => {

@@ -533,6 +533,7 @@ impl Checker {
                 .and_then(|s| s.parse().ok())
                 .unwrap_or_default(),
             verify: o.verify.unwrap_or(true),
+            predict: o.predict.unwrap_or(true),
         }
     }
 }
