@@ -269,6 +269,7 @@ fn print_outcome(
             "wall_time_s": wall.as_secs_f64(),
             "record_seconds": o.record_seconds,
             "verify_seconds": o.verify_seconds,
+            "cpu_seconds": cpu_seconds(),
             "peak_rss_bytes": peak_rss_bytes(),
         });
         outln!("{}", serde_json::to_string(&json)?);
@@ -301,6 +302,22 @@ fn print_outcome(
         outln!("{key:<10} {value}");
     }
     Ok(())
+}
+
+/// Clock ticks per second of `/proc`'s times (Linux's USER_HZ, fixed at 100 for user space).
+const USER_HZ: f64 = 100.0;
+
+/// The CPU time (user + system, all threads) this process used so far \[s\]; `None` where `/proc` does not
+/// report it. With the wall time it says how many cores the sweep kept busy.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command name (which may hold spaces) start at its closing parenthesis:
+    // utime and stime are fields 14 and 15, the 12th and 13th after it.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let mut fields = rest.split_whitespace().skip(11);
+    let user: f64 = fields.next()?.parse().ok()?;
+    let system: f64 = fields.next()?.parse().ok()?;
+    Some((user + system) / USER_HZ)
 }
 
 fn failed_text(failed: u64) -> String {

@@ -644,7 +644,11 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
         "circle-plus is a stable steady circle"
     );
     assert!(row["steady_residual"].parse::<f64>().is_ok());
-    write_sweep(dir.path(), "off.toml", &format!("{base}verify = false\npredict = false\n"));
+    write_sweep(
+        dir.path(),
+        "off.toml",
+        &format!("{base}verify = false\npredict = false\n"),
+    );
     let (code, json) = sweep_json(dir.path(), "off.toml", "off", &[]);
     assert_eq!(code, 0, "{json}");
     let row = &Csv::read(&dir.path().join("off/catalogue.csv")).records()[0];
@@ -652,7 +656,11 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
         (row["status"].as_str(), row["verify"].as_str()),
         ("finished", "off")
     );
-    for column in ["predicted_motion", "predicted_stability", "predicted_termination"] {
+    for column in [
+        "predicted_motion",
+        "predicted_stability",
+        "predicted_termination",
+    ] {
         assert_eq!(row[column], "", "no prediction asked");
     }
 }

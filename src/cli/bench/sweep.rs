@@ -53,6 +53,8 @@ struct SweepRun {
     process: f64,
     record: f64,
     verify: f64,
+    /// CPU time of the child, all threads (NaN where not reported).
+    cpu: f64,
     peak_rss: f64,
 }
 
@@ -107,6 +109,10 @@ fn sweep(exe: &Path, file: &Path, dir: &Path, jobs: usize) -> anyhow::Result<Swe
         process,
         record: number("record_seconds")?,
         verify: number("verify_seconds")?,
+        cpu: json
+            .get("cpu_seconds")
+            .and_then(serde_json::Value::as_f64)
+            .unwrap_or(f64::NAN),
         peak_rss,
     })
 }
@@ -189,48 +195,59 @@ fn speed(exe: &Path, work: &Path, repeats: usize) -> anyhow::Result<Vec<Throughp
             .collect(),
     );
     let work_per_run = median(one.iter().map(|r| (r.record + r.verify) / n).collect());
-    Ok(vec![
-        row(
-            &workload,
+    let busy = |runs: &[SweepRun]| median(runs.iter().map(|r| r.cpu / r.process).collect());
+    let note = |text: &str| text.to_string();
+    let rows = [
+        (
             "wall time, --jobs 1",
             w1,
             "s",
             None,
             format!("{repeats} repeats, alternating with --jobs 2"),
         ),
-        row(
-            &workload,
-            "wall time, --jobs 2",
-            w2,
-            "s",
-            None,
-            String::new(),
-        ),
-        row(
-            &workload,
+        ("wall time, --jobs 2", w2, "s", None, String::new()),
+        (
             "speed-up --jobs 2 / --jobs 1",
             w1 / w2,
             "",
             Some(Target::AtLeast(1.8)),
-            "each recording also runs a compression thread".into(),
+            note("2 cores"),
         ),
-        row(
-            &workload,
+        (
+            "cores kept busy, --jobs 1",
+            busy(&one),
+            "",
+            None,
+            note("CPU time / wall time of the process"),
+        ),
+        (
+            "cores kept busy, --jobs 2",
+            busy(&two),
+            "",
+            None,
+            note("each recording also runs a compression thread"),
+        ),
+        (
             "recording + verifying per run",
             work_per_run,
             "s",
             None,
-            "--jobs 1".into(),
+            note("--jobs 1"),
         ),
-        row(
-            &workload,
+        (
             "sweep's own cost per run",
             overhead,
             "s",
             Some(Target::Below(5e-3)),
-            "wall − recording − verifying, over the runs, --jobs 1".into(),
+            note("wall − recording − verifying, over the runs, --jobs 1"),
         ),
-    ])
+    ];
+    Ok(rows
+        .into_iter()
+        .map(|(quantity, value, unit, target, note)| {
+            row(&workload, quantity, value, unit, target, note)
+        })
+        .collect())
 }
 
 /// The memory workload (tiny runs: what grows with the run count) and the resume of the finished

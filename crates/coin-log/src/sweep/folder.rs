@@ -194,20 +194,29 @@ impl Folder {
             .tempfile_in(&self.path)
     }
 
-    /// Deletes temporary files left by runs of `shard` that a killed process did not finish.
+    /// Deletes the temporary files a killed process of `shard` left: of its runs, and of its catalogue
+    /// (for the whole sweep, also of `sweep.json`).
     pub fn remove_stale_temps(&self, shard: Shard) {
         let Ok(entries) = fs::read_dir(&self.path) else {
             return;
         };
+        let mut own = vec![temp_prefix(&self.path.join(part_file_name(shard)))];
+        if shard.is_all() {
+            own = [CATALOGUE_FILE, SWEEP_JSON_FILE]
+                .map(|n| temp_prefix(&self.path.join(n)))
+                .into();
+        }
         for entry in entries.flatten() {
             let name = entry.file_name();
             let name = name.to_string_lossy();
-            let index = name
+            let run = name
                 .strip_prefix(".run-")
                 .filter(|_| name.ends_with(".mcap.tmp"))
                 .and_then(|rest| rest.split('.').next())
                 .and_then(|i| i.parse::<u64>().ok());
-            if index.is_some_and(|i| shard.takes(i)) {
+            let catalogue =
+                name.ends_with(".tmp") && own.iter().any(|p| name.starts_with(p.as_str()));
+            if run.is_some_and(|i| shard.takes(i)) || catalogue {
                 let _ = fs::remove_file(entry.path());
             }
         }
@@ -440,14 +449,23 @@ fn publish_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
     temp.persist_noclobber(path).map(drop).map_err(|e| e.error)
 }
 
-/// A temporary file beside `path` holding what `write` wrote, flushed, synced and readable.
+/// `.NAME.`: the temporary files of `path` are named after it, so that a process cleans up only its own.
+fn temp_prefix(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    format!(".{name}.")
+}
+
+/// A temporary file beside `path` (`.NAME.<random>.tmp`) holding what `write` wrote, flushed, synced and
+/// readable.
 fn temp_beside(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<tempfile::NamedTempFile> {
     let folder = path.parent().unwrap_or_else(|| Path::new("."));
     let mut temp = tempfile::Builder::new()
-        .prefix(".coin-log-")
+        .prefix(&temp_prefix(path))
         .suffix(".tmp")
         .tempfile_in(folder)?;
     {
