@@ -166,9 +166,13 @@ fn measure(exe: &Path, work: &Path, repeats: usize) -> anyhow::Result<Vec<Throug
     Ok(rows)
 }
 
-/// The speed workload: `--jobs 1` and `--jobs 2` alternating, fresh folders.
-#[allow(clippy::cast_precision_loss)]
-fn speed(exe: &Path, work: &Path, repeats: usize) -> anyhow::Result<Vec<ThroughputRow>> {
+/// The speed workload's runs: `--jobs 1` and `--jobs 2` alternating (which goes first alternates too),
+/// each in a fresh folder.
+fn alternate(
+    exe: &Path,
+    work: &Path,
+    repeats: usize,
+) -> anyhow::Result<(Vec<SweepRun>, Vec<SweepRun>)> {
     let file = work.join("speed.toml");
     write(&file, &sweep_text(SPEED_RUNS, 2.0))?;
     let (mut one, mut two) = (Vec::new(), Vec::new());
@@ -185,6 +189,13 @@ fn speed(exe: &Path, work: &Path, repeats: usize) -> anyhow::Result<Vec<Throughp
             }
         }
     }
+    Ok((one, two))
+}
+
+/// The speed workload: wall times, speed-up, cores kept busy, and the sweep's own cost per run.
+#[allow(clippy::cast_precision_loss)]
+fn speed(exe: &Path, work: &Path, repeats: usize) -> anyhow::Result<Vec<ThroughputRow>> {
+    let (one, two) = alternate(exe, work, repeats)?;
     let n = SPEED_RUNS as f64;
     let workload = format!("sweep {SPEED_RUNS} runs of wobble, 2 u @ 100/u, verified");
     let wall = |runs: &[SweepRun]| median(runs.iter().map(|r| r.wall).collect());
