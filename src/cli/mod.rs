@@ -16,6 +16,7 @@ mod record;
 mod rss;
 mod scene_arg;
 mod scenes;
+mod sweep;
 mod text;
 mod verify;
 
@@ -74,6 +75,9 @@ enum Command {
     Man(completions::ManArgs),
     /// What a scene's motion will do, without simulating it; `analyse map`: the stability map.
     Analyse(analyse::AnalyseArgs),
+    /// Record a dataset: every run of a sweep file (grid axes, random draws), with a catalogue; resumable,
+    /// shardable over a cluster (`sweep collect` merges the shards).
+    Sweep(sweep::SweepArgs),
 }
 
 /// `live` in a build without the `live` feature: any arguments, to answer with how to get it.
@@ -145,6 +149,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Completions(args) => completions::completions(&args),
         Command::Man(args) => completions::man(&args),
         Command::Analyse(args) => analyse::run(args),
+        Command::Sweep(args) => sweep::run(args),
     }
 }
 

@@ -68,6 +68,13 @@ mod scenes;
 mod second_model;
 mod stability;
 mod steady_states;
+mod sweep;
+#[cfg(feature = "external-readers")]
+mod sweep_python;
+mod sweep_resume;
+mod sweep_shards;
+#[cfg(feature = "slurm")]
+mod sweep_slurm;
 mod verify;
 mod verify_bad_input;
 mod writer;

@@ -23,4 +23,5 @@ pub mod palette;
 pub mod record;
 pub mod scene;
 pub mod simulation;
+pub mod sweep;
 pub mod verify;

@@ -1,6 +1,7 @@
 //! `coin-log bench`: accuracy against cost of every integrator, the hard-case suite, and throughput
 //! and memory of record and verify.
 
+mod sweep;
 mod throughput;
 
 use super::Outcome;
@@ -58,6 +59,10 @@ enum BenchCommand {
     /// whichever comes first. Each preset is run again with μ = 0.3 to see where it slips. Writes
     /// euler.csv and euler.svg (log α against log |t0 − t| with the fitted lines).
     Euler(EulerArgs),
+    /// What a sweep costs beyond its runs: --jobs 2 against --jobs 1 on 200 short runs, the cost per run
+    /// besides recording and verifying it, peak memory and catalogue size of 1000 and 10 000 runs, and
+    /// the resume of a finished 1000-run sweep; each sweep a child `coin-log sweep`. Writes sweep.csv.
+    Sweep(sweep::SweepBenchArgs),
 }
 
 /// Arguments of `coin-log bench euler`.
@@ -95,6 +100,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
         BenchCommand::Stability(a) => stability_suite(&a),
         BenchCommand::Throughput(a) => throughput::run(&a),
         BenchCommand::Euler(a) => euler(&a),
+        BenchCommand::Sweep(a) => sweep::run(&a),
     }
 }
 

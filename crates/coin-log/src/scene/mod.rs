@@ -18,7 +18,7 @@ pub use file::{
     SteadyFile,
 };
 pub use notes::{compact, Note};
-pub use overrides::{apply_set, FlagOverrides};
+pub use overrides::{apply_set, set_value, FlagOverrides};
 pub use problems::{Problem, SceneProblems};
 pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
 
@@ -232,7 +232,11 @@ pub fn file_with_sets(file: &SceneFile, sets: &[String]) -> Result<SceneFile, Sc
     file_from_table(table)
 }
 
-fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
+/// A scene table (after edits) as a raw scene file, not yet validated.
+///
+/// # Errors
+/// [`SceneError::Parse`] for a key or type that does not fit (serde's message, on one line).
+pub fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
     toml::Value::Table(table)
         .try_into::<SceneFile>()
         .map_err(|e| SceneError::Parse(e.to_string().trim().replace('\n', " ")))

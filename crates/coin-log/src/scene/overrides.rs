@@ -20,14 +20,37 @@ use super::SceneError;
 /// [`SceneError::Set`] when there is no `=`, the key is empty or has an empty part, or a part of the path
 /// is a value rather than a table.
 pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
-    let error = |reason: String| SceneError::Set {
-        arg: arg.to_string(),
-        reason,
-    };
     let Some((key, raw)) = arg.split_once('=') else {
-        return Err(error(
-            "expected KEY=VALUE, e.g. `--set initial.theta=0.4`".into(),
-        ));
+        return Err(SceneError::Set {
+            arg: arg.to_string(),
+            reason: "expected KEY=VALUE, e.g. `--set initial.theta=0.4`".into(),
+        });
+    };
+    set_value(table, key, parse_value(raw.trim())).map_err(|e| match e {
+        SceneError::Set { reason, .. } => SceneError::Set {
+            arg: arg.to_string(),
+            reason,
+        },
+        other => other,
+    })
+}
+
+/// Sets the dotted KEY to a typed `value` (the form of [`apply_set`] for callers that hold TOML values,
+/// such as `coin-log sweep`); missing tables on the way are created.
+///
+/// ```
+/// let mut t = toml::Table::new();
+/// coin_log::scene::set_value(&mut t, "initial.omega", toml::Value::from(vec![0.0, 0.2, 1.5])).unwrap();
+/// assert_eq!(t["initial"]["omega"].as_array().map(Vec::len), Some(3));
+/// ```
+///
+/// # Errors
+/// [`SceneError::Set`] (its `arg` the key) when the key is empty or has an empty part, or a part of the
+/// path is a value rather than a table.
+pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), SceneError> {
+    let error = |reason: String| SceneError::Set {
+        arg: key.to_string(),
+        reason,
     };
     let key = key.trim();
     let parts: Vec<&str> = key.split('.').map(str::trim).collect();
@@ -36,7 +59,6 @@ pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
             "`{key}` is not a dotted key like `run.rate` or `initial.steady.kind`"
         )));
     }
-    let value = parse_value(raw.trim());
     let (last, path) = parts
         .split_last()
         .ok_or_else(|| error("the key is empty".into()))?;

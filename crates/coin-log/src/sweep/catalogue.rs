@@ -1,0 +1,316 @@
+//! The catalogue (format.md: The catalogue): one row per run, as CSV that pandas, polars and DuckDB read
+//! in one line (RFC 4180: a field is quoted when it holds a comma, a quote or a line break; numbers in
+//! their shortest round-trip form). Every column but `wall_time_s` depends only on the sweep and the
+//! run's index, so that a sharded sweep's collected catalogue equals the one-process one.
+
+use crate::format::Termination;
+use crate::verify::Verdict;
+
+coin_log_names::named_enum! {
+    /// Whether a run finished (recorded to its end or to a physical event, and verified when asked).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum RunStatus: "status" {
+        /// Recorded, and verified `ok` when the sweep verifies.
+        Finished = "finished",
+        /// Not: the `failure` and `reason` columns say why.
+        Failed = "failed",
+    }
+}
+
+coin_log_names::named_enum! {
+    /// What made a run fail.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum FailureKind: "failure" {
+        /// The values give no valid scene (or a bounded draw found no value): no file.
+        Scene = "scene",
+        /// The integration failed (step-size underflow, non-finite, Newton failure): the file holds the
+        /// samples up to the failure.
+        Numerical = "numerical",
+        /// The file was recorded, but `verify` did not judge it `ok`.
+        Verify = "verify",
+        /// Writing the file failed (a full disk, a lost folder): no file. Redone on resume.
+        Io = "io",
+    }
+}
+
+/// The columns before the swept keys.
+pub const LEADING_COLUMNS: [&str; 1] = ["index"];
+
+/// The columns after the swept keys.
+pub const TRAILING_COLUMNS: [&str; 20] = [
+    "status",
+    "termination",
+    "t_end",
+    "verify",
+    "failure",
+    "reason",
+    "file",
+    "bytes",
+    "sha256",
+    "samples",
+    "messages",
+    "steps",
+    "energy_drift",
+    "invariant_drift",
+    "steady_residual",
+    "event_trusted",
+    "predicted_motion",
+    "predicted_stability",
+    "predicted_termination",
+    "wall_time_s",
+];
+
+/// The one column that depends on the machine.
+pub const WALL_TIME_COLUMN: &str = "wall_time_s";
+
+/// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
+#[must_use]
+pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let keys = keys.map(str::to_string);
+    let fixed = |c: &[&str]| c.iter().map(|c| (*c).to_string()).collect::<Vec<_>>();
+    fixed(&LEADING_COLUMNS)
+        .into_iter()
+        .chain(keys)
+        .chain(fixed(&TRAILING_COLUMNS))
+        .collect()
+}
+
+/// What `analyse` predicts for a run's initial state, by quadrature of the conservative motion
+/// (format.md: The catalogue).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Prediction {
+    /// `steady`, `nutation` or `flat-landing`.
+    pub motion: &'static str,
+    /// The linear stability of the steady motion the run starts on (or, perturbed, starts from).
+    pub stability: Option<&'static str>,
+    /// How the run should end.
+    pub termination: Termination,
+}
+
+/// What a recorded run's file and summary say.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recorded {
+    /// The file's name in the sweep's folder.
+    pub file: String,
+    /// Its size.
+    pub bytes: u64,
+    /// Its SHA-256, hex.
+    pub sha256: String,
+    /// How the run ended, and when.
+    pub termination: Termination,
+    /// The end time.
+    pub t_end: f64,
+    /// Samples written.
+    pub samples: u64,
+    /// Messages written.
+    pub messages: u64,
+    /// Accepted integrator steps.
+    pub steps: u64,
+    /// As `record --json`'s `energy_drift`.
+    pub energy_drift: f64,
+    /// As `record --json`'s `invariant_drift`.
+    pub invariant_drift: Option<f64>,
+    /// As `record --json`'s `steady_residual`.
+    pub steady_residual: Option<f64>,
+    /// As `record --json`'s `event_trusted`.
+    pub event_trusted: Option<bool>,
+    /// `verify`'s verdict, when the sweep verifies.
+    pub verify: Option<Verdict>,
+}
+
+/// One run's row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// The run's index.
+    pub index: u64,
+    /// The swept keys' values, as cells ([`cell`]).
+    pub values: Vec<String>,
+    /// Finished or failed.
+    pub status: RunStatus,
+    /// Why it failed.
+    pub failure: Option<FailureKind>,
+    /// The failure's detail, one line (empty for a finished run).
+    pub reason: String,
+    /// The file and summary, when the run was recorded.
+    pub recorded: Option<Recorded>,
+    /// The prediction, when the scene is valid and conservative.
+    pub prediction: Option<Prediction>,
+    /// Wall time of the run (resolve, record, hash, verify), seconds.
+    pub wall_time: f64,
+}
+
+/// A number in its shortest round-trip form (`0.1`, `1e-12`, `5.0`, `NaN`).
+#[must_use]
+pub fn number(x: f64) -> String {
+    ryu::Buffer::new().format(x).to_string()
+}
+
+/// A swept value as a cell: numbers shortest, strings as they are, arrays and tables as TOML.
+#[must_use]
+pub fn cell(value: &toml::Value) -> String {
+    match value {
+        toml::Value::Float(x) => number(*x),
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+impl Row {
+    /// The row's cells, in the order of [`columns`].
+    #[must_use]
+    pub fn fields(&self) -> Vec<String> {
+        let r = self.recorded.as_ref();
+        let opt = |x: Option<f64>| x.map(number).unwrap_or_default();
+        let verify = match r {
+            None => String::new(),
+            Some(r) => r.verify.map_or("off", verdict_name).to_string(),
+        };
+        let p = self.prediction.as_ref();
+        let mut fields = vec![self.index.to_string()];
+        fields.extend(self.values.iter().cloned());
+        fields.extend([
+            self.status.name().to_string(),
+            r.map(|r| r.termination.name().to_string())
+                .unwrap_or_default(),
+            opt(r.map(|r| r.t_end)),
+            verify,
+            self.failure
+                .map(|f| f.name().to_string())
+                .unwrap_or_default(),
+            one_line(&self.reason),
+            r.map(|r| r.file.clone()).unwrap_or_default(),
+            r.map(|r| r.bytes.to_string()).unwrap_or_default(),
+            r.map(|r| r.sha256.clone()).unwrap_or_default(),
+            r.map(|r| r.samples.to_string()).unwrap_or_default(),
+            r.map(|r| r.messages.to_string()).unwrap_or_default(),
+            r.map(|r| r.steps.to_string()).unwrap_or_default(),
+            opt(r.map(|r| r.energy_drift)),
+            opt(r.and_then(|r| r.invariant_drift)),
+            opt(r.and_then(|r| r.steady_residual)),
+            r.and_then(|r| r.event_trusted)
+                .map(|b| b.to_string())
+                .unwrap_or_default(),
+            p.map(|p| p.motion.to_string()).unwrap_or_default(),
+            p.and_then(|p| p.stability).unwrap_or_default().to_string(),
+            p.map(|p| p.termination.name().to_string())
+                .unwrap_or_default(),
+            number(self.wall_time),
+        ]);
+        fields
+    }
+
+    /// The row as one CSV line, without the line break.
+    #[must_use]
+    pub fn line(&self) -> String {
+        csv_line(&self.fields())
+    }
+}
+
+/// The name `verify --json` gives a verdict.
+#[must_use]
+pub fn verdict_name(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Ok => "ok",
+        Verdict::Failed => "failed",
+        Verdict::CannotVerify => "cannot-verify",
+        Verdict::Unusable => "unusable",
+    }
+}
+
+/// Line breaks as `; `, so that every row is one line (the journal's unit).
+fn one_line(text: &str) -> String {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Fields as one CSV line (RFC 4180 quoting).
+#[must_use]
+pub fn csv_line<S: AsRef<str>>(fields: &[S]) -> String {
+    let mut line = String::new();
+    for (i, f) in fields.iter().enumerate() {
+        let f = f.as_ref();
+        if i > 0 {
+            line.push(',');
+        }
+        if f.contains([',', '"', '\n', '\r']) {
+            line.push('"');
+            line.push_str(&f.replace('"', "\"\""));
+            line.push('"');
+        } else {
+            line.push_str(f);
+        }
+    }
+    line
+}
+
+/// The fields of one CSV line (RFC 4180), or `None` when a quote is not closed or is followed by
+/// something other than a comma.
+#[must_use]
+pub fn split_csv_line(line: &str) -> Option<Vec<String>> {
+    let mut fields = Vec::new();
+    let mut chars = line.chars().peekable();
+    loop {
+        let mut field = String::new();
+        if chars.peek() == Some(&'"') {
+            chars.next();
+            loop {
+                match chars.next()? {
+                    '"' if chars.peek() == Some(&'"') => {
+                        chars.next();
+                        field.push('"');
+                    }
+                    '"' => break,
+                    c => field.push(c),
+                }
+            }
+            if !matches!(chars.peek(), None | Some(',')) {
+                return None;
+            }
+        } else {
+            while let Some(&c) = chars.peek() {
+                if c == ',' {
+                    break;
+                }
+                field.push(c);
+                chars.next();
+            }
+        }
+        fields.push(field);
+        if chars.next().is_none() {
+            return Some(fields);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fields_round_trip_through_csv_quoting() {
+        let fields = ["1", "a,b", "say \"hi\"", "", "[0.0, 0.2]", "x"];
+        let line = csv_line(&fields);
+        assert_eq!(line, "1,\"a,b\",\"say \"\"hi\"\"\",,\"[0.0, 0.2]\",x");
+        assert_eq!(split_csv_line(&line).unwrap(), fields);
+        assert_eq!(split_csv_line("").unwrap(), [""]);
+        assert!(split_csv_line("1,\"open").is_none());
+        assert!(split_csv_line("1,\"a\"b").is_none());
+    }
+
+    #[test]
+    fn values_are_written_in_their_shortest_form() {
+        assert_eq!(cell(&toml::Value::Float(0.1)), "0.1");
+        assert_eq!(cell(&toml::Value::Float(1e-12)), "1e-12");
+        assert_eq!(cell(&toml::Value::Float(5.0)), "5.0");
+        assert_eq!(cell(&toml::Value::Integer(250)), "250");
+        assert_eq!(cell(&toml::Value::from("hoop")), "hoop");
+        assert_eq!(cell(&toml::Value::from(vec![0.0, 1.5])), "[0.0, 1.5]");
+        assert_eq!(
+            one_line("2 problems:\n  `a` x\n  `b` y"),
+            "2 problems:; `a` x; `b` y"
+        );
+    }
+}

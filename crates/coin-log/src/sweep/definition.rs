@@ -1,0 +1,334 @@
+//! A validated sweep: the base scene as a TOML table, the fixed edits, the grid and the random draws, and
+//! how each run is written. A run's values, scene and file name follow from the sweep and the run's index
+//! alone (format.md: Sweep files).
+
+use super::error::SweepError;
+use super::random::{Distribution, Drawn, OutOfBounds};
+use super::validate;
+use crate::format::Encoding;
+use crate::record::foxglove::PROTOBUF_MAX_SECONDS;
+use crate::record::RecordOptions;
+use crate::scene::{self, FlagOverrides, Scene, SceneError};
+use coin_log_mcap::Compression;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The most runs a sweep may have: far more than any disk holds, few enough that an index fits the
+/// file names and the catalogue comfortably.
+pub const MAX_RUNS: u64 = 1_000_000_000;
+
+/// One grid axis, its values expanded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// Dotted scene key.
+    pub key: String,
+    /// The values, in order.
+    pub values: Vec<toml::Value>,
+    /// The zip group it varies with, if any.
+    pub zip: Option<String>,
+}
+
+/// One random draw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Draw {
+    /// Dotted scene key.
+    pub key: String,
+    /// What it samples.
+    pub distribution: Distribution,
+    /// The values of a `choice` draw (empty otherwise).
+    pub choices: Vec<toml::Value>,
+}
+
+/// `[random]`, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Random {
+    /// The generator's seed.
+    pub seed: u64,
+    /// Runs per grid point.
+    pub count: u64,
+    /// The draws, in the file's order.
+    pub draws: Vec<Draw>,
+}
+
+/// `[output]`, validated, with the defaults filled in.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Settings {
+    /// The channels every run records (as `record.channels`), or `None` for the scenes' own lists.
+    pub channels: Option<Vec<String>>,
+    /// Message encoding.
+    #[serde(serialize_with = "by_name")]
+    pub encoding: Encoding,
+    /// Chunk compression.
+    #[serde(serialize_with = "by_name")]
+    pub compression: Compression,
+    /// Whether each file is verified after recording.
+    pub verify: bool,
+    /// Whether the catalogue gets `analyse`'s prediction of each run.
+    pub predict: bool,
+}
+
+fn by_name<T: coin_log_names::Named, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(v.name())
+}
+
+/// A sweep, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    /// One line.
+    pub description: String,
+    /// `base` as written.
+    pub base: String,
+    /// The base scene as a table, before any edit.
+    pub base_table: toml::Table,
+    /// The fixed edits, in the order applied (sorted by key: a table before the keys inside it).
+    pub set: Vec<(String, toml::Value)>,
+    /// The grid axes, in the file's order.
+    pub axes: Vec<Axis>,
+    /// The grid's dimensions, slowest first: each a lone axis or a zip group (indexes into `axes`), at
+    /// the place of its first axis.
+    pub dimensions: Vec<Vec<usize>>,
+    /// The random draws.
+    pub random: Option<Random>,
+    /// How runs are written.
+    pub settings: Settings,
+}
+
+/// Why a run has no scene: its values give no valid scene, or a draw found nothing within its bounds.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunSceneError {
+    /// A bounded normal draw failed.
+    #[error(transparent)]
+    Draw(#[from] OutOfBounds),
+    /// The edited scene does not parse or validate.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// Longer than a Protobuf timestamp of Foxglove's schemas holds.
+    #[error(
+        "run.duration = {0} is longer than {PROTOBUF_MAX_SECONDS} time units, the most Foxglove's Protobuf \
+         timestamps hold: set output.encoding = \"json\", or shorten run.duration"
+    )]
+    TooLongForProtobuf(f64),
+}
+
+impl Sweep {
+    /// Reads and validates the sweep file at `path`; a base scene file is found relative to it.
+    ///
+    /// # Errors
+    /// [`SweepError::Read`], [`SweepError::Parse`] or [`SweepError::Invalid`] (every problem at once).
+    pub fn load(path: &Path) -> Result<Self, SweepError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SweepError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let folder = path.parent().unwrap_or_else(|| Path::new("."));
+        Self::parse(&text, folder, &path.display().to_string())
+    }
+
+    /// Validates sweep-file text; `folder` is where a base scene path starts from, `label` names the
+    /// file in errors.
+    ///
+    /// # Errors
+    /// [`SweepError::Parse`] or [`SweepError::Invalid`].
+    pub fn parse(text: &str, folder: &Path, label: &str) -> Result<Self, SweepError> {
+        let file = toml::from_str(text).map_err(|e| SweepError::Parse {
+            label: label.to_string(),
+            message: e.to_string().trim().to_string(),
+        })?;
+        validate::sweep(file, folder).map_err(|problems| SweepError::Invalid {
+            label: label.to_string(),
+            problems: Box::new(problems),
+        })
+    }
+
+    /// Grid points: the product of the dimensions' lengths (1 without axes).
+    #[must_use]
+    pub fn grid_points(&self) -> u64 {
+        self.dimensions
+            .iter()
+            .map(|d| self.axes[d[0]].values.len() as u64)
+            .product()
+    }
+
+    /// How many runs: grid points × `random.count`.
+    #[must_use]
+    pub fn runs(&self) -> u64 {
+        self.grid_points() * self.random.as_ref().map_or(1, |r| r.count)
+    }
+
+    /// The swept keys, each a catalogue column: the axes, then the draws, in the file's order.
+    pub fn keys(&self) -> impl Iterator<Item = &str> {
+        let draws = self.random.iter().flat_map(|r| &r.draws);
+        self.axes
+            .iter()
+            .map(|a| a.key.as_str())
+            .chain(draws.map(|d| d.key.as_str()))
+    }
+
+    /// The swept keys' values of run `index` (< [`runs`](Self::runs)), in the order of
+    /// [`keys`](Self::keys): grid point ⌊index / count⌋ (its coordinates with the last dimension varying
+    /// fastest), then the draws of run `index`.
+    ///
+    /// # Errors
+    /// [`OutOfBounds`] when a bounded normal draw finds nothing within its bounds.
+    pub fn values(&self, index: u64) -> Result<Vec<toml::Value>, OutOfBounds> {
+        let count = self.random.as_ref().map_or(1, |r| r.count);
+        let mut point = index / count;
+        let mut values = vec![toml::Value::Boolean(false); self.axes.len()];
+        for dimension in self.dimensions.iter().rev() {
+            let len = self.axes[dimension[0]].values.len() as u64;
+            // point % len < len, a length of a Vec: it fits usize.
+            let at = usize::try_from(point % len).unwrap_or(0);
+            point /= len;
+            for &axis in dimension {
+                values[axis] = self.axes[axis].values[at].clone();
+            }
+        }
+        for (j, draw) in self.random.iter().flat_map(|r| r.draws.iter().enumerate()) {
+            let seed = self.random.as_ref().map_or(0, |r| r.seed);
+            values.push(match draw.distribution.draw(seed, index, j as u64)? {
+                Drawn::Number(x) => toml::Value::Float(x),
+                Drawn::Choice(k) => draw.choices[k].clone(),
+            });
+        }
+        Ok(values)
+    }
+
+    /// The scene table of a run with these values: the base, then `set`, then the values, then
+    /// `output.channels` as `record.channels`.
+    ///
+    /// # Errors
+    /// [`SceneError::Set`] when a key runs through a value that is not a table.
+    pub fn table(&self, values: &[toml::Value]) -> Result<toml::Table, SceneError> {
+        let mut table = self.base_table.clone();
+        for (key, value) in &self.set {
+            scene::set_value(&mut table, key, value.clone())?;
+        }
+        for (key, value) in self.keys().zip(values) {
+            scene::set_value(&mut table, key, value.clone())?;
+        }
+        if let Some(channels) = &self.settings.channels {
+            let list = channels.iter().map(|c| toml::Value::from(c.as_str()));
+            scene::set_value(&mut table, CHANNELS_KEY, toml::Value::Array(list.collect()))?;
+        }
+        Ok(table)
+    }
+
+    /// The resolved, validated scene of a run with these values, exactly as `coin-log record` resolves
+    /// the same scene file.
+    ///
+    /// # Errors
+    /// [`RunSceneError`] when the values give no valid scene.
+    pub fn scene(&self, values: &[toml::Value]) -> Result<Scene, RunSceneError> {
+        let file = scene::file_from_table(self.table(values)?)?;
+        let scene = scene::resolve(&file, &FlagOverrides::default())?;
+        if self.settings.encoding == Encoding::Protobuf && scene.run.duration > PROTOBUF_MAX_SECONDS
+        {
+            return Err(RunSceneError::TooLongForProtobuf(scene.run.duration));
+        }
+        Ok(scene)
+    }
+
+    /// How every run is written.
+    #[must_use]
+    pub fn record_options(&self) -> RecordOptions {
+        RecordOptions {
+            compression: self.settings.compression,
+            encoding: self.settings.encoding,
+        }
+    }
+
+    /// Digits of the largest index: the width run indexes are zero-padded to in file names.
+    #[must_use]
+    pub fn index_width(&self) -> usize {
+        self.runs().saturating_sub(1).to_string().len()
+    }
+
+    /// The sweep as resolved, the `sweep` object of `sweep.json` (format.md: sweep.json): what the
+    /// identity hashes.
+    #[must_use]
+    pub fn description_json(&self) -> serde_json::Value {
+        let description = Description {
+            description: &self.description,
+            base: &self.base,
+            base_scene: toml::to_string(&self.base_table).unwrap_or_default(),
+            set: self.set.iter().map(|(k, v)| (k.as_str(), v)).collect(),
+            axes: self.axes.iter().map(AxisJson::from).collect(),
+            random: self.random.as_ref().map(RandomJson::from),
+            output: &self.settings,
+        };
+        serde_json::to_value(description).unwrap_or(serde_json::Value::Null)
+    }
+
+    /// SHA-256 (hex) of the compact JSON of [`description_json`](Self::description_json): two sweeps
+    /// with the same identity make the same runs.
+    #[must_use]
+    pub fn identity(&self) -> String {
+        super::hash::sha256_hex(self.description_json().to_string().as_bytes())
+    }
+}
+
+/// The scene key `output.channels` sets.
+pub const CHANNELS_KEY: &str = "record.channels";
+
+#[derive(Serialize)]
+struct Description<'a> {
+    description: &'a str,
+    base: &'a str,
+    base_scene: String,
+    set: BTreeMap<&'a str, &'a toml::Value>,
+    axes: Vec<AxisJson<'a>>,
+    random: Option<RandomJson>,
+    output: &'a Settings,
+}
+
+#[derive(Serialize)]
+struct AxisJson<'a> {
+    key: &'a str,
+    values: &'a [toml::Value],
+    zip: Option<&'a str>,
+}
+
+impl<'a> From<&'a Axis> for AxisJson<'a> {
+    fn from(a: &'a Axis) -> Self {
+        Self {
+            key: &a.key,
+            values: &a.values,
+            zip: a.zip.as_deref(),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct RandomJson {
+    seed: u64,
+    count: u64,
+    draws: Vec<serde_json::Value>,
+}
+
+impl From<&Random> for RandomJson {
+    fn from(r: &Random) -> Self {
+        let bound = |x: f64| x.is_finite().then_some(x);
+        let draws = r.draws.iter().map(|d| match d.distribution {
+            Distribution::Uniform { lo, hi } => {
+                serde_json::json!({"key": d.key, "uniform": [lo, hi]})
+            }
+            Distribution::LogUniform { lo, hi } => {
+                serde_json::json!({"key": d.key, "log_uniform": [lo, hi]})
+            }
+            Distribution::Normal {
+                mean,
+                std,
+                min,
+                max,
+            } => serde_json::json!({"key": d.key,
+                "normal": {"mean": mean, "std": std, "min": bound(min), "max": bound(max)}}),
+            Distribution::Choice { .. } => serde_json::json!({"key": d.key, "choice": d.choices}),
+        });
+        Self {
+            seed: r.seed,
+            count: r.count,
+            draws: draws.collect(),
+        }
+    }
+}

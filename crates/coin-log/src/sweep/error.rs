@@ -1,0 +1,72 @@
+//! Why a sweep could not be loaded, run or collected. A run that fails is not an error of the sweep: it
+//! is a row of the catalogue with its reason ([`super::catalogue`]).
+
+use crate::scene::SceneProblems;
+use std::path::PathBuf;
+
+/// A sweep file that cannot be used, a folder that cannot hold the sweep, or an I/O error on the sweep's
+/// own files (the catalogue, the journal, the state).
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The sweep file cannot be read.
+    #[error("cannot read sweep file `{}`: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The sweep file is not TOML or does not fit the sweep's keys and types (serde's message, alone).
+    #[error("sweep file `{label}`: {message}")]
+    Parse {
+        /// The sweep file as named.
+        label: String,
+        /// What is wrong, and where.
+        message: String,
+    },
+    /// Values out of range, missing or contradictory: every problem found, each with its key.
+    #[error("sweep file `{label}`: {problems}")]
+    Invalid {
+        /// The sweep file as named.
+        label: String,
+        /// Every problem (at least one; boxed: a list is large beside the other variants).
+        problems: Box<SceneProblems>,
+    },
+    /// The output folder cannot hold this sweep (not empty, another sweep's, another version's).
+    #[error("`{}`: {reason}", path.display())]
+    Folder {
+        /// The folder.
+        path: PathBuf,
+        /// Why, and what to do.
+        reason: String,
+    },
+    /// Reading or writing one of the sweep's own files failed.
+    #[error("{what} `{}`: {source}", path.display())]
+    Io {
+        /// What was being done (`writing the catalogue`).
+        what: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+impl SweepError {
+    /// True for a sweep file that cannot be used (exit 2 in the CLI), as opposed to a folder or I/O error.
+    #[must_use]
+    pub fn is_bad_sweep_file(&self) -> bool {
+        matches!(
+            self,
+            Self::Read { .. } | Self::Parse { .. } | Self::Invalid { .. }
+        )
+    }
+
+    pub(super) fn io(
+        what: &'static str,
+        path: impl Into<PathBuf>,
+    ) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.into();
+        move |source| Self::Io { what, path, source }
+    }
+}

@@ -1,0 +1,512 @@
+//! The sweep's folder (format.md: The sweep folder): the run files, the catalogue (or its parts), the
+//! sweep's JSON, and the private state beside them in `.coin-log-sweep/`: the plan (the sweep's identity,
+//! written once) and one append-only journal per shard, a line per finished row, synced to disk as the
+//! runs end (rows that end during a sync share the next one), so that a crash or SIGKILL loses at most
+//! the runs in progress and the rows still being synced.
+
+use super::catalogue::{self, split_csv_line};
+use super::definition::Sweep;
+use super::error::SweepError;
+use super::shard::Shard;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::time::UNIX_EPOCH;
+
+/// The private state folder.
+pub const STATE_DIR: &str = ".coin-log-sweep";
+/// The plan, in the state folder: the sweep as resolved and its identity.
+pub const PLAN_FILE: &str = "plan.json";
+/// The whole sweep's catalogue.
+pub const CATALOGUE_FILE: &str = "catalogue.csv";
+/// The whole sweep's JSON: the plan and the counts.
+pub const SWEEP_JSON_FILE: &str = "sweep.json";
+/// What `format` says in the plan and `sweep.json`.
+pub const FORMAT_NAME: &str = "coin-log sweep";
+/// The version of the sweep folder's layout (format.md: The sweep folder).
+pub const FORMAT_VERSION: &str = "1";
+/// The journal's first column, before the catalogue's: the file's modification time when its row was
+/// written, nanoseconds since 1970 (0 without a file).
+pub const MTIME_COLUMN: &str = "mtime_ns";
+
+/// `run-<index>.mcap`, the index zero-padded to `width` digits.
+#[must_use]
+pub fn run_file_name(index: u64, width: usize) -> String {
+    format!("run-{index:0width$}.mcap")
+}
+
+/// `catalogue.part-K-of-N.csv`.
+#[must_use]
+pub fn part_file_name(shard: Shard) -> String {
+    format!("catalogue.part-{}-of-{}.csv", shard.index(), shard.count())
+}
+
+/// The shard of a part's file name.
+#[must_use]
+pub fn shard_of_part(name: &str) -> Option<Shard> {
+    let rest = name.strip_prefix("catalogue.part-")?.strip_suffix(".csv")?;
+    let (k, n) = rest.split_once("-of-")?;
+    Shard::new(k.parse().ok()?, n.parse().ok()?).ok()
+}
+
+fn journal_file_name(shard: Shard) -> String {
+    format!("journal-{}-of-{}.csv", shard.index(), shard.count())
+}
+
+/// The plan: the sweep as resolved, its identity, and what `collect` needs (runs, columns, file names).
+#[must_use]
+pub fn plan_json(sweep: &Sweep) -> serde_json::Value {
+    serde_json::json!({
+        "format": FORMAT_NAME,
+        "format_version": FORMAT_VERSION,
+        "tool_version": env!("CARGO_PKG_VERSION"),
+        "identity": sweep.identity(),
+        "runs": sweep.runs(),
+        "keys": sweep.keys().collect::<Vec<_>>(),
+        "columns": catalogue::columns(sweep.keys()),
+        "index_width": sweep.index_width(),
+        "sweep": sweep.description_json(),
+    })
+}
+
+/// A sweep folder, open.
+#[derive(Debug, Clone)]
+pub struct Folder {
+    /// The folder.
+    pub path: PathBuf,
+    /// The plan it holds.
+    pub plan: serde_json::Value,
+}
+
+/// A run's modification time, nanoseconds since 1970 (0 when the system gives none).
+fn mtime_ns(meta: &fs::Metadata) -> u128 {
+    meta.modified()
+        .ok()
+        .and_then(|t| t.duration_since(UNIX_EPOCH).ok())
+        .map_or(0, |d| d.as_nanos())
+}
+
+/// The size and modification time of a file, if it is there.
+#[must_use]
+pub fn size_and_mtime(path: &Path) -> Option<(u64, u128)> {
+    fs::metadata(path).ok().map(|m| (m.len(), mtime_ns(&m)))
+}
+
+impl Folder {
+    /// Opens `path` for `sweep`: creates it if missing; otherwise it must be empty or hold this same
+    /// sweep (same identity, same tool version). Several shards may open one folder at once.
+    ///
+    /// # Errors
+    /// [`SweepError::Folder`] for a file, a folder with other content, another sweep's or another
+    /// version's folder; [`SweepError::Io`] when it cannot be created or read.
+    pub fn open(path: &Path, sweep: &Sweep) -> Result<Self, SweepError> {
+        let folder_error = |reason: String| SweepError::Folder {
+            path: path.to_path_buf(),
+            reason,
+        };
+        if path.exists() && !path.is_dir() {
+            return Err(folder_error(
+                "is not a folder: give -o a folder for the sweep's files".into(),
+            ));
+        }
+        fs::create_dir_all(path).map_err(SweepError::io("creating the sweep folder", path))?;
+        let state = path.join(STATE_DIR);
+        if !state.is_dir() {
+            let entries =
+                fs::read_dir(path).map_err(SweepError::io("reading the sweep folder", path))?;
+            if let Some(other) = entries.flatten().find(|e| e.file_name() != STATE_DIR) {
+                return Err(folder_error(format!(
+                    "is not empty and holds no sweep (it has `{}`): give -o a new or empty folder",
+                    other.file_name().to_string_lossy()
+                )));
+            }
+            fs::create_dir_all(&state)
+                .map_err(SweepError::io("creating the sweep's state folder", &state))?;
+        }
+        let plan = plan_json(sweep);
+        let plan_path = state.join(PLAN_FILE);
+        match publish_new(&plan_path, format!("{plan}\n").as_bytes()) {
+            Ok(()) => {}
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
+                let held = read_plan(&plan_path)?;
+                check_same(path, &held, &plan)?;
+            }
+            Err(e) => return Err(SweepError::io("writing the sweep's plan", &plan_path)(e)),
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            plan,
+        })
+    }
+
+    /// Opens a folder that holds a sweep, for `collect`.
+    ///
+    /// # Errors
+    /// [`SweepError::Folder`] when it holds no sweep.
+    pub fn existing(path: &Path) -> Result<Self, SweepError> {
+        let plan_path = path.join(STATE_DIR).join(PLAN_FILE);
+        if !plan_path.is_file() {
+            return Err(SweepError::Folder {
+                path: path.to_path_buf(),
+                reason: format!("holds no sweep (no {STATE_DIR}/{PLAN_FILE}): give the folder a sweep was run into"),
+            });
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            plan: read_plan(&plan_path)?,
+        })
+    }
+
+    fn state(&self) -> PathBuf {
+        self.path.join(STATE_DIR)
+    }
+
+    /// A run's file in the folder.
+    #[must_use]
+    pub fn file(&self, name: &str) -> PathBuf {
+        self.path.join(name)
+    }
+
+    /// The runs in the plan.
+    #[must_use]
+    pub fn runs(&self) -> u64 {
+        self.plan["runs"].as_u64().unwrap_or(0)
+    }
+
+    /// The catalogue's columns in the plan.
+    #[must_use]
+    pub fn columns(&self) -> Vec<String> {
+        let columns = self.plan["columns"].as_array().into_iter().flatten();
+        columns
+            .filter_map(|c| c.as_str().map(str::to_string))
+            .collect()
+    }
+
+    /// A temporary file for run `index` (`.run-<index>.<random>.mcap.tmp`), moved to its final name when
+    /// the run is finished and deleted if it is dropped before.
+    ///
+    /// # Errors
+    /// The folder refuses it.
+    pub fn temp_file(&self, index: u64, width: usize) -> io::Result<tempfile::NamedTempFile> {
+        tempfile::Builder::new()
+            .prefix(&format!(".run-{index:0width$}."))
+            .suffix(".mcap.tmp")
+            .tempfile_in(&self.path)
+    }
+
+    /// Deletes the temporary files a killed process of `shard` left: of its runs, and of its catalogue
+    /// (for the whole sweep, also of `sweep.json`).
+    pub fn remove_stale_temps(&self, shard: Shard) {
+        let Ok(entries) = fs::read_dir(&self.path) else {
+            return;
+        };
+        let mut own = vec![temp_prefix(&self.path.join(part_file_name(shard)))];
+        if shard.is_all() {
+            own = [CATALOGUE_FILE, SWEEP_JSON_FILE]
+                .map(|n| temp_prefix(&self.path.join(n)))
+                .into();
+        }
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            let run = name
+                .strip_prefix(".run-")
+                .filter(|_| name.ends_with(".mcap.tmp"))
+                .and_then(|rest| rest.split('.').next())
+                .and_then(|i| i.parse::<u64>().ok());
+            let catalogue =
+                name.ends_with(".tmp") && own.iter().any(|p| name.starts_with(p.as_str()));
+            if run.is_some_and(|i| shard.takes(i)) || catalogue {
+                let _ = fs::remove_file(entry.path());
+            }
+        }
+    }
+
+    /// Every journal line of every shard, in the order written (journals by name): the rows, each with
+    /// its file's recorded modification time. A last line without its line break (torn by a crash) and
+    /// any line that does not parse are left out.
+    ///
+    /// # Errors
+    /// A journal that exists but cannot be read.
+    pub fn journal_rows(&self) -> Result<Vec<JournalRow>, SweepError> {
+        let width = 1 + self.columns().len();
+        let mut names: Vec<PathBuf> = fs::read_dir(self.state())
+            .map_err(SweepError::io(
+                "reading the sweep's state folder",
+                self.state(),
+            ))?
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| {
+                p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.starts_with("journal-") && n.ends_with(".csv"))
+            })
+            .collect();
+        names.sort();
+        let mut rows = Vec::new();
+        for path in names {
+            let text =
+                fs::read_to_string(&path).map_err(SweepError::io("reading the journal", &path))?;
+            let complete = text.rfind('\n').map_or("", |end| &text[..end]);
+            rows.extend(
+                complete
+                    .lines()
+                    .filter_map(|line| JournalRow::parse(line, width)),
+            );
+        }
+        Ok(rows)
+    }
+
+    /// The journal of `shard`, opened for appending (created with its header line if new).
+    ///
+    /// # Errors
+    /// It cannot be created or written.
+    pub fn journal(&self, shard: Shard) -> Result<Journal, SweepError> {
+        let path = self.state().join(journal_file_name(shard));
+        let mut file = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(SweepError::io("opening the journal", &path))?;
+        let len = file
+            .metadata()
+            .map_err(SweepError::io("reading the journal", &path))?
+            .len();
+        if len > 0 && !ends_with_line_break(&path)? {
+            // A line torn by a crash: end it, so that it stays one bad (ignored) line instead of
+            // swallowing the next row.
+            file.write_all(b"\n")
+                .and_then(|()| file.sync_data())
+                .map_err(SweepError::io("writing the journal", &path))?;
+        }
+        if len == 0 {
+            let mut header = vec![MTIME_COLUMN.to_string()];
+            header.extend(self.columns());
+            let line = format!("{}\n", catalogue::csv_line(&header));
+            file.write_all(line.as_bytes())
+                .and_then(|()| file.sync_data())
+                .map_err(SweepError::io("writing the journal", &path))?;
+        }
+        Ok(Journal { file, path })
+    }
+
+    /// Writes `name` in the folder atomically: a temporary file beside it, synced, then renamed over it.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn write_atomically(&self, name: &str, bytes: &[u8]) -> Result<PathBuf, SweepError> {
+        self.write_atomically_with(name, |w| w.write_all(bytes))
+    }
+
+    /// A catalogue (or part) `name`: the header, then `lines`, each ending in a line break, streamed
+    /// into place atomically.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn write_catalogue<S: AsRef<str>>(
+        &self,
+        name: &str,
+        lines: impl Iterator<Item = S>,
+    ) -> Result<PathBuf, SweepError> {
+        let header = catalogue::csv_line(&self.columns());
+        self.write_atomically_with(name, |w| {
+            writeln!(w, "{header}")?;
+            for line in lines {
+                writeln!(w, "{}", line.as_ref())?;
+            }
+            Ok(())
+        })
+    }
+
+    fn write_atomically_with(
+        &self,
+        name: &str,
+        write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+    ) -> Result<PathBuf, SweepError> {
+        let path = self.path.join(name);
+        let persist =
+            |temp: tempfile::NamedTempFile| temp.persist(&path).map(drop).map_err(|e| e.error);
+        temp_beside(&path, write)
+            .and_then(persist)
+            .map_err(SweepError::io("writing", &path))?;
+        Ok(path)
+    }
+}
+
+fn ends_with_line_break(path: &Path) -> Result<bool, SweepError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = File::open(path).map_err(SweepError::io("reading the journal", path))?;
+    let mut last = [0u8];
+    file.seek(SeekFrom::End(-1))
+        .and_then(|_| file.read_exact(&mut last))
+        .map_err(SweepError::io("reading the journal", path))?;
+    Ok(last[0] == b'\n')
+}
+
+/// A journal line: the file's modification time when the row was written, and the row's fields.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JournalRow {
+    /// Modification time of the run's file, ns since 1970 (0 without a file).
+    pub mtime_ns: u128,
+    /// The catalogue row's fields.
+    pub fields: Vec<String>,
+}
+
+impl JournalRow {
+    fn parse(line: &str, width: usize) -> Option<Self> {
+        let mut fields = split_csv_line(line).filter(|f| f.len() == width)?;
+        let mtime_ns = fields.first()?.parse().ok()?;
+        fields.remove(0);
+        fields.first()?.parse::<u64>().ok()?;
+        Some(Self { mtime_ns, fields })
+    }
+
+    /// The run's index.
+    #[must_use]
+    pub fn index(&self) -> u64 {
+        self.fields
+            .first()
+            .and_then(|i| i.parse().ok())
+            .unwrap_or(u64::MAX)
+    }
+}
+
+/// One shard's journal, open for appending.
+#[derive(Debug)]
+pub struct Journal {
+    file: File,
+    path: PathBuf,
+}
+
+impl Journal {
+    /// Appends rows (each with its file's modification time) and syncs them to disk before returning.
+    ///
+    /// # Errors
+    /// Writing or syncing failed (the last row may be torn: it is ignored when read back).
+    pub fn append(&mut self, rows: &[(u128, String)]) -> Result<(), SweepError> {
+        if rows.is_empty() {
+            return Ok(());
+        }
+        let text: String = rows
+            .iter()
+            .map(|(mtime, line)| format!("{mtime},{line}\n"))
+            .collect();
+        self.file
+            .write_all(text.as_bytes())
+            .and_then(|()| self.file.sync_data())
+            .map_err(SweepError::io("writing the journal", &self.path))
+    }
+}
+
+fn read_plan(path: &Path) -> Result<serde_json::Value, SweepError> {
+    let text =
+        fs::read_to_string(path).map_err(SweepError::io("reading the sweep's plan", path))?;
+    serde_json::from_str(&text).map_err(|e| SweepError::Io {
+        what: "reading the sweep's plan",
+        path: path.to_path_buf(),
+        source: io::Error::new(io::ErrorKind::InvalidData, e),
+    })
+}
+
+/// The folder's plan against this sweep's: same identity, same tool version.
+fn check_same(
+    folder: &Path,
+    held: &serde_json::Value,
+    plan: &serde_json::Value,
+) -> Result<(), SweepError> {
+    let error = |reason: String| {
+        Err(SweepError::Folder {
+            path: folder.to_path_buf(),
+            reason,
+        })
+    };
+    let text = |v: &serde_json::Value, key: &str| v[key].as_str().unwrap_or_default().to_string();
+    if text(held, "identity") != text(plan, "identity") {
+        return error(format!(
+            "holds another sweep (identity {}, this one {}): its sweep file, its base scene or its settings \
+             differ; give -o a new folder for this sweep, or delete this folder to start it over",
+            short(&text(held, "identity")), short(&text(plan, "identity"))));
+    }
+    if text(held, "tool_version") != text(plan, "tool_version") {
+        return error(format!(
+            "holds a sweep made by coin-log {}, and this is {}: its files could differ byte for byte from \
+             what this version records; finish it with coin-log {0}, or start over in a new folder",
+            text(held, "tool_version"), text(plan, "tool_version")));
+    }
+    Ok(())
+}
+
+fn short(identity: &str) -> &str {
+    identity.get(..12).unwrap_or(identity)
+}
+
+// A minimal private atomic output, for the sweep's own files (the catalogue, its parts, sweep.json, the
+// plan); the library's shared atomic-output helper replaces `temp_beside` and its two callers once it lands.
+/// Writes `path` through a synced temporary file beside it, unless `path` exists (`AlreadyExists`).
+fn publish_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let temp = temp_beside(path, |w| w.write_all(bytes))?;
+    temp.persist_noclobber(path).map(drop).map_err(|e| e.error)
+}
+
+/// `.NAME.`: the temporary files of `path` are named after it, so that a process cleans up only its own.
+fn temp_prefix(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    format!(".{name}.")
+}
+
+/// A temporary file beside `path` (`.NAME.<random>.tmp`) holding what `write` wrote, flushed, synced and
+/// readable.
+fn temp_beside(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<tempfile::NamedTempFile> {
+    let folder = path.parent().unwrap_or_else(|| Path::new("."));
+    let mut temp = tempfile::Builder::new()
+        .prefix(&temp_prefix(path))
+        .suffix(".tmp")
+        .tempfile_in(folder)?;
+    {
+        let mut buffered = io::BufWriter::new(temp.as_file_mut());
+        write(&mut buffered)?;
+        buffered.flush()?;
+    }
+    temp.as_file().sync_all()?;
+    make_readable(temp.as_file());
+    Ok(temp)
+}
+
+/// Temporary files are created owner-only; a finished file is an ordinary file.
+pub(super) fn make_readable(file: &File) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = file.set_permissions(fs::Permissions::from_mode(0o644));
+    }
+    #[cfg(not(unix))]
+    let _ = file;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_torn_last_journal_line_and_garbage_are_left_out() {
+        let width = 3;
+        assert!(JournalRow::parse("12,0,a", width).is_some());
+        assert!(JournalRow::parse("12,0", width).is_none());
+        assert!(JournalRow::parse("x,0,a", width).is_none());
+        assert!(JournalRow::parse("12,\"0,a", width).is_none());
+    }
+
+    #[test]
+    fn part_names_give_their_shard() {
+        let s = Shard::new(2, 5).unwrap();
+        assert_eq!(shard_of_part(&part_file_name(s)), Some(s));
+        assert_eq!(shard_of_part("catalogue.part-5-of-5.csv"), None);
+        assert_eq!(run_file_name(7, 3), "run-007.mcap");
+    }
+}

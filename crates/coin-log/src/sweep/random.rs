@@ -1,0 +1,257 @@
+//! The random draws of a sweep (format.md: Sweep files, Random draws): a counter-based generator, so that
+//! a run's values depend only on the seed, the run's index and the draw's index, never on the number of
+//! jobs, the shards or the order in which runs are done.
+//!
+//! Written out here, not taken from a crate, because its numbers are part of the contract: another tool
+//! must reproduce them from format.md, and a crate's algorithm may change between versions. With γ =
+//! 0x9e3779b97f4a7c15 and mix the finaliser of splitmix64 (Steele, Lea and Flood 2014; all arithmetic
+//! wrapping on u64):
+//!
+//! ```text
+//! mix(z)  = z ^= z >> 30; z *= 0xbf58476d1ce4e5b9; z ^= z >> 27; z *= 0x94d049bb133111eb; z ^ (z >> 31)
+//! step(h, x) = mix(h + γ + x)
+//! word(seed, run, draw, n) = step(step(step(seed, run), draw), n)
+//! u = (word >> 11) · 2⁻⁵³                  a uniform number in [0, 1), exact
+//! ```
+//!
+//! `n` counts the words one draw uses (0 for uniform, log-uniform and choice; 2a and 2a + 1 for attempt a
+//! of a normal draw).
+
+/// splitmix64's increment, ⌊2⁶⁴/φ⌋.
+const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// Attempts a bounded normal draw makes before it gives up: the bounds would have to hold less than
+/// about one millionth of the distribution to reach it.
+pub const NORMAL_ATTEMPTS: u64 = 1_000_000;
+
+/// splitmix64's output function: a bijection of u64 that mixes every bit into every other.
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+fn step(h: u64, x: u64) -> u64 {
+    mix(h.wrapping_add(GAMMA).wrapping_add(x))
+}
+
+/// The `n`-th random word of draw `draw` of run `run`.
+#[must_use]
+pub fn word(seed: u64, run: u64, draw: u64, n: u64) -> u64 {
+    step(step(step(seed, run), draw), n)
+}
+
+/// A word as a uniform number in [0, 1): its top 53 bits times 2⁻⁵³.
+#[must_use]
+#[allow(clippy::cast_precision_loss)] // below 2⁵³: exact
+pub fn unit(word: u64) -> f64 {
+    (word >> 11) as f64 * f64::EPSILON / 2.0
+}
+
+/// What one draw samples from (validated: finite bounds, lo < hi, 0 < lo for log-uniform, std > 0).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Distribution {
+    /// lo + (hi − lo)·u.
+    Uniform {
+        /// Lower bound.
+        lo: f64,
+        /// Upper bound.
+        hi: f64,
+    },
+    /// exp(ln lo + (ln hi − ln lo)·u).
+    LogUniform {
+        /// Lower bound, > 0.
+        lo: f64,
+        /// Upper bound.
+        hi: f64,
+    },
+    /// mean + std·z, z = √(−2 ln(1 − u₁))·cos(2π u₂) (Box–Muller), redrawn until within [min, max].
+    Normal {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation, > 0.
+        std: f64,
+        /// Lower bound (−∞ when not given).
+        min: f64,
+        /// Upper bound (+∞ when not given).
+        max: f64,
+    },
+    /// The k-th of `len` choices, k = ⌊(word >> 11)·len / 2⁵³⌋.
+    Choice {
+        /// How many choices.
+        len: usize,
+    },
+}
+
+/// What a draw gave: a number, or the index of a choice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Drawn {
+    /// A uniform, log-uniform or normal number.
+    Number(f64),
+    /// The index of the choice.
+    Choice(usize),
+}
+
+/// A bounded normal draw found no value within its bounds in [`NORMAL_ATTEMPTS`] attempts.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error(
+    "no normal draw (mean {mean}, std {std}) fell within [{min}, {max}] in {NORMAL_ATTEMPTS} attempts: \
+     widen the bounds"
+)]
+pub struct OutOfBounds {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound.
+    pub max: f64,
+}
+
+impl Distribution {
+    /// The value of draw `draw` of run `run`.
+    ///
+    /// # Errors
+    /// [`OutOfBounds`] when a bounded normal draw finds nothing within its bounds.
+    pub fn draw(&self, seed: u64, run: u64, draw: u64) -> Result<Drawn, OutOfBounds> {
+        let word = |n| word(seed, run, draw, n);
+        Ok(match *self {
+            Self::Uniform { lo, hi } => Drawn::Number(lo + (hi - lo) * unit(word(0))),
+            Self::LogUniform { lo, hi } => {
+                Drawn::Number((lo.ln() + (hi.ln() - lo.ln()) * unit(word(0))).exp())
+            }
+            Self::Normal {
+                mean,
+                std,
+                min,
+                max,
+            } => {
+                for attempt in 0..NORMAL_ATTEMPTS {
+                    let (u1, u2) = (unit(word(2 * attempt)), unit(word(2 * attempt + 1)));
+                    let z = (-2.0 * (1.0 - u1).ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+                    let x = mean + std * z;
+                    if (min..=max).contains(&x) {
+                        return Ok(Drawn::Number(x));
+                    }
+                }
+                return Err(OutOfBounds {
+                    mean,
+                    std,
+                    min,
+                    max,
+                });
+            }
+            Self::Choice { len } => {
+                let k = (u128::from(word(0) >> 11) * len as u128) >> 53;
+                // k < len ≤ usize::MAX by construction.
+                Drawn::Choice(usize::try_from(k).unwrap_or(0))
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values computed independently (a 10-line Python transcription of format.md's definition).
+    #[test]
+    fn the_generator_gives_the_documented_words() {
+        assert_eq!(
+            mix(GAMMA),
+            0xe220_a839_7b1d_cdaf,
+            "splitmix64(0)'s first output"
+        );
+        let cases = [
+            (
+                (0, 0, 0, 0),
+                0x2382_75bc_38fc_be91,
+                0.138_709_410_145_554_27,
+            ),
+            (
+                (42, 0, 0, 0),
+                0x6310_bf04_d820_7f46,
+                0.386_974_276_240_040_9,
+            ),
+            (
+                (42, 1, 0, 0),
+                0x9bb6_c981_ed5e_f223,
+                0.608_257_860_394_015_4,
+            ),
+            (
+                (42, 0, 1, 0),
+                0x2ce0_2c4e_e4d2_ea09,
+                0.175_295_609_723_274_4,
+            ),
+            (
+                (42, 0, 0, 1),
+                0xb682_ee25_ce24_109e,
+                0.712_935_337_285_799_4,
+            ),
+            (
+                ((1 << 63) - 1, 999, 3, 7),
+                0xb103_0064_3a16_ce5a,
+                0.691_452_049_703_083_5,
+            ),
+        ];
+        for ((seed, run, draw, n), expected, u) in cases {
+            let w = word(seed, run, draw, n);
+            assert_eq!(w, expected, "word({seed}, {run}, {draw}, {n}) = {w:#x}");
+            assert_eq!(unit(w).to_bits(), f64::to_bits(u), "unit of {w:#x}");
+        }
+    }
+
+    #[test]
+    fn draws_stay_within_their_bounds_and_cover_them() {
+        let uniform = Distribution::Uniform { lo: 2.0, hi: 3.0 };
+        let log = Distribution::LogUniform { lo: 1e-3, hi: 1e3 };
+        let normal = Distribution::Normal {
+            mean: 0.0,
+            std: 1.0,
+            min: -0.5,
+            max: 2.0,
+        };
+        let choice = Distribution::Choice { len: 3 };
+        let mut seen = [0; 3];
+        let (mut below_one, mut n) = (0, 0);
+        for run in 0..2000 {
+            let Ok(Drawn::Number(x)) = uniform.draw(7, run, 0) else {
+                panic!()
+            };
+            assert!((2.0..=3.0).contains(&x), "{x}");
+            let Ok(Drawn::Number(y)) = log.draw(7, run, 1) else {
+                panic!()
+            };
+            assert!((1e-3..=1e3).contains(&y), "{y}");
+            below_one += usize::from(y < 1.0);
+            let Ok(Drawn::Number(z)) = normal.draw(7, run, 2) else {
+                panic!()
+            };
+            assert!((-0.5..=2.0).contains(&z), "{z}");
+            let Ok(Drawn::Choice(k)) = choice.draw(7, run, 3) else {
+                panic!()
+            };
+            seen[k] += 1;
+            n += 1;
+        }
+        // Log-uniform over six decades: half below 1; each choice about a third (4σ bounds).
+        assert!(
+            (900..1100).contains(&below_one),
+            "{below_one} of {n} below 1"
+        );
+        assert!(seen.iter().all(|&c| (580..760).contains(&c)), "{seen:?}");
+    }
+
+    #[test]
+    fn a_normal_draw_with_unreachable_bounds_says_so() {
+        let far = Distribution::Normal {
+            mean: 0.0,
+            std: 1.0,
+            min: 50.0,
+            max: 51.0,
+        };
+        let e = far.draw(1, 0, 0).unwrap_err().to_string();
+        assert!(e.contains("widen the bounds"), "{e}");
+    }
+}

@@ -1,0 +1,599 @@
+//! Running a sweep (format.md: Running a sweep): the runs still to do (resume), `jobs` of them at once on
+//! threads of this process, each recorded to a temporary file, hashed, verified and moved into place, its
+//! row journalled as it finishes; then the catalogue (or this shard's part) and, for a whole sweep,
+//! `sweep.json`.
+
+use super::catalogue::{self, cell, FailureKind, Prediction, Recorded, Row, RunStatus};
+use super::definition::{RunSceneError, Sweep};
+use super::error::SweepError;
+use super::folder::{self, Folder, JournalRow};
+use super::hash::sha256_file;
+use super::shard::Shard;
+use crate::analyse::{motion_name, Analysis};
+use crate::format::Termination;
+use crate::model::nutation::Motion;
+use crate::record::{self, RecordSummary};
+use crate::scene::Scene;
+use crate::verify::{self, FileReport, Status, Verdict};
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::Instant;
+
+/// Write buffer in front of each run's file (as `record`'s: the writer issues many small writes).
+const WRITE_BUFFER: usize = 1 << 20;
+
+/// How to run a sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Runs at once (threads), ≥ 1.
+    pub jobs: usize,
+    /// The runs to take.
+    pub shard: Shard,
+    /// Redo failed runs on resume (runs that failed for a reason other than I/O are kept otherwise:
+    /// their failure is a property of their values).
+    pub retry_failed: bool,
+}
+
+/// Where a sweep stands, after each run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Progress {
+    /// This shard's runs.
+    pub runs: u64,
+    /// Runs to do in this invocation (the rest were done before).
+    pub todo: u64,
+    /// Of those, done so far.
+    pub done: u64,
+    /// Rows of this shard that are failed, so far (kept and new).
+    pub failed: u64,
+}
+
+/// How a sweep invocation ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepOutcome {
+    /// This shard's runs.
+    pub runs: u64,
+    /// Rows finished.
+    pub finished: u64,
+    /// Rows failed.
+    pub failed: u64,
+    /// Runs without a row (interrupted, or not started).
+    pub pending: u64,
+    /// Rows kept from an earlier invocation (resume).
+    pub kept: u64,
+    /// Runs done now (finished or failed).
+    pub done: u64,
+    /// Whether a stop request ended it early.
+    pub interrupted: bool,
+    /// The catalogue written (`catalogue.csv`, or this shard's part).
+    pub catalogue: PathBuf,
+    /// `sweep.json`, for a whole sweep.
+    pub summary: Option<PathBuf>,
+    /// Seconds spent in recording, summed over the runs done now.
+    pub record_seconds: f64,
+    /// Seconds spent in verifying, summed over the runs done now.
+    pub verify_seconds: f64,
+}
+
+/// A run done, as a worker hands it over: the row, its file's modification time and the seconds
+/// recording and verifying took. A run stopped by a stop request hands over nothing (no row: redone on
+/// resume).
+struct Done {
+    row: Row,
+    mtime_ns: u128,
+    record: f64,
+    verify: f64,
+}
+
+impl Done {
+    fn without_file(row: Row) -> Self {
+        Self {
+            row,
+            mtime_ns: 0,
+            record: 0.0,
+            verify: 0.0,
+        }
+    }
+}
+
+/// What resume found: the rows to keep, the runs to do, and kept rows whose file was touched but not
+/// changed (to journal again with the new modification time).
+struct Resumed {
+    held: BTreeMap<u64, Held>,
+    todo: Vec<u64>,
+    refreshed: Vec<(u128, String)>,
+}
+
+/// A row held for the catalogue: its line and status.
+struct Held {
+    line: String,
+    status: RunStatus,
+}
+
+/// Runs `sweep` into the folder `dir` (or resumes it there). `stop` set (by a signal handler) stops
+/// starting runs and ends the running recordings early; their files are discarded and the runs redone on
+/// resume. The sweep sets `stop` itself when it cannot write its journal. `progress` is called as runs
+/// end, on the calling thread.
+///
+/// # Errors
+/// [`SweepError`] for a folder that cannot hold the sweep or a catalogue or journal that cannot be
+/// written. A run that fails is a row, not an error.
+pub fn run(
+    sweep: &Sweep,
+    dir: &std::path::Path,
+    options: &RunOptions,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<SweepOutcome, SweepError> {
+    let folder = Folder::open(dir, sweep)?;
+    let Resumed {
+        held,
+        todo,
+        refreshed,
+    } = resume(sweep, &folder, options)?;
+    folder.remove_stale_temps(options.shard);
+    let mut journal = folder.journal(options.shard)?;
+    journal.append(&refreshed)?;
+    let mut tally = Tally::new(held, options.shard.len(sweep.runs()), todo.len() as u64);
+    progress(&tally.progress);
+    let mut error = None;
+    pool(sweep, &folder, &todo, options.jobs, stop, |batch| {
+        let lines: Vec<(u128, String)> = batch.iter().map(|d| (d.mtime_ns, d.row.line())).collect();
+        if let Err(e) = journal.append(&lines) {
+            stop.store(true, Ordering::SeqCst);
+            error.get_or_insert(e);
+            return;
+        }
+        for (done, (_, line)) in batch.into_iter().zip(lines) {
+            tally.add(&done, line);
+        }
+        progress(&tally.progress);
+    });
+    if let Some(e) = error {
+        return Err(e);
+    }
+    let (catalogue, summary) = write_catalogue(sweep, &folder, options.shard, &tally.held)?;
+    Ok(tally.outcome(catalogue, summary, stop.load(Ordering::SeqCst)))
+}
+
+/// The rows held for the catalogue and the counts, as the runs come in.
+struct Tally {
+    held: BTreeMap<u64, Held>,
+    progress: Progress,
+    kept: u64,
+    record_seconds: f64,
+    verify_seconds: f64,
+}
+
+impl Tally {
+    fn new(held: BTreeMap<u64, Held>, runs: u64, todo: u64) -> Self {
+        let failed = held
+            .values()
+            .filter(|h| h.status == RunStatus::Failed)
+            .count() as u64;
+        Self {
+            kept: held.len() as u64,
+            held,
+            progress: Progress {
+                runs,
+                todo,
+                done: 0,
+                failed,
+            },
+            record_seconds: 0.0,
+            verify_seconds: 0.0,
+        }
+    }
+
+    fn add(&mut self, done: &Done, line: String) {
+        let status = done.row.status;
+        self.record_seconds += done.record;
+        self.verify_seconds += done.verify;
+        self.progress.done += 1;
+        self.progress.failed += u64::from(status == RunStatus::Failed);
+        self.held.insert(done.row.index, Held { line, status });
+    }
+
+    fn outcome(
+        self,
+        catalogue: PathBuf,
+        summary: Option<PathBuf>,
+        interrupted: bool,
+    ) -> SweepOutcome {
+        let rows = self.held.len() as u64;
+        let failed = self
+            .held
+            .values()
+            .filter(|h| h.status == RunStatus::Failed)
+            .count() as u64;
+        SweepOutcome {
+            runs: self.progress.runs,
+            finished: rows - failed,
+            failed,
+            pending: self.progress.runs - rows,
+            kept: self.kept,
+            done: self.progress.done,
+            interrupted,
+            catalogue,
+            summary,
+            record_seconds: self.record_seconds,
+            verify_seconds: self.verify_seconds,
+        }
+    }
+}
+
+/// Runs `todo` on `jobs` threads; `handle` sees the results on the calling thread, in the order they end,
+/// in batches of those that ended while it handled the previous batch (so that one journal sync serves
+/// them all: the sweep is never slower than the disk syncs one row).
+fn pool(
+    sweep: &Sweep,
+    folder: &Folder,
+    todo: &[u64],
+    jobs: usize,
+    stop: &AtomicBool,
+    mut handle: impl FnMut(Vec<Done>),
+) {
+    let next = AtomicUsize::new(0);
+    let (sender, receiver) = mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, todo.len().max(1)) {
+            let sender = sender.clone();
+            let next = &next;
+            scope.spawn(move || {
+                while !stop.load(Ordering::SeqCst) {
+                    let Some(&index) = todo.get(next.fetch_add(1, Ordering::SeqCst)) else {
+                        break;
+                    };
+                    let Some(done) = run_one(sweep, folder, index, stop) else {
+                        continue;
+                    };
+                    if sender.send(done).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(sender);
+        for first in &receiver {
+            let mut batch = vec![first];
+            batch.extend(receiver.try_iter());
+            handle(batch);
+        }
+    });
+}
+
+/// The rows to keep from the journals and the runs to do. A row is kept when its file is there with
+/// the size and modification time it was journalled with, or, if only the time differs, with the same
+/// SHA-256; a failed row is kept unless it failed on I/O or `retry_failed` is set.
+fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resumed, SweepError> {
+    let columns = folder.columns();
+    let at = |name: &str| columns.iter().position(|c| c == name).unwrap_or(0);
+    let (status_at, failure_at, file_at, bytes_at, sha_at) = (
+        at("status"),
+        at("failure"),
+        at("file"),
+        at("bytes"),
+        at("sha256"),
+    );
+    let mut latest: BTreeMap<u64, JournalRow> = BTreeMap::new();
+    for row in folder.journal_rows()? {
+        if row.index() < sweep.runs() && options.shard.takes(row.index()) {
+            latest.insert(row.index(), row);
+        }
+    }
+    let (mut held, mut todo, mut refreshed) = (BTreeMap::new(), Vec::new(), Vec::new());
+    for index in options.shard.runs(sweep.runs()) {
+        let Some(row) = latest.remove(&index) else {
+            todo.push(index);
+            continue;
+        };
+        let f = &row.fields;
+        let Ok(status) = f[status_at].parse::<RunStatus>() else {
+            todo.push(index);
+            continue;
+        };
+        let retry = status == RunStatus::Failed
+            && (options.retry_failed || f[failure_at] == FailureKind::Io.name());
+        let file_ok = f[file_at].is_empty() || {
+            let path = folder.file(&f[file_at]);
+            match folder::size_and_mtime(&path) {
+                Some((size, mtime)) if size.to_string() == f[bytes_at] && mtime == row.mtime_ns => {
+                    true
+                }
+                Some((size, mtime)) if size.to_string() == f[bytes_at] => {
+                    let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
+                    if same {
+                        refreshed.push((mtime, catalogue::csv_line(f)));
+                    }
+                    same
+                }
+                _ => false,
+            }
+        };
+        if retry || !file_ok {
+            todo.push(index);
+        } else {
+            held.insert(
+                index,
+                Held {
+                    line: catalogue::csv_line(f),
+                    status,
+                },
+            );
+        }
+    }
+    Ok(Resumed {
+        held,
+        todo,
+        refreshed,
+    })
+}
+
+/// The catalogue (or the shard's part) in index order, and for a whole sweep `sweep.json`, each written
+/// atomically.
+fn write_catalogue(
+    sweep: &Sweep,
+    folder: &Folder,
+    shard: Shard,
+    held: &BTreeMap<u64, Held>,
+) -> Result<(PathBuf, Option<PathBuf>), SweepError> {
+    let lines = held.values().map(|h| h.line.as_str());
+    if !shard.is_all() {
+        return Ok((
+            folder.write_catalogue(&folder::part_file_name(shard), lines)?,
+            None,
+        ));
+    }
+    let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
+    let failed = held
+        .values()
+        .filter(|h| h.status == RunStatus::Failed)
+        .count() as u64;
+    let json = summary_json(
+        &folder.plan,
+        held.len() as u64 - failed,
+        failed,
+        sweep.runs() - held.len() as u64,
+    );
+    let summary =
+        folder.write_atomically(folder::SWEEP_JSON_FILE, format!("{json}\n").as_bytes())?;
+    Ok((catalogue, Some(summary)))
+}
+
+/// `sweep.json`: the plan with the counts (format.md: sweep.json).
+pub(super) fn summary_json(
+    plan: &serde_json::Value,
+    finished: u64,
+    failed: u64,
+    pending: u64,
+) -> serde_json::Value {
+    let mut json = plan.clone();
+    json["counts"] =
+        serde_json::json!({"finished": finished, "failed": failed, "pending": pending});
+    json
+}
+
+/// One run: values → scene → record into a temporary file → hash → verify → move into place → row.
+fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Option<Done> {
+    let started = Instant::now();
+    let values = sweep.values(index);
+    let cells = match &values {
+        Ok(v) => v.iter().map(cell).collect(),
+        Err(_) => vec![String::new(); sweep.keys().count()],
+    };
+    let failed = |failure, reason: String| Row {
+        index,
+        values: cells.clone(),
+        status: RunStatus::Failed,
+        failure: Some(failure),
+        reason,
+        recorded: None,
+        prediction: None,
+        wall_time: started.elapsed().as_secs_f64(),
+    };
+    let scene = values
+        .map_err(RunSceneError::from)
+        .and_then(|v| sweep.scene(&v));
+    let scene = match scene {
+        Ok(scene) => scene,
+        Err(e) => {
+            return Some(Done::without_file(failed(
+                FailureKind::Scene,
+                e.to_string(),
+            )))
+        }
+    };
+    let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
+    match record_and_check(sweep, folder, index, &scene, stop) {
+        Ok(None) => None,
+        Ok(Some(checked)) => {
+            let (status, failure, reason) = judge(&checked.summary, checked.report.as_ref());
+            let row = Row {
+                index,
+                values: cells,
+                status,
+                failure,
+                reason,
+                recorded: Some(recorded(&checked, sweep.index_width(), index)),
+                prediction,
+                wall_time: started.elapsed().as_secs_f64(),
+            };
+            Some(Done {
+                row,
+                mtime_ns: checked.mtime_ns,
+                record: checked.record_seconds,
+                verify: checked.verify_seconds,
+            })
+        }
+        Err(e) => Some(Done::without_file(failed(FailureKind::Io, e))),
+    }
+}
+
+/// A recorded run, in place under its final name.
+struct Checked {
+    summary: RecordSummary,
+    report: Option<FileReport>,
+    sha256: String,
+    mtime_ns: u128,
+    record_seconds: f64,
+    verify_seconds: f64,
+}
+
+/// Records the run into a temporary file, syncs, hashes and verifies it, and moves it to its name;
+/// `None` when a stop request interrupted it (the temporary file is deleted).
+fn record_and_check(
+    sweep: &Sweep,
+    folder: &Folder,
+    index: u64,
+    scene: &Scene,
+    stop: &AtomicBool,
+) -> Result<Option<Checked>, String> {
+    let width = sweep.index_width();
+    let name = folder::run_file_name(index, width);
+    let target = folder.file(&name);
+    let io = |what: &str| {
+        let what = format!("{what} `{name}`");
+        move |e: std::io::Error| format!("{what}: {e}")
+    };
+    let mut temp = folder
+        .temp_file(index, width)
+        .map_err(io("creating a temporary file for"))?;
+    let started = Instant::now();
+    let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());
+    let summary = record::record(scene, &sweep.record_options(), writer, stop, |_| {})
+        .map_err(|e| error_chain(&e))?;
+    if summary.termination == Termination::Interrupted {
+        return Ok(None);
+    }
+    temp.as_file().sync_all().map_err(io("writing"))?;
+    folder::make_readable(temp.as_file());
+    let record_seconds = started.elapsed().as_secs_f64();
+    let (sha256, _) = sha256_file(temp.path()).map_err(io("reading back"))?;
+    let started = Instant::now();
+    let report = sweep
+        .settings
+        .verify
+        .then(|| verify::verify_file(temp.path(), &verify::Options::default()));
+    let verify_seconds = started.elapsed().as_secs_f64();
+    temp.persist(&target)
+        .map_err(|e| io("moving the recording to")(e.error))?;
+    let (_, mtime_ns) = folder::size_and_mtime(&target)
+        .ok_or_else(|| format!("`{name}` vanished once moved into place"))?;
+    Ok(Some(Checked {
+        summary,
+        report,
+        sha256,
+        mtime_ns,
+        record_seconds,
+        verify_seconds,
+    }))
+}
+
+/// An error with its causes: `writing the MCAP file failed: No space left on device`.
+fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(&format!(": {s}"));
+        source = s.source();
+    }
+    text
+}
+
+fn recorded(c: &Checked, width: usize, index: u64) -> Recorded {
+    let s = &c.summary;
+    Recorded {
+        file: folder::run_file_name(index, width),
+        bytes: s.bytes,
+        sha256: c.sha256.clone(),
+        termination: s.termination,
+        t_end: s.termination_time,
+        samples: s.samples,
+        messages: s.messages,
+        steps: s.stats.steps,
+        energy_drift: s.energy_drift,
+        invariant_drift: s.invariant_drift,
+        steady_residual: s.steady_residual,
+        event_trusted: s.event_trusted,
+        verify: c.report.as_ref().map(|r| r.verdict),
+    }
+}
+
+/// Finished, or failed with the kind and reason: a numerical failure first, then a verdict other than ok.
+fn judge(
+    s: &RecordSummary,
+    report: Option<&FileReport>,
+) -> (RunStatus, Option<FailureKind>, String) {
+    if let Some(f) = &s.failure {
+        let reason = format!(
+            "{} at t = {}: {f}",
+            s.termination.name(),
+            s.termination_time
+        );
+        return (RunStatus::Failed, Some(FailureKind::Numerical), reason);
+    }
+    match report {
+        Some(r) if r.verdict != Verdict::Ok => (
+            RunStatus::Failed,
+            Some(FailureKind::Verify),
+            verify_reason(r),
+        ),
+        _ => (RunStatus::Finished, None, String::new()),
+    }
+}
+
+/// `verify: failed: energy 1.2e-5 > 3.1e-7, ...`, or the problem of a file that cannot be verified.
+fn verify_reason(r: &FileReport) -> String {
+    let failing: Vec<String> = r
+        .checks
+        .iter()
+        .filter(|c| c.status == Status::Fail)
+        .map(|c| match (c.value, c.tolerance) {
+            (Some(v), Some(t)) => format!("{} {v:.3e} > {t:.3e}", c.id),
+            _ => c.id.to_string(),
+        })
+        .collect();
+    let mut reason = format!("verify: {}", catalogue::verdict_name(r.verdict));
+    if !failing.is_empty() {
+        reason.push_str(&format!(": {}", failing.join(", ")));
+    }
+    if let Some(p) = &r.problem {
+        reason.push_str(&format!(": {p}"));
+    }
+    reason
+}
+
+/// What the quadrature predicts for a conservative scene (format.md: The catalogue, predicted_*).
+fn predict(scene: &Scene) -> Option<Prediction> {
+    if scene.dissipation.is_some() {
+        return None;
+    }
+    let a = Analysis::of_scene(scene).ok()?;
+    let duration = scene.run.duration;
+    let lift_off = a.orbit.lift_off.map(|e| e.time).filter(|&t| t <= duration);
+    let landing = match a.orbit.motion {
+        Motion::FlatLanding { time, .. } if time <= duration => Some(time),
+        _ => None,
+    };
+    let needs_more =
+        a.slips() == Some(true) && (a.orbit.max_friction_ratio.is_some() || lift_off.is_some());
+    let termination = match (lift_off, landing) {
+        _ if needs_more => Termination::Slip,
+        (Some(l), Some(f)) if f < l => Termination::FlatLanding,
+        (Some(_), _) => Termination::LiftOff,
+        (None, Some(_)) => Termination::FlatLanding,
+        (None, None) => Termination::Completed,
+    };
+    let stability = a
+        .steady
+        .as_ref()
+        .or(a.base_steady.as_ref())
+        .map(|s| s.verdict.name());
+    Some(Prediction {
+        motion: motion_name(&a.orbit.motion),
+        stability,
+        termination,
+    })
+}

@@ -1,0 +1,695 @@
+//! Sweep file → [`Sweep`]: every problem found at once, each with its key, the value and the fix
+//! (format.md: Sweep files). A key is checked against the scene's keys and types by applying a value of
+//! it to the base scene and reading the result as a scene file; whether the values give a *valid* scene
+//! is each run's business (an invalid combination is a failed run, not a bad sweep file).
+
+use super::definition::{Axis, Draw, Random, Settings, Sweep, CHANNELS_KEY, MAX_RUNS};
+use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
+use super::random::Distribution;
+use super::space::{linspace, logspace};
+use crate::format::{Channel, Encoding};
+use crate::scene::{self, presets, Problem, SceneProblems};
+use coin_log_mcap::Compression;
+use std::path::Path;
+
+/// Values of a `values` axis or `choice` draw checked against the scene's types before running (the
+/// rest are checked by their runs).
+const CHECKED_VALUES: usize = 100;
+
+/// Validates a parsed sweep file; `folder` is where a base scene path starts from.
+pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProblems> {
+    let mut c = Checker::default();
+    let places = places(&file);
+    let base_table = c.base(&file.base, folder);
+    let set = c.set(&file.set);
+    let parsed: Vec<Option<Axis>> = (file.axis.iter().enumerate())
+        .map(|(i, a)| c.axis(i, a))
+        .collect();
+    let dimensions = c.dimensions(&parsed);
+    let axes: Vec<Axis> = parsed.into_iter().flatten().collect();
+    let random = file.random.as_ref().and_then(|r| c.random(r));
+    let settings = c.settings(&file.output.unwrap_or_default());
+    let mut sweep = Sweep {
+        description: file.description.unwrap_or_default(),
+        base: file.base,
+        base_table: base_table.clone().unwrap_or_default(),
+        set,
+        axes,
+        dimensions,
+        random,
+        settings,
+    };
+    c.collisions(&places);
+    if c.problems.is_empty() {
+        if let Some(base) = base_table {
+            c.scene_keys(&sweep, &base, &places);
+        }
+        c.size(&sweep);
+    }
+    match SceneProblems::from_vec(c.problems) {
+        Some(problems) => Err(problems),
+        None => {
+            sweep.set.sort_by(|a, b| a.0.cmp(&b.0));
+            Ok(sweep)
+        }
+    }
+}
+
+#[derive(Default)]
+struct Checker {
+    problems: Vec<Problem>,
+}
+
+/// A TOML number as f64.
+fn number(v: &toml::Value) -> Option<f64> {
+    match v {
+        #[allow(clippy::cast_precision_loss)] // a TOML integer used as a bound or an exponent
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(x) => Some(*x),
+        _ => None,
+    }
+}
+
+/// A whole number ≥ 0 (an integer, or a float with no fraction below 2⁵³).
+fn whole(v: &toml::Value) -> Option<u64> {
+    match v {
+        toml::Value::Integer(i) => u64::try_from(*i).ok(),
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        // checked whole and in range
+        toml::Value::Float(x) if x.fract() == 0.0 && (0.0..9e15).contains(x) => Some(*x as u64),
+        _ => None,
+    }
+}
+
+fn array_text(values: &[toml::Value]) -> String {
+    toml::Value::Array(values.to_vec()).to_string()
+}
+
+/// True for a dotted key with no empty part.
+fn dotted(key: &str) -> bool {
+    !key.trim().is_empty() && key.split('.').all(|p| !p.trim().is_empty())
+}
+
+impl Checker {
+    fn problem(
+        &mut self,
+        key: impl Into<String>,
+        value: impl Into<String>,
+        reason: impl Into<String>,
+    ) {
+        self.problems.push(Problem {
+            key: key.into(),
+            value: value.into(),
+            reason: reason.into(),
+            flag: None,
+        });
+    }
+
+    /// The base scene as a table: a built-in by name, or a scene file by path.
+    fn base(&mut self, base: &str, folder: &Path) -> Option<toml::Table> {
+        let quoted = format!("\"{base}\"");
+        let is_path = base.contains('/')
+            || base.contains(std::path::MAIN_SEPARATOR)
+            || base.ends_with(".toml");
+        if !is_path {
+            if let Some(preset) = presets::preset(base) {
+                return toml::Table::try_from(&preset).ok();
+            }
+            let names = presets::NAMES.join(", ");
+            self.problem("base", quoted, format!(
+                "is no built-in scene ({names}) and not a path: a scene file is given by its path relative \
+                 to the sweep file, such as \"./{base}.toml\""));
+            return None;
+        }
+        let path = folder.join(base);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) => {
+                self.problem("base", quoted, format!(
+                    "cannot be read ({e}; looked for `{}`): give the path of a scene file relative to the \
+                     sweep file", path.display()));
+                return None;
+            }
+        };
+        match toml::from_str::<toml::Table>(&text) {
+            Ok(table) => Some(table),
+            Err(e) => {
+                let message = e.to_string().trim().replace('\n', " ");
+                self.problem(
+                    "base",
+                    quoted,
+                    format!("is not a TOML scene file: {message}"),
+                );
+                None
+            }
+        }
+    }
+
+    fn set(&mut self, set: &toml::Table) -> Vec<(String, toml::Value)> {
+        let mut edits = Vec::new();
+        for (key, value) in set {
+            let name = format!("set.\"{key}\"");
+            if !dotted(key) {
+                self.problem(
+                    name,
+                    value.to_string(),
+                    "is not a dotted scene key like \"run.duration\"",
+                );
+            } else if let (Some(inner), false) = (value.as_table(), key.contains('.')) {
+                let example = inner.iter().next().map_or_else(
+                    || format!("\"{key}.name\" = value"),
+                    |(k, v)| format!("\"{key}.{k}\" = {v}"),
+                );
+                self.problem(
+                    format!("set.{key}"),
+                    value.to_string(),
+                    format!(
+                        "is a table: TOML reads an unquoted dotted key as nested tables, which would \
+                         replace the whole `{key}` table; quote the key so that it names one scene key: \
+                         set = {{ {example} }}"
+                    ),
+                );
+            } else {
+                edits.push((key.clone(), value.clone()));
+            }
+        }
+        edits
+    }
+
+    fn axis(&mut self, i: usize, a: &AxisFile) -> Option<Axis> {
+        let name = format!("axis[{i}]");
+        if !dotted(&a.key) {
+            self.problem(
+                format!("{name}.key"),
+                format!("\"{}\"", a.key),
+                "is not a dotted scene key like \"initial.theta\"",
+            );
+        }
+        if a.zip.as_deref().is_some_and(|z| z.trim().is_empty()) {
+            self.problem(
+                format!("{name}.zip"),
+                "\"\"",
+                "is empty: give the zip group a name",
+            );
+        }
+        let given: Vec<&str> = [
+            ("values", a.values.is_some()),
+            ("linspace", a.linspace.is_some()),
+            ("logspace", a.logspace.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(n, on)| on.then_some(n))
+        .collect();
+        let values = match given.as_slice() {
+            ["values"] => self.listed(
+                &format!("{name}.values"),
+                a.values.as_deref().unwrap_or_default(),
+            ),
+            ["linspace"] => self.spaced(
+                &format!("{name}.linspace"),
+                a.linspace.as_deref().unwrap_or_default(),
+                linspace,
+            ),
+            ["logspace"] => self.spaced(
+                &format!("{name}.logspace"),
+                a.logspace.as_deref().unwrap_or_default(),
+                logspace,
+            ),
+            [] => {
+                self.problem(name, "", "has no values: give one of `values = [...]`, `linspace = [first, last, n]` or `logspace = [first_exp, last_exp, n]`");
+                None
+            }
+            several => {
+                self.problem(
+                    name,
+                    "",
+                    format!("gives {}: give exactly one of them", several.join(" and ")),
+                );
+                None
+            }
+        }?;
+        Some(Axis {
+            key: a.key.trim().to_string(),
+            values,
+            zip: a.zip.clone(),
+        })
+    }
+
+    fn listed(&mut self, name: &str, values: &[toml::Value]) -> Option<Vec<toml::Value>> {
+        if values.is_empty() {
+            self.problem(name, "[]", "is empty: give at least one value");
+            return None;
+        }
+        Some(values.to_vec())
+    }
+
+    /// `[first, last, n]` through `space` (linspace or logspace of the exponents).
+    fn spaced(
+        &mut self,
+        name: &str,
+        spec: &[toml::Value],
+        space: fn(f64, f64, u64) -> Vec<f64>,
+    ) -> Option<Vec<toml::Value>> {
+        let text = array_text(spec);
+        let [first, last, n] = spec else {
+            self.problem(
+                name,
+                text,
+                "must be [first, last, n]: two numbers and a count",
+            );
+            return None;
+        };
+        let ends = [first, last].map(|v| number(v).filter(|x| x.is_finite()));
+        let n = whole(n).filter(|&n| n >= 1);
+        let (Some(first), Some(last)) = (ends[0], ends[1]) else {
+            self.problem(
+                name,
+                text,
+                "must start with two finite numbers, [first, last, n]",
+            );
+            return None;
+        };
+        let Some(n) = n.filter(|&n| n <= MAX_RUNS) else {
+            self.problem(
+                name,
+                text,
+                format!("must end with a whole number of values n, 1 ≤ n ≤ {MAX_RUNS}"),
+            );
+            return None;
+        };
+        let values: Vec<f64> = space(first, last, n);
+        if let Some(bad) = values.iter().find(|x| !x.is_finite()) {
+            self.problem(
+                name,
+                text,
+                format!("gives {bad}: keep the exponents within ±300"),
+            );
+            return None;
+        }
+        Some(values.into_iter().map(toml::Value::Float).collect())
+    }
+
+    /// The grid's dimensions: each axis alone, or with the axes sharing its zip name, placed at the first
+    /// (indexes of the file's axes; those that had a problem are left out, and then the sweep is refused).
+    fn dimensions(&mut self, axes: &[Option<Axis>]) -> Vec<Vec<usize>> {
+        let mut dimensions: Vec<Vec<usize>> = Vec::new();
+        for (i, axis) in axes.iter().enumerate() {
+            let Some(axis) = axis else { continue };
+            let zip = axis.zip.as_ref();
+            let group = zip.and_then(|z| {
+                dimensions
+                    .iter_mut()
+                    .find(|d| axes[d[0]].as_ref().and_then(|a| a.zip.as_ref()) == Some(z))
+            });
+            let Some(group) = group else {
+                dimensions.push(vec![i]);
+                continue;
+            };
+            let first = group[0];
+            let len = axes[first].as_ref().map_or(0, |a| a.values.len());
+            if len != axis.values.len() {
+                self.problem(
+                    format!("axis[{i}].zip"),
+                    format!("\"{}\"", zip.map_or("", String::as_str)),
+                    format!(
+                        "zips axes of different lengths (axis[{first}] has {len}, axis[{i}] has {} values): \
+                         zipped axes vary together, so give each as many values",
+                        axis.values.len()
+                    ),
+                );
+            }
+            group.push(i);
+        }
+        dimensions
+    }
+
+    fn random(&mut self, r: &RandomFile) -> Option<Random> {
+        let seed = whole(&r.seed).filter(|&s| i64::try_from(s).is_ok());
+        if seed.is_none() {
+            self.problem(
+                "random.seed",
+                r.seed.to_string(),
+                "must be a whole number from 0 to 9223372036854775807",
+            );
+        }
+        let count = whole(&r.count).filter(|&c| (1..=MAX_RUNS).contains(&c));
+        if count.is_none() {
+            self.problem(
+                "random.count",
+                r.count.to_string(),
+                format!("must be a whole number of runs per grid point, 1 … {MAX_RUNS}"),
+            );
+        }
+        if r.draw.is_empty() {
+            self.problem("random.draw", "", "has no draws: add a [[random.draw]] with a key and a distribution, or remove [random]");
+        }
+        let draws: Vec<Draw> = r
+            .draw
+            .iter()
+            .enumerate()
+            .filter_map(|(j, d)| self.draw(j, d))
+            .collect();
+        (draws.len() == r.draw.len()).then_some(Random {
+            seed: seed?,
+            count: count?,
+            draws,
+        })
+    }
+
+    fn draw(&mut self, j: usize, d: &DrawFile) -> Option<Draw> {
+        let name = format!("random.draw[{j}]");
+        if !dotted(&d.key) {
+            self.problem(
+                format!("{name}.key"),
+                format!("\"{}\"", d.key),
+                "is not a dotted scene key like \"body.friction\"",
+            );
+        }
+        let given: Vec<&str> = [
+            ("uniform", d.uniform.is_some()),
+            ("log_uniform", d.log_uniform.is_some()),
+            ("normal", d.normal.is_some()),
+            ("choice", d.choice.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(n, on)| on.then_some(n))
+        .collect();
+        let (distribution, choices) = match given.as_slice() {
+            ["uniform"] => (
+                self.bounds(
+                    &format!("{name}.uniform"),
+                    d.uniform.as_deref().unwrap_or_default(),
+                    false,
+                )?,
+                Vec::new(),
+            ),
+            ["log_uniform"] => (
+                self.bounds(
+                    &format!("{name}.log_uniform"),
+                    d.log_uniform.as_deref().unwrap_or_default(),
+                    true,
+                )?,
+                Vec::new(),
+            ),
+            ["normal"] => (
+                self.normal(&format!("{name}.normal"), d.normal.as_ref()?)?,
+                Vec::new(),
+            ),
+            ["choice"] => {
+                let choices = self.listed(
+                    &format!("{name}.choice"),
+                    d.choice.as_deref().unwrap_or_default(),
+                )?;
+                (Distribution::Choice { len: choices.len() }, choices)
+            }
+            [] => {
+                self.problem(name, "", "has no distribution: give one of `uniform = [lo, hi]`, `log_uniform = [lo, hi]`, `normal = { mean, std, min, max }` or `choice = [...]`");
+                return None;
+            }
+            several => {
+                self.problem(
+                    name,
+                    "",
+                    format!(
+                        "gives {}: give exactly one distribution",
+                        several.join(" and ")
+                    ),
+                );
+                return None;
+            }
+        };
+        Some(Draw {
+            key: d.key.trim().to_string(),
+            distribution,
+            choices,
+        })
+    }
+
+    /// `[lo, hi]` of a uniform (or, `log`, log-uniform) draw.
+    fn bounds(&mut self, name: &str, spec: &[toml::Value], log: bool) -> Option<Distribution> {
+        let pair = match spec {
+            [lo, hi] => number(lo).zip(number(hi)),
+            _ => None,
+        };
+        let ok = |(lo, hi): (f64, f64)| {
+            lo.is_finite() && hi.is_finite() && lo < hi && (!log || lo > 0.0)
+        };
+        match pair.filter(|&p| ok(p)) {
+            Some((lo, hi)) if log => Some(Distribution::LogUniform { lo, hi }),
+            Some((lo, hi)) => Some(Distribution::Uniform { lo, hi }),
+            None => {
+                let need = if log { "0 < lo < hi" } else { "lo < hi" };
+                self.problem(
+                    name,
+                    array_text(spec),
+                    format!("must be [lo, hi], two finite numbers with {need}"),
+                );
+                None
+            }
+        }
+    }
+
+    fn normal(&mut self, name: &str, n: &NormalFile) -> Option<Distribution> {
+        let mut get = |key: &str, v: Option<&toml::Value>, default: f64, need: &str| match v {
+            None => Some(default),
+            Some(v) => match number(v).filter(|x| !x.is_nan()) {
+                Some(x) => Some(x),
+                None => {
+                    self.problem(
+                        format!("{name}.{key}"),
+                        v.to_string(),
+                        format!("must be {need}"),
+                    );
+                    None
+                }
+            },
+        };
+        let mean = get("mean", Some(&n.mean), 0.0, "a finite number").filter(|m| m.is_finite());
+        let std = get("std", Some(&n.std), 1.0, "a finite number > 0");
+        let min = get("min", n.min.as_ref(), f64::NEG_INFINITY, "a number");
+        let max = get("max", n.max.as_ref(), f64::INFINITY, "a number");
+        let (mean, std, min, max) = (mean?, std?, min?, max?);
+        if !(std.is_finite() && std > 0.0) {
+            self.problem(
+                format!("{name}.std"),
+                n.std.to_string(),
+                "must be a finite number > 0",
+            );
+            return None;
+        }
+        if min >= max {
+            self.problem(
+                name,
+                format!("{{ min = {min}, max = {max} }}"),
+                "has min ≥ max: give min < max",
+            );
+            return None;
+        }
+        Some(Distribution::Normal {
+            mean,
+            std,
+            min,
+            max,
+        })
+    }
+
+    fn settings(&mut self, o: &OutputFile) -> Settings {
+        let mut named =
+            |key: &str, v: &Option<String>, parse: &dyn Fn(&str) -> Result<(), String>| {
+                if let Some(e) = v.as_deref().and_then(|s| parse(s).err()) {
+                    self.problem(
+                        format!("output.{key}"),
+                        format!("\"{}\"", v.as_deref().unwrap_or_default()),
+                        e,
+                    );
+                }
+            };
+        named("encoding", &o.encoding, &|s| {
+            s.parse::<Encoding>().map(drop).map_err(|e| e.to_string())
+        });
+        named("compression", &o.compression, &|s| {
+            s.parse::<Compression>()
+                .map(drop)
+                .map_err(|e| e.to_string())
+        });
+        for c in o.channels.iter().flatten() {
+            if let Err(e) = c.trim().parse::<Channel>() {
+                self.problem("output.channels", format!("\"{c}\""), e.to_string());
+            }
+        }
+        Settings {
+            channels: o
+                .channels
+                .as_ref()
+                .map(|l| l.iter().map(|c| c.trim().to_string()).collect()),
+            encoding: o
+                .encoding
+                .as_deref()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or_default(),
+            compression: o
+                .compression
+                .as_deref()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or_default(),
+            verify: o.verify.unwrap_or(true),
+            predict: o.predict.unwrap_or(true),
+        }
+    }
+}
+
+/// Every key the sweep writes, in the order the edits apply, with where it is given and what is checked
+/// against the scene: `set` (sorted), the axes, the draws, `output.channels`.
+struct Place {
+    key: String,
+    /// `set."run.duration"`, `axis[0]`, `random.draw[1]`, `output.channels`.
+    name: String,
+    /// The key holding the values (`axis[0].values`), for problems with a value.
+    values_name: String,
+}
+
+fn places(file: &SweepFile) -> Vec<Place> {
+    let mut places: Vec<Place> = file
+        .set
+        .keys()
+        .map(|k| Place {
+            key: k.trim().to_string(),
+            name: format!("set.\"{k}\""),
+            values_name: format!("set.\"{k}\""),
+        })
+        .collect();
+    for (i, a) in file.axis.iter().enumerate() {
+        let form = ["values", "linspace", "logspace"]
+            .into_iter()
+            .zip([
+                a.values.is_some(),
+                a.linspace.is_some(),
+                a.logspace.is_some(),
+            ])
+            .find_map(|(n, on)| on.then_some(n))
+            .unwrap_or("values");
+        places.push(Place {
+            key: a.key.trim().to_string(),
+            name: format!("axis[{i}]"),
+            values_name: format!("axis[{i}].{form}"),
+        });
+    }
+    for (j, d) in file.random.iter().flat_map(|r| r.draw.iter().enumerate()) {
+        places.push(Place {
+            key: d.key.trim().to_string(),
+            name: format!("random.draw[{j}]"),
+            values_name: format!("random.draw[{j}]"),
+        });
+    }
+    if file.output.as_ref().is_some_and(|o| o.channels.is_some()) {
+        places.push(Place {
+            key: CHANNELS_KEY.to_string(),
+            name: "output.channels".to_string(),
+            values_name: "output.channels".to_string(),
+        });
+    }
+    places
+}
+
+impl Checker {
+    /// A key given twice, or a key inside a table that a later edit replaces.
+    fn collisions(&mut self, places: &[Place]) {
+        for (later_at, later) in places.iter().enumerate() {
+            for earlier in &places[..later_at] {
+                if earlier.key == later.key {
+                    self.problem(
+                        format!("{}.key", later.name),
+                        format!("\"{}\"", later.key),
+                        format!(
+                            "is also given by {}: each key is set or swept in one place only",
+                            earlier.name
+                        ),
+                    );
+                } else if earlier.key.starts_with(&format!("{}.", later.key)) {
+                    self.problem(format!("{}.key", later.name), format!("\"{}\"", later.key), format!(
+                        "replaces the whole table holding `{}` (given by {}, which applies first): give that key \
+                         inside {}'s values, or sweep a key inside `{}`", earlier.key, earlier.name, later.name, later.key));
+                }
+            }
+        }
+    }
+
+    /// Each key's values against the scene's keys and types, on the base scene with `set` applied.
+    fn scene_keys(&mut self, sweep: &Sweep, base: &toml::Table, places: &[Place]) {
+        let fits = |table: &toml::Table, key: &str, value: &toml::Value| -> Result<(), String> {
+            let mut table = table.clone();
+            scene::set_value(&mut table, key, value.clone()).map_err(|e| e.to_string())?;
+            scene::file_from_table(table)
+                .map(drop)
+                .map_err(|e| e.to_string())
+        };
+        let mut with_set = base.clone();
+        for (key, value) in &sweep.set {
+            if let Err(e) = fits(base, key, value) {
+                self.problem(
+                    format!("set.\"{key}\""),
+                    value.to_string(),
+                    format!("does not fit the scene: {e}"),
+                );
+            }
+            let _ = scene::set_value(&mut with_set, key, value.clone());
+        }
+        if !self.problems.is_empty() {
+            return;
+        }
+        if let Err(e) = scene::file_from_table(with_set.clone()) {
+            self.problem("set", "", format!("does not fit the scene: {e}"));
+            return;
+        }
+        let draws = sweep.random.iter().flat_map(|r| &r.draws);
+        let candidates = sweep
+            .axes
+            .iter()
+            .map(|a| a.values.clone())
+            .chain(draws.map(representatives));
+        let channels = sweep.settings.channels.iter().map(|l| {
+            vec![toml::Value::Array(
+                l.iter().map(|c| toml::Value::from(c.as_str())).collect(),
+            )]
+        });
+        let swept = places.iter().filter(|p| !p.name.starts_with("set."));
+        for (place, values) in swept.zip(candidates.chain(channels)) {
+            for value in values.iter().take(CHECKED_VALUES) {
+                if let Err(e) = fits(&with_set, &place.key, value) {
+                    self.problem(
+                        place.values_name.clone(),
+                        value.to_string(),
+                        format!("does not fit the scene key `{}`: {e}", place.key),
+                    );
+                    break;
+                }
+            }
+        }
+    }
+
+    /// At most [`MAX_RUNS`] runs.
+    fn size(&mut self, sweep: &Sweep) {
+        let lengths = sweep
+            .dimensions
+            .iter()
+            .map(|d| sweep.axes[d[0]].values.len() as u64);
+        let count = sweep.random.as_ref().map_or(1, |r| r.count);
+        let runs = lengths.chain([count]).try_fold(1u64, u64::checked_mul);
+        if runs.is_none_or(|r| r > MAX_RUNS) {
+            let what = runs.map_or_else(|| "more than 2⁶⁴".to_string(), |r| r.to_string());
+            self.problem("axis", "", format!(
+                "gives {what} runs, more than the {MAX_RUNS} a sweep may have: sweep fewer values, or split the sweep"));
+        }
+    }
+}
+
+/// Values of a draw that show whether its key takes them: the lower bound or the mean, or the choices.
+fn representatives(d: &Draw) -> Vec<toml::Value> {
+    match d.distribution {
+        Distribution::Uniform { lo, .. } | Distribution::LogUniform { lo, .. } => {
+            vec![toml::Value::Float(lo)]
+        }
+        Distribution::Normal { mean, .. } => vec![toml::Value::Float(mean)],
+        Distribution::Choice { .. } => d.choices.clone(),
+    }
+}

@@ -1,0 +1,775 @@
+//! `coin-log sweep` (docs/format.md: Sweeps): the sweep file's keys and every error, the run files byte
+//! for byte `record`'s, the catalogue's columns and values, the dry run and the exit codes. Resume and
+//! interruption are in `sweep_resume`, shards and collect in `sweep_shards`; the helpers here serve all.
+// Helpers outside #[test] functions: a failed unwrap there is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{exe, listing};
+use coin_log::sweep::{linspace, Sweep};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A small sweep with every kind of ending: lift-off, flat landing, completed; 2 × 3 grid points with a
+/// zipped pair, 2 draws each (12 runs of at most 3 time units at 50 samples per unit).
+pub const SMALL: &str = r#"
+description = "test sweep"
+base = "wobble"
+set = { "run.duration" = 3.0, "run.rate" = 50.0 }
+
+[[axis]]
+key = "initial.omega"
+values = [[0.0, 0.0, 0.0], [0.3, 0.2, 1.5]]
+
+[[axis]]
+key = "initial.theta"
+values = [0.2, 0.6, 1.0]
+zip = "lean"
+
+[[axis]]
+key = "initial.phi"
+linspace = [0.0, 1.0, 3]
+zip = "lean"
+
+[random]
+seed = 11
+count = 2
+
+[[random.draw]]
+key = "body.thickness"
+choice = [0.04, 0.06]
+"#;
+
+/// Runs of [`SMALL`].
+pub const SMALL_RUNS: usize = 12;
+
+/// Writes a sweep file `name` into `dir`.
+pub fn write_sweep(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The schedulers' variables, which would make a sweep take one shard: kept from every child but the
+/// ones that set them on purpose.
+pub const SCHEDULER_VARIABLES: [&str; 5] = [
+    "SLURM_ARRAY_TASK_ID",
+    "SLURM_ARRAY_TASK_COUNT",
+    "SLURM_ARRAY_TASK_MIN",
+    "SLURM_ARRAY_TASK_MAX",
+    "JOB_COMPLETION_INDEX",
+];
+
+/// Runs `coin-log ARGS` in `dir` with `env` set (and no other scheduler variable): exit code, stdout,
+/// stderr.
+pub fn run_with_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
+    let mut command = std::process::Command::new(exe());
+    command.args(args).current_dir(dir);
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    command.envs(env.iter().copied());
+    let out = command.output().expect("coin-log runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Runs `coin-log ARGS` in `dir`: exit code, stdout, stderr.
+pub fn run_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    run_with_env(dir, args, &[])
+}
+
+/// Runs the sweep `sweep` into `out` (both relative to `dir`) with `extra` flags and `--json`; returns
+/// the exit code and the summary object.
+pub fn sweep_json(dir: &Path, sweep: &str, out: &str, extra: &[&str]) -> (i32, serde_json::Value) {
+    let mut args = vec!["sweep", sweep, "-o", out, "--json"];
+    args.extend_from_slice(extra);
+    let (code, stdout, stderr) = run_in(dir, &args);
+    let json = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("sweep --json printed no JSON ({e}): {stdout}{stderr}"));
+    (code, json)
+}
+
+/// A CSV file read by RFC 4180, independently of the library's writer: header and rows.
+pub struct Csv {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Csv {
+    pub fn read(path: &Path) -> Self {
+        let text =
+            std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(
+            text.ends_with('\n'),
+            "{}: the last row ends with a line break",
+            path.display()
+        );
+        let mut lines = text.lines().map(parse_csv_line);
+        let header = lines.next().expect("a header");
+        let rows: Vec<Vec<String>> = lines.collect();
+        for (n, r) in rows.iter().enumerate() {
+            assert_eq!(r.len(), header.len(), "{} row {n}: {r:?}", path.display());
+        }
+        Self { header, rows }
+    }
+
+    pub fn column(&self, name: &str) -> usize {
+        self.header
+            .iter()
+            .position(|c| c == name)
+            .unwrap_or_else(|| panic!("no column `{name}` in {:?}", self.header))
+    }
+
+    /// Each row as column → value.
+    pub fn records(&self) -> Vec<BTreeMap<String, String>> {
+        let zip = |r: &Vec<String>| self.header.iter().cloned().zip(r.iter().cloned()).collect();
+        self.rows.iter().map(zip).collect()
+    }
+
+    /// The rows without the one host-dependent column, `wall_time_s`.
+    pub fn without_wall_time(&self) -> Vec<Vec<String>> {
+        let wall = self.column("wall_time_s");
+        let keep = |r: &Vec<String>| {
+            let mut r = r.clone();
+            r.remove(wall);
+            r
+        };
+        self.rows.iter().map(keep).collect()
+    }
+}
+
+fn parse_csv_line(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted, mut chars) =
+        (Vec::new(), String::new(), false, line.chars().peekable());
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', false) if field.is_empty() => quoted = true,
+            ('"', true) if chars.peek() == Some(&'"') => {
+                chars.next();
+                field.push('"');
+            }
+            ('"', true) => quoted = false,
+            (',', false) => fields.push(std::mem::take(&mut field)),
+            (c, _) => field.push(c),
+        }
+    }
+    assert!(!quoted, "unclosed quote in {line}");
+    fields.push(field);
+    fields
+}
+
+/// SHA-256 of a file, by the system's `sha256sum` (independent of the library's hash).
+pub fn sha256sum(path: &Path) -> String {
+    let out = std::process::Command::new("sha256sum")
+        .arg(path)
+        .output()
+        .expect("sha256sum runs");
+    String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .next()
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// The run files of a folder (`run-*.mcap`), sorted.
+pub fn run_files(dir: &Path) -> Vec<String> {
+    listing(dir)
+        .into_iter()
+        .filter(|n| n.starts_with("run-") && n.ends_with(".mcap"))
+        .collect()
+}
+
+#[test]
+fn a_sweep_runs_every_combination_and_its_catalogue_has_the_contracts_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &["--jobs", "2"]);
+    assert_eq!(code, 0, "{json}");
+    assert_eq!(
+        (
+            json["runs"].as_u64(),
+            json["finished"].as_u64(),
+            json["failed"].as_u64()
+        ),
+        (Some(12), Some(12), Some(0))
+    );
+    let out = dir.path().join("out");
+    let c = Csv::read(&out.join("catalogue.csv"));
+    let expected: Vec<&str> = "index,initial.omega,initial.theta,initial.phi,body.thickness,status,termination,t_end,verify,failure,reason,file,bytes,sha256,samples,messages,steps,energy_drift,invariant_drift,steady_residual,event_trusted,predicted_motion,predicted_stability,predicted_termination,wall_time_s".split(',').collect();
+    assert_eq!(c.header, expected);
+    assert_eq!(c.rows.len(), SMALL_RUNS);
+    let phis = linspace(0.0, 1.0, 3);
+    for (i, r) in c.records().iter().enumerate() {
+        // Grid point i / 2 (two draws each): omega slowest, then the zipped (theta, phi) pair.
+        let point = i / 2;
+        assert_eq!(r["index"], i.to_string());
+        assert_eq!(
+            r["initial.omega"],
+            ["[0.0, 0.0, 0.0]", "[0.3, 0.2, 1.5]"][point / 3]
+        );
+        assert_eq!(r["initial.theta"], ["0.2", "0.6", "1.0"][point % 3]);
+        assert_eq!(
+            r["initial.phi"].parse::<f64>().unwrap().to_bits(),
+            phis[point % 3].to_bits()
+        );
+        assert!(
+            ["0.04", "0.06"].contains(&r["body.thickness"].as_str()),
+            "{r:?}"
+        );
+        assert_eq!(
+            (
+                r["status"].as_str(),
+                r["verify"].as_str(),
+                r["failure"].as_str(),
+                r["reason"].as_str()
+            ),
+            ("finished", "ok", "", "")
+        );
+        let file = out.join(&r["file"]);
+        assert_eq!(r["file"], format!("run-{i:02}.mcap"));
+        assert_eq!(
+            r["bytes"],
+            std::fs::metadata(&file).unwrap().len().to_string()
+        );
+        assert_eq!(r["sha256"], sha256sum(&file));
+        assert_eq!(
+            r["termination"], r["predicted_termination"],
+            "run {i}: simulation and quadrature agree on these"
+        );
+        assert!(r["wall_time_s"].parse::<f64>().unwrap() > 0.0);
+        let no_spin = point < 3;
+        let ending = if !no_spin {
+            "completed"
+        } else if point == 0 {
+            "lift-off"
+        } else {
+            "flat-landing"
+        };
+        assert_eq!(r["termination"], ending, "run {i}");
+        assert_eq!(
+            r["predicted_motion"],
+            if no_spin { "flat-landing" } else { "nutation" }
+        );
+        assert_eq!(r["event_trusted"], if no_spin { "true" } else { "" });
+        assert!(r["energy_drift"].parse::<f64>().unwrap() < 1e-9, "{r:?}");
+        assert!(r["invariant_drift"].parse::<f64>().is_ok() && r["steady_residual"].is_empty());
+        if !no_spin {
+            assert_eq!(
+                r["samples"], "151",
+                "3 time units at 50 samples per unit, both ends included"
+            );
+        }
+    }
+    // The draws are the documented generator's, whatever the jobs: a second folder with --jobs 1 agrees.
+    let (code, _) = sweep_json(dir.path(), "s.toml", "one", &["--jobs", "1"]);
+    assert_eq!(code, 0);
+    assert_eq!(
+        Csv::read(&dir.path().join("one/catalogue.csv")).without_wall_time(),
+        c.without_wall_time()
+    );
+    assert_eq!(run_files(&out).len(), SMALL_RUNS);
+    assert!(
+        !listing(&out).iter().any(|n| n.ends_with(".tmp")),
+        "no temporary file left: {:?}",
+        listing(&out)
+    );
+}
+
+#[test]
+fn sweep_json_holds_the_resolved_sweep_and_the_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let text = std::fs::read_to_string(dir.path().join("out/sweep.json")).unwrap();
+    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(j["format"], "coin-log sweep");
+    assert_eq!(j["format_version"], "1");
+    assert_eq!(j["tool_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(j["runs"], 12);
+    assert_eq!(j["index_width"], 2);
+    assert_eq!(
+        j["keys"],
+        serde_json::json!([
+            "initial.omega",
+            "initial.theta",
+            "initial.phi",
+            "body.thickness"
+        ])
+    );
+    assert_eq!(
+        j["counts"],
+        serde_json::json!({"finished": 12, "failed": 0, "pending": 0})
+    );
+    let s = &j["sweep"];
+    assert_eq!(s["base"], "wobble");
+    assert!(s["base_scene"].as_str().unwrap().contains("[body]"));
+    assert_eq!(
+        s["set"],
+        serde_json::json!({"run.duration": 3.0, "run.rate": 50.0})
+    );
+    assert_eq!(
+        s["axes"][2],
+        serde_json::json!({"key": "initial.phi", "values": [0.0, 0.5, 1.0], "zip": "lean"})
+    );
+    assert_eq!(
+        s["random"],
+        serde_json::json!({"seed": 11, "count": 2, "draws": [{"key": "body.thickness", "choice": [0.04, 0.06]}]})
+    );
+    assert_eq!(
+        s["output"],
+        serde_json::json!({"channels": null, "encoding": "json", "compression": "zstd", "verify": true, "predict": true})
+    );
+    // The identity is the SHA-256 of the compact `sweep` object (format.md: sweep.json).
+    let identity = coin_log::sweep::sha256_hex(s.to_string().as_bytes());
+    assert_eq!(j["identity"], identity.as_str());
+    let plan = std::fs::read_to_string(dir.path().join("out/.coin-log-sweep/plan.json")).unwrap();
+    let mut without_counts = j.clone();
+    without_counts.as_object_mut().unwrap().remove("counts");
+    assert_eq!(
+        serde_json::from_str::<serde_json::Value>(&plan).unwrap(),
+        without_counts
+    );
+}
+
+/// The resolved scene of run `index` of `sweep_text` (through the library, as the sweep resolves it).
+fn scene_of(sweep_text: &str, index: u64) -> coin_log::scene::Scene {
+    let sweep = Sweep::parse(sweep_text, Path::new("."), "s.toml").unwrap();
+    sweep.scene(&sweep.values(index).unwrap()).unwrap()
+}
+
+#[test]
+fn a_run_file_is_byte_for_byte_what_record_writes_for_the_same_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMALL.replace(
+        "[random]",
+        "[output]\nencoding = \"protobuf\"\ncompression = \"lz4\"\n\n[random]",
+    );
+    write_sweep(dir.path(), "s.toml", &text);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "2"]).0,
+        0
+    );
+    let c = Csv::read(&dir.path().join("out/catalogue.csv"));
+    for (i, r) in c.records().iter().enumerate().step_by(3) {
+        // 1. The stored scene recorded again, as `coin-log info --scene` documents.
+        let run = dir.path().join("out").join(&r["file"]);
+        let (code, scene, err) = run_in(dir.path(), &["info", run.to_str().unwrap(), "--scene"]);
+        assert_eq!(code, 0, "{err}");
+        std::fs::write(dir.path().join("stored.toml"), scene).unwrap();
+        let again = dir.path().join(format!("again-{i}.mcap"));
+        let (code, _, err) = run_in(
+            dir.path(),
+            &[
+                "record",
+                "stored.toml",
+                "-o",
+                again.to_str().unwrap(),
+                "--encoding",
+                "protobuf",
+                "--compression",
+                "lz4",
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            std::fs::read(&again).unwrap() == std::fs::read(&run).unwrap(),
+            "run {i}: `record` of its stored scene differs"
+        );
+        // 2. The base scene with the run's values as --set edits.
+        let mut args: Vec<String> = [
+            "record",
+            "wobble",
+            "--encoding",
+            "protobuf",
+            "--compression",
+            "lz4",
+        ]
+        .map(String::from)
+        .into();
+        for (key, value) in [("run.duration", "3.0"), ("run.rate", "50.0")] {
+            args.push("--set".into());
+            args.push(format!("{key}={value}"));
+        }
+        for key in [
+            "initial.omega",
+            "initial.theta",
+            "initial.phi",
+            "body.thickness",
+        ] {
+            args.push("--set".into());
+            args.push(format!("{key}={}", r[key]));
+        }
+        let by_set = dir.path().join(format!("set-{i}.mcap"));
+        args.extend(["-o".into(), by_set.to_str().unwrap().into()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = run_in(dir.path(), &args);
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            std::fs::read(&by_set).unwrap() == std::fs::read(&run).unwrap(),
+            "run {i}: `record --set` differs"
+        );
+        // 3. And the library resolves the same scene the file stores.
+        let stored = std::fs::read_to_string(dir.path().join("stored.toml")).unwrap();
+        let stored: Vec<&str> = stored.lines().filter(|l| !l.starts_with('#')).collect();
+        assert_eq!(
+            scene_of(&text, i as u64)
+                .to_toml()
+                .lines()
+                .collect::<Vec<_>>(),
+            stored,
+            "run {i}"
+        );
+    }
+}
+
+/// The problems of a bad sweep file: exit 2, nothing written, every problem named with its key.
+fn refused(text: &str) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "bad.toml", text);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "bad.toml", "-o", "out"]);
+    assert_eq!(code, 2, "a bad sweep file exits 2: {out}{err}");
+    assert!(
+        !dir.path().join("out").exists(),
+        "nothing written for a bad sweep file"
+    );
+    assert!(err.starts_with("error: sweep file `bad.toml`: "), "{err}");
+    err
+}
+
+#[test]
+fn a_bad_sweep_file_gets_every_problem_at_once_with_key_value_and_fix() {
+    let err = refused(
+        r#"
+base = "wobbel"
+set = { "run..rate" = 1.0, run = { duration = 2.0 } }
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 0.5, 0]
+[[axis]]
+key = "initial.phi"
+[[axis]]
+key = "body.mass"
+values = []
+[[axis]]
+key = "initial.psi"
+values = [1.0]
+logspace = [0, 1, 2]
+[[axis]]
+key = "x"
+values = [1.0, 2.0]
+zip = "a"
+[[axis]]
+key = "y"
+values = [1.0]
+zip = "a"
+[random]
+seed = -1
+count = 0
+[[random.draw]]
+key = "body.friction"
+uniform = [0.9, 0.1]
+[[random.draw]]
+key = "body.radius"
+log_uniform = [0.0, 1.0]
+[[random.draw]]
+key = "initial.theta"
+normal = { mean = 0.3, std = 0.0 }
+[[random.draw]]
+key = "run.rate"
+[output]
+encoding = "yaml"
+compression = "brotli"
+channels = ["omega", "velocity"]
+"#,
+    );
+    let expected = [
+        "`base` = \"wobbel\" is no built-in scene (",
+        "and not a path: a scene file is given by its path relative to the sweep file, such as \"./wobbel.toml\"",
+        "`set.\"run..rate\"` = 1.0 is not a dotted scene key",
+        "`set.run` = { duration = 2.0 } is a table: TOML reads an unquoted dotted key as nested tables, which would replace the whole `run` table; quote the key so that it names one scene key: set = { \"run.duration\" = 2.0 }",
+        "`axis[0].linspace` = [0.1, 0.5, 0] must end with a whole number of values n, 1 ≤ n ≤ 1000000000",
+        "`axis[1]` has no values: give one of `values = [...]`, `linspace = [first, last, n]` or `logspace = [first_exp, last_exp, n]`",
+        "`axis[2].values` = [] is empty: give at least one value",
+        "`axis[3]` gives values and logspace: give exactly one of them",
+        "`axis[5].zip` = \"a\" zips axes of different lengths (axis[4] has 2, axis[5] has 1 values)",
+        "`random.seed` = -1 must be a whole number from 0 to 9223372036854775807",
+        "`random.count` = 0 must be a whole number of runs per grid point",
+        "`random.draw[0].uniform` = [0.9, 0.1] must be [lo, hi], two finite numbers with lo < hi",
+        "`random.draw[1].log_uniform` = [0.0, 1.0] must be [lo, hi], two finite numbers with 0 < lo < hi",
+        "`random.draw[2].normal.std` = 0.0 must be a finite number > 0",
+        "`random.draw[3]` has no distribution: give one of `uniform = [lo, hi]`",
+        "`output.encoding` = \"yaml\" unknown encoding `yaml`; valid: json, protobuf",
+        "`output.compression` = \"brotli\" unknown compression `brotli`; valid: zstd, lz4, none",
+        "`output.channels` = \"velocity\" unknown channel `velocity`",
+        "`random.draw[2].key` = \"initial.theta\" is also given by axis[0]: each key is set or swept in one place only",
+    ];
+    for e in expected {
+        assert!(err.contains(e), "missing `{e}` in:\n{err}");
+    }
+    assert!(
+        err.contains(&format!("{} problems:", expected.len() - 1)),
+        "{err}"
+    );
+}
+
+#[test]
+fn keys_that_are_no_scene_keys_or_collide_are_refused_naming_them() {
+    let err = refused(
+        r#"
+base = "wobble"
+set = { "initial.theta" = 0.3, "run.duration" = 1.0 }
+[[axis]]
+key = "initial.thetta"
+values = [0.1]
+[[axis]]
+key = "initial.theta"
+values = [0.2]
+[[axis]]
+key = "initial"
+values = [{ theta = 0.3, omega = [0.0, 0.0, 1.0] }]
+[[axis]]
+key = "run.rate"
+values = [100.0, "fast"]
+"#,
+    );
+    for e in [
+        "`axis[1].key` = \"initial.theta\" is also given by set.\"initial.theta\": each key is set or swept in one place only",
+        "`axis[2].key` = \"initial\" replaces the whole table holding `initial.theta` (given by set.\"initial.theta\", which applies first)",
+    ] {
+        assert!(err.contains(e), "missing `{e}` in:\n{err}");
+    }
+    // Without the collisions, each key's values are checked against the scene's keys and types.
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.thetta"
+values = [0.1]
+[[axis]]
+key = "run.rate"
+values = [100.0, "fast"]
+[random]
+seed = 1
+count = 1
+[[random.draw]]
+key = "body.shape"
+choice = ["hoop", 3]
+"#,
+    );
+    for e in [
+        "`axis[0].values` = 0.1 does not fit the scene key `initial.thetta`: unknown field `thetta`",
+        "`axis[1].values` = \"fast\" does not fit the scene key `run.rate`: invalid type: string \"fast\", expected f64",
+        "`random.draw[0]` = 3 does not fit the scene key `body.shape`: invalid type: integer `3`, expected a string",
+    ] {
+        assert!(err.contains(e), "missing `{e}` in:\n{err}");
+    }
+    let err = refused("base = \"./missing.toml\"\n");
+    assert!(
+        err.contains("`base` = \"./missing.toml\" cannot be read (")
+            && err.contains("give the path of a scene file relative to the sweep file"),
+        "{err}"
+    );
+    let err = refused("base = \"wobble\"\nbogus = 1\n");
+    assert!(
+        err.contains("unknown field `bogus`"),
+        "serde names the unknown key: {err}"
+    );
+}
+
+#[test]
+fn a_base_scene_file_is_found_beside_the_sweep_file_and_an_invalid_combination_is_a_failed_row() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("sweeps")).unwrap();
+    let (code, scene, _) = run_in(dir.path(), &["scenes", "--show", "topple"]);
+    assert_eq!(code, 0);
+    std::fs::write(dir.path().join("sweeps/topple.toml"), scene).unwrap();
+    write_sweep(
+        &dir.path().join("sweeps"),
+        "s.toml",
+        "base = \"topple.toml\"\nset = { \"run.duration\" = 1.0 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6]\n",
+    );
+    let (code, json) = sweep_json(dir.path(), "sweeps/s.toml", "out", &[]);
+    assert_eq!(code, 1, "a failed run exits 1: {json}");
+    assert_eq!(
+        (json["finished"].as_u64(), json["failed"].as_u64()),
+        (Some(1), Some(1))
+    );
+    let c = Csv::read(&dir.path().join("out/catalogue.csv"));
+    let bad = &c.records()[1];
+    assert_eq!(
+        (
+            bad["status"].as_str(),
+            bad["failure"].as_str(),
+            bad["file"].as_str(),
+            bad["verify"].as_str()
+        ),
+        ("failed", "scene", "", "")
+    );
+    assert!(
+        bad["reason"].starts_with("`initial.theta` = 1.6 is outside"),
+        "{bad:?}"
+    );
+    assert_eq!(run_files(&dir.path().join("out")), ["run-0.mcap"]);
+}
+
+#[test]
+fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = "base = \"circle-plus\"\nset = { \"run.duration\" = 1.0 }\n[output]\nchannels = [\"energy\"]\n";
+    write_sweep(dir.path(), "on.toml", base);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "on.toml", "-o", "on"]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(
+        err.contains("warning: verify will not be able to judge these recordings"),
+        "{err}"
+    );
+    let row = &Csv::read(&dir.path().join("on/catalogue.csv")).records()[0];
+    assert_eq!(
+        (
+            row["status"].as_str(),
+            row["failure"].as_str(),
+            row["verify"].as_str()
+        ),
+        ("failed", "verify", "cannot-verify")
+    );
+    assert!(
+        row["reason"].starts_with("verify: cannot-verify"),
+        "{row:?}"
+    );
+    assert_eq!(
+        row["predicted_stability"], "stable",
+        "circle-plus is a stable steady circle"
+    );
+    assert!(row["steady_residual"].parse::<f64>().is_ok());
+    write_sweep(
+        dir.path(),
+        "off.toml",
+        &format!("{base}verify = false\npredict = false\n"),
+    );
+    let (code, json) = sweep_json(dir.path(), "off.toml", "off", &[]);
+    assert_eq!(code, 0, "{json}");
+    let row = &Csv::read(&dir.path().join("off/catalogue.csv")).records()[0];
+    assert_eq!(
+        (row["status"].as_str(), row["verify"].as_str()),
+        ("finished", "off")
+    );
+    for column in [
+        "predicted_motion",
+        "predicted_stability",
+        "predicted_termination",
+    ] {
+        assert_eq!(row[column], "", "no prediction asked");
+    }
+}
+
+#[test]
+fn a_dry_run_counts_shows_and_estimates_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "s.toml", "--dry-run"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.starts_with(
+            "12 runs; swept keys: initial.omega, initial.theta, initial.phi, body.thickness\n"
+        ),
+        "{out}"
+    );
+    assert!(
+        out.contains("  … (2 more)")
+            && out.contains("estimate: ")
+            && out.ends_with("nothing written (--dry-run)\n"),
+        "{out}"
+    );
+    let (code, out, _) = run_in(
+        dir.path(),
+        &[
+            "sweep",
+            "s.toml",
+            "-o",
+            "out",
+            "--dry-run",
+            "--json",
+            "--shard",
+            "1/4",
+        ],
+    );
+    assert_eq!(code, 0);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (j["runs"].as_u64(), j["shard"].as_str()),
+        (Some(3), Some("1/4"))
+    );
+    assert_eq!(j["first"][1]["index"], 5);
+    assert_eq!(j["first"][0]["values"]["initial.theta"], "0.2");
+    assert!(j["estimated_bytes"].as_u64().unwrap() > 10_000 && j["invalid"] == 0);
+    assert_eq!(listing(dir.path()), ["s.toml"], "a dry run writes nothing");
+}
+
+#[test]
+fn a_folder_with_other_content_or_another_sweep_is_refused_naming_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    std::fs::create_dir(dir.path().join("busy")).unwrap();
+    std::fs::write(dir.path().join("busy/notes.txt"), "mine").unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "busy"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("`busy`: is not empty and holds no sweep (it has `notes.txt`): give -o a new or empty folder"), "{err}");
+    assert_eq!(listing(&dir.path().join("busy")), ["notes.txt"]);
+    let short = SMALL.replace("count = 2", "count = 1");
+    write_sweep(dir.path(), "other.toml", &short);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let (code, _, err) = run_in(dir.path(), &["sweep", "other.toml", "-o", "out"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("holds another sweep (identity")
+            && err.contains(
+                "give -o a new folder for this sweep, or delete this folder to start it over"
+            ),
+        "{err}"
+    );
+    // A comment or a reordered table is the same sweep: the identity is of the sweep as resolved.
+    write_sweep(
+        dir.path(),
+        "same.toml",
+        &format!("# the same sweep\n{SMALL}"),
+    );
+    let (code, json) = sweep_json(dir.path(), "same.toml", "out", &[]);
+    assert_eq!((code, json["done"].as_u64()), (0, Some(0)), "{json}");
+}
+
+#[test]
+fn the_sweep_subcommand_needs_its_arguments_and_documents_itself() {
+    let (code, _, err) = run_in(Path::new("."), &["sweep"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run_in(Path::new("."), &["sweep", "s.toml"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("--output <DIR>"),
+        "-o is required but for --dry-run: {err}"
+    );
+    let (code, _, err) = run_in(
+        Path::new("."),
+        &["sweep", "x.toml", "-o", "d", "--shard", "4/4"],
+    );
+    assert_eq!(code, 2);
+    assert!(err.contains("K must be 0 … N − 1"), "{err}");
+    let out = std::process::Command::new(exe())
+        .args(["sweep", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8_lossy(&out.stdout);
+    for flag in [
+        "--jobs",
+        "--shard",
+        "--shard-count",
+        "--retry-failed",
+        "--dry-run",
+        "--json",
+        "collect",
+    ] {
+        assert!(help.contains(flag), "{flag} in --help:\n{help}");
+    }
+}

@@ -1,0 +1,72 @@
+//! The sweep from Python (README.md, Sweeps): `examples/sweep_catalogue.py` opens the catalogue of the
+//! README's first sweep (`examples/sweep.toml`) with pandas, picks the runs that toppled and reads one
+//! channel of one of them with the `mcap` package; its output is checked against the catalogue as read
+//! here. Needs the test venv (`scripts/test`: pandas and mcap from scripts/requirements.txt): a missing
+//! package fails the test, never skips it.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::other_writers::python;
+use crate::support::repo;
+use crate::sweep::{run_in, Csv};
+use std::process::Command;
+
+#[test]
+fn the_python_example_picks_the_toppled_runs_and_reads_a_channel_of_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = repo().join("examples/sweep.toml");
+    let (code, out, err) = run_in(
+        dir.path(),
+        &["sweep", sweep.to_str().unwrap(), "-o", "lean-sweep"],
+    );
+    assert_eq!(
+        code, 0,
+        "the README's first sweep finishes every run: {out}{err}"
+    );
+    let c = Csv::read(&dir.path().join("lean-sweep/catalogue.csv"));
+    let toppled: Vec<_> = c
+        .records()
+        .into_iter()
+        .filter(|r| r["termination"] == "flat-landing")
+        .collect();
+    assert_eq!(
+        toppled.len(),
+        10,
+        "every coin released without spin topples, none of the spinning ones"
+    );
+    let first = toppled
+        .iter()
+        .min_by(|a, b| {
+            a["t_end"]
+                .parse::<f64>()
+                .unwrap()
+                .total_cmp(&b["t_end"].parse().unwrap())
+        })
+        .unwrap();
+    let script = repo().join("examples/sweep_catalogue.py");
+    let run = Command::new(python())
+        .arg(&script)
+        .arg("lean-sweep")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    println!("{stdout}{stderr}");
+    assert!(run.status.success(), "examples/sweep_catalogue.py failed (is pandas in the venv? scripts/test installs scripts/requirements.txt): {stderr}");
+    assert!(
+        stderr.trim().is_empty(),
+        "no warning from pandas or mcap: {stderr}"
+    );
+    assert!(stdout.starts_with("10 of 20 runs toppled\n"), "{stdout}");
+    let samples = first["samples"].as_str();
+    let expected = format!(
+        "run {} ({}): {samples} samples of /coin/angles, theta from {} to ",
+        first["index"], first["file"], first["initial.theta"]
+    );
+    let last = stdout.lines().last().unwrap_or_default();
+    assert!(last.starts_with(&expected), "`{expected}` in `{last}`");
+    assert!(
+        last.ends_with(&format!(" at t = {}", first["t_end"])),
+        "the last sample is at t_end: {last}"
+    );
+}

@@ -1,0 +1,245 @@
+//! Resuming a sweep (docs/format.md: Resume): only runs that are missing, failed on I/O or whose file does
+//! not match its row are redone; and a sweep interrupted at random points by SIGINT and SIGKILL, then
+//! resumed, ends with the catalogue and files of an uninterrupted one, no half file ever under a final
+//! name, no temporary file left.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{exe, listing};
+use crate::sweep::{
+    run_files, run_in, sweep_json, write_sweep, Csv, SCHEDULER_VARIABLES, SMALL, SMALL_RUNS,
+};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+/// The catalogue of `dir` without wall times.
+fn rows(dir: &Path) -> Vec<Vec<String>> {
+    Csv::read(&dir.join("catalogue.csv")).without_wall_time()
+}
+
+/// Every run file of `dir` equals the file of that name in `reference`, byte for byte.
+fn files_match(dir: &Path, reference: &Path) {
+    for name in run_files(dir) {
+        assert!(
+            std::fs::read(dir.join(&name)).unwrap() == std::fs::read(reference.join(&name)).unwrap(),
+            "{name} under its final name differs from the uninterrupted sweep's: a half or wrong file"
+        );
+    }
+}
+
+fn journal_lines(dir: &Path) -> usize {
+    let text = std::fs::read_to_string(dir.join(".coin-log-sweep/journal-0-of-1.csv")).unwrap();
+    text.lines().count()
+}
+
+#[test]
+fn resume_redoes_only_missing_cut_or_changed_files_and_keeps_what_it_can_prove_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
+        0
+    );
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "2"]).0,
+        0
+    );
+    let (reference, out) = (dir.path().join("ref"), dir.path().join("out"));
+    // Nothing to do: every row kept, the catalogue unchanged apart from nothing at all.
+    let before = std::fs::read(out.join("catalogue.csv")).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(0), Some(12)),
+        "{json}"
+    );
+    assert!(
+        std::fs::read(out.join("catalogue.csv")).unwrap() == before,
+        "a resume with nothing to do rewrites the same catalogue"
+    );
+    // Damage: a file gone, one cut short, one with a byte changed (same size, new time), one touched
+    // only (new time, same bytes), and a torn last journal line as a crash leaves it.
+    std::fs::remove_file(out.join("run-01.mcap")).unwrap();
+    let cut = std::fs::read(out.join("run-03.mcap")).unwrap();
+    std::fs::write(out.join("run-03.mcap"), &cut[..cut.len() / 2]).unwrap();
+    let mut changed = std::fs::read(out.join("run-05.mcap")).unwrap();
+    changed[1000] ^= 1;
+    std::thread::sleep(Duration::from_millis(20));
+    std::fs::write(out.join("run-05.mcap"), &changed).unwrap();
+    let same = std::fs::read(out.join("run-07.mcap")).unwrap();
+    std::fs::write(out.join("run-07.mcap"), &same).unwrap();
+    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let mut text = std::fs::read_to_string(&journal).unwrap();
+    text.push_str("17,9,\"[0.3, 0.2");
+    std::fs::write(&journal, text).unwrap();
+    let lines = journal_lines(&out);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(3), Some(9)),
+        "runs 1, 3 and 5 redone: {json}"
+    );
+    assert_eq!(
+        rows(&out),
+        rows(&reference),
+        "the resumed catalogue is the uninterrupted one, wall times aside"
+    );
+    files_match(&out, &reference);
+    assert_eq!(run_files(&out).len(), SMALL_RUNS);
+    // Run 7 was re-hashed once and journalled again with its new time (beside runs 1, 3 and 5; the torn
+    // line stays, ignored): the next resume proves it unchanged by size and time alone.
+    assert_eq!(journal_lines(&out), lines + 4);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!((code, json["done"].as_u64()), (0, Some(0)));
+    assert_eq!(journal_lines(&out), lines + 4, "nothing more to journal");
+}
+
+#[test]
+fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "base = \"wobble\"\nset = { \"run.duration\" = 0.5 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6, 0.5]\n";
+    write_sweep(dir.path(), "s.toml", text);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["failed"].as_u64()),
+        (1, Some(1)),
+        "θ = 1.6 is no valid scene: {json}"
+    );
+    let out = dir.path().join("out");
+    // A folder where run 2's file should go: moving the recording there fails, an I/O failure.
+    std::fs::remove_file(out.join("run-2.mcap")).unwrap();
+    std::fs::create_dir(out.join("run-2.mcap")).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["failed"].as_u64()),
+        (1, Some(1), Some(2)),
+        "{json}"
+    );
+    let row = &Csv::read(&out.join("catalogue.csv")).records()[2];
+    assert_eq!(
+        (row["failure"].as_str(), row["file"].as_str()),
+        ("io", ""),
+        "{row:?}"
+    );
+    assert!(
+        row["reason"].starts_with("moving the recording to `run-2.mcap`: "),
+        "{row:?}"
+    );
+    assert!(
+        !listing(&out).iter().any(|n| n.ends_with(".tmp")),
+        "the failed run's temporary file is gone"
+    );
+    std::fs::remove_dir(out.join("run-2.mcap")).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["failed"].as_u64()),
+        (1, Some(1), Some(1)),
+        "the I/O failure is redone, the scene failure kept: {json}"
+    );
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &["--retry-failed"]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["failed"].as_u64()),
+        (1, Some(1), Some(1)),
+        "--retry-failed redoes the scene failure (which fails again): {json}"
+    );
+}
+
+/// A fixed sequence of pseudo-random delays (splitmix64), so that a failure can be replayed.
+fn delays(seed: u64, n: usize, range: std::ops::Range<u64>) -> Vec<u64> {
+    (0..n as u64)
+        .map(|i| {
+            let w = coin_log::sweep::random::word(seed, i, 0, 0);
+            range.start + w % (range.end - range.start)
+        })
+        .collect()
+}
+
+/// One round: start the sweep, wait `delay` ms, send SIGINT (`kill` false) or SIGKILL; the exit code.
+fn interrupt(dir: &Path, delay: u64, kill: bool) -> Option<i32> {
+    let mut command = Command::new(exe());
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    let mut child = command
+        .args(["sweep", "s.toml", "-o", "cut", "--jobs", "2"])
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(delay));
+    if kill {
+        let _ = child.kill();
+    } else {
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+    }
+    child.wait().unwrap().code()
+}
+
+#[test]
+fn a_sweep_interrupted_at_random_points_resumes_to_the_uninterrupted_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMALL
+        .replace("count = 2", "count = 4")
+        .replace("\"run.duration\" = 3.0", "\"run.duration\" = 10.0");
+    write_sweep(dir.path(), "s.toml", &text);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]);
+    assert_eq!(code, 0, "{json}");
+    let (reference, cut) = (dir.path().join("ref"), dir.path().join("cut"));
+    // Delays from 2 % to 15 % of the uninterrupted sweep's time, so that most rounds stop it midway.
+    let whole = (json["wall_time_s"].as_f64().unwrap() * 1000.0) as u64;
+    let plan = delays(2024, 8, whole / 50..whole * 3 / 20 + 2);
+    println!("uninterrupted: {whole} ms; delays (ms), SIGINT on even rounds, SIGKILL on odd ones: {plan:?}");
+    let mut stopped = 0;
+    for (round, &delay) in plan.iter().enumerate() {
+        let kill = round % 2 == 1;
+        let code = interrupt(dir.path(), delay, kill);
+        println!(
+            "round {round}: {} after {delay} ms: exit {code:?}",
+            if kill { "SIGKILL" } else { "SIGINT" }
+        );
+        stopped += usize::from(code != Some(0));
+        if !cut.exists() {
+            continue;
+        }
+        // Never a half file under a final name, whatever the moment.
+        files_match(&cut, &reference);
+        if !kill {
+            assert!(
+                matches!(code, Some(130 | 0)),
+                "SIGINT exits 130 (or 0 if the sweep had finished): {code:?}"
+            );
+            let all = rows(&reference);
+            assert!(
+                rows(&cut).iter().all(|r| all.contains(r)),
+                "the interrupted catalogue holds finished rows only"
+            );
+            assert!(
+                !listing(&cut).iter().any(|n| n.ends_with(".tmp")),
+                "SIGINT discards the runs in progress"
+            );
+        }
+    }
+    assert!(
+        stopped >= 4,
+        "at least half the rounds stopped the sweep midway ({stopped} of 8)"
+    );
+    let (code, out, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "cut", "--jobs", "2"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert_eq!(
+        rows(&cut),
+        rows(&reference),
+        "interrupted and resumed = uninterrupted, wall times aside"
+    );
+    files_match(&cut, &reference);
+    assert_eq!(run_files(&cut), run_files(&reference));
+    assert!(
+        !listing(&cut).iter().any(|n| n.ends_with(".tmp")),
+        "no temporary file left: {:?}",
+        listing(&cut)
+    );
+    let summary = |d: &Path| std::fs::read_to_string(d.join("sweep.json")).unwrap();
+    assert_eq!(summary(&cut), summary(&reference));
+}

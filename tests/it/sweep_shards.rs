@@ -1,0 +1,322 @@
+//! Shards and collect (docs/format.md: Shards and collect): for N = 1 … 5 the shards K/N together make
+//! every run exactly once, and the collected catalogue equals the one-process one (wall times aside);
+//! the schedulers' variables pick the shard; collect names a missing part, a run in two parts and a
+//! changed, cut or lost file, and then writes nothing.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::listing;
+use crate::sweep::{
+    run_files, run_in, run_with_env, sweep_json, write_sweep, Csv, SMALL, SMALL_RUNS,
+};
+use std::path::Path;
+
+fn rows(path: &Path) -> Vec<Vec<String>> {
+    Csv::read(path).without_wall_time()
+}
+
+/// `collect DIR` in `dir`: exit code and stderr.
+fn collect(dir: &Path, folder: &str) -> (i32, String) {
+    let (code, _, err) = run_in(dir, &["sweep", "collect", folder]);
+    (code, err)
+}
+
+#[test]
+fn the_shards_of_every_count_make_each_run_once_and_collect_to_the_one_process_catalogue() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "one", &["--jobs", "1"]).0,
+        0
+    );
+    let reference = rows(&dir.path().join("one/catalogue.csv"));
+    let summary = std::fs::read_to_string(dir.path().join("one/sweep.json")).unwrap();
+    for n in 1..=5u64 {
+        let folder = format!("n{n}");
+        let mut made = vec![0; SMALL_RUNS];
+        for k in 0..n {
+            let shard = format!("{k}/{n}");
+            let (code, json) = sweep_json(
+                dir.path(),
+                "s.toml",
+                &folder,
+                &["--shard", &shard, "--jobs", "2"],
+            );
+            assert_eq!(code, 0, "{json}");
+            let part = if n == 1 {
+                "catalogue.csv".to_string()
+            } else {
+                format!("catalogue.part-{k}-of-{n}.csv")
+            };
+            for row in Csv::read(&dir.path().join(&folder).join(part)).records() {
+                let index: usize = row["index"].parse().unwrap();
+                assert_eq!(index as u64 % n, k, "shard {shard} holds run {index}");
+                made[index] += 1;
+            }
+        }
+        assert!(
+            made.iter().all(|&m| m == 1),
+            "N = {n}: every run exactly once: {made:?}"
+        );
+        if n > 1 {
+            assert!(
+                !dir.path().join(&folder).join("catalogue.csv").exists(),
+                "a shard writes only its part"
+            );
+            let (code, err) = collect(dir.path(), &folder);
+            assert_eq!(code, 0, "{err}");
+        }
+        let collected = dir.path().join(&folder);
+        assert_eq!(
+            rows(&collected.join("catalogue.csv")),
+            reference,
+            "N = {n}: collected = one process, wall times aside"
+        );
+        assert_eq!(
+            std::fs::read_to_string(collected.join("sweep.json")).unwrap(),
+            summary,
+            "N = {n}"
+        );
+        assert_eq!(run_files(&collected).len(), SMALL_RUNS);
+    }
+}
+
+#[test]
+fn slurm_array_variables_and_a_kubernetes_index_pick_the_shard() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let slurm = [
+        ("SLURM_ARRAY_TASK_ID", "5"),
+        ("SLURM_ARRAY_TASK_MIN", "4"),
+        ("SLURM_ARRAY_TASK_MAX", "6"),
+        ("SLURM_ARRAY_TASK_COUNT", "3"),
+    ];
+    let (code, out, err) = run_with_env(
+        dir.path(),
+        &["sweep", "s.toml", "-o", "slurm", "--json"],
+        &slurm,
+    );
+    assert_eq!(code, 0, "{out}{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (j["shard"].as_str(), j["runs"].as_u64()),
+        (Some("1/3"), Some(4)),
+        "task 5 of 4–6 is shard 1/3"
+    );
+    let indexes: Vec<String> = Csv::read(&dir.path().join("slurm/catalogue.part-1-of-3.csv"))
+        .records()
+        .iter()
+        .map(|r| r["index"].clone())
+        .collect();
+    assert_eq!(indexes, ["1", "4", "7", "10"]);
+    let (code, out, err) = run_with_env(
+        dir.path(),
+        &[
+            "sweep",
+            "s.toml",
+            "-o",
+            "k8s",
+            "--json",
+            "--shard-count",
+            "4",
+        ],
+        &[("JOB_COMPLETION_INDEX", "3")],
+    );
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(
+        dir.path().join("k8s/catalogue.part-3-of-4.csv").exists(),
+        "{:?}",
+        listing(&dir.path().join("k8s"))
+    );
+    // --shard wins over the environment.
+    let (code, out, _) = run_with_env(
+        dir.path(),
+        &["sweep", "s.toml", "-o", "flag", "--json", "--shard", "0/2"],
+        &slurm,
+    );
+    assert_eq!(code, 0);
+    assert!(out.contains("\"shard\":\"0/2\""), "{out}");
+    for (env, flags, says) in [
+        (
+            vec![
+                ("SLURM_ARRAY_TASK_ID", "2"),
+                ("SLURM_ARRAY_TASK_MIN", "0"),
+                ("SLURM_ARRAY_TASK_MAX", "6"),
+                ("SLURM_ARRAY_TASK_COUNT", "4"),
+            ],
+            vec![],
+            "submit --array=0-3",
+        ),
+        (
+            vec![("JOB_COMPLETION_INDEX", "1")],
+            vec![],
+            "pass --shard-count N",
+        ),
+        (
+            vec![],
+            vec!["--shard-count", "2"],
+            "needs JOB_COMPLETION_INDEX",
+        ),
+        (
+            vec![
+                ("SLURM_ARRAY_TASK_ID", "x"),
+                ("SLURM_ARRAY_TASK_COUNT", "2"),
+            ],
+            vec![],
+            "SLURM_ARRAY_TASK_ID=x is not a whole number",
+        ),
+    ] {
+        let mut args = vec!["sweep", "s.toml", "-o", "bad"];
+        args.extend(flags);
+        let (code, _, err) = run_with_env(dir.path(), &args, &env);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(says), "`{says}` in: {err}");
+        assert!(
+            !dir.path().join("bad").exists(),
+            "nothing written for a bad shard"
+        );
+    }
+}
+
+#[test]
+fn collect_names_a_missing_part_a_run_in_two_parts_and_changed_files_and_then_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "one", &["--jobs", "1"]).0,
+        0
+    );
+    for k in 0..3 {
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &format!("{k}/3")]).0,
+            0
+        );
+    }
+    let d = dir.path().join("d");
+    let part = |k: u64| d.join(format!("catalogue.part-{k}-of-3.csv"));
+    let refused = |says: &[&str]| {
+        let (code, err) = collect(dir.path(), "d");
+        assert_eq!(code, 1, "{err}");
+        for s in says {
+            assert!(err.contains(s), "`{s}` in:\n{err}");
+        }
+        assert!(err.trim_end().ends_with("; nothing written"), "{err}");
+        assert!(
+            !d.join("catalogue.csv").exists() && !d.join("sweep.json").exists(),
+            "collect wrote despite problems"
+        );
+    };
+    // A missing part.
+    let saved = std::fs::read(part(1)).unwrap();
+    std::fs::remove_file(part(1)).unwrap();
+    refused(&[
+        "error: d: 4 of 12 runs are in no part: 1, 4, 7, 10; run the shards that hold them again",
+    ]);
+    std::fs::write(part(1), &saved).unwrap();
+    // A run in two parts (a part of an earlier sharding left behind), and a part of another sweep.
+    let other_n = d.join("catalogue.part-0-of-2.csv");
+    let text = std::fs::read_to_string(part(0)).unwrap();
+    std::fs::write(
+        &other_n,
+        text.lines()
+            .take(2)
+            .map(|l| format!("{l}\n"))
+            .collect::<String>(),
+    )
+    .unwrap();
+    let foreign = d.join("catalogue.part-1-of-2.csv");
+    std::fs::write(&foreign, "index,x\n1,2\n").unwrap();
+    refused(&[
+        "run 0 is in both `catalogue.part-0-of-2.csv` and `catalogue.part-0-of-3.csv`",
+        "`catalogue.part-1-of-2.csv` does not start with this sweep's header",
+    ]);
+    std::fs::remove_file(&other_n).unwrap();
+    std::fs::remove_file(&foreign).unwrap();
+    // A file changed (same size), one cut, one gone.
+    let mut changed = std::fs::read(d.join("run-04.mcap")).unwrap();
+    changed[500] ^= 0x20;
+    std::fs::write(d.join("run-04.mcap"), &changed).unwrap();
+    let cut = std::fs::read(d.join("run-07.mcap")).unwrap();
+    std::fs::write(d.join("run-07.mcap"), &cut[..100]).unwrap();
+    std::fs::remove_file(d.join("run-10.mcap")).unwrap();
+    refused(&[
+        "`run-04.mcap` (run 4) does not match its row's SHA-256: it was changed; run its shard again to redo it",
+        "`run-07.mcap` (run 7) has 100 bytes, its row",
+        "`run-10.mcap` (run 10) cannot be read",
+    ]);
+    // The shards run again redo exactly those three; then collect writes the one catalogue.
+    let mut redone = 0;
+    for k in 0..3 {
+        let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", &format!("{k}/3")]);
+        assert_eq!(code, 0);
+        redone += json["done"].as_u64().unwrap();
+    }
+    assert_eq!(redone, 3);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "collect", "d", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (
+            j["runs"].as_u64(),
+            j["finished"].as_u64(),
+            j["problems"].as_array().map(Vec::len)
+        ),
+        (Some(12), Some(12), Some(0))
+    );
+    assert_eq!(
+        rows(&d.join("catalogue.csv")),
+        rows(&dir.path().join("one/catalogue.csv"))
+    );
+    // A folder with no sweep in it.
+    std::fs::create_dir(dir.path().join("empty")).unwrap();
+    let (code, err) = collect(dir.path(), "empty");
+    assert_eq!(code, 2);
+    assert!(err.contains("holds no sweep"), "{err}");
+}
+
+#[test]
+fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "one", &["--jobs", "1"]).0,
+        0
+    );
+    let children: Vec<_> = (0..4)
+        .map(|k| {
+            let mut command = std::process::Command::new(crate::support::record::exe());
+            for v in crate::sweep::SCHEDULER_VARIABLES {
+                command.env_remove(v);
+            }
+            command
+                .args([
+                    "sweep",
+                    "s.toml",
+                    "-o",
+                    "together",
+                    "--jobs",
+                    "1",
+                    "--shard",
+                    &format!("{k}/4"),
+                ])
+                .current_dir(dir.path())
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    for child in children {
+        let out = child.wait_with_output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let (code, err) = collect(dir.path(), "together");
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        rows(&dir.path().join("together/catalogue.csv")),
+        rows(&dir.path().join("one/catalogue.csv"))
+    );
+}
