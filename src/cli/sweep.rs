@@ -198,6 +198,10 @@ fn install_signals() -> anyhow::Result<Arc<AtomicBool>> {
             return;
         }
         errln!("stopped again: quitting at once; run the sweep again to resume it");
+        #[allow(
+            clippy::disallowed_methods,
+            reason = "a second signal quits at once; no final name holds a half file, and resume removes the temporary ones"
+        )]
         std::process::exit(130);
     })
     .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;

@@ -59,6 +59,10 @@ struct SweepRun {
 }
 
 /// Runs `coin-log sweep FILE -o DIR --jobs N --json` and reads its summary; every run must finish.
+#[allow(
+    clippy::disallowed_methods,
+    reason = "each measured sweep is its own process, for its own peak memory and a cold start"
+)]
 fn sweep(exe: &Path, file: &Path, dir: &Path, jobs: usize) -> anyhow::Result<SweepRun> {
     let command = format!(
         "{} sweep {} -o {} --jobs {jobs}",
