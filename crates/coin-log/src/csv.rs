@@ -30,6 +30,53 @@ pub fn record<S: AsRef<str>>(fields: &[S]) -> String {
     line.finish().to_string()
 }
 
+/// One line of text fields, each by [`field`], without its line end.
+#[must_use]
+pub fn line<S: AsRef<str>>(fields: &[S]) -> String {
+    let mut line = record(fields);
+    line.pop();
+    line
+}
+
+/// The fields of one CSV line (RFC 4180), or `None` when a quote is not closed or is followed by
+/// something other than a comma.
+#[must_use]
+pub fn split(line: &str) -> Option<Vec<String>> {
+    let mut fields = Vec::new();
+    let mut chars = line.chars().peekable();
+    loop {
+        let mut field = String::new();
+        if chars.peek() == Some(&'"') {
+            chars.next();
+            loop {
+                match chars.next()? {
+                    '"' if chars.peek() == Some(&'"') => {
+                        chars.next();
+                        field.push('"');
+                    }
+                    '"' => break,
+                    c => field.push(c),
+                }
+            }
+            if !matches!(chars.peek(), None | Some(',')) {
+                return None;
+            }
+        } else {
+            while let Some(&c) = chars.peek() {
+                if c == ',' {
+                    break;
+                }
+                field.push(c);
+                chars.next();
+            }
+        }
+        fields.push(field);
+        if chars.next().is_none() {
+            return Some(fields);
+        }
+    }
+}
+
 /// CSV being built field by field: one line reused from line to line (clear it after writing it out), or
 /// a whole table (finish each line and go on).
 #[derive(Default)]
@@ -83,7 +130,7 @@ impl Line {
 
 #[cfg(test)]
 mod tests {
-    use super::{field, record, Line};
+    use super::{field, line, record, split, Line};
 
     #[test]
     fn fields_are_quoted_by_one_rule_on_commas_quotes_cr_and_lf() {
@@ -109,5 +156,16 @@ mod tests {
         line.clear();
         line.number(-0.0);
         assert_eq!(line.finish(), "-0.0\n");
+    }
+
+    #[test]
+    fn fields_round_trip_through_csv_quoting() {
+        let fields = ["1", "a,b", "say \"hi\"", "", "[0.0, 0.2]", "x"];
+        let line = line(&fields);
+        assert_eq!(line, "1,\"a,b\",\"say \"\"hi\"\"\",,\"[0.0, 0.2]\",x");
+        assert_eq!(split(&line).unwrap(), fields);
+        assert_eq!(split("").unwrap(), [""]);
+        assert!(split("1,\"open").is_none());
+        assert!(split("1,\"a\"b").is_none());
     }
 }

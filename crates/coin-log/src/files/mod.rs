@@ -13,7 +13,7 @@ pub mod input;
 pub mod output;
 
 pub use input::{read_scene, InputError, InputKind};
-pub use output::{Output, OutputError, OutputFolder, Policy};
+pub use output::{make_readable, Output, OutputError, OutputFolder, Policy};
 
 use std::borrow::Cow;
 use std::path::Path;

@@ -350,7 +350,7 @@ fn sticky_owner(target: &Path, meta: &Metadata, temp: &NamedTempFile) -> Option<
 }
 
 /// A finished output file is an ordinary file (the temporary file is created owner-only).
-fn make_readable(file: &File) {
+pub fn make_readable(file: &File) {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;

@@ -202,7 +202,7 @@ impl Row {
     /// The row as one CSV line, without the line break.
     #[must_use]
     pub fn line(&self) -> String {
-        csv_line(&self.fields())
+        crate::csv::line(&self.fields())
     }
 }
 
@@ -226,79 +226,9 @@ fn one_line(text: &str) -> String {
         .join("; ")
 }
 
-/// Fields as one CSV line (RFC 4180 quoting).
-#[must_use]
-pub fn csv_line<S: AsRef<str>>(fields: &[S]) -> String {
-    let mut line = String::new();
-    for (i, f) in fields.iter().enumerate() {
-        let f = f.as_ref();
-        if i > 0 {
-            line.push(',');
-        }
-        if f.contains([',', '"', '\n', '\r']) {
-            line.push('"');
-            line.push_str(&f.replace('"', "\"\""));
-            line.push('"');
-        } else {
-            line.push_str(f);
-        }
-    }
-    line
-}
-
-/// The fields of one CSV line (RFC 4180), or `None` when a quote is not closed or is followed by
-/// something other than a comma.
-#[must_use]
-pub fn split_csv_line(line: &str) -> Option<Vec<String>> {
-    let mut fields = Vec::new();
-    let mut chars = line.chars().peekable();
-    loop {
-        let mut field = String::new();
-        if chars.peek() == Some(&'"') {
-            chars.next();
-            loop {
-                match chars.next()? {
-                    '"' if chars.peek() == Some(&'"') => {
-                        chars.next();
-                        field.push('"');
-                    }
-                    '"' => break,
-                    c => field.push(c),
-                }
-            }
-            if !matches!(chars.peek(), None | Some(',')) {
-                return None;
-            }
-        } else {
-            while let Some(&c) = chars.peek() {
-                if c == ',' {
-                    break;
-                }
-                field.push(c);
-                chars.next();
-            }
-        }
-        fields.push(field);
-        if chars.next().is_none() {
-            return Some(fields);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fields_round_trip_through_csv_quoting() {
-        let fields = ["1", "a,b", "say \"hi\"", "", "[0.0, 0.2]", "x"];
-        let line = csv_line(&fields);
-        assert_eq!(line, "1,\"a,b\",\"say \"\"hi\"\"\",,\"[0.0, 0.2]\",x");
-        assert_eq!(split_csv_line(&line).unwrap(), fields);
-        assert_eq!(split_csv_line("").unwrap(), [""]);
-        assert!(split_csv_line("1,\"open").is_none());
-        assert!(split_csv_line("1,\"a\"b").is_none());
-    }
 
     #[test]
     fn values_are_written_in_their_shortest_form() {

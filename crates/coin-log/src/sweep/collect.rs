@@ -2,11 +2,12 @@
 //! the one catalogue, after checking that every run is there exactly once and that every file matches
 //! its row (size and SHA-256, each file read once). Nothing is written unless every check holds.
 
-use super::catalogue::{split_csv_line, RunStatus};
+use super::catalogue::RunStatus;
 use super::error::SweepError;
 use super::folder::{self, Folder};
 use super::hash::sha256_file;
 use super::run::summary_json;
+use crate::csv;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -81,7 +82,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         .count() as u64;
     let finished = rows.len() as u64 - failed;
     let written = if problems.is_empty() {
-        let lines = rows.values().map(|f| super::catalogue::csv_line(&f.fields));
+        let lines = rows.values().map(|f| csv::line(&f.fields));
         let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
         let json = summary_json(&folder.plan, finished, failed, 0);
         let summary =
@@ -114,13 +115,13 @@ fn read_part(
     let text = std::fs::read_to_string(&path)
         .map_err(SweepError::io("reading the catalogue part", &path))?;
     let mut lines = text.lines();
-    let header = lines.next().and_then(split_csv_line);
+    let header = lines.next().and_then(csv::split);
     if header.as_deref() != Some(columns) {
         problems.push(format!("`{name}` does not start with this sweep's header: it is not a part of this sweep; delete it"));
         return Ok(());
     }
     for (n, line) in lines.enumerate() {
-        let fields = split_csv_line(line).filter(|f| f.len() == columns.len());
+        let fields = csv::split(line).filter(|f| f.len() == columns.len());
         let index = fields
             .as_ref()
             .and_then(|f| f[0].parse::<u64>().ok())

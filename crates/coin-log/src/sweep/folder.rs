@@ -4,10 +4,12 @@
 //! runs end (rows that end during a sync share the next one), so that a crash or SIGKILL loses at most
 //! the runs in progress and the rows still being synced.
 
-use super::catalogue::{self, split_csv_line};
+use super::catalogue;
 use super::definition::Sweep;
 use super::error::SweepError;
 use super::shard::Shard;
+use crate::csv;
+use crate::files;
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -283,7 +285,7 @@ impl Folder {
         if len == 0 {
             let mut header = vec![MTIME_COLUMN.to_string()];
             header.extend(self.columns());
-            let line = format!("{}\n", catalogue::csv_line(&header));
+            let line = format!("{}\n", csv::line(&header));
             file.write_all(line.as_bytes())
                 .and_then(|()| file.sync_data())
                 .map_err(SweepError::io("writing the journal", &path))?;
@@ -309,7 +311,7 @@ impl Folder {
         name: &str,
         lines: impl Iterator<Item = S>,
     ) -> Result<PathBuf, SweepError> {
-        let header = catalogue::csv_line(&self.columns());
+        let header = csv::line(&self.columns());
         self.write_atomically_with(name, |w| {
             writeln!(w, "{header}")?;
             for line in lines {
@@ -355,7 +357,7 @@ pub struct JournalRow {
 
 impl JournalRow {
     fn parse(line: &str, width: usize) -> Option<Self> {
-        let mut fields = split_csv_line(line).filter(|f| f.len() == width)?;
+        let mut fields = csv::split(line).filter(|f| f.len() == width)?;
         let mtime_ns = fields.first()?.parse().ok()?;
         fields.remove(0);
         fields.first()?.parse::<u64>().ok()?;
@@ -474,19 +476,8 @@ fn temp_beside(
         buffered.flush()?;
     }
     temp.as_file().sync_all()?;
-    make_readable(temp.as_file());
+    files::make_readable(temp.as_file());
     Ok(temp)
-}
-
-/// Temporary files are created owner-only; a finished file is an ordinary file.
-pub(super) fn make_readable(file: &File) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = file;
 }
 
 #[cfg(test)]

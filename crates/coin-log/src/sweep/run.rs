@@ -305,7 +305,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
                 Some((size, mtime)) if size.to_string() == f[bytes_at] => {
                     let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
                     if same {
-                        refreshed.push((mtime, catalogue::csv_line(f)));
+                        refreshed.push((mtime, crate::csv::line(f)));
                     }
                     same
                 }
@@ -318,7 +318,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             held.insert(
                 index,
                 Held {
-                    line: catalogue::csv_line(f),
+                    line: crate::csv::line(f),
                     status,
                 },
             );
@@ -468,7 +468,7 @@ fn record_and_check(
         return Ok(None);
     }
     temp.as_file().sync_all().map_err(io("writing"))?;
-    folder::make_readable(temp.as_file());
+    crate::files::make_readable(temp.as_file());
     let record_seconds = started.elapsed().as_secs_f64();
     let (sha256, _) = sha256_file(temp.path()).map_err(io("reading back"))?;
     let started = Instant::now();
