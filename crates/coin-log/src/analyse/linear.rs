@@ -70,7 +70,7 @@ pub fn displaced(coin: &Coin, steady: &State, amplitude: f64) -> State {
 #[must_use]
 pub fn straight_tilt_linear(coin: &Coin, omega_z0: f64, theta0: f64, t: f64) -> f64 {
     let p = coin.params();
-    let g = p.mass() * p.gravity() * p.radius() / (p.inertia_x() + p.ma2());
+    let g = p.topple_rate_squared();
     let l2 = straight_lambda_squared(coin, omega_z0);
     let growth = if l2.abs() * t * t < 1e-8 {
         // Series: t²/2 + λ²t⁴/24 (the closed forms cancel here).

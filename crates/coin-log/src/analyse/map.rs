@@ -378,7 +378,7 @@ impl StabilityMap {
 pub fn boundary(coin: &Coin, theta0: f64) -> Vec<BoundaryPoint> {
     let p = coin.params();
     let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
-    let mga = p.mass() * p.gravity() * p.radius();
+    let mga = p.energy_scale();
     let (s, c) = theta0.sin_cos();
     let t = s / c;
     if t == 0.0 || !t.is_finite() {
@@ -445,7 +445,7 @@ pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
             vec![q / a, c / q]
         }
     };
-    let mga = p.mass() * p.gravity() * p.radius();
+    let mga = p.energy_scale();
     roots
         .into_iter()
         .filter(|u| u.is_finite() && *u > 0.0)

@@ -21,7 +21,7 @@ pub fn alpha_of(s: &State) -> f64 {
 #[must_use]
 pub fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
     let p = coin.params();
-    let mga = p.mass() * p.gravity() * p.radius();
+    let mga = p.energy_scale();
     law.coefficient() * (mga / p.inertia_x()).powf(0.5 * law.m()) / (1.5 * mga)
 }
 

@@ -76,7 +76,7 @@ pub fn energy(coin: &Coin, s: &State) -> Energy {
     );
     let kinetic =
         0.5 * p.ma2() * (wx2 + wz2) + 0.5 * (p.inertia_x() * (wx2 + wy2) + p.inertia_z() * wz2);
-    let potential = p.mass() * p.gravity() * p.radius() * s.theta.cos();
+    let potential = p.energy_scale() * s.theta.cos();
     Energy {
         total: kinetic + potential,
         kinetic,

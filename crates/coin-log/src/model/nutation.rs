@@ -217,7 +217,7 @@ pub fn steady_residual(coin: &Coin, theta: f64, omega_y: f64, omega_z: f64) -> (
     let terms = [
         p.inertia_x() * st / ct * omega_y * omega_y,
         (p.inertia_z() + p.ma2()) * omega_y * omega_z,
-        -p.mass() * p.gravity() * p.radius() * st,
+        -p.energy_scale() * st,
     ];
     (
         terms.iter().sum(),
@@ -315,7 +315,7 @@ impl<'a> Reduced<'a> {
         let (wy, wz) = self.rates(theta);
         0.5 * p.inertia_x() * wy * wy
             + 0.5 * (p.inertia_z() + p.ma2()) * wz * wz
-            + p.mass() * p.gravity() * p.radius() * theta.cos()
+            + p.energy_scale() * theta.cos()
     }
 
     /// S(θ) = dU/dθ, eq (26).
@@ -615,7 +615,7 @@ impl Reduced<'_> {
         let (wy, wz) = self.rates(mid);
         let u_terms = 0.5 * p.inertia_x() * wy * wy
             + 0.5 * (p.inertia_z() + p.ma2()) * wz * wz
-            + p.mass() * p.gravity() * p.radius();
+            + p.energy_scale();
         let reach = (hi - self.theta0).abs().max((lo - self.theta0).abs());
         let (_, s_terms) = steady_residual(self.coin, mid, wy, wz);
         let du = if reach <= self.short {

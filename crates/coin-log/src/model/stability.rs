@@ -17,7 +17,7 @@ use nalgebra::Matrix4;
 #[must_use]
 pub fn straight_lambda_squared(coin: &Coin, omega_z0: f64) -> f64 {
     let p = coin.params();
-    let mga = p.mass() * p.gravity() * p.radius();
+    let mga = p.energy_scale();
     (mga - p.inertia_z() * (p.inertia_z() + p.ma2()) * omega_z0 * omega_z0 / p.inertia_x())
         / (p.inertia_x() + p.ma2())
 }
@@ -27,9 +27,7 @@ pub fn straight_lambda_squared(coin: &Coin, omega_z0: f64) -> f64 {
 #[must_use]
 pub fn critical_spin(coin: &Coin) -> f64 {
     let p = coin.params();
-    (p.mass() * p.gravity() * p.radius() * p.inertia_x()
-        / (p.inertia_z() * (p.inertia_z() + p.ma2())))
-    .sqrt()
+    (p.energy_scale() * p.inertia_x() / (p.inertia_z() * (p.inertia_z() + p.ma2()))).sqrt()
 }
 
 /// σ² of the upright spin about the vertical diameter at rate Ω (physics §5): σ² = Ω² − Mga/(I_X + Ma²).
@@ -45,8 +43,7 @@ pub fn spin_upright_sigma_squared(coin: &Coin, omega: f64) -> f64 {
 pub fn centre_fixed_sigma_squared(coin: &Coin, theta0: f64) -> f64 {
     let p = coin.params();
     let (s, c) = theta0.sin_cos();
-    p.mass() * p.gravity() * p.radius() * (p.ma2() * c / p.inertia_x() + 3.0 * s * s / c)
-        / (p.inertia_x() + p.ma2())
+    p.energy_scale() * (p.ma2() * c / p.inertia_x() + 3.0 * s * s / c) / (p.inertia_x() + p.ma2())
 }
 
 /// The reduced system of eqs (14)–(17) linearised about a state with ω_X = 0 (physics §9).
@@ -82,7 +79,7 @@ impl Linearisation {
     pub fn at(coin: &Coin, theta: f64, omega_y: f64, omega_z: f64) -> Self {
         let p = coin.params();
         let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
-        let mga = p.mass() * p.gravity() * p.radius();
+        let mga = p.energy_scale();
         let (st, ct) = theta.sin_cos();
         let tan_t = st / ct;
         let lever = ix + ma2;
@@ -160,7 +157,7 @@ pub fn eigenvalues(sigma_squared: f64) -> [(f64, f64); 4] {
 pub fn steady_sigma_squared(coin: &Coin, theta0: f64, omega_y0: f64, omega_z0: f64) -> f64 {
     let p = coin.params();
     let (ix, iz, ma2) = (p.inertia_x(), p.inertia_z(), p.ma2());
-    let mga = p.mass() * p.gravity() * p.radius();
+    let mga = p.energy_scale();
     let (s, c) = theta0.sin_cos();
     let (wy, wz) = (omega_y0, omega_z0);
     ((ix * (1.0 + 2.0 * s * s) / (c * c) + ma2) * wy * wy

@@ -134,7 +134,7 @@ pub fn steady_omega_y(coin: &Coin, theta: f64, omega_z: f64, branch: Branch) -> 
     let p = coin.params();
     let qa = p.inertia_x() * theta.tan();
     let qb = (p.inertia_z() + p.ma2()) * omega_z;
-    let qc = -p.mass() * p.gravity() * p.radius() * theta.sin();
+    let qc = -p.energy_scale() * theta.sin();
     // D = B² − 4AC ≥ 0 always, since A·C = −I_X Mga tan θ sin θ ≤ 0.
     let root_d = (qb * qb - 4.0 * qa * qc).sqrt();
     // Stable quadratic formula: q = −½(B + sgn(B)√D); roots q/A and C/q. The root (−B + √D)/(2A) is q/A

@@ -110,7 +110,7 @@ impl ConsistencyCheck {
             let e0 = *self.energy0.get_or_insert(e.total);
             if let Some(change) = e.change {
                 // Scale: that of the energy drift, max(|E₀|, Mga).
-                let scale = e0.abs().max(p.mass() * p.gravity() * p.radius());
+                let scale = e0.abs().max(p.energy_scale());
                 self.added[2].offer((change - (e.total - e0)).abs() / scale, s.t);
                 self.added_counts[2] += 1;
             }
