@@ -108,11 +108,11 @@ pub struct EulerRow {
     /// The slow-change time scale T of the presets (eq (37)).
     pub time_scale: f64,
     /// How the run without μ ended (the scene has none): `lift-off`, `flat-landing` or `completed`.
-    pub end: RunEnd,
+    pub end: DiskEnd,
     /// The smallest N/(Mg) of the run without μ, and α there.
     pub lowest_normal: (f64, f64),
     /// How the same run with μ = [`SLIP_FRICTION`] ended: a `slip` when friction gives out first.
-    pub with_friction: RunEnd,
+    pub with_friction: DiskEnd,
     /// The thinned samples (t, α) of the whole run, for the diagram.
     pub samples: Vec<(f64, f64)>,
     /// Wall time of the run without μ \[s\].
@@ -168,7 +168,7 @@ pub const SLIP_FRICTION: f64 = 0.3;
 
 /// How a run ended: its termination, time and α.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RunEnd {
+pub struct DiskEnd {
     /// `lift-off`, `slip`, `flat-landing`, `completed`, or a failure.
     pub termination: String,
     /// When \[time\].
@@ -200,7 +200,7 @@ fn model_case(
 /// the bench's limit (0 if never), and the wall time.
 struct AlphaSeries {
     series: Vec<(f64, f64)>,
-    end: RunEnd,
+    end: DiskEnd,
     spin_alpha: f64,
     lowest_normal: (f64, f64),
     wall_seconds: f64,
@@ -228,7 +228,7 @@ fn alpha_series(setting: &EulerSetting, case: &BenchCase, spin_share: f64) -> Al
         .last()
         .copied()
         .unwrap_or((0.0, alpha_of(&case.initial)));
-    let end = RunEnd {
+    let end = DiskEnd {
         termination: run.termination_name(),
         time,
         alpha,

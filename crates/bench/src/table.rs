@@ -243,7 +243,7 @@ pub fn euler_table(rows: &[EulerRow]) -> String {
         "end (mu = 0.3)",
     ];
     let end =
-        |e: &super::euler::RunEnd| format!("{} t={:.4} a={:.3e}", e.termination, e.time, e.alpha);
+        |e: &super::euler::DiskEnd| format!("{} t={:.4} a={:.3e}", e.termination, e.time, e.alpha);
     let body: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {

@@ -9,7 +9,7 @@ const REFINE_STEPS: usize = 100;
 
 /// The least-squares line y = intercept + slope·x.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Line {
+pub struct FittedLine {
     /// Its slope.
     pub slope: f64,
     /// Its value at x = 0.
@@ -26,7 +26,7 @@ pub struct Line {
 /// assert!((line.slope - 2.0).abs() < 1e-15 && (line.intercept - 1.0).abs() < 1e-15);
 /// ```
 #[must_use]
-pub fn line(points: &[(f64, f64)]) -> Option<Line> {
+pub fn line(points: &[(f64, f64)]) -> Option<FittedLine> {
     #[allow(clippy::cast_precision_loss)]
     let n = points.len() as f64;
     let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
@@ -42,7 +42,7 @@ pub fn line(points: &[(f64, f64)]) -> Option<Line> {
         .iter()
         .map(|p| (p.1 - intercept - slope * p.0).powi(2))
         .sum();
-    Some(Line {
+    Some(FittedLine {
         slope,
         intercept,
         residual,
@@ -122,7 +122,7 @@ pub fn power_law(points: &[(f64, f64)]) -> Option<PowerLaw> {
 }
 
 /// Least squares of ln α = ln A + n ln |t₀ − t| for a fixed t₀; `None` unless its residual is finite.
-fn log_line(points: &[(f64, f64)], t0: f64) -> Option<Line> {
+fn log_line(points: &[(f64, f64)], t0: f64) -> Option<FittedLine> {
     let logs: Vec<(f64, f64)> = points
         .iter()
         .map(|(t, a)| ((t0 - t).abs().ln(), a.ln()))
