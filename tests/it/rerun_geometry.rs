@@ -37,8 +37,7 @@ fn geometry(mcap: &Path, rrd: &Path, shift: bool) -> (i32, Option<Value>, String
     )
 }
 
-fn record(out: &Path, extra: &[&str]) {
-    let path = out.to_str().unwrap();
+fn record(path: &str, extra: &[&str]) {
     let mut args = vec![
         "record",
         "wobble",
@@ -58,7 +57,7 @@ fn rerun_draws_the_coin_table_and_track_where_the_recording_puts_them() {
     let dir = tempfile::tempdir().unwrap();
     let mcap = dir.path().join("wobble.mcap");
     let rrd = dir.path().join("wobble.rrd");
-    record(&mcap, &["--rerun"]);
+    record(mcap.to_str().unwrap(), &["--rerun"]);
     let (code, doc, err) = geometry(&mcap, &rrd, false);
     assert_eq!(code, 0, "{err}");
     let doc = doc.expect("rerun_geometry.py prints JSON");
@@ -93,7 +92,7 @@ fn rerun_draws_the_coin_table_and_track_where_the_recording_puts_them() {
 
     // Negative control 2: the default recording has no Rerun geometry.
     let plain = dir.path().join("plain.mcap");
-    record(&plain, &[]);
+    record(plain.to_str().unwrap(), &[]);
     let (code, doc, err) = geometry(&plain, &rrd, false);
     assert_eq!(code, 1, "{err}");
     assert!(doc.is_none());

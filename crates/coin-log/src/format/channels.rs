@@ -317,7 +317,7 @@ mod tests {
             assert_eq!(Topic::from_name(t.name()), Some(*t));
             for &e in t.channel().encodings() {
                 assert!(t.wire(e).is_some(), "{t} {e}");
-                if t != Topic::RerunRobot {
+                if *t != Topic::RerunRobot {
                     assert!(schema_data(t.schema_name(), e).is_some(), "{t} {e}");
                 }
             }

@@ -254,13 +254,14 @@ pub fn urdf(thickness: f64) -> String {
 /// `text` as a CDR `std_msgs/msg/String`: the little-endian encapsulation header, the length with the NUL,
 /// the bytes, the NUL, padding to 4.
 fn cdr_string(buf: &mut Vec<u8>, text: &str) {
+    let start = buf.len();
     buf.extend_from_slice(&[0, 1, 0, 0]);
     // A URDF of a few hundred bytes: its length fits in a u32.
     let len = u32::try_from(text.len() + 1).unwrap_or(u32::MAX);
     buf.extend_from_slice(&len.to_le_bytes());
     buf.extend_from_slice(text.as_bytes());
     buf.push(0);
-    while buf.len() % 4 != 0 {
+    while !(buf.len() - start).is_multiple_of(4) {
         buf.push(0);
     }
 }
@@ -273,7 +274,7 @@ mod tests {
     fn the_urdf_is_a_cdr_string_with_the_disc_and_its_marks() {
         let mut buf = vec![7];
         cdr_string(&mut buf, "ab");
-        assert_eq!(buf, [7, 0, 1, 0, 0, 3, 0, 0, 0, b'a', b'b', 0]);
+        assert_eq!(buf, [7, 0, 1, 0, 0, 3, 0, 0, 0, b'a', b'b', 0, 0]);
         let u = urdf(0.05);
         println!("{u}");
         assert!(u.contains("<cylinder radius=\"1\" length=\"0.05\"/>"));
