@@ -89,7 +89,8 @@ pub struct SceneFlags {
     #[arg(long, value_name = "H")]
     pub step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
-    /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
+    /// invariants, tf, scene, and work with dissipation, rerun with --encoding protobuf (overrides
+    /// `record.channels`; default all but work and rerun).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub channels: Option<Vec<String>>,
     /// Add the `rerun` channel: the coin, table and track as geometry for Rerun's MCAP importer (needs

@@ -279,10 +279,15 @@ mod tests {
         println!("{u}");
         assert!(u.contains("<cylinder radius=\"1\" length=\"0.05\"/>"));
         assert!(u.contains("<robot name=\"coin_shape\">"));
-        assert_eq!(u.matches("<box size=\"0.85 0.12 0.01\"/>").count(), 2);
+        // The marks of /scene, 0.2 · thickness thick (0.010000000000000002), just outside each face.
+        assert_eq!(u.matches("<box size=\"0.85 0.12 0.01").count(), 2);
         assert!(
-            u.contains("xyz=\"0.45 0.0 0.03\""),
+            u.contains("xyz=\"0.45 0.0 0.03"),
             "top mark outside the face"
+        );
+        assert!(
+            u.contains("xyz=\"0.45 0.0 -0.03"),
+            "bottom mark outside the face"
         );
     }
 
