@@ -89,9 +89,14 @@ pub struct SceneFlags {
     #[arg(long, value_name = "H")]
     pub step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
-    /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
+    /// invariants, tf, scene, and work with dissipation, rerun with --encoding protobuf (overrides
+    /// `record.channels`; default all but work and rerun).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub channels: Option<Vec<String>>,
+    /// Add the `rerun` channel: the coin, table and track as geometry for Rerun's MCAP importer (needs
+    /// --encoding protobuf; about +6 % file size, docs/format.md: Rerun geometry) (sets `record.rerun`).
+    #[arg(long)]
+    pub rerun: bool,
     /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
     /// records about twice as fast, and Rerun reads it; the file is about 0.9× JSON's size with zstd, 0.6×
     /// with lz4 or uncompressed: README, Performance). Both carry the same f64 values (docs/format.md:
@@ -115,6 +120,7 @@ impl SceneFlags {
             atol: self.atol,
             step: self.step,
             channels: self.channels.clone(),
+            rerun: self.rerun,
         }
     }
 }
@@ -280,6 +286,17 @@ pub(super) fn resolve_flags(
              timestamps hold (32-bit seconds); record it with --encoding json, or shorten it with --duration",
             source.label,
             scene.run.duration
+        ));
+    }
+    if let Some(c) = scene
+        .channels
+        .iter()
+        .find(|c| !c.encodings().contains(&encoding))
+    {
+        return Err(anyhow!(
+            "scene `{}`: {}",
+            source.label,
+            record::RecordError::Encoding { channel: *c }
         ));
     }
     for note in notes {

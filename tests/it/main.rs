@@ -63,6 +63,8 @@ mod protobuf_readers;
 mod read_budget;
 mod readme;
 mod record_roundtrip;
+#[cfg(feature = "external-readers")]
+mod rerun_geometry;
 mod rk4_order;
 mod scenes;
 mod second_model;

@@ -3,7 +3,8 @@
 
 use super::messages::{
     schema_bytes, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, MessageType, Position,
-    QuaternionMessage, ReactionMessage, WorkMessage, FRAME_TRANSFORM, SCENE_UPDATE,
+    QuaternionMessage, ReactionMessage, WorkMessage, FRAME_TRANSFORM, POINT_CLOUD, SCENE_UPDATE,
+    VOXEL_GRID,
 };
 use super::Encoding;
 use std::fmt;
@@ -14,9 +15,9 @@ pub const SCHEMA_ENCODING: &str = Encoding::Json.schema_encoding();
 pub const MESSAGE_ENCODING: &str = Encoding::Json.message_encoding();
 
 coin_log_names::named_enum! {
-    /// A recordable channel; the name is the one of scene files and `--channels`. `work` is last here, but
-    /// in a file it is written, and registered, with the other `coin_log.*` channels before `/tf` and
-    /// `/scene` (format.md's channel table).
+    /// A recordable channel; the name is the one of scene files and `--channels`. `work` and `rerun` are
+    /// last here (both opt-in), but in a file `work` is written, and registered, with the other
+    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table).
     #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
     pub enum Channel: "channel" {
         /// ω in the lean frame.
@@ -41,16 +42,27 @@ coin_log_names::named_enum! {
         Scene = "scene",
         /// Dissipated work W and the balance E + W (only with dissipation, physics §11).
         Work = "work",
+        /// The coin, table and track as geometry Rerun's MCAP importer draws (opt-in, Protobuf only).
+        Rerun = "rerun",
     }
 }
 
 impl Channel {
     /// The channels a scene records when it lists none and has no dissipation (format.md: all ten, every
-    /// channel but the last, `work`, which dissipation adds).
+    /// channel but the last two, `work`, which dissipation adds, and `rerun`, which `record.rerun` adds).
     pub const DEFAULT: &'static [Channel] = match Self::ALL.split_last() {
-        Some((_, default)) => default,
-        None => &[],
+        Some((_, [default @ .., _])) => default,
+        _ => &[],
     };
+
+    /// The encodings a file may record the channel in: Rerun's importer decodes Protobuf, not JSON.
+    #[must_use]
+    pub fn encodings(self) -> &'static [Encoding] {
+        match self {
+            Self::Rerun => &[Encoding::Protobuf],
+            _ => Encoding::ALL,
+        }
+    }
 
     /// MCAP topic.
     #[must_use]
@@ -67,10 +79,11 @@ impl Channel {
             Self::Tf => "/tf",
             Self::Scene => "/scene",
             Self::Work => "/coin/work",
+            Self::Rerun => "/rerun/coin_body",
         }
     }
 
-    /// The `coin_log.*` message type of the channel; `None` for Foxglove's `/tf` and `/scene`.
+    /// The `coin_log.*` message type of the channel; `None` for Foxglove's `/tf`, `/scene`, `/rerun/coin_body`.
     #[must_use]
     pub fn message_type(self) -> Option<&'static MessageType> {
         Some(match self {
@@ -82,7 +95,7 @@ impl Channel {
             Self::Energy => &EnergyMessage::TYPE,
             Self::Invariants => &InvariantsMessage::TYPE,
             Self::Work => &WorkMessage::TYPE,
-            Self::Tf | Self::Scene => return None,
+            Self::Tf | Self::Scene | Self::Rerun => return None,
         })
     }
 
@@ -91,8 +104,8 @@ impl Channel {
     pub fn schema_name(self) -> &'static str {
         match self.message_type() {
             Some(t) => t.schema,
-            None if self == Self::Tf => FRAME_TRANSFORM,
-            None => SCENE_UPDATE,
+            None if self == Self::Scene => SCENE_UPDATE,
+            None => FRAME_TRANSFORM,
         }
     }
 
@@ -143,7 +156,8 @@ const TRACK_TOPICS: [&str; TRACK_LEVELS] = [
 /// An MCAP topic of the format. Every channel writes its main topic ([`Channel::topic`]); the two Foxglove
 /// channels write more, so that a viewer that restores only the latest message of each topic after a seek
 /// still has every frame and the whole track: `tf` also writes `/tf_static`, and `scene` writes
-/// `/scene/follow`, `/scene/table` and the track levels `/scene/track/<level>`.
+/// `/scene/follow`, `/scene/table` and the track levels `/scene/track/<level>`. `rerun` writes, beside its
+/// `/rerun/coin_body`, the coin's shape, the table and the track in the types Rerun's importer draws.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Topic {
     /// The channel's main topic.
@@ -156,22 +170,36 @@ pub enum Topic {
     SceneTable,
     /// `/scene/track/<level>` (`scene`): one level of the contact track, level < [`TRACK_LEVELS`].
     SceneTrack(u8),
+    /// `/rerun/robot_description` (`rerun`): the coin's shape as a URDF, once (ROS 2 `std_msgs/msg/String`).
+    RerunRobot,
+    /// `/rerun/table` (`rerun`): the table as a voxel grid, when it moves.
+    RerunTable,
+    /// `/rerun/track` (`rerun`): the contact points since the previous drawing update, as a point cloud.
+    RerunTrack,
 }
+
+/// The schema of `/rerun/robot_description`: ROS 2's `std_msgs/msg/String` in CDR, the one form Rerun's
+/// URDF decoder reads (whatever the file's encoding).
+pub const ROS_STRING: &str = "std_msgs/msg/String";
+/// The MCAP schema encoding, schema text and message encoding of [`ROS_STRING`].
+pub const ROS_STRING_WIRE: (&str, &[u8], &str) = ("ros2msg", b"string data", "cdr");
 
 impl Topic {
     /// Number of topics: every channel's main topic, then the Foxglove extras.
-    pub const COUNT: usize = Channel::ALL.len() + 3 + TRACK_LEVELS;
+    pub const COUNT: usize = Channel::ALL.len() + 6 + TRACK_LEVELS;
 
     /// Every topic, main topics first in the channel table's order.
     pub fn all() -> impl Iterator<Item = Topic> {
         let extras = [Self::TfStatic, Self::SceneFollow, Self::SceneTable];
         // TRACK_LEVELS (16) fits in a u8.
         let levels = (0..TRACK_LEVELS).map(|l| Self::SceneTrack(u8::try_from(l).unwrap_or(0)));
+        let rerun = [Self::RerunRobot, Self::RerunTable, Self::RerunTrack];
         Channel::ALL
             .iter()
             .map(|&c| Self::Main(c))
             .chain(extras)
             .chain(levels)
+            .chain(rerun)
     }
 
     /// A dense index in 0..[`Self::COUNT`].
@@ -184,6 +212,9 @@ impl Topic {
             Self::SceneFollow => n + 1,
             Self::SceneTable => n + 2,
             Self::SceneTrack(l) => n + 3 + usize::from(l).min(TRACK_LEVELS - 1),
+            Self::RerunRobot => n + 3 + TRACK_LEVELS,
+            Self::RerunTable => n + 4 + TRACK_LEVELS,
+            Self::RerunTrack => n + 5 + TRACK_LEVELS,
         }
     }
 
@@ -194,6 +225,7 @@ impl Topic {
             Self::Main(c) => c,
             Self::TfStatic => Channel::Tf,
             Self::SceneFollow | Self::SceneTable | Self::SceneTrack(_) => Channel::Scene,
+            Self::RerunRobot | Self::RerunTable | Self::RerunTrack => Channel::Rerun,
         }
     }
 
@@ -206,6 +238,9 @@ impl Topic {
             Self::SceneFollow => "/scene/follow",
             Self::SceneTable => "/scene/table",
             Self::SceneTrack(l) => TRACK_TOPICS[usize::from(l).min(TRACK_LEVELS - 1)],
+            Self::RerunRobot => "/rerun/robot_description",
+            Self::RerunTable => "/rerun/table",
+            Self::RerunTrack => "/rerun/track",
         }
     }
 
@@ -216,7 +251,28 @@ impl Topic {
             Self::Main(c) => c.schema_name(),
             Self::TfStatic | Self::SceneFollow => Channel::Tf.schema_name(),
             Self::SceneTable | Self::SceneTrack(_) => Channel::Scene.schema_name(),
+            Self::RerunRobot => ROS_STRING,
+            Self::RerunTable => VOXEL_GRID,
+            Self::RerunTrack => POINT_CLOUD,
         }
+    }
+
+    /// The MCAP schema encoding, schema bytes and message encoding of the topic in a file of `encoding`
+    /// (`None` if the topic cannot be recorded in it: [`Channel::encodings`]).
+    #[must_use]
+    pub fn wire(self, encoding: Encoding) -> Option<(&'static str, &'static [u8], &'static str)> {
+        if self == Self::RerunRobot {
+            return Some(ROS_STRING_WIRE);
+        }
+        if !self.channel().encodings().contains(&encoding) {
+            return None;
+        }
+        let data = schema_data(self.schema_name(), encoding)?;
+        Some((
+            encoding.schema_encoding(),
+            data,
+            encoding.message_encoding(),
+        ))
     }
 
     /// The topic with this name.
@@ -259,8 +315,11 @@ mod tests {
         for (i, t) in all.iter().enumerate() {
             assert_eq!(t.index(), i, "{t}");
             assert_eq!(Topic::from_name(t.name()), Some(*t));
-            for &e in Encoding::ALL {
-                assert!(schema_data(t.schema_name(), e).is_some(), "{t} {e}");
+            for &e in t.channel().encodings() {
+                assert!(t.wire(e).is_some(), "{t} {e}");
+                if *t != Topic::RerunRobot {
+                    assert!(schema_data(t.schema_name(), e).is_some(), "{t} {e}");
+                }
             }
         }
         let names: std::collections::BTreeSet<&str> = all.iter().map(|t| t.name()).collect();
@@ -268,5 +327,14 @@ mod tests {
         assert_eq!(Channel::from_topic("/scene/track/15"), Some(Channel::Scene));
         assert_eq!(Channel::from_topic("/tf_static"), Some(Channel::Tf));
         assert_eq!(Channel::from_topic("/scene/track/16"), None);
+        assert_eq!(Channel::from_topic("/rerun/track"), Some(Channel::Rerun));
+        assert_eq!(
+            Topic::RerunTrack.wire(Encoding::Json),
+            None,
+            "Rerun reads Protobuf"
+        );
+        assert!(!Channel::DEFAULT.contains(&Channel::Rerun));
+        assert!(!Channel::DEFAULT.contains(&Channel::Work));
+        assert_eq!(Channel::DEFAULT.len(), 10);
     }
 }

@@ -118,6 +118,11 @@ foxglove_schema!(
     SCENE_UPDATE, SCENE_UPDATE_JSON = "foxglove.SceneUpdate"
 );
 
+/// Foxglove's point cloud (`/rerun/track`, Protobuf only: for Rerun's MCAP importer).
+pub const POINT_CLOUD: &str = "foxglove.PointCloud";
+/// Foxglove's voxel grid (`/rerun/table`, Protobuf only: for Rerun's MCAP importer).
+pub const VOXEL_GRID: &str = "foxglove.VoxelGrid";
+
 /// The bytes of `schemas/<name>.json` for a schema name this tool writes.
 #[must_use]
 pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {

@@ -20,7 +20,9 @@ mod termination;
 mod time;
 pub mod tolerances;
 
-pub use channels::{schema_data, Channel, Topic, MESSAGE_ENCODING, SCHEMA_ENCODING, TRACK_LEVELS};
+pub use channels::{
+    schema_data, Channel, Topic, MESSAGE_ENCODING, ROS_STRING, SCHEMA_ENCODING, TRACK_LEVELS,
+};
 pub use encoding::Encoding;
 pub use messages::{schema_bytes, FRAME_TRANSFORM, SCENE_UPDATE};
 pub use metadata::{

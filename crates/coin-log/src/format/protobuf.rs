@@ -14,7 +14,7 @@
 //! f64, like the JSON fast path ([`super::json`]): a generated message struct per type would add nothing.
 
 use super::json::FieldsError;
-use super::messages::{FRAME_TRANSFORM, MESSAGE_TYPES, SCENE_UPDATE};
+use super::messages::{FRAME_TRANSFORM, MESSAGE_TYPES, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID};
 use prost::encoding::{decode_key, decode_varint, WireType};
 use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
@@ -25,7 +25,7 @@ use std::sync::OnceLock;
 pub const PACKAGE: &str = "coin_log";
 
 /// The serialized `FileDescriptorSet` of a schema this tool writes in Protobuf: a `coin_log.*` type or
-/// `foxglove.FrameTransform` / `foxglove.SceneUpdate`.
+/// one of the `foxglove.*` types it writes (FrameTransform, SceneUpdate, and PointCloud, VoxelGrid for Rerun).
 #[must_use]
 pub fn descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
     static COIN: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
@@ -42,20 +42,24 @@ pub fn descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
 }
 
 fn foxglove_descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
-    use foxglove::messages::{FrameTransform, SceneUpdate};
+    use foxglove::messages::{FrameTransform, PointCloud, SceneUpdate, VoxelGrid};
     use foxglove::Encode;
-    static FOXGLOVE: OnceLock<[Vec<u8>; 2]> = OnceLock::new();
-    let [tf, scene] = FOXGLOVE.get_or_init(|| {
+    static FOXGLOVE: OnceLock<[Vec<u8>; 4]> = OnceLock::new();
+    let [tf, scene, cloud, grid] = FOXGLOVE.get_or_init(|| {
         let bytes =
             |s: Option<foxglove::Schema>| s.map(|s| s.data.into_owned()).unwrap_or_default();
         [
             bytes(FrameTransform::get_schema()),
             bytes(SceneUpdate::get_schema()),
+            bytes(PointCloud::get_schema()),
+            bytes(VoxelGrid::get_schema()),
         ]
     });
     match schema_name {
         FRAME_TRANSFORM => Some(tf),
         SCENE_UPDATE => Some(scene),
+        POINT_CLOUD => Some(cloud),
+        VOXEL_GRID => Some(grid),
         _ => None,
     }
 }
@@ -367,7 +371,7 @@ mod tests {
         }
         assert_eq!(json_name("drift_eps"), "driftEps");
         assert_eq!(json_name("t"), "t");
-        for name in [FRAME_TRANSFORM, SCENE_UPDATE] {
+        for name in [FRAME_TRANSFORM, SCENE_UPDATE, POINT_CLOUD, VOXEL_GRID] {
             let set = FileDescriptorSet::decode(descriptor_set(name).unwrap()).unwrap();
             let declared = set.file.iter().any(|f| {
                 f.message_type

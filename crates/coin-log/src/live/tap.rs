@@ -1,7 +1,7 @@
 //! The recorder's tap of `coin-log live`: channels, messages and the clock.
 
 use super::LiveServer;
-use crate::format::{schema_data, Channel, Encoding, Topic};
+use crate::format::{Channel, Encoding, Topic};
 use crate::record::{ChannelDeclaration, Tap};
 use foxglove::{ChannelBuilder, RawChannel, Schema};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -214,16 +214,15 @@ impl<F: FnMut(LiveEvent)> LiveTap<'_, F> {
     /// URL is announced are in every viewer's first advertisement.
     pub fn announce_topics(&mut self, channels: &[Channel], encoding: Encoding) {
         for topic in Topic::all().filter(|t| channels.contains(&t.channel())) {
-            let schema_name = topic.schema_name();
-            let Some(schema) = schema_data(schema_name, encoding) else {
+            let Some((schema_encoding, schema, message_encoding)) = topic.wire(encoding) else {
                 continue;
             };
             self.channel(&ChannelDeclaration {
                 topic,
-                schema_name,
-                schema_encoding: encoding.schema_encoding(),
+                schema_name: topic.schema_name(),
+                schema_encoding,
                 schema,
-                message_encoding: encoding.message_encoding(),
+                message_encoding,
             });
         }
     }

@@ -32,6 +32,11 @@ pub const TF_PROTOBUF_BYTES: u64 = 100;
 pub const SCENE_PROTOBUF_BYTES: u64 = 900;
 /// Bytes of one track point in a Protobuf `/scene` update.
 pub const TRACK_POINT_PROTOBUF_BYTES: u64 = 20;
+/// Bytes of a display update on the `rerun` channel without its track points (`/rerun/coin_body` and the
+/// point cloud's header).
+pub const RERUN_UPDATE_BYTES: u64 = 220;
+/// Bytes of one track point in `/rerun/track` (at most one per sample: points are spaced by distance).
+pub const TRACK_POINT_RERUN_BYTES: u64 = 16;
 /// Messages per display update on the `scene` channel's topics (follow frame, coin, ~2 track levels).
 pub const SCENE_MESSAGES_PER_UPDATE: u64 = 4;
 /// Bytes of a `/scene` update without its track points (measured: 1700–1760).
@@ -139,6 +144,12 @@ pub fn estimate(scene: &Scene, compression: Compression, encoding: Encoding) -> 
                     (update + point * n.div_ceil(updates.max(1))) / SCENE_MESSAGES_PER_UPDATE,
                 )
             }
+            // Per display update: /rerun/coin_body and a point cloud of the track; the URDF once and the
+            // table (a 60 × 60 voxel grid, 14.5 kB, compressing to little) once, then when it moves.
+            Channel::Rerun => (
+                2 * updates + 2,
+                RERUN_UPDATE_BYTES + TRACK_POINT_RERUN_BYTES * n.div_ceil(updates.max(1)) / 2,
+            ),
             _ if protobuf => (n, c.fields().map_or(100, flat_protobuf_bytes)),
             _ => (n, c.fields().map_or(100, flat_bytes)),
         };

@@ -19,8 +19,8 @@ use crate::format::messages::{
 };
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
-    log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Termination, TimeError,
-    Topic, FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+    log_time, Channel, Encoding, ResultMetadata, RunMetadata, Termination, TimeError, Topic,
+    FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Flow, RunOutcome, RunSettings};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
@@ -74,6 +74,16 @@ pub enum RecordError {
         duration: f64,
         /// The longest.
         max: f64,
+    },
+    /// A channel the file's encoding cannot carry (`rerun` is for Rerun, which decodes Protobuf).
+    #[error(
+        "the `{channel}` channel is recorded in {} only (Rerun's MCAP importer decodes Protobuf, not JSON): \
+         record it with --encoding protobuf, or leave `{channel}` out",
+        channel.encodings().iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
+    )]
+    Encoding {
+        /// The channel.
+        channel: Channel,
     },
 }
 
@@ -221,12 +231,13 @@ impl<W: Write + Seek, T: Tap> Output<W, T> {
     #[cold]
     fn register(&mut self, topic: Topic) -> Result<u16, WriteError> {
         let schema_name = topic.schema_name();
-        // Every topic has a schema in each encoding (a test checks it).
-        let data = schema_data(schema_name, self.encoding).unwrap_or_default();
-        let (schema_encoding, message_encoding) = (
+        // Every topic has a schema in each encoding of its channel (a test checks it), and `start` refused
+        // a channel the file's encoding cannot carry.
+        let (schema_encoding, data, message_encoding) = topic.wire(self.encoding).unwrap_or((
             self.encoding.schema_encoding(),
+            &[],
             self.encoding.message_encoding(),
-        );
+        ));
         let schema_id = self.writer.add_schema(schema_name, schema_encoding, data)?;
         let id =
             self.writer
@@ -670,6 +681,13 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 max: PROTOBUF_MAX_SECONDS,
             });
         }
+        if let Some(&channel) = scene
+            .channels
+            .iter()
+            .find(|c| !c.encodings().contains(&options.encoding))
+        {
+            return Err(RecordError::Encoding { channel });
+        }
         let chaplygin = if on[Channel::Invariants as usize] {
             Some(Chaplygin::new(&scene.params)?)
         } else {
@@ -679,10 +697,14 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         writer.write_metadata(RUN_METADATA_NAME, &run_metadata(scene).to_map())?;
         let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
         let foxglove = (tf || scene_on).then(|| {
-            (
-                Foxglove3d::with_encoding(&coin, scene.thickness, tf, scene_on, options.encoding),
-                FoxgloveBatch::default(),
-            )
+            let fox =
+                Foxglove3d::with_encoding(&coin, scene.thickness, tf, scene_on, options.encoding);
+            let fox = if on[Channel::Rerun as usize] {
+                fox.with_rerun()
+            } else {
+                fox
+            };
+            (fox, FoxgloveBatch::default())
         });
         Ok(Self {
             out: Output {

@@ -110,6 +110,8 @@ pub struct FlagOverrides {
     pub step: Option<f64>,
     /// `--channels` → `record.channels`.
     pub channels: Option<Vec<String>>,
+    /// `--rerun` → `record.rerun = true`.
+    pub rerun: bool,
 }
 
 impl FlagOverrides {
@@ -142,6 +144,10 @@ impl FlagOverrides {
         if let Some(channels) = &self.channels {
             file.record.get_or_insert_with(RecordFile::default).channels = Some(channels.clone());
             provenance.push(("record.channels", "--channels"));
+        }
+        if self.rerun {
+            file.record.get_or_insert_with(RecordFile::default).rerun = Some(true);
+            provenance.push(("record.rerun", "--rerun"));
         }
         (file, provenance)
     }

@@ -821,6 +821,28 @@ fn check_channels(
     dissipative: bool,
     problems: &mut ProblemCollector,
 ) -> Option<Vec<Channel>> {
+    let rerun = record.and_then(|r| r.rerun) == Some(true);
+    let mut channels = listed_channels(record, dissipative, problems)?;
+    if rerun && !channels.contains(&Channel::Rerun) {
+        channels.push(Channel::Rerun);
+    }
+    if channels.contains(&Channel::Rerun) && !channels.contains(&Channel::Scene) {
+        problems.push(
+            "record.channels",
+            quoted(Channel::Rerun.name()),
+            "draws the coin in the frames of the `scene` channel, which is not recorded: add \"scene\" or leave \"rerun\" out",
+        );
+        return None;
+    }
+    Some(channels)
+}
+
+/// The channels `record.channels` lists (sorted), or the default ones.
+fn listed_channels(
+    record: Option<&RecordFile>,
+    dissipative: bool,
+    problems: &mut ProblemCollector,
+) -> Option<Vec<Channel>> {
     let Some(names) = record.and_then(|r| r.channels.as_ref()) else {
         return Some(default_channels(dissipative));
     };
@@ -917,6 +939,7 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
                     .map(|c| c.name().to_string())
                     .collect(),
             ),
+            rerun: None,
         }),
     }
 }

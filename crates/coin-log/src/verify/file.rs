@@ -10,15 +10,16 @@ use super::report::{CheckId, CheckResult, FileReport, Status, Verdict};
 use super::samples::{Assembler, Sample, Slot, Value};
 use super::tolerances::{RunAccuracy, Tolerances};
 use super::Options;
+use crate::format::channels::ROS_STRING_WIRE;
 use crate::format::json;
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage, WorkMessage,
+    ReactionMessage, WorkMessage, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID,
 };
 use crate::format::protobuf::{self, MessageDecoder};
 use crate::format::{
     log_time, schema_bytes, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
-    FRAME_TRANSFORM, MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+    FRAME_TRANSFORM, MESSAGE_ENCODING, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
@@ -149,7 +150,7 @@ fn foxglove_message(
     channels: &[Option<ChannelState>],
     data: &[u8],
 ) -> Result<(), String> {
-    use foxglove::messages::{FrameTransform, SceneUpdate};
+    use foxglove::messages::{FrameTransform, PointCloud, SceneUpdate, VoxelGrid};
     use prost::Message;
     match encoding {
         Encoding::Json => serde_json::from_slice::<serde::de::IgnoredAny>(data)
@@ -162,8 +163,10 @@ fn foxglove_message(
                 .and_then(|c| Topic::from_name(&c.topic));
             let decoded = match topic.map(Topic::schema_name) {
                 Some(FRAME_TRANSFORM) => FrameTransform::decode(data).map(|_| ()),
-                Some(_) => SceneUpdate::decode(data).map(|_| ()),
-                None => Ok(()),
+                Some(POINT_CLOUD) => PointCloud::decode(data).map(|_| ()),
+                Some(VOXEL_GRID) => VoxelGrid::decode(data).map(|_| ()),
+                Some(SCENE_UPDATE) => SceneUpdate::decode(data).map(|_| ()),
+                _ => Ok(()),
             };
             decoded.map_err(|e| format!("is not a valid Protobuf message of its type: {e}"))
         }
@@ -332,7 +335,21 @@ impl Visitor for Judge {
         message_encoding: &str,
         schema: Option<&Schema<'_>>,
     ) {
-        let judged = schema.map(|s| self.schema(s)).unwrap_or_default();
+        // A topic of fixed wire form (the CDR robot description) is judged by that form, not by the file's.
+        let fixed = Topic::from_name(topic).filter(|t| *t == Topic::RerunRobot);
+        let judged = match (schema, fixed) {
+            (Some(s), Some(_)) => {
+                let (encoding, data, _) = ROS_STRING_WIRE;
+                if (s.encoding.as_str(), &s.data[..]) != (encoding, data) {
+                    self.problems.push_with(|| {
+                        format!("topic `{topic}` has a schema other than ROS 2's {ROS_STRING} ({encoding})")
+                    });
+                }
+                SchemaJudged::default()
+            }
+            (Some(s), None) => self.schema(s),
+            (None, _) => SchemaJudged::default(),
+        };
         let kind = match Topic::from_name(topic) {
             None => {
                 self.problems
@@ -349,9 +366,12 @@ impl Visitor for Judge {
                         )
                     });
                 }
-                let expected = judged
-                    .encoding
-                    .map_or(MESSAGE_ENCODING, |e| e.message_encoding());
+                let expected = match fixed {
+                    Some(_) => ROS_STRING_WIRE.2,
+                    None => judged
+                        .encoding
+                        .map_or(MESSAGE_ENCODING, |e| e.message_encoding()),
+                };
                 if message_encoding != expected {
                     self.problems.push_with(|| {
                         format!("topic `{topic}` has message encoding {message_encoding:?}, not {expected:?} as its schema's encoding says")
@@ -367,7 +387,9 @@ impl Visitor for Judge {
                     Channel::Energy => Kind::Coin(Slot::Energy),
                     Channel::Invariants => Kind::Coin(Slot::Invariants),
                     Channel::Work => Kind::Coin(Slot::Work),
-                    Channel::Tf | Channel::Scene => Kind::Foxglove,
+                    // The robot description is CDR, whatever the file's encoding: its schema is judged.
+                    Channel::Rerun if fixed.is_some() => Kind::Unknown,
+                    Channel::Tf | Channel::Scene | Channel::Rerun => Kind::Foxglove,
                 }
             }
         };

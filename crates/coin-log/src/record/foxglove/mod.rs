@@ -37,9 +37,13 @@
 //!   [`track::MAX_TOLERANCE`] (0.01 a).
 //!
 //! All timestamps `{sec, nsec}` are the log time of the sample ([`crate::format::log_time`]).
+//!
+//! With the opt-in `rerun` channel, each drawing update also gives the same coin, table and track in the
+//! types Rerun's MCAP importer draws ([`rerun`]).
 
 mod json;
 mod proto;
+pub mod rerun;
 pub mod track;
 
 use crate::format::messages::NonFiniteField;
@@ -217,6 +221,8 @@ pub struct Foxglove3d {
     track: Track,
     /// Whether the latest message of each track level drew a line (else it deleted it, or there was none).
     drawn: [bool; TRACK_LEVELS],
+    /// The `rerun` channel's output, when recorded.
+    rerun: Option<rerun::Rerun3d>,
 }
 
 impl Foxglove3d {
@@ -250,7 +256,16 @@ impl Foxglove3d {
             table: None,
             track: Track::default(),
             drawn: [false; TRACK_LEVELS],
+            rerun: None,
         }
+    }
+
+    /// The output with the `rerun` channel too (drawn with the scene, so only when `scene` is on;
+    /// Protobuf messages whatever the encoding: the recorder refuses `rerun` in JSON).
+    #[must_use]
+    pub fn with_rerun(mut self) -> Self {
+        self.rerun = self.scene.then(|| rerun::Rerun3d::new(self.thickness));
+        self
     }
 
     /// True when neither `/tf` nor `/scene` is recorded (nothing to compute).
@@ -300,6 +315,9 @@ impl Foxglove3d {
             check(SCENE_UPDATE, "lines.points.x", c.x)?;
             check(SCENE_UPDATE, "lines.points.y", c.z)?;
             self.track.add(c.x * self.inv_a, -c.z * self.inv_a);
+            if let Some(r) = &mut self.rerun {
+                r.contact([c.x * self.inv_a, -c.z * self.inv_a]);
+            }
             let slot = scene_slot(t);
             if first || last || slot > self.last_scene_slot {
                 self.last_scene_slot = slot;
@@ -351,6 +369,9 @@ impl Foxglove3d {
                 self.write_coin(buf, log_time, &rotation)
             }
         })?;
+        if let Some(r) = &mut self.rerun {
+            r.coin(log_time, &rotation, out)?;
+        }
         let moved = match self.table {
             Some(t) if (centre[0] - t[0]).abs().max((centre[1] - t[1]).abs()) <= TABLE_SNAP => None,
             _ => Some([snap(centre[0]), snap(centre[1])]),
@@ -363,12 +384,21 @@ impl Foxglove3d {
                     write_table(buf, log_time, table)
                 }
             })?;
+            if self.rerun.is_some() {
+                out.push(Topic::RerunTable, |buf| {
+                    rerun::table(buf, log_time, table);
+                    Ok(())
+                })?;
+            }
             self.table = Some(table);
         }
         if let Some(change) = self.track.update() {
             for level in (0..=change.level).rev() {
                 self.push_track_level(level, log_time, out)?;
             }
+        }
+        if let Some(r) = &mut self.rerun {
+            r.track(log_time, out)?;
         }
         self.last_had_scene = true;
         Ok(())

@@ -22,7 +22,7 @@ use prost::Message;
 
 /// The timestamp of a log time (ns). Foxglove's `Timestamp` counts seconds in a u32: up to 4.29e9 time
 /// units, beyond the longest run the recorder accepts in Protobuf ([`MAX_SECONDS`]).
-fn timestamp(log_time: u64) -> Timestamp {
+pub(super) fn timestamp(log_time: u64) -> Timestamp {
     let sec = u32::try_from(log_time / 1_000_000_000).unwrap_or(u32::MAX);
     // log_time % 1e9 < 1e9 fits in a u32.
     let nsec = u32::try_from(log_time % 1_000_000_000).unwrap_or(0);
@@ -79,7 +79,7 @@ fn identity() -> Option<Pose> {
     })
 }
 
-fn transform(
+pub(super) fn transform(
     log_time: u64,
     parent: &str,
     child: &str,
