@@ -219,14 +219,31 @@ pub fn upright_departure(coin: &Coin, state: &State) -> f64 {
 /// 2 rtol|y| of the tilt's, the accuracy every O(1) state gets. Only where rtol·d < atol does anything
 /// change (d < 1e-2 at the defaults), so every other scene integrates, and records, the same bytes; the
 /// metadata keeps the scene's atol, which verify's tolerances derive from (the effective one is tighter).
+/// Floored at the smallest subnormal, so that no weight is 0 (at d < 5e-314, rtol·d underflows).
 #[must_use]
 pub fn working_atol(config: &MethodConfig, coin: &Coin, initial: &State) -> f64 {
     let d = upright_departure(coin, initial);
     if d > 0.0 && config.rtol * d < config.atol {
-        config.rtol * d
+        (config.rtol * d).max(f64::from_bits(1))
     } else {
         config.atol
     }
+}
+
+/// Why an event time from `initial` is not to be trusted whatever the energy drift says, if it is not:
+/// a departure from upright below the smallest normal number, 2.2e-308, is subnormal and carries fewer
+/// than 53 bits (2^-1074/d relative), so neither it nor the tolerance rtol·d is what the escape time
+/// ln(C/d)/λ needs (physics §12). Measured, 1e-310 still lands on the ln law and 1e-320 does not.
+#[must_use]
+pub fn departure_doubt(coin: &Coin, initial: &State) -> Option<String> {
+    let d = upright_departure(coin, initial);
+    (d > 0.0 && d < f64::MIN_POSITIVE).then(|| {
+        format!(
+            "the departure from upright max(|θ|, τ|ω_X|) = {d:e} is below 2.2e-308, the smallest \
+             normal number: it carries fewer than 53 bits, so the escape time ln(C/d)/λ cannot be \
+             integrated to the tolerance; start at least 2.2e-308 from upright"
+        )
+    })
 }
 
 /// Runs `stepper` on `coin` from `initial`, observing samples; a thin wrapper over [`integrate::run`].

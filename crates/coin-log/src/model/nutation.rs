@@ -680,7 +680,16 @@ impl Reduced<'_> {
         if !(p > 0.0 && q > 0.0) {
             return None;
         }
-        let linear = |x: f64| 2.0 / q.sqrt() * (q * x / p).sqrt().asinh();
+        // asinh(z) = ln(2z) to rounding for z² > 1e30, and q x/p overflows for a subnormal turn.
+        let linear = |x: f64| {
+            let z2 = q * x / p;
+            let asinh = if z2 < 1e30 {
+                z2.sqrt().asinh()
+            } else {
+                0.5 * ((4.0 * q * x).ln() - p.ln())
+            };
+            2.0 / q.sqrt() * asinh
+        };
         let time_from = |x: f64| {
             let at = turn + direction * x;
             let f = |theta: f64| 1.0 / self.theta_dot_squared(theta).max(0.0).sqrt();
@@ -691,7 +700,10 @@ impl Reduced<'_> {
         };
         let (t, e) = time_from(MATCHING);
         let (t_half, e_half) = time_from(0.5 * MATCHING);
-        let rounding = 64.0 * f64::EPSILON * (1.0 + p / (q * x2)) * linear(MATCHING);
+        // p to a few ulp, or to the smallest subnormal (2/(I_X + Ma²) 2^-1074 absolute) below 2.2e-308.
+        let p_error = (4.0 * f64::EPSILON).max(2.0 * f64::from_bits(1) / self.lever / p);
+        let rounding = 64.0 * f64::EPSILON * (1.0 + p / (q * x2)) * linear(MATCHING)
+            + p_error / q.sqrt();
         // Richardson on the O(x_m²) term; were it O(x_m) (an upright without symmetry), 2|t − t_half|
         // still bounds what is left.
         let extrapolated = t_half + (t_half - t) / 3.0;
