@@ -9,8 +9,8 @@
 #![allow(clippy::unwrap_used)]
 
 use coin_log::analyse::Analysis;
-use coin_log::integrate::{run_method, Flow, RunEnd, RunSettings};
 use coin_log::format::Termination;
+use coin_log::integrate::{run_method, Flow, RunEnd, RunSettings};
 use coin_log::record::{record, RecordOptions, RecordSummary};
 use coin_log::scene::{self, presets, Scene};
 use coin_log::simulation::CoinEvents;
@@ -110,8 +110,15 @@ fn lift_off_from_near_upright_follows_the_ln_law_is_trusted_verifies_and_analyse
         let ((k, t1, l), (j, t2, _)) = (pair[0], pair[1]);
         let expected = f64::from(j - k) * 10f64.ln() / l;
         let relative = ((t2 - t1) - expected).abs() / expected;
-        println!("t(1e-{j}) − t(1e-{k}) = {}: relative error {relative:.1e}", t2 - t1);
-        assert!(relative <= 1e-6, "1e-{k} → 1e-{j}: {} against {expected}", t2 - t1);
+        println!(
+            "t(1e-{j}) − t(1e-{k}) = {}: relative error {relative:.1e}",
+            t2 - t1
+        );
+        assert!(
+            relative <= 1e-6,
+            "1e-{k} → 1e-{j}: {} against {expected}",
+            t2 - t1
+        );
     }
 }
 
@@ -167,7 +174,11 @@ fn a_subnormal_departure_gives_an_event_marked_untrusted_with_the_reason() {
         );
         assert_eq!(summary.event_trusted, Some(false), "1e-{k}");
         assert!(
-            summary.event_doubt.as_deref().unwrap().contains("subnormal")
+            summary
+                .event_doubt
+                .as_deref()
+                .unwrap()
+                .contains("subnormal")
                 || summary.event_doubt.as_deref().unwrap().contains("2.2e-308"),
             "{:?}",
             summary.event_doubt

@@ -214,7 +214,7 @@ pub fn upright_departure(coin: &Coin, state: &State) -> f64 {
 /// departure d > 0 from upright (physics §12). Near the unstable upright the tilt grows like d·e^{λt} and
 /// the escape time is ln(C/d)/λ: its error is the relative error of the tilt over λ, so the tilt must be
 /// integrated relative to itself. With atol ≥ d the step control sees no error at all (measured: the
-/// lift-off from θ₀ = 1e-12 at atol 1e-12, rtol 1e-10 is 7.2e-3 late, from 1e-50 341 late; with rtol·d
+/// lift-off from θ₀ = 1e-12 at atol 1e-12, rtol 1e-10 is 7.2e-3 late, from 1e-50 340 late; with rtol·d
 /// it is on the ln law to 1e-8, tests/it/escape_time.rs). Weights atol + rtol|y| then stay within
 /// 2 rtol|y| of the tilt's, the accuracy every O(1) state gets. Only where rtol·d < atol does anything
 /// change (d < 1e-2 at the defaults), so every other scene integrates, and records, the same bytes; the

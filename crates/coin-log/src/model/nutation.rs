@@ -21,7 +21,9 @@
 //!   geometrically. The number of nodes is doubled from 32 until two estimates agree to 1e-14.
 //! * **Times to an event** (flat landing, lift-off) along the path from θ₀, leg by leg, by adaptive
 //!   Gauss–Legendre; a leg that starts or ends at a turning point r is integrated in v with
-//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there.
+//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there. A leg leaving a turning point close
+//!   to upright is done in closed form up to a matching angle and by quadrature beyond (physics §12):
+//!   the substitution alone cannot resolve the scale θ₀ ≲ 1e-25 of the ln(1/θ₀)/λ escape.
 //! * **N and |F|/N** are functions of θ on the orbit (θ̇² = f(θ), ω̇ from eqs (14)–(16)); their extremes
 //!   by a scan of 257 points and golden-section refinement.
 
@@ -702,12 +704,15 @@ impl Reduced<'_> {
         let (t_half, e_half) = time_from(0.5 * MATCHING);
         // p to a few ulp, or to the smallest subnormal (2/(I_X + Ma²) 2^-1074 absolute) below 2.2e-308.
         let p_error = (4.0 * f64::EPSILON).max(2.0 * f64::from_bits(1) / self.lever / p);
-        let rounding = 64.0 * f64::EPSILON * (1.0 + p / (q * x2)) * linear(MATCHING)
-            + p_error / q.sqrt();
+        let rounding =
+            64.0 * f64::EPSILON * (1.0 + p / (q * x2)) * linear(MATCHING) + p_error / q.sqrt();
         // Richardson on the O(x_m²) term; were it O(x_m) (an upright without symmetry), 2|t − t_half|
         // still bounds what is left.
         let extrapolated = t_half + (t_half - t) / 3.0;
-        Some((extrapolated, e + e_half + 2.0 * (t - t_half).abs() + rounding))
+        Some((
+            extrapolated,
+            e + e_half + 2.0 * (t - t_half).abs() + rounding,
+        ))
     }
 
     /// ∫dθ/|θ̇| from the turning point `turn` to `other` (where θ̇ ≠ 0), with θ = turn + (other − turn) v².
