@@ -42,7 +42,7 @@ fn lambda(scene: &Scene) -> f64 {
 
 /// The ln law without its O(θ₀²) term (below 1e-12 in time from θ₀ = 1e-6 on).
 fn law(scene: &Scene, theta0: f64) -> f64 {
-    (8.0 * (PI / 12.0).tan() / theta0).ln() / lambda(scene)
+    ((8.0 * (PI / 12.0).tan()).ln() - theta0.ln()) / lambda(scene)
 }
 
 /// The accuracy the recording claims for an event time t: the integrator's ε = max(rtol, atol/a) per
