@@ -437,6 +437,13 @@ fn print_summary(
 
 /// Why an event is not to be trusted, in one sentence.
 pub(super) fn untrusted_event(s: &RecordSummary) -> String {
+    if let Some(doubt) = &s.event_doubt {
+        return format!(
+            "the {} at t = {} is not to be trusted: {doubt}",
+            s.termination.name(),
+            number(s.termination_time)
+        );
+    }
     format!(
         "the {} at t = {} is not to be trusted: the energy drift {:.3e} is above {:.3e}, the energy \
          tolerance verify derives from these integrator settings, so the integration had gone wrong \
@@ -578,7 +585,11 @@ fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
         termination.push_str(&format!(" (α = {a:.4e} rad from the table)"));
     }
     if s.event_trusted == Some(false) {
-        termination.push_str(" (not to be trusted: energy drift above the tolerance)");
+        termination.push_str(if s.event_doubt.is_some() {
+            " (not to be trusted: the departure from upright is subnormal)"
+        } else {
+            " (not to be trusted: energy drift above the tolerance)"
+        });
     }
     rows.push(("termination", termination));
     rows

@@ -41,6 +41,7 @@ mod cli_scene_limits;
 mod cli_words;
 mod datasets;
 mod dissipation;
+mod escape_time;
 mod events;
 #[cfg(feature = "external-readers")]
 mod external_readers;

@@ -10,13 +10,13 @@ use coin_log::format::{
     log_time, Channel, ResultMetadata, RunMetadata, Termination, Topic, RESULT_METADATA_NAME,
     RUN_METADATA_NAME,
 };
-use coin_log::integrate::{run_method, Flow, RunSettings};
+use coin_log::integrate::{run_method, Flow, MethodConfig, RunSettings};
 use coin_log::model::{energy, Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use coin_log::record::{
     self, run_metadata, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
 };
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
-use coin_log::simulation::{CoinEvents, DissipativeEvents};
+use coin_log::simulation::{working_atol, CoinEvents, DissipativeEvents};
 use coin_log_mcap::Compression;
 use std::io::Cursor;
 use std::sync::atomic::AtomicBool;
@@ -55,12 +55,17 @@ fn simulated_samples(scene: &Scene) -> Vec<(f64, [f64; STATE_LEN], Option<f64>)>
         sample_interval: 1.0 / scene.run.rate,
     };
     let (margin, mu) = (scene.run.flat_margin, scene.friction);
+    // The tolerance the library integrates to: the scene's, tightened near upright (physics §12).
+    let method = MethodConfig {
+        atol: working_atol(&scene.run.method, &scene.coin(), &scene.initial),
+        ..scene.run.method
+    };
     let mut samples = Vec::new();
     match scene.dynamics() {
         Dynamics::Conservative(coin) => {
             let events = CoinEvents::new(coin, margin, mu);
             let y0 = scene.initial.to_array();
-            let _ = run_method(&scene.run.method, &coin, &y0, &settings, &events, |t, y| {
+            let _ = run_method(&method, &coin, &y0, &settings, &events, |t, y| {
                 samples.push((t, *y, None));
                 Flow::Continue
             });
@@ -69,7 +74,7 @@ fn simulated_samples(scene: &Scene) -> Vec<(f64, [f64; STATE_LEN], Option<f64>)>
             let events = DissipativeEvents::new(coin, margin, mu);
             let mut y0 = [0.0; DISSIPATIVE_STATE_LEN];
             y0[..STATE_LEN].copy_from_slice(&scene.initial.to_array());
-            let _ = run_method(&scene.run.method, &coin, &y0, &settings, &events, |t, y| {
+            let _ = run_method(&method, &coin, &y0, &settings, &events, |t, y| {
                 let mut s = [0.0; STATE_LEN];
                 s.copy_from_slice(&y[..STATE_LEN]);
                 samples.push((t, s, Some(y[STATE_LEN])));

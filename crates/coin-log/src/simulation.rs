@@ -168,6 +168,14 @@ pub fn run_dynamics<O>(
 where
     O: FnMut(f64, &[f64; STATE_LEN], Option<f64>) -> Flow,
 {
+    let coin = match dynamics {
+        Dynamics::Conservative(coin) => coin,
+        Dynamics::Dissipative(coin) => coin.coin(),
+    };
+    let config = &MethodConfig {
+        atol: working_atol(config, coin, initial),
+        ..*config
+    };
     match dynamics {
         Dynamics::Conservative(coin) => run_method(
             config,
@@ -190,6 +198,52 @@ where
             )
         }
     }
+}
+
+/// The departure d = max(|θ|, τ|ω_X|) of `state` from upright (θ = 0, θ̇ = 0, whatever the spin), τ the
+/// time unit: the size of the state that grows away from the unstable upright (physics §5, §12).
+#[must_use]
+pub fn upright_departure(coin: &Coin, state: &State) -> f64 {
+    state
+        .theta
+        .abs()
+        .max(coin.params().time_unit() * state.omega_x.abs())
+}
+
+/// The absolute tolerance the integration works to: the scene's atol, but at most rtol·d for a state a
+/// departure d > 0 from upright (physics §12). Near the unstable upright the tilt grows like d·e^{λt} and
+/// the escape time is ln(C/d)/λ: its error is the relative error of the tilt over λ, so the tilt must be
+/// integrated relative to itself. With atol ≥ d the step control sees no error at all (measured: the
+/// lift-off from θ₀ = 1e-12 at atol 1e-12, rtol 1e-10 is 7.2e-3 late, from 1e-50 340 late; with rtol·d
+/// it is on the ln law to 1e-8, tests/it/escape_time.rs). Weights atol + rtol|y| then stay within
+/// 2 rtol|y| of the tilt's, the accuracy every O(1) state gets. Only where rtol·d < atol does anything
+/// change (d < 1e-2 at the defaults), so every other scene integrates, and records, the same bytes; the
+/// metadata keeps the scene's atol, which verify's tolerances derive from (the effective one is tighter).
+/// Floored at the smallest subnormal, so that no weight is 0 (at d < 5e-314, rtol·d underflows).
+#[must_use]
+pub fn working_atol(config: &MethodConfig, coin: &Coin, initial: &State) -> f64 {
+    let d = upright_departure(coin, initial);
+    if d > 0.0 && config.rtol * d < config.atol {
+        (config.rtol * d).max(f64::from_bits(1))
+    } else {
+        config.atol
+    }
+}
+
+/// Why an event time from `initial` is not to be trusted whatever the energy drift says, if it is not:
+/// a departure from upright below the smallest normal number, 2.2e-308, is subnormal and carries fewer
+/// than 53 bits (2^-1074/d relative), so neither it nor the tolerance rtol·d is what the escape time
+/// ln(C/d)/λ needs (physics §12). Measured, 1e-310 still lands on the ln law and 1e-320 does not.
+#[must_use]
+pub fn departure_doubt(coin: &Coin, initial: &State) -> Option<String> {
+    let d = upright_departure(coin, initial);
+    (d > 0.0 && d < f64::MIN_POSITIVE).then(|| {
+        format!(
+            "the departure from upright max(|θ|, τ|ω_X|) = {d:e} is below 2.2e-308, the smallest \
+             normal number: it carries fewer than 53 bits, so the escape time ln(C/d)/λ cannot be \
+             integrated to the tolerance; start at least 2.2e-308 from upright"
+        )
+    })
 }
 
 /// Runs `stepper` on `coin` from `initial`, observing samples; a thin wrapper over [`integrate::run`].

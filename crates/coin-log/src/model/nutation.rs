@@ -21,7 +21,9 @@
 //!   geometrically. The number of nodes is doubled from 32 until two estimates agree to 1e-14.
 //! * **Times to an event** (flat landing, lift-off) along the path from θ₀, leg by leg, by adaptive
 //!   Gauss–Legendre; a leg that starts or ends at a turning point r is integrated in v with
-//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there.
+//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there. A leg leaving a turning point close
+//!   to upright is done in closed form up to a matching angle and by quadrature beyond (physics §12):
+//!   the substitution alone cannot resolve the scale θ₀ ≲ 1e-25 of the ln(1/θ₀)/λ escape.
 //! * **N and |F|/N** are functions of θ on the orbit (θ̇² = f(θ), ω̇ from eqs (14)–(16)); their extremes
 //!   by a scan of 257 points and golden-section refinement.
 
@@ -53,6 +55,10 @@ const FIRST_NODES: usize = 32;
 const MOST_NODES: usize = 1 << 19;
 /// Relative tolerance of the adaptive travel-time integrals.
 const TRAVEL_RTOL: f64 = 1e-14;
+/// The matching angle of the escape from near upright (physics §12): below it θ̇² is taken as its
+/// expansion to second order about the turning point, which errs by about θ_m²/(48λ) in time, 2e-8 at
+/// 1e-3 \[rad\].
+const MATCHING: f64 = 1e-3;
 /// Points of the scan for the extremes of N and |F|/N.
 const EXTREME_SCAN: usize = 257;
 
@@ -646,8 +652,71 @@ impl Reduced<'_> {
         }
     }
 
-    /// ∫dθ/|θ̇| from the turning point `turn` to `other` (where θ̇ ≠ 0), with θ = turn + (other − turn) v².
+    /// ∫dθ/|θ̇| from the turning point `turn` to `other` (where θ̇ ≠ 0): the escape from near upright
+    /// when that applies ([`Self::escape`]), otherwise [`Self::leaving_by_quadrature`].
     fn leaving_turning_point(&self, turn: f64, other: f64) -> (f64, f64) {
+        self.escape(turn, other)
+            .unwrap_or_else(|| self.leaving_by_quadrature(turn, other))
+    }
+
+    /// The escape from a turning point `turn` close to upright (|turn| ≤ [`MATCHING`]/64) out past the
+    /// matching angle θ_m = turn ± [`MATCHING`] (physics §12). With x = |θ − turn|, θ̇² = x g(x) and
+    /// g = p + q x + O(x²) (p = 2|S(turn)|/(I_X + Ma²), q ≈ λ² cos turn), so the time to θ_m is
+    /// (2/√q) asinh(√(q x_m/p)), which grows like ln(1/θ₀)/λ, and the rest is a regular quadrature.
+    /// The error of stopping g at x: θ̇⁻¹ changes by O(x²) relative (O(x³) of g for an upright that is
+    /// symmetric, θ_m²/(48λ) without spin), an O(x_m²) error independent of θ₀, removed by Richardson
+    /// from halving x_m and bounded by twice that change. `None` where it does not apply (the quadrature in v resolves the
+    /// singularity there: measured at θ₀ = 1e-5, within 2e-16 of the ln law; below 1e-25 it cannot).
+    fn escape(&self, turn: f64, other: f64) -> Option<(f64, f64)> {
+        let (span, direction) = ((other - turn).abs(), (other - turn).signum());
+        if turn.abs() > MATCHING / 64.0 || span <= 2.0 * MATCHING {
+            return None;
+        }
+        let p = (2.0 * self.slope(turn) / self.lever).abs();
+        let g = |x: f64| self.theta_dot_squared(turn + direction * x) / x;
+        // q = g′(0) by Richardson from the secants at two small x: the O(x) and O(x²) terms of the
+        // secant cancel to O(x₁x₂) ~ 1e-13 relative; rounding of g − p adds ~1e-15 (1 + p/(q x)).
+        let secant = |x: f64| (g(x) - p) / x;
+        let (x1, x2) = (MATCHING / 512.0, MATCHING / 1024.0);
+        let q = 2.0 * secant(x2) - secant(x1);
+        if !(p > 0.0 && q > 0.0) {
+            return None;
+        }
+        // asinh(z) = ln(2z) to rounding for z² > 1e30, and q x/p overflows for a subnormal turn.
+        let linear = |x: f64| {
+            let z2 = q * x / p;
+            let asinh = if z2 < 1e30 {
+                z2.sqrt().asinh()
+            } else {
+                0.5 * ((4.0 * q * x).ln() - p.ln())
+            };
+            2.0 / q.sqrt() * asinh
+        };
+        let time_from = |x: f64| {
+            let at = turn + direction * x;
+            let f = |theta: f64| 1.0 / self.theta_dot_squared(theta).max(0.0).sqrt();
+            let r = self
+                .adaptive
+                .integrate(&f, at.min(other), at.max(other), TRAVEL_RTOL);
+            (linear(x) + r.value, r.error)
+        };
+        let (t, e) = time_from(MATCHING);
+        let (t_half, e_half) = time_from(0.5 * MATCHING);
+        // p to a few ulp, or to the smallest subnormal (2/(I_X + Ma²) 2^-1074 absolute) below 2.2e-308.
+        let p_error = (4.0 * f64::EPSILON).max(2.0 * f64::from_bits(1) / self.lever / p);
+        let rounding =
+            64.0 * f64::EPSILON * (1.0 + p / (q * x2)) * linear(MATCHING) + p_error / q.sqrt();
+        // Richardson on the O(x_m²) term; were it O(x_m) (an upright without symmetry), 2|t − t_half|
+        // still bounds what is left.
+        let extrapolated = t_half + (t_half - t) / 3.0;
+        Some((
+            extrapolated,
+            e + e_half + 2.0 * (t - t_half).abs() + rounding,
+        ))
+    }
+
+    /// ∫dθ/|θ̇| from the turning point `turn` to `other` (where θ̇ ≠ 0), with θ = turn + (other − turn) v².
+    fn leaving_by_quadrature(&self, turn: f64, other: f64) -> (f64, f64) {
         let span = other - turn;
         if span == 0.0 {
             return (0.0, 0.0);

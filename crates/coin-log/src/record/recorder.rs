@@ -29,7 +29,7 @@ use crate::model::{
     STATE_LEN,
 };
 use crate::scene::Scene;
-use crate::simulation::run_dynamics;
+use crate::simulation::{departure_doubt, run_dynamics};
 use coin_log_mcap::{Compression, McapWriter, WriteError, WriterOptions};
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
@@ -566,9 +566,11 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
     let tolerance = energy_tolerance(scene, sampler.drift.max_omega, termination_time);
     let mut summary = sampler.finish(outcome.stats, termination, termination_time, failure)?;
     summary.energy_tolerance = tolerance;
+    let doubt = departure_doubt(&scene.coin(), &scene.initial).filter(|_| termination.is_event());
     summary.event_trusted = termination
         .is_event()
-        .then_some(summary.energy_drift <= tolerance);
+        .then_some(summary.energy_drift <= tolerance && doubt.is_none());
+    summary.event_doubt = doubt;
     Ok(summary)
 }
 
@@ -770,6 +772,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             steady_residual: drift.steady.map(|_| drift.steady_residual),
             energy_tolerance: f64::NAN,
             event_trusted: None,
+            event_doubt: None,
             dissipated_work: drift.last_work,
             termination_alpha: drift.termination_alpha(),
         })

@@ -76,6 +76,10 @@ pub struct RecordSummary {
     /// event is within [`energy_tolerance`](Self::energy_tolerance). When it is not, the integration had
     /// already gone wrong and the event may be an artefact of it, not physics. `None` without an event.
     pub event_trusted: Option<bool>,
+    /// Why the event is not to be trusted when the energy drift does not say it: a departure from
+    /// upright too small to represent ([`crate::simulation::departure_doubt`]). Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub event_doubt: Option<String>,
     /// With dissipation: the work W dissipated by the end of the run \[energy\] (physics §11); the energy
     /// drift is then that of the balance E + W.
     pub dissipated_work: Option<f64>,
