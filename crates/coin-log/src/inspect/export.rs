@@ -9,7 +9,8 @@
 //! - `/tf` (per channel only) is flattened into `tf.csv`, and so are the other frame-transform topics
 //!   (`/tf_static` into `tf_static.csv`, `/scene/follow` into `scene_follow.csv`): `t`, the two frame ids, translation and
 //!   rotation. `/scene` is skipped: it holds display geometry (the coin, the table, pieces of the track),
-//!   and the track's points are `/coin/contact`.
+//!   and the track's points are `/coin/contact`; so are the `rerun` channel's topics, the same drawing for
+//!   Rerun.
 //!
 //! Numbers are written in the shortest form that reads back to the same f64 (ryu) after an exact read
 //! ([`crate::format::json`]), so every value equals the file's bit for bit. Timestamps of `/tf` are
@@ -272,6 +273,12 @@ impl<W: Write> Exporter<'_, W> {
         let Some(channel) = Channel::from_topic(topic) else {
             return self.skip(topic, "not a coin-log channel");
         };
+        if channel == Channel::Rerun {
+            return self.skip(
+                topic,
+                "the drawing again for Rerun (the coin, the table, the track); the track's points are /coin/contact",
+            );
+        }
         // Every frame-transform topic (/tf, /tf_static, /scene/follow) is flattened into a table named
         // after the topic, so that two topics of one channel never share a file.
         if schema == Channel::Tf.schema_name() && matches!(channel, Channel::Tf | Channel::Scene) {
