@@ -6,8 +6,10 @@ use anyhow::bail;
 use coin_log::files::input::check;
 use coin_log::files::{shown, InputKind};
 use coin_log::format::metadata::number_string as n;
+use coin_log::format::{Encoding, RunMetadata, Termination};
 use coin_log::inspect::info::{self, FileInfo};
 use coin_log::inspect::seconds_text;
+use coin_log_mcap::Compression;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -16,9 +18,9 @@ use std::path::{Path, PathBuf};
 /// Shows what each file holds without opening a viewer: its channels (topic, schema, message count,
 /// rate), the time range, the body and run settings, the termination, the file's size and compression and
 /// the version that wrote it. Read from the summary section when the file has one (instant whatever its
-/// size), otherwise by one pass over the file. `--scene` prints the stored scene as TOML:
-/// `coin-log info F --scene > s.toml && coin-log record s.toml -o G` writes G byte for byte equal to F
-/// (with the same `--compression`, and the same coin-log version).
+/// size), otherwise by one pass over the file. `--scene` prints the stored scene as TOML after a comment
+/// with the command line that records it again into the same bytes (`coin-log record s.toml -o G
+/// --encoding E --compression C`, with the same coin-log version).
 #[derive(Debug, clap::Args)]
 pub struct InfoArgs {
     /// MCAP files.
@@ -108,17 +110,56 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
         Ok(run) => run,
         Err(e) => bail!("{shown}: {e}"),
     };
-    let compression = i.compression();
-    let flag = match compression.as_str() {
-        "zstd" => String::new(),
-        other => format!(" and --compression {other}"),
-    };
     out!(
-        "# The scene stored in `{shown}` (written by coin-log {}). `coin-log record` this file\n# with that version{flag} to write the same bytes again.\n{}",
-        run.tool_version, run.scene
+        "{}{}",
+        reproduction(&shown, &i, run),
+        coin_log::scene::readable_toml(&run.scene)
     );
     Ok(Outcome::Success)
 }
+
+/// The comment lines before `--scene`'s TOML: the `coin-log record` command line that writes the file's
+/// bytes again from that text (every setting the scene does not hold: encoding and compression), or why
+/// no command can.
+fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
+    let mut text = format!(
+        "# The scene stored in `{shown}` (written by coin-log {}).\n",
+        run.tool_version
+    );
+    let (encoding, compression) = (i.encoding(), i.compression());
+    let named = |word: &str, names: &[&str]| names.contains(&word);
+    if !named(&encoding, Encoding::NAMES) || !named(&compression, Compression::NAMES) {
+        let _ = writeln!(
+            text,
+            "# Its encoding ({encoding}) and compression ({compression}) are not those of one `coin-log \
+             record`,\n# so no command line writes the same bytes again."
+        );
+        return text;
+    }
+    let _ = writeln!(
+        text,
+        "# Saved as SCENE.toml, with coin-log {} this writes the same bytes again:\n{REPRODUCE}SCENE.toml -o \
+         OUT.mcap --encoding {encoding} --compression {compression}",
+        run.tool_version
+    );
+    if let Some(result) = i
+        .result
+        .as_ref()
+        .ok()
+        .filter(|r| r.termination == Termination::Interrupted)
+    {
+        let _ = writeln!(
+            text,
+            "# (up to t = {}, where the run was interrupted: a run that is not interrupted goes on, and \
+             ends differently)",
+            n(result.termination_time)
+        );
+    }
+    text
+}
+
+/// How the command line starts in `--scene`'s comment (tests find it by this).
+pub const REPRODUCE: &str = "#     coin-log record ";
 
 /// The text description of one file: a row per property, then the channels.
 fn text(shown: &str, i: &FileInfo) -> String {

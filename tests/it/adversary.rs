@@ -1,0 +1,252 @@
+//! Issue 25 as an adversary would try it, one test per class: reproduction that reproduces (`info --scene`
+//! names every flag of the bytes), help texts whose numeric bounds are exactly the bounds enforced, scene
+//! text without hundreds of digits, and writers that refuse what an output may not be before any work.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{coin_log, coin_log_text};
+use std::path::Path;
+
+/// The command line `info --scene` prints, with its placeholders for the scene and the output filled in.
+fn reproduction(text: &str, scene: &Path, out: &Path) -> Vec<String> {
+    let line = text
+        .lines()
+        .find_map(|l| l.strip_prefix("#     coin-log record "))
+        .unwrap_or_else(|| panic!("no command line in:\n{text}"));
+    line.split_whitespace()
+        .map(|w| match w {
+            "SCENE.toml" => scene.display().to_string(),
+            "OUT.mcap" => out.display().to_string(),
+            w => w.to_string(),
+        })
+        .collect()
+}
+
+/// For every encoding × compression, the command `info --scene` prints, run on the text it prints, writes
+/// the same bytes; the bare `record` of that text (what the old comment offered for Protobuf) does not,
+/// except for the defaults (the negative control).
+#[test]
+fn info_scene_prints_the_command_that_writes_the_same_bytes_for_every_encoding_and_compression() {
+    let dir = tempfile::tempdir().unwrap();
+    for encoding in coin_log::format::Encoding::NAMES {
+        for compression in coin_log_mcap::Compression::NAMES {
+            let original = dir.path().join(format!("{encoding}-{compression}.mcap"));
+            let out = coin_log(
+                dir.path(),
+                &[
+                    "record",
+                    "wobble",
+                    "--duration",
+                    "2",
+                    "--channels",
+                    "omega,angles,energy,tf",
+                    "--set",
+                    "initial.theta=1e-300",
+                    "--encoding",
+                    encoding,
+                    "--compression",
+                    compression,
+                    "-o",
+                    original.to_str().unwrap(),
+                ],
+            );
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let (code, text, err) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
+            assert_eq!(code, 0, "{err}");
+            let scene = dir.path().join(format!("{encoding}-{compression}.toml"));
+            std::fs::write(&scene, &text).unwrap();
+            let again = dir
+                .path()
+                .join(format!("again-{encoding}-{compression}.mcap"));
+            let mut args = vec!["record".to_string()];
+            args.extend(reproduction(&text, &scene, &again));
+            let out = coin_log(dir.path(), &args);
+            assert!(
+                out.status.success(),
+                "{args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let same = std::fs::read(&original).unwrap() == std::fs::read(&again).unwrap();
+            println!(
+                "{encoding:>8} × {compression:<4}: {args:?} → {}",
+                if same { "identical" } else { "DIFFERENT" }
+            );
+            assert!(
+                same,
+                "{encoding} × {compression}: the printed command line reproduces\n{text}"
+            );
+            let bare = dir
+                .path()
+                .join(format!("bare-{encoding}-{compression}.mcap"));
+            let out = coin_log(
+                dir.path(),
+                &[
+                    "record",
+                    scene.to_str().unwrap(),
+                    "-o",
+                    bare.to_str().unwrap(),
+                ],
+            );
+            assert!(out.status.success());
+            let defaults = *encoding == "json" && *compression == "zstd";
+            assert_eq!(
+                std::fs::read(&original).unwrap() == std::fs::read(&bare).unwrap(),
+                defaults,
+                "{encoding} × {compression}: without the printed flags the bytes differ unless both are defaults"
+            );
+        }
+    }
+}
+
+/// A coin upright at rest (M = a = g = 1): W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = 1 exactly, so the bounds
+/// stated in terms of W are plain numbers.
+const AT_REST: &str = "[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"\n\
+[initial]\ntheta = 0.0\nomega = [0.0, 0.0, 0.0]\n[run]\nduration = 1.0\n";
+
+/// The number the help states right after `before` (up to a space, `·` or `)`), as typed.
+fn stated(help: &str, before: &str) -> f64 {
+    let at = help
+        .find(before)
+        .unwrap_or_else(|| panic!("the help states {before:?}: {help}"))
+        + before.len();
+    let word: String = help[at..]
+        .chars()
+        .take_while(|c| !" ·)(".contains(*c))
+        .collect();
+    word.parse()
+        .unwrap_or_else(|e| panic!("{before:?} is followed by a number, not {word:?}: {e}"))
+}
+
+/// A rate whose sample interval 1/rate is exactly `h`, so that a step `h` is used as given (it divides
+/// the interval once): the step bound is then tested on the step itself.
+fn rate_for_interval(h: f64) -> f64 {
+    let mut rate = 1.0 / h;
+    for _ in 0..64 {
+        match (1.0 / rate).total_cmp(&h) {
+            std::cmp::Ordering::Equal => return rate,
+            std::cmp::Ordering::Less => rate = rate.next_down(),
+            std::cmp::Ordering::Greater => rate = rate.next_up(),
+        }
+    }
+    panic!("no rate has the interval {h}")
+}
+
+/// Each numeric bound that `record --help` and `live --help` state (printed there from the constants
+/// scene::limits enforces) is accepted, and the next double beyond it refused naming the key; the bounds
+/// are parsed from the help text itself, so a rounded or stale number fails. `live` shares the flags.
+#[test]
+fn every_stated_bound_is_accepted_and_the_next_double_beyond_it_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("rest.toml"), AT_REST).unwrap();
+    let dry_run = |flags: &[(&str, f64)], integrator: &str| {
+        let mut args = vec![
+            "record",
+            "rest.toml",
+            "--dry-run",
+            "--integrator",
+            integrator,
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+        for (flag, value) in flags {
+            args.extend([(*flag).to_string(), format!("{value:e}")]);
+        }
+        let out = coin_log(dir.path(), &args);
+        (
+            out.status.code().unwrap(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    for command in ["record", "live"] {
+        let (_, help, _) = coin_log_text(&[command, "--help"]);
+        let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+        let rtol_min = stated(&help, "Relative tolerance of adaptive methods, ");
+        let rtol_max = stated(&help, "(ten units of rounding, 10·2⁻⁵²) to ");
+        let atol_max = stated(&help, "Absolute tolerance of adaptive methods, at most ");
+        let step_max = stated(&help, "then step·W ≤ ");
+        let radians = stated(&help, "with T·W ≤ ");
+        assert!(help.contains("at most 1/(1e-9 + 3·2⁻⁵²·T)"), "{help}");
+        let rate_max = coin_log::scene::limits::max_rate(1.0);
+        // (what, integrator, flags at the bound, flags just beyond it, the key the refusal names)
+        let cases: [(&str, &str, Vec<(&str, f64)>, Vec<(&str, f64)>, &str); 6] = [
+            (
+                "rtol min",
+                "dop853",
+                vec![("--rtol", rtol_min)],
+                vec![("--rtol", rtol_min.next_down())],
+                "run.rtol",
+            ),
+            (
+                "rtol max",
+                "dop853",
+                vec![("--rtol", rtol_max)],
+                vec![("--rtol", rtol_max.next_up())],
+                "run.rtol",
+            ),
+            (
+                "atol max",
+                "dop853",
+                vec![("--atol", atol_max)],
+                vec![("--atol", atol_max.next_up())],
+                "run.atol",
+            ),
+            (
+                "step max",
+                "rk4",
+                vec![
+                    ("--step", step_max),
+                    ("--rate", rate_for_interval(step_max)),
+                ],
+                vec![
+                    ("--step", step_max.next_up()),
+                    ("--rate", rate_for_interval(step_max.next_up())),
+                ],
+                "run.step",
+            ),
+            (
+                "duration max",
+                "dop853",
+                vec![("--duration", radians), ("--rate", 1e-3)],
+                vec![("--duration", radians.next_up()), ("--rate", 1e-3)],
+                "run.duration",
+            ),
+            (
+                "rate max",
+                "dop853",
+                vec![("--rate", rate_max)],
+                vec![("--rate", rate_max.next_up())],
+                "run.rate",
+            ),
+        ];
+        for (what, integrator, at, beyond, key) in cases {
+            let (code, err) = dry_run(&at, integrator);
+            assert_eq!(
+                code, 0,
+                "{command} --help, {what}: {at:?} is at the bound: {err}"
+            );
+            let (code, err) = dry_run(&beyond, integrator);
+            println!(
+                "{command} --help, {what}: {at:?} accepted, {beyond:?} → {}",
+                err.trim()
+            );
+            assert_eq!(
+                code, 1,
+                "{command} --help, {what}: {beyond:?} is beyond the bound"
+            );
+            assert!(err.contains(key), "{what}: the refusal names {key}: {err}");
+        }
+        // "> 0": a positive duration is taken, zero refused.
+        assert!(
+            help.contains("Duration in the scene's time unit, > 0"),
+            "{help}"
+        );
+        assert_eq!(dry_run(&[("--duration", 1e-3)], "dop853").0, 0);
+        let (code, err) = dry_run(&[("--duration", 0.0)], "dop853");
+        assert!(code == 1 && err.contains("run.duration"), "{err}");
+    }
+}
