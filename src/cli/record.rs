@@ -147,7 +147,7 @@ const LARGE: u64 = 1 << 30;
 /// a scene file), or with `--json` one object; nothing is written.
 fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outcome> {
     let e = record::estimate(scene, args.compression, args.flags.encoding);
-    let toml = scene.to_toml();
+    let toml = coin_log::scene::readable_toml(&scene.to_toml());
     if args.json {
         #[derive(Serialize)]
         struct DryRun<'a> {

@@ -11,6 +11,12 @@ pub fn size(bytes: u64) -> String {
     }
 }
 
+/// `n` things: `1 job`, `2 jobs`, `0 runs`.
+pub fn counted(n: impl TryInto<u64>, thing: &str) -> String {
+    let n = n.try_into().unwrap_or(u64::MAX);
+    format!("{n} {thing}{}", if n == 1 { "" } else { "s" })
+}
+
 /// A number for a table or message: as Rust prints it when that is short (1e-4 ≤ |x| < 1e16, or 0:
 /// `0.25`, `1`, `30.5`), else in the shortest exponent form that reads back the same (`1e-300`,
 /// `2.5e20`), never as hundreds of digits. The rule of the scene errors' numbers.

@@ -6,6 +6,7 @@
 
 use crate::support::record::{coin_log, coin_log_text};
 use std::path::Path;
+use std::process::Command;
 
 /// The command line `info --scene` prints, with its placeholders for the scene and the output filled in.
 fn reproduction(text: &str, scene: &Path, out: &Path) -> Vec<String> {
@@ -248,5 +249,49 @@ fn every_stated_bound_is_accepted_and_the_next_double_beyond_it_refused() {
         assert_eq!(dry_run(&[("--duration", 1e-3)], "dop853").0, 0);
         let (code, err) = dry_run(&[("--duration", 0.0)], "dop853");
         assert!(code == 1 && err.contains("run.duration"), "{err}");
+    }
+}
+
+/// Every `bench` refuses a link, a named pipe or a folder where one of its result files goes before it
+/// measures anything (it used to find out after minutes of work), and leaves what is there untouched.
+#[test]
+fn bench_refuses_what_is_in_the_way_of_its_results_before_any_work() {
+    use crate::support::record::coin_log_within;
+    use std::time::Duration;
+    let dir = tempfile::tempdir().unwrap();
+    let victim = dir.path().join("victim");
+    std::fs::write(&victim, "precious").unwrap();
+    for (bench, file) in [
+        ("precision", "precision.csv"),
+        ("stability", "stability.csv"),
+        ("throughput", "throughput.csv"),
+        ("euler", "euler.svg"),
+        ("sweep", "sweep.csv"),
+    ] {
+        for (what, needle) in [
+            ("link", "is a symbolic link"),
+            ("pipe", "is a named pipe"),
+            ("folder", "is a folder"),
+        ] {
+            let out = dir.path().join(format!("{bench}-{what}"));
+            std::fs::create_dir(&out).unwrap();
+            let at = out.join(file);
+            match what {
+                "link" => std::os::unix::fs::symlink(&victim, &at).unwrap(),
+                "pipe" => assert!(Command::new("mkfifo").arg(&at).status().unwrap().success()),
+                _ => std::fs::create_dir(&at).unwrap(),
+            }
+            let (code, _, err) = coin_log_within(
+                Duration::from_secs(20),
+                &["bench", bench, "--out", out.to_str().unwrap()],
+            );
+            println!(
+                "bench {bench}, {what} at {file}: exit {code}: {}",
+                err.trim()
+            );
+            assert_eq!(code, 1, "bench {bench}: {err}");
+            assert!(err.contains(needle), "bench {bench}, {what}: {err}");
+            assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+        }
     }
 }
