@@ -2,7 +2,7 @@
 //! names every flag of the bytes), help texts whose numeric bounds are exactly the bounds enforced, scene
 //! text without hundreds of digits, and writers that refuse what an output may not be before any work.
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::cast_precision_loss)]
 
 use crate::support::record::{coin_log, coin_log_text};
 use std::path::Path;
@@ -116,7 +116,7 @@ fn stated(help: &str, before: &str) -> f64 {
         + before.len();
     let word: String = help[at..]
         .chars()
-        .take_while(|c| !" ·)(".contains(*c))
+        .take_while(|c| !" ·)(×,".contains(*c))
         .collect();
     word.parse()
         .unwrap_or_else(|e| panic!("{before:?} is followed by a number, not {word:?}: {e}"))
@@ -293,5 +293,47 @@ fn bench_refuses_what_is_in_the_way_of_its_results_before_any_work() {
             assert!(err.contains(needle), "bench {bench}, {what}: {err}");
             assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
         }
+    }
+}
+
+/// The Protobuf-to-JSON size ratios `record --help` states are those of `wobble` (the built-in scene,
+/// every default) recorded both ways, to ±0.05, for each compression; the old "half the size" and "0.6×
+/// uncompressed" fail this.
+#[test]
+fn record_help_states_the_measured_protobuf_size_for_each_compression() {
+    let (_, help, _) = coin_log_text(&["record", "--help"]);
+    let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(!help.contains("half the size"), "{help}");
+    let dir = tempfile::tempdir().unwrap();
+    for (compression, said) in [
+        ("zstd", "the file is about "),
+        ("lz4", "JSON's size with zstd, "),
+        ("none", "× with lz4, "),
+    ] {
+        let claim = stated(&help, said);
+        let size = |encoding: &str| {
+            let file = dir.path().join(format!("{encoding}-{compression}.mcap"));
+            let out = coin_log(
+                dir.path(),
+                &[
+                    "record",
+                    "wobble",
+                    "--encoding",
+                    encoding,
+                    "--compression",
+                    compression,
+                    "-o",
+                    file.to_str().unwrap(),
+                ],
+            );
+            assert!(out.status.success());
+            std::fs::metadata(&file).unwrap().len() as f64
+        };
+        let ratio = size("protobuf") / size("json");
+        println!("{compression}: Protobuf/JSON = {ratio:.3}, help says {claim}");
+        assert!(
+            (ratio - claim).abs() <= 0.05,
+            "{compression}: measured {ratio:.3}, help says {claim}×"
+        );
     }
 }
