@@ -1,10 +1,10 @@
 //! `coin-log info`: what each file holds, as text or JSON, or the scene stored in one file.
 
-use super::text::size;
+use super::text::{counted, size};
 use super::Outcome;
 use anyhow::bail;
 use coin_log::files::input::check;
-use coin_log::files::{shown, InputKind};
+use coin_log::files::{escaped, shown, InputKind};
 use coin_log::format::metadata::number_string as n;
 use coin_log::format::{Encoding, RunMetadata, Termination};
 use coin_log::inspect::info::{self, FileInfo};
@@ -186,15 +186,18 @@ fn text(shown: &str, i: &FileInfo) -> String {
 /// Size, compression, writer, description, time span and message count.
 fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     let (packed, unpacked) = i.chunk_bytes;
+    // A file cut inside its only chunk has seen that chunk's compression but counts no (complete) chunk.
+    let chunks = match (i.chunks, i.compressions.is_empty()) {
+        (0, true) => "no chunks".to_string(),
+        (0, false) => format!("no complete chunk ({})", i.compression()),
+        (n, _) => format!("{} {}", counted(n, "chunk"), i.compression()),
+    };
     let mut rows = vec![(
         "file",
         format!(
-            "{} ({} B), {} chunk{} {}, {} of records in {}",
+            "{} ({} B), {chunks}, {} of records in {}",
             size(i.file_size),
             i.file_size,
-            i.chunks,
-            if i.chunks == 1 { "" } else { "s" },
-            i.compression(),
             size(unpacked),
             size(packed)
         ),
@@ -209,9 +212,14 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
         |_| String::new(),
         |r| format!(", format {}", r.format_version),
     );
-    rows.push(("written by", format!("{}{version}", i.library)));
+    let library = if i.library.is_empty() {
+        "(no library named: no header, or an empty one)".into()
+    } else {
+        escaped(&i.library).into_owned()
+    };
+    rows.push(("written by", format!("{library}{version}")));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
-        rows.push(("scene", d.clone()));
+        rows.push(("scene", escaped(d).into_owned()));
     }
     let span = i.time_range.map_or_else(
         || "no messages".into(),
@@ -289,6 +297,9 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
 }
 
 fn channels(out: &mut String, i: &FileInfo) {
+    if i.channels.is_empty() {
+        return; // the `encoding` row says "no channels"
+    }
     let topic_w = i
         .channels
         .iter()
@@ -313,7 +324,9 @@ fn channels(out: &mut String, i: &FileInfo) {
         let _ = writeln!(
             out,
             "  {:<topic_w$}  {:<schema_w$}  {:>9}  {rate:>9}",
-            c.topic, c.schema, c.messages
+            escaped(&c.topic),
+            escaped(&c.schema),
+            c.messages
         );
     }
 }

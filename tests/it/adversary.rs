@@ -337,3 +337,57 @@ fn record_help_states_the_measured_protobuf_size_for_each_compression() {
         );
     }
 }
+
+/// The scene text printed for people (`record --dry-run`, `info --scene`) writes tiny and huge values in
+/// exponent form, never as hundreds of digits (the `toml` crate's positional form, which stays in the
+/// file's metadata), and reads back to the same scene: the dry-run's text re-recorded equals the file.
+#[test]
+fn printed_scenes_write_tiny_values_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = [
+        "--set",
+        "initial.theta=1e-300",
+        "--set",
+        "body.thickness=1e-200",
+        "--duration",
+        "1",
+    ];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["record", "wobble"];
+        args.extend_from_slice(&set);
+        args.extend_from_slice(extra);
+        let out = coin_log(dir.path(), &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let dry = run(&["--dry-run"]);
+    run(&["-o", "f.mcap"]);
+    let (code, info, err) = coin_log_text(&[
+        "info",
+        dir.path().join("f.mcap").to_str().unwrap(),
+        "--scene",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    for (what, text) in [("dry-run", &dry), ("info --scene", &info)] {
+        println!("{what}:\n{text}");
+        assert!(
+            text.contains("theta = 1e-300") && text.contains("thickness = 1e-200"),
+            "{what}: {text}"
+        );
+        assert!(
+            text.lines().all(|l| l.len() < 200),
+            "{what}: no line of hundreds of digits"
+        );
+    }
+    std::fs::write(dir.path().join("dry.toml"), &dry).unwrap();
+    let out = coin_log(dir.path(), &["record", "dry.toml", "-o", "g.mcap"]);
+    assert!(out.status.success());
+    assert!(
+        std::fs::read(dir.path().join("f.mcap")).unwrap()
+            == std::fs::read(dir.path().join("g.mcap")).unwrap()
+    );
+}

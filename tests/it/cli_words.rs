@@ -1,7 +1,6 @@
 //! What the command line says agrees with what it does (the help's bounds and Protobuf sizes: adversary.rs):
-//! `verify --help` names every check; a description is
-//! one line of bounded length; tiny numbers print short; control characters in paths are escaped in
-//! messages; `--help` into a full disk is an error.
+//! `verify --help` names every check; a description is one line of bounded length; tiny numbers print
+//! short; control characters in paths are escaped in messages; `--help` into a full disk is an error.
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 

@@ -508,7 +508,13 @@ impl Output {
 /// Keeps a finished temporary file that could not be moved into place.
 fn keep(temp: NamedTempFile, reason: String) -> OutputError {
     let kept = match temp.keep() {
-        Ok((_, path)) => shown(&path),
+        // The temporary file's path is the folder's joined with its name: `/x/./.coin-log-…` for `.`.
+        Ok((_, path)) => shown(
+            &path
+                .components()
+                .filter(|c| *c != std::path::Component::CurDir)
+                .collect::<PathBuf>(),
+        ),
         Err(e) => format!("nowhere: it could not be kept either ({})", e.error),
     };
     OutputError::Kept { reason, kept }
