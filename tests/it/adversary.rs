@@ -122,6 +122,9 @@ fn stated(help: &str, before: &str) -> f64 {
         .unwrap_or_else(|e| panic!("{before:?} is followed by a number, not {word:?}: {e}"))
 }
 
+/// Flags with their values, as `--flag value` pairs.
+type Flags = Vec<(&'static str, f64)>;
+
 /// A rate whose sample interval 1/rate is exactly `h`, so that a step `h` is used as given (it divides
 /// the interval once): the step bound is then tested on the step itself.
 fn rate_for_interval(h: f64) -> f64 {
@@ -174,7 +177,7 @@ fn every_stated_bound_is_accepted_and_the_next_double_beyond_it_refused() {
         assert!(help.contains("at most 1/(1e-9 + 3·2⁻⁵²·T)"), "{help}");
         let rate_max = coin_log::scene::limits::max_rate(1.0);
         // (what, integrator, flags at the bound, flags just beyond it, the key the refusal names)
-        let cases: [(&str, &str, Vec<(&str, f64)>, Vec<(&str, f64)>, &str); 6] = [
+        let cases: [(&str, &str, Flags, Flags, &str); 6] = [
             (
                 "rtol min",
                 "dop853",
