@@ -1,13 +1,15 @@
 //! `coin-log info`: what each file holds, as text or JSON, or the scene stored in one file.
 
-use super::text::size;
+use super::text::{counted, size};
 use super::Outcome;
 use anyhow::bail;
 use coin_log::files::input::check;
-use coin_log::files::{shown, InputKind};
+use coin_log::files::{escaped, shown, InputKind};
 use coin_log::format::metadata::number_string as n;
+use coin_log::format::{Encoding, RunMetadata, Termination};
 use coin_log::inspect::info::{self, FileInfo};
 use coin_log::inspect::seconds_text;
+use coin_log_mcap::Compression;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -16,9 +18,9 @@ use std::path::{Path, PathBuf};
 /// Shows what each file holds without opening a viewer: its channels (topic, schema, message count,
 /// rate), the time range, the body and run settings, the termination, the file's size and compression and
 /// the version that wrote it. Read from the summary section when the file has one (instant whatever its
-/// size), otherwise by one pass over the file. `--scene` prints the stored scene as TOML:
-/// `coin-log info F --scene > s.toml && coin-log record s.toml -o G` writes G byte for byte equal to F
-/// (with the same `--compression`, and the same coin-log version).
+/// size), otherwise by one pass over the file. `--scene` prints the stored scene as TOML after a comment
+/// with the command line that records it again into the same bytes (`coin-log record s.toml -o G
+/// --encoding E --compression C`, with the same coin-log version).
 #[derive(Debug, clap::Args)]
 pub struct InfoArgs {
     /// MCAP files.
@@ -108,17 +110,56 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
         Ok(run) => run,
         Err(e) => bail!("{shown}: {e}"),
     };
-    let compression = i.compression();
-    let flag = match compression.as_str() {
-        "zstd" => String::new(),
-        other => format!(" and --compression {other}"),
-    };
     out!(
-        "# The scene stored in `{shown}` (written by coin-log {}). `coin-log record` this file\n# with that version{flag} to write the same bytes again.\n{}",
-        run.tool_version, run.scene
+        "{}{}",
+        reproduction(&shown, &i, run),
+        coin_log::scene::readable_toml(&run.scene)
     );
     Ok(Outcome::Success)
 }
+
+/// The comment lines before `--scene`'s TOML: the `coin-log record` command line that writes the file's
+/// bytes again from that text (every setting the scene does not hold: encoding and compression), or why
+/// no command can.
+fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
+    let mut text = format!(
+        "# The scene stored in `{shown}` (written by coin-log {}).\n",
+        run.tool_version
+    );
+    let (encoding, compression) = (i.encoding(), i.compression());
+    let named = |word: &str, names: &[&str]| names.contains(&word);
+    if !named(&encoding, Encoding::NAMES) || !named(&compression, Compression::NAMES) {
+        let _ = writeln!(
+            text,
+            "# Its encoding ({encoding}) and compression ({compression}) are not those of one `coin-log \
+             record`,\n# so no command line writes the same bytes again."
+        );
+        return text;
+    }
+    let _ = writeln!(
+        text,
+        "# Saved as SCENE.toml, with coin-log {} this writes the same bytes again:\n{REPRODUCE}SCENE.toml -o \
+         OUT.mcap --encoding {encoding} --compression {compression}",
+        run.tool_version
+    );
+    if let Some(result) = i
+        .result
+        .as_ref()
+        .ok()
+        .filter(|r| r.termination == Termination::Interrupted)
+    {
+        let _ = writeln!(
+            text,
+            "# (up to t = {}, where the run was interrupted: a run that is not interrupted goes on, and \
+             ends differently)",
+            n(result.termination_time)
+        );
+    }
+    text
+}
+
+/// How the command line starts in `--scene`'s comment (tests find it by this).
+pub const REPRODUCE: &str = "#     coin-log record ";
 
 /// The text description of one file: a row per property, then the channels.
 fn text(shown: &str, i: &FileInfo) -> String {
@@ -145,15 +186,18 @@ fn text(shown: &str, i: &FileInfo) -> String {
 /// Size, compression, writer, description, time span and message count.
 fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     let (packed, unpacked) = i.chunk_bytes;
+    // A file cut inside its only chunk has seen that chunk's compression but counts no (complete) chunk.
+    let chunks = match (i.chunks, i.compressions.is_empty()) {
+        (0, true) => "no chunks".to_string(),
+        (0, false) => format!("no complete chunk ({})", i.compression()),
+        (n, _) => format!("{} {}", counted(n, "chunk"), i.compression()),
+    };
     let mut rows = vec![(
         "file",
         format!(
-            "{} ({} B), {} chunk{} {}, {} of records in {}",
+            "{} ({} B), {chunks}, {} of records in {}",
             size(i.file_size),
             i.file_size,
-            i.chunks,
-            if i.chunks == 1 { "" } else { "s" },
-            i.compression(),
             size(unpacked),
             size(packed)
         ),
@@ -168,9 +212,14 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
         |_| String::new(),
         |r| format!(", format {}", r.format_version),
     );
-    rows.push(("written by", format!("{}{version}", i.library)));
+    let library = if i.library.is_empty() {
+        "(no library named: no header, or an empty one)".into()
+    } else {
+        escaped(&i.library).into_owned()
+    };
+    rows.push(("written by", format!("{library}{version}")));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
-        rows.push(("scene", d.clone()));
+        rows.push(("scene", escaped(d).into_owned()));
     }
     let span = i.time_range.map_or_else(
         || "no messages".into(),
@@ -248,6 +297,9 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
 }
 
 fn channels(out: &mut String, i: &FileInfo) {
+    if i.channels.is_empty() {
+        return; // the `encoding` row says "no channels"
+    }
     let topic_w = i
         .channels
         .iter()
@@ -272,7 +324,9 @@ fn channels(out: &mut String, i: &FileInfo) {
         let _ = writeln!(
             out,
             "  {:<topic_w$}  {:<schema_w$}  {:>9}  {rate:>9}",
-            c.topic, c.schema, c.messages
+            escaped(&c.topic),
+            escaped(&c.schema),
+            c.messages
         );
     }
 }

@@ -4,6 +4,7 @@
 
 use super::rss::peak_rss_bytes;
 use super::scene_arg::{load_source, SceneSource};
+use super::text::help;
 use super::text::{number, size};
 use super::{output, Outcome};
 use anyhow::{anyhow, Context};
@@ -65,9 +66,8 @@ pub struct RecordArgs {
 /// The flags `record` and `live` share: scene overrides, edits and the message encoding.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SceneFlags {
-    /// Duration in the scene's time unit, > 0, with T·W ≤ 1e10 radians of the fastest motion W =
-    /// max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0 (overrides `run.duration`).
-    #[arg(long, value_name = "T")]
+    // The bounds in these help texts are the ones scene::limits enforces, printed from its constants.
+    #[arg(long, value_name = "T", help = help::duration())]
     pub duration: Option<f64>,
     /// Samples per time unit, > 0, at most 1/(1e-9 + 3·2⁻⁵²·T) (just under 1e9: samples stay ≥ 1 ns apart)
     /// (overrides `run.rate`; scene default 100).
@@ -76,17 +76,11 @@ pub struct SceneFlags {
     /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
     #[arg(long, value_name = "NAME")]
     pub integrator: Option<String>,
-    /// Relative tolerance of adaptive methods, 2.221e-15 (ten units of rounding, 10·2⁻⁵²) to 1e-3 (overrides
-    /// `run.rtol`; default 1e-10).
-    #[arg(long, value_name = "X")]
+    #[arg(long, value_name = "X", help = help::rtol())]
     pub rtol: Option<f64>,
-    /// Absolute tolerance of adaptive methods, at most 1e-3·min(1, a, 1/τ) (overrides `run.atol`; default
-    /// 1e-12).
-    #[arg(long, value_name = "X")]
+    #[arg(long, value_name = "X", help = help::atol())]
     pub atol: Option<f64>,
-    /// Step of fixed-step methods, rounded down to divide 1/rate; then step·W ≤ 0.1778 with W the fastest
-    /// rate at t = 0, as for --duration (overrides `run.step`; default 1e-3).
-    #[arg(long, value_name = "H")]
+    #[arg(long, value_name = "H", help = help::step())]
     pub step: Option<f64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
     /// invariants, tf, scene, and work with dissipation, rerun with --encoding protobuf (overrides
@@ -98,9 +92,9 @@ pub struct SceneFlags {
     #[arg(long)]
     pub rerun: bool,
     /// Message encoding: json (JSON Schemas; readable as text) or protobuf (FileDescriptorSet schemas;
-    /// records about twice as fast, and Rerun reads it; the file is about 0.9× JSON's size with zstd, 0.6×
-    /// with lz4 or uncompressed: README, Performance). Both carry the same f64 values (docs/format.md:
-    /// Encodings).
+    /// records about twice as fast, and Rerun reads it; the file is about 0.9× JSON's size with zstd,
+    /// 0.65× with lz4, 0.5× uncompressed, measured on `wobble`: README, Performance). Both carry the same
+    /// f64 values (docs/format.md: Encodings).
     #[arg(long, default_value_t, value_parser = super::named::<Encoding>())]
     pub encoding: Encoding,
     /// Set a scene key before the flags above apply: KEY is a dotted path (`initial.theta`, `run.rtol`,
@@ -159,7 +153,7 @@ const LARGE: u64 = 1 << 30;
 /// a scene file), or with `--json` one object; nothing is written.
 fn dry_run(args: &RecordArgs, scene: &Scene, label: &str) -> anyhow::Result<Outcome> {
     let e = record::estimate(scene, args.compression, args.flags.encoding);
-    let toml = scene.to_toml();
+    let toml = coin_log::scene::readable_toml(&scene.to_toml());
     if args.json {
         #[derive(Serialize)]
         struct DryRun<'a> {

@@ -76,6 +76,6 @@ fn resolved(name: &str) -> anyhow::Result<SceneFile> {
 fn show(name: &str, file: &SceneFile) -> String {
     format!(
         "# Built-in scene `{name}` with every default filled in; written by `coin-log scenes --show {name}`.\n{}",
-        coin_log::scene::to_toml(file)
+        coin_log::scene::readable_toml(&coin_log::scene::to_toml(file))
     )
 }

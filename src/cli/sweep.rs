@@ -4,9 +4,10 @@
 //! handler, draws the progress bar, prints, and maps the result to the exit code.
 
 use super::rss::peak_rss_bytes;
-use super::text::size;
+use super::text::{counted, size};
 use super::Outcome;
 use anyhow::Context;
+use coin_log::files::shown;
 use coin_log::sweep::{
     self, Preview, Progress, RunOptions, Shard, Sweep, SweepError, SweepOutcome,
 };
@@ -285,18 +286,25 @@ fn print_outcome(
         format!(" of shard {shard}")
     };
     let rows = [
-        ("sweep", format!("{} ({} runs{of_shard})", path.display(), o.runs)),
-        ("folder", dir.display().to_string()),
-        ("done now", format!("{} ({} kept from before)", o.done, o.kept)),
+        (
+            "sweep",
+            format!("{} ({}{of_shard})", shown(path), counted(o.runs, "run")),
+        ),
+        ("folder", shown(dir)),
+        (
+            "done now",
+            format!("{} ({} kept from before)", o.done, o.kept),
+        ),
         ("finished", o.finished.to_string()),
         ("failed", failed_text(o.failed)),
         ("pending", pending_text(o)),
-        ("catalogue", o.catalogue.display().to_string()),
+        ("catalogue", shown(&o.catalogue)),
         (
             "wall time",
             format!(
-                "{:.3} s with {jobs} jobs (recording {:.3} s, verifying {:.3} s, summed over the runs)",
+                "{:.3} s with {} (recording {:.3} s, verifying {:.3} s, summed over the runs)",
                 wall.as_secs_f64(),
+                counted(jobs, "job"),
                 o.record_seconds,
                 o.verify_seconds
             ),
@@ -383,8 +391,8 @@ fn print_preview(sweep: &Sweep, shard: Shard, jobs: usize, keys: &[&str], p: &Pr
         format!(" in shard {shard}, of {}", sweep.runs())
     };
     outln!(
-        "{} runs{of_shard}; swept keys: {}",
-        p.runs,
+        "{}{of_shard}; swept keys: {}",
+        counted(p.runs, "run"),
         if keys.is_empty() {
             "none".to_string()
         } else {
@@ -420,11 +428,12 @@ fn print_preview(sweep: &Sweep, shard: Shard, jobs: usize, keys: &[&str], p: &Pr
         outln!("  … ({} more)", p.runs - p.first.len() as u64);
     }
     outln!(
-        "estimate: {} messages, about {} in {} files, about {:.0} s with {jobs} jobs (a rough guide: {} messages/s per job)",
+        "estimate: {} messages, about {} in {}, about {:.0} s with {} (a rough guide: {} messages/s per job)",
         p.messages,
         size(p.bytes),
-        p.runs,
+        counted(p.runs, "file"),
         p.seconds.ceil(),
+        counted(jobs, "job"),
         sweep::MESSAGES_PER_SECOND
     );
     if let Some((index, reason)) = &p.first_invalid {
@@ -444,7 +453,7 @@ fn collect(args: &CollectArgs) -> anyhow::Result<Outcome> {
         Err(e) => return Err(e.into()),
     };
     for problem in &collected.problems {
-        errln!("error: {}: {problem}", args.dir.display());
+        errln!("error: {}: {problem}", shown(&args.dir));
     }
     if args.json {
         let json = serde_json::json!({

@@ -153,7 +153,7 @@ fn tolerances_and_steps_beyond_what_the_integrators_deliver_are_refused() {
         &["wobble", "--rtol", "1e-30", "--atol", "1e-30"],
         &[
             "`run.rtol` = 1e-30 is below 2.22e-15",
-            "use rtol ≥ 2.221e-15",
+            "use rtol ≥ 2.220446049250313e-15",
         ],
     );
     refused(

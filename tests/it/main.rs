@@ -26,6 +26,7 @@
 mod support;
 
 mod added_fields;
+mod adversary;
 mod analyse;
 mod architecture;
 mod bench_euler;

@@ -6,6 +6,7 @@ mod throughput;
 
 use super::Outcome;
 use anyhow::Context;
+use coin_log::files::output::check;
 use coin_log::files::{shown, Output, Policy};
 use coin_log::integrate::Method;
 use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
@@ -104,19 +105,28 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
     }
 }
 
-fn create_dir(out: &Path) -> anyhow::Result<()> {
-    fs::create_dir_all(out).with_context(|| format!("creating the output folder `{}`", shown(out)))
+/// Creates the output folder and checks, before the (long) measurement, that every file the bench will
+/// write there can be: a link, pipe or device in its place is refused now, not after the work.
+fn create_dir(out: &Path, files: &[String]) -> anyhow::Result<()> {
+    fs::create_dir_all(out)
+        .with_context(|| format!("creating the output folder `{}`", shown(out)))?;
+    for file in files {
+        check(&out.join(file), &POLICY)?;
+    }
+    Ok(())
 }
 
-/// Writes a result file, replacing an earlier run's (never a link, pipe or device: files::output).
+/// The result files replace an earlier run's (never a link, pipe or device: files::output).
+const POLICY: Policy<'static> = Policy {
+    overwrite: true,
+    flag: "--out",
+    example: "bench-results",
+    protect: None,
+};
+
+/// Writes a result file.
 fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
-    let policy = Policy {
-        overwrite: true,
-        flag: "--out",
-        example: "bench-results",
-        protect: None,
-    };
-    Ok(Output::write(path, &policy, contents.as_bytes())?)
+    Ok(Output::write(path, &POLICY, contents.as_bytes())?)
 }
 
 /// A built-in scene by name, or a scene file by path (named by its stem), by the rule of
@@ -147,7 +157,12 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         .iter()
         .map(|n| load_case(n))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    create_dir(&args.out)?;
+    let mut files: Vec<String> = cases
+        .iter()
+        .map(|c| format!("precision-{}.svg", c.name))
+        .collect();
+    files.push("precision.csv".into());
+    create_dir(&args.out, &files)?;
     let options = PrecisionOptions::full(args.repeats as usize);
     let mut all_rows = Vec::new();
     for case in &cases {
@@ -176,7 +191,7 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
 }
 
 fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
-    create_dir(&args.out)?;
+    create_dir(&args.out, &["stability.csv".into()])?;
     let rows = suite::run_suite(&stability::SuiteOptions::full())?;
     out!("{}", stability_table(&rows));
     let csv_path = args.out.join("stability.csv");
@@ -186,7 +201,7 @@ fn stability_suite(args: &StabilityArgs) -> anyhow::Result<Outcome> {
 }
 
 fn euler(args: &EulerArgs) -> anyhow::Result<Outcome> {
-    create_dir(&args.out)?;
+    create_dir(&args.out, &["euler.csv".into(), "euler.svg".into()])?;
     let options = EulerOptions::full();
     let rows = euler_bench(&options)?;
     if let Some(first) = rows.first() {

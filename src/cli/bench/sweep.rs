@@ -146,11 +146,11 @@ fn row(
 
 /// Runs `coin-log bench sweep`: measure, clean up, print the table, write the CSV.
 pub fn run(args: &SweepBenchArgs) -> anyhow::Result<Outcome> {
-    create_dir(&args.out)?;
+    create_dir(&args.out, &["sweep.csv".into()])?;
     let exe = std::env::current_exe().context("locating the coin-log binary")?;
     let work = args.out.join("sweep-bench");
     let _ = fs::remove_dir_all(&work);
-    create_dir(&work)?;
+    create_dir(&work, &[])?;
     let result = measure(&exe, &work, args.repeats as usize);
     if !args.keep {
         let _ = fs::remove_dir_all(&work);
@@ -160,7 +160,7 @@ pub fn run(args: &SweepBenchArgs) -> anyhow::Result<Outcome> {
     out!("{}", throughput::table(&report));
     let csv_path = args.out.join("sweep.csv");
     write(&csv_path, &throughput::csv(&report))?;
-    outln!("CSV: {}", csv_path.display());
+    outln!("CSV: {}", coin_log::files::shown(&csv_path));
     Ok(Outcome::Success)
 }
 

@@ -43,7 +43,7 @@ pub struct ThroughputArgs {
 /// Runs `coin-log bench throughput`: measure, clean up, print the table, write the CSV.
 pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
     let durations = durations(args)?;
-    create_dir(&args.out)?;
+    create_dir(&args.out, &["throughput.csv".into()])?;
     let exe = std::env::current_exe().context("locating the coin-log binary")?;
     let result = measure(
         &exe,

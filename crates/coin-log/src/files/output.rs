@@ -360,6 +360,16 @@ pub fn make_readable(file: &File) {
     let _ = file;
 }
 
+/// Checks `target` against `policy` as [`Output::create`] will, creating nothing: for a command that works
+/// long before it writes (`bench`), so that a target it would refuse at the end is refused first.
+///
+/// # Errors
+/// As [`Output::create`]'s checks: the target is not a file that may be written or replaced, or its folder
+/// is missing.
+pub fn check(target: &Path, policy: &Policy) -> Result<(), OutputError> {
+    check_target(target, policy).map(drop)
+}
+
 /// One output file being written: a temporary file beside its target until [`Output::commit`].
 #[derive(Debug)]
 pub struct Output {
@@ -498,7 +508,13 @@ impl Output {
 /// Keeps a finished temporary file that could not be moved into place.
 fn keep(temp: NamedTempFile, reason: String) -> OutputError {
     let kept = match temp.keep() {
-        Ok((_, path)) => shown(&path),
+        // The temporary file's path is the folder's joined with its name: `/x/./.coin-log-…` for `.`.
+        Ok((_, path)) => shown(
+            &path
+                .components()
+                .filter(|c| *c != std::path::Component::CurDir)
+                .collect::<PathBuf>(),
+        ),
         Err(e) => format!("nowhere: it could not be kept either ({})", e.error),
     };
     OutputError::Kept { reason, kept }

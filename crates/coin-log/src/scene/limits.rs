@@ -214,7 +214,7 @@ pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Probl
             format!(
                 "is below {}, ten units of double-precision rounding (10·2⁻⁵²): the error estimate would be rounding noise and the step would shrink without end; use rtol ≥ {}",
                 short(RTOL_MIN, Round::Nearest),
-                short(RTOL_MIN, Round::Up)
+                number(RTOL_MIN)
             ),
         );
     } else if rtol > RTOL_MAX {
