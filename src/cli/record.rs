@@ -65,8 +65,8 @@ pub struct RecordArgs {
 /// The flags `record` and `live` share: scene overrides, edits and the message encoding.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SceneFlags {
-    /// Duration in the scene's time unit, > 0, with T·W ≤ 1e10 radians of the fastest motion W =
-    /// max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0 (overrides `run.duration`).
+    /// Duration in the scene's time unit, ≥ 1e-9 (the 1 ns log-time resolution), with T·W ≤ 1e10 radians
+    /// of the fastest motion W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0 (overrides `run.duration`).
     #[arg(long, value_name = "T")]
     pub duration: Option<f64>,
     /// Samples per time unit, > 0, at most 1/(1e-9 + 3·2⁻⁵²·T) (just under 1e9: samples stay ≥ 1 ns apart)
@@ -85,9 +85,15 @@ pub struct SceneFlags {
     #[arg(long, value_name = "X")]
     pub atol: Option<f64>,
     /// Step of fixed-step methods, rounded down to divide 1/rate; then step·W ≤ 0.1778 with W the fastest
-    /// rate at t = 0, as for --duration (overrides `run.step`; default 1e-3).
+    /// rate at t = 0, as for --duration, and duration/step ≤ --max-steps (overrides `run.step`; default
+    /// 1e-3).
     #[arg(long, value_name = "H")]
     pub step: Option<f64>,
+    /// Most integrator steps, ≥ 1: a fixed-step run needing more is refused before it starts, an adaptive
+    /// one stops when they are spent (termination `step-budget-spent`, exit 1) (overrides `run.max_steps`;
+    /// default 10000000, a few seconds of work).
+    #[arg(long, value_name = "N")]
+    pub max_steps: Option<u64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
     /// invariants, tf, scene, and work with dissipation (overrides `record.channels`; default all).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
@@ -114,6 +120,7 @@ impl SceneFlags {
             rtol: self.rtol,
             atol: self.atol,
             step: self.step,
+            max_steps: self.max_steps,
             channels: self.channels.clone(),
         }
     }
@@ -132,6 +139,14 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     // Before simulating: say which required checks `verify` will not be able to run on this recording.
     for warning in coin_log::verify::coverage(&scene) {
         errln!("warning: verify will not be able to judge this recording: {warning}");
+    }
+    let shortfalls = record::expected_shortfalls(&scene);
+    if !shortfalls.is_empty() {
+        let said: Vec<String> = shortfalls.iter().map(ToString::to_string).collect();
+        errln!(
+            "warning: verify is expected to refuse this recording (the summary and the file's metadata will              say so too): {}",
+            said.join("; ")
+        );
     }
     warn_if_large(&args, &scene);
     let target = output_path(&args, &source);
@@ -360,8 +375,13 @@ pub(super) fn persist(output: Output, signals: &Signals) -> anyhow::Result<()> {
 pub(super) fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
     match &summary.failure {
         Some(f) => {
+            let fix = if summary.termination == Termination::StepBudgetSpent {
+                " (raise --max-steps, run.max_steps, or loosen --rtol/--atol)"
+            } else {
+                ""
+            };
             errln!(
-                "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
+                "error: the integration failed at t = {}: {f}{fix}; `{}` holds the samples up to it",
                 number(summary.termination_time),
                 shown(target)
             );
@@ -564,5 +584,15 @@ fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
         termination.push_str(" (not to be trusted: energy drift above the tolerance)");
     }
     rows.push(("termination", termination));
+    if !s.shortfalls.is_empty() {
+        let checks: Vec<&str> = s.shortfalls.iter().flat_map(|f| f.checks.iter().copied()).collect();
+        rows.push((
+            "verify",
+            format!(
+                "expected to fail {} (settings looser than its tolerances)",
+                checks.join(", ")
+            ),
+        ));
+    }
     rows
 }
