@@ -41,6 +41,7 @@ fn stated_bounds() -> Vec<(
     &'static str,
 )> {
     let up = |x: f64| f64::from_bits(x.to_bits() + 1);
+    let down = |x: f64| f64::from_bits(x.to_bits() - 1);
     let rk4 = || ("--integrator", "rk4".to_string());
     // A step equal to the sampling interval is used as given (no rounding).
     let step = |h: f64| {
@@ -87,10 +88,22 @@ fn stated_bounds() -> Vec<(
             "run.rate",
         ),
         (
-            "Duration in the scene's time unit, > 0",
-            vec![("--duration", "1e-3".into())],
-            vec![("--duration", "0".into())],
+            "Duration in the scene's time unit, ≥ 1e-9",
+            vec![("--duration", "1e-9".into())],
+            vec![("--duration", down(1e-9).to_string())],
             "run.duration",
+        ),
+        (
+            "Most integrator steps, ≥ 1",
+            vec![("--max-steps", "1".into())],
+            vec![("--max-steps", "0".into())],
+            "run.max_steps",
+        ),
+        (
+            "duration/step ≤ --max-steps",
+            vec![rk4(), ("--max-steps", "1000".into())],
+            vec![rk4(), ("--max-steps", "999".into())],
+            "run.step",
         ),
     ]
 }

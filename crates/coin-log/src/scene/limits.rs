@@ -257,7 +257,8 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
     let shown = number(given.unwrap_or(h));
     #[allow(clippy::float_cmp)] // exactly the question: does t + h round back to t?
     let stuck = duration + h == duration;
-    let steps = (duration / h).ceil();
+    // The same relative slack as the step's fitting to the sample grid: 0.001/1e-10 is 1e7 steps, not 1e7 + 1.
+    let steps = (duration / h * (1.0 - 1e-12)).ceil();
     #[allow(clippy::cast_precision_loss)]
     let max = run.max_steps as f64;
     if stuck {
@@ -276,7 +277,8 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
             "run.step",
             shown,
             format!(
-                "takes {steps:e} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step; beyond 1e7 steps rounding also grows past verify's tolerance floor): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
+                "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step; beyond 1e7 steps rounding also grows past verify's tolerance floor): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
+                power_of_ten(steps.log10()),
                 number(duration),
                 run.max_steps,
                 short(duration / max, Round::Up)
