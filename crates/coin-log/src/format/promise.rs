@@ -9,6 +9,11 @@
 //!   drifts and residuals   ≈ [`GROWTH_SHARE`] · ε (1 + T/τ)     (the integrator's share of its budget)
 //!   nutation (relative)    ≈ [`NUTATION_SHARE`] · ε
 //!   rounding of n steps    ≈ [`ROUNDING_SHARE`] · n · 2⁻⁵³       (fixed-step methods; n = T/h)
+//!   rounding differenced   ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ / (Δt Ω)  (fixed-step methods, constraint)
+//!
+//! The last is the constraint's finite difference over samples Δt apart dividing the rounding that each
+//! fixed step leaves on the sample it ends on (Ω = max(max|ω|, 1/τ)); an adaptive method's samples are
+//! interpolated within a step, and at the highest rate its constraint passed (measured below).
 //!
 //! A check whose predicted error is above its tolerance is expected to fail. The shares are measured
 //! (below); `tests/it/record_verify_agreement.rs` sweeps the corners of every integrator and checks that no
@@ -30,6 +35,12 @@ pub const NUTATION_SHARE: f64 = 1.0;
 /// the 1e-12 floor, as verify judged them.
 pub const ROUNDING_SHARE: f64 = 5e-4;
 
+/// Gain of the constraint's 8th-order central difference on independent rounding of its samples:
+/// 2 Σ|wₖ| = 2 (4/5 + 1/5 + 4/105 + 1/280) = 2.08. Measured on `wobble` at the highest rate (samples 1 ns
+/// apart, over 1e-3 time units): rk4 and gauss4 fail `constraint`, whose floor 1e-10 this puts below
+/// 2.08·2⁻⁵³/(1e-9·1.54) = 1.5e-7, while dop853 and dopri5 pass.
+pub const DIFFERENCE_GAIN: f64 = 2.08;
+
 /// Unit roundoff 2⁻⁵³.
 const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
@@ -41,10 +52,11 @@ pub enum Cause {
         /// ε of the tolerances.
         epsilon: f64,
     },
-    /// The rounding of very many fixed steps exceeds the tolerance's floor.
+    /// The rounding of very many fixed steps, or of fixed steps differenced over samples very close
+    /// together, exceeds the tolerance's floor.
     Rounding {
-        /// Number of steps.
-        steps: f64,
+        /// The steps.
+        fixed: Option<FixedSteps>,
     },
 }
 
@@ -77,33 +89,55 @@ impl fmt::Display for Shortfall {
                  {:.1e} verify judges by; tighten --rtol/--atol (dopri5, dop853) or --step (rk4, gauss4)",
                 self.predicted, self.tolerance
             ),
-            Cause::Rounding { steps } => write!(
-                f,
-                "{steps:.1e} fixed steps accumulate rounding of about {:.1e}, above the tolerance {:.1e} \
-                 verify judges by; take a larger --step (fewer steps)",
-                self.predicted, self.tolerance
-            ),
+            Cause::Rounding { fixed } => {
+                let FixedSteps {
+                    steps,
+                    sample_interval,
+                } = fixed.unwrap_or(FixedSteps {
+                    steps: 0.0,
+                    sample_interval: 0.0,
+                });
+                write!(
+                    f,
+                    "{steps:.1e} fixed steps with samples {sample_interval:.1e} apart leave rounding of \
+                     about {:.1e}, above the tolerance {:.1e} verify judges by; take a larger --step \
+                     (fewer steps) or a lower --rate",
+                    self.predicted, self.tolerance
+                )
+            }
         }
     }
 }
 
+/// The fixed steps of a run, as far as their rounding goes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixedSteps {
+    /// Steps over the span.
+    pub steps: f64,
+    /// Distance between samples Δt.
+    pub sample_interval: f64,
+}
+
 /// The checks of a recording integrated as `run` that verify's default tolerances are expected to fail;
-/// `fixed_steps` is the number of steps of a fixed-step method (`None` for adaptive ones, whose steps
-/// are few enough for their rounding to stay below the floors).
+/// `fixed` describes the steps of a fixed-step method (`None` for adaptive ones, whose steps are few
+/// enough for their rounding to stay below the floors).
 #[must_use]
-pub fn shortfalls(run: &RunAccuracy, fixed_steps: Option<f64>) -> Vec<Shortfall> {
+pub fn shortfalls(run: &RunAccuracy, fixed: Option<FixedSteps>) -> Vec<Shortfall> {
     let tolerances = Tolerances::derive(run, None, None);
     let epsilon = tolerances.epsilon;
     let growth = epsilon * (1.0 + (run.span / run.time_unit).max(0.0));
+    let fixed_steps = fixed.map(|f| f.steps);
     let rounding = fixed_steps.map_or(0.0, |n| ROUNDING_SHARE * n * UNIT_ROUNDOFF);
+    let omega = run.max_omega.max(1.0 / run.time_unit);
+    let differenced = fixed.map_or(0.0, |f| {
+        DIFFERENCE_GAIN * UNIT_ROUNDOFF / (f.sample_interval * omega)
+    });
     let accumulated = GROWTH_SHARE * growth;
     let cause = |share: f64, rounding: f64| {
         if share >= rounding {
             Cause::Accuracy { epsilon }
         } else {
-            Cause::Rounding {
-                steps: fixed_steps.unwrap_or(0.0),
-            }
+            Cause::Rounding { fixed }
         }
     };
     [
@@ -116,7 +150,7 @@ pub fn shortfalls(run: &RunAccuracy, fixed_steps: Option<f64>) -> Vec<Shortfall>
         (
             &["constraint", "steady"][..],
             accumulated,
-            rounding,
+            rounding + differenced,
             tolerances.residual,
         ),
         (
@@ -170,15 +204,23 @@ mod tests {
     #[test]
     fn loose_settings_and_very_many_steps_are_predicted_to_fail() {
         assert!(shortfalls(&run("dop853", 1e-10, 0.0, 30.0), None).is_empty());
-        assert!(shortfalls(&run("rk4", 0.0, 1e-3, 30.0), Some(3e4)).is_empty());
+        let fixed = |steps: f64, sample_interval: f64| {
+            Some(FixedSteps {
+                steps,
+                sample_interval,
+            })
+        };
+        assert!(shortfalls(&run("rk4", 0.0, 1e-3, 30.0), fixed(3e4, 0.01)).is_empty());
         let loose = shortfalls(&run("dop853", 1e-3, 0.0, 30.0), None);
         println!("{}", loose[0]);
         assert_eq!(check_list(&loose), "energy,invariants,constraint,steady,nutation");
-        let long = shortfalls(&run("rk4", 0.0, 0.1, 30.0), Some(300.0));
+        let long = shortfalls(&run("rk4", 0.0, 0.1, 30.0), fixed(300.0, 1.0));
         assert!(matches!(long[0].cause, Cause::Accuracy { .. }), "{long:?}");
-        let many = shortfalls(&run("rk4", 0.0, 1e-12, 1e-3), Some(1e9));
+        let many = shortfalls(&run("rk4", 0.0, 1e-12, 1e-3), fixed(1e9, 1e-3));
         println!("{}", many[0]);
         assert!(matches!(many[0].cause, Cause::Rounding { .. }), "{many:?}");
         assert_eq!(check_list(&many), "energy,invariants");
+        let dense = shortfalls(&run("rk4", 0.0, 1e-9, 1e-3), fixed(1e6, 1e-9));
+        assert_eq!(check_list(&dense), "constraint,steady");
     }
 }

@@ -582,9 +582,12 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
 }
 
 /// The steps a fixed-step method takes over `span`; `None` for adaptive methods.
-fn fixed_steps(scene: &Scene, span: f64) -> Option<f64> {
+fn fixed_steps(scene: &Scene, span: f64) -> Option<promise::FixedSteps> {
     let m = &scene.run.method;
-    (!m.method.is_adaptive()).then(|| (span / m.step).ceil())
+    (!m.method.is_adaptive()).then(|| promise::FixedSteps {
+        steps: (span / m.step).ceil(),
+        sample_interval: scene.run.sample_interval(),
+    })
 }
 
 /// How `scene` is integrated, as `verify` will derive its tolerances from it (format.md: Tolerances), over
