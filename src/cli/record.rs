@@ -585,7 +585,11 @@ fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
     }
     rows.push(("termination", termination));
     if !s.shortfalls.is_empty() {
-        let checks: Vec<&str> = s.shortfalls.iter().flat_map(|f| f.checks.iter().copied()).collect();
+        let checks: Vec<&str> = s
+            .shortfalls
+            .iter()
+            .flat_map(|f| f.checks.iter().copied())
+            .collect();
         rows.push((
             "verify",
             format!(

@@ -68,11 +68,24 @@ fn fixed_steps_that_cannot_end_or_exceed_the_budget_are_refused_before_simulatin
     }
     // At the budget (0.001 / 1e-10 = 1e7 steps) accepted, one step beyond refused.
     let (code, err, _, _) = record(&[
-        "--integrator", "gauss4", "--step", "1e-10", "--duration", "0.001", "--dry-run",
+        "--integrator",
+        "gauss4",
+        "--step",
+        "1e-10",
+        "--duration",
+        "0.001",
+        "--dry-run",
     ]);
     assert_eq!(code, 0, "at the budget: {err}");
     let (code, err, _, _) = record(&[
-        "--integrator", "rk4", "--step", "1e-10", "--duration", "0.001", "--max-steps", "9999999",
+        "--integrator",
+        "rk4",
+        "--step",
+        "1e-10",
+        "--duration",
+        "0.001",
+        "--max-steps",
+        "9999999",
         "--dry-run",
     ]);
     assert_eq!(code, 1, "one step beyond: {err}");
@@ -90,7 +103,15 @@ fn an_adaptive_run_stops_when_its_step_budget_is_spent() {
     let dir = tempfile::tempdir().unwrap();
     let out = coin_log(
         dir.path(),
-        &["record", "wobble", "-o", "w.mcap", "--max-steps", "100", "--json"],
+        &[
+            "record",
+            "wobble",
+            "-o",
+            "w.mcap",
+            "--max-steps",
+            "100",
+            "--json",
+        ],
     );
     let err = String::from_utf8_lossy(&out.stderr);
     println!("{err}");
@@ -101,7 +122,8 @@ fn an_adaptive_run_stops_when_its_step_budget_is_spent() {
     let t = summary["termination_time"].as_f64().unwrap();
     assert!(t > 0.0 && t < 30.0, "stopped inside the run: {t}");
     assert!(
-        err.contains("the step budget of 100 steps was spent at t = ") && err.contains("--max-steps"),
+        err.contains("the step budget of 100 steps was spent at t = ")
+            && err.contains("--max-steps"),
         "{err}"
     );
     let verify = coin_log(dir.path(), &["verify", "w.mcap", "--json"]);
@@ -129,15 +151,24 @@ fn durations_below_the_log_time_resolution_are_refused_with_the_figure() {
         println!("--duration {duration}: exit {code}: {err}");
         assert_eq!(code, 1, "{err}");
         assert!(
-            err.contains("is below 1e-9, the log-time resolution") && err.contains("duration ≥ 1e-9"),
+            err.contains("is below 1e-9, the log-time resolution")
+                && err.contains("duration ≥ 1e-9"),
             "{err}"
         );
         assert!(!err.contains("stiff or singular"), "{err}");
         assert!(listing.is_empty());
     }
     let dir = tempfile::tempdir().unwrap();
-    let out = coin_log(dir.path(), &["record", "wobble", "-o", "w.mcap", "--duration", "1e-9"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "-o", "w.mcap", "--duration", "1e-9"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let verify = coin_log(dir.path(), &["verify", "w.mcap", "--json"]);
     let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
     let checks = report["files"][0]["checks"].as_array().unwrap();
@@ -173,10 +204,18 @@ fn the_driver_sees_a_stop_and_a_spent_budget_between_samples() {
     };
     let run = |bounds: &Bounds<'_>| {
         let mut samples = 0;
-        let outcome = run_method_bounded(&config, &Clock, &[0.0], &settings, bounds, &NoEvents, |_, _| {
-            samples += 1;
-            coin_log::integrate::Flow::Continue
-        });
+        let outcome = run_method_bounded(
+            &config,
+            &Clock,
+            &[0.0],
+            &settings,
+            bounds,
+            &NoEvents,
+            |_, _| {
+                samples += 1;
+                coin_log::integrate::Flow::Continue
+            },
+        );
         (outcome, samples)
     };
     let stop = AtomicBool::new(true);
@@ -198,5 +237,8 @@ fn the_driver_sees_a_stop_and_a_spent_budget_between_samples() {
         "{spent:?}"
     );
     let (free, samples) = run(&Bounds::default());
-    assert_eq!((free.termination, free.stats.steps, samples), (RunEnd::Completed, 1000, 2));
+    assert_eq!(
+        (free.termination, free.stats.steps, samples),
+        (RunEnd::Completed, 1000, 2)
+    );
 }

@@ -27,12 +27,12 @@ mod support;
 
 mod added_fields;
 mod analyse;
-mod bounded_work;
 mod architecture;
 mod bench_euler;
 mod bench_precision;
 mod bench_stability;
 mod bench_throughput;
+mod bounded_work;
 mod cli_files;
 mod cli_inspect;
 mod cli_paths;

@@ -19,10 +19,22 @@ use std::path::Path;
 fn largest_step(dir: &Path, integrator: &str) -> String {
     let out = coin_log(
         dir,
-        &["record", "wobble", "--dry-run", "--integrator", integrator, "--step", "1", "--rate", "1"],
+        &[
+            "record",
+            "wobble",
+            "--dry-run",
+            "--integrator",
+            integrator,
+            "--step",
+            "1",
+            "--rate",
+            "1",
+        ],
     );
     let err = String::from_utf8_lossy(&out.stderr);
-    let (_, tail) = err.split_once("use step ≤ ").expect("the refusal names the largest step");
+    let (_, tail) = err
+        .split_once("use step ≤ ")
+        .expect("the refusal names the largest step");
     tail.split_whitespace().next().unwrap().to_string()
 }
 
@@ -56,7 +68,10 @@ impl Row {
         match (self.verify_code, self.failed.is_empty()) {
             (0, _) => "pass".into(),
             (_, true) => "cannot verify".into(),
-            (_, false) => format!("fail {}", self.failed.iter().cloned().collect::<Vec<_>>().join(",")),
+            (_, false) => format!(
+                "fail {}",
+                self.failed.iter().cloned().collect::<Vec<_>>().join(",")
+            ),
         }
     }
 
@@ -129,13 +144,22 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
     for integrator in ["dop853", "dopri5"] {
         let i = |rest: &[&str]| [s(&["--integrator", integrator]), s(rest)].concat();
         for (case, flags) in [
-            ("loosest rtol and atol", i(&["--rtol", "1e-3", "--atol", "1e-3"])),
+            (
+                "loosest rtol and atol",
+                i(&["--rtol", "1e-3", "--atol", "1e-3"]),
+            ),
             ("loosest rtol", i(&["--rtol", "1e-3"])),
-            ("tightest rtol and atol", i(&["--rtol", "2.221e-15", "--atol", "1e-16"])),
+            (
+                "tightest rtol and atol",
+                i(&["--rtol", "2.221e-15", "--atol", "1e-16"]),
+            ),
             ("rtol 1e-6", i(&["--rtol", "1e-6", "--atol", "1e-9"])),
             ("defaults", i(&[])),
             ("lowest rate 0.1", i(&["--rate", "0.1"])),
-            ("highest rate", i(&["--duration", "1e-3", "--rate", &fast, "--channels", few])),
+            (
+                "highest rate",
+                i(&["--duration", "1e-3", "--rate", &fast, "--channels", few]),
+            ),
         ] {
             rows.push(corner(d, format!("{integrator}: {case}"), &flags));
         }
@@ -145,8 +169,14 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
         let per_step = (1.0 / largest.parse::<f64>().unwrap()).to_string();
         let i = |rest: &[&str]| [s(&["--integrator", integrator]), s(rest)].concat();
         let mut cases = vec![
-            (format!("largest step {largest}"), i(&["--step", &largest, "--rate", &per_step])),
-            ("step 0.11 at rate 1".to_string(), i(&["--step", "0.11", "--rate", "1"])),
+            (
+                format!("largest step {largest}"),
+                i(&["--step", &largest, "--rate", &per_step]),
+            ),
+            (
+                "step 0.11 at rate 1".to_string(),
+                i(&["--step", "0.11", "--rate", "1"]),
+            ),
             ("defaults".to_string(), i(&[])),
             (
                 "smallest step (1e7 steps)".to_string(),
@@ -161,7 +191,14 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
         if integrator == "rk4" {
             cases.push((
                 "1e8 steps (budget raised)".to_string(),
-                i(&["--step", "1e-10", "--duration", "0.01", "--max-steps", "100000000"]),
+                i(&[
+                    "--step",
+                    "1e-10",
+                    "--duration",
+                    "0.01",
+                    "--max-steps",
+                    "100000000",
+                ]),
             ));
         }
         for (case, flags) in cases {
@@ -182,7 +219,14 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
         );
     }
     for r in &rows {
-        assert_ne!(r.agreement(), "BROKEN PROMISE", "{}: {} / {}", r.case, r.word(), r.verdict());
+        assert_ne!(
+            r.agreement(),
+            "BROKEN PROMISE",
+            "{}: {} / {}",
+            r.case,
+            r.word(),
+            r.verdict()
+        );
         assert!(
             r.failed.is_subset(&r.expected),
             "{}: verify failed {:?}, record expected {:?}",
@@ -191,16 +235,35 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
             r.expected
         );
         if r.verify_code != 0 && r.failed.is_empty() {
-            assert!(r.cannot_judge_warned, "{}: cannot verify, not warned", r.case);
+            assert!(
+                r.cannot_judge_warned,
+                "{}: cannot verify, not warned",
+                r.case
+            );
         }
     }
     // The negative control: the cases are among the warned, and the defaults among the promised.
-    for case in ["dop853: loosest rtol and atol", "dopri5: loosest rtol", "rk4: step 0.11 at rate 1", "rk4: 1e8 steps (budget raised)"] {
+    for case in [
+        "dop853: loosest rtol and atol",
+        "dopri5: loosest rtol",
+        "rk4: step 0.11 at rate 1",
+        "rk4: 1e8 steps (budget raised)",
+    ] {
         let r = rows.iter().find(|r| r.case == case).unwrap();
-        assert!(!r.expected.is_empty() && r.verify_code != 0, "{case}: {} / {}", r.word(), r.verdict());
+        assert!(
+            !r.expected.is_empty() && r.verify_code != 0,
+            "{case}: {} / {}",
+            r.word(),
+            r.verdict()
+        );
     }
     for case in ["dop853: defaults", "rk4: defaults", "gauss4: defaults"] {
         let r = rows.iter().find(|r| r.case == case).unwrap();
-        assert!(r.promised() && r.verify_code == 0, "{case}: {} / {}", r.word(), r.verdict());
+        assert!(
+            r.promised() && r.verify_code == 0,
+            "{case}: {} / {}",
+            r.word(),
+            r.verdict()
+        );
     }
 }

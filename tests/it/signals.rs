@@ -40,7 +40,10 @@ fn record_then_interrupt(dir: &Path, args: &[&str]) -> (Option<i32>, Duration, S
         .stderr(Stdio::null())
         .status()
         .unwrap();
-    assert!(status.success(), "kill -INT: the recording ended before the signal");
+    assert!(
+        status.success(),
+        "kill -INT: the recording ended before the signal"
+    );
     let out = child.wait_within(Duration::from_secs(60));
     (
         out.status.code(),
@@ -57,33 +60,60 @@ fn record_then_interrupt(dir: &Path, args: &[&str]) -> (Option<i32>, Duration, S
 fn the_first_signal_stops_a_recording_between_samples_at_once_at_any_rate() {
     let highest = max_rate(10.0).floor().to_string();
     let cases: [(&str, Vec<&str>); 6] = [
-        ("dop853, rate 1e-7", vec!["--rate", "1e-7", "--duration", "1e8"]),
+        (
+            "dop853, rate 1e-7",
+            vec!["--rate", "1e-7", "--duration", "1e8"],
+        ),
         (
             "dop853, rate 1e-300",
             vec!["--rate", "1e-300", "--duration", "1e9"],
         ),
         (
             "dopri5, rate 1e-7",
-            vec!["--integrator", "dopri5", "--rate", "1e-7", "--duration", "1e8"],
+            vec![
+                "--integrator",
+                "dopri5",
+                "--rate",
+                "1e-7",
+                "--duration",
+                "1e8",
+            ],
         ),
         (
             "rk4, rate 1e-7",
             vec![
-                "--integrator", "rk4", "--rate", "1e-7", "--duration", "1e8", "--max-steps",
+                "--integrator",
+                "rk4",
+                "--rate",
+                "1e-7",
+                "--duration",
+                "1e8",
+                "--max-steps",
                 "100000000000",
             ],
         ),
         (
             "gauss4, rate 1e-7",
             vec![
-                "--integrator", "gauss4", "--rate", "1e-7", "--duration", "1e8", "--max-steps",
+                "--integrator",
+                "gauss4",
+                "--rate",
+                "1e-7",
+                "--duration",
+                "1e8",
+                "--max-steps",
                 "100000000000",
             ],
         ),
         (
             "dop853, highest rate",
             vec![
-                "--rate", &highest, "--duration", "10", "--channels", "omega,angles,position",
+                "--rate",
+                &highest,
+                "--duration",
+                "10",
+                "--channels",
+                "omega,angles,position",
             ],
         ),
     ];

@@ -157,6 +157,10 @@ impl EventFunctions<DISSIPATIVE_STATE_LEN> for DissipativeEvents {
 ///
 /// The dispatch happens here, once: conservative dynamics integrate [`Coin`] itself, dissipative ones
 /// [`DissipativeCoin`] with W as a ninth component starting at 0.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "what to integrate, how, for how long, within which bounds, until which events: each its own"
+)]
 pub fn run_dynamics<O>(
     config: &MethodConfig,
     dynamics: &Dynamics,

@@ -67,7 +67,15 @@ where
     E: EventFunctions<N>,
     O: FnMut(f64, &[f64; N]) -> Flow,
 {
-    run_method_bounded(config, sys, y0, settings, &Bounds::default(), events, observe)
+    run_method_bounded(
+        config,
+        sys,
+        y0,
+        settings,
+        &Bounds::default(),
+        events,
+        observe,
+    )
 }
 
 /// [`run_method`] within `bounds`; see [`run_bounded`].

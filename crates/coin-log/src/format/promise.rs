@@ -213,7 +213,10 @@ mod tests {
         assert!(shortfalls(&run("rk4", 0.0, 1e-3, 30.0), fixed(3e4, 0.01)).is_empty());
         let loose = shortfalls(&run("dop853", 1e-3, 0.0, 30.0), None);
         println!("{}", loose[0]);
-        assert_eq!(check_list(&loose), "energy,invariants,constraint,steady,nutation");
+        assert_eq!(
+            check_list(&loose),
+            "energy,invariants,constraint,steady,nutation"
+        );
         let long = shortfalls(&run("rk4", 0.0, 0.1, 30.0), fixed(300.0, 1.0));
         assert!(matches!(long[0].cause, Cause::Accuracy { .. }), "{long:?}");
         let many = shortfalls(&run("rk4", 0.0, 1e-12, 1e-3), fixed(1e9, 1e-3));
