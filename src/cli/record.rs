@@ -91,7 +91,7 @@ pub struct SceneFlags {
     pub step: Option<f64>,
     /// Most integrator steps, ≥ 1: a fixed-step run needing more is refused before it starts, an adaptive
     /// one stops when they are spent (termination `step-budget-spent`, exit 1) (overrides `run.max_steps`;
-    /// default 10000000, a few seconds of work).
+    /// default 100000000, under a minute of work).
     #[arg(long, value_name = "N")]
     pub max_steps: Option<u64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
@@ -140,15 +140,15 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     for warning in coin_log::verify::coverage(&scene) {
         errln!("warning: verify will not be able to judge this recording: {warning}");
     }
+    warn_if_large(&args, &scene);
     let shortfalls = record::expected_shortfalls(&scene);
     if !shortfalls.is_empty() {
         let said: Vec<String> = shortfalls.iter().map(ToString::to_string).collect();
         errln!(
-            "warning: verify is expected to refuse this recording (the summary and the file's metadata will              say so too): {}",
+            "warning: verify is expected to refuse this recording (the summary and the file's metadata say so too): {}",
             said.join("; ")
         );
     }
-    warn_if_large(&args, &scene);
     let target = output_path(&args, &source);
     let mut output = prepare_output(&target, args.overwrite, &source, &signals)?;
     if signals.stopped() {

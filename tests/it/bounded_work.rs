@@ -49,13 +49,13 @@ fn fixed_steps_that_cannot_end_or_exceed_the_budget_are_refused_before_simulatin
             &[
                 "--integrator", "gauss4", "--step", "1e-17", "--duration", "0.001",
             ][..],
-            "`run.step` = 1e-17 takes 1e14 steps over duration 0.001, more than run.max_steps = 10000000",
+            "`run.step` = 1e-17 takes 1e14 steps over duration 0.001, more than run.max_steps = 100000000",
         ),
         (
             &[
                 "--integrator", "rk4", "--step", "1e-12", "--duration", "0.001",
             ][..],
-            "`run.step` = 1e-12 takes 1e9 steps over duration 0.001, more than run.max_steps = 10000000",
+            "`run.step` = 1e-12 takes 1e9 steps over duration 0.001, more than run.max_steps = 100000000",
         ),
     ] {
         let (code, err, listing, took) = record(flags);

@@ -277,7 +277,7 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
             "run.step",
             shown,
             format!(
-                "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step; beyond 1e7 steps rounding also grows past verify's tolerance floor): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
+                "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
                 power_of_ten(steps.log10()),
                 number(duration),
                 run.max_steps,

@@ -760,7 +760,7 @@ fn check_run(
         problems.push(
             "run.max_steps",
             "0".to_string(),
-            "is not positive: give the most integrator steps the run may take, e.g. max_steps = 10_000_000",
+            "is not positive: give the most integrator steps the run may take, e.g. max_steps = 100_000_000",
         );
     }
     if !margin_ok {
