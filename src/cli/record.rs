@@ -82,6 +82,11 @@ pub struct SceneFlags {
     pub atol: Option<f64>,
     #[arg(long, value_name = "H", help = help::step())]
     pub step: Option<f64>,
+    /// Most integrator steps, ≥ 1: a fixed-step run needing more is refused before it starts, an adaptive
+    /// one stops when they are spent (termination `step-budget-spent`, exit 1) (overrides `run.max_steps`;
+    /// default 100000000, under a minute of work).
+    #[arg(long, value_name = "N")]
+    pub max_steps: Option<u64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
     /// invariants, tf, scene, and work with dissipation, rerun with --encoding protobuf (overrides
     /// `record.channels`; default all but work and rerun).
@@ -113,6 +118,7 @@ impl SceneFlags {
             rtol: self.rtol,
             atol: self.atol,
             step: self.step,
+            max_steps: self.max_steps,
             channels: self.channels.clone(),
             rerun: self.rerun,
         }
@@ -134,6 +140,14 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
         errln!("warning: verify will not be able to judge this recording: {warning}");
     }
     warn_if_large(&args, &scene);
+    let shortfalls = record::expected_shortfalls(&scene);
+    if !shortfalls.is_empty() {
+        let said: Vec<String> = shortfalls.iter().map(ToString::to_string).collect();
+        errln!(
+            "warning: verify is expected to refuse this recording (the summary and the file's metadata say so too): {}",
+            said.join("; ")
+        );
+    }
     let target = output_path(&args, &source);
     let mut output = prepare_output(&target, args.overwrite, &source, &signals)?;
     if signals.stopped() {
@@ -371,8 +385,13 @@ pub(super) fn persist(output: Output, signals: &Signals) -> anyhow::Result<()> {
 pub(super) fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
     match &summary.failure {
         Some(f) => {
+            let fix = if summary.termination == Termination::StepBudgetSpent {
+                " (raise --max-steps, run.max_steps, or loosen --rtol/--atol)"
+            } else {
+                ""
+            };
             errln!(
-                "error: the integration failed at t = {}: {f}; `{}` holds the samples up to it",
+                "error: the integration failed at t = {}: {f}{fix}; `{}` holds the samples up to it",
                 number(summary.termination_time),
                 shown(target)
             );
@@ -586,5 +605,19 @@ fn physics_rows(s: &RecordSummary) -> Vec<(&'static str, String)> {
         });
     }
     rows.push(("termination", termination));
+    if !s.shortfalls.is_empty() {
+        let checks: Vec<&str> = s
+            .shortfalls
+            .iter()
+            .flat_map(|f| f.checks.iter().copied())
+            .collect();
+        rows.push((
+            "verify",
+            format!(
+                "expected to fail {} (settings looser than its tolerances)",
+                checks.join(", ")
+            ),
+        ));
+    }
     rows
 }

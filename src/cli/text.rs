@@ -34,7 +34,7 @@ pub fn number(x: f64) -> String {
 pub mod help {
     use coin_log::scene::defaults;
     use coin_log::scene::limits::{
-        ATOL_MAX_FRACTION, MAX_RADIANS, RTOL_MAX, RTOL_MIN, STEP_MAX_PRODUCT,
+        ATOL_MAX_FRACTION, MAX_RADIANS, MIN_DURATION, RTOL_MAX, RTOL_MIN, STEP_MAX_PRODUCT,
     };
 
     /// A bound as it must be typed to be the bound: the shortest text that reads back to the same double,
@@ -49,8 +49,9 @@ pub mod help {
 
     pub fn duration() -> String {
         format!(
-            "Duration in the scene's time unit, > 0, with T·W ≤ {} radians of the fastest motion W = \
-             max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0 (overrides `run.duration`)",
+            "Duration in the scene's time unit, ≥ {} (the 1 ns log-time resolution), with T·W ≤ {} radians \
+             of the fastest motion W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0 (overrides `run.duration`)",
+            bound(MIN_DURATION),
             bound(MAX_RADIANS)
         )
     }
@@ -77,7 +78,8 @@ pub mod help {
     pub fn step() -> String {
         format!(
             "Step of fixed-step methods, rounded down to divide 1/rate; then step·W ≤ {} (1e-3^(1/4)) with W \
-             the fastest rate at t = 0, as for --duration (overrides `run.step`; default {})",
+             the fastest rate at t = 0, as for --duration, and duration/step ≤ --max-steps (overrides `run.step`; \
+             default {})",
             bound(STEP_MAX_PRODUCT),
             bound(defaults::STEP)
         )

@@ -175,6 +175,7 @@ pub fn run_sampled_with(
         &case.dynamics(),
         &case.initial,
         settings,
+        &coin_log::integrate::Bounds::default(),
         case.flat_margin,
         case.friction,
         |t, y, w| {

@@ -6,8 +6,8 @@
 //! before the integration, so the conservative hot loop is exactly what it is without dissipation.
 
 use crate::integrate::{
-    self, run_method, EventFunctions, Flow, MethodConfig, OdeSystem, RunOutcome, RunSettings,
-    Stepper,
+    self, run_method_bounded, Bounds, EventFunctions, Flow, MethodConfig, OdeSystem, RunOutcome,
+    RunSettings, Stepper,
 };
 use crate::model::{
     reaction, Coin, DissipativeCoin, Dynamics, Reaction, State, DISSIPATIVE_STATE_LEN, STATE_LEN,
@@ -152,15 +152,21 @@ impl EventFunctions<DISSIPATIVE_STATE_LEN> for DissipativeEvents {
 
 /// Runs `config` on the scene's dynamics from `initial`, with the physical events (flat landing at
 /// |θ| = π/2 − `flat_margin`, lift-off, slip when `friction` is given), calling `observe(t, y, W)` at every
-/// sample: y the eight coin components, W the dissipated work (`None` for conservative dynamics).
+/// sample: y the eight coin components, W the dissipated work (`None` for conservative dynamics), within
+/// `bounds` (a step budget, a stop flag seen after every step).
 ///
 /// The dispatch happens here, once: conservative dynamics integrate [`Coin`] itself, dissipative ones
 /// [`DissipativeCoin`] with W as a ninth component starting at 0.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "what to integrate, how, for how long, within which bounds, until which events: each its own"
+)]
 pub fn run_dynamics<O>(
     config: &MethodConfig,
     dynamics: &Dynamics,
     initial: &State,
     settings: &RunSettings,
+    bounds: &Bounds<'_>,
     flat_margin: f64,
     friction: Option<f64>,
     mut observe: O,
@@ -177,22 +183,24 @@ where
         ..*config
     };
     match dynamics {
-        Dynamics::Conservative(coin) => run_method(
+        Dynamics::Conservative(coin) => run_method_bounded(
             config,
             coin,
             &initial.to_array(),
             settings,
+            bounds,
             &CoinEvents::new(*coin, flat_margin, friction),
             |t, y| observe(t, y, None),
         ),
         Dynamics::Dissipative(coin) => {
             let mut y0 = [0.0; DISSIPATIVE_STATE_LEN];
             y0[..STATE_LEN].copy_from_slice(&initial.to_array());
-            run_method(
+            run_method_bounded(
                 config,
                 coin,
                 &y0,
                 settings,
+                bounds,
                 &DissipativeEvents::new(*coin, flat_margin, friction),
                 |t, y| observe(t, &coin_part(y), Some(y[WORK_INDEX])),
             )

@@ -2,6 +2,7 @@
 //! ends at the first event, located by root finding on the dense output.
 
 use super::{OdeSystem, Stats, StepError, Stepper};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Largest number of event functions a system may declare.
 pub const MAX_EVENTS: usize = 8;
@@ -52,6 +53,18 @@ pub struct RunSettings {
     pub t_end: f64,
     /// Distance between samples; samples fall on t0 + k·interval and on t_end.
     pub sample_interval: f64,
+}
+
+/// Bounds on the work of a run beyond its time span, checked after every accepted step (one relaxed load
+/// and one comparison: nothing beside a step's stages), so that a stop is seen within one step however far
+/// apart the samples are, and no run takes more steps than it was given.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Bounds<'a> {
+    /// Most accepted steps; the run fails with [`StepError::BudgetSpent`] instead of taking one more.
+    pub max_steps: Option<u64>,
+    /// Raised (by a signal handler, on another thread) to stop the run: it then ends as
+    /// [`RunEnd::Stopped`] at its last sample, as when the observer returns [`Flow::Stop`].
+    pub stop: Option<&'a AtomicBool>,
 }
 
 /// How a run ended.
@@ -109,10 +122,39 @@ where
     E: EventFunctions<N>,
     O: FnMut(f64, &[f64; N]) -> Flow,
 {
+    run_bounded(
+        sys,
+        stepper,
+        y0,
+        settings,
+        &Bounds::default(),
+        events,
+        observe,
+    )
+}
+
+/// [`run`] within `bounds`: also ends when the step budget is spent or the stop flag is raised.
+pub fn run_bounded<const N: usize, S, M, E, O>(
+    sys: &S,
+    stepper: &mut M,
+    y0: &[f64; N],
+    settings: &RunSettings,
+    bounds: &Bounds<'_>,
+    events: &E,
+    observe: O,
+) -> RunOutcome
+where
+    S: OdeSystem<N>,
+    M: Stepper<N>,
+    E: EventFunctions<N>,
+    O: FnMut(f64, &[f64; N]) -> Flow,
+{
     let mut run = Run {
         sys,
         stepper,
         settings,
+        bounds: *bounds,
+        steps: 0,
         events,
         observe,
         n_events: events.count().min(MAX_EVENTS),
@@ -136,6 +178,9 @@ struct Run<'a, const N: usize, S, M, E, O> {
     sys: &'a S,
     stepper: &'a mut M,
     settings: &'a RunSettings,
+    bounds: Bounds<'a>,
+    /// Accepted steps so far.
+    steps: u64,
     events: &'a E,
     observe: O,
     n_events: usize,
@@ -180,9 +225,13 @@ where
     /// Steps until the run ends; returns how it ended.
     fn steps(&mut self) -> RunEnd {
         loop {
+            if let Some(end) = self.out_of_bounds() {
+                return end;
+            }
             if let Err(e) = self.stepper.step(self.sys, self.settings.t_end) {
                 return RunEnd::Failed(e);
             }
+            self.steps += 1;
             self.dense_ready = false;
             let t_new = self.stepper.t();
             let event = self.event_in_step(t_new);
@@ -203,6 +252,21 @@ where
             }
             let n = self.n_events;
             self.g_old[..n].copy_from_slice(&self.g_new[..n]);
+        }
+    }
+
+    /// How the run ends before its next step, if the stop flag is up or the step budget is spent.
+    #[inline]
+    fn out_of_bounds(&self) -> Option<RunEnd> {
+        if self.bounds.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            return Some(RunEnd::Stopped { t: self.t_last });
+        }
+        match self.bounds.max_steps {
+            Some(max) if self.steps >= max => Some(RunEnd::Failed(StepError::BudgetSpent {
+                t: self.stepper.t(),
+                steps: self.steps,
+            })),
+            _ => None,
         }
     }
 

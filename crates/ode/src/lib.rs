@@ -21,11 +21,12 @@ pub use coin_log_names::UnknownName;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use driver::{
-    run, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings, MAX_EVENTS,
+    run, run_bounded, Bounds, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings,
+    MAX_EVENTS,
 };
 pub use gauss4::Gauss4;
 pub use hermite::hermite_interpolate;
-pub use method::{run_method, Method, MethodConfig};
+pub use method::{run_method, run_method_bounded, Method, MethodConfig};
 pub use rk4::Rk4;
 
 use thiserror::Error;
@@ -65,6 +66,14 @@ pub enum StepError {
         t: f64,
         /// Last attempted step.
         h: f64,
+    },
+    /// The run's step budget ([`Bounds::max_steps`]) was spent before its end.
+    #[error("the step budget of {steps} steps was spent at t = {t}")]
+    BudgetSpent {
+        /// Time reached.
+        t: f64,
+        /// Steps taken (the budget).
+        steps: u64,
     },
     /// The implicit stage equations did not converge.
     #[error("stage equations did not converge at t = {t} (h = {h:e}, residual {residual:e} after {iterations} iterations); reduce the step")]

@@ -1,6 +1,6 @@
 //! The user-facing choice of integrator (format.md: record) and the one dispatch from it to a stepper.
 
-use super::driver::{run, EventFunctions, Flow, RunOutcome, RunSettings};
+use super::driver::{run_bounded, Bounds, EventFunctions, Flow, RunOutcome, RunSettings};
 use super::{Dop853, Dopri5, Gauss4, OdeSystem, Rk4};
 
 coin_log_names::named_enum! {
@@ -53,7 +53,7 @@ pub struct MethodConfig {
     pub step: f64,
 }
 
-/// Runs `config.method` on `sys` from `y0`; see [`run`].
+/// Runs `config.method` on `sys` from `y0`; see [`run`](super::run).
 pub fn run_method<const N: usize, S, E, O>(
     config: &MethodConfig,
     sys: &S,
@@ -67,36 +67,66 @@ where
     E: EventFunctions<N>,
     O: FnMut(f64, &[f64; N]) -> Flow,
 {
+    run_method_bounded(
+        config,
+        sys,
+        y0,
+        settings,
+        &Bounds::default(),
+        events,
+        observe,
+    )
+}
+
+/// [`run_method`] within `bounds`; see [`run_bounded`].
+pub fn run_method_bounded<const N: usize, S, E, O>(
+    config: &MethodConfig,
+    sys: &S,
+    y0: &[f64; N],
+    settings: &RunSettings,
+    bounds: &Bounds<'_>,
+    events: &E,
+    observe: O,
+) -> RunOutcome
+where
+    S: OdeSystem<N>,
+    E: EventFunctions<N>,
+    O: FnMut(f64, &[f64; N]) -> Flow,
+{
     match config.method {
-        Method::Rk4 => run(
+        Method::Rk4 => run_bounded(
             sys,
             &mut Rk4::new(config.step),
             y0,
             settings,
+            bounds,
             events,
             observe,
         ),
-        Method::Gauss4 => run(
+        Method::Gauss4 => run_bounded(
             sys,
             &mut Gauss4::new(config.step),
             y0,
             settings,
+            bounds,
             events,
             observe,
         ),
-        Method::Dopri5 => run(
+        Method::Dopri5 => run_bounded(
             sys,
             &mut Dopri5::new(config.rtol, config.atol),
             y0,
             settings,
+            bounds,
             events,
             observe,
         ),
-        Method::Dop853 => run(
+        Method::Dop853 => run_bounded(
             sys,
             &mut Dop853::new(config.rtol, config.atol),
             y0,
             settings,
+            bounds,
             events,
             observe,
         ),

@@ -488,6 +488,7 @@ pub fn record(spec: &Spec, path: &Path) {
         termination,
         termination_time: outcome.t_last,
         termination_alpha: None,
+        expected_to_fail: None,
     };
     w.write_metadata(&mcap::records::Metadata {
         name: RESULT_METADATA_NAME.into(),

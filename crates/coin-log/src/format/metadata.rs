@@ -165,6 +165,21 @@ impl OptionalKeys for Option<f64> {
     }
 }
 
+impl OptionalKeys for Option<String> {
+    fn write(&self, key: &'static str, map: &mut BTreeMap<String, String>) {
+        if let Some(v) = self {
+            map.insert(key.to_string(), v.clone());
+        }
+    }
+    fn read(
+        _: &'static str,
+        map: &BTreeMap<String, String>,
+        key: &'static str,
+    ) -> Result<Self, MetadataError> {
+        Ok(map.get(key).cloned())
+    }
+}
+
 /// The keys of the dissipation law in the `coin-log` record, present together or not at all.
 pub const DISSIPATION_KEYS: [&str; 4] = [
     "dissipation",
@@ -323,5 +338,9 @@ record! {
         /// α = π/2 − |θ| at the last sample (`termination_alpha`), written only with dissipation: how
         /// flat the coin was when the run ended (physics §11).
         pub termination_alpha: Option<f64>,
+        /// The checks `verify` is expected to fail with its default tolerances (`expected_to_fail`, check ids
+        /// comma-separated), written only when there are some: the settings could not meet them
+        /// ([`crate::format::promise`]).
+        pub expected_to_fail: Option<String>,
     }
 }

@@ -3,7 +3,8 @@
 //! the `coin_log.*` message types with their JSON form ([`messages`], read back by [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
 //! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
 //! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
-//! recorded integrator settings ([`tolerances`]).
+//! recorded integrator settings ([`tolerances`]), and what they will accept, predicted from the settings
+//! ([`promise`]).
 //!
 //! It knows the physics' vocabulary (integrator [`Method`](crate::integrate::Method), steady
 //! [`SteadyFamily`](crate::model::SteadyFamily), [`Branch`](crate::model::Branch), physical events) but
@@ -15,6 +16,7 @@ pub mod fields;
 pub mod json;
 pub mod messages;
 pub mod metadata;
+pub mod promise;
 pub mod protobuf;
 mod termination;
 mod time;

@@ -24,6 +24,8 @@ coin_log_names::named_enum! {
         NonFinite = "non-finite",
         /// The implicit stage equations did not converge.
         NewtonFailure = "newton-failure",
+        /// The adaptive integrator spent its step budget (`run.max_steps`) before the duration.
+        StepBudgetSpent = "step-budget-spent",
     }
 }
 
@@ -41,6 +43,7 @@ impl Termination {
             StepError::NonFinite { .. } => Self::NonFinite,
             StepError::StepSizeUnderflow { .. } => Self::StepSizeUnderflow,
             StepError::NewtonFailure { .. } => Self::NewtonFailure,
+            StepError::BudgetSpent { .. } => Self::StepBudgetSpent,
         }
     }
 

@@ -17,12 +17,13 @@ use crate::format::messages::{
     drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
     NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
+use crate::format::promise::{self, Shortfall};
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
     log_time, Channel, Encoding, ResultMetadata, RunMetadata, Termination, TimeError, Topic,
     FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
-use crate::integrate::{self, Flow, RunOutcome, RunSettings};
+use crate::integrate::{self, Bounds, Flow, RunOutcome, RunSettings};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{
     centre, contact_point, energy, orientation, Chaplygin, Coin, Dynamics, InvariantsError, State,
@@ -527,7 +528,8 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
 }
 
 /// Integrates `scene` and writes it to `writer` as a finished MCAP file, calling `progress(t)` now and
-/// then and stopping (termination `interrupted`) soon after `stop` is raised.
+/// then and stopping (termination `interrupted`) within one integrator step after `stop` is raised,
+/// whatever the sampling rate: the file then ends with the samples recorded so far.
 ///
 /// A physical event or a numerical failure still gives a finished file; the returned summary says which
 /// ([`Termination`]). The writer is flushed before returning.
@@ -563,8 +565,15 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
         Some(SampleError::Failure(f)) => (f.termination(), outcome.t_last, Some(f)),
         None => ending(&outcome.termination, outcome.t_last),
     };
-    let tolerance = energy_tolerance(scene, sampler.drift.max_omega, termination_time);
-    let mut summary = sampler.finish(outcome.stats, termination, termination_time, failure)?;
+    let accuracy = accuracy(scene, sampler.drift.max_omega, termination_time);
+    let tolerance = Tolerances::derive(&accuracy, None, None).energy;
+    let shortfalls = promise::shortfalls(&accuracy, fixed_steps(scene, termination_time));
+    let mut summary = sampler.finish(
+        outcome.stats,
+        (termination, termination_time),
+        failure,
+        shortfalls,
+    )?;
     summary.energy_tolerance = tolerance;
     let doubt = departure_doubt(&scene.coin(), &scene.initial).filter(|_| termination.is_event());
     summary.event_trusted = termination
@@ -574,11 +583,33 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
     Ok(summary)
 }
 
-/// The energy drift tolerance `verify` will derive for the file (format.md: Tolerances).
-fn energy_tolerance(scene: &Scene, max_omega: f64, span: f64) -> f64 {
+/// The checks `verify` is expected to fail on a recording of `scene`, predicted before it runs from the
+/// settings, the duration and |ω| at t = 0 ([`promise`]); the summary repeats the prediction with the
+/// run's own span and max|ω|.
+#[must_use]
+pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
+    let s = &scene.initial;
+    let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
+    let span = scene.run.duration;
+    promise::shortfalls(&accuracy(scene, omega, span), fixed_steps(scene, span))
+}
+
+/// The steps a fixed-step method takes over `span`; `None` for adaptive methods.
+fn fixed_steps(scene: &Scene, span: f64) -> Option<promise::FixedSteps> {
+    let m = &scene.run.method;
+    (!m.method.is_adaptive()).then(|| promise::FixedSteps {
+        steps: (span / m.step).ceil(),
+        sample_interval: scene.run.sample_interval(),
+    })
+}
+
+/// How `scene` is integrated, as `verify` will derive its tolerances from it (format.md: Tolerances), over
+/// `span` with rates up to `max_omega`.
+#[must_use]
+pub fn accuracy(scene: &Scene, max_omega: f64, span: f64) -> RunAccuracy {
     let m = &scene.run.method;
     let p = &scene.params;
-    let accuracy = RunAccuracy {
+    RunAccuracy {
         integrator: m.method,
         rtol: m.rtol,
         atol: m.atol,
@@ -587,8 +618,7 @@ fn energy_tolerance(scene: &Scene, max_omega: f64, span: f64) -> f64 {
         time_unit: p.time_unit(),
         span,
         max_omega,
-    };
-    Tolerances::derive(&accuracy, None, None).energy
+    }
 }
 
 /// How the integration ended, as the file records it: termination, its time, and the failure if any.
@@ -603,7 +633,8 @@ fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Fai
             let t = match e {
                 integrate::StepError::NonFinite { t }
                 | integrate::StepError::StepSizeUnderflow { t, .. }
-                | integrate::StepError::NewtonFailure { t, .. } => *t,
+                | integrate::StepError::NewtonFailure { t, .. }
+                | integrate::StepError::BudgetSpent { t, .. } => *t,
             };
             (termination, t, Some(Failure::Step(e.clone())))
         }
@@ -628,11 +659,23 @@ fn integrate_into<W: Write + Seek, T: Tap>(
     let mut pending: Option<(f64, [f64; STATE_LEN], Option<f64>)> = None;
     let mut error: Option<SampleError> = None;
     let mut observed: u64 = 0;
+    // Fixed-step runs were refused up front beyond the budget (scene::limits); counting their steps again
+    // would only trip on the final partial step.
+    let bounds = Bounds {
+        max_steps: scene
+            .run
+            .method
+            .method
+            .is_adaptive()
+            .then_some(scene.run.max_steps),
+        stop: Some(stop),
+    };
     let outcome = run_dynamics(
         &scene.run.method,
         &dynamics,
         &scene.initial,
         &settings,
+        &bounds,
         scene.run.flat_margin,
         scene.friction,
         |t, y, work| {
@@ -735,9 +778,9 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     fn finish(
         self,
         stats: integrate::Stats,
-        termination: Termination,
-        termination_time: f64,
+        (termination, termination_time): (Termination, f64),
         failure: Option<Failure>,
+        shortfalls: Vec<Shortfall>,
     ) -> Result<RecordSummary, RecordError> {
         let Self {
             mut out,
@@ -754,6 +797,8 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 termination,
                 termination_time,
                 termination_alpha: drift.termination_alpha(),
+                expected_to_fail: (!shortfalls.is_empty())
+                    .then(|| promise::check_list(&shortfalls)),
             }
             .to_map(),
         )?;
@@ -775,6 +820,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             event_doubt: None,
             dissipated_work: drift.last_work,
             termination_alpha: drift.termination_alpha(),
+            shortfalls,
         })
     }
 }

@@ -1,6 +1,7 @@
 //! How a recording ended and what it cost: the numbers of the end-of-run summary.
 
 use crate::format::messages::NonFiniteField;
+use crate::format::promise::Shortfall;
 use crate::format::{Termination, TimeError};
 use crate::integrate::{Stats, StepError};
 use serde::{Serialize, Serializer};
@@ -85,6 +86,15 @@ pub struct RecordSummary {
     pub dissipated_work: Option<f64>,
     /// With dissipation: α = π/2 − |θ| at the last sample, how flat the coin was when the run ended.
     pub termination_alpha: Option<f64>,
+    /// The checks `verify` is expected to fail with its default tolerances, and why
+    /// ([`crate::format::promise`]); serialized as `expected_to_fail`, the check ids. Empty: `verify` is
+    /// expected to accept the file.
+    #[serde(rename = "expected_to_fail", serialize_with = "check_ids")]
+    pub shortfalls: Vec<Shortfall>,
+}
+
+fn check_ids<S: Serializer>(shortfalls: &[Shortfall], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(shortfalls.iter().flat_map(|f| f.checks.iter()))
 }
 
 /// [`Stats`]'s fields, for the summary's JSON (the stepper crate knows no serde).

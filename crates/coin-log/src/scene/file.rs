@@ -155,6 +155,9 @@ pub struct RunFile {
     /// Step (fixed-step methods) \[time\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f64>,
+    /// Most integrator steps (format.md: Limits).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_steps: Option<u64>,
     /// The run ends at |θ| ≥ π/2 − flat_margin \[rad\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flat_margin: Option<f64>,

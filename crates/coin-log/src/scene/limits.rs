@@ -40,6 +40,10 @@ pub const STEP_MAX_PRODUCT: f64 = 0.177_827_941_003_892_3; // 1e-3^(1/4)
 /// ≈ 5.6 steps per radian this is ≥ 5.6e10 steps, hours of work; beyond it a run (for instance with
 /// ω = 1e100) would not reach its next sample, so neither its progress nor Ctrl-C would ever be seen.
 pub const MAX_RADIANS: f64 = 1e10;
+/// Shortest duration: the log-time resolution, 1 ns (log_time = round(t·10⁹)). A shorter run's first and
+/// last samples would share a log time (or stand 1 ns apart after rounding only by luck), which
+/// `integrity` refuses; `--duration 5e-324` also left the integrator no step to take.
+pub const MIN_DURATION: f64 = 1e-9;
 /// Unit roundoff 2⁻⁵³.
 const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
@@ -226,6 +230,63 @@ pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Probl
     }
 }
 
+/// The duration against the 1 ns log-time base: at least [`MIN_DURATION`], and short enough for its log
+/// time to fit in 64 bits.
+pub(super) fn check_duration(duration: f64, problems: &mut ProblemCollector) {
+    if duration < MIN_DURATION {
+        problems.push(
+            "run.duration",
+            number(duration),
+            "is below 1e-9, the log-time resolution (log times are whole nanoseconds, round(t·1e9), so the first and last samples would share one): use duration ≥ 1e-9",
+        );
+    } else if crate::format::log_time(duration).is_err() {
+        problems.push(
+            "run.duration",
+            number(duration),
+            "is too long: log times must fit in 64-bit nanoseconds (duration < 1.8e10)",
+        );
+    }
+}
+
+/// The work of a fixed-step run, known before it starts: its step must advance time at t = duration (the
+/// largest t of the run, where floating point is coarsest), and it takes duration/step ≤ `run.max_steps`
+/// steps. (An adaptive run spends its budget as it goes: the driver stops it.)
+fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCollector) {
+    let run = &scene.run;
+    let (h, duration) = (run.method.step, run.duration);
+    let shown = number(given.unwrap_or(h));
+    #[allow(clippy::float_cmp)] // exactly the question: does t + h round back to t?
+    let stuck = duration + h == duration;
+    // The same relative slack as the step's fitting to the sample grid: 0.001/1e-10 is 1e7 steps, not 1e7 + 1.
+    let steps = (duration / h * (1.0 - 1e-12)).ceil();
+    #[allow(clippy::cast_precision_loss)]
+    let max = run.max_steps as f64;
+    if stuck {
+        problems.push(
+            "run.step",
+            shown,
+            format!(
+                "cannot advance time: t + step rounds back to t at t = duration = {} (the spacing of doubles there is {}), so the run would never end; use step ≥ {}",
+                number(duration),
+                short(duration * f64::EPSILON, Round::Nearest),
+                short((duration / max).max(duration * f64::EPSILON), Round::Up)
+            ),
+        );
+    } else if steps > max {
+        problems.push(
+            "run.step",
+            shown,
+            format!(
+                "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
+                power_of_ten(steps.log10()),
+                number(duration),
+                run.max_steps,
+                short(duration / max, Round::Up)
+            ),
+        );
+    }
+}
+
 /// The sample rate against the 1 ns log-time base ([`max_rate`]).
 pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollector) {
     if !(rate.is_finite() && rate > 0.0 && duration.is_finite() && duration > 0.0) {
@@ -270,7 +331,10 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     let w = fastest_rate(&scene.params, &scene.initial);
     if run.method.method.is_adaptive() {
         check_atol(scene, problems);
-    } else if run.method.step * w > STEP_MAX_PRODUCT {
+    } else {
+        check_fixed_work(scene, file.run.as_ref().and_then(|r| r.step), problems);
+    }
+    if !run.method.method.is_adaptive() && run.method.step * w > STEP_MAX_PRODUCT {
         let given = file.run.as_ref().and_then(|r| r.step);
         let used = if given.is_some_and(|h| h != run.method.step) {
             format!(

@@ -108,6 +108,8 @@ pub struct FlagOverrides {
     pub atol: Option<f64>,
     /// `--step` → `run.step`.
     pub step: Option<f64>,
+    /// `--max-steps` → `run.max_steps`.
+    pub max_steps: Option<u64>,
     /// `--channels` → `record.channels`.
     pub channels: Option<Vec<String>>,
     /// `--rerun` → `record.rerun = true`.
@@ -137,6 +139,10 @@ impl FlagOverrides {
         set(&mut run.rtol, self.rtol, "run.rtol", "--rtol");
         set(&mut run.atol, self.atol, "run.atol", "--atol");
         set(&mut run.step, self.step, "run.step", "--step");
+        if let Some(n) = self.max_steps {
+            run.max_steps = Some(n);
+            provenance.push(("run.max_steps", "--max-steps"));
+        }
         if let Some(name) = &self.integrator {
             run.integrator = Some(name.clone());
             provenance.push(("run.integrator", "--integrator"));

@@ -705,12 +705,8 @@ fn check_run(
     let before = problems.list.len();
     let duration = match run.duration {
         Some(d) => {
-            if problems.positive("run.duration", d) && crate::format::log_time(d).is_err() {
-                problems.push(
-                    "run.duration",
-                    number(d),
-                    "is too long: log times must fit in 64-bit nanoseconds (duration < 1.8e10)",
-                );
+            if problems.positive("run.duration", d) {
+                limits::check_duration(d, problems);
             }
             d
         }
@@ -759,6 +755,14 @@ fn check_run(
     problems.positive("run.atol", atol);
     let step = run.step.unwrap_or(defaults::STEP);
     problems.positive("run.step", step);
+    let max_steps = run.max_steps.unwrap_or(defaults::MAX_STEPS);
+    if max_steps == 0 {
+        problems.push(
+            "run.max_steps",
+            "0".to_string(),
+            "is not positive: give the most integrator steps the run may take, e.g. max_steps = 100_000_000",
+        );
+    }
     if !margin_ok {
         problems.push(
             "run.flat_margin",
@@ -775,6 +779,7 @@ fn check_run(
         rate,
         method: used_settings(method, rtol, atol, step, rate),
         flat_margin,
+        max_steps,
     })
 }
 
@@ -955,6 +960,8 @@ fn run_file(run: &RunConfig) -> RunFile {
         rtol: adaptive.then_some(m.rtol),
         atol: adaptive.then_some(m.atol),
         step: (!adaptive).then_some(m.step),
+        // Only when not the default, so that the stored scene of every earlier file is unchanged.
+        max_steps: (run.max_steps != defaults::MAX_STEPS).then_some(run.max_steps),
         flat_margin: Some(run.flat_margin),
     }
 }

@@ -1,0 +1,270 @@
+//! `record` promises only what `verify` will accept. For the accepted corners of every integrator (the
+//! loosest and tightest rtol/atol, the largest and smallest fixed steps within the limits, the lowest and
+//! highest rates) `record`'s word, its warnings before the run, and the `expected_to_fail` of its
+//! summary and metadata, is checked against `verify`'s verdict with its default tolerances: a run
+//! promised to verify verifies, every check that fails was named in advance, and a file verify cannot
+//! judge was warned about. Before, `--rtol 1e-3 --atol 1e-3`, dopri5 at 1e-3, `rk4 --step 0.11 --rate 1`
+//! and 1e8 steps of rk4 recorded without a word and failed verify. The table is printed.
+// Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use crate::support::record::{coin_log, read_back};
+use coin_log::format::{ResultMetadata, RESULT_METADATA_NAME};
+use coin_log::scene::limits::max_rate;
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// The largest step `record` accepts for `integrator` on `wobble` (at rate 1/step), read from the refusal
+/// of a step of 1: "use step ≤ H".
+fn largest_step(dir: &Path, integrator: &str) -> String {
+    let out = coin_log(
+        dir,
+        &[
+            "record",
+            "wobble",
+            "--dry-run",
+            "--integrator",
+            integrator,
+            "--step",
+            "1",
+            "--rate",
+            "1",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    let (_, tail) = err
+        .split_once("use step ≤ ")
+        .expect("the refusal names the largest step");
+    tail.split_whitespace().next().unwrap().to_string()
+}
+
+/// What record said and verify found for one corner.
+struct Row {
+    case: String,
+    cannot_judge_warned: bool,
+    expected: BTreeSet<String>,
+    verify_code: i32,
+    failed: BTreeSet<String>,
+}
+
+impl Row {
+    fn promised(&self) -> bool {
+        !self.cannot_judge_warned && self.expected.is_empty()
+    }
+
+    fn word(&self) -> String {
+        match (self.cannot_judge_warned, self.expected.is_empty()) {
+            (false, true) => "verifies".into(),
+            (true, true) => "cannot be judged".into(),
+            (judge, false) => format!(
+                "fails {}{}",
+                self.expected.iter().cloned().collect::<Vec<_>>().join(","),
+                if judge { " (and cannot be judged)" } else { "" }
+            ),
+        }
+    }
+
+    fn verdict(&self) -> String {
+        match (self.verify_code, self.failed.is_empty()) {
+            (0, _) => "pass".into(),
+            (_, true) => "cannot verify".into(),
+            (_, false) => format!(
+                "fail {}",
+                self.failed.iter().cloned().collect::<Vec<_>>().join(",")
+            ),
+        }
+    }
+
+    fn agreement(&self) -> &'static str {
+        match (self.promised(), self.verify_code == 0) {
+            (true, true) | (false, false) => "agree",
+            (false, true) => "warned, passed",
+            (true, false) => "BROKEN PROMISE",
+        }
+    }
+}
+
+/// Records `wobble` with `flags` in `dir`, then verifies it.
+fn corner(dir: &Path, case: String, flags: &[String]) -> Row {
+    let mut args: Vec<String> = ["record", "wobble", "-o", "c.mcap", "--overwrite", "--json"]
+        .map(String::from)
+        .to_vec();
+    args.extend_from_slice(flags);
+    let out = coin_log(dir, &args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(0), "{case}: {err}");
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let expected: BTreeSet<String> = summary["expected_to_fail"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    // The file is marked as the summary says.
+    let file = read_back(&std::fs::read(dir.join("c.mcap")).unwrap());
+    let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
+    let marked: BTreeSet<String> = result
+        .expected_to_fail
+        .as_deref()
+        .map(|s| s.split(',').map(String::from).collect())
+        .unwrap_or_default();
+    assert_eq!(marked, expected, "{case}: metadata and summary agree");
+    // What the summary expects, the warning before the run said (the same prediction from t = 0).
+    assert_eq!(
+        err.contains("verify is expected to refuse this recording"),
+        !expected.is_empty(),
+        "{case}: {err}"
+    );
+    let verify = coin_log(dir, &["verify", "c.mcap", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
+    let failed = report["files"][0]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["status"] == "fail")
+        .map(|c| c["id"].as_str().unwrap().to_string())
+        .collect();
+    Row {
+        case,
+        cannot_judge_warned: err.contains("verify will not be able to judge this recording"),
+        expected,
+        verify_code: verify.status.code().unwrap(),
+        failed,
+    }
+}
+
+#[test]
+fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |words: &[&str]| words.iter().map(|w| (*w).to_string()).collect::<Vec<_>>();
+    let fast = max_rate(1e-3).floor().to_string();
+    let few = "omega,angles,position,energy,invariants";
+    let mut rows = Vec::new();
+    for integrator in ["dop853", "dopri5"] {
+        let i = |rest: &[&str]| [s(&["--integrator", integrator]), s(rest)].concat();
+        for (case, flags) in [
+            (
+                "loosest rtol and atol",
+                i(&["--rtol", "1e-3", "--atol", "1e-3"]),
+            ),
+            ("loosest rtol", i(&["--rtol", "1e-3"])),
+            (
+                "tightest rtol and atol",
+                i(&["--rtol", "2.221e-15", "--atol", "1e-16"]),
+            ),
+            ("rtol 1e-6", i(&["--rtol", "1e-6", "--atol", "1e-9"])),
+            ("defaults", i(&[])),
+            ("lowest rate 0.1", i(&["--rate", "0.1"])),
+            (
+                "highest rate",
+                i(&["--duration", "1e-3", "--rate", &fast, "--channels", few]),
+            ),
+        ] {
+            rows.push(corner(d, format!("{integrator}: {case}"), &flags));
+        }
+    }
+    for integrator in ["rk4", "gauss4"] {
+        let largest = largest_step(d, integrator);
+        let per_step = (1.0 / largest.parse::<f64>().unwrap()).to_string();
+        let i = |rest: &[&str]| [s(&["--integrator", integrator]), s(rest)].concat();
+        let mut cases = vec![
+            (
+                format!("largest step {largest}"),
+                i(&["--step", &largest, "--rate", &per_step]),
+            ),
+            (
+                "step 0.11 at rate 1".to_string(),
+                i(&["--step", "0.11", "--rate", "1"]),
+            ),
+            ("defaults".to_string(), i(&[])),
+            // 1e7 steps under a budget lowered to them; rk4 also at the default budget (1e8 steps) below.
+            (
+                "smallest step under budget 1e7".to_string(),
+                i(&[
+                    "--step",
+                    "1e-7",
+                    "--duration",
+                    "1",
+                    "--max-steps",
+                    "10000000",
+                ]),
+            ),
+            ("lowest rate 0.1".to_string(), i(&["--rate", "0.1"])),
+            (
+                "highest rate".to_string(),
+                i(&["--duration", "1e-3", "--rate", &fast, "--channels", few]),
+            ),
+        ];
+        if integrator == "rk4" {
+            cases.push((
+                "smallest step (1e8 steps)".to_string(),
+                i(&["--step", "1e-10", "--duration", "0.01"]),
+            ));
+        }
+        for (case, flags) in cases {
+            rows.push(corner(d, format!("{integrator}: {case}"), &flags));
+        }
+    }
+    println!(
+        "{:<40} {:<52} {:<44} {}",
+        "integrator: corner", "record's word", "verify's verdict", "agreement"
+    );
+    for r in &rows {
+        println!(
+            "{:<40} {:<52} {:<44} {}",
+            r.case,
+            r.word(),
+            r.verdict(),
+            r.agreement()
+        );
+    }
+    for r in &rows {
+        assert_ne!(
+            r.agreement(),
+            "BROKEN PROMISE",
+            "{}: {} / {}",
+            r.case,
+            r.word(),
+            r.verdict()
+        );
+        assert!(
+            r.failed.is_subset(&r.expected),
+            "{}: verify failed {:?}, record expected {:?}",
+            r.case,
+            r.failed,
+            r.expected
+        );
+        if r.verify_code != 0 && r.failed.is_empty() {
+            assert!(
+                r.cannot_judge_warned,
+                "{}: cannot verify, not warned",
+                r.case
+            );
+        }
+    }
+    // The negative control: the cases are among the warned, and the defaults among the promised.
+    for case in [
+        "dop853: loosest rtol and atol",
+        "dopri5: loosest rtol",
+        "rk4: step 0.11 at rate 1",
+        "rk4: smallest step (1e8 steps)",
+    ] {
+        let r = rows.iter().find(|r| r.case == case).unwrap();
+        assert!(
+            !r.expected.is_empty() && r.verify_code != 0,
+            "{case}: {} / {}",
+            r.word(),
+            r.verdict()
+        );
+    }
+    for case in ["dop853: defaults", "rk4: defaults", "gauss4: defaults"] {
+        let r = rows.iter().find(|r| r.case == case).unwrap();
+        assert!(
+            r.promised() && r.verify_code == 0,
+            "{case}: {} / {}",
+            r.word(),
+            r.verdict()
+        );
+    }
+}
