@@ -66,9 +66,9 @@ mod protobuf_readers;
 mod read_budget;
 mod readme;
 mod record_roundtrip;
+mod record_verify_agreement;
 #[cfg(feature = "external-readers")]
 mod rerun_geometry;
-mod record_verify_agreement;
 mod rk4_order;
 mod scenes;
 mod second_model;

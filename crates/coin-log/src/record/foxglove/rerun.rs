@@ -221,7 +221,7 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     .encode_raw(buf);
 }
 
-/// The coin's URDF: the disc and its two face marks (those of `/scene`, [`coin_marks`]) in the body frame.
+/// The coin's URDF: the disc and its two face marks (those of `/scene`, `coin_marks`) in the body frame.
 #[must_use]
 pub fn urdf(thickness: f64) -> String {
     let colour = |c: Rgba| format!("{:?} {:?} {:?} {:?}", c[0], c[1], c[2], c[3]);
