@@ -17,7 +17,7 @@ use std::path::Path;
 
 /// One channel of a file (an entry of `info --json`'s `channels`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ChannelSummary {
+pub struct ChannelReport {
     /// Topic.
     pub topic: String,
     /// Schema name (`""` without a schema).
@@ -62,7 +62,7 @@ pub struct FileInfo {
     /// The chunks' records compressed and uncompressed \[bytes\].
     pub chunk_bytes: (u64, u64),
     /// Channels, by id.
-    pub channels: Vec<ChannelSummary>,
+    pub channels: Vec<ChannelReport>,
     /// The `coin-log` record, or why it is missing or unusable.
     pub run: Result<RunMetadata, String>,
     /// The `coin-log.result` record, or why it is missing or unusable.
@@ -198,7 +198,7 @@ struct FileJson<'a> {
     encoding: String,
     compressed_bytes: u64,
     uncompressed_bytes: u64,
-    channels: &'a [ChannelSummary],
+    channels: &'a [ChannelReport],
     body: Option<BodyJson>,
     run: Option<RunJson>,
     result: Option<ResultJson>,
@@ -321,7 +321,7 @@ fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
         channels: s
             .channels
             .iter()
-            .map(|c| ChannelSummary {
+            .map(|c| ChannelReport {
                 topic: c.topic.clone(),
                 schema: c.schema_name.clone(),
                 message_encoding: c.message_encoding.clone(),
@@ -339,7 +339,7 @@ fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
 /// What the streaming pass gathers.
 #[derive(Default)]
 struct Scan {
-    channels: BTreeMap<u16, ChannelSummary>,
+    channels: BTreeMap<u16, ChannelReport>,
     metadata: Vec<(String, BTreeMap<String, String>)>,
     counts: BTreeMap<u16, u64>,
     time_range: Option<(u64, u64)>,
@@ -355,7 +355,7 @@ impl Visitor for Scan {
     ) {
         self.channels.insert(
             id,
-            ChannelSummary {
+            ChannelReport {
                 topic: topic.to_string(),
                 schema: schema.map(|s| s.name.clone()).unwrap_or_default(),
                 message_encoding: message_encoding.to_string(),
