@@ -10,7 +10,7 @@
 
 use crate::support::newton_euler::{Couple, Dissipating, NewtonEuler, NE_LEN};
 use crate::support::physics::{self, rate_unit};
-use crate::support::record::{coin_log_text, read_back};
+use crate::support::record::{coin_log_text, read_back, record_to_memory};
 use crate::support::writers::{nudge, rewrite};
 use coin_log::format::metadata::DISSIPATION_KEYS;
 use coin_log::format::{Channel, RESULT_METADATA_NAME, RUN_METADATA_NAME};
@@ -18,13 +18,11 @@ use coin_log::model::{
     energy, Coin, CoinParams, Dissipation, DissipationModel, DissipativeCoin,
     DISSIPATIVE_STATE_LEN, STATE_LEN, WORK_INDEX,
 };
-use coin_log::record::{record, RecordOptions, RecordSummary};
+use coin_log::record::RecordOptions;
 use coin_log::scene::{self, presets, Scene, SceneError};
 use coin_log::verify::{verify_bytes, verify_file, CheckId, FileReport, Options, Status};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
-use std::io::Cursor;
-use std::sync::atomic::AtomicBool;
 
 /// Round-off bound of dE/dt + P relative to the largest term of the sum (O(10) operations: 1e-13).
 const ROUND_OFF: f64 = 1e-13;
@@ -133,20 +131,6 @@ fn preset(name: &str, sets: &[&str]) -> Scene {
     Scene::from_file(&file).unwrap()
 }
 
-/// Records `scene` into memory with the library's recorder.
-fn record_in_memory(scene: &Scene) -> (Vec<u8>, RecordSummary) {
-    let mut out = Cursor::new(Vec::new());
-    let summary = record(
-        scene,
-        &RecordOptions::default(),
-        &mut out,
-        &AtomicBool::new(false),
-        |_| {},
-    )
-    .unwrap();
-    (out.into_inner(), summary)
-}
-
 /// (t, JSON) of every message on `topic`.
 fn messages(bytes: &[u8], topic: &str) -> Vec<serde_json::Value> {
     read_back(bytes)
@@ -175,7 +159,7 @@ fn show(r: &FileReport) -> String {
 /// Max |θ_recording − θ_Newton–Euler| and |W_recording − W_Newton–Euler| / E₀ over the samples of a
 /// recording of `scene` (rate 10), the Newton–Euler model integrated by rk4 at 400 steps per sample.
 fn disagreement_with_newton_euler(scene: &Scene, couple: Couple) -> (f64, f64) {
-    let (bytes, summary) = record_in_memory(scene);
+    let (bytes, summary) = record_to_memory(scene, &RecordOptions::default());
     assert!(summary.failure.is_none());
     let angles = messages(&bytes, "/coin/angles");
     let work = messages(&bytes, "/coin/work");
@@ -283,7 +267,7 @@ fn euler_disk_keeps_e_plus_w_to_1e_10_and_verifies() {
         "euler-disk",
         &["record.channels=[\"omega\", \"angles\", \"position\", \"work\"]"],
     );
-    let (bytes, summary) = record_in_memory(&scene);
+    let (bytes, summary) = record_to_memory(&scene, &RecordOptions::default());
     println!("{summary:?}");
     physics::check(
         "max |E + W - E0| / max(|E0|, Mga)",
@@ -366,7 +350,7 @@ fn with_friction_the_run_ends_at_a_located_slip() {
             "record.channels=[\"angles\", \"reaction\", \"work\"]",
         ],
     );
-    let (bytes, summary) = record_in_memory(&scene);
+    let (bytes, summary) = record_to_memory(&scene, &RecordOptions::default());
     assert_eq!(summary.termination.name(), "slip");
     let last = messages(&bytes, "/coin/reaction").pop().unwrap();
     let (f, n) = (
@@ -483,7 +467,10 @@ fn the_work_channel_needs_dissipation_and_is_recorded_by_default_with_it() {
 /// its resolved scene reads back to the same law.
 #[test]
 fn dissipation_metadata_is_written_only_with_dissipation() {
-    let (bytes, _) = record_in_memory(&preset("wobble", &["run.duration=1"]));
+    let (bytes, _) = record_to_memory(
+        &preset("wobble", &["run.duration=1"]),
+        &RecordOptions::default(),
+    );
     let run = &read_back(&bytes).metadata[RUN_METADATA_NAME].1;
     for key in DISSIPATION_KEYS {
         assert!(!run.contains_key(key), "{key} in a conservative file");
@@ -498,7 +485,7 @@ fn dissipation_metadata_is_written_only_with_dissipation() {
             "body.dissipation={ model = \"power-law\", coefficient = 1e-9, m = 1.5, k = -0.25 }",
         ],
     );
-    let (bytes, _) = record_in_memory(&scene);
+    let (bytes, _) = record_to_memory(&scene, &RecordOptions::default());
     let run = &read_back(&bytes).metadata[RUN_METADATA_NAME].1;
     assert_eq!(run["dissipation"], "power-law");
     assert_eq!(run["dissipation_m"], "1.5");

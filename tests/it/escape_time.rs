@@ -8,16 +8,15 @@
 // Helpers outside #[test] functions unwrap too: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used)]
 
+use crate::support::record::record_to_memory;
 use coin_log::analyse::Analysis;
 use coin_log::format::Termination;
 use coin_log::integrate::{run_method, Flow, RunEnd, RunSettings};
-use coin_log::record::{record, RecordOptions, RecordSummary};
+use coin_log::record::RecordOptions;
 use coin_log::scene::{self, presets, Scene};
 use coin_log::simulation::CoinEvents;
 use coin_log::verify::{verify_bytes, Options};
 use std::f64::consts::PI;
-use std::io::Cursor;
-use std::sync::atomic::AtomicBool;
 
 /// The decades k of θ₀ = 10^-k.
 const DECADES: [i32; 8] = [3, 6, 12, 25, 50, 100, 200, 300];
@@ -54,19 +53,6 @@ fn claimed_error(scene: &Scene, t: f64) -> f64 {
     100.0 * m.rtol.max(m.atol / scene.params.radius()) * (1.0 + t / tau) * tau
 }
 
-fn record_in_memory(scene: &Scene) -> (Vec<u8>, RecordSummary) {
-    let mut out = Cursor::new(Vec::new());
-    let summary = record(
-        scene,
-        &RecordOptions::default(),
-        &mut out,
-        &AtomicBool::new(false),
-        |_| {},
-    )
-    .unwrap();
-    (out.into_inner(), summary)
-}
-
 #[test]
 fn lift_off_from_near_upright_follows_the_ln_law_is_trusted_verifies_and_analyse_predicts_it() {
     let mut times = Vec::new();
@@ -74,7 +60,7 @@ fn lift_off_from_near_upright_follows_the_ln_law_is_trusted_verifies_and_analyse
     for k in DECADES {
         let scene = released(k);
         let theta0 = scene.initial.theta;
-        let (bytes, summary) = record_in_memory(&scene);
+        let (bytes, summary) = record_to_memory(&scene, &RecordOptions::default());
         assert_eq!(summary.termination, Termination::LiftOff, "θ₀ = {theta0:e}");
         let t = summary.termination_time;
         let analysis = Analysis::of_scene(&scene).unwrap();
@@ -166,7 +152,7 @@ fn negative_control_the_absolute_tolerance_alone_misses_the_ln_law() {
 fn a_subnormal_departure_gives_an_event_marked_untrusted_with_the_reason() {
     for k in [310, 320] {
         let scene = released(k);
-        let (_, summary) = record_in_memory(&scene);
+        let (_, summary) = record_to_memory(&scene, &RecordOptions::default());
         let law = law(&scene, scene.initial.theta);
         println!(
             "θ₀ = 1e-{k}: recorded {} ({:?}), the ln law {law}",

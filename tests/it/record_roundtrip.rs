@@ -3,7 +3,7 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use crate::support::record::{read_back, schema_file, validate_flat, ReadBack};
+use crate::support::record::{read_back, record_to_memory, schema_file, validate_flat, ReadBack};
 use crate::support::writers::{message_json_with, COIN_CHANNELS};
 use crate::support::FailingWriter;
 use coin_log::format::{
@@ -36,14 +36,6 @@ fn preset_scene(name: &str, flags: FlagOverrides) -> Scene {
         ..flags
     };
     scene::resolve(&file, &flags).unwrap_or_else(|e| panic!("{name}: {e}"))
-}
-
-fn record_to_memory(scene: &Scene, options: &RecordOptions) -> (Vec<u8>, RecordSummary) {
-    let mut cursor = Cursor::new(Vec::new());
-    let stop = AtomicBool::new(false);
-    let summary =
-        record::record(scene, options, &mut cursor, &stop, |_| {}).expect("recording succeeds");
-    (cursor.into_inner(), summary)
 }
 
 /// The samples of a scene's run, (t, y, W), integrated here with the library's integrator on the scene's

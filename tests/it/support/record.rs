@@ -5,11 +5,25 @@
 
 use super::process::run_within;
 use super::repo;
+use coin_log::record::{self, RecordOptions, RecordSummary};
+use coin_log::scene::Scene;
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
+use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::atomic::AtomicBool;
 use std::time::Duration;
+
+/// Records `scene` with `options` into memory with the library's recorder: the file's bytes and the
+/// summary.
+pub fn record_to_memory(scene: &Scene, options: &RecordOptions) -> (Vec<u8>, RecordSummary) {
+    let mut cursor = Cursor::new(Vec::new());
+    let stop = AtomicBool::new(false);
+    let summary =
+        record::record(scene, options, &mut cursor, &stop, |_| {}).expect("recording succeeds");
+    (cursor.into_inner(), summary)
+}
 
 /// One message as read back.
 #[derive(Debug, Clone)]
