@@ -19,7 +19,7 @@
 //! (below); `tests/it/record_verify_agreement.rs` sweeps the corners of every integrator and checks that no
 //! run predicted to pass fails.
 
-use super::tolerances::{RunAccuracy, Tolerances};
+use super::tolerances::{RunAccuracy, Tolerances, UNIT_ROUNDOFF};
 use std::fmt;
 
 /// Share of ε (1 + T/τ) reached by the energy drift, the invariant drift and the constraint residual.
@@ -40,9 +40,6 @@ pub const ROUNDING_SHARE: f64 = 5e-4;
 /// apart, over 1e-3 time units): rk4 and gauss4 fail `constraint`, whose floor 1e-10 this puts below
 /// 2.08·2⁻⁵³/(1e-9·1.54) = 1.5e-7, while dop853 and dopri5 pass.
 pub const DIFFERENCE_GAIN: f64 = 2.08;
-
-/// Unit roundoff 2⁻⁵³.
-const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
 /// Why a check is expected to fail.
 #[derive(Debug, Clone, Copy, PartialEq)]

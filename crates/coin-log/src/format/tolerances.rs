@@ -28,6 +28,9 @@
 
 use crate::integrate::Method;
 
+/// Unit roundoff of f64, 2⁻⁵³: what one rounding costs, relative (the limits of a scene, the rounding
+/// `record` predicts).
+pub const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 /// Contract ceiling of the energy drift tolerance.
 pub const ENERGY_CEILING: f64 = 1e-6;
 /// Contract ceiling of the constraint (and steady) residual tolerance.

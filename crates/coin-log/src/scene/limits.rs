@@ -7,6 +7,7 @@
 use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
+use crate::format::tolerances::UNIT_ROUNDOFF;
 use crate::integrate::Method;
 use crate::model::{energy, reaction, CoinParams, Inertia, State};
 
@@ -44,8 +45,6 @@ pub const MAX_RADIANS: f64 = 1e10;
 /// last samples would share a log time (or stand 1 ns apart after rounding only by luck), which
 /// `integrity` refuses; `--duration 5e-324` also left the integrator no step to take.
 pub const MIN_DURATION: f64 = 1e-9;
-/// Unit roundoff 2⁻⁵³.
-const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
 /// The highest rate whose samples get strictly increasing log times (round(t·10⁹) ns) over `duration`.
 ///
