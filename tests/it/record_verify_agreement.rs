@@ -11,6 +11,7 @@
 use crate::support::record::{coin_log, read_back};
 use coin_log::format::{ResultMetadata, RESULT_METADATA_NAME};
 use coin_log::scene::limits::max_rate;
+use coin_log::verify::CheckId;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -100,6 +101,13 @@ fn corner(dir: &Path, case: String, flags: &[String]) -> Row {
         .iter()
         .map(|c| c.as_str().unwrap().to_string())
         .collect();
+    // Each is one of verify's check ids (format::promise spells them; verify declares them).
+    for id in &expected {
+        assert!(
+            id.parse::<CheckId>().is_ok(),
+            "{case}: {id:?} is no check id"
+        );
+    }
     // The file is marked as the summary says.
     let file = read_back(&std::fs::read(dir.join("c.mcap")).unwrap());
     let result = ResultMetadata::from_map(&file.metadata[RESULT_METADATA_NAME].1).unwrap();
