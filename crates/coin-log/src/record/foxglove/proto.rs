@@ -72,11 +72,12 @@ fn color(c: Rgba) -> Option<Color> {
     })
 }
 
-fn identity() -> Option<Pose> {
-    Some(Pose {
+/// The pose of a frame's own origin, unrotated.
+pub(super) fn identity() -> Pose {
+    Pose {
         position: vector3(0.0, 0.0, 0.0),
         orientation: quaternion(&UnitQuaternion::identity()),
-    })
+    }
 }
 
 pub(super) fn transform(
@@ -278,7 +279,7 @@ pub(super) fn track(
     let mut e = entity(log_time, WORLD_FRAME, "track");
     e.lines.push(LinePrimitive {
         r#type: line_primitive::Type::LineStrip as i32,
-        pose: identity(),
+        pose: Some(identity()),
         thickness: TRACK_WIDTH,
         scale_invariant: true,
         points: line,

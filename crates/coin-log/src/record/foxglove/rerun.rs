@@ -15,7 +15,7 @@
 //!   contact at that time). Rerun shows a point cloud at its time only: its blueprint
 //!   (`scripts/rerun_blueprint.py`) shows every message from t = 0 to the cursor, which draws the whole track.
 
-use super::proto::{timestamp, transform};
+use super::proto::{identity, timestamp, transform};
 use super::{
     coin_marks, Rgba, COIN_RGBA, FOLLOW_FRAME, TABLE_HALF_SIDE, TABLE_RGBA, TABLE_THICKNESS,
     TABLE_TOP, TRACK_RGBA, WORLD_FRAME,
@@ -24,7 +24,7 @@ use super::{FoxgloveBatch, Topic};
 use crate::format::messages::NonFiniteField;
 use crate::format::Channel;
 use foxglove::messages::packed_element_field::NumericType;
-use foxglove::messages::{PackedElementField, PointCloud, Pose, Quaternion, Vector3, VoxelGrid};
+use foxglove::messages::{PackedElementField, PointCloud, Pose, Vector3, VoxelGrid};
 use nalgebra::UnitQuaternion;
 use prost::Message;
 
@@ -154,16 +154,6 @@ impl Rerun3d {
             .encode_raw(buf);
             Ok(())
         })
-    }
-}
-
-fn identity() -> Pose {
-    Pose {
-        position: Some(Vector3::default()),
-        orientation: Some(Quaternion {
-            w: 1.0,
-            ..Quaternion::default()
-        }),
     }
 }
 
