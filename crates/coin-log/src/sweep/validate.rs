@@ -7,10 +7,11 @@ use super::definition::{Axis, Draw, Random, Settings, Sweep, CHANNELS_KEY, MAX_R
 use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
 use super::random::Distribution;
 use super::space::{linspace, logspace};
-use crate::format::{Channel, Encoding};
+use crate::format::Channel;
 use crate::scene::{self, presets, Problem, SceneProblems};
-use coin_log_mcap::Compression;
+use std::fmt::Display;
 use std::path::Path;
+use std::str::FromStr;
 
 /// Values of a `values` axis or `choice` draw checked against the scene's types before running (the
 /// rest are checked by their runs).
@@ -79,6 +80,20 @@ fn whole(v: &toml::Value) -> Option<u64> {
         toml::Value::Float(x) if x.fract() == 0.0 && (0.0..9e15).contains(x) => Some(*x as u64),
         _ => None,
     }
+}
+
+/// A list the file gives, or the empty list.
+fn spec(values: Option<&Vec<toml::Value>>) -> &[toml::Value] {
+    values.map_or(&[], Vec::as_slice)
+}
+
+/// An axis's forms, each with whether it is given.
+fn axis_forms(a: &AxisFile) -> [(&'static str, bool); 3] {
+    [
+        ("values", a.values.is_some()),
+        ("linspace", a.linspace.is_some()),
+        ("logspace", a.logspace.is_some()),
+    ]
 }
 
 fn array_text(values: &[toml::Value]) -> String {
@@ -176,15 +191,49 @@ impl Checker {
         edits
     }
 
-    fn axis(&mut self, i: usize, a: &AxisFile) -> Option<Axis> {
-        let name = format!("axis[{i}]");
-        if !dotted(&a.key) {
+    /// Notes `{name}.key` unless `key` is dotted like `example`.
+    fn key(&mut self, name: &str, key: &str, example: &str) {
+        if !dotted(key) {
             self.problem(
                 format!("{name}.key"),
-                format!("\"{}\"", a.key),
-                "is not a dotted scene key like \"initial.theta\"",
+                format!("\"{key}\""),
+                format!("is not a dotted scene key like \"{example}\""),
             );
         }
+    }
+
+    /// The one of `forms` (name, given) that is given at `name`; else notes `none`, or that several are.
+    fn form(
+        &mut self,
+        name: &str,
+        forms: &[(&'static str, bool)],
+        none: &str,
+        one: &str,
+    ) -> Option<&'static str> {
+        let given: Vec<&str> = forms
+            .iter()
+            .filter_map(|&(n, on)| on.then_some(n))
+            .collect();
+        match given.as_slice() {
+            [form] => Some(form),
+            [] => {
+                self.problem(name, "", none);
+                None
+            }
+            several => {
+                self.problem(
+                    name,
+                    "",
+                    format!("gives {}: give exactly one {one}", several.join(" and ")),
+                );
+                None
+            }
+        }
+    }
+
+    fn axis(&mut self, i: usize, a: &AxisFile) -> Option<Axis> {
+        let name = format!("axis[{i}]");
+        self.key(&name, &a.key, "initial.theta");
         if a.zip.as_deref().is_some_and(|z| z.trim().is_empty()) {
             self.problem(
                 format!("{name}.zip"),
@@ -192,41 +241,12 @@ impl Checker {
                 "is empty: give the zip group a name",
             );
         }
-        let given: Vec<&str> = [
-            ("values", a.values.is_some()),
-            ("linspace", a.linspace.is_some()),
-            ("logspace", a.logspace.is_some()),
-        ]
-        .into_iter()
-        .filter_map(|(n, on)| on.then_some(n))
-        .collect();
-        let values = match given.as_slice() {
-            ["values"] => self.listed(
-                &format!("{name}.values"),
-                a.values.as_deref().unwrap_or_default(),
-            ),
-            ["linspace"] => self.spaced(
-                &format!("{name}.linspace"),
-                a.linspace.as_deref().unwrap_or_default(),
-                linspace,
-            ),
-            ["logspace"] => self.spaced(
-                &format!("{name}.logspace"),
-                a.logspace.as_deref().unwrap_or_default(),
-                logspace,
-            ),
-            [] => {
-                self.problem(name, "", "has no values: give one of `values = [...]`, `linspace = [first, last, n]` or `logspace = [first_exp, last_exp, n]`");
-                None
-            }
-            several => {
-                self.problem(
-                    name,
-                    "",
-                    format!("gives {}: give exactly one of them", several.join(" and ")),
-                );
-                None
-            }
+        let form = self.form(&name, &axis_forms(a), "has no values: give one of `values = [...]`, `linspace = [first, last, n]` or `logspace = [first_exp, last_exp, n]`", "of them")?;
+        let at = format!("{name}.{form}");
+        let values = match form {
+            "values" => self.listed(&at, spec(a.values.as_ref())),
+            "linspace" => self.spaced(&at, spec(a.linspace.as_ref()), linspace),
+            _ => self.spaced(&at, spec(a.logspace.as_ref()), logspace),
         }?;
         Some(Axis {
             key: a.key.trim().to_string(),
@@ -358,70 +378,27 @@ impl Checker {
 
     fn draw(&mut self, j: usize, d: &DrawFile) -> Option<Draw> {
         let name = format!("random.draw[{j}]");
-        if !dotted(&d.key) {
-            self.problem(
-                format!("{name}.key"),
-                format!("\"{}\"", d.key),
-                "is not a dotted scene key like \"body.friction\"",
-            );
-        }
-        let given: Vec<&str> = [
+        self.key(&name, &d.key, "body.friction");
+        let forms = [
             ("uniform", d.uniform.is_some()),
             ("log_uniform", d.log_uniform.is_some()),
             ("normal", d.normal.is_some()),
             ("choice", d.choice.is_some()),
-        ]
-        .into_iter()
-        .filter_map(|(n, on)| on.then_some(n))
-        .collect();
-        let (distribution, choices) = match given.as_slice() {
-            ["uniform"] => (
-                self.bounds(
-                    &format!("{name}.uniform"),
-                    d.uniform.as_deref().unwrap_or_default(),
-                    false,
-                )?,
-                Vec::new(),
-            ),
-            ["log_uniform"] => (
-                self.bounds(
-                    &format!("{name}.log_uniform"),
-                    d.log_uniform.as_deref().unwrap_or_default(),
-                    true,
-                )?,
-                Vec::new(),
-            ),
-            ["normal"] => (
-                self.normal(&format!("{name}.normal"), d.normal.as_ref()?)?,
-                Vec::new(),
-            ),
-            ["choice"] => {
-                let choices = self.listed(
-                    &format!("{name}.choice"),
-                    d.choice.as_deref().unwrap_or_default(),
-                )?;
-                (Distribution::Choice { len: choices.len() }, choices)
-            }
-            [] => {
-                self.problem(name, "", "has no distribution: give one of `uniform = [lo, hi]`, `log_uniform = [lo, hi]`, `normal = { mean, std, min, max }` or `choice = [...]`");
-                return None;
-            }
-            several => {
-                self.problem(
-                    name,
-                    "",
-                    format!(
-                        "gives {}: give exactly one distribution",
-                        several.join(" and ")
-                    ),
-                );
-                return None;
-            }
-        };
+        ];
+        let form = self.form(&name, &forms, "has no distribution: give one of `uniform = [lo, hi]`, `log_uniform = [lo, hi]`, `normal = { mean, std, min, max }` or `choice = [...]`", "distribution")?;
+        let at = format!("{name}.{form}");
+        let distribution = match form {
+            "uniform" => self.bounds(&at, spec(d.uniform.as_ref()), false),
+            "log_uniform" => self.bounds(&at, spec(d.log_uniform.as_ref()), true),
+            "normal" => self.normal(&at, d.normal.as_ref()?),
+            _ => (self.listed(&at, spec(d.choice.as_ref())))
+                .map(|choices| Distribution::Choice { len: choices.len() }),
+        }?;
         Some(Draw {
             key: d.key.trim().to_string(),
             distribution,
-            choices,
+            // Empty but for a choice draw: only one form is given.
+            choices: d.choice.clone().unwrap_or_default(),
         })
     }
 
@@ -494,24 +471,8 @@ impl Checker {
     }
 
     fn settings(&mut self, o: &OutputFile) -> Settings {
-        let mut named =
-            |key: &str, v: &Option<String>, parse: &dyn Fn(&str) -> Result<(), String>| {
-                if let Some(e) = v.as_deref().and_then(|s| parse(s).err()) {
-                    self.problem(
-                        format!("output.{key}"),
-                        format!("\"{}\"", v.as_deref().unwrap_or_default()),
-                        e,
-                    );
-                }
-            };
-        named("encoding", &o.encoding, &|s| {
-            s.parse::<Encoding>().map(drop).map_err(|e| e.to_string())
-        });
-        named("compression", &o.compression, &|s| {
-            s.parse::<Compression>()
-                .map(drop)
-                .map_err(|e| e.to_string())
-        });
+        let encoding = self.named("encoding", o.encoding.as_deref());
+        let compression = self.named("compression", o.compression.as_deref());
         for c in o.channels.iter().flatten() {
             if let Err(e) = c.trim().parse::<Channel>() {
                 self.problem("output.channels", format!("\"{c}\""), e.to_string());
@@ -522,19 +483,29 @@ impl Checker {
                 .channels
                 .as_ref()
                 .map(|l| l.iter().map(|c| c.trim().to_string()).collect()),
-            encoding: o
-                .encoding
-                .as_deref()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or_default(),
-            compression: o
-                .compression
-                .as_deref()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or_default(),
+            encoding,
+            compression,
             verify: o.verify.unwrap_or(true),
             predict: o.predict.unwrap_or(true),
         }
+    }
+
+    /// `output.{key}` by its name, or (none given, or a wrong name noted) the default.
+    fn named<T: FromStr + Default>(&mut self, key: &str, name: Option<&str>) -> T
+    where
+        T::Err: Display,
+    {
+        let Some(name) = name else {
+            return T::default();
+        };
+        name.parse().unwrap_or_else(|e: T::Err| {
+            self.problem(
+                format!("output.{key}"),
+                format!("\"{name}\""),
+                e.to_string(),
+            );
+            T::default()
+        })
     }
 }
 
@@ -559,13 +530,7 @@ fn places(file: &SweepFile) -> Vec<Place> {
         })
         .collect();
     for (i, a) in file.axis.iter().enumerate() {
-        let form = ["values", "linspace", "logspace"]
-            .into_iter()
-            .zip([
-                a.values.is_some(),
-                a.linspace.is_some(),
-                a.logspace.is_some(),
-            ])
+        let form = (axis_forms(a).into_iter())
             .find_map(|(n, on)| on.then_some(n))
             .unwrap_or("values");
         places.push(Place {
