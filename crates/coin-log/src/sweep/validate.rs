@@ -391,7 +391,8 @@ impl Checker {
             "uniform" => self.bounds(&at, spec(d.uniform.as_ref()), false),
             "log_uniform" => self.bounds(&at, spec(d.log_uniform.as_ref()), true),
             "normal" => self.normal(&at, d.normal.as_ref()?),
-            _ => (self.listed(&at, spec(d.choice.as_ref())))
+            _ => self
+                .listed(&at, spec(d.choice.as_ref()))
                 .map(|choices| Distribution::Choice { len: choices.len() }),
         }?;
         Some(Draw {
@@ -519,39 +520,38 @@ struct Place {
     values_name: String,
 }
 
+impl Place {
+    /// A place whose values are given at `name` itself.
+    fn new(key: &str, name: String) -> Self {
+        Self {
+            key: key.trim().to_string(),
+            values_name: name.clone(),
+            name,
+        }
+    }
+}
+
 fn places(file: &SweepFile) -> Vec<Place> {
     let mut places: Vec<Place> = file
         .set
         .keys()
-        .map(|k| Place {
-            key: k.trim().to_string(),
-            name: format!("set.\"{k}\""),
-            values_name: format!("set.\"{k}\""),
-        })
+        .map(|k| Place::new(k, format!("set.\"{k}\"")))
         .collect();
     for (i, a) in file.axis.iter().enumerate() {
-        let form = (axis_forms(a).into_iter())
+        let form = axis_forms(a)
+            .into_iter()
             .find_map(|(n, on)| on.then_some(n))
             .unwrap_or("values");
         places.push(Place {
-            key: a.key.trim().to_string(),
-            name: format!("axis[{i}]"),
             values_name: format!("axis[{i}].{form}"),
+            ..Place::new(&a.key, format!("axis[{i}]"))
         });
     }
     for (j, d) in file.random.iter().flat_map(|r| r.draw.iter().enumerate()) {
-        places.push(Place {
-            key: d.key.trim().to_string(),
-            name: format!("random.draw[{j}]"),
-            values_name: format!("random.draw[{j}]"),
-        });
+        places.push(Place::new(&d.key, format!("random.draw[{j}]")));
     }
     if file.output.as_ref().is_some_and(|o| o.channels.is_some()) {
-        places.push(Place {
-            key: CHANNELS_KEY.to_string(),
-            name: "output.channels".to_string(),
-            values_name: "output.channels".to_string(),
-        });
+        places.push(Place::new(CHANNELS_KEY, "output.channels".to_string()));
     }
     places
 }
