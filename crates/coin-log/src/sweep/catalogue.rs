@@ -161,39 +161,29 @@ impl Row {
     pub fn fields(&self) -> Vec<String> {
         let r = self.recorded.as_ref();
         let opt = |x: Option<f64>| x.map(number).unwrap_or_default();
-        let verify = match r {
-            None => String::new(),
-            Some(r) => r.verify.map_or("off", verdict_name).to_string(),
-        };
         let p = self.prediction.as_ref();
         let mut fields = vec![self.index.to_string()];
         fields.extend(self.values.iter().cloned());
         fields.extend([
             self.status.name().to_string(),
-            r.map(|r| r.termination.name().to_string())
-                .unwrap_or_default(),
+            text(r.map(|r| r.termination.name())),
             opt(r.map(|r| r.t_end)),
-            verify,
-            self.failure
-                .map(|f| f.name().to_string())
-                .unwrap_or_default(),
+            text(r.map(|r| r.verify.map_or("off", verdict_name))),
+            text(self.failure.map(|f| f.name())),
             one_line(&self.reason),
-            r.map(|r| r.file.clone()).unwrap_or_default(),
-            r.map(|r| r.bytes.to_string()).unwrap_or_default(),
-            r.map(|r| r.sha256.clone()).unwrap_or_default(),
-            r.map(|r| r.samples.to_string()).unwrap_or_default(),
-            r.map(|r| r.messages.to_string()).unwrap_or_default(),
-            r.map(|r| r.steps.to_string()).unwrap_or_default(),
+            text(r.map(|r| &r.file)),
+            text(r.map(|r| r.bytes)),
+            text(r.map(|r| &r.sha256)),
+            text(r.map(|r| r.samples)),
+            text(r.map(|r| r.messages)),
+            text(r.map(|r| r.steps)),
             opt(r.map(|r| r.energy_drift)),
             opt(r.and_then(|r| r.invariant_drift)),
             opt(r.and_then(|r| r.steady_residual)),
-            r.and_then(|r| r.event_trusted)
-                .map(|b| b.to_string())
-                .unwrap_or_default(),
-            p.map(|p| p.motion.to_string()).unwrap_or_default(),
-            p.and_then(|p| p.stability).unwrap_or_default().to_string(),
-            p.map(|p| p.termination.name().to_string())
-                .unwrap_or_default(),
+            text(r.and_then(|r| r.event_trusted)),
+            text(p.map(|p| p.motion)),
+            text(p.and_then(|p| p.stability)),
+            text(p.map(|p| p.termination.name())),
             number(self.wall_time),
         ]);
         fields
@@ -215,6 +205,11 @@ pub fn verdict_name(v: Verdict) -> &'static str {
         Verdict::CannotVerify => "cannot-verify",
         Verdict::Unusable => "unusable",
     }
+}
+
+/// A cell that is empty when there is no value.
+fn text(value: Option<impl ToString>) -> String {
+    value.map(|v| v.to_string()).unwrap_or_default()
 }
 
 /// Line breaks as `; `, so that every row is one line (the journal's unit).

@@ -6,7 +6,6 @@ use super::catalogue::RunStatus;
 use super::error::SweepError;
 use super::folder::{self, Folder};
 use super::hash::sha256_file;
-use super::run::summary_json;
 use crate::csv;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -84,10 +83,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     let written = if problems.is_empty() {
         let lines = rows.values().map(|f| csv::line(&f.fields));
         let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
-        let json = summary_json(&folder.plan, finished, failed, 0);
-        let summary =
-            folder.write_atomically(folder::SWEEP_JSON_FILE, format!("{json}\n").as_bytes())?;
-        Some((catalogue, summary))
+        Some((catalogue, folder.write_summary(finished, failed, 0)?))
     } else {
         None
     };

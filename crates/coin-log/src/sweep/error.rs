@@ -62,6 +62,13 @@ impl SweepError {
         )
     }
 
+    pub(super) fn folder(path: &std::path::Path) -> impl Fn(String) -> Self + '_ {
+        |reason| Self::Folder {
+            path: path.to_path_buf(),
+            reason,
+        }
+    }
+
     pub(super) fn io(
         what: &'static str,
         path: impl Into<PathBuf>,

@@ -102,10 +102,7 @@ impl Folder {
     /// [`SweepError::Folder`] for a file, a folder with other content, another sweep's or another
     /// version's folder; [`SweepError::Io`] when it cannot be created or read.
     pub fn open(path: &Path, sweep: &Sweep) -> Result<Self, SweepError> {
-        let folder_error = |reason: String| SweepError::Folder {
-            path: path.to_path_buf(),
-            reason,
-        };
+        let folder_error = SweepError::folder(path);
         if path.exists() && !path.is_dir() {
             return Err(folder_error(
                 "is not a folder: give -o a folder for the sweep's files".into(),
@@ -148,10 +145,9 @@ impl Folder {
     pub fn existing(path: &Path) -> Result<Self, SweepError> {
         let plan_path = path.join(STATE_DIR).join(PLAN_FILE);
         if !plan_path.is_file() {
-            return Err(SweepError::Folder {
-                path: path.to_path_buf(),
-                reason: format!("holds no sweep (no {STATE_DIR}/{PLAN_FILE}): give the folder a sweep was run into"),
-            });
+            return Err(SweepError::folder(path)(format!(
+                "holds no sweep (no {STATE_DIR}/{PLAN_FILE}): give the folder a sweep was run into"
+            )));
         }
         Ok(Self {
             path: path.to_path_buf(),
@@ -266,39 +262,41 @@ impl Folder {
     /// It cannot be created or written.
     pub fn journal(&self, shard: Shard) -> Result<Journal, SweepError> {
         let path = self.state().join(journal_file_name(shard));
-        let mut file = OpenOptions::new()
+        let file = OpenOptions::new()
             .create(true)
             .append(true)
             .open(&path)
             .map_err(SweepError::io("opening the journal", &path))?;
-        let len = file
-            .metadata()
-            .map_err(SweepError::io("reading the journal", &path))?
-            .len();
-        if len > 0 && !ends_with_line_break(&path)? {
+        let last = last_byte(&file, &path).map_err(SweepError::io("reading the journal", &path))?;
+        let mut journal = Journal { file, path };
+        match last {
+            None => {
+                let mut header = vec![MTIME_COLUMN.to_string()];
+                header.extend(self.columns());
+                journal.write(&format!("{}\n", csv::line(&header)))?;
+            }
             // A line torn by a crash: end it, so that it stays one bad (ignored) line instead of
             // swallowing the next row.
-            file.write_all(b"\n")
-                .and_then(|()| file.sync_data())
-                .map_err(SweepError::io("writing the journal", &path))?;
+            Some(last) if last != b'\n' => journal.write("\n")?,
+            Some(_) => {}
         }
-        if len == 0 {
-            let mut header = vec![MTIME_COLUMN.to_string()];
-            header.extend(self.columns());
-            let line = format!("{}\n", csv::line(&header));
-            file.write_all(line.as_bytes())
-                .and_then(|()| file.sync_data())
-                .map_err(SweepError::io("writing the journal", &path))?;
-        }
-        Ok(Journal { file, path })
+        Ok(journal)
     }
 
-    /// Writes `name` in the folder atomically: a temporary file beside it, synced, then renamed over it.
+    /// Writes `sweep.json`: the plan with the counts (format.md: sweep.json).
     ///
     /// # Errors
     /// The file cannot be written.
-    pub fn write_atomically(&self, name: &str, bytes: &[u8]) -> Result<PathBuf, SweepError> {
-        self.write_atomically_with(name, |w| w.write_all(bytes))
+    pub fn write_summary(
+        &self,
+        finished: u64,
+        failed: u64,
+        pending: u64,
+    ) -> Result<PathBuf, SweepError> {
+        let mut json = self.plan.clone();
+        json["counts"] =
+            serde_json::json!({"finished": finished, "failed": failed, "pending": pending});
+        self.write_atomically(SWEEP_JSON_FILE, |w| writeln!(w, "{json}"))
     }
 
     /// A catalogue (or part) `name`: the header, then `lines`, each ending in a line break, streamed
@@ -312,7 +310,7 @@ impl Folder {
         lines: impl Iterator<Item = S>,
     ) -> Result<PathBuf, SweepError> {
         let header = csv::line(&self.columns());
-        self.write_atomically_with(name, |w| {
+        self.write_atomically(name, |w| {
             writeln!(w, "{header}")?;
             for line in lines {
                 writeln!(w, "{}", line.as_ref())?;
@@ -321,7 +319,8 @@ impl Folder {
         })
     }
 
-    fn write_atomically_with(
+    /// Writes `name` in the folder atomically: a temporary file beside it, synced, then renamed over it.
+    fn write_atomically(
         &self,
         name: &str,
         write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
@@ -336,14 +335,17 @@ impl Folder {
     }
 }
 
-fn ends_with_line_break(path: &Path) -> Result<bool, SweepError> {
+/// The last byte of `file` (open for appending at `path`), `None` when it is empty.
+fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {
     use std::io::{Read, Seek, SeekFrom};
-    let mut file = File::open(path).map_err(SweepError::io("reading the journal", path))?;
+    if file.metadata()?.len() == 0 {
+        return Ok(None);
+    }
+    let mut file = File::open(path)?;
     let mut last = [0u8];
-    file.seek(SeekFrom::End(-1))
-        .and_then(|_| file.read_exact(&mut last))
-        .map_err(SweepError::io("reading the journal", path))?;
-    Ok(last[0] == b'\n')
+    file.seek(SeekFrom::End(-1))?;
+    file.read_exact(&mut last)?;
+    Ok(Some(last[0]))
 }
 
 /// A journal line: the file's modification time when the row was written, and the row's fields.
@@ -394,6 +396,10 @@ impl Journal {
             .iter()
             .map(|(mtime, line)| format!("{mtime},{line}\n"))
             .collect();
+        self.write(&text)
+    }
+
+    fn write(&mut self, text: &str) -> Result<(), SweepError> {
         self.file
             .write_all(text.as_bytes())
             .and_then(|()| self.file.sync_data())
@@ -402,13 +408,12 @@ impl Journal {
 }
 
 fn read_plan(path: &Path) -> Result<serde_json::Value, SweepError> {
-    let text =
-        fs::read_to_string(path).map_err(SweepError::io("reading the sweep's plan", path))?;
-    serde_json::from_str(&text).map_err(|e| SweepError::Io {
-        what: "reading the sweep's plan",
-        path: path.to_path_buf(),
-        source: io::Error::new(io::ErrorKind::InvalidData, e),
-    })
+    let parse = |text: String| {
+        serde_json::from_str(&text).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))
+    };
+    fs::read_to_string(path)
+        .and_then(parse)
+        .map_err(SweepError::io("reading the sweep's plan", path))
 }
 
 /// The folder's plan against this sweep's: same identity, same tool version.
@@ -417,12 +422,7 @@ fn check_same(
     held: &serde_json::Value,
     plan: &serde_json::Value,
 ) -> Result<(), SweepError> {
-    let error = |reason: String| {
-        Err(SweepError::Folder {
-            path: folder.to_path_buf(),
-            reason,
-        })
-    };
+    let error = |reason| Err(SweepError::folder(folder)(reason));
     let text = |v: &serde_json::Value, key: &str| v[key].as_str().unwrap_or_default().to_string();
     if text(held, "identity") != text(plan, "identity") {
         return error(format!(

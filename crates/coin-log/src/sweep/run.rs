@@ -167,12 +167,16 @@ struct Tally {
     verify_seconds: f64,
 }
 
+/// How many of the held rows are failed.
+fn failed(held: &BTreeMap<u64, Held>) -> u64 {
+    held.values()
+        .filter(|h| h.status == RunStatus::Failed)
+        .count() as u64
+}
+
 impl Tally {
     fn new(held: BTreeMap<u64, Held>, runs: u64, todo: u64) -> Self {
-        let failed = held
-            .values()
-            .filter(|h| h.status == RunStatus::Failed)
-            .count() as u64;
+        let failed = failed(&held);
         Self {
             kept: held.len() as u64,
             held,
@@ -202,12 +206,7 @@ impl Tally {
         summary: Option<PathBuf>,
         interrupted: bool,
     ) -> SweepOutcome {
-        let rows = self.held.len() as u64;
-        let failed = self
-            .held
-            .values()
-            .filter(|h| h.status == RunStatus::Failed)
-            .count() as u64;
+        let (rows, failed) = (self.held.len() as u64, failed(&self.held));
         SweepOutcome {
             runs: self.progress.runs,
             finished: rows - failed,
@@ -347,32 +346,9 @@ fn write_catalogue(
         ));
     }
     let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
-    let failed = held
-        .values()
-        .filter(|h| h.status == RunStatus::Failed)
-        .count() as u64;
-    let json = summary_json(
-        &folder.plan,
-        held.len() as u64 - failed,
-        failed,
-        sweep.runs() - held.len() as u64,
-    );
-    let summary =
-        folder.write_atomically(folder::SWEEP_JSON_FILE, format!("{json}\n").as_bytes())?;
+    let (rows, failed) = (held.len() as u64, failed(held));
+    let summary = folder.write_summary(rows - failed, failed, sweep.runs() - rows)?;
     Ok((catalogue, Some(summary)))
-}
-
-/// `sweep.json`: the plan with the counts (format.md: sweep.json).
-pub(super) fn summary_json(
-    plan: &serde_json::Value,
-    finished: u64,
-    failed: u64,
-    pending: u64,
-) -> serde_json::Value {
-    let mut json = plan.clone();
-    json["counts"] =
-        serde_json::json!({"finished": finished, "failed": failed, "pending": pending});
-    json
 }
 
 /// One run: values → scene → record into a temporary file → hash → verify → move into place → row.
@@ -383,27 +359,24 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
         Ok(v) => v.iter().map(cell).collect(),
         Err(_) => vec![String::new(); sweep.keys().count()],
     };
-    let failed = |failure, reason: String| Row {
-        index,
-        values: cells.clone(),
-        status: RunStatus::Failed,
-        failure: Some(failure),
-        reason,
-        recorded: None,
-        prediction: None,
-        wall_time: started.elapsed().as_secs_f64(),
+    let failed = |failure, reason: String| {
+        Done::without_file(Row {
+            index,
+            values: cells.clone(),
+            status: RunStatus::Failed,
+            failure: Some(failure),
+            reason,
+            recorded: None,
+            prediction: None,
+            wall_time: started.elapsed().as_secs_f64(),
+        })
     };
     let scene = values
         .map_err(RunSceneError::from)
         .and_then(|v| sweep.scene(&v));
     let scene = match scene {
         Ok(scene) => scene,
-        Err(e) => {
-            return Some(Done::without_file(failed(
-                FailureKind::Scene,
-                e.to_string(),
-            )))
-        }
+        Err(e) => return Some(failed(FailureKind::Scene, e.to_string())),
     };
     let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
     match record_and_check(sweep, folder, index, &scene, stop) {
@@ -427,7 +400,7 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
                 verify: checked.verify_seconds,
             })
         }
-        Err(e) => Some(Done::without_file(failed(FailureKind::Io, e))),
+        Err(e) => Some(failed(FailureKind::Io, e)),
     }
 }
 
