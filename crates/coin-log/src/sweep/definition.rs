@@ -1,6 +1,5 @@
-//! A validated sweep: the base scene as a TOML table, the fixed edits, the grid and the random draws, and
-//! how each run is written. A run's values, scene and file name follow from the sweep and the run's index
-//! alone (format.md: Sweep files).
+//! A validated sweep (format.md: Sweep files), and what a run's index alone gives: its values, scene and
+//! file name.
 
 use super::error::SweepError;
 use super::random::{Distribution, Drawn, OutOfBounds};
@@ -144,10 +143,14 @@ impl Sweep {
     /// Grid points: the product of the dimensions' lengths (1 without axes).
     #[must_use]
     pub fn grid_points(&self) -> u64 {
+        self.lengths().product()
+    }
+
+    /// Each dimension's length, slowest first.
+    pub(super) fn lengths(&self) -> impl DoubleEndedIterator<Item = u64> + ExactSizeIterator + '_ {
         self.dimensions
             .iter()
             .map(|d| self.axes[d[0]].values.len() as u64)
-            .product()
     }
 
     /// How many runs: grid points × `random.count`.
@@ -175,8 +178,7 @@ impl Sweep {
         let count = self.random.as_ref().map_or(1, |r| r.count);
         let mut point = index / count;
         let mut values = vec![toml::Value::Boolean(false); self.axes.len()];
-        for dimension in self.dimensions.iter().rev() {
-            let len = self.axes[dimension[0]].values.len() as u64;
+        for (dimension, len) in self.dimensions.iter().zip(self.lengths()).rev() {
             // point % len < len, a length of a Vec: it fits usize.
             let at = usize::try_from(point % len).unwrap_or(0);
             point /= len;

@@ -10,7 +10,6 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct SweepFile {
     /// One line saying what the sweep is for.
-    #[serde(default)]
     pub description: Option<String>,
     /// A built-in scene name, or the path of a scene file relative to the sweep file.
     pub base: String,
@@ -21,10 +20,8 @@ pub struct SweepFile {
     #[serde(default)]
     pub axis: Vec<AxisFile>,
     /// Random draws.
-    #[serde(default)]
     pub random: Option<RandomFile>,
     /// The sweep's own settings.
-    #[serde(default)]
     pub output: Option<OutputFile>,
 }
 
@@ -35,16 +32,12 @@ pub struct AxisFile {
     /// Dotted scene key.
     pub key: String,
     /// The values, any TOML values.
-    #[serde(default)]
     pub values: Option<Vec<toml::Value>>,
     /// `[first, last, n]`.
-    #[serde(default)]
     pub linspace: Option<Vec<toml::Value>>,
     /// `[first_exp, last_exp, n]`, base 10.
-    #[serde(default)]
     pub logspace: Option<Vec<toml::Value>>,
     /// Axes with the same name vary together (equal lengths).
-    #[serde(default)]
     pub zip: Option<String>,
 }
 
@@ -68,16 +61,12 @@ pub struct DrawFile {
     /// Dotted scene key.
     pub key: String,
     /// `[lo, hi]`.
-    #[serde(default)]
     pub uniform: Option<Vec<toml::Value>>,
     /// `[lo, hi]`, 0 < lo.
-    #[serde(default)]
     pub log_uniform: Option<Vec<toml::Value>>,
     /// `{ mean, std, min, max }`.
-    #[serde(default)]
     pub normal: Option<NormalFile>,
     /// Values to choose from, any TOML values.
-    #[serde(default)]
     pub choice: Option<Vec<toml::Value>>,
 }
 
@@ -90,10 +79,8 @@ pub struct NormalFile {
     /// Standard deviation, > 0.
     pub std: toml::Value,
     /// Lower bound (draws below are redrawn).
-    #[serde(default)]
     pub min: Option<toml::Value>,
     /// Upper bound.
-    #[serde(default)]
     pub max: Option<toml::Value>,
 }
 
@@ -102,19 +89,14 @@ pub struct NormalFile {
 #[serde(deny_unknown_fields)]
 pub struct OutputFile {
     /// The channels to record (as `record.channels`; default the scene's).
-    #[serde(default)]
     pub channels: Option<Vec<String>>,
     /// `json` (default) or `protobuf`.
-    #[serde(default)]
     pub encoding: Option<String>,
     /// `zstd` (default), `lz4` or `none`.
-    #[serde(default)]
     pub compression: Option<String>,
     /// Verify each file after recording it (default true).
-    #[serde(default)]
     pub verify: Option<bool>,
     /// Fill the catalogue's `predicted_*` columns by `analyse`'s quadrature (default true; about 1.7 ms
     /// a run on the development machine).
-    #[serde(default)]
     pub predict: Option<bool>,
 }

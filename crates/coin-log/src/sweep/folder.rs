@@ -443,8 +443,6 @@ fn short(identity: &str) -> &str {
     identity.get(..12).unwrap_or(identity)
 }
 
-// A minimal private atomic output, for the sweep's own files (the catalogue, its parts, sweep.json, the
-// plan); the library's shared atomic-output helper replaces `temp_beside` and its two callers once it lands.
 /// Writes `path` through a synced temporary file beside it, unless `path` exists (`AlreadyExists`).
 fn publish_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let temp = temp_beside(path, |w| w.write_all(bytes))?;

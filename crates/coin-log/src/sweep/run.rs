@@ -77,9 +77,7 @@ pub struct SweepOutcome {
     pub verify_seconds: f64,
 }
 
-/// A run done, as a worker hands it over: the row, its file's modification time and the seconds
-/// recording and verifying took. A run stopped by a stop request hands over nothing (no row: redone on
-/// resume).
+/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume).
 struct Done {
     row: Row,
     mtime_ns: u128,

@@ -634,10 +634,7 @@ impl Checker {
 
     /// At most [`MAX_RUNS`] runs.
     fn size(&mut self, sweep: &Sweep) {
-        let lengths = sweep
-            .dimensions
-            .iter()
-            .map(|d| sweep.axes[d[0]].values.len() as u64);
+        let lengths = sweep.lengths();
         let count = sweep.random.as_ref().map_or(1, |r| r.count);
         let runs = lengths.chain([count]).try_fold(1u64, u64::checked_mul);
         if runs.is_none_or(|r| r > MAX_RUNS) {
