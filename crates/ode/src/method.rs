@@ -93,42 +93,16 @@ where
     E: EventFunctions<N>,
     O: FnMut(f64, &[f64; N]) -> Flow,
 {
+    // One call per stepper type; a closure cannot take the stepper, whose type differs per arm.
+    macro_rules! run_with {
+        ($stepper:expr) => {
+            run_bounded(sys, &mut $stepper, y0, settings, bounds, events, observe)
+        };
+    }
     match config.method {
-        Method::Rk4 => run_bounded(
-            sys,
-            &mut Rk4::new(config.step),
-            y0,
-            settings,
-            bounds,
-            events,
-            observe,
-        ),
-        Method::Gauss4 => run_bounded(
-            sys,
-            &mut Gauss4::new(config.step),
-            y0,
-            settings,
-            bounds,
-            events,
-            observe,
-        ),
-        Method::Dopri5 => run_bounded(
-            sys,
-            &mut Dopri5::new(config.rtol, config.atol),
-            y0,
-            settings,
-            bounds,
-            events,
-            observe,
-        ),
-        Method::Dop853 => run_bounded(
-            sys,
-            &mut Dop853::new(config.rtol, config.atol),
-            y0,
-            settings,
-            bounds,
-            events,
-            observe,
-        ),
+        Method::Rk4 => run_with!(Rk4::new(config.step)),
+        Method::Gauss4 => run_with!(Gauss4::new(config.step)),
+        Method::Dopri5 => run_with!(Dopri5::new(config.rtol, config.atol)),
+        Method::Dop853 => run_with!(Dop853::new(config.rtol, config.atol)),
     }
 }
