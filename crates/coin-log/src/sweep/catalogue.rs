@@ -3,6 +3,7 @@
 //! their shortest round-trip form). Every column but `wall_time_s` depends only on the sweep and the
 //! run's index, so that a sharded sweep's collected catalogue equals the one-process one.
 
+use crate::format::metadata::number_string as number;
 use crate::format::Termination;
 use crate::verify::Verdict;
 
@@ -137,12 +138,6 @@ pub struct Row {
     pub prediction: Option<Prediction>,
     /// Wall time of the run (resolve, record, hash, verify), seconds.
     pub wall_time: f64,
-}
-
-/// A number in its shortest round-trip form (`0.1`, `1e-12`, `5.0`, `NaN`).
-#[must_use]
-pub fn number(x: f64) -> String {
-    ryu::Buffer::new().format(x).to_string()
 }
 
 /// A swept value as a cell: numbers shortest, strings as they are, arrays and tables as TOML.

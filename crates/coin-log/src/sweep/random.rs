@@ -17,6 +17,8 @@
 //! `n` counts the words one draw uses (0 for uniform, log-uniform and choice; 2a and 2a + 1 for attempt a
 //! of a normal draw).
 
+use crate::format::metadata::number_string;
+
 /// splitmix64's increment, ⌊2⁶⁴/φ⌋.
 const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 
@@ -95,8 +97,8 @@ pub enum Drawn {
 /// A bounded normal draw found no value within its bounds in [`NORMAL_ATTEMPTS`] attempts.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error(
-    "no normal draw (mean {mean}, std {std}) fell within [{min}, {max}] in {NORMAL_ATTEMPTS} attempts: \
-     widen the bounds"
+    "no normal draw (mean {}, std {}) fell within [{}, {}] in {NORMAL_ATTEMPTS} attempts: widen the bounds",
+    number_string(*mean), number_string(*std), number_string(*min), number_string(*max)
 )]
 pub struct OutOfBounds {
     /// Mean.
@@ -243,15 +245,21 @@ mod tests {
         assert!(seen.iter().all(|&c| (580..760).contains(&c)), "{seen:?}");
     }
 
+    /// A normal draw whose bounds lie 10³⁰⁰ σ away fails after its attempts and says so, with its numbers
+    /// short (`1e-300`, not 300 digits).
     #[test]
     fn a_normal_draw_with_unreachable_bounds_says_so() {
-        let far = Distribution::Normal {
+        let normal = Distribution::Normal {
             mean: 0.0,
-            std: 1.0,
-            min: 50.0,
-            max: 51.0,
+            std: 1e-300,
+            min: 1e10,
+            max: 1e11,
         };
-        let e = far.draw(1, 0, 0).unwrap_err().to_string();
-        assert!(e.contains("widen the bounds"), "{e}");
+        let e = normal.draw(3, 0, 0).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "no normal draw (mean 0.0, std 1e-300) fell within [10000000000.0, 100000000000.0] in \
+                       1000000 attempts: widen the bounds"
+        );
     }
 }
