@@ -185,6 +185,8 @@ enum InTheWay {
     Pipe,
     Device,
     Folder,
+    /// `-`, which is no standard output: a file named `-` is `./-`.
+    Dash,
 }
 
 /// Puts `what` where `w` writes in `dir`; returns the output argument and what stderr must say.
@@ -221,11 +223,13 @@ fn obstruct(w: &Writer, dir: &Path, what: InTheWay) -> (String, &'static str) {
             std::fs::create_dir(&path).unwrap();
             (arg, "is a folder")
         }
+        InTheWay::Dash => ("-".into(), "`-` would be a file named `-`"),
     }
 }
 
 /// Every writing command refuses a link, a pipe (without blocking), a device and a folder where its output
-/// goes, with or without its overwrite flag, and leaves everything as it was.
+/// goes, and a file output `-` (no standard output), with or without its overwrite flag, and leaves
+/// everything as it was.
 #[test]
 fn no_command_writes_over_a_link_a_pipe_a_device_or_a_folder() {
     for w in WRITERS {
@@ -234,7 +238,11 @@ fn no_command_writes_over_a_link_a_pipe_a_device_or_a_folder() {
             InTheWay::Pipe,
             InTheWay::Device,
             InTheWay::Folder,
+            InTheWay::Dash,
         ] {
+            if matches!(what, InTheWay::Dash) && w.in_folder.is_some() {
+                continue; // A folder output named `-` is just a folder.
+            }
             for flag in [None, w.overwrite] {
                 let dir = setup();
                 let (arg, needle) = obstruct(w, dir.path(), what);
@@ -414,6 +422,89 @@ fn a_scene_path_to_a_device_a_pipe_a_folder_or_stdin_is_refused_at_once() {
                 "{args:?}: stderr should say {needle:?}: {err}"
             );
         }
+    }
+}
+
+/// A sweep file, and the base scene file it names, are inputs like a scene: a device, a pipe, a folder,
+/// `-` or a file above the limit is refused at once (exit 2, the sweep's code for a file it cannot use),
+/// with nothing written; and a sweep folder's own files (journal, plan, catalogue parts, run files) are
+/// read only if they are regular files, so a pipe put there cannot block a resume or a collect.
+#[test]
+fn a_sweep_file_its_base_and_its_folders_files_are_read_only_as_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.toml");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    std::fs::write(dir.path().join("big.toml"), vec![b'#'; (1 << 20) + 1]).unwrap();
+    let cases = [
+        (
+            "/dev/zero",
+            "is a character device, not a regular file: a sweep file is read whole",
+        ),
+        ("pipe.toml", "is a named pipe, not a regular file"),
+        ("/tmp/", "is a directory, not a sweep file"),
+        ("-", "reading standard input is not offered"),
+        ("big.toml", "more than 1048576 bytes"),
+    ];
+    for (path, needle) in cases {
+        let (code, _, err) = run(dir.path(), &["sweep", path, "-o", "out"], Stdio::null());
+        assert_eq!(code, 2, "{path}: {err}");
+        assert!(
+            err.contains(needle),
+            "{path}: stderr should say {needle:?}: {err}"
+        );
+        if path == "-" {
+            continue; // As a base, `-` is a name: no built-in scene (tested in sweep.rs).
+        }
+        let base = format!("base = \"{path}\"\n");
+        std::fs::write(dir.path().join("s.toml"), base).unwrap();
+        let (code, _, err) = run(dir.path(), &["sweep", "s.toml", "-o", "out"], Stdio::null());
+        assert_eq!(code, 2, "base {path}: {err}");
+        let needle = needle.replace("a sweep file", "a scene file");
+        assert!(
+            err.contains("`base`") && err.contains(&needle),
+            "base {path}: {err}"
+        );
+        assert!(!dir.path().join("out").exists(), "{path}: nothing written");
+    }
+    let sweep = "base = \"wobble\"\nset = { \"run.duration\" = 1.0, \"run.rate\" = 20.0 }\n";
+    std::fs::write(dir.path().join("s.toml"), sweep).unwrap();
+    let (code, _, err) = run(dir.path(), &["sweep", "s.toml", "-o", "out"], Stdio::null());
+    assert_eq!(code, 0, "{err}");
+    let state = dir.path().join("out/.coin-log-sweep");
+    let journal = std::fs::read_dir(&state)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            p.file_name()
+                .unwrap()
+                .to_str()
+                .unwrap()
+                .starts_with("journal-")
+        })
+        .expect("a journal");
+    for (victim, needle) in [
+        (journal, "reading the journal"),
+        (state.join("plan.json"), "plan"),
+    ] {
+        let saved = std::fs::read(&victim).unwrap();
+        std::fs::remove_file(&victim).unwrap();
+        assert!(Command::new("mkfifo")
+            .arg(&victim)
+            .status()
+            .unwrap()
+            .success());
+        let (code, _, err) = run(dir.path(), &["sweep", "s.toml", "-o", "out"], Stdio::null());
+        assert_ne!(code, 0, "{victim:?}: {err}");
+        assert!(
+            err.contains(needle) && err.contains("is a named pipe, not a regular file"),
+            "{victim:?}: {err}"
+        );
+        std::fs::remove_file(&victim).unwrap();
+        std::fs::write(&victim, saved).unwrap();
     }
 }
 

@@ -1,7 +1,7 @@
 //! What a path given as an input may be (format.md: Commands, Inputs and outputs). Every input is a regular
 //! file, looked at before it is opened, so a named pipe, a device (`/dev/zero`, `/dev/urandom`), a socket
 //! or a folder is refused with the reason instead of blocking or being read without end; a symbolic link
-//! is followed to what it names. A scene is read whole and must be at most [`SCENE_MAX_BYTES`]; an MCAP
+//! is followed to what it names. A scene or sweep file is read whole and must be at most [`SCENE_MAX_BYTES`]; an MCAP
 //! file is read in bounded memory by its reader, which seeks (to the summary and metadata), so it cannot
 //! be a stream. Standard input is offered nowhere: `-` is refused with that reason.
 
@@ -10,8 +10,9 @@ use std::fs::{self, File, Metadata};
 use std::io::{self, Read};
 use std::path::Path;
 
-/// The largest scene file read \[bytes\]: scenes are a few kB of TOML (the built-ins are under 2 kB), so
-/// 1 MiB leaves room for any hand-written scene while bounding what a wrong path can make the tool read.
+/// The largest scene or sweep file read \[bytes\]: scenes are a few kB of TOML (the built-ins are under 2 kB),
+/// so 1 MiB leaves room for any hand-written scene, or a sweep axis of ~10⁵ listed values, while bounding
+/// what a wrong path can make the tool read.
 pub const SCENE_MAX_BYTES: u64 = 1 << 20;
 
 /// What an input is read as, for the rules and the words of a refusal.
@@ -19,6 +20,8 @@ pub const SCENE_MAX_BYTES: u64 = 1 << 20;
 pub enum InputKind {
     /// A TOML scene file, read whole.
     Scene,
+    /// A TOML sweep file, read whole.
+    Sweep,
     /// An MCAP file, read by seeking.
     Mcap,
 }
@@ -55,10 +58,12 @@ pub enum InputError {
     },
     /// A scene file above [`SCENE_MAX_BYTES`].
     #[error(
-        "holds more than {limit} bytes (at least {bytes}), more than a scene file may (scenes are a few kB of \
-         TOML): is this the scene you meant?"
+        "holds more than {limit} bytes (at least {bytes}), more than {} may (they are a few kB of TOML): is \
+         this the file you meant?", what(*kind)
     )]
     TooLarge {
+        /// What is read.
+        kind: InputKind,
         /// What it holds, as far as it was read.
         bytes: u64,
         /// The limit.
@@ -69,6 +74,7 @@ pub enum InputError {
 fn what(kind: InputKind) -> &'static str {
     match kind {
         InputKind::Scene => "a scene file",
+        InputKind::Sweep => "a sweep file",
         InputKind::Mcap => "an MCAP file",
     }
 }
@@ -81,10 +87,11 @@ fn special(kind: InputKind, what: &str, stdin: bool) -> String {
              summary and metadata, which a stream cannot do; save it to a file first",
             if stdin { "standard input, " } else { "" }
         ),
-        InputKind::Scene => format!(
-            "is {}{what}, not a regular file: a scene file is read whole, and a pipe or device may never end; \
-             save the scene to a file and give its path",
-            if stdin { "standard input, " } else { "" }
+        InputKind::Scene | InputKind::Sweep => format!(
+            "is {}{what}, not a regular file: {} is read whole, and a pipe or device may never end; save it \
+             to a file and give its path",
+            if stdin { "standard input, " } else { "" },
+            self::what(kind)
         ),
     }
 }
@@ -115,27 +122,77 @@ pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
     Ok(meta)
 }
 
-/// Reads the scene file at `path` as text: a regular file of at most [`SCENE_MAX_BYTES`] (the bound holds
-/// while reading too, for files that grow or whose size the system does not report, like `/proc` files).
+/// Reads the scene file at `path` as text: [`read_toml`] of a [`InputKind::Scene`].
+///
+/// # Errors
+/// As [`read_toml`].
+pub fn read_scene(path: &Path) -> Result<String, InputError> {
+    read_toml(path, InputKind::Scene)
+}
+
+/// Reads the scene or sweep file at `path` as text: a regular file of at most [`SCENE_MAX_BYTES`] (the
+/// bound holds while reading too, for files that grow or whose size the system does not report, like
+/// `/proc` files).
 ///
 /// # Errors
 /// As [`check`]; a file above the limit, one that cannot be read, or that is not UTF-8.
-pub fn read_scene(path: &Path) -> Result<String, InputError> {
-    check(path, InputKind::Scene)?;
+pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
+    check(path, kind)?;
     let mut text = String::new();
     let read = File::open(path)
         .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_string(&mut text))
-        .map_err(|source| InputError::Io {
-            kind: InputKind::Scene,
-            source,
-        })?;
+        .map_err(|source| InputError::Io { kind, source })?;
     if read as u64 > SCENE_MAX_BYTES {
         let bytes = fs::metadata(path).map_or(read as u64, |m| m.len().max(read as u64));
         return Err(InputError::TooLarge {
+            kind,
             bytes,
             limit: SCENE_MAX_BYTES,
         });
     }
+    Ok(text)
+}
+
+/// Ok if `path` is absent or a regular file (following links): for the files a command keeps in a folder
+/// of its own (a sweep's journal, plan and catalogue parts), which a crafted folder could replace with a
+/// pipe that blocks an open or a device that never ends.
+///
+/// # Errors
+/// [`io::ErrorKind::InvalidInput`] naming what the path is instead; another error of looking at it.
+pub fn absent_or_regular(path: &Path) -> io::Result<()> {
+    match fs::metadata(path) {
+        Ok(meta) if meta.is_file() => Ok(()),
+        Ok(meta) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "is {}, not a regular file: move it away",
+                if meta.is_dir() {
+                    "a folder"
+                } else {
+                    kind_of(&meta)
+                }
+            ),
+        )),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
+/// The regular file at `path` opened for reading, as [`absent_or_regular`] allows.
+///
+/// # Errors
+/// As [`absent_or_regular`], or of opening it.
+pub fn open_regular(path: &Path) -> io::Result<File> {
+    absent_or_regular(path).and_then(|()| File::open(path))
+}
+
+/// The regular file at `path` read as text, as [`absent_or_regular`] allows.
+///
+/// # Errors
+/// As [`open_regular`], or of reading it (not UTF-8).
+pub fn read_regular(path: &Path) -> io::Result<String> {
+    let mut text = String::new();
+    open_regular(path)?.read_to_string(&mut text)?;
     Ok(text)
 }
 

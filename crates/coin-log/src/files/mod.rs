@@ -12,7 +12,9 @@
 pub mod input;
 pub mod output;
 
-pub use input::{read_scene, InputError, InputKind};
+pub use input::{
+    absent_or_regular, open_regular, read_regular, read_scene, read_toml, InputError, InputKind,
+};
 pub use output::{make_readable, Output, OutputError, OutputFolder, Policy};
 
 use std::borrow::Cow;

@@ -81,6 +81,15 @@ pub enum OutputError {
         /// What to do instead.
         fix: String,
     },
+    /// The target is `-`, which would be a file of that name, not standard output.
+    #[error(
+        "`-` would be a file named `-`: coin-log does not write to standard output, it writes a file and \
+         moves it into place; {fix} (a file named `-` is `./-`)"
+    )]
+    Stdout {
+        /// What to do instead.
+        fix: String,
+    },
     /// The target exists and may not be replaced.
     #[error("`{path}` already exists; {fix}")]
     Exists {
@@ -227,6 +236,10 @@ fn folder_of(target: &Path) -> PathBuf {
 /// Checks `target` against `policy`; returns its metadata when it is a regular file that may be replaced,
 /// `None` when it does not exist (its folder then does).
 fn check_target(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
+    if target.as_os_str() == "-" {
+        let fix = policy.fix(Refused::Special, target);
+        return Err(OutputError::Stdout { fix });
+    }
     let path = shown(target);
     let meta = match fs::symlink_metadata(target) {
         Ok(meta) => meta,

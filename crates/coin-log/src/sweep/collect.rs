@@ -108,7 +108,7 @@ fn read_part(
     problems: &mut Vec<String>,
 ) -> Result<(), SweepError> {
     let path = folder.file(name);
-    let text = std::fs::read_to_string(&path)
+    let text = crate::files::read_regular(&path)
         .map_err(SweepError::io("reading the catalogue part", &path))?;
     let mut lines = text.lines();
     let header = lines.next().and_then(csv::split);

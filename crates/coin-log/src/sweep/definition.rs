@@ -4,6 +4,7 @@
 use super::error::SweepError;
 use super::random::{Distribution, Drawn, OutOfBounds};
 use super::validate;
+use crate::files::{self, InputKind};
 use crate::format::Encoding;
 use crate::record::foxglove::PROTOBUF_MAX_SECONDS;
 use crate::record::RecordOptions;
@@ -116,7 +117,7 @@ impl Sweep {
     /// # Errors
     /// [`SweepError::Read`], [`SweepError::Parse`] or [`SweepError::Invalid`] (every problem at once).
     pub fn load(path: &Path) -> Result<Self, SweepError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SweepError::Read {
+        let text = files::read_toml(path, InputKind::Sweep).map_err(|source| SweepError::Read {
             path: path.to_path_buf(),
             source,
         })?;

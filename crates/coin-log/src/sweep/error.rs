@@ -14,7 +14,7 @@ pub enum SweepError {
         /// The file.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        source: crate::files::InputError,
     },
     /// The sweep file is not TOML or does not fit the sweep's keys and types (serde's message, alone).
     #[error("sweep file `{label}`: {message}")]

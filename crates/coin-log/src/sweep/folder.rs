@@ -245,7 +245,7 @@ impl Folder {
         let mut rows = Vec::new();
         for path in names {
             let text =
-                fs::read_to_string(&path).map_err(SweepError::io("reading the journal", &path))?;
+                files::read_regular(&path).map_err(SweepError::io("reading the journal", &path))?;
             let complete = text.rfind('\n').map_or("", |end| &text[..end]);
             rows.extend(
                 complete
@@ -262,10 +262,8 @@ impl Folder {
     /// It cannot be created or written.
     pub fn journal(&self, shard: Shard) -> Result<Journal, SweepError> {
         let path = self.state().join(journal_file_name(shard));
-        let file = OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&path)
+        let file = files::absent_or_regular(&path)
+            .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
             .map_err(SweepError::io("opening the journal", &path))?;
         let last = last_byte(&file, &path).map_err(SweepError::io("reading the journal", &path))?;
         let mut journal = Journal { file, path };
@@ -411,7 +409,7 @@ fn read_plan(path: &Path) -> Result<serde_json::Value, SweepError> {
     let parse = |text: String| {
         serde_json::from_str(&text).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))
     };
-    fs::read_to_string(path)
+    files::read_regular(path)
         .and_then(parse)
         .map_err(SweepError::io("reading the sweep's plan", path))
 }

@@ -16,9 +16,9 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 /// SHA-256 of the file at `path` and its length, read once in bounded memory.
 ///
 /// # Errors
-/// The file cannot be read.
+/// The file cannot be read, or is not a regular file.
 pub fn sha256_file(path: &Path) -> std::io::Result<(String, u64)> {
-    let mut file = std::fs::File::open(path)?;
+    let mut file = crate::files::open_regular(path)?;
     let mut hasher = Sha256::new();
     let mut buffer = vec![0; BUFFER];
     let mut len = 0;

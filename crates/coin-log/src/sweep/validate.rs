@@ -137,7 +137,7 @@ impl Checker {
             return None;
         }
         let path = folder.join(base);
-        let text = match std::fs::read_to_string(&path) {
+        let text = match crate::files::read_scene(&path) {
             Ok(text) => text,
             Err(e) => {
                 self.problem("base", quoted, format!(
