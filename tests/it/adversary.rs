@@ -4,9 +4,9 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::cast_precision_loss)]
 
+use crate::support::mkfifo;
 use crate::support::record::{coin_log, coin_log_text};
 use std::path::Path;
-use std::process::Command;
 
 /// The command line `info --scene` prints, with its placeholders for the scene and the output filled in.
 fn reproduction(text: &str, scene: &Path, out: &Path) -> Vec<String> {
@@ -287,7 +287,7 @@ fn bench_refuses_what_is_in_the_way_of_its_results_before_any_work() {
             let at = out.join(file);
             match what {
                 "link" => std::os::unix::fs::symlink(&victim, &at).unwrap(),
-                "pipe" => assert!(Command::new("mkfifo").arg(&at).status().unwrap().success()),
+                "pipe" => mkfifo(&at),
                 _ => std::fs::create_dir(&at).unwrap(),
             }
             let (code, _, err) = coin_log_within(

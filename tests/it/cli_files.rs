@@ -8,6 +8,7 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::mkfifo;
 use crate::support::record::{coin_log, exe, listing};
 use std::io::{Read, Write};
 use std::os::unix::fs::FileTypeExt;
@@ -210,8 +211,7 @@ fn obstruct(w: &Writer, dir: &Path, what: InTheWay) -> (String, &'static str) {
             (arg, "is a symbolic link")
         }
         InTheWay::Pipe => {
-            let status = Command::new("mkfifo").arg(&path).status().unwrap();
-            assert!(status.success(), "mkfifo");
+            mkfifo(&path);
             (arg, "is a named pipe, not a regular file")
         }
         InTheWay::Device if w.in_folder.is_some() => ("/dev/null".into(), "is not a folder"),
@@ -389,11 +389,7 @@ fn a_recording_whose_move_fails_is_kept_under_the_name_the_error_gives() {
 fn a_scene_path_to_a_device_a_pipe_a_folder_or_stdin_is_refused_at_once() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("scene.toml");
-    assert!(Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap()
-        .success());
+    mkfifo(&fifo);
     let big = dir.path().join("big.toml");
     let mut file = std::fs::File::create(&big).unwrap();
     file.write_all(&vec![b'#'; (1 << 20) + 1]).unwrap();
@@ -433,11 +429,7 @@ fn a_scene_path_to_a_device_a_pipe_a_folder_or_stdin_is_refused_at_once() {
 fn a_sweep_file_its_base_and_its_folders_files_are_read_only_as_regular_files() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("pipe.toml");
-    assert!(Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap()
-        .success());
+    mkfifo(&fifo);
     std::fs::write(dir.path().join("big.toml"), vec![b'#'; (1 << 20) + 1]).unwrap();
     let cases = [
         (
@@ -492,11 +484,7 @@ fn a_sweep_file_its_base_and_its_folders_files_are_read_only_as_regular_files() 
     ] {
         let saved = std::fs::read(&victim).unwrap();
         std::fs::remove_file(&victim).unwrap();
-        assert!(Command::new("mkfifo")
-            .arg(&victim)
-            .status()
-            .unwrap()
-            .success());
+        mkfifo(&victim);
         let (code, _, err) = run(dir.path(), &["sweep", "s.toml", "-o", "out"], Stdio::null());
         assert_ne!(code, 0, "{victim:?}: {err}");
         assert!(
@@ -514,11 +502,7 @@ fn a_sweep_file_its_base_and_its_folders_files_are_read_only_as_regular_files() 
 fn info_refuses_a_pipe_and_says_when_it_is_standard_input() {
     let dir = setup();
     let fifo = dir.path().join("pipe.mcap");
-    assert!(Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap()
-        .success());
+    mkfifo(&fifo);
     for command in ["info", "export", "plot", "verify"] {
         let (code, _, err) = run(dir.path(), &[command, "pipe.mcap"], Stdio::null());
         assert!(code == 1 || code == 2, "{command}: {err}");

@@ -5,6 +5,7 @@
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use crate::support::mkfifo;
 use crate::support::process::Process;
 use crate::support::record::{coin_log, exe, listing, read_back};
 use coin_log::format::{ResultMetadata, Termination, RESULT_METADATA_NAME};
@@ -92,11 +93,7 @@ fn dev_stdout_is_a_symbolic_link_and_is_refused() {
 #[test]
 fn a_named_pipe_is_never_replaced() {
     let dir = tempfile::tempdir().unwrap();
-    let status = Command::new("mkfifo")
-        .arg(dir.path().join("pipe"))
-        .status()
-        .unwrap();
-    assert!(status.success(), "mkfifo");
+    mkfifo(&dir.path().join("pipe"));
     refused(
         dir.path(),
         "pipe",
@@ -313,8 +310,7 @@ fn plot_export_and_the_map_never_replace_a_pipe_or_a_link() {
     std::fs::create_dir(d.join("tables")).unwrap();
     std::fs::write(d.join("real"), "precious").unwrap();
     for name in ["pipe.svg", "tables/omega.csv", "stability-map.csv"] {
-        let status = Command::new("mkfifo").arg(d.join(name)).status().unwrap();
-        assert!(status.success(), "mkfifo {name}");
+        mkfifo(&d.join(name));
     }
     std::os::unix::fs::symlink("real", d.join("link.svg")).unwrap();
     let runs: [(&[&str], &str); 4] = [

@@ -493,11 +493,7 @@ fn a_truncated_file_says_where_it_was_cut_once_on_stderr_and_in_the_json() {
 fn a_pipe_is_refused_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("pipe.mcap");
-    let status = std::process::Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    crate::support::mkfifo(&fifo);
     // Nothing ever writes to the FIFO: verify must not open it for reading (which would block).
     let (code, out, err) = coin_log_within(HANG_DEADLINE, &["verify", fifo.to_str().unwrap()]);
     assert_eq!(code, 2, "{out}");

@@ -20,6 +20,17 @@ pub mod writers;
 use std::io::{Cursor, Seek, SeekFrom, Write};
 use std::path::PathBuf;
 
+/// Makes a named pipe at `path` (the tests put pipes where a file is read or written, to show it is
+/// refused without blocking).
+pub fn mkfifo(path: &std::path::Path) {
+    let status = std::process::Command::new("mkfifo").arg(path).status();
+    assert!(
+        status.is_ok_and(|s| s.success()),
+        "mkfifo {}",
+        path.display()
+    );
+}
+
 /// The repository root (cargo also runs the tests there).
 pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

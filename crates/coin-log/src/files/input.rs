@@ -1,18 +1,19 @@
 //! What a path given as an input may be (format.md: Commands, Inputs and outputs). Every input is a regular
 //! file, looked at before it is opened, so a named pipe, a device (`/dev/zero`, `/dev/urandom`), a socket
 //! or a folder is refused with the reason instead of blocking or being read without end; a symbolic link
-//! is followed to what it names. A scene or sweep file is read whole and must be at most [`SCENE_MAX_BYTES`]; an MCAP
-//! file is read in bounded memory by its reader, which seeks (to the summary and metadata), so it cannot
-//! be a stream. Standard input is offered nowhere: `-` is refused with that reason.
+//! is followed to what it names. A scene or sweep file is read whole and must be at most
+//! [`SCENE_MAX_BYTES`]; an MCAP file is read in bounded memory by its reader, which seeks (to the summary
+//! and metadata), so it cannot be a stream. Standard input is offered nowhere: `-` is refused with that
+//! reason.
 
 use super::output::kind_of;
 use std::fs::{self, File, Metadata};
 use std::io::{self, Read};
 use std::path::Path;
 
-/// The largest scene or sweep file read \[bytes\]: scenes are a few kB of TOML (the built-ins are under 2 kB),
-/// so 1 MiB leaves room for any hand-written scene, or a sweep axis of ~10⁵ listed values, while bounding
-/// what a wrong path can make the tool read.
+/// The largest scene or sweep file read \[bytes\]: scenes are a few kB of TOML (the built-ins are under
+/// 2 kB), so 1 MiB leaves room for any hand-written scene, or a sweep axis of ~10⁵ listed values, while
+/// bounding what a wrong path can make the tool read.
 pub const SCENE_MAX_BYTES: u64 = 1 << 20;
 
 /// What an input is read as, for the rules and the words of a refusal.
