@@ -22,7 +22,9 @@ use crate::digest::Digest;
 use crate::early_metadata::{self, Lookahead, ScanEnd};
 use crate::findings::BoundedFindings;
 use crate::prefetch::{self, Batch, ChunkError, Event};
-use crate::records::{Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN};
+use crate::records::{
+    AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
+};
 use mcap::records::{
     op, Channel, ChunkHeader, ChunkIndex, Footer, Header, MessageHeader, MessageIndex, Metadata,
     MetadataIndex, Statistics, SummaryOffset,
@@ -812,6 +814,17 @@ impl Book {
             op::METADATA => self.metadata(data, at, visitor),
             op::ATTACHMENT => {
                 self.attachment_count += 1;
+                let a: AttachmentRecord = parse(data, at)?;
+                let found = crc32fast::hash(&data[..a.crc_covered_len()]);
+                if a.crc != 0 && a.crc != found {
+                    let (name, stored) = (a.name, a.crc);
+                    self.problem(|| {
+                        format!(
+                            "attachment `{name}` at byte {at}: CRC {found:#010x} of its data does not \
+                             match the stored {stored:#010x}"
+                        )
+                    });
+                }
                 Ok(())
             }
             op::CHUNK_INDEX => self.chunk_index(data, at),
@@ -1160,6 +1173,54 @@ mod tests {
         assert!(s.problems.is_empty(), "{}", s.problems.summary());
         assert_eq!(v.events, ["metadata late after 0 messages"]);
         assert_eq!(v.messages, 8192);
+    }
+
+    /// A file by the `mcap` crate's writer with one attachment whose data is `hello`, and the offset of
+    /// that data (no data-section CRC, so that the tests can edit the attachment alone).
+    fn file_with_attachment() -> (Vec<u8>, usize) {
+        let options = mcap::WriteOptions::new().calculate_data_section_crc(false);
+        let mut w = options.create(IoCursor::new(Vec::new())).unwrap();
+        w.attach(&mcap::Attachment {
+            log_time: 1,
+            create_time: 2,
+            name: "note".into(),
+            media_type: "text/plain".into(),
+            data: Cow::Borrowed(b"hello"),
+        })
+        .unwrap();
+        w.finish().unwrap();
+        let bytes = w.into_inner().into_inner();
+        let at = bytes.windows(5).position(|w| w == b"hello").unwrap();
+        (bytes, at)
+    }
+
+    #[test]
+    fn an_attachment_is_checked_for_its_framing_and_crc() {
+        let (bytes, at) = file_with_attachment();
+        let (_, s, e) = read_with_deadline(bytes.clone(), u64::MAX);
+        assert_eq!(e, None);
+        assert!(s.problems.is_empty(), "{}", s.problems.summary());
+        // One byte of its data changed: the CRC it stores no longer holds.
+        let mut flipped = bytes.clone();
+        flipped[at] ^= 1;
+        let (_, s, _) = read_with_deadline(flipped, u64::MAX);
+        let problems = s.problems.summary();
+        assert!(
+            problems.contains("attachment `note` at byte ")
+                && problems.contains("does not match the stored"),
+            "{problems}"
+        );
+        // Its data length claiming more than the record holds: malformed, not an allocation.
+        let mut lying = bytes;
+        lying[at - 8..at].copy_from_slice(&u64::MAX.to_le_bytes());
+        let (_, _, e) = read_with_deadline(lying, u64::MAX);
+        let e = e.unwrap();
+        assert_eq!(e.kind, ReadErrorKind::Corrupt);
+        assert!(
+            e.to_string()
+                .contains("malformed attachment record at byte "),
+            "{e}"
+        );
     }
 
     #[test]

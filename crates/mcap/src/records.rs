@@ -462,6 +462,63 @@ impl<'a> Field<'a> for ChunkRecord<'a> {
 
 record!(ChunkRecord<'a> = op::CHUNK, "chunk");
 
+/// An attachment record: its times, name and media type, `data`, and the CRC-32 of every byte before the
+/// CRC (0: not computed). Only read, for its framing and its CRC: coin-log writes none.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AttachmentRecord<'a> {
+    /// When it was logged (ns).
+    pub log_time: u64,
+    /// When it was made (ns).
+    pub create_time: u64,
+    /// Its name.
+    pub name: String,
+    /// Its media type.
+    pub media_type: String,
+    /// Its data (with a u64 length prefix in the file).
+    pub data: Tail<'a>,
+    /// The stored CRC.
+    pub crc: u32,
+}
+
+impl AttachmentRecord<'_> {
+    /// Bytes of the body that the CRC covers: every field before it.
+    #[must_use]
+    pub fn crc_covered_len(&self) -> usize {
+        8 + 8 + 4 + self.name.len() + 4 + self.media_type.len() + 8 + self.data.0.len()
+    }
+}
+
+impl<'a> Field<'a> for AttachmentRecord<'a> {
+    fn parse(c: &mut Cursor<'a>, _: &'static str) -> Result<Self, WireError> {
+        let log_time = u64::parse(c, "log_time")?;
+        let create_time = u64::parse(c, "create_time")?;
+        let name = String::parse(c, "name")?;
+        let media_type = String::parse(c, "media_type")?;
+        let len = u64::parse(c, "data")?;
+        let data = Tail(c.take(len, "data")?);
+        let crc = u32::parse(c, "crc")?;
+        Ok(Self {
+            log_time,
+            create_time,
+            name,
+            media_type,
+            data,
+            crc,
+        })
+    }
+    fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), TooLong> {
+        self.log_time.encode(out, "log_time")?;
+        self.create_time.encode(out, "create_time")?;
+        self.name.encode(out, "name")?;
+        self.media_type.encode(out, "media_type")?;
+        (self.data.0.len() as u64).encode(out, "data")?;
+        out.extend_from_slice(self.data.0);
+        self.crc.encode(out, "crc")
+    }
+}
+
+record!(AttachmentRecord<'a> = op::ATTACHMENT, "attachment");
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
