@@ -320,3 +320,64 @@ fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
         rows(&dir.path().join("one/catalogue.csv"))
     );
 }
+
+/// Holds shard `shard`'s lock in `folder` as a running sweep would (an advisory lock on its own open
+/// file: a second one conflicts with it even within this process).
+fn hold_lock(folder: &Path, shard: &str) -> std::fs::File {
+    let (k, n) = shard.split_once('/').unwrap();
+    let path = folder.join(format!(".coin-log-sweep/lock-{k}-of-{n}"));
+    let file = std::fs::File::create(path).unwrap();
+    file.try_lock().unwrap();
+    file
+}
+
+#[test]
+fn a_shard_that_a_running_sweep_makes_is_refused_and_collect_waits_for_it() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "0/2"]);
+    assert_eq!(code, 0, "{json}");
+    let folder = dir.path().join("d");
+    let journals = || {
+        let state = folder.join(".coin-log-sweep");
+        let names = listing(&state)
+            .into_iter()
+            .filter(|n| n.starts_with("journal-"));
+        names
+            .map(|n| (std::fs::read(state.join(&n)).unwrap(), n))
+            .collect::<Vec<_>>()
+    };
+    let before = (listing(&folder), journals());
+    let held = hold_lock(&folder, "1/2");
+    // The same shard, and the whole sweep (which shares shard 1/2's runs): refused, nothing changed.
+    for (args, says) in [
+        (&["--shard", "1/2"][..], "is making shard 1/2 now ("),
+        (
+            &[][..],
+            "is making shard 1/2 now, which shares runs with shard 0/1 (",
+        ),
+    ] {
+        let (code, out, err) = run_in(
+            dir.path(),
+            &[&["sweep", "s.toml", "-o", "d"][..], args].concat(),
+        );
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(
+            err.contains("`d`: is in use: another `coin-log sweep` ") && err.contains(says),
+            "{args:?}: {err}"
+        );
+        assert_eq!((listing(&folder), journals()), before, "{args:?}");
+    }
+    // A shard that shares no run with it goes ahead (shard 0/2 again: nothing to do).
+    let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "0/2"]);
+    assert_eq!(code, 0, "{json}");
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("shard 1/2 is still running in `"), "{err}");
+    // Negative control: once the lock is released, the same commands go through.
+    drop(held);
+    let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/2"]);
+    assert_eq!(code, 0, "{json}");
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 0, "{err}");
+}

@@ -56,6 +56,12 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         .collect();
     parts.sort_by_key(|(s, _)| (s.count(), s.index()));
     let mut problems = Vec::new();
+    if let Some(shard) = folder.held_lock(|_| true) {
+        problems.push(format!(
+            "shard {shard} is still running in `{}`: collect when every shard has ended",
+            dir.display()
+        ));
+    }
     if parts.is_empty() {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: run the shards first, `coin-log sweep SWEEP.toml -o DIR --shard K/N`",

@@ -55,6 +55,22 @@ fn journal_file_name(shard: Shard) -> String {
     format!("journal-{}-of-{}.csv", shard.index(), shard.count())
 }
 
+fn lock_file_name(shard: Shard) -> String {
+    format!("lock-{}-of-{}", shard.index(), shard.count())
+}
+
+fn shard_of_lock(name: &str) -> Option<Shard> {
+    let (k, n) = name.strip_prefix("lock-")?.split_once("-of-")?;
+    Shard::new(k.parse().ok()?, n.parse().ok()?).ok()
+}
+
+/// A shard's lock (an advisory `flock` on `.coin-log-sweep/lock-K-of-N`), held while a process makes
+/// the shard's runs; the system releases it when the process ends, however it ends.
+#[derive(Debug)]
+pub struct ShardLock {
+    _file: Option<File>,
+}
+
 /// The plan: the sweep as resolved, its identity, and what `collect` needs (runs, columns, file names).
 #[must_use]
 pub fn plan_json(sweep: &Sweep) -> serde_json::Value {
@@ -190,6 +206,62 @@ impl Folder {
             .prefix(&format!(".run-{index:0width$}."))
             .suffix(".mcap.tmp")
             .tempfile_in(&self.path)
+    }
+
+    /// Takes `shard`'s lock, so that no two processes make a run at once (the second would also delete
+    /// the first's temporary files as stale). Refused while another process holds the lock of this shard
+    /// or of one whose runs overlap it (`sweep` without `--shard` and shard 1/4, say). On a file system
+    /// without locks, runs unlocked.
+    ///
+    /// # Errors
+    /// [`SweepError::Folder`] when another process holds such a lock; [`SweepError::Io`] when the lock
+    /// file cannot be opened.
+    pub fn lock(&self, shard: Shard) -> Result<ShardLock, SweepError> {
+        let path = self.state().join(lock_file_name(shard));
+        let file = files::absent_or_regular(&path)
+            .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
+            .map_err(SweepError::io("opening the shard's lock", &path))?;
+        // A process looking whether the lock is held (below, or `collect`) holds it shared for a moment:
+        // try again before calling the shard busy.
+        for attempt in 1.. {
+            match file.try_lock() {
+                Ok(()) => break,
+                Err(fs::TryLockError::WouldBlock) if attempt < 5 => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                Err(fs::TryLockError::WouldBlock) => return Err(self.busy(shard, shard)),
+                Err(fs::TryLockError::Error(_)) => return Ok(ShardLock { _file: None }),
+            }
+        }
+        if let Some(other) = self.held_lock(|other| other != shard && other.overlaps(shard)) {
+            return Err(self.busy(shard, other));
+        }
+        Ok(ShardLock { _file: Some(file) })
+    }
+
+    /// The first shard whose lock another process holds, among those `wanted` takes.
+    pub fn held_lock(&self, wanted: impl Fn(Shard) -> bool) -> Option<Shard> {
+        let entries = fs::read_dir(self.state()).ok()?;
+        entries.flatten().find_map(|e| {
+            let other = shard_of_lock(e.file_name().to_str()?).filter(|&s| wanted(s))?;
+            let file = files::open_regular(&e.path()).ok()?;
+            // Shared, so that two processes looking at once do not see each other; dropped at once.
+            let held = matches!(file.try_lock_shared(), Err(fs::TryLockError::WouldBlock));
+            held.then_some(other)
+        })
+    }
+
+    fn busy(&self, shard: Shard, holder: Shard) -> SweepError {
+        let shares = if holder == shard {
+            String::new()
+        } else {
+            format!(", which shares runs with shard {shard}")
+        };
+        SweepError::folder(&self.path)(format!(
+            "is in use: another `coin-log sweep` is making shard {holder} now{shares} (it holds \
+             {STATE_DIR}/{}); wait for it to end or stop it, then run again to resume",
+            lock_file_name(holder)
+        ))
     }
 
     /// Deletes the temporary files a killed process of `shard` left: of its runs, and of its catalogue

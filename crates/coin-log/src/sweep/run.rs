@@ -126,6 +126,7 @@ pub fn run(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
+    let _lock = folder.lock(options.shard)?;
     let Resumed {
         held,
         todo,

@@ -76,6 +76,16 @@ impl Shard {
         run % self.count == self.index
     }
 
+    /// Whether some run is both this shard's and `other`'s: K ≡ K' (mod gcd(N, N')).
+    #[must_use]
+    pub fn overlaps(self, other: Self) -> bool {
+        let (mut a, mut b) = (self.count, other.count);
+        while b != 0 {
+            (a, b) = (b, a % b);
+        }
+        self.index % a == other.index % a
+    }
+
     /// How many of a sweep's `runs` are this shard's.
     #[must_use]
     pub fn len(self, runs: u64) -> u64 {
@@ -192,6 +202,19 @@ impl fmt::Display for Shard {
 mod tests {
     use super::*;
     use std::collections::HashMap;
+
+    #[test]
+    fn shards_overlap_exactly_when_they_share_a_run() {
+        let all: Vec<Shard> = (1..=6)
+            .flat_map(|n| (0..n).map(move |k| Shard::new(k, n).unwrap()))
+            .collect();
+        for &a in &all {
+            for &b in &all {
+                let shared = (0..60).any(|i| a.takes(i) && b.takes(i));
+                assert_eq!(a.overlaps(b), shared, "{a} and {b}");
+            }
+        }
+    }
 
     #[test]
     fn the_shards_of_every_count_make_each_run_exactly_once() {
