@@ -37,31 +37,51 @@ pub fn run_file_name(index: u64, width: usize) -> String {
     format!("run-{index:0width$}.mcap")
 }
 
+/// The name of a file that each shard has its own of: `<prefix>K-of-N<suffix>`.
+struct ShardFile {
+    prefix: &'static str,
+    suffix: &'static str,
+}
+
+/// A shard's catalogue, in the folder.
+const PART: ShardFile = ShardFile {
+    prefix: "catalogue.part-",
+    suffix: ".csv",
+};
+/// A shard's journal, in the state folder.
+const JOURNAL: ShardFile = ShardFile {
+    prefix: "journal-",
+    suffix: ".csv",
+};
+/// A shard's lock, in the state folder.
+const LOCK: ShardFile = ShardFile {
+    prefix: "lock-",
+    suffix: "",
+};
+
+impl ShardFile {
+    fn name(&self, shard: Shard) -> String {
+        let (prefix, suffix) = (self.prefix, self.suffix);
+        format!("{prefix}{}-of-{}{suffix}", shard.index(), shard.count())
+    }
+
+    fn shard_of(&self, name: &str) -> Option<Shard> {
+        let rest = name.strip_prefix(self.prefix)?.strip_suffix(self.suffix)?;
+        let (k, n) = rest.split_once("-of-")?;
+        Shard::new(k.parse().ok()?, n.parse().ok()?).ok()
+    }
+}
+
 /// `catalogue.part-K-of-N.csv`.
 #[must_use]
 pub fn part_file_name(shard: Shard) -> String {
-    format!("catalogue.part-{}-of-{}.csv", shard.index(), shard.count())
+    PART.name(shard)
 }
 
 /// The shard of a part's file name.
 #[must_use]
 pub fn shard_of_part(name: &str) -> Option<Shard> {
-    let rest = name.strip_prefix("catalogue.part-")?.strip_suffix(".csv")?;
-    let (k, n) = rest.split_once("-of-")?;
-    Shard::new(k.parse().ok()?, n.parse().ok()?).ok()
-}
-
-fn journal_file_name(shard: Shard) -> String {
-    format!("journal-{}-of-{}.csv", shard.index(), shard.count())
-}
-
-fn lock_file_name(shard: Shard) -> String {
-    format!("lock-{}-of-{}", shard.index(), shard.count())
-}
-
-fn shard_of_lock(name: &str) -> Option<Shard> {
-    let (k, n) = name.strip_prefix("lock-")?.split_once("-of-")?;
-    Shard::new(k.parse().ok()?, n.parse().ok()?).ok()
+    PART.shard_of(name)
 }
 
 /// A shard's lock (an advisory `flock` on `.coin-log-sweep/lock-K-of-N`), held while a process makes
@@ -217,7 +237,7 @@ impl Folder {
     /// [`SweepError::Folder`] when another process holds such a lock; [`SweepError::Io`] when the lock
     /// file cannot be opened.
     pub fn lock(&self, shard: Shard) -> Result<ShardLock, SweepError> {
-        let path = self.state().join(lock_file_name(shard));
+        let path = self.state().join(LOCK.name(shard));
         let file = files::absent_or_regular(&path)
             .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
             .map_err(SweepError::io("opening the shard's lock", &path))?;
@@ -243,7 +263,9 @@ impl Folder {
     pub fn held_lock(&self, wanted: impl Fn(Shard) -> bool) -> Option<Shard> {
         let entries = fs::read_dir(self.state()).ok()?;
         entries.flatten().find_map(|e| {
-            let other = shard_of_lock(e.file_name().to_str()?).filter(|&s| wanted(s))?;
+            let other = LOCK
+                .shard_of(e.file_name().to_str()?)
+                .filter(|&s| wanted(s))?;
             let file = files::open_regular(&e.path()).ok()?;
             // Shared, so that two processes looking at once do not see each other; dropped at once.
             let held = matches!(file.try_lock_shared(), Err(fs::TryLockError::WouldBlock));
@@ -260,7 +282,7 @@ impl Folder {
         SweepError::folder(&self.path)(format!(
             "is in use: another `coin-log sweep` is making shard {holder} now{shares} (it holds \
              {STATE_DIR}/{}); wait for it to end or stop it, then run again to resume",
-            lock_file_name(holder)
+            LOCK.name(holder)
         ))
     }
 
@@ -310,7 +332,7 @@ impl Folder {
             .filter(|p| {
                 p.file_name()
                     .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with("journal-") && n.ends_with(".csv"))
+                    .is_some_and(|n| n.starts_with(JOURNAL.prefix) && n.ends_with(JOURNAL.suffix))
             })
             .collect();
         names.sort();
@@ -333,7 +355,7 @@ impl Folder {
     /// # Errors
     /// It cannot be created or written.
     pub fn journal(&self, shard: Shard) -> Result<Journal, SweepError> {
-        let path = self.state().join(journal_file_name(shard));
+        let path = self.state().join(JOURNAL.name(shard));
         let file = files::absent_or_regular(&path)
             .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
             .map_err(SweepError::io("opening the journal", &path))?;
