@@ -559,6 +559,24 @@ mod tests {
     }
 
     #[test]
+    fn an_attachment_parses_back_and_its_crc_covers_all_but_the_crc() {
+        let a = AttachmentRecord {
+            log_time: 1,
+            create_time: 2,
+            name: "note".into(),
+            media_type: "text/plain".into(),
+            data: Tail(b"hello"),
+            crc: 7,
+        };
+        let mut out = Vec::new();
+        a.encode_record(&mut out).unwrap();
+        let (opcode, body) = Cursor::new(&out).record().unwrap();
+        assert_eq!(opcode, op::ATTACHMENT);
+        assert_eq!(AttachmentRecord::parse_body(body).unwrap(), a);
+        assert_eq!(a.crc_covered_len(), body.len() - 4);
+    }
+
+    #[test]
     fn the_footer_is_as_long_as_declared() {
         let mut out = Vec::new();
         Footer::default().encode_record(&mut out).unwrap();
