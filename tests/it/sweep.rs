@@ -489,7 +489,7 @@ channels = ["omega", "velocity"]
         "and not a path: a scene file is given by its path relative to the sweep file, such as \"./wobbel.toml\"",
         "`set.\"run..rate\"` = 1.0 is not a dotted scene key",
         "`set.run` = { duration = 2.0 } is a table: TOML reads an unquoted dotted key as nested tables, which would replace the whole `run` table; quote the key so that it names one scene key: set = { \"run.duration\" = 2.0 }",
-        "`axis[0].linspace` = [0.1, 0.5, 0] must end with a whole number of values n, 1 ≤ n ≤ 1000000000",
+        "`axis[0].linspace` = [0.1, 0.5, 0] must end with a whole number of values n, 1 ≤ n ≤ 1000000 (more samples of a key: draw it, [[random.draw]])",
         "`axis[1]` has no values: give one of `values = [...]`, `linspace = [first, last, n]` or `logspace = [first_exp, last_exp, n]`",
         "`axis[2].values` = [] is empty: give at least one value",
         "`axis[3]` gives values and logspace: give exactly one of them",
@@ -510,6 +510,41 @@ channels = ["omega", "velocity"]
     }
     assert!(
         err.contains(&format!("{} problems:", expected.len() - 1)),
+        "{err}"
+    );
+}
+
+#[test]
+fn axes_of_more_values_than_memory_and_sweep_json_take_are_refused_before_any_is_made() {
+    // A linspace of 10⁹ values (as many as a sweep's runs) once asked for 32 GB and aborted.
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [0.2, 1.0, 1000000000]
+"#,
+    );
+    assert!(
+        err.contains("`axis[0].linspace` = [0.2, 1.0, 1000000000] must end with a whole number of values n, 1 ≤ n ≤ 1000000"),
+        "{err}"
+    );
+    // Zipped axes make one dimension, so only the values' total stops these (6·10⁵ runs).
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [0.2, 1.0, 600000]
+zip = "z"
+[[axis]]
+key = "initial.phi"
+linspace = [0.0, 1.0, 600000]
+zip = "z"
+"#,
+    );
+    assert!(
+        err.contains("`axis` gives 1200000 values in all, more than the 1000000 the axes may"),
         "{err}"
     );
 }

@@ -26,7 +26,9 @@ pub use catalogue::{
     columns, FailureKind, RunStatus, LEADING_COLUMNS, TRAILING_COLUMNS, WALL_TIME_COLUMN,
 };
 pub use collect::{collect, Collected};
-pub use definition::{Axis, Draw, Random, RunSceneError, Settings, Sweep, CHANNELS_KEY, MAX_RUNS};
+pub use definition::{
+    Axis, Draw, Random, RunSceneError, Settings, Sweep, CHANNELS_KEY, MAX_AXIS_VALUES, MAX_RUNS,
+};
 pub use error::SweepError;
 pub use file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
 pub use folder::{

@@ -3,7 +3,9 @@
 //! it to the base scene and reading the result as a scene file; whether the values give a *valid* scene
 //! is each run's business (an invalid combination is a failed run, not a bad sweep file).
 
-use super::definition::{Axis, Draw, Random, Settings, Sweep, CHANNELS_KEY, MAX_RUNS};
+use super::definition::{
+    Axis, Draw, Random, Settings, Sweep, CHANNELS_KEY, MAX_AXIS_VALUES, MAX_RUNS,
+};
 use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
 use super::random::Distribution;
 use super::space::{linspace, logspace};
@@ -289,12 +291,9 @@ impl Checker {
             );
             return None;
         };
-        let Some(n) = n.filter(|&n| n <= MAX_RUNS) else {
-            self.problem(
-                name,
-                text,
-                format!("must end with a whole number of values n, 1 ≤ n ≤ {MAX_RUNS}"),
-            );
+        let Some(n) = n.filter(|&n| n <= MAX_AXIS_VALUES) else {
+            self.problem(name, text, format!(
+                "must end with a whole number of values n, 1 ≤ n ≤ {MAX_AXIS_VALUES} (more samples of a key: draw it, [[random.draw]])"));
             return None;
         };
         let values: Vec<f64> = space(first, last, n);
@@ -632,8 +631,14 @@ impl Checker {
         }
     }
 
-    /// At most [`MAX_RUNS`] runs.
+    /// At most [`MAX_RUNS`] runs and [`MAX_AXIS_VALUES`] axis values.
     fn size(&mut self, sweep: &Sweep) {
+        let values: usize = sweep.axes.iter().map(|a| a.values.len()).sum();
+        if values as u64 > MAX_AXIS_VALUES {
+            self.problem("axis", "", format!(
+                "gives {values} values in all, more than the {MAX_AXIS_VALUES} the axes may (sweep.json lists them): \
+                 draw the densest keys at random ([[random.draw]]), or split the sweep"));
+        }
         let lengths = sweep.lengths();
         let count = sweep.random.as_ref().map_or(1, |r| r.count);
         let runs = lengths.chain([count]).try_fold(1u64, u64::checked_mul);
