@@ -120,10 +120,23 @@ pub fn main() -> ExitCode {
         Err(e) => return output::settle(output::clap_message(&e)).into(),
     };
     let outcome = run(cli).unwrap_or_else(|e| {
-        output::errln!("error: {e:#}");
+        output::errln!("error: {}", with_causes(&e));
         Outcome::Failure
     });
     output::settle(outcome).into()
+}
+
+/// The error and its causes, each cause left out where the message already says it: the library's errors
+/// name their cause in their own message, and `{:#}` printed it twice ("is a named pipe…: is a named
+/// pipe…").
+fn with_causes(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1).map(ToString::to_string) {
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    text
 }
 
 fn run(cli: Cli) -> anyhow::Result<Outcome> {

@@ -478,10 +478,11 @@ fn collect(args: &CollectArgs) -> anyhow::Result<Outcome> {
             summary.display()
         );
     } else {
+        let n = collected.problems.len();
+        let problems = if n == 1 { "problem" } else { "problems" };
         errln!(
-            "error: {}: {} problems; nothing written",
-            args.dir.display(),
-            collected.problems.len()
+            "error: {}: {n} {problems}; nothing written",
+            args.dir.display()
         );
     }
     Ok(if collected.problems.is_empty() && collected.failed == 0 {

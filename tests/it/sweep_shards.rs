@@ -381,3 +381,70 @@ fn a_shard_that_a_running_sweep_makes_is_refused_and_collect_waits_for_it() {
     let (code, err) = collect(dir.path(), "d");
     assert_eq!(code, 0, "{err}");
 }
+
+#[test]
+fn links_in_the_sweep_folder_are_refused_never_written_through_or_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let victim = dir.path().join("victim");
+    std::fs::write(&victim, "keep me\n").unwrap();
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "d", &["--shard", "0/2"]).0,
+        0
+    );
+    let d = dir.path().join("d");
+    let link = |name: &str| {
+        let path = d.join(name);
+        std::os::unix::fs::symlink(&victim, &path).unwrap();
+        path
+    };
+    // A journal through a link: appending would write into the victim.
+    let journal = link(".coin-log-sweep/journal-1-of-2.csv");
+    let (code, out, err) = run_in(
+        dir.path(),
+        &["sweep", "s.toml", "-o", "d", "--shard", "1/2"],
+    );
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(
+        err.contains("journal-1-of-2.csv`: is a symbolic link (to `"),
+        "{err}"
+    );
+    std::fs::remove_file(&journal).unwrap();
+    // A run's name held by a link: that run fails on I/O, the link stays.
+    let run = link("run-01.mcap");
+    let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/2"]);
+    assert_eq!(code, 1, "{json}");
+    assert_eq!(json["failed"], 1, "{json}");
+    assert!(std::fs::symlink_metadata(&run)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    std::fs::remove_file(&run).unwrap();
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/2"]).0,
+        0
+    );
+    // The catalogue's name held by a link: collect refuses rather than replacing it.
+    let catalogue = link("catalogue.csv");
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("catalogue.csv`: is a symbolic link (to `"),
+        "{err}"
+    );
+    assert!(std::fs::symlink_metadata(&catalogue)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me\n");
+    std::fs::remove_file(&catalogue).unwrap();
+    // A part that is a pipe is named once, not once per cause in the error's chain.
+    let pipe = d.join("catalogue.part-9-of-10.csv");
+    crate::support::mkfifo(&pipe);
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.matches("is a named pipe").count(), 1, "{err}");
+    std::fs::remove_file(&pipe).unwrap();
+    // Negative control: without the link and the pipe, collect writes the catalogue.
+    assert_eq!(collect(dir.path(), "d").0, 0);
+}

@@ -179,6 +179,25 @@ pub fn absent_or_regular(path: &Path) -> io::Result<()> {
     }
 }
 
+/// Ok if `path` is absent or a regular file itself, not a link to one: for the files a command writes in a
+/// folder of its own (a sweep's journal, catalogue and summary), where through a link an append would go
+/// to the file it points to and a move into place would replace the link with a plain file.
+///
+/// # Errors
+/// As [`absent_or_regular`], and [`io::ErrorKind::InvalidInput`] for a symbolic link.
+pub fn absent_or_plain(path: &Path) -> io::Result<()> {
+    match fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_symlink() => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "is a symbolic link (to `{}`), not a regular file: move it away",
+                fs::read_link(path).map_or_else(|_| "?".into(), |to| to.display().to_string())
+            ),
+        )),
+        _ => absent_or_regular(path),
+    }
+}
+
 /// The regular file at `path` opened for reading, as [`absent_or_regular`] allows.
 ///
 /// # Errors

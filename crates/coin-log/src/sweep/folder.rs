@@ -238,7 +238,7 @@ impl Folder {
     /// file cannot be opened.
     pub fn lock(&self, shard: Shard) -> Result<ShardLock, SweepError> {
         let path = self.state().join(LOCK.name(shard));
-        let file = files::absent_or_regular(&path)
+        let file = files::absent_or_plain(&path)
             .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
             .map_err(SweepError::io("opening the shard's lock", &path))?;
         // A process looking whether the lock is held (below, or `collect`) holds it shared for a moment:
@@ -356,7 +356,7 @@ impl Folder {
     /// It cannot be created or written.
     pub fn journal(&self, shard: Shard) -> Result<Journal, SweepError> {
         let path = self.state().join(JOURNAL.name(shard));
-        let file = files::absent_or_regular(&path)
+        let file = files::absent_or_plain(&path)
             .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
             .map_err(SweepError::io("opening the journal", &path))?;
         let last = last_byte(&file, &path).map_err(SweepError::io("reading the journal", &path))?;
@@ -420,7 +420,8 @@ impl Folder {
         let path = self.path.join(name);
         let persist =
             |temp: tempfile::NamedTempFile| temp.persist(&path).map(drop).map_err(|e| e.error);
-        temp_beside(&path, write)
+        files::absent_or_plain(&path)
+            .and_then(|()| temp_beside(&path, write))
             .and_then(persist)
             .map_err(SweepError::io("writing", &path))?;
         Ok(path)

@@ -449,6 +449,7 @@ fn record_and_check(
         .verify
         .then(|| verify::verify_file(temp.path(), &verify::Options::default()));
     let verify_seconds = started.elapsed().as_secs_f64();
+    crate::files::absent_or_plain(&target).map_err(io("moving the recording to"))?;
     temp.persist(&target)
         .map_err(|e| io("moving the recording to")(e.error))?;
     let (_, mtime_ns) = folder::size_and_mtime(&target)

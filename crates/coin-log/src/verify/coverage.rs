@@ -76,7 +76,7 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
     let samples = (run.duration * run.rate).floor() + 1.0;
     if samples < WINDOW {
         return Some(format!(
-            "needs {WINDOW} samples in a row and the run records {samples}; raise --rate or --duration"
+            "needs {WINDOW} evenly spaced samples in a row and the run has {samples} on its sampling grid; raise --rate or --duration"
         ));
     }
     let s = &scene.initial;
