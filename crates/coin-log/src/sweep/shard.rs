@@ -43,10 +43,16 @@ impl Shard {
     /// # Errors
     /// Unless 0 ≤ index < count.
     pub fn new(index: u64, count: u64) -> Result<Self, ShardError> {
+        if count == 0 {
+            return Err(ShardError(format!(
+                "shard {index}/0: N must be at least 1 (the number of shards)"
+            )));
+        }
         if index >= count {
             return Err(ShardError(format!(
-                "shard {index}/{count}: K must be 0 … N − 1 (Slurm numbers array tasks from 0: --array=0-{})",
-                count.saturating_sub(1).max(index)
+                "shard {index}/{count}: K must be 0 … N − 1 = {} (number a Slurm array from 0: --array=0-{})",
+                count - 1,
+                count - 1
             )));
         }
         Ok(Self { index, count })
@@ -243,8 +249,10 @@ mod tests {
 
     #[test]
     fn a_shard_outside_its_count_is_refused() {
-        assert!(Shard::new(4, 4).is_err());
-        assert!(Shard::new(0, 0).is_err());
+        let e = Shard::new(4, 4).unwrap_err().to_string();
+        assert!(e.contains("K must be 0 … N − 1 = 3") && e.contains("--array=0-3"), "{e}");
+        let e = Shard::new(0, 0).unwrap_err().to_string();
+        assert!(e.contains("N must be at least 1"), "{e}");
         assert!("3/2".parse::<Shard>().is_err());
         assert!("a/2"
             .parse::<Shard>()
