@@ -196,6 +196,30 @@ fn a_missing_folder_or_a_file_used_as_a_folder_is_named() {
     refused(dir.path(), "plain/x.mcap", &["Not a directory"]);
 }
 
+/// The benchmarks' `--out` folder is created as export's is: a device or file in its place is named as
+/// not a folder before any measuring (it said "File exists (os error 17)").
+#[test]
+fn a_bench_out_that_is_no_folder_is_named_before_measuring() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("plain"), "x").unwrap();
+    for (out, says) in [
+        (
+            "/dev/null",
+            "`/dev/null` is not a folder; --out takes a folder",
+        ),
+        ("plain", "`plain` is not a folder; --out takes a folder"),
+        (
+            "plain/sub",
+            "`plain` is not a folder, so `plain/sub` cannot be created in it",
+        ),
+    ] {
+        let output = coin_log(dir.path(), &["bench", "euler", "--out", out]);
+        assert_eq!(code(&output), 1, "{out}");
+        assert!(stderr(&output).contains(says), "{out}: {}", stderr(&output));
+    }
+    assert_eq!(std::fs::read(dir.path().join("plain")).unwrap(), b"x");
+}
+
 #[test]
 fn a_folder_without_write_permission_fails_before_simulating() {
     use std::os::unix::fs::PermissionsExt;

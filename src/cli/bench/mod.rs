@@ -5,9 +5,8 @@ mod sweep;
 mod throughput;
 
 use super::Outcome;
-use anyhow::Context;
 use coin_log::files::output::check;
-use coin_log::files::{shown, Output, Policy};
+use coin_log::files::{shown, Output, OutputFolder, Policy};
 use coin_log::integrate::Method;
 use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
 use coin_log_bench::plot::{euler_svg, work_precision_svg};
@@ -18,7 +17,6 @@ use coin_log_bench::table::{
 };
 use coin_log_bench::BenchCase;
 use coin_log_bench::{stability, suite};
-use std::fs;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `coin-log bench`.
@@ -108,8 +106,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
 /// Creates the output folder and checks, before the (long) measurement, that every file the bench will
 /// write there can be: a link, pipe or device in its place is refused now, not after the work.
 fn create_dir(out: &Path, files: &[String]) -> anyhow::Result<()> {
-    fs::create_dir_all(out)
-        .with_context(|| format!("creating the output folder `{}`", shown(out)))?;
+    // Created as export's and man's folders are, so that a file or device in its place is named as such.
+    OutputFolder::create(out, true)?.commit()?;
     for file in files {
         check(&out.join(file), &POLICY)?;
     }

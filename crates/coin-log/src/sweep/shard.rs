@@ -250,7 +250,10 @@ mod tests {
     #[test]
     fn a_shard_outside_its_count_is_refused() {
         let e = Shard::new(4, 4).unwrap_err().to_string();
-        assert!(e.contains("K must be 0 … N − 1 = 3") && e.contains("--array=0-3"), "{e}");
+        assert!(
+            e.contains("K must be 0 … N − 1 = 3") && e.contains("--array=0-3"),
+            "{e}"
+        );
         let e = Shard::new(0, 0).unwrap_err().to_string();
         assert!(e.contains("N must be at least 1"), "{e}");
         assert!("3/2".parse::<Shard>().is_err());
