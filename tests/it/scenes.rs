@@ -432,3 +432,29 @@ mod round_trip {
         }
     }
 }
+
+#[test]
+fn a_toml_error_quotes_its_line_cut_to_a_readable_length() {
+    // serde's message quotes the offending line whole: 200 000 brackets made a 200 kB error.
+    let deep = format!(
+        "description = {}{}",
+        "[".repeat(100_000),
+        "]".repeat(100_000)
+    );
+    let long = format!("[run]\nfoo = \"{}\"\n", "b".repeat(500_000));
+    for text in [deep, long] {
+        let e = coin_log::scene::parse_with_sets(&text, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.len() < 1000, "{} bytes: {}", e.len(), &e[..300]);
+        assert!(
+            e.contains("TOML parse error at line") && e.contains('…'),
+            "{e}"
+        );
+    }
+    // Negative control: a short line is quoted whole, nothing cut.
+    let e = coin_log::scene::parse_with_sets("[run]\nfoo = 1\n", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("foo = 1") && !e.contains('…'), "{e}");
+}

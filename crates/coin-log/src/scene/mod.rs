@@ -216,14 +216,32 @@ pub fn to_toml(file: &SceneFile) -> String {
 pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneError> {
     if sets.is_empty() {
         // Straight from the text: serde's message then points at the line.
-        return toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string().trim().into()));
+        return toml::from_str(text).map_err(|e| SceneError::Parse(toml_message(&e)));
     }
     let mut table: toml::Table =
-        toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string().trim().into()))?;
+        toml::from_str(text).map_err(|e| SceneError::Parse(toml_message(&e)))?;
     for set in sets {
         apply_set(&mut table, set)?;
     }
     file_from_table(table)
+}
+
+/// Longest line of a TOML error kept whole: serde's message quotes the offending line, which in a
+/// crafted file held 200 000 characters.
+const TOML_LINE_CHARS: usize = 200;
+
+/// A TOML parse error's message, trimmed, each quoted line cut to [`TOML_LINE_CHARS`] characters.
+#[must_use]
+pub fn toml_message(e: &toml::de::Error) -> String {
+    let text = e.to_string();
+    let lines = text
+        .trim()
+        .lines()
+        .map(|line| match line.char_indices().nth(TOML_LINE_CHARS) {
+            Some((cut, _)) => format!("{}…", &line[..cut]),
+            None => line.to_string(),
+        });
+    lines.collect::<Vec<_>>().join("\n")
 }
 
 /// A preset (or any file) with `--set` edits applied.

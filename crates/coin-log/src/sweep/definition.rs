@@ -139,7 +139,7 @@ impl Sweep {
     pub fn parse(text: &str, folder: &Path, label: &str) -> Result<Self, SweepError> {
         let file = toml::from_str(text).map_err(|e| SweepError::Parse {
             label: label.to_string(),
-            message: e.to_string().trim().to_string(),
+            message: scene::toml_message(&e),
         })?;
         validate::sweep(file, folder).map_err(|problems| SweepError::Invalid {
             label: label.to_string(),

@@ -151,7 +151,7 @@ impl Checker {
         match toml::from_str::<toml::Table>(&text) {
             Ok(table) => Some(table),
             Err(e) => {
-                let message = e.to_string().trim().replace('\n', " ");
+                let message = scene::toml_message(&e).replace('\n', " ");
                 self.problem(
                     "base",
                     quoted,
