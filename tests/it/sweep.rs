@@ -554,7 +554,7 @@ fn keys_that_are_no_scene_keys_or_collide_are_refused_naming_them() {
     let err = refused(
         r#"
 base = "wobble"
-set = { "initial.theta" = 0.3, "run.duration" = 1.0 }
+set = { "initial.theta" = 0.3, "run.duration" = 1.0, "record.channels" = ["omega"] }
 [[axis]]
 key = "initial.thetta"
 values = [0.1]
@@ -567,11 +567,15 @@ values = [{ theta = 0.3, omega = [0.0, 0.0, 1.0] }]
 [[axis]]
 key = "run.rate"
 values = [100.0, "fast"]
+[output]
+channels = ["angles"]
 "#,
     );
     for e in [
         "`axis[1].key` = \"initial.theta\" is also given by set.\"initial.theta\": each key is set or swept in one place only",
         "`axis[2].key` = \"initial\" replaces the whole table holding `initial.theta` (given by set.\"initial.theta\", which applies first)",
+        // output.channels has no key of its own to quote: it says which key it sets.
+        "`output.channels` sets `record.channels`, which is also given by set.\"record.channels\"",
     ] {
         assert!(err.contains(e), "missing `{e}` in:\n{err}");
     }

@@ -520,6 +520,20 @@ struct Place {
 }
 
 impl Place {
+    /// How a problem with the key names it: `axis[0].key` = "initial.theta", `set."run"` (the key is the
+    /// name), or `output.channels`, saying which key it sets.
+    fn key_problem(&self, reason: &str) -> (String, String, String) {
+        if self.name.ends_with(']') {
+            let value = format!("\"{}\"", self.key);
+            (format!("{}.key", self.name), value, reason.to_string())
+        } else if self.name.starts_with("set.") {
+            (self.name.clone(), String::new(), reason.to_string())
+        } else {
+            let reason = format!("sets `{}`, which {reason}", self.key);
+            (self.name.clone(), String::new(), reason)
+        }
+    }
+
     /// A place whose values are given at `name` itself.
     fn new(key: &str, name: String) -> Self {
         Self {
@@ -560,20 +574,22 @@ impl Checker {
     fn collisions(&mut self, places: &[Place]) {
         for (later_at, later) in places.iter().enumerate() {
             for earlier in &places[..later_at] {
-                if earlier.key == later.key {
-                    self.problem(
-                        format!("{}.key", later.name),
-                        format!("\"{}\"", later.key),
-                        format!(
-                            "is also given by {}: each key is set or swept in one place only",
-                            earlier.name
-                        ),
-                    );
+                let reason = if earlier.key == later.key {
+                    format!(
+                        "is also given by {}: each key is set or swept in one place only",
+                        earlier.name
+                    )
                 } else if earlier.key.starts_with(&format!("{}.", later.key)) {
-                    self.problem(format!("{}.key", later.name), format!("\"{}\"", later.key), format!(
+                    format!(
                         "replaces the whole table holding `{}` (given by {}, which applies first): give that key \
-                         inside {}'s values, or sweep a key inside `{}`", earlier.key, earlier.name, later.name, later.key));
-                }
+                         inside {}'s values, or sweep a key inside `{}`",
+                        earlier.key, earlier.name, later.name, later.key
+                    )
+                } else {
+                    continue;
+                };
+                let (name, value, reason) = later.key_problem(&reason);
+                self.problem(name, value, reason);
             }
         }
     }
