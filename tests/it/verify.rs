@@ -115,6 +115,44 @@ fn verify_flags_a_log_with_one_position_moved_by_1e_4() {
     assert_fails(&r, CheckId::Constraint, 2e-3, 1e-2);
 }
 
+/// A coin released at θ = 1.5 sinks flat and spins up (φ̇ doubles every 0.05 time units): the windows
+/// where its rates grow that fast are not resolved at rate 100, and must be left out rather than failed
+/// (they measured 2.5e-7 against a tolerance of 2e-7, all of it the difference's truncation).
+#[test]
+fn a_coin_spinning_up_as_it_sinks_flat_is_resolved_where_the_sampling_allows_and_a_moved_position_still_fails(
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(
+        dir.path(),
+        "wobble",
+        &["--set", "initial.theta=1.5", "--duration", "1"],
+    );
+    let r = verify_file(&path, &Options::default());
+    assert_eq!(r.exit_code, 0, "{}", show(&r));
+    let c = r.check(CheckId::Constraint).unwrap();
+    assert_eq!(c.status, Status::Pass, "{}", show(&r));
+    assert!(
+        c.reason
+            .contains("windows left out: the sampling does not resolve"),
+        "{}",
+        c.reason
+    );
+    // Negative control: a position moved by 1e-4 where the windows are resolved (t = 0.9) fails.
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&path, &bad, |e| {
+        if e.topic == "/coin/position" && e.index == 90 {
+            nudge(e.data, "x", 1e-4);
+        }
+    });
+    let r = verify_file(&bad, &Options::default());
+    assert_eq!(
+        r.check(CheckId::Constraint).unwrap().status,
+        Status::Fail,
+        "{}",
+        show(&r)
+    );
+}
+
 #[test]
 fn verify_flags_a_log_with_one_omega_sample_changed_by_1e_5() {
     let r = tampered("wobble", |e| {
