@@ -384,3 +384,74 @@ fn an_event_just_after_a_grid_sample_never_repeats_a_nanosecond_of_log_time() {
         assert_eq!(*times.last().unwrap(), 500_000_000);
     }
 }
+
+/// An event when the clock's y is within `half_width` of 1: g = (y − 1)² − half_width², which is positive
+/// at both ends of [0, 2] and ≤ 0 only inside (negative half-widths: never).
+struct Dips(f64);
+impl EventFunctions<1> for Dips {
+    fn count(&self) -> usize {
+        1
+    }
+    fn evaluate(&self, _t: f64, y: &[f64; 1], out: &mut [f64]) {
+        out[0] = (y[0] - 1.0).powi(2) - self.0 * self.0.abs();
+    }
+}
+
+/// An event function that dips to 0 and back within one step is found at its first root: the adaptive
+/// methods cross [0, 2] of the clock in a few long steps whose ends all have g > 0.
+#[test]
+fn an_event_that_dips_below_zero_inside_one_step_ends_the_run_at_its_first_root() {
+    let settings = RunSettings {
+        t0: 0.0,
+        t_end: 2.0,
+        sample_interval: 2.0,
+    };
+    for method in Method::ALL {
+        let config = MethodConfig {
+            method: *method,
+            rtol: 1e-10,
+            atol: 1e-12,
+            step: 1e-3,
+        };
+        let outcome = run_method(&config, &Clock, &[0.0], &settings, &Dips(0.2), |_, _| {
+            Flow::Continue
+        });
+        println!(
+            "{method}: {:?} after {} steps",
+            outcome.termination, outcome.stats.steps
+        );
+        let RunEnd::Event { t, .. } = outcome.termination else {
+            panic!(
+                "{method}: the dip must end the run, got {:?}",
+                outcome.termination
+            );
+        };
+        assert!(
+            (t - 0.8).abs() <= 1e-12,
+            "{method}: event at {t}, expected the first root 0.8"
+        );
+        // Negative control: a function that stays positive lets the run complete.
+        let outcome = run_method(&config, &Clock, &[0.0], &settings, &Dips(-0.2), |_, _| {
+            Flow::Continue
+        });
+        assert_eq!(outcome.termination, RunEnd::Completed, "{method}");
+    }
+}
+
+/// Released at θ₀ = 0.5 without spin, N dips below 0 for 0.1 time units around t = 1.84 and comes back
+/// (physics §7): the run must end at the first N = 0. At the default rtol dop853's steps (0.17) were
+/// longer than the dip, and the run went on as if the coin still rolled.
+#[test]
+fn a_disk_released_at_0_5_leaves_the_table_where_n_first_reaches_0_though_n_comes_back() {
+    let coin = Coin::new(CoinParams::unit_disk());
+    let theta_lift = lift_off_tilt(&coin, 0.5).expect("N must reach 0 for θ₀ = 0.5");
+    let default_rtol = MethodConfig {
+        method: Method::Dop853,
+        rtol: 1e-10,
+        atol: 1e-12,
+        step: 0.0,
+    };
+    for config in configurations().into_iter().chain([default_rtol]) {
+        check_event(&config, 0.5, PhysicalEvent::LiftOff, theta_lift);
+    }
+}
