@@ -167,6 +167,7 @@ where
         n_events: events.count().min(MAX_EVENTS),
         g_old: [0.0; MAX_EVENTS],
         g_new: [0.0; MAX_EVENTS],
+        g_change: [f64::INFINITY; MAX_EVENTS],
         k: 1,
         t_last: settings.t0,
         buffer: [0.0; N],
@@ -194,6 +195,8 @@ struct Run<'a, const N: usize, S, M, E, O> {
     /// Event functions at the start and at the end of the current step.
     g_old: [f64; MAX_EVENTS],
     g_new: [f64; MAX_EVENTS],
+    /// |Δg| over the previous step (infinite before the first): how far g moves in a step.
+    g_change: [f64; MAX_EVENTS],
     /// Number of the next grid sample.
     k: u64,
     /// Time of the last sample emitted.
@@ -258,6 +261,9 @@ where
                 return RunEnd::Completed;
             }
             let n = self.n_events;
+            for i in 0..n {
+                self.g_change[i] = (self.g_new[i] - self.g_old[i]).abs();
+            }
             self.g_old[..n].copy_from_slice(&self.g_new[..n]);
         }
     }
@@ -316,10 +322,19 @@ where
 
     /// The earliest crossing of an event function that is positive at both ends of the last step but
     /// not throughout: looked for at [`EVENT_PROBES`] points inside the step, then located between the
-    /// probes around it.
+    /// probes around it. Only functions that end the step near 0 against how far they move in a step
+    /// are probed: a parabola dipping below 0 between two ends at m > 0 moved by more than 8m in the
+    /// step before, so min(g_old, g_new) ≤ max(|Δg| now, |Δg| in the step before) selects every such
+    /// dip with a margin of 8, and leaves out the steps of a rolling coin far from every event (probing
+    /// all of them cost 20 % on a run with few samples: 2.12 s against 1.77 s).
     fn dip_in_step(&mut self, t_old: f64, t_new: f64) -> Option<(usize, f64)> {
         let n = self.n_events;
-        if !(0..n).any(|i| self.g_old[i] > 0.0 && self.g_new[i] > 0.0) {
+        let mut near = [false; MAX_EVENTS];
+        for i in 0..n {
+            let (g0, g1) = (self.g_old[i], self.g_new[i]);
+            near[i] = g0 > 0.0 && g1 > 0.0 && g0.min(g1) <= (g1 - g0).abs().max(self.g_change[i]);
+        }
+        if !near[..n].contains(&true) {
             return None;
         }
         let mut lo = t_old;
@@ -332,12 +347,12 @@ where
             // probes). A dip seen there is confirmed on the full dense output.
             self.stepper.interpolate(t, &mut self.buffer);
             self.events.evaluate(t, &self.buffer, &mut g[..n]);
-            if !self.dense_ready && (0..n).any(|i| self.g_new[i] > 0.0 && g[i] <= 0.0) {
+            if !self.dense_ready && (0..n).any(|i| near[i] && g[i] <= 0.0) {
                 self.prepare_dense();
                 self.stepper.interpolate(t, &mut self.buffer);
                 self.events.evaluate(t, &self.buffer, &mut g[..n]);
             }
-            let dips = (0..n).filter(|&i| self.g_new[i] > 0.0 && g[i] <= 0.0);
+            let dips = (0..n).filter(|&i| near[i] && g[i] <= 0.0);
             let roots = dips.map(|i| {
                 (
                     i,
