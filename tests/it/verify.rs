@@ -197,11 +197,14 @@ fn a_disk_braked_a_million_times_harder_than_air_is_unresolved_at_400_hz_and_pas
 #[test]
 fn a_light_coin_braked_within_its_first_sample_verifies() {
     let dir = tempfile::tempdir().unwrap();
+    // θ0 as the sweep that found it drew it.
     let args = [
         "--set",
         "body.mass=1e-6",
         "--set",
         "body.dissipation={model=\"viscous\",coefficient=0.1}",
+        "--set",
+        "initial.theta=0.10693772645821076",
     ];
     let path = record_scene(
         dir.path(),
