@@ -230,7 +230,7 @@ pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneEr
 /// crafted file held 200 000 characters.
 const TOML_LINE_CHARS: usize = 200;
 
-/// A TOML parse error's message, trimmed, each quoted line cut to [`TOML_LINE_CHARS`] characters.
+/// A TOML parse error's message, trimmed, each quoted line cut to 200 characters.
 #[must_use]
 pub fn toml_message(e: &toml::de::Error) -> String {
     let text = e.to_string();
