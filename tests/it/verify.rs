@@ -6,7 +6,7 @@ use crate::support::record::{coin_log_text, read_messages, record_scene, scene_n
 use crate::support::writers::{
     nudge, record, recorded, rewrite, rewrite_with_schemas, steady_circle, wobble, Edit, Spec,
 };
-use coin_log::verify::{verify_file, CheckId, FileReport, Options, Status, Verdict};
+use coin_log::verify::{verify_file, CheckId, CheckResult, FileReport, Options, Status, Verdict};
 
 fn show(r: &FileReport) -> String {
     r.checks
@@ -115,6 +115,19 @@ fn verify_flags_a_log_with_one_position_moved_by_1e_4() {
     assert_fails(&r, CheckId::Constraint, 2e-3, 1e-2);
 }
 
+/// Records built-in `scene` with `args` into `dir` and verifies it: the report and its constraint check,
+/// and the file.
+fn constraint_of(
+    dir: &std::path::Path,
+    scene: &str,
+    args: &[&str],
+) -> (FileReport, CheckResult, std::path::PathBuf) {
+    let path = record_scene(dir, scene, args);
+    let r = verify_file(&path, &Options::default());
+    let c = r.check(CheckId::Constraint).unwrap().clone();
+    (r, c, path)
+}
+
 /// A coin released at θ = 1.5 sinks flat and spins up (φ̇ doubles every 0.05 time units): the windows
 /// where its rates grow that fast are not resolved at rate 100, and must be left out rather than failed
 /// (they measured 2.5e-7 against a tolerance of 2e-7, all of it the difference's truncation).
@@ -122,14 +135,9 @@ fn verify_flags_a_log_with_one_position_moved_by_1e_4() {
 fn a_coin_spinning_up_as_it_sinks_flat_is_resolved_where_the_sampling_allows_and_a_moved_position_still_fails(
 ) {
     let dir = tempfile::tempdir().unwrap();
-    let path = record_scene(
-        dir.path(),
-        "wobble",
-        &["--set", "initial.theta=1.5", "--duration", "1"],
-    );
-    let r = verify_file(&path, &Options::default());
+    let args = ["--set", "initial.theta=1.5", "--duration", "1"];
+    let (r, c, path) = constraint_of(dir.path(), "wobble", &args);
     assert_eq!(r.exit_code, 0, "{}", show(&r));
-    let c = r.check(CheckId::Constraint).unwrap();
     assert_eq!(c.status, Status::Pass, "{}", show(&r));
     assert!(
         c.reason
@@ -166,9 +174,7 @@ fn a_disk_braked_a_million_times_harder_than_air_is_unresolved_at_400_hz_and_pas
         "--set",
         "initial.phi=0.5",
     ];
-    let path = record_scene(dir.path(), "euler-disk", &braked);
-    let r = verify_file(&path, &Options::default());
-    let c = r.check(CheckId::Constraint).unwrap();
+    let (r, c, _) = constraint_of(dir.path(), "euler-disk", &braked);
     assert_eq!(c.status, Status::Skip, "{}", show(&r));
     assert!(
         c.reason
@@ -176,14 +182,9 @@ fn a_disk_braked_a_million_times_harder_than_air_is_unresolved_at_400_hz_and_pas
         "{}",
         c.reason
     );
-    let path = record_scene(
-        dir.path(),
-        "euler-disk",
-        &[&braked[..], &["--rate", "4000"]].concat(),
-    );
-    let r = verify_file(&path, &Options::default());
+    let fast = [&braked[..], &["--rate", "4000"]].concat();
+    let (r, c, _) = constraint_of(dir.path(), "euler-disk", &fast);
     assert_eq!(r.exit_code, 0, "{}", show(&r));
-    let c = r.check(CheckId::Constraint).unwrap();
     assert!(
         c.status == Status::Pass && c.value.unwrap() < 1e-8,
         "{}",
@@ -206,19 +207,13 @@ fn a_light_coin_braked_within_its_first_sample_verifies() {
         "--set",
         "initial.theta=0.10693772645821076",
     ];
-    let path = record_scene(
+    let (r, c, _) = constraint_of(
         dir.path(),
         "wobble",
         &[&args[..], &["--duration", "3"]].concat(),
     );
-    let r = verify_file(&path, &Options::default());
     assert_eq!(r.exit_code, 0, "{}", show(&r));
-    assert_eq!(
-        r.check(CheckId::Constraint).unwrap().status,
-        Status::Pass,
-        "{}",
-        show(&r)
-    );
+    assert_eq!(c.status, Status::Pass, "{}", show(&r));
 }
 
 #[test]

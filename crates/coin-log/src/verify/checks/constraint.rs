@@ -5,16 +5,15 @@
 //! The residual is max|v_fd − v| / (a max|ω|).
 //!
 //! The difference's leading error, −h⁸x⁽⁹⁾/630, is cancelled by the eighth difference of the constraint's
-//! velocities over the window (Δ⁸v/630); what is left is estimated as the first term was. That term is
-//! h⁸ x⁽⁹⁾/630; positions move with the heading rate φ̇ and the rates
-//! in ω, and as fast again as those rates themselves change (a coin sinking flat spins up: φ̇ doubled every
-//! 0.05 time units from θ = 1.5, and windows judged resolved by max(|ω|, |φ̇|) alone had 30 times the
-//! estimated truncation, 2.5e-7 against a tolerance of 2e-7). So Ω = max(|ω|, |φ̇|) + g + 3 min(√|Δg/h|, g) over
-//! the window, g = |Δ ln r|/h from sample to sample of r = max(|ω|, |φ̇|) (see `difference`), and the
-//! error is about (hΩ)⁸/630 relative to the
-//! velocity. Windows where 4 (hΩ)⁸/630 exceeds a tenth of the tolerance are not resolved by the sampling and
-//! are left out (and counted); if none is resolved the check is skipped and says so. Ω is taken from the
-//! stored rates, not from the differences themselves, so that noise in a tampered file cannot make its
+//! velocities over the window (Δ⁸v/630). Whether the sampling resolves a window is still judged by that
+//! leading term, a conservative bound on what is left: about (hΩ)⁸/630 relative to the velocity, with Ω
+//! the fastest rate the positions move at. That is the heading rate φ̇ and the rates in ω, and faster when
+//! those rates themselves change fast (a coin sinking flat from θ = 1.5 doubled φ̇ every 0.05 time units,
+//! and windows judged by max(|ω|, |φ̇|) alone erred 30 times beyond the estimate, 2.5e-7 against a
+//! tolerance of 2e-7). So Ω = r + g + 3 min(√|Δg/h|, g) over the window, r = max(|ω|, |φ̇|) and
+//! g = |Δ ln r|/h from sample to sample (see `difference`). Windows where 4 (hΩ)⁸/630 exceeds a tenth of
+//! the tolerance are left out (and counted); if none is left the check is skipped and says so. Ω comes
+//! from the stored rates, not from the differences, so that noise in a tampered file cannot make its
 //! windows look unresolved.
 
 use super::{fmt_num, Max};
