@@ -62,10 +62,15 @@ struct MapArgs {
     /// A scene whose body to map (built-in name or `.toml` file) [default: the thin disk, M = a = g = 1].
     scene: Option<String>,
     /// θ0 grid A:B:N: N values from A to B, each with 0 < |θ0| < π/2 [rad].
-    #[arg(long, value_name = "A:B:N", default_value = DEFAULT_THETA)]
+    #[arg(long, value_name = "A:B:N", default_value = DEFAULT_THETA, allow_hyphen_values = true)]
     theta: String,
     /// ω_Z0 grid A:B:N: N values from A to B [rad per time unit].
-    #[arg(long = "omega-z", value_name = "A:B:N", default_value = DEFAULT_OMEGA_Z)]
+    #[arg(
+        long = "omega-z",
+        value_name = "A:B:N",
+        default_value = DEFAULT_OMEGA_Z,
+        allow_hyphen_values = true
+    )]
     omega_z: String,
     /// Which root of the steady family: +, - or both.
     #[arg(

@@ -114,7 +114,8 @@ impl From<Outcome> for ExitCode {
 
 /// Parses the command line, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let matches = negative_numbers(<Cli as clap::CommandFactory>::command()).try_get_matches();
+    let cli = match matches.and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m)) {
         Ok(cli) => cli,
         // --help, --version and usage errors, printed so that a failed write is seen (`--help > /dev/full`).
         Err(e) => return output::settle(output::clap_message(&e)).into(),
@@ -124,6 +125,18 @@ pub fn main() -> ExitCode {
         Outcome::Failure
     });
     output::settle(outcome).into()
+}
+
+/// Every option of every command takes a negative number as its value: without it clap read
+/// `--duration -1` as an unknown flag `-1` and advised `-- -1`, which does not work either; with it the
+/// value reaches the option's own check, which says what range it takes.
+fn negative_numbers(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|a| {
+            let positional = a.is_positional();
+            a.allow_negative_numbers(!positional)
+        })
+        .mut_subcommands(negative_numbers)
 }
 
 /// The error and its causes, each cause left out where the message already says it: the library's errors

@@ -480,6 +480,17 @@ fn analyse_rejects_bad_input_with_a_clear_error() {
         (vec!["analyse", "map", "--theta", "0:1"], "A:B:N"),
         (vec!["analyse", "no-such-scene"], "no-such-scene"),
         (vec!["analyse", "map", "--branch", "x"], "branch"),
+        // σ² ∝ ω_Z0² overflows past ω_Z0 ≈ 1e154: refused, not written as `inf` "marginal" and `NaN`
+        // "unstable" rows; the number is named in exponent form, not as 160 digits.
+        (
+            vec!["analyse", "map", "--omega-z", "0:1e160:3"],
+            "ω_Z0 = 5e159 (+ branch) gives ω_Y0 = 0, σ² = inf: too fast",
+        ),
+        // B − A = −inf made every value NaN and the map ran forever.
+        (
+            vec!["analyse", "map", "--omega-z", "1e308:-1e308:3"],
+            "B − A = -inf overflows double precision",
+        ),
     ] {
         let out = coin_log(dir.path(), &args);
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -488,6 +499,40 @@ fn analyse_rejects_bad_input_with_a_clear_error() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
     assert!(!dir.path().join("stability-map.csv").exists());
+}
+
+#[test]
+fn negative_numbers_are_values_of_the_options_that_take_them() {
+    // clap read `--theta -0.5:…` and `--duration -1` as unknown flags and advised `-- -1`, which fails too.
+    let dir = tempfile::tempdir().unwrap();
+    let map = [
+        "analyse",
+        "map",
+        "--theta",
+        "-0.5:-0.1:3",
+        "--omega-z",
+        "-1:1:3",
+        "--out",
+        "m",
+    ];
+    let out = coin_log(dir.path(), &map);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("m/stability-map.csv")).unwrap();
+    assert!(csv.contains("\n-0.5,-1.0,+,"), "{csv}");
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--duration", "-1", "--dry-run"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("`run.duration` = -1 is outside (0, ∞)"),
+        "{stderr}"
+    );
 }
 
 #[test]

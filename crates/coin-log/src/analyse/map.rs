@@ -12,7 +12,7 @@ use super::steady::{Stability, SteadyAnalysis};
 use crate::model::{
     critical_spin, steady_omega_y, steady_sigma_squared, Branch, Coin, Linearisation,
 };
-use crate::scene::{self, presets, InitialSpec, Scene};
+use crate::scene::{self, presets, InitialSpec, Scene, Short};
 use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write as _;
 use std::str::FromStr;
@@ -41,6 +41,20 @@ pub enum MapError {
     TooLarge {
         /// θ₀ count × ω_Z0 count × branches.
         points: usize,
+    },
+    /// A grid point whose ω_Y0 or σ² is not a finite number in double precision.
+    #[error("the circle θ0 = {}, ω_Z0 = {} ({branch} branch) gives ω_Y0 = {}, σ² = {}: too fast or too near flat for double precision; narrow --theta or --omega-z", Short(*theta0), Short(*omega_z0), Short(*omega_y0), Short(*sigma_squared))]
+    NonFinite {
+        /// θ₀ \[rad\].
+        theta0: f64,
+        /// ω_Z0 [rad/time].
+        omega_z0: f64,
+        /// `+` or `-`.
+        branch: &'static str,
+        /// ω_Y0 [rad/time].
+        omega_y0: f64,
+        /// σ² [1/time²].
+        sigma_squared: f64,
     },
     /// `--branch` other than `+`, `-` or `both`.
     #[error("`--branch {0}`: use `+`, `-` or `both`")]
@@ -85,6 +99,12 @@ impl Grid {
                 .ok_or_else(|| error(format!("{what} `{s}` is not a finite number")))
         };
         let (from, to) = (number(from, "A")?, number(to, "B")?);
+        if !(to - from).is_finite() {
+            return Err(error(format!(
+                "B − A = {} overflows double precision; give A and B nearer each other",
+                to - from
+            )));
+        }
         let count = count
             .parse::<usize>()
             .ok()
@@ -125,7 +145,8 @@ impl Grid {
 
 impl std::fmt::Display for Grid {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}:{}:{}", self.from, self.to, self.count)
+        let (from, to) = (Short(self.from), Short(self.to));
+        write!(f, "{from}:{to}:{}", self.count)
     }
 }
 
@@ -286,26 +307,44 @@ pub struct StabilityMap {
 }
 
 /// σ² and its verdict for the circle (θ₀, ω_Z0) on `branch`.
-#[must_use]
-fn map_point(coin: &Coin, theta0: f64, omega_z0: f64, branch: Branch) -> MapPoint {
+///
+/// # Errors
+/// [`MapError::NonFinite`] where ω_Y0 or σ² overflows (σ² grows as ω_Z0² tan²θ₀: ω_Z0 = 1e154 made it
+/// `inf` and the − branch `NaN`, which the CSV would have called "marginal" and "unstable").
+fn map_point(
+    coin: &Coin,
+    theta0: f64,
+    omega_z0: f64,
+    branch: Branch,
+) -> Result<MapPoint, MapError> {
     let omega_y0 = steady_omega_y(coin, theta0, omega_z0, branch);
     let sigma_squared = steady_sigma_squared(coin, theta0, omega_y0, omega_z0);
     let scale = Linearisation::at(coin, theta0, omega_y0, omega_z0).scale();
-    MapPoint {
+    if !(omega_y0.is_finite() && sigma_squared.is_finite() && scale.is_finite()) {
+        return Err(MapError::NonFinite {
+            theta0,
+            omega_z0,
+            branch: branch.name(),
+            omega_y0,
+            sigma_squared,
+        });
+    }
+    Ok(MapPoint {
         theta0,
         omega_z0,
         branch,
         omega_y0,
         sigma_squared,
         verdict: Stability::of(sigma_squared, scale),
-    }
+    })
 }
 
 /// The map over `options`' grid for `coin`, with the built-in scenes of the same shape and `extra`
 /// (a scene of the caller's) placed on it.
 ///
 /// # Errors
-/// [`MapError`] for a grid that [`MapOptions::validate`] refuses.
+/// [`MapError`] for a grid that [`MapOptions::validate`] refuses, or a circle of it that double
+/// precision cannot hold ([`MapError::NonFinite`]).
 pub fn stability_map(
     coin: &Coin,
     options: &MapOptions,
@@ -320,7 +359,7 @@ pub fn stability_map(
         for j in 0..options.omega_z.count {
             let omega_z0 = options.omega_z.value(j);
             for &branch in branches {
-                points.push(map_point(coin, theta0, omega_z0, branch));
+                points.push(map_point(coin, theta0, omega_z0, branch)?);
             }
         }
     }

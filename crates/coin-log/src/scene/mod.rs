@@ -21,7 +21,7 @@ pub use file::{
 pub use notes::{compact, Note};
 pub use overrides::{apply_set, set_value, FlagOverrides};
 pub use problems::{Problem, SceneProblems};
-pub use readable::{float_literal, readable_toml};
+pub use readable::{float_literal, readable_toml, Short};
 pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
 
 use crate::format::Channel;

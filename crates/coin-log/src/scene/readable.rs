@@ -28,14 +28,27 @@ pub fn readable_toml(text: &str) -> String {
 /// exponent form (`1e-10`, `2.220446049250313e-15`); either reads back to `x` exactly.
 #[must_use]
 pub fn float_literal(x: f64) -> String {
-    if x.is_finite() && x != 0.0 && !(1e-4..1e16).contains(&x.abs()) {
-        return ryu::Buffer::new().format_finite(x).to_string();
-    }
-    let text = format!("{x}");
-    if x.is_finite() && !text.contains('.') {
+    let text = Short(x).to_string();
+    if x.is_finite() && !text.contains(['.', 'e']) {
         format!("{text}.0")
     } else {
         text
+    }
+}
+
+/// A number in messages: `{}` between 1e-4 and 1e16 (`0.5`, `100`), the shortest exponent form outside
+/// (`1e-10`, `5e159`: `{}` writes 5e159 as 160 digits); either reads back to the same double.
+#[derive(Debug, Clone, Copy)]
+pub struct Short(pub f64);
+
+impl std::fmt::Display for Short {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        if x.is_finite() && x != 0.0 && !(1e-4..1e16).contains(&x.abs()) {
+            f.write_str(ryu::Buffer::new().format_finite(x))
+        } else {
+            write!(f, "{x}")
+        }
     }
 }
 
