@@ -604,6 +604,21 @@ choice = ["hoop", 3]
     ] {
         assert!(err.contains(e), "missing `{e}` in:\n{err}");
     }
+    // A later edit that removes an earlier one as the other form of its fact (a shape stands for both
+    // inertias) would drop it from every run.
+    let err = refused(
+        r#"
+base = "wobble"
+set = { "body.inertia_x" = 0.3, "body.inertia_z" = 0.5 }
+[[axis]]
+key = "body.shape"
+values = ["hoop"]
+"#,
+    );
+    assert!(
+        err.contains("`axis[0].key` = \"body.shape\" removes `body.inertia_x` (given by set.\"body.inertia_x\", which applies first), the other form of the same fact"),
+        "{err}"
+    );
     let err = refused("base = \"./missing.toml\"\n");
     assert!(
         err.contains("`base` = \"./missing.toml\" cannot be read (")
@@ -615,6 +630,32 @@ choice = ["hoop", 3]
         err.contains("unknown field `bogus`"),
         "serde names the unknown key: {err}"
     );
+}
+
+#[test]
+fn an_inertia_swept_on_a_built_in_scene_replaces_its_shape() {
+    // wobble gives `body.shape`; an inertia set or swept on it used to fail every run as "given together".
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+base = "wobble"
+set = { "run.duration" = 0.5, "body.inertia_x" = 0.25 }
+[[axis]]
+key = "body.inertia_z"
+values = [0.3, 0.5]
+"#;
+    write_sweep(dir.path(), "s.toml", text);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "out"]);
+    assert_eq!(code, 0, "{out}{err}");
+    for (i, iz) in ["0.3", "0.5"].into_iter().enumerate() {
+        let file = dir.path().join(format!("out/run-{i}.mcap"));
+        let (code, json, err) = run_in(dir.path(), &["info", "--json", file.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+        let body = &v["files"][0]["body"];
+        assert_eq!(body["inertia_z"].to_string(), iz, "{body}");
+        assert_eq!(body["inertia_x"].to_string(), "0.25", "{body}");
+        assert!(!v["files"][0]["scene"].as_str().unwrap().contains("shape"));
+    }
 }
 
 #[test]

@@ -36,7 +36,8 @@ pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
 }
 
 /// Sets the dotted KEY to a typed `value` (the form of [`apply_set`] for callers that hold TOML values,
-/// such as `coin-log sweep`); missing tables on the way are created.
+/// such as `coin-log sweep`); missing tables on the way are created. The keys of the fact's other form
+/// ([`other_form`]) are removed: `body.inertia_z = 0.4` on a scene with `body.shape` drops the shape.
 ///
 /// ```
 /// let mut t = toml::Table::new();
@@ -62,6 +63,9 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
     let (last, path) = parts
         .split_last()
         .ok_or_else(|| error("the key is empty".into()))?;
+    for other in other_form(&parts.join(".")) {
+        remove(table, other);
+    }
     let mut current = table;
     for (depth, part) in path.iter().enumerate() {
         let entry = current
@@ -82,6 +86,39 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
     }
     current.insert((*last).to_string(), value);
     Ok(())
+}
+
+/// The keys that an edit of `key` removes: the other form of the same fact, which the scene may give one
+/// way only (format.md: `--set`). A shape stands for both inertias, and a steady motion for θ and ω: without
+/// this, `--set body.inertia_z=0.4` on a built-in scene, or a sweep axis over it, was refused as "given
+/// together with `body.shape`", and only replacing the whole `[body]` table got past it.
+#[must_use]
+pub fn other_form(key: &str) -> &'static [&'static str] {
+    match key {
+        "body.shape" => &["body.inertia_x", "body.inertia_z"],
+        "body.inertia_x" | "body.inertia_z" => &["body.shape"],
+        "initial.theta" | "initial.omega" => &["initial.steady"],
+        k if k == "initial.steady" || k.starts_with("initial.steady.") => {
+            &["initial.theta", "initial.omega"]
+        }
+        _ => &[],
+    }
+}
+
+/// Removes the dotted `key` where its tables exist.
+fn remove(table: &mut toml::Table, key: &str) {
+    let Some((path, last)) = key.rsplit_once('.') else {
+        table.remove(key);
+        return;
+    };
+    let mut current = table;
+    for part in path.split('.') {
+        match current.get_mut(part) {
+            Some(toml::Value::Table(t)) => current = t,
+            _ => return,
+        }
+    }
+    current.remove(last);
 }
 
 /// VALUE as TOML, else as a bare string.
@@ -185,5 +222,28 @@ mod tests {
         assert!(e.contains("`body.mass` is float"), "{e}");
         assert!(apply_set(&mut t, "run..rate=1").is_err());
         assert!(apply_set(&mut t, "run.rate").is_err());
+    }
+
+    #[test]
+    fn an_edit_of_one_form_of_a_fact_removes_the_other() {
+        let scene = "[body]\nmass = 1.0\nshape = \"thin-disk\"\n[initial]\ntheta = 0.5\nomega = [0.0, 0.0, 1.0]\nphi = 0.1\n";
+        let keys = |t: &toml::Table, table: &str| -> Vec<String> {
+            t[table].as_table().unwrap().keys().cloned().collect()
+        };
+        let mut t: toml::Table = toml::from_str(scene).unwrap();
+        apply_set(&mut t, " body . inertia_z =0.4").unwrap();
+        assert_eq!(keys(&t, "body"), ["inertia_z", "mass"]);
+        apply_set(&mut t, "body.inertia_x=0.25").unwrap();
+        apply_set(&mut t, "body.shape=hoop").unwrap();
+        assert_eq!(keys(&t, "body"), ["mass", "shape"]);
+        apply_set(&mut t, "initial.steady.kind=straight").unwrap();
+        assert_eq!(keys(&t, "initial"), ["phi", "steady"]);
+        apply_set(&mut t, "initial.theta=0.2").unwrap();
+        assert_eq!(keys(&t, "initial"), ["phi", "theta"]);
+        // Negative control: other keys of the same tables stay, and a file giving both forms is still
+        // its author's contradiction, refused when read (scene::validate).
+        apply_set(&mut t, "body.mass=2.0").unwrap();
+        assert_eq!(keys(&t, "body"), ["mass", "shape"]);
+        assert!(other_form("body.mass").is_empty() && other_form("initial.phi").is_empty());
     }
 }

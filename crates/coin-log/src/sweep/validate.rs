@@ -570,7 +570,8 @@ fn places(file: &SweepFile) -> Vec<Place> {
 }
 
 impl Checker {
-    /// A key given twice, or a key inside a table that a later edit replaces.
+    /// A key given twice, a key inside a table that a later edit replaces, or one a later edit removes as
+    /// the other form of its fact ([`scene::other_form`]).
     fn collisions(&mut self, places: &[Place]) {
         for (later_at, later) in places.iter().enumerate() {
             for earlier in &places[..later_at] {
@@ -584,6 +585,12 @@ impl Checker {
                         "replaces the whole table holding `{}` (given by {}, which applies first): give that key \
                          inside {}'s values, or sweep a key inside `{}`",
                         earlier.key, earlier.name, later.name, later.key
+                    )
+                } else if scene::other_form(&later.key).contains(&earlier.key.as_str()) {
+                    format!(
+                        "removes `{}` (given by {}, which applies first), the other form of the same fact: \
+                         give one form only",
+                        earlier.key, earlier.name
                     )
                 } else {
                     continue;
