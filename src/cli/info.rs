@@ -1,13 +1,13 @@
 //! `coin-log info`: what each file holds, as text or JSON, or the scene stored in one file.
 
-use super::text::{counted, size};
+use super::text::{counted, cut, padded, size, CELL_MAX, COLUMN_MAX};
 use super::Outcome;
 use anyhow::bail;
 use coin_log::files::input::check;
 use coin_log::files::{escaped, shown, InputKind};
 use coin_log::format::metadata::number_string as n;
 use coin_log::format::{Encoding, RunMetadata, Termination};
-use coin_log::inspect::info::{self, FileInfo};
+use coin_log::inspect::info::{self, ChannelReport, FileInfo};
 use coin_log::inspect::seconds_text;
 use coin_log_mcap::Compression;
 use std::fmt::Write as _;
@@ -296,36 +296,36 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     rows
 }
 
+/// A name as a table cell: control characters escaped, cut to [`CELL_MAX`] characters.
+fn cell(name: &str) -> String {
+    cut(&escaped(name), CELL_MAX).into_owned()
+}
+
 fn channels(out: &mut String, i: &FileInfo) {
     if i.channels.is_empty() {
         return; // the `encoding` row says "no channels"
     }
-    let topic_w = i
-        .channels
-        .iter()
-        .map(|c| c.topic.len())
-        .max()
-        .unwrap_or(5)
-        .max(5);
-    let schema_w = i
-        .channels
-        .iter()
-        .map(|c| c.schema.len())
-        .max()
-        .unwrap_or(6)
-        .max(6);
+    let width = |text: fn(&ChannelReport) -> &str, header: &str| {
+        let widest = i.channels.iter().map(|c| cell(text(c)).chars().count());
+        widest.max().unwrap_or(0).clamp(header.len(), COLUMN_MAX)
+    };
+    let topic_w = width(|c| &c.topic, "topic");
+    let schema_w = width(|c| &c.schema, "schema");
     let _ = writeln!(
         out,
-        "  {:<topic_w$}  {:<schema_w$}  {:>9}  {:>9}",
-        "topic", "schema", "messages", "rate"
+        "  {}  {}  {:>9}  {:>9}",
+        padded("topic", topic_w),
+        padded("schema", schema_w),
+        "messages",
+        "rate"
     );
     for c in &i.channels {
         let rate = c.rate.map_or_else(|| "-".into(), |r| format!("{r:.2}"));
         let _ = writeln!(
             out,
-            "  {:<topic_w$}  {:<schema_w$}  {:>9}  {rate:>9}",
-            escaped(&c.topic),
-            escaped(&c.schema),
+            "  {}  {}  {:>9}  {rate:>9}",
+            padded(&cell(&c.topic), topic_w),
+            padded(&cell(&c.schema), schema_w),
             c.messages
         );
     }

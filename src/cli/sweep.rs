@@ -4,7 +4,7 @@
 //! handler, draws the progress bar, prints, and maps the result to the exit code.
 
 use super::rss::peak_rss_bytes;
-use super::text::{counted, size};
+use super::text::{counted, padded, size, COLUMN_MAX};
 use super::Outcome;
 use anyhow::Context;
 use coin_log::files::shown;
@@ -414,13 +414,14 @@ fn print_preview(sweep: &Sweep, shard: Shard, jobs: usize, keys: &[&str], p: &Pr
                 .map(|r| r.get(c).map_or(0, |s| s.chars().count()))
                 .max()
                 .unwrap_or(0)
+                .min(COLUMN_MAX)
         })
         .collect();
     for row in &table {
         let cells: Vec<String> = row
             .iter()
             .zip(&widths)
-            .map(|(c, w)| format!("{c:<w$}"))
+            .map(|(c, w)| padded(c, *w))
             .collect();
         outln!("  {}", cells.join("  ").trim_end());
     }

@@ -19,13 +19,34 @@ pub fn counted(n: impl TryInto<u64>, thing: &str) -> String {
 
 /// A number for a table or message: as Rust prints it when that is short (1e-4 ≤ |x| < 1e16, or 0:
 /// `0.25`, `1`, `30.5`), else in the shortest exponent form that reads back the same (`1e-300`,
-/// `2.5e20`), never as hundreds of digits. The rule of the scene errors' numbers.
+/// `2.5e20`), never as hundreds of digits: the library's [`coin_log::scene::Short`].
 pub fn number(x: f64) -> String {
-    if x.is_finite() && x != 0.0 && !(1e-4..1e16).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        x.to_string()
+    coin_log::scene::Short(x).to_string()
+}
+
+/// The widest a table column grows for its longest cell; a longer cell overflows its column.
+pub const COLUMN_MAX: usize = 64;
+
+/// The most characters of a name (a topic, a schema) that a table shows: a crafted file's 1 MB topics
+/// printed 16 MB of one table.
+pub const CELL_MAX: usize = 200;
+
+/// `text` cut to `max` characters, with `…` where it was cut.
+pub fn cut(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(max) {
+        Some((at, _)) => format!("{}…", &text[..at]).into(),
+        None => text.into(),
     }
+}
+
+/// `text` and spaces after it up to `width` characters; never cut. `format!("{:<w$}")` panics for a
+/// width above 65 535, which a crafted file's 1 MB topic name and a sweep's 70 000-character value reached.
+pub fn padded(text: &str, width: usize) -> String {
+    let fill = width.saturating_sub(text.chars().count());
+    let mut out = String::with_capacity(text.len() + fill);
+    out.push_str(text);
+    out.extend(std::iter::repeat_n(' ', fill));
+    out
 }
 
 /// The help texts of the flags whose values the scene limits bound (coin_log::scene::limits), with each

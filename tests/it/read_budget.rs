@@ -159,6 +159,44 @@ fn records_claiming_more_than_the_limit_are_refused_with_the_figure() {
 }
 
 #[test]
+fn topics_longer_than_a_format_width_are_shown_cut_in_a_table_that_keeps_its_columns() {
+    // `info` padded its columns with `{:<w$}`, which panics for w > 65 535: a topic of 70 000 characters did.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long-topics.mcap");
+    let mut f = crafted::start();
+    for (id, topic) in [(0u16, "t".repeat(70_000)), (1, "/coin/omega".to_string())] {
+        let mut body = id.to_le_bytes().to_vec();
+        body.extend(0u16.to_le_bytes());
+        body.extend(crafted::string(&topic));
+        body.extend(crafted::string("json"));
+        body.extend(0u32.to_le_bytes());
+        f.extend(crafted::record(op::CHANNEL, &body));
+    }
+    f.extend(crafted::end());
+    std::fs::write(&path, f).unwrap();
+    let runs = every_command("two channels, one with a 70 000-character topic", &path);
+    for (run, command) in runs.iter().zip(["verify", "info", "export", "plot"]) {
+        assert!(
+            !run.stderr.contains("panicked") && run.code != 101,
+            "{command}: {}",
+            run.stderr
+        );
+    }
+    let info = &runs[1];
+    assert_eq!(info.code, 0, "{}", info.stderr);
+    assert!(
+        info.stdout.len() < 2000,
+        "{} bytes of info",
+        info.stdout.len()
+    );
+    let cut = format!("  {}…  ", "t".repeat(200));
+    assert!(info.stdout.contains(&cut), "{}", info.stdout);
+    // The other rows keep the column width of 64 characters, not the long topic's.
+    let omega = format!("  {:<64}  ", "/coin/omega");
+    assert!(info.stdout.contains(&omega), "{}", info.stdout);
+}
+
+#[test]
 fn a_metadata_record_of_a_million_entries_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("entries.mcap");

@@ -633,6 +633,24 @@ values = ["hoop"]
 }
 
 #[test]
+fn a_dry_run_shows_a_value_longer_than_a_format_width() {
+    // The preview padded its columns with `{:<w$}`, which panics for w > 65 535.
+    let dir = tempfile::tempdir().unwrap();
+    let long = "x".repeat(70_000);
+    let text =
+        format!("base = \"wobble\"\n[[axis]]\nkey = \"description\"\nvalues = [\"{long}\"]\n");
+    write_sweep(dir.path(), "s.toml", &text);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "out", "--dry-run"]);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains(&format!("  0      {long}")),
+        "{}",
+        &out[..out.len().min(300)]
+    );
+}
+
+#[test]
 fn an_inertia_swept_on_a_built_in_scene_replaces_its_shape() {
     // wobble gives `body.shape`; an inertia set or swept on it used to fail every run as "given together".
     let dir = tempfile::tempdir().unwrap();
