@@ -1,10 +1,10 @@
 //! `coin-log info`: what each file holds, as text or JSON, or the scene stored in one file.
 
-use super::text::{counted, cut, padded, size, CELL_MAX, COLUMN_MAX};
+use super::text::{counted, padded, size, COLUMN_MAX};
 use super::Outcome;
 use anyhow::bail;
 use coin_log::files::input::check;
-use coin_log::files::{escaped, shown, InputKind};
+use coin_log::files::{cut, escaped, shown, InputKind, SHOWN_CHARS};
 use coin_log::format::metadata::number_string as n;
 use coin_log::format::{Encoding, RunMetadata, Termination};
 use coin_log::inspect::info::{self, ChannelReport, FileInfo};
@@ -296,9 +296,9 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     rows
 }
 
-/// A name as a table cell: control characters escaped, cut to [`CELL_MAX`] characters.
+/// A name as a table cell: control characters escaped, cut to [`SHOWN_CHARS`] characters.
 fn cell(name: &str) -> String {
-    cut(&escaped(name), CELL_MAX).into_owned()
+    cut(&escaped(name), SHOWN_CHARS).into_owned()
 }
 
 fn channels(out: &mut String, i: &FileInfo) {

@@ -27,18 +27,6 @@ pub fn number(x: f64) -> String {
 /// The widest a table column grows for its longest cell; a longer cell overflows its column.
 pub const COLUMN_MAX: usize = 64;
 
-/// The most characters of a name (a topic, a schema) that a table shows: a crafted file's 1 MB topics
-/// printed 16 MB of one table.
-pub const CELL_MAX: usize = 200;
-
-/// `text` cut to `max` characters, with `…` where it was cut.
-pub fn cut(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
-    match text.char_indices().nth(max) {
-        Some((at, _)) => format!("{}…", &text[..at]).into(),
-        None => text.into(),
-    }
-}
-
 /// `text` and spaces after it up to `width` characters; never cut. `format!("{:<w$}")` panics for a
 /// width above 65 535, which a crafted file's 1 MB topic name and a sweep's 70 000-character value reached.
 pub fn padded(text: &str, width: usize) -> String {

@@ -191,6 +191,19 @@ fn topics_longer_than_a_format_width_are_shown_cut_in_a_table_that_keeps_its_col
     );
     let cut = format!("  {}…  ", "t".repeat(200));
     assert!(info.stdout.contains(&cut), "{}", info.stdout);
+    let export = &runs[2];
+    assert!(
+        export.stderr.len() < 2000,
+        "{} bytes of export error",
+        export.stderr.len()
+    );
+    assert!(
+        export
+            .stderr
+            .contains(&format!("({}…: not a coin-log channel", "t".repeat(200))),
+        "{}",
+        export.stderr
+    );
     // The other rows keep the column width of 64 characters, not the long topic's.
     let omega = format!("  {:<64}  ", "/coin/omega");
     assert!(info.stdout.contains(&omega), "{}", info.stdout);

@@ -18,6 +18,7 @@
 
 use super::seconds_text;
 use crate::csv;
+use crate::files::{cut, escaped, SHOWN_CHARS};
 use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::Channel;
@@ -536,11 +537,17 @@ impl<W: Write> Exporter<'_, W> {
             let why = if self.skipped.is_empty() {
                 "the file has no coin-log channel with messages".to_string()
             } else {
-                let skipped: Vec<String> = self
+                // A crafted file's 65 535 channels of 1 MB topics would make a message of gigabytes.
+                const LISTED: usize = 8;
+                let mut skipped: Vec<String> = self
                     .skipped
                     .iter()
-                    .map(|k| format!("{}: {}", k.topic, k.reason))
+                    .take(LISTED)
+                    .map(|k| format!("{}: {}", cut(&escaped(&k.topic), SHOWN_CHARS), k.reason))
                     .collect();
+                if self.skipped.len() > LISTED {
+                    skipped.push(format!("and {} more", self.skipped.len() - LISTED));
+                }
                 format!(
                     "no channel of the file makes a table ({})",
                     skipped.join("; ")

@@ -226,21 +226,15 @@ pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneEr
     file_from_table(table)
 }
 
-/// Longest line of a TOML error kept whole: serde's message quotes the offending line, which in a
-/// crafted file held 200 000 characters.
-const TOML_LINE_CHARS: usize = 200;
-
-/// A TOML parse error's message, trimmed, each quoted line cut to 200 characters.
+/// A TOML parse error's message, trimmed, each quoted line cut to [`crate::files::SHOWN_CHARS`] characters:
+/// serde's message quotes the offending line, which in a crafted file held 200 000 characters.
 #[must_use]
 pub fn toml_message(e: &toml::de::Error) -> String {
     let text = e.to_string();
     let lines = text
         .trim()
         .lines()
-        .map(|line| match line.char_indices().nth(TOML_LINE_CHARS) {
-            Some((cut, _)) => format!("{}…", &line[..cut]),
-            None => line.to_string(),
-        });
+        .map(|line| crate::files::cut(line, crate::files::SHOWN_CHARS));
     lines.collect::<Vec<_>>().join("\n")
 }
 
