@@ -12,9 +12,7 @@ use coin_log::format::{
 };
 use coin_log::integrate::{run_method, Flow, MethodConfig, RunSettings};
 use coin_log::model::{energy, Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
-use coin_log::record::{
-    self, run_metadata, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary,
-};
+use coin_log::record::{self, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary};
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log::simulation::{working_atol, CoinEvents, DissipativeEvents};
 use coin_log_mcap::Compression;
@@ -252,7 +250,7 @@ fn check_recording(name: &str, scene: &Scene, bytes: &[u8], summary: &RecordSumm
         "{name}: coin-log metadata at {run_offset}, first chunk at {first_chunk}"
     );
     let run = RunMetadata::from_map(run_map).expect("coin-log metadata parses");
-    assert_eq!(run, run_metadata(scene));
+    assert_eq!(run, scene.run_metadata());
     let back = scene::parse_with_sets(&run.scene, &[])
         .and_then(|f| Scene::from_file(&f))
         .expect("scene metadata parses");

@@ -4,7 +4,8 @@
 
 use crate::support::record::{coin_log_text, read_messages, record_scene, scene_names};
 use crate::support::writers::{
-    nudge, record, recorded, rewrite, rewrite_with_schemas, steady_circle, wobble, Edit, Spec,
+    nudge, record, recorded, rewrite, rewrite_run_metadata, rewrite_with_schemas, steady_circle,
+    wobble, Edit, Spec,
 };
 use coin_log::verify::{verify_file, CheckId, CheckResult, FileReport, Options, Status, Verdict};
 
@@ -73,6 +74,61 @@ fn tampered(scene: &str, edit: impl FnMut(Edit<'_>)) -> FileReport {
     let r = verify_file(&bad, &Options::default());
     println!("{}", show(&r));
     r
+}
+
+#[test]
+fn a_stored_scene_that_disagrees_with_its_record_or_first_sample_or_does_not_validate_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), "wobble", &[]);
+    let edited = |name: &str, from: &str, to: &str| {
+        let path = dir.path().join(name);
+        let (from, to) = (from.to_string(), to.to_string());
+        rewrite_run_metadata(&good, &path, &move |m| {
+            let scene = m["scene"].replace(&from, &to);
+            assert_ne!(scene, m["scene"], "`{from}` is in the stored scene");
+            m.insert("scene".into(), scene);
+        });
+        let r = verify_file(&path, &Options::default());
+        println!("{}", show(&r));
+        r
+    };
+    let reason = |r: &FileReport, id| r.check(id).unwrap().reason.clone();
+    // Negative control: the same copy with an edit that changes nothing the run depends on.
+    let r = edited(
+        "described.mcap",
+        "description = \"",
+        "description = \"Copied: ",
+    );
+    assert_eq!(r.exit_code, 0, "{}", show(&r));
+    assert!(
+        reason(&r, CheckId::Consistency).contains("initial state 0"),
+        "{}",
+        show(&r)
+    );
+    // The body: the record says M = 1, the scene 2 (and the inertias of its shape with it).
+    let r = edited("mass.mcap", "mass = 1.0", "mass = 2.0");
+    assert_eq!(status(&r, CheckId::Integrity), Status::Fail);
+    assert!(
+        reason(&r, CheckId::Integrity)
+            .contains("the `coin-log` metadata says mass = 1.0, but the scene it stores gives 2.0"),
+        "{}",
+        show(&r)
+    );
+    // The initial state, which no other field of the record holds: θ0 off by 1e-8.
+    let r = edited("theta.mcap", "theta = 0.5", "theta = 0.50000001");
+    assert_fails(&r, CheckId::Consistency, 0.9e-8, 1.1e-8);
+    assert_eq!(status(&r, CheckId::Integrity), Status::Pass, "{}", show(&r));
+    // A scene that record would refuse: its steady check skipped, the file passed.
+    let r = edited(
+        "invalid.mcap",
+        "description = \"",
+        "description = \"\\u0007",
+    );
+    assert!(
+        reason(&r, CheckId::Integrity).contains("the metadata's scene is not valid: `description`"),
+        "{}",
+        show(&r)
+    );
 }
 
 fn assert_fails(r: &FileReport, id: CheckId, low: f64, high: f64) {
@@ -661,21 +717,34 @@ fn verify_flags_a_log_whose_normal_force_goes_negative_without_a_lift_off_event(
     assert_only_failure(&r, &clean, CheckId::Validity, -min_normal, 1e-15);
 }
 
-/// Negative control of `validity`, |F| > μN: a steady circle (F/N constant) whose metadata gives μ at 0.9
-/// of its friction ratio, recorded without a slip event: the value is max(|F| - μN)/(Mg) of the stored
-/// reactions.
+/// Negative control of `validity`, |F| > μN: a nutating coin whose metadata gives μ halfway between its
+/// friction ratio at t = 0 (so the scene is one `record` accepts) and the largest it reaches, recorded
+/// without a slip event: the value is max(|F| - μN)/(Mg) of the stored reactions.
 #[test]
 fn verify_flags_a_log_whose_friction_exceeds_mu_n_without_a_slip_event() {
-    let (_dir, probe) = recorded(&steady_circle(), "probe.mcap");
-    let ratio = stored(&probe, "/coin/reaction")
+    // The built-in wobble's state: F/N swings from 0.35 at t = 0 to 0.41 as it nutates.
+    let nutating = Spec {
+        initial: coin_log::model::State {
+            theta: 0.5,
+            omega_x: 0.3,
+            omega_y: 0.2,
+            omega_z: 1.5,
+            ..Default::default()
+        },
+        ..wobble()
+    };
+    let (_dir, probe) = recorded(&nutating, "probe.mcap");
+    let ratios: Vec<f64> = stored(&probe, "/coin/reaction")
         .iter()
         .map(|m| m["friction"].as_f64().unwrap() / m["normal"].as_f64().unwrap())
-        .fold(0.0, f64::max);
-    let mu = 0.9 * ratio;
+        .collect();
+    let largest = ratios.iter().copied().fold(0.0, f64::max);
+    assert!(largest > 1.1 * ratios[0], "{} against {largest}", ratios[0]);
+    let mu = 0.5 * (ratios[0] + largest);
     let spec = Spec {
         friction: Some(mu),
         events: false,
-        ..steady_circle()
+        ..nutating
     };
     let (_dir2, path) = recorded(&spec, "slipping.mcap");
     let clean = verify_file(&probe, &Options::default());
@@ -684,9 +753,12 @@ fn verify_flags_a_log_whose_friction_exceeds_mu_n_without_a_slip_event() {
         .iter()
         .map(|m| m["friction"].as_f64().unwrap() - mu * m["normal"].as_f64().unwrap())
         .fold(f64::NEG_INFINITY, f64::max);
-    println!("μ = {mu} (F/N = {ratio}), max |F| - μN = {excess}");
+    println!(
+        "μ = {mu} (F/N from {} to {largest}), max |F| - μN = {excess}",
+        ratios[0]
+    );
     assert!(excess > 1e-3);
-    // An ulp of each parsed number (see above), amplified by the cancellation in |F| - μN ≈ 0.1 |F|.
+    // An ulp of each parsed number (see above), amplified by the cancellation in |F| - μN.
     assert_only_failure(&r, &clean, CheckId::Validity, excess, 1e-13);
 }
 

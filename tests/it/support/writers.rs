@@ -11,14 +11,15 @@ use coin_log::format::messages::{
     ReactionMessage, WorkMessage,
 };
 use coin_log::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
-    MESSAGE_ENCODING, RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, ResultMetadata, Topic, MESSAGE_ENCODING, RESULT_METADATA_NAME,
+    RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunEnd, RunSettings};
 use coin_log::model::{
     centre, contact_point, energy, orientation, Branch, Chaplygin, Coin, CoinParams, Dynamics,
     State, Steady, SteadyKind, STATE_LEN,
 };
+use coin_log::scene::{file_from_table, set_value, Scene};
 use coin_log::simulation::CoinEvents;
 // `record_circle`'s (the independent readers' tests).
 #[cfg(feature = "external-readers")]
@@ -398,33 +399,41 @@ pub fn steady_circle() -> Spec {
     }
 }
 
+/// The scene of `spec` as `record` would store it: `spec.scene` with the spec's initial state (unless it
+/// is a steady motion), run settings, μ and channels set on it, resolved.
+fn stored_scene(spec: &Spec) -> Scene {
+    let mut t: toml::Table = toml::from_str(&spec.scene).unwrap();
+    let mut set = |key: &str, value: toml::Value| set_value(&mut t, key, value).unwrap();
+    let s = &spec.initial;
+    if spec.steady.is_none() {
+        set("initial.theta", s.theta.into());
+        set(
+            "initial.omega",
+            vec![s.omega_x, s.omega_y, s.omega_z].into(),
+        );
+        for (key, value) in [("phi", s.phi), ("psi", s.psi), ("x", s.x), ("z", s.z)] {
+            set(&format!("initial.{key}"), value.into());
+        }
+    }
+    set("run.duration", spec.duration.into());
+    set("run.rate", spec.rate.into());
+    set("run.integrator", spec.method.name().into());
+    set("run.rtol", spec.rtol.into());
+    set("run.atol", spec.atol.into());
+    set("run.step", spec.step.into());
+    if let Some(mu) = spec.friction {
+        set("body.friction", mu.into());
+    }
+    let channels: Vec<&str> = spec.channels.iter().map(|c| c.name()).collect();
+    set("record.channels", channels.into());
+    Scene::from_file(&file_from_table(t).unwrap()).unwrap()
+}
+
 /// Simulates `spec` with rk4 and writes it as a coin-log MCAP at `path`, following format.md.
 pub fn record(spec: &Spec, path: &Path) {
     let coin = Coin::new(CoinParams::unit_disk());
-    let p = coin.params();
-    let run = RunMetadata {
-        format_version: FORMAT_VERSION.into(),
-        tool_version: "test".into(),
-        scene: spec.scene.clone(),
-        mass: p.mass(),
-        radius: p.radius(),
-        gravity: p.gravity(),
-        inertia_x: p.inertia_x(),
-        inertia_z: p.inertia_z(),
-        friction: spec.friction,
-        time_unit: p.time_unit(),
-        integrator: spec.method,
-        rtol: spec.rtol,
-        atol: spec.atol,
-        step: spec.step,
-        rate: spec.rate,
-        steady_kind: spec.steady.map(|s| s.kind.family()),
-        phi_dot: spec.steady.map(|s| s.phi_dot),
-        psi_dot: spec.steady.map(|s| s.psi_dot),
-        r_g: spec.steady.and_then(|s| s.r_g),
-        r_c: spec.steady.and_then(|s| s.r_c),
-        dissipation: None,
-    };
+    let mut run = stored_scene(spec).run_metadata();
+    run.tool_version = "test".into();
     let file = BufWriter::new(std::fs::File::create(path).unwrap());
     let mut options = mcap::WriteOptions::new()
         .compression(spec.compression)
@@ -517,15 +526,37 @@ pub fn rewrite_with_schemas(
     src: &Path,
     dst: &Path,
     schema_of: &dyn Fn(&str) -> Vec<u8>,
+    edit: impl FnMut(Edit<'_>),
+) {
+    copy(src, dst, schema_of, &|_| {}, edit);
+}
+
+/// Copies the coin-log MCAP `src` to `dst` with its `coin-log` record's entries changed by `edit_run`.
+pub fn rewrite_run_metadata(
+    src: &Path,
+    dst: &Path,
+    edit_run: &dyn Fn(&mut BTreeMap<String, String>),
+) {
+    copy(src, dst, &tool_schema, edit_run, |_| {});
+}
+
+fn copy(
+    src: &Path,
+    dst: &Path,
+    schema_of: &dyn Fn(&str) -> Vec<u8>,
+    edit_run: &dyn Fn(&mut BTreeMap<String, String>),
     mut edit: impl FnMut(Edit<'_>),
 ) {
     let bytes = std::fs::read(src).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
-    let metadata: Vec<mcap::records::Metadata> = summary
+    let mut metadata: Vec<mcap::records::Metadata> = summary
         .metadata_indexes
         .iter()
         .map(|i| mcap::read::metadata(&bytes, i).unwrap())
         .collect();
+    for m in metadata.iter_mut().filter(|m| m.name == RUN_METADATA_NAME) {
+        edit_run(&mut m.metadata);
+    }
     let file = BufWriter::new(std::fs::File::create(dst).unwrap());
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))

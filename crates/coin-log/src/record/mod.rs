@@ -10,7 +10,7 @@ pub mod summary;
 pub use estimate::{estimate, Estimate};
 pub use foxglove::{Foxglove3d, FoxgloveBatch};
 pub use recorder::{
-    expected_shortfalls, record, record_with_tap, run_metadata, ChannelDeclaration, NoTap,
-    RecordError, RecordOptions, Tap, COMPRESSION_THREADS,
+    expected_shortfalls, record, record_with_tap, ChannelDeclaration, NoTap, RecordError,
+    RecordOptions, Tap, COMPRESSION_THREADS,
 };
 pub use summary::{Failure, RecordSummary};

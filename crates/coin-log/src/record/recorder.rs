@@ -20,8 +20,8 @@ use crate::format::messages::{
 use crate::format::promise::{self, Shortfall};
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
-    log_time, Channel, Encoding, ResultMetadata, RunMetadata, Termination, TimeError, Topic,
-    FORMAT_VERSION, RESULT_METADATA_NAME, RUN_METADATA_NAME,
+    log_time, Channel, Encoding, ResultMetadata, Termination, TimeError, Topic,
+    RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Bounds, Flow, RunOutcome, RunSettings};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
@@ -98,36 +98,6 @@ fn write_options(options: &RecordOptions) -> WriterOptions {
             options.compression,
             format!("coin-log/{}", env!("CARGO_PKG_VERSION")),
         )
-    }
-}
-
-/// The `coin-log` metadata record of a scene.
-#[must_use]
-pub fn run_metadata(scene: &Scene) -> RunMetadata {
-    let p = &scene.params;
-    let steady = scene.unperturbed_steady();
-    RunMetadata {
-        format_version: FORMAT_VERSION.to_string(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        scene: scene.to_toml(),
-        mass: p.mass(),
-        radius: p.radius(),
-        gravity: p.gravity(),
-        inertia_x: p.inertia_x(),
-        inertia_z: p.inertia_z(),
-        friction: scene.friction,
-        time_unit: p.time_unit(),
-        integrator: scene.run.method.method,
-        rtol: scene.run.method.rtol,
-        atol: scene.run.method.atol,
-        step: scene.run.method.step,
-        rate: scene.run.rate,
-        steady_kind: steady.map(|s| s.kind.family()),
-        phi_dot: steady.map(|s| s.phi_dot),
-        psi_dot: steady.map(|s| s.psi_dot),
-        r_g: steady.and_then(|s| s.r_g),
-        r_c: steady.and_then(|s| s.r_c),
-        dissipation: scene.dissipation,
     }
 }
 
@@ -739,7 +709,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             None
         };
         let mut writer = McapWriter::new(writer, &write_options(options))?;
-        writer.write_metadata(RUN_METADATA_NAME, &run_metadata(scene).to_map())?;
+        writer.write_metadata(RUN_METADATA_NAME, &scene.run_metadata().to_map())?;
         let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
         let foxglove = (tf || scene_on).then(|| {
             let fox =

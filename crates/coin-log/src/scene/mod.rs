@@ -24,7 +24,7 @@ pub use problems::{Problem, SceneProblems};
 pub use readable::{float_literal, readable_toml, Short};
 pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
 
-use crate::format::Channel;
+use crate::format::{Channel, RunMetadata, FORMAT_VERSION};
 use crate::integrate::MethodConfig;
 use crate::model::{Coin, CoinParams, Dissipation, Dynamics, Inertia, State, Steady};
 
@@ -198,6 +198,37 @@ impl Scene {
     #[must_use]
     pub fn to_toml(&self) -> String {
         to_toml(&self.to_file())
+    }
+
+    /// The `coin-log` metadata record of a run of this scene: what `record` writes, and what `verify`
+    /// holds a file's record against, rebuilt from the scene the record stores.
+    #[must_use]
+    pub fn run_metadata(&self) -> RunMetadata {
+        let p = &self.params;
+        let steady = self.unperturbed_steady();
+        RunMetadata {
+            format_version: FORMAT_VERSION.to_string(),
+            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: self.to_toml(),
+            mass: p.mass(),
+            radius: p.radius(),
+            gravity: p.gravity(),
+            inertia_x: p.inertia_x(),
+            inertia_z: p.inertia_z(),
+            friction: self.friction,
+            time_unit: p.time_unit(),
+            integrator: self.run.method.method,
+            rtol: self.run.method.rtol,
+            atol: self.run.method.atol,
+            step: self.run.method.step,
+            rate: self.run.rate,
+            steady_kind: steady.map(|s| s.kind.family()),
+            phi_dot: steady.map(|s| s.phi_dot),
+            psi_dot: steady.map(|s| s.psi_dot),
+            r_g: steady.and_then(|s| s.r_g),
+            r_c: steady.and_then(|s| s.r_c),
+            dissipation: self.dissipation,
+        }
     }
 }
 

@@ -23,8 +23,10 @@ use crate::format::{
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
+use crate::scene::{self, Scene};
+use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::rc::Rc;
@@ -302,13 +304,24 @@ impl Judge {
         };
         let coin = Coin::new(params);
         let dynamics = Dynamics::new(coin, run.dissipation);
+        let scene = stored_scene(&run);
+        match &scene {
+            Ok(scene) => {
+                for disagreement in disagreements(&run, &scene.run_metadata()) {
+                    self.problems.push_with(|| disagreement);
+                }
+            }
+            Err(e) => self.problems.push_with(|| {
+                format!("{e}: record stores a scene that reads back to the run it made")
+            }),
+        }
         let steady = match &run.dissipation {
             Some(d) => Err(format!(
                 "the run has dissipation ({}, κ = {}): a dissipative couple moves the coin off every steady motion (physics §11)",
                 d.model(),
                 super::checks::fmt_num(d.coefficient())
             )),
-            None => steady::plan(&coin, &run),
+            None => steady::plan(&coin, &run, &scene),
         };
         let chaplygin = Chaplygin::new(&params)
             .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
@@ -317,10 +330,51 @@ impl Judge {
             dynamics,
             run,
             result: None,
+            scene,
             steady,
             chaplygin,
         });
     }
+}
+
+/// The scene of the `coin-log` record, read and validated as `record` reads a scene file.
+fn stored_scene(run: &RunMetadata) -> Result<Scene, String> {
+    let file = scene::parse_with_sets(&run.scene, &[])
+        .map_err(|e| format!("the metadata's scene does not parse: {e}"))?;
+    Scene::from_file(&file).map_err(|e| format!("the metadata's scene is not valid: {e}"))
+}
+
+/// Where the `coin-log` record's fields differ from those its own scene gives (`expected`): the body, the
+/// run settings the integrator uses, the steady motion, the dissipation. Numbers agree within
+/// [`RECOMPUTE_TOLERANCE`] relative (the same computation on the same numbers). Not compared: the versions,
+/// the scene text, and the settings the integrator does not use (earlier versions wrote the rounded step
+/// for adaptive methods too: `tests/fixtures/wobble-first-version.mcap` has step = 0.00098 with dop853).
+fn disagreements(file: &RunMetadata, expected: &RunMetadata) -> Vec<String> {
+    let unused: &[&str] = if file.integrator.is_adaptive() {
+        &["step"]
+    } else {
+        &["rtol", "atol"]
+    };
+    let (file, expected) = (file.to_map(), expected.to_map());
+    let keys: BTreeSet<&String> = file.keys().chain(expected.keys()).collect();
+    let absent = String::from("(absent)");
+    keys.into_iter()
+        .filter(|k| !matches!(k.as_str(), "format_version" | "tool_version" | "scene"))
+        .filter(|k| !unused.contains(&k.as_str()))
+        .filter_map(|k| {
+            let (f, e) = (
+                file.get(k).unwrap_or(&absent),
+                expected.get(k).unwrap_or(&absent),
+            );
+            let agree = match (f.parse::<f64>(), e.parse::<f64>()) {
+                (Ok(x), Ok(y)) => (x - y).abs() <= RECOMPUTE_TOLERANCE * x.abs().max(y.abs()),
+                _ => f == e,
+            };
+            (!agree).then(|| {
+                format!("the `coin-log` metadata says {k} = {f}, but the scene it stores gives {e}")
+            })
+        })
+        .collect()
 }
 
 impl Visitor for Judge {

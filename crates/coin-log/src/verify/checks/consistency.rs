@@ -10,6 +10,7 @@
 use super::{fmt_num, worst, Context, Max};
 use crate::format::messages::{drift_eps, friction_ratio};
 use crate::model::orientation;
+use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
@@ -29,6 +30,8 @@ pub struct ConsistencyCheck {
     added_counts: [u64; 4],
     /// The first stored total energy (E₀ of `change`).
     energy0: Option<f64>,
+    /// The sample at t = 0 against the initial state of the stored scene, when both are there.
+    initial: Option<f64>,
 }
 
 /// Labels of the added-field measures.
@@ -84,6 +87,13 @@ impl ConsistencyCheck {
             self.reaction.offer(d / scale, s.t);
         }
         self.observe_added(s, ctx);
+        if s.t == 0.0 && self.initial.is_none() {
+            self.initial = ctx
+                .scene
+                .as_ref()
+                .ok()
+                .and_then(|scene| initial_offset(s, scene));
+        }
     }
 
     /// The fields added since the first version, each against its recomputation from other stored fields,
@@ -173,6 +183,13 @@ impl ConsistencyCheck {
                 ));
             }
         }
+        if let Some(offset) = self.initial {
+            measures.push((offset, tol, "initial state"));
+            parts.push(format!(
+                "t = 0 vs the stored scene's initial state {}",
+                fmt_num(offset)
+            ));
+        }
         let Some((value, tolerance, which)) = worst(&measures) else {
             return CheckResult::skip(
                 CheckId::Consistency,
@@ -186,4 +203,32 @@ impl ConsistencyCheck {
             format!("worst: {which}; {}", parts.join(", ")),
         )
     }
+}
+
+/// How far the sample at t = 0 is from the stored scene's initial state, which `record` writes as its first
+/// sample: angles in radians (or their size), ω relative to max(|ω₀|, 1/τ), the centre relative to
+/// max(a, |x₀|, |z₀|); `None` when the sample holds none of them.
+fn initial_offset(s: &Sample, scene: &Scene) -> Option<f64> {
+    let (x0, p) = (&scene.initial, &scene.params);
+    let relative = |stored: f64, expected: f64, scale: f64| (stored - expected).abs() / scale;
+    let mut offsets = Vec::new();
+    if let Some(a) = s.angles {
+        for (stored, expected) in [(a.theta, x0.theta), (a.phi, x0.phi), (a.psi, x0.psi)] {
+            offsets.push(relative(stored, expected, expected.abs().max(1.0)));
+        }
+    }
+    if let Some(w) = s.omega {
+        let omega = [x0.omega_x, x0.omega_y, x0.omega_z];
+        let scale = omega
+            .iter()
+            .fold(1.0 / p.time_unit(), |m, v| m.max(v.abs()));
+        for (stored, expected) in [w.x, w.y, w.z].into_iter().zip(omega) {
+            offsets.push(relative(stored, expected, scale));
+        }
+    }
+    if let Some(c) = s.position {
+        let scale = p.radius().max(x0.x.abs()).max(x0.z.abs());
+        offsets.extend([relative(c.x, x0.x, scale), relative(c.z, x0.z, scale)]);
+    }
+    offsets.into_iter().reduce(f64::max)
 }

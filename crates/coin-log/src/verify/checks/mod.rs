@@ -14,6 +14,7 @@ use super::samples::Sample;
 use crate::format::{ResultMetadata, RunMetadata};
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, Dynamics, Steady};
+use crate::scene::Scene;
 use nalgebra::Vector3;
 
 /// What the checks know about the run besides its samples: the file's metadata.
@@ -27,6 +28,9 @@ pub struct Context {
     pub run: RunMetadata,
     /// The `coin-log.result` record, if the run finished writing it.
     pub result: Option<ResultMetadata>,
+    /// The scene the `coin-log` record stores, read and validated as `record` reads one, or why it cannot
+    /// be.
+    pub scene: Result<Scene, String>,
     /// The steady motion the scene asks for, or why the steady check does not apply.
     pub steady: Result<Steady, String>,
     /// C1, C2 for these parameters (physics §6), or why they cannot be evaluated.

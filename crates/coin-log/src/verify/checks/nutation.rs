@@ -12,7 +12,7 @@
 use super::{fmt_num, worst, Context};
 use crate::model::nutation::{Motion, Orbit};
 use crate::model::{State, TurningPoints};
-use crate::scene::{self, defaults};
+use crate::scene::defaults;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
@@ -162,8 +162,7 @@ impl NutationCheck {
 
 /// The flat margin of the stored scene (the default when the scene cannot be read).
 fn flat_margin(ctx: &Context) -> f64 {
-    scene::parse_with_sets(&ctx.run.scene, &[])
-        .ok()
-        .and_then(|f| f.run.and_then(|r| r.flat_margin))
-        .unwrap_or(defaults::FLAT_MARGIN)
+    ctx.scene
+        .as_ref()
+        .map_or(defaults::FLAT_MARGIN, |s| s.run.flat_margin)
 }

@@ -5,7 +5,7 @@
 use super::{fmt_num, worst, Context, Max};
 use crate::format::RunMetadata;
 use crate::model::{Coin, Steady};
-use crate::scene::{self, Scene};
+use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use crate::verify::tolerances::Tolerances;
@@ -14,19 +14,21 @@ use nalgebra::{Matrix3, Vector3};
 /// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
 const MIN_ARC: f64 = 0.5;
 
-/// The steady motion a log's scene asks for, or why the check does not apply. The stored scene is read by
-/// the same typed parser and validation as `record` uses; the motion is rebuilt for the metadata's body.
+/// The steady motion a log's scene asks for, or why the check does not apply. The stored scene (`scene`,
+/// read by the same typed parser and validation as `record` uses) names it; the motion is rebuilt for the
+/// metadata's body.
 ///
 /// # Errors
 /// A sentence saying why there is no steady motion to compare with.
-pub fn plan(coin: &Coin, run: &RunMetadata) -> Result<Steady, String> {
+pub fn plan(
+    coin: &Coin,
+    run: &RunMetadata,
+    scene: &Result<Scene, String>,
+) -> Result<Steady, String> {
     let Some(family) = run.steady_kind else {
         return Err("not a steady scene (steady_kind = none)".into());
     };
-    let file = scene::parse_with_sets(&run.scene, &[])
-        .map_err(|e| format!("the metadata's scene does not parse: {e}"))?;
-    let scene =
-        Scene::from_file(&file).map_err(|e| format!("the metadata's scene is not valid: {e}"))?;
+    let scene = scene.as_ref().map_err(Clone::clone)?;
     let steady = scene.unperturbed_steady().ok_or(
         "the scene perturbs its steady motion (or has none), so it is not expected to stay steady",
     )?;
