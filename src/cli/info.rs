@@ -219,7 +219,7 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     };
     rows.push(("written by", format!("{library}{version}")));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
-        rows.push(("scene", escaped(d).into_owned()));
+        rows.push(("scene", cell(d)));
     }
     let span = i.time_range.map_or_else(
         || "no messages".into(),

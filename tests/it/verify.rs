@@ -129,6 +129,24 @@ fn a_stored_scene_that_disagrees_with_its_record_or_first_sample_or_does_not_val
         "{}",
         show(&r)
     );
+    // A description of 100 000 characters fails too, and info and plot show 200 of them.
+    let long = format!("description = \"{}", "d".repeat(100_000));
+    let r = edited("long.mcap", "description = \"", &long);
+    assert_eq!(status(&r, CheckId::Integrity), Status::Fail);
+    let path = dir.path().join("long.mcap");
+    let (code, info, err) = coin_log_text(&["info", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        info.len() < 3000 && info.contains(&format!("{}…", "d".repeat(199))),
+        "{info}"
+    );
+    let svg = dir.path().join("long.svg");
+    let (code, _, err) =
+        coin_log_text(&["plot", path.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!std::fs::read_to_string(&svg)
+        .unwrap()
+        .contains(&"d".repeat(201)));
 }
 
 fn assert_fails(r: &FileReport, id: CheckId, low: f64, high: f64) {
