@@ -733,14 +733,29 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
         ("failed", "verify", "cannot-verify")
     );
     assert!(
-        row["reason"].starts_with("verify: cannot-verify"),
-        "{row:?}"
+        row["reason"].starts_with("verify: cannot-verify")
+            && !row["reason"].contains("record expected it"),
+        "a refusal record did not predict is not called expected: {row:?}"
     );
     assert_eq!(
         row["predicted_stability"], "stable",
         "circle-plus is a stable steady circle"
     );
     assert!(row["steady_residual"].parse::<f64>().is_ok());
+    // A refusal record warned of: the reason says so, with the checks it named.
+    write_sweep(
+        dir.path(),
+        "loose.toml",
+        "base = \"euler-disk\"\nset = { \"run.duration\" = 3.0, \"run.rtol\" = 1e-3, \"run.integrator\" = \"dopri5\" }\n",
+    );
+    let (code, out, err) = run_in(dir.path(), &["sweep", "loose.toml", "-o", "loose"]);
+    assert_eq!(code, 1, "{out}{err}");
+    let row = &Csv::read(&dir.path().join("loose/catalogue.csv")).records()[0];
+    assert!(
+        row["reason"].starts_with("verify: failed: constraint ")
+            && row["reason"].ends_with("; record expected it: its settings allow more error than verify accepts in energy, invariants, constraint, steady, nutation (tighten rtol/atol, or step)"),
+        "{row:?}"
+    );
     write_sweep(
         dir.path(),
         "off.toml",

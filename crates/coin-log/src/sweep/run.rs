@@ -508,11 +508,22 @@ fn judge(
         return (RunStatus::Failed, Some(FailureKind::Numerical), reason);
     }
     match report {
-        Some(r) if r.verdict != Verdict::Ok => (
-            RunStatus::Failed,
-            Some(FailureKind::Verify),
-            verify_reason(r),
-        ),
+        Some(r) if r.verdict != Verdict::Ok => {
+            let mut reason = verify_reason(r);
+            let expected: Vec<&str> = s
+                .shortfalls
+                .iter()
+                .flat_map(|f| f.checks.iter().copied())
+                .collect();
+            if !expected.is_empty() {
+                // What record warns of before the run: a dataset's reader sees it beside the failure.
+                reason.push_str(&format!(
+                    "; record expected it: its settings allow more error than verify accepts in {} (tighten rtol/atol, or step)",
+                    expected.join(", ")
+                ));
+            }
+            (RunStatus::Failed, Some(FailureKind::Verify), reason)
+        }
         _ => (RunStatus::Finished, None, String::new()),
     }
 }
