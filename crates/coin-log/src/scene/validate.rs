@@ -489,7 +489,7 @@ fn initial_base(
             problems.finite("initial.theta", theta);
             problems.missing(
                 "initial.omega",
-                "is missing: theta needs omega = [ω_X, ω_Y, ω_Z]",
+                "is missing: theta needs omega = [ω_X, ω_Y, ω_Z] (the lean of a steady motion is `initial.steady.theta`)",
             );
             None
         }
