@@ -8,7 +8,7 @@ use super::rss::peak_rss_bytes;
 use super::Outcome;
 use anyhow::{anyhow, bail};
 use coin_log::files::input::check;
-use coin_log::files::{cut, escaped, shown, InputKind, OutputFolder, SHOWN_CHARS};
+use coin_log::files::{shown, shown_name, InputKind, OutputFolder};
 use coin_log::inspect::export::{self, ExportSummary, Layout};
 use std::path::{Path, PathBuf};
 
@@ -121,11 +121,7 @@ fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()
         );
     }
     for k in &s.skipped {
-        outln!(
-            "skipped {}: {}",
-            cut(&escaped(&k.topic), SHOWN_CHARS),
-            k.reason
-        );
+        outln!("skipped {}: {}", shown_name(&k.topic), k.reason);
     }
     Ok(())
 }

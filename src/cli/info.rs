@@ -4,7 +4,7 @@ use super::text::{counted, padded, size, COLUMN_MAX};
 use super::Outcome;
 use anyhow::bail;
 use coin_log::files::input::check;
-use coin_log::files::{cut, escaped, shown, InputKind, SHOWN_CHARS};
+use coin_log::files::{shown, shown_name, InputKind};
 use coin_log::format::metadata::number_string as n;
 use coin_log::format::{Encoding, RunMetadata, Termination};
 use coin_log::inspect::info::{self, ChannelReport, FileInfo};
@@ -215,11 +215,11 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     let library = if i.library.is_empty() {
         "(no library named: no header, or an empty one)".into()
     } else {
-        escaped(&i.library).into_owned()
+        shown_name(&i.library)
     };
     rows.push(("written by", format!("{library}{version}")));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
-        rows.push(("scene", cell(d)));
+        rows.push(("scene", shown_name(d)));
     }
     let span = i.time_range.map_or_else(
         || "no messages".into(),
@@ -296,17 +296,15 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
     rows
 }
 
-/// A name as a table cell: control characters escaped, cut to [`SHOWN_CHARS`] characters.
-fn cell(name: &str) -> String {
-    cut(&escaped(name), SHOWN_CHARS).into_owned()
-}
-
 fn channels(out: &mut String, i: &FileInfo) {
     if i.channels.is_empty() {
         return; // the `encoding` row says "no channels"
     }
     let width = |text: fn(&ChannelReport) -> &str, header: &str| {
-        let widest = i.channels.iter().map(|c| cell(text(c)).chars().count());
+        let widest = i
+            .channels
+            .iter()
+            .map(|c| shown_name(text(c)).chars().count());
         widest.max().unwrap_or(0).clamp(header.len(), COLUMN_MAX)
     };
     let topic_w = width(|c| &c.topic, "topic");
@@ -324,8 +322,8 @@ fn channels(out: &mut String, i: &FileInfo) {
         let _ = writeln!(
             out,
             "  {}  {}  {:>9}  {rate:>9}",
-            padded(&cell(&c.topic), topic_w),
-            padded(&cell(&c.schema), schema_w),
+            padded(&shown_name(&c.topic), topic_w),
+            padded(&shown_name(&c.schema), schema_w),
             c.messages
         );
     }

@@ -51,6 +51,13 @@ pub fn escaped(text: &str) -> Cow<'_, str> {
 /// 70 000 to 1 000 000 (a topic, a line of TOML), which printed megabytes of one message.
 pub const SHOWN_CHARS: usize = 200;
 
+/// A name a file holds (a topic, a schema, a description) as a message or a table shows it: control
+/// characters escaped ([`escaped`]), cut to [`SHOWN_CHARS`] characters.
+#[must_use]
+pub fn shown_name(text: &str) -> String {
+    cut(&escaped(text), SHOWN_CHARS).into_owned()
+}
+
 /// `text` cut to `max` characters, with `…` where it was cut.
 #[must_use]
 pub fn cut(text: &str, max: usize) -> Cow<'_, str> {

@@ -18,7 +18,7 @@
 
 use super::seconds_text;
 use crate::csv;
-use crate::files::{cut, escaped, SHOWN_CHARS};
+use crate::files::shown_name;
 use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::Channel;
@@ -543,7 +543,7 @@ impl<W: Write> Exporter<'_, W> {
                     .skipped
                     .iter()
                     .take(LISTED)
-                    .map(|k| format!("{}: {}", cut(&escaped(&k.topic), SHOWN_CHARS), k.reason))
+                    .map(|k| format!("{}: {}", shown_name(&k.topic), k.reason))
                     .collect();
                 if self.skipped.len() > LISTED {
                     skipped.push(format!("and {} more", self.skipped.len() - LISTED));

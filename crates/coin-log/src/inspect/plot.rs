@@ -9,7 +9,7 @@
 //! with the minimum and maximum of the samples in each (so no spike is lost), and the paths keep every
 //! k-th point with k doubling as needed.
 
-use crate::files::{cut, SHOWN_CHARS};
+use crate::files::shown_name;
 use crate::format::fields::FieldReader;
 use crate::format::json::read_fields;
 use crate::format::{
@@ -402,7 +402,7 @@ fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (S
     let description = toml::from_str::<SceneFile>(&run.scene)
         .ok()
         .and_then(|s| s.description)
-        .map(|d| cut(&d, SHOWN_CHARS).into_owned())
+        .map(|d| shown_name(&d))
         .unwrap_or_default();
     let end = match (&c.result, broken) {
         (_, Some(b)) => format!("file breaks off after t = {}: {b}", c.last_t),
