@@ -7,7 +7,7 @@ use coin_log::files::input::check;
 use coin_log::files::{shown, shown_name, InputKind};
 use coin_log::format::metadata::number_string as n;
 use coin_log::format::{Encoding, RunMetadata, Termination};
-use coin_log::inspect::info::{self, ChannelReport, FileInfo};
+use coin_log::inspect::info::{self, FileInfo};
 use coin_log::inspect::seconds_text;
 use coin_log_mcap::Compression;
 use std::fmt::Write as _;
@@ -300,15 +300,17 @@ fn channels(out: &mut String, i: &FileInfo) {
     if i.channels.is_empty() {
         return; // the `encoding` row says "no channels"
     }
-    let width = |text: fn(&ChannelReport) -> &str, header: &str| {
-        let widest = i
-            .channels
-            .iter()
-            .map(|c| shown_name(text(c)).chars().count());
-        widest.max().unwrap_or(0).clamp(header.len(), COLUMN_MAX)
+    // Each name escaped and cut once; the columns as wide as the widest, up to COLUMN_MAX.
+    let cells: Vec<[String; 2]> = i
+        .channels
+        .iter()
+        .map(|c| [shown_name(&c.topic), shown_name(&c.schema)])
+        .collect();
+    let width = |k: usize, header: &str| {
+        let widest = cells.iter().map(|c| c[k].chars().count()).max();
+        widest.unwrap_or(0).clamp(header.len(), COLUMN_MAX)
     };
-    let topic_w = width(|c| &c.topic, "topic");
-    let schema_w = width(|c| &c.schema, "schema");
+    let (topic_w, schema_w) = (width(0, "topic"), width(1, "schema"));
     let _ = writeln!(
         out,
         "  {}  {}  {:>9}  {:>9}",
@@ -317,13 +319,13 @@ fn channels(out: &mut String, i: &FileInfo) {
         "messages",
         "rate"
     );
-    for c in &i.channels {
+    for (c, [topic, schema]) in i.channels.iter().zip(&cells) {
         let rate = c.rate.map_or_else(|| "-".into(), |r| format!("{r:.2}"));
         let _ = writeln!(
             out,
             "  {}  {}  {:>9}  {rate:>9}",
-            padded(&shown_name(&c.topic), topic_w),
-            padded(&shown_name(&c.schema), schema_w),
+            padded(topic, topic_w),
+            padded(schema, schema_w),
             c.messages
         );
     }

@@ -70,13 +70,13 @@ pub fn cut(text: &str, max: usize) -> Cow<'_, str> {
 #[cfg(test)]
 mod tests {
     use super::{cut, shown};
+    use std::path::Path;
 
     #[test]
     fn a_cut_keeps_whole_characters() {
         assert_eq!(cut("ééé", 2), "éé…");
         assert_eq!(cut("ab", 2), "ab");
     }
-    use std::path::Path;
 
     #[test]
     fn control_characters_in_paths_are_escaped_and_the_rest_kept() {

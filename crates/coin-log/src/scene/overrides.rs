@@ -63,10 +63,7 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
     let (last, path) = parts
         .split_last()
         .ok_or_else(|| error("the key is empty".into()))?;
-    for other in other_form(&parts.join(".")) {
-        remove(table, other);
-    }
-    let mut current = table;
+    let mut current = &mut *table;
     for (depth, part) in path.iter().enumerate() {
         let entry = current
             .entry((*part).to_string())
@@ -85,6 +82,9 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
         };
     }
     current.insert((*last).to_string(), value);
+    for other in other_form(&parts.join(".")) {
+        remove(table, other);
+    }
     Ok(())
 }
 
