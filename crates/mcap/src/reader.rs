@@ -11,7 +11,7 @@
 //! allocated for it.
 //!
 //! Ours rather than the `mcap` crate's readers: on the 7 M-message workload of `bench throughput`
-//! (`benches/crate_vs_ours.rs`, its "read" race, file in the page cache, medians of 3 alternating rounds
+//! (`crates/bench/benches/crate_vs_ours.rs`, its "read" race, file in the page cache, medians of 3 alternating rounds
 //! at load 7 on 2 cores) this reader, every check included, took 1.31 s; the crate's sans-io
 //! `LinearReader` with `mcap::parse_record` on every record, checking nothing beyond CRCs, 2.34 s, and
 //! `mcap::MessageStream` over the file in memory 2.33 s. The crate's `LinearReader` still splits the file

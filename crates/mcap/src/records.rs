@@ -6,7 +6,7 @@
 //! Parsing is bounded: every length inside a record is checked against what the record holds before
 //! anything is allocated for it, so parsing a record never allocates more than the record's own size
 //! (plus [`MAX_MAP_ENTRIES`] entries per map). `mcap::parse_record` instead reserves what a string claims:
-//! 4 GiB for a 30-byte metadata index record (measured by `benches/crate_vs_ours.rs`, which also times
+//! 4 GiB for a 30-byte metadata index record (measured by `crates/bench/benches/crate_vs_ours.rs`, which also times
 //! both parsers on the 7 M-message workload: see [`MessageRecord`]).
 
 use mcap::records::{
@@ -408,7 +408,7 @@ const MESSAGE_HEADER_LEN: usize = 2 + 4 + 8 + 8;
 ///
 /// Parsing it is the streaming reader's hot path: every record of the 7 M-message workload, decompressed
 /// in memory beforehand, took 0.127 s with this codec and 0.469 s with `mcap::parse_record`
-/// (`benches/crate_vs_ours.rs`' "parse" race, medians of 3 alternating rounds at load 7 on 2 cores).
+/// (`crates/bench/benches/crate_vs_ours.rs`' "parse" race, medians of 3 alternating rounds at load 7 on 2 cores).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MessageRecord<'a> {
     /// Channel, sequence, log and publish time.

@@ -8,7 +8,7 @@
 //! (bounds-checked), every length is checked against the file size before anything is allocated for it,
 //! and the summary section and the metadata records it indexes are held to the reader's budget. On the
 //! 7 M-message workload's file this takes 0.13 ms (with its seeks), `mcap::Summary::read` and
-//! `mcap::read::metadata` 0.28 ms over the file already in memory (`benches/crate_vs_ours.rs`' "summary"
+//! `mcap::read::metadata` 0.28 ms over the file already in memory (`crates/bench/benches/crate_vs_ours.rs`' "summary"
 //! race, medians of 3 rounds of 101 reads); the crate's parsers also reserve what a length claims.
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};

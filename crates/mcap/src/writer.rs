@@ -4,7 +4,7 @@
 //!
 //! Written here rather than taken from `mcap::Writer` (0.26), which streams every record through a
 //! streaming zstd context on the calling thread and cannot hand a finished chunk away and go on. On the
-//! 7 M-message workload of `bench throughput` (`benches/crate_vs_ours.rs`, its "write" race, in memory,
+//! 7 M-message workload of `bench throughput` (`crates/bench/benches/crate_vs_ours.rs`, its "write" race, in memory,
 //! zstd level 1, 1 MiB chunks, medians of 3 alternating rounds at load 7 on 2 cores), this writer took
 //! 3.81 s with 1 worker (2.94 s with 2), `mcap::Writer` 6.07 s with `compression_threads(0)`, 5.93 s with
 //! 1 and 7.72 s with 2: 1.56 to 2.03 times as long. It would also change every recording's bytes.

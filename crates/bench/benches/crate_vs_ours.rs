@@ -7,7 +7,7 @@
 //! ```text
 //! coin-log record wobble --duration 1000 --rate 1000 \
 //!     --channels omega,angles,quaternion,position,contact,reaction,energy -o /tmp/wobble-1000.mcap
-//! cargo bench -p coin-log-mcap --bench crate_vs_ours -- /tmp/wobble-1000.mcap [ROUNDS]
+//! cargo bench -p coin-log-bench --bench crate_vs_ours -- /tmp/wobble-1000.mcap [ROUNDS]
 //! ```
 //!
 //! Its messages are loaded into memory once (1.2 GB), then every variant runs once per round, in turn
@@ -441,7 +441,7 @@ fn main() -> Result<()> {
         .filter(|a| !a.starts_with("--"))
         .collect();
     let path = PathBuf::from(args.first().ok_or(
-        "usage: cargo bench -p coin-log-mcap --bench crate_vs_ours -- FILE.mcap [ROUNDS] (see the doc)",
+        "usage: cargo bench -p coin-log-bench --bench crate_vs_ours -- FILE.mcap [ROUNDS] (see the doc)",
     )?);
     let rounds: usize = args.get(1).map_or(Ok(3), |r| r.parse())?;
     let (crate_peak, _) =
