@@ -55,6 +55,7 @@ mod invariants;
 mod linearisation;
 #[cfg(feature = "live")]
 mod live;
+mod mcap_reader;
 #[cfg(feature = "external-readers")]
 mod other_writers;
 mod params;

@@ -108,7 +108,6 @@ impl Visitor for Recording {
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
         self.metadata.push((name.into(), entries.clone()));
     }
-    fn library(&mut self, _: &str) {}
     fn message(&mut self, header: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         self.headers.push(*header);
         self.data.extend_from_slice(data);
@@ -125,9 +124,6 @@ struct Count {
 }
 
 impl Visitor for Count {
-    fn channel(&mut self, _: u16, _: &str, _: &str, _: Option<&Schema<'_>>) {}
-    fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
-    fn library(&mut self, _: &str) {}
     fn message(&mut self, _: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         self.messages += 1;
         self.bytes += data.len() as u64;

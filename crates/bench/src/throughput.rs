@@ -25,10 +25,8 @@ use coin_log::format::{Channel, Encoding};
 use coin_log::record::COMPRESSION_THREADS;
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
 use coin_log_mcap::{
-    self, ChunkCompressor, Compression, MessageHeader, Schema, Visitor, DEFAULT_CHUNK_SIZE,
-    ZSTD_LEVEL,
+    self, ChunkCompressor, Compression, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
 };
-use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -267,9 +265,6 @@ impl Compressing {
 }
 
 impl Visitor for Compressing {
-    fn channel(&mut self, _: u16, _: &str, _: &str, _: Option<&Schema<'_>>) {}
-    fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
-    fn library(&mut self, _: &str) {}
     fn message(&mut self, _: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         self.bound.messages += 1;
         self.bound.json_bytes += data.len() as u64;

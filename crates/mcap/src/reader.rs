@@ -50,17 +50,16 @@ pub trait Visitor {
     /// or an id that no schema record before it defines.
     fn channel(
         &mut self,
-        id: u16,
-        topic: &str,
-        message_encoding: &str,
-        schema: Option<&Schema<'_>>,
-    );
+        _id: u16,
+        _topic: &str,
+        _message_encoding: &str,
+        _schema: Option<&Schema<'_>>,
+    ) {
+    }
     /// A metadata record with its entries. Every metadata record the summary indexes (or, in a file
     /// without one, every one a scan of the top-level records finds) comes before the first message,
     /// wherever it sits in the file; each comes once.
-    fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>);
-    /// The header record's library string.
-    fn library(&mut self, library: &str);
+    fn metadata(&mut self, _name: &str, _entries: &BTreeMap<String, String>) {}
     /// A message; `Break` stops reading (e.g. the file is not one the caller understands).
     fn message(&mut self, header: &MessageHeader, data: &[u8]) -> ControlFlow<()>;
 }
@@ -630,7 +629,6 @@ impl Book {
         match opcode {
             op::HEADER => {
                 let header: Header = parse(data, at)?;
-                visitor.library(&header.library);
                 self.s.library = header.library;
             }
             op::MESSAGE_INDEX => self.message_index(data, at)?,
@@ -1072,167 +1070,5 @@ impl Book {
                 format!("summary offsets {bad:?} (opcode, start, length) point at no group of the summary")
             });
         }
-    }
-}
-
-#[cfg(test)]
-#[allow(clippy::unwrap_used)]
-mod tests {
-    use super::super::writer::{Compression, McapWriter, WriterOptions};
-    use super::*;
-    use std::io::Cursor as IoCursor;
-    use std::time::Duration;
-
-    /// Generous deadline of the hang tests: reading these few MiB takes milliseconds.
-    const DEADLINE: Duration = Duration::from_secs(20);
-
-    /// An uncompressed file of `messages` 1 KiB messages in 64 KiB chunks (many more batches than the
-    /// prefetch queue holds), with a metadata record `late` written after the first `late_after` messages.
-    fn file(messages: u32, late_after: u32) -> Vec<u8> {
-        let mut options = WriterOptions::new(Compression::None, "test");
-        options.chunk_size = 1 << 16;
-        let mut w = McapWriter::new(IoCursor::new(Vec::new()), &options).unwrap();
-        let schema = w.add_schema("s", "jsonschema", b"{}").unwrap();
-        let channel = w
-            .add_channel(schema, "/t", "json", &BTreeMap::new())
-            .unwrap();
-        let data = vec![b' '; 1024];
-        for i in 0..messages {
-            if i == late_after {
-                let entries = BTreeMap::from([("k".to_string(), "v".to_string())]);
-                w.write_metadata("late", &entries).unwrap();
-            }
-            w.write_message(channel, i, u64::from(i), u64::from(i), &data)
-                .unwrap();
-        }
-        w.finish().unwrap().0.into_inner()
-    }
-
-    /// Records what it is given; stops at message `stop_at`.
-    #[derive(Default)]
-    struct Recorder {
-        stop_at: u64,
-        messages: u64,
-        events: Vec<String>,
-    }
-
-    impl Visitor for Recorder {
-        fn channel(&mut self, _: u16, _: &str, _: &str, _: Option<&Schema<'_>>) {}
-        fn metadata(&mut self, name: &str, _: &BTreeMap<String, String>) {
-            self.events
-                .push(format!("metadata {name} after {} messages", self.messages));
-        }
-        fn library(&mut self, _: &str) {}
-        fn message(&mut self, _: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
-            self.messages += 1;
-            if self.messages == self.stop_at {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        }
-    }
-
-    /// Reads `bytes` on another thread, failing the test if it has not returned by [`DEADLINE`].
-    fn read_with_deadline(
-        bytes: Vec<u8>,
-        stop_at: u64,
-    ) -> (Recorder, Structure, Option<ReadError>) {
-        let (done, result) = mpsc::channel();
-        std::thread::spawn(move || {
-            let mut v = Recorder {
-                stop_at,
-                ..Recorder::default()
-            };
-            let len = bytes.len() as u64;
-            let (s, e) = read_from(IoCursor::new(bytes), len, &mut v);
-            let _ = done.send((v, s, e));
-        });
-        result
-            .recv_timeout(DEADLINE)
-            .unwrap_or_else(|_| panic!("the reader did not return within {DEADLINE:?}: it hangs"))
-    }
-
-    #[test]
-    fn a_visitor_that_stops_early_ends_the_read_and_its_worker() {
-        // 8 MiB of records: the worker fills the queue (4 batches of ~1 MiB) long before the end.
-        let bytes = file(8192, u32::MAX);
-        assert!(bytes.len() > 8 << 20, "{} bytes", bytes.len());
-        for stop_at in [1, 100, 5000] {
-            let (v, _, e) = read_with_deadline(bytes.clone(), stop_at);
-            assert_eq!(v.messages, stop_at);
-            assert_eq!(e.unwrap().kind, ReadErrorKind::Stopped);
-        }
-    }
-
-    #[test]
-    fn a_metadata_record_after_the_first_chunks_comes_before_the_first_message() {
-        let bytes = file(8192, 3000);
-        let (v, s, e) = read_with_deadline(bytes, u64::MAX);
-        assert_eq!(e, None);
-        assert!(s.problems.is_empty(), "{}", s.problems.summary());
-        assert_eq!(v.events, ["metadata late after 0 messages"]);
-        assert_eq!(v.messages, 8192);
-    }
-
-    /// A file by the `mcap` crate's writer with one attachment whose data is `hello`, and the offset of
-    /// that data (no data-section CRC, so that the tests can edit the attachment alone).
-    fn file_with_attachment() -> (Vec<u8>, usize) {
-        let options = mcap::WriteOptions::new().calculate_data_section_crc(false);
-        let mut w = options.create(IoCursor::new(Vec::new())).unwrap();
-        w.attach(&mcap::Attachment {
-            log_time: 1,
-            create_time: 2,
-            name: "note".into(),
-            media_type: "text/plain".into(),
-            data: Cow::Borrowed(b"hello"),
-        })
-        .unwrap();
-        w.finish().unwrap();
-        let bytes = w.into_inner().into_inner();
-        let at = bytes.windows(5).position(|w| w == b"hello").unwrap();
-        (bytes, at)
-    }
-
-    #[test]
-    fn an_attachment_is_checked_for_its_framing_and_crc() {
-        let (bytes, at) = file_with_attachment();
-        let (_, s, e) = read_with_deadline(bytes.clone(), u64::MAX);
-        assert_eq!(e, None);
-        assert!(s.problems.is_empty(), "{}", s.problems.summary());
-        // One byte of its data changed: the CRC it stores no longer holds.
-        let mut flipped = bytes.clone();
-        flipped[at] ^= 1;
-        let (_, s, _) = read_with_deadline(flipped, u64::MAX);
-        let problems = s.problems.summary();
-        assert!(
-            problems.contains("attachment `note` at byte ")
-                && problems.contains("does not match the stored"),
-            "{problems}"
-        );
-        // Its data length claiming more than the record holds: malformed, not an allocation.
-        let mut lying = bytes;
-        lying[at - 8..at].copy_from_slice(&u64::MAX.to_le_bytes());
-        let (_, _, e) = read_with_deadline(lying, u64::MAX);
-        let e = e.unwrap();
-        assert_eq!(e.kind, ReadErrorKind::Corrupt);
-        assert!(
-            e.to_string()
-                .contains("malformed attachment record at byte "),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn an_error_in_the_middle_ends_the_read_and_its_worker() {
-        // A byte flipped in the middle of the file, inside a chunk's records (chunks are 98% of these
-        // bytes; this file is deterministic): a chunk CRC error the consumer returns while the worker is
-        // still reading ahead.
-        let mut bytes = file(8192, u32::MAX);
-        let middle = bytes.len() / 2;
-        bytes[middle] ^= 1;
-        let (_, _, e) = read_with_deadline(bytes, u64::MAX);
-        let e = e.unwrap();
-        assert_eq!(e.kind, ReadErrorKind::Corrupt, "{e}");
     }
 }

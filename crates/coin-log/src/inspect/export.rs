@@ -577,8 +577,6 @@ impl<W: Write> Visitor for Exporter<'_, W> {
         let target = self.target(topic, schema);
         self.targets.insert(id, (topic.to_string(), target));
     }
-    fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
-    fn library(&mut self, _: &str) {}
     fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         self.messages += 1;
         match self.targets.get(&h.channel_id) {

@@ -367,7 +367,6 @@ impl Visitor for Scan {
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
         self.metadata.push((name.to_string(), entries.clone()));
     }
-    fn library(&mut self, _: &str) {}
     fn message(&mut self, header: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
         *self.counts.entry(header.channel_id).or_insert(0) += 1;
         let t = header.log_time;

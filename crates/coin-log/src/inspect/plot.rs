@@ -306,7 +306,6 @@ impl Visitor for Collect {
             self.result = ResultMetadata::from_map(entries).ok();
         }
     }
-    fn library(&mut self, _: &str) {}
     fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         if self.run.is_none() {
             return ControlFlow::Break(());

@@ -195,7 +195,6 @@ struct Judge {
     result: Option<ResultMetadata>,
     run_error: Option<String>,
     result_error: Option<String>,
-    library: String,
     problems: BoundedFindings,
     notes: Vec<String>,
     assembler: Assembler,
@@ -378,10 +377,6 @@ fn disagreements(file: &RunMetadata, expected: &RunMetadata) -> Vec<String> {
 }
 
 impl Visitor for Judge {
-    fn library(&mut self, library: &str) {
-        self.library = library.to_string();
-    }
-
     fn channel(
         &mut self,
         id: u16,
@@ -763,7 +758,7 @@ fn verdict(
                  judge",
                 e.detail
             ),
-            (None, None) => judge.not_coin_log(),
+            (None, None) => judge.not_coin_log(&structure.library),
         };
         return unusable(&shown, why);
     };
@@ -807,12 +802,12 @@ fn verdict(
 
 impl Judge {
     /// Why a file without a usable `coin-log` metadata record is not judged.
-    fn not_coin_log(&mut self) -> String {
+    fn not_coin_log(&mut self, library: &str) -> String {
         self.run_error.take().unwrap_or_else(|| {
-            let by = if self.library.is_empty() {
+            let by = if library.is_empty() {
                 String::new()
             } else {
-                format!(" (written by `{}`)", self.library)
+                format!(" (written by `{library}`)")
             };
             format!("not a coin-log file: it has no `coin-log` metadata record{by}")
         })
