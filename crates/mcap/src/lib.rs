@@ -28,6 +28,7 @@ mod early_metadata;
 mod findings;
 mod prefetch;
 mod reader;
+#[doc(hidden)]
 pub mod records;
 mod summary;
 mod writer;

@@ -35,29 +35,19 @@ pub(crate) const POOL: usize = QUEUE + 2;
 /// One step of the read, in file order.
 #[derive(Debug)]
 pub(crate) enum Event {
-    /// A top-level record other than a chunk, and its body in the batch.
-    Record {
-        /// Record opcode.
-        opcode: u8,
-        /// Its body in [`Batch::bytes`].
-        body: Range<usize>,
-    },
-    /// A chunk, its records decompressed (their size and CRC checked).
+    /// A top-level record other than a chunk; `body` is in [`Batch::bytes`].
+    Record { opcode: u8, body: Range<usize> },
+    /// A chunk (`len`: its record's body length), its records decompressed into [`Batch::bytes`] and
+    /// their size and CRC checked.
     Chunk {
-        /// The chunk record's body length.
         len: u64,
-        /// Its header.
         header: ChunkHeader,
-        /// Its decompressed records in [`Batch::bytes`].
         records: Range<usize>,
     },
-    /// A chunk that cannot be read; nothing follows.
+    /// A chunk that cannot be read (`header`: when it could be parsed); nothing follows.
     BadChunk {
-        /// The chunk record's body length.
         len: u64,
-        /// Its header, when it could be parsed.
         header: Option<ChunkHeader>,
-        /// What is wrong.
         error: ChunkError,
     },
     /// The top-level reader failed (bad magic, truncation, data or summary CRC, lengths); nothing
@@ -68,38 +58,31 @@ pub(crate) enum Event {
 }
 
 /// Why a chunk's records cannot be read.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub(crate) enum ChunkError {
     /// Its header runs past the record.
+    #[error(transparent)]
     Malformed(WireError),
     /// It declares more than [`MAX_RECORD_BYTES`] of records.
+    #[error("it declares {0} bytes of records")]
     TooLarge(u64),
-    /// A compression this reader does not know.
+    /// The text is [`McapError::UnsupportedCompression`]'s.
+    #[error("Unsupported compression format `{0}`")]
     Unsupported(String),
-    /// The compressed records are not a valid stream.
+    #[error("its records cannot be decompressed: {0}")]
     Decompress(String),
-    /// They decompress to another size than declared (`None`: to more).
-    Size {
-        /// What they decompress to, when not more than declared.
-        got: Option<u64>,
-        /// What the header declares.
-        declared: u64,
-    },
-    /// Their CRC is not the stored one.
-    Crc {
-        /// The header's.
-        saved: u32,
-        /// The records'.
-        calculated: u32,
-    },
+    #[error("its records decompress to {got} bytes, its header claims {declared}")]
+    Short { got: u64, declared: u64 },
+    #[error("its records decompress to more than the {declared} bytes its header claims")]
+    Long { declared: u64 },
+    #[error("CRC {calculated:#010x} of its records does not match the stored {saved:#010x}")]
+    Crc { saved: u32, calculated: u32 },
 }
 
-/// Records and the events that point into them.
+/// Record bodies and decompressed chunks back to back, and the events that point into them, in order.
 #[derive(Debug, Default)]
 pub(crate) struct Batch {
-    /// Record bodies and decompressed chunks back to back.
     pub(crate) bytes: Vec<u8>,
-    /// What happened, in order.
     pub(crate) events: Vec<Event>,
 }
 
@@ -115,37 +98,22 @@ impl Batch {
     }
 }
 
-/// The worker's end: where batches go and where spent ones come back.
-pub(crate) struct Producer {
-    /// Filled batches, to the consumer.
-    pub(crate) to_consumer: SyncSender<Batch>,
-    /// Spent batches, from the consumer.
-    pub(crate) recycled: Receiver<Batch>,
-}
-
-/// The worker's batches: the one being filled, and the spent ones back from the consumer.
-struct Batches<'p> {
-    producer: &'p Producer,
+/// The worker's batches: the one being filled, the spent ones back from the consumer, and the two
+/// channel ends.
+struct Batches {
+    to_consumer: SyncSender<Batch>,
+    recycled: Receiver<Batch>,
     current: Batch,
     spare: Vec<Batch>,
     /// Batches made so far (at most [`POOL`]).
     made: usize,
 }
 
-impl<'p> Batches<'p> {
-    fn new(producer: &'p Producer) -> Self {
-        Self {
-            producer,
-            current: Batch::default(),
-            spare: Vec::new(),
-            made: 1,
-        }
-    }
-
+impl Batches {
     /// A batch to fill: a spare one, a new one while fewer than [`POOL`] exist, or the next to come
     /// back; `None` when the consumer has gone.
     fn fresh(&mut self) -> Option<Batch> {
-        while let Ok(b) = self.producer.recycled.try_recv() {
+        while let Ok(b) = self.recycled.try_recv() {
             self.spare.push(b);
         }
         let mut b = match self.spare.pop() {
@@ -154,7 +122,7 @@ impl<'p> Batches<'p> {
                 self.made += 1;
                 Batch::default()
             }
-            None => self.producer.recycled.recv().ok()?,
+            None => self.recycled.recv().ok()?,
         };
         b.bytes.clear();
         b.events.clear();
@@ -169,7 +137,7 @@ impl<'p> Batches<'p> {
     fn hand_over(&mut self) -> Option<()> {
         let next = self.fresh()?;
         let full = std::mem::replace(&mut self.current, next);
-        self.producer.to_consumer.send(full).ok()
+        self.to_consumer.send(full).ok()
     }
 
     /// Makes room for `size` more bytes: hands the batch over when full, and before something larger
@@ -183,7 +151,7 @@ impl<'p> Batches<'p> {
                 self.hand_over()?;
             }
             while self.spare.len() + 1 < self.made {
-                self.spare.push(self.producer.recycled.recv().ok()?);
+                self.spare.push(self.recycled.recv().ok()?);
             }
         }
         Some(())
@@ -192,7 +160,12 @@ impl<'p> Batches<'p> {
 
 /// Reads an MCAP stream of `file_len` bytes from `source` and sends its records to the consumer, ending
 /// after the last record, the first error, or when the consumer hangs up.
-pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer) {
+pub(crate) fn produce(
+    mut source: impl Read,
+    file_len: u64,
+    to_consumer: SyncSender<Batch>,
+    recycled: Receiver<Batch>,
+) {
     let limit = usize::try_from(file_len.min(MAX_RECORD_BYTES)).unwrap_or(usize::MAX);
     let mut outer = LinearReader::new_with_options(
         LinearReaderOptions::default()
@@ -202,7 +175,13 @@ pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer)
             .with_check_finishes_after_end_magic(true)
             .with_record_length_limit(limit),
     );
-    let mut batches = Batches::new(producer);
+    let mut batches = Batches {
+        to_consumer,
+        recycled,
+        current: Batch::default(),
+        spare: Vec::new(),
+        made: 1,
+    };
     let mut decompressor = Decompressor::default();
     let mut read_so_far: u64 = 0;
     while let Some(event) = outer.next_event() {
@@ -246,12 +225,12 @@ pub(crate) fn produce(mut source: impl Read, file_len: u64, producer: &Producer)
             }
         }
     }
-    let _ = producer.to_consumer.send(batches.current);
+    let _ = batches.to_consumer.send(batches.current);
 }
 
 /// Decompresses the chunk record `data` into the current batch (making room first); `None` when the
 /// consumer has gone.
-fn chunk(data: &[u8], batches: &mut Batches<'_>, decompressor: &mut Decompressor) -> Option<Event> {
+fn chunk(data: &[u8], batches: &mut Batches, decompressor: &mut Decompressor) -> Option<Event> {
     let len = data.len() as u64;
     let chunk = match ChunkRecord::parse_body(data) {
         Ok(chunk) => chunk,
@@ -326,10 +305,7 @@ impl Decompressor {
                             e.is(zstd::zstd_safe::zstd_sys::ZSTD_ErrorCode::ZSTD_error_dstSize_tooSmall)
                         });
                     return Err(if too_small {
-                        ChunkError::Size {
-                            got: None,
-                            declared,
-                        }
+                        ChunkError::Long { declared }
                     } else {
                         decompress(e)
                     });
@@ -345,9 +321,11 @@ impl Decompressor {
             other => return Err(ChunkError::Unsupported(other.to_string())),
         }
         let got = (out.len() - start) as u64;
-        if got != declared {
-            let got = (got < declared).then_some(got);
-            return Err(ChunkError::Size { got, declared });
+        if got < declared {
+            return Err(ChunkError::Short { got, declared });
+        }
+        if got > declared {
+            return Err(ChunkError::Long { declared });
         }
         let calculated = crc32fast::hash(&out[start..]);
         if h.uncompressed_crc != 0 && calculated != h.uncompressed_crc {

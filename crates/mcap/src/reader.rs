@@ -379,14 +379,7 @@ fn read_into(
     let (to_producer, recycled) = mpsc::sync_channel(prefetch::POOL);
     std::thread::scope(|scope| {
         let worker = scope.spawn(move || {
-            prefetch::produce(
-                file,
-                file_len,
-                &prefetch::Producer {
-                    to_consumer,
-                    recycled,
-                },
-            );
+            prefetch::produce(file, file_len, to_consumer, recycled);
         });
         // `consume` owns the receiving end: when it returns early (an error, or the visitor stopped) or
         // unwinds, the receiver is dropped, so a worker blocked sending into the full queue wakes with an
@@ -704,7 +697,6 @@ impl Book {
     }
 
     fn chunk_error(&self, at: u64, e: &ChunkError) -> ReadError {
-        let before = format!("judged the {} messages read before it", self.s.messages);
         let error = match e {
             ChunkError::Malformed(e) => wire_error("chunk", at, e),
             ChunkError::TooLarge(declared) => ReadError::new(
@@ -715,30 +707,12 @@ impl Book {
                     budget::limit()
                 ),
             ),
-            ChunkError::Unsupported(name) => corrupt(format!(
-                "corrupt chunk at byte {at}: {}",
-                McapError::UnsupportedCompression(name.clone())
-            )),
-            ChunkError::Decompress(e) => corrupt(format!(
-                "corrupt chunk at byte {at}: its records cannot be decompressed: {e}"
-            )),
-            ChunkError::Size {
-                got: Some(got),
-                declared,
-            } => corrupt(format!(
-                "corrupt chunk at byte {at}: its records decompress to {got} bytes, its header claims \
-                 {declared}"
-            )),
-            ChunkError::Size { got: None, declared } => corrupt(format!(
-                "corrupt chunk at byte {at}: its records decompress to more than the {declared} bytes \
-                 its header claims"
-            )),
-            ChunkError::Crc { saved, calculated } => corrupt(format!(
-                "corrupt chunk at byte {at}: CRC {calculated:#010x} of its records does not match \
-                 the stored {saved:#010x}"
-            )),
+            e => corrupt(format!("corrupt chunk at byte {at}: {e}")),
         };
-        error.after(before)
+        error.after(format!(
+            "judged the {} messages read before it",
+            self.s.messages
+        ))
     }
 
     fn message(

@@ -1,13 +1,10 @@
-//! Every MCAP record this crate reads or writes (<https://mcap.dev/spec#records>), each declared once: a
-//! type (the `mcap::records` one where it fits; for the records that end in bulk data, a type that
-//! borrows it) and its field list, from which one macro makes both the parser and the encoder that the
-//! writer, the streaming reader, the summary reader and the metadata lookup share.
+//! Every MCAP record this crate reads or writes, each declared once: a type (`mcap::records`' where it
+//! fits) and its field list, from which `codec!` makes both parser and encoder. Public (hidden) only for
+//! the bench `crates/bench/benches/crate_vs_ours.rs`.
 //!
-//! Parsing is bounded: every length inside a record is checked against what the record holds before
-//! anything is allocated for it, so parsing a record never allocates more than the record's own size
-//! (plus [`MAX_MAP_ENTRIES`] entries per map). `mcap::parse_record` instead reserves what a string claims:
-//! 4 GiB for a 30-byte metadata index record (measured by `crates/bench/benches/crate_vs_ours.rs`, which also times
-//! both parsers on the 7 M-message workload: see [`MessageRecord`]).
+//! Parsing is bounded: every length is checked against what the record holds before anything is
+//! allocated, so a record never costs more than its size (plus [`MAX_MAP_ENTRIES`] entries per map).
+//! `mcap::parse_record` reserves what a string claims: 4 GiB for a 30-byte metadata index record.
 
 use mcap::records::{
     op, ChunkHeader, ChunkIndex, DataEnd, Footer, Header, MessageHeader, MessageIndex,
@@ -16,69 +13,31 @@ use mcap::records::{
 use mcap::Schema;
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::fmt;
 
-/// The MCAP magic, at the start and at the end of every file.
+use crate::WriteError;
+
 pub(crate) const MAGIC: &[u8] = mcap::MAGIC;
-/// [`MAGIC`]'s length.
 pub(crate) const MAGIC_LEN: u64 = 8;
 /// Bytes before every record's body: its opcode and its body's length (u64).
 pub(crate) const PREFIX_LEN: u64 = 9;
-/// Bytes of the footer record, prefix included (its body: summary start, summary offset start, CRC).
+/// Bytes of the footer record, prefix included (body: summary start, summary offset start, CRC).
 pub(crate) const FOOTER_LEN: u64 = PREFIX_LEN + 8 + 8 + 4;
-/// Most entries a map field may hold (channel metadata, metadata records, statistics and chunk index
-/// maps): a coin-log metadata record has about 30, and an id-keyed map at most 65536 distinct ones. It
-/// bounds the memory of a parsed map (about 100 bytes per entry beyond its strings), which the record's
-/// size alone would not: an entry of two empty strings is 8 bytes in the file.
-pub const MAX_MAP_ENTRIES: usize = 1 << 16;
+/// Most entries a map field may hold: a coin-log metadata record has about 30, an id-keyed map at most
+/// 65536. It bounds a parsed map's memory (about 100 bytes per entry beyond its strings), which the
+/// record's size does not: an entry of two empty strings is 8 bytes in the file.
+pub(crate) const MAX_MAP_ENTRIES: usize = 1 << 16;
 
 /// A record body that does not hold what its fields declare.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum WireError {
-    /// The body ends before the field.
+    #[error("field `{field}` needs {needed} bytes but the record has {available} left")]
     Short {
-        /// The field being read.
         field: &'static str,
-        /// Bytes it needed.
         needed: u64,
-        /// Bytes left in the record.
         available: u64,
     },
-    /// A map or array with more than [`MAX_MAP_ENTRIES`] entries.
-    TooManyEntries {
-        /// The field.
-        field: &'static str,
-    },
-}
-
-impl fmt::Display for WireError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Short {
-                field,
-                needed,
-                available,
-            } => write!(
-                f,
-                "field `{field}` needs {needed} bytes but the record has {available} left"
-            ),
-            Self::TooManyEntries { field } => write!(
-                f,
-                "`{field}` has more than {MAX_MAP_ENTRIES} entries, more than this reader accepts"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for WireError {}
-
-/// A field too long for its MCAP length prefix (u32), when encoding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TooLong {
-    /// The field.
-    pub field: &'static str,
-    /// Its length.
-    pub len: usize,
+    #[error("`{field}` has more than {MAX_MAP_ENTRIES} entries, more than this reader accepts")]
+    TooManyEntries { field: &'static str },
 }
 
 /// A cursor over one record body.
@@ -88,7 +47,6 @@ pub(crate) struct Cursor<'a> {
 }
 
 impl<'a> Cursor<'a> {
-    /// A cursor at the start of `data`.
     pub(crate) fn new(data: &'a [u8]) -> Self {
         Self { data }
     }
@@ -98,10 +56,6 @@ impl<'a> Cursor<'a> {
         self.data
     }
 
-    /// Takes `n` bytes.
-    ///
-    /// # Errors
-    /// [`WireError`] if fewer are left.
     #[inline]
     pub(crate) fn take(&mut self, n: u64, field: &'static str) -> Result<&'a [u8], WireError> {
         let err = WireError::Short {
@@ -119,18 +73,12 @@ impl<'a> Cursor<'a> {
     }
 
     /// A u32-length-prefixed run of bytes.
-    ///
-    /// # Errors
-    /// [`WireError`] if the prefix claims more than the record holds.
     pub(crate) fn bytes(&mut self, field: &'static str) -> Result<&'a [u8], WireError> {
         let len = u32::parse(self, field)?;
         self.take(u64::from(len), field)
     }
 
     /// The next whole record: its opcode and body.
-    ///
-    /// # Errors
-    /// [`WireError`] if the prefix or the body it claims runs past the data.
     pub(crate) fn record(&mut self) -> Result<(u8, &'a [u8]), WireError> {
         let opcode = u8::parse(self, "opcode")?;
         let len = u64::parse(self, "record length")?;
@@ -149,16 +97,8 @@ pub(crate) fn prefix(bytes: &[u8]) -> Option<(u8, u64)> {
 
 /// A value of a record field: how it is parsed from, and encoded into, a record body.
 pub(crate) trait Field<'a>: Sized {
-    /// Reads the field at the cursor.
-    ///
-    /// # Errors
-    /// [`WireError`] if the record ends first.
     fn parse(c: &mut Cursor<'a>, field: &'static str) -> Result<Self, WireError>;
-    /// Appends the field.
-    ///
-    /// # Errors
-    /// [`TooLong`] if a length does not fit its prefix.
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong>;
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError>;
 }
 
 macro_rules! integer_fields {
@@ -172,7 +112,7 @@ macro_rules! integer_fields {
                 Ok(<$t>::from_le_bytes(le))
             }
             #[inline]
-            fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), TooLong> {
+            fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), WriteError> {
                 out.extend_from_slice(&self.to_le_bytes());
                 Ok(())
             }
@@ -181,9 +121,8 @@ macro_rules! integer_fields {
 }
 integer_fields!(u8, u16, u32, u64);
 
-/// A u32 length, checked.
-fn len32(len: usize, field: &'static str) -> Result<u32, TooLong> {
-    u32::try_from(len).map_err(|_| TooLong { field, len })
+fn len32(len: usize, what: &'static str) -> Result<u32, WriteError> {
+    u32::try_from(len).map_err(|_| WriteError::TooLong { what, len })
 }
 
 /// Bytes with a u32 length prefix (MCAP `Bytes` within a record), borrowed.
@@ -191,7 +130,7 @@ impl<'a> Field<'a> for Cow<'a, [u8]> {
     fn parse(c: &mut Cursor<'a>, field: &'static str) -> Result<Self, WireError> {
         Ok(Cow::Borrowed(c.bytes(field)?))
     }
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         len32(self.len(), field)?.encode(out, field)?;
         out.extend_from_slice(self);
         Ok(())
@@ -204,7 +143,7 @@ impl<'a> Field<'a> for String {
         let bytes = Cow::<[u8]>::parse(c, field)?;
         Ok(String::from_utf8_lossy(&bytes).into_owned())
     }
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         Cow::Borrowed(self.as_bytes()).encode(out, field)
     }
 }
@@ -234,8 +173,8 @@ fn encode_entries<T>(
     out: &mut Vec<u8>,
     field: &'static str,
     items: impl Iterator<Item = T>,
-    mut entry: impl FnMut(&mut Vec<u8>, T) -> Result<(), TooLong>,
-) -> Result<(), TooLong> {
+    mut entry: impl FnMut(&mut Vec<u8>, T) -> Result<(), WriteError>,
+) -> Result<(), WriteError> {
     let at = out.len();
     out.extend_from_slice(&[0; 4]);
     for item in items {
@@ -261,7 +200,7 @@ where
         })?;
         Ok(map)
     }
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         encode_entries(out, field, self.iter(), |out, (k, v)| {
             k.encode(out, field)?;
             v.encode(out, field)
@@ -280,7 +219,7 @@ impl<'a> Field<'a> for Vec<MessageIndexEntry> {
         }
         Ok(list)
     }
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         encode_entries(out, field, self.iter(), |out, e| e.encode(out, field))
     }
 }
@@ -295,7 +234,7 @@ macro_rules! codec {
                 Ok(Self { $($field: Field::parse(c, stringify!($field))?),* })
             }
             #[inline]
-            fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), TooLong> {
+            fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), WriteError> {
                 $(Field::encode(&self.$field, out, stringify!($field))?;)*
                 Ok(())
             }
@@ -318,38 +257,26 @@ macro_rules! record {
                 Self::parse(&mut Cursor::new(body), $name)
             }
             #[inline]
-            fn encode_body(&self, out: &mut Vec<u8>) -> Result<(), TooLong> {
+            fn encode_body(&self, out: &mut Vec<u8>) -> Result<(), WriteError> {
                 self.encode(out, $name)
             }
         }
     };
 }
 
-/// An MCAP record: its opcode, its name in messages, and its body's codec.
+/// An MCAP record: its opcode, its name in messages ("chunk index"), and its body's codec.
 pub trait Record<'a>: Sized {
-    /// The opcode.
     const OPCODE: u8;
-    /// What it is called in messages ("chunk index").
     const NAME: &'static str;
 
     /// Parses a record body (bytes after the fields are ignored: MCAP lets records grow).
-    ///
-    /// # Errors
-    /// [`WireError`] if the body ends before a field it declares.
     fn parse_body(body: &'a [u8]) -> Result<Self, WireError>;
 
-    /// Appends the body.
-    ///
-    /// # Errors
-    /// [`TooLong`] if a field does not fit its length prefix.
-    fn encode_body(&self, out: &mut Vec<u8>) -> Result<(), TooLong>;
+    fn encode_body(&self, out: &mut Vec<u8>) -> Result<(), WriteError>;
 
     /// Appends the whole record: opcode, length, body.
-    ///
-    /// # Errors
-    /// [`TooLong`] if a field does not fit its length prefix.
     #[inline]
-    fn encode_record(&self, out: &mut Vec<u8>) -> Result<(), TooLong> {
+    fn encode_record(&self, out: &mut Vec<u8>) -> Result<(), WriteError> {
         let at = out.len();
         out.extend_from_slice(&[Self::OPCODE, 0, 0, 0, 0, 0, 0, 0, 0]);
         self.encode_body(out)?;
@@ -399,7 +326,7 @@ codec!(ChunkHeader {
 /// The data of a message or a chunk: the rest of the record, or the chunk's compressed records (which
 /// its header gives the length of; padding may follow).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Tail<'a>(pub &'a [u8]);
+pub(crate) struct Tail<'a>(pub(crate) &'a [u8]);
 
 /// Bytes of a message header: channel id, sequence, log time, publish time.
 const MESSAGE_HEADER_LEN: usize = 2 + 4 + 8 + 8;
@@ -407,14 +334,12 @@ const MESSAGE_HEADER_LEN: usize = 2 + 4 + 8 + 8;
 /// A message record: its header, then its data, to the end of the record.
 ///
 /// Parsing it is the streaming reader's hot path: every record of the 7 M-message workload, decompressed
-/// in memory beforehand, took 0.127 s with this codec and 0.469 s with `mcap::parse_record`
-/// (`crates/bench/benches/crate_vs_ours.rs`' "parse" race, medians of 3 alternating rounds at load 7 on 2 cores).
+/// beforehand, took 0.127 s with this codec and 0.469 s with `mcap::parse_record` (crate_vs_ours'
+/// "parse" race, medians of 3 alternating rounds at load 7 on 2 cores).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MessageRecord<'a> {
-    /// Channel, sequence, log and publish time.
     pub header: MessageHeader,
-    /// The message.
-    pub data: Tail<'a>,
+    pub(crate) data: Tail<'a>,
 }
 
 impl<'a> Field<'a> for MessageRecord<'a> {
@@ -427,7 +352,7 @@ impl<'a> Field<'a> for MessageRecord<'a> {
         })
     }
     #[inline]
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         // One allocation check for the whole record: the writer's hot path.
         out.reserve(MESSAGE_HEADER_LEN + self.data.0.len());
         self.header.encode(out, field)?;
@@ -440,11 +365,10 @@ record!(MessageRecord<'a> = op::MESSAGE, "message");
 
 /// A chunk record: its header, then `compressed_size` bytes of (compressed) records.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ChunkRecord<'a> {
-    /// Times, sizes, CRC, compression.
-    pub header: ChunkHeader,
+pub(crate) struct ChunkRecord<'a> {
+    pub(crate) header: ChunkHeader,
     /// The records as stored.
-    pub records: Tail<'a>,
+    pub(crate) records: Tail<'a>,
 }
 
 impl<'a> Field<'a> for ChunkRecord<'a> {
@@ -453,7 +377,7 @@ impl<'a> Field<'a> for ChunkRecord<'a> {
         let records = Tail(c.take(header.compressed_size, "records")?);
         Ok(Self { header, records })
     }
-    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         self.header.encode(out, field)?;
         out.extend_from_slice(self.records.0);
         Ok(())
@@ -465,25 +389,19 @@ record!(ChunkRecord<'a> = op::CHUNK, "chunk");
 /// An attachment record: its times, name and media type, `data`, and the CRC-32 of every byte before the
 /// CRC (0: not computed). Only read, for its framing and its CRC: coin-log writes none.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct AttachmentRecord<'a> {
-    /// When it was logged (ns).
-    pub log_time: u64,
-    /// When it was made (ns).
-    pub create_time: u64,
-    /// Its name.
-    pub name: String,
-    /// Its media type.
-    pub media_type: String,
-    /// Its data (with a u64 length prefix in the file).
-    pub data: Tail<'a>,
-    /// The stored CRC.
-    pub crc: u32,
+pub(crate) struct AttachmentRecord<'a> {
+    pub(crate) log_time: u64,
+    pub(crate) create_time: u64,
+    pub(crate) name: String,
+    pub(crate) media_type: String,
+    /// With a u64 length prefix in the file.
+    pub(crate) data: Tail<'a>,
+    pub(crate) crc: u32,
 }
 
 impl AttachmentRecord<'_> {
     /// Bytes of the body that the CRC covers: every field before it.
-    #[must_use]
-    pub fn crc_covered_len(&self) -> usize {
+    pub(crate) fn crc_covered_len(&self) -> usize {
         8 + 8 + 4 + self.name.len() + 4 + self.media_type.len() + 8 + self.data.0.len()
     }
 }
@@ -506,7 +424,7 @@ impl<'a> Field<'a> for AttachmentRecord<'a> {
             crc,
         })
     }
-    fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), TooLong> {
+    fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), WriteError> {
         self.log_time.encode(out, "log_time")?;
         self.create_time.encode(out, "create_time")?;
         self.name.encode(out, "name")?;
@@ -525,7 +443,7 @@ mod tests {
     use super::*;
 
     /// Encodes `r` and parses it back.
-    fn round_trip<T: for<'a> Record<'a> + PartialEq + fmt::Debug>(r: &T) {
+    fn round_trip<T: for<'a> Record<'a> + PartialEq + std::fmt::Debug>(r: &T) {
         let mut out = Vec::new();
         r.encode_record(&mut out).unwrap();
         let (opcode, body) = Cursor::new(&out).record().unwrap();

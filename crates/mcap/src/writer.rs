@@ -11,7 +11,7 @@
 //!
 //! [`McapWriter`]'s doc describes the pipeline, why the bytes are deterministic, and the file's layout.
 
-use crate::records::{ChunkRecord, MessageRecord, Record, Tail, TooLong, MAGIC};
+use crate::records::{ChunkRecord, MessageRecord, Record, Tail, MAGIC};
 use mcap::records::{
     op, Channel, ChunkHeader, ChunkIndex, DataEnd, Footer, Header, MessageHeader, MessageIndex,
     MessageIndexEntry, Metadata, MetadataIndex, Statistics, SummaryOffset,
@@ -142,15 +142,6 @@ pub enum WriteError {
         /// Its length.
         len: usize,
     },
-}
-
-impl From<TooLong> for WriteError {
-    fn from(e: TooLong) -> Self {
-        Self::TooLong {
-            what: e.field,
-            len: e.len,
-        }
-    }
 }
 
 /// What the calling thread knows about a chunk; reused from chunk to chunk.
