@@ -91,7 +91,7 @@ pub struct ReadError {
     pub detail: String,
     /// What the visitor was given before it (`judged the 8008 messages read before it`); empty when the
     /// failure came before the stream reached it.
-    pub read_before: String,
+    read_before: String,
 }
 
 impl ReadError {
@@ -130,8 +130,6 @@ pub struct Structure {
     pub chunks: u64,
     /// Structural problems (indexes, statistics, summary).
     pub problems: BoundedFindings,
-    /// Whether a summary section, statistics and chunk indexes were present.
-    pub has_summary: bool,
     /// The `library` of the header record.
     pub library: String,
     /// Chunks by compression name (`""` for uncompressed chunks).
@@ -252,10 +250,7 @@ fn parse<'a, R: Record<'a>>(data: &'a [u8], at: u64) -> Result<R, ReadError> {
 /// Reads `path` to its end, passing records to `visitor`. The [`Structure`] is returned in both cases, so
 /// that a truncated or corrupt file still reports how far it was read.
 pub fn read(path: &Path, visitor: &mut impl Visitor) -> (Structure, Option<ReadError>) {
-    match open(path) {
-        Ok((file, len)) => read_from(file, len, visitor),
-        Err(e) => (Structure::default(), Some(e)),
-    }
+    read_with_progress(path, visitor, &|_| {})
 }
 
 /// [`read`], calling `progress` with the number of bytes read from the file so far (from the reading
@@ -1010,8 +1005,7 @@ impl Book {
 
     fn finish(&mut self) {
         self.close_chunk();
-        self.s.has_summary = self.summary_start.is_some();
-        if !self.s.has_summary {
+        if self.summary_start.is_none() {
             self.problem(|| "no summary section (no statistics, no indexes)".into());
             return;
         }

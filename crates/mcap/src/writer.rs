@@ -64,9 +64,8 @@ impl Compression {
     #[must_use]
     pub fn mcap_name(self) -> &'static str {
         match self {
-            Self::Zstd => "zstd",
-            Self::Lz4 => "lz4",
             Self::None => "",
+            _ => self.name(),
         }
     }
 }
@@ -80,22 +79,18 @@ pub struct WriterOptions {
     pub chunk_size: usize,
     /// Compression worker threads (at least 1). The bytes do not depend on it.
     pub workers: usize,
-    /// The Header's `profile` ("" for none).
-    pub profile: String,
     /// The Header's `library`.
     pub library: String,
 }
 
 impl WriterOptions {
-    /// Options with the given compression and library string, [`DEFAULT_CHUNK_SIZE`], one worker and
-    /// no profile.
+    /// Options with the given compression and library string, [`DEFAULT_CHUNK_SIZE`] and one worker.
     #[must_use]
     pub fn new(compression: Compression, library: impl Into<String>) -> Self {
         Self {
             compression,
             chunk_size: DEFAULT_CHUNK_SIZE,
             workers: 1,
-            profile: String::new(),
             library: library.into(),
         }
     }
@@ -416,7 +411,7 @@ impl<W: Write> McapWriter<W> {
         };
         let mut header = MAGIC.to_vec();
         Header {
-            profile: options.profile.clone(),
+            profile: String::new(),
             library: options.library.clone(),
         }
         .encode_record(&mut header)?;
