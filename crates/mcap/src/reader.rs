@@ -216,8 +216,12 @@ struct Book {
     statistics: u64,
 }
 
-fn corrupt(detail: String) -> ReadError {
+pub(crate) fn corrupt(detail: String) -> ReadError {
     ReadError::new(ReadErrorKind::Corrupt, detail)
+}
+
+pub(crate) fn io_error(e: std::io::Error) -> ReadError {
+    ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"))
 }
 
 /// The message for a file that ends at byte `len` inside (or just before) the record at `at`.
@@ -324,10 +328,7 @@ pub fn read_from(
     }
     let error = match source.seek(SeekFrom::Start(0)) {
         Ok(_) => read_into(source, len, visitor, &mut book).err(),
-        Err(e) => Some(ReadError::new(
-            ReadErrorKind::Io,
-            format!("cannot read: {e}"),
-        )),
+        Err(e) => Some(io_error(e)),
     };
     let error = match error {
         // The visitor stopped before the stream reached the place where the scan found the file cut
@@ -341,9 +342,9 @@ pub fn read_from(
     (book.s, error)
 }
 
-fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
-    let io = |e: std::io::Error| ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"));
-    let meta = std::fs::metadata(path).map_err(io)?;
+/// Opens the regular file at `path` and gives its length.
+pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
+    let meta = std::fs::metadata(path).map_err(io_error)?;
     if meta.is_dir() {
         return Err(ReadError::new(
             ReadErrorKind::Io,
@@ -357,7 +358,7 @@ fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
              summary and metadata, which a stream cannot do; save it to a file first",
         ));
     }
-    let file = std::fs::File::open(path).map_err(io)?;
+    let file = std::fs::File::open(path).map_err(io_error)?;
     Ok((file, meta.len()))
 }
 

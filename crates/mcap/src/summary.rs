@@ -13,7 +13,7 @@
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::early_metadata;
-use crate::reader::{ReadError, ReadErrorKind};
+use crate::reader::{self, corrupt, io_error, ReadError, ReadErrorKind};
 use crate::records::{self, Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
 use mcap::records::{op, Channel, ChunkIndex, Header, MetadataIndex, Statistics};
 use mcap::Schema;
@@ -63,14 +63,6 @@ pub struct Summary {
     pub metadata: Vec<(String, BTreeMap<String, String>)>,
 }
 
-fn io_error(e: &std::io::Error) -> ReadError {
-    ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"))
-}
-
-fn corrupt(detail: String) -> ReadError {
-    ReadError::new(ReadErrorKind::Corrupt, detail)
-}
-
 /// Reads the summary of the MCAP file at `path`. `Ok(None)` when the file has no summary section, its
 /// summary has no statistics record, or it is larger than the largest record the reader accepts (then
 /// only a streaming pass can tell what the file holds).
@@ -79,15 +71,7 @@ fn corrupt(detail: String) -> ReadError {
 /// [`ReadError`] if the file cannot be read, is not MCAP, or its footer, summary (CRC included) or a
 /// record it points at is malformed or beyond the reader's budget.
 pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
-    let meta = std::fs::metadata(path).map_err(|e| io_error(&e))?;
-    if meta.is_dir() {
-        return Err(ReadError::new(
-            ReadErrorKind::Io,
-            "is a directory, not an MCAP file",
-        ));
-    }
-    let file_len = meta.len();
-    let mut file = std::fs::File::open(path).map_err(|e| io_error(&e))?;
+    let (mut file, file_len) = reader::open(path)?;
     let Some(library) = header_library(&mut file, file_len)? else {
         return Ok(None);
     };
@@ -260,10 +244,9 @@ fn bytes_at(
             "a record of {length} bytes at byte {offset} does not fit in the file's {file_len} bytes"
         )));
     }
-    file.seek(SeekFrom::Start(offset))
-        .map_err(|e| io_error(&e))?;
+    file.seek(SeekFrom::Start(offset)).map_err(io_error)?;
     let mut buf = vec![0; usize::try_from(length).unwrap_or(0)];
-    file.read_exact(&mut buf).map_err(|e| io_error(&e))?;
+    file.read_exact(&mut buf).map_err(io_error)?;
     Ok(buf)
 }
 
@@ -272,7 +255,7 @@ fn bytes_at(
 fn header_library(file: &mut std::fs::File, file_len: u64) -> Result<Option<String>, ReadError> {
     let mut start = [0u8; (MAGIC_LEN + PREFIX_LEN) as usize];
     let n = usize::try_from(file_len.min(start.len() as u64)).unwrap_or(0);
-    file.read_exact(&mut start[..n]).map_err(|e| io_error(&e))?;
+    file.read_exact(&mut start[..n]).map_err(io_error)?;
     let magic = n.min(MAGIC.len());
     if start[..magic] != MAGIC[..magic] {
         return Err(ReadError::new(
