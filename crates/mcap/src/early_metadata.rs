@@ -27,12 +27,13 @@
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::digest::Digest;
 use crate::reader::ReadError;
-use crate::records::{self, Record, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
-use mcap::records::{op, Footer, Metadata, MetadataIndex};
+use crate::records::{self, Record, MAGIC, MAGIC_LEN, PREFIX_LEN};
+use crate::summary::{bytes_at, metadata_indexes};
+use mcap::records::{op, Metadata};
 use std::io::{self, Read, Seek, SeekFrom};
 
 /// Most metadata records passed on ahead of the stream (further ones come with the stream).
-const MAX_EARLY: usize = 1024;
+pub(crate) const MAX_EARLY: usize = 1024;
 
 /// One metadata record found ahead of the stream.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -83,22 +84,18 @@ pub(crate) struct Lookahead {
 /// counting them in `kept`. Leaves the source at an unspecified position.
 pub(crate) fn find(source: &mut (impl Read + Seek), len: u64, kept: &mut Kept) -> Lookahead {
     let mut p = Lookahead::default();
-    let mut head = [0u8; MAGIC_LEN as usize];
-    let n = usize::try_from(len.min(MAGIC_LEN)).unwrap_or(0);
-    if read_at(source, 0, &mut head[..n]).is_err() {
+    let Ok(head) = bytes_at(source, len, 0, len.min(MAGIC_LEN)) else {
         return p;
-    }
-    p.magic_prefix = head[..n] == MAGIC[..n];
+    };
+    p.magic_prefix = head == MAGIC[..head.len()];
     if len < MAGIC_LEN || !p.magic_prefix {
         return p;
     }
     // The end magic is a second copy: a file of 8 to 15 bytes holds only the first.
-    let mut tail = [0u8; MAGIC_LEN as usize];
     p.ends_with_magic = len >= 2 * MAGIC_LEN
-        && read_at(source, len - MAGIC_LEN, &mut tail).is_ok()
-        && tail == MAGIC;
+        && bytes_at(source, len, len - MAGIC_LEN, MAGIC_LEN).is_ok_and(|tail| tail == MAGIC);
     if p.ends_with_magic {
-        if let Some(indexes) = summary_metadata_indexes(source, len) {
+        if let Some(indexes) = metadata_indexes(source, len) {
             if !indexes.is_empty() {
                 // Counted aside: if the index proves untrustworthy, the scan counts them again.
                 let mut found = kept.clone();
@@ -125,11 +122,6 @@ pub(crate) fn find(source: &mut (impl Read + Seek), len: u64, kept: &mut Kept) -
     p
 }
 
-fn read_at(source: &mut (impl Read + Seek), at: u64, buf: &mut [u8]) -> io::Result<()> {
-    source.seek(SeekFrom::Start(at))?;
-    source.read_exact(buf)
-}
-
 /// Reads the record prefix at the reader's position: (opcode, body length), or `None` at a short read.
 fn prefix(r: &mut impl Read) -> Option<(u8, u64)> {
     let mut b = [0u8; PREFIX_LEN as usize];
@@ -146,49 +138,6 @@ fn body(r: &mut impl Read, len: u64) -> Option<Vec<u8>> {
     let mut body = vec![0u8; usize::try_from(len).ok()?];
     r.read_exact(&mut body).ok()?;
     Some(body)
-}
-
-/// The footer of the MCAP file of `len` bytes and where it starts, if it has a readable one.
-pub(crate) fn footer(source: &mut (impl Read + Seek), len: u64) -> Option<(Footer, u64)> {
-    let at = len.checked_sub(MAGIC_LEN + FOOTER_LEN)?;
-    source.seek(SeekFrom::Start(at)).ok()?;
-    match prefix(source)? {
-        (op::FOOTER, n) if n == FOOTER_LEN - PREFIX_LEN => {
-            Some((Footer::parse_body(&body(source, n)?).ok()?, at))
-        }
-        _ => None,
-    }
-}
-
-/// The (offset, length) of every MetadataIndex record of the summary, or `None` when the file has no
-/// readable footer or summary.
-fn summary_metadata_indexes(source: &mut (impl Read + Seek), len: u64) -> Option<Vec<(u64, u64)>> {
-    let (footer, footer_at) = footer(source, len)?;
-    let summary_start = footer.summary_start;
-    if summary_start < MAGIC_LEN || summary_start >= footer_at {
-        return None;
-    }
-    // Walk the summary's records up to the footer, reading only the metadata indexes.
-    source.seek(SeekFrom::Start(summary_start)).ok()?;
-    let mut r = io::BufReader::new(source);
-    let mut at = summary_start;
-    let mut found = Vec::new();
-    while at < footer_at {
-        let (opcode, body_len) = prefix(&mut r)?;
-        let end = (at + PREFIX_LEN).checked_add(body_len)?;
-        if end > footer_at {
-            return Some(found);
-        }
-        if opcode == op::METADATA_INDEX && found.len() < MAX_EARLY {
-            if let Ok(i) = MetadataIndex::parse_body(&body(&mut r, body_len)?) {
-                found.push((i.offset, i.length));
-            }
-        } else {
-            r.seek_relative(i64::try_from(body_len).ok()?).ok()?;
-        }
-        at = end;
-    }
-    Some(found)
 }
 
 /// Reads the metadata records the index points at: in file order, each once, never two that overlap
@@ -304,10 +253,10 @@ fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Lookahead, kept: &mut
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-    use std::io::Cursor as IoCursor;
-
-    use mcap::records::{DataEnd, Header};
+    use crate::records::FOOTER_LEN;
+    use mcap::records::{DataEnd, Footer, Header, MetadataIndex};
     use std::collections::BTreeMap;
+    use std::io::Cursor as IoCursor;
 
     fn encoded<'a>(r: &impl Record<'a>) -> Vec<u8> {
         let mut out = Vec::new();

@@ -12,10 +12,10 @@
 //! race, medians of 3 rounds of 101 reads); the crate's parsers also reserve what a length claims.
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
-use crate::early_metadata;
+use crate::early_metadata::{self, MAX_EARLY};
 use crate::reader::{self, corrupt, io_error, ReadError, ReadErrorKind};
 use crate::records::{self, Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
-use mcap::records::{op, Channel, ChunkIndex, Header, MetadataIndex, Statistics};
+use mcap::records::{op, Channel, ChunkIndex, Footer, Header, MetadataIndex, Statistics};
 use mcap::Schema;
 use std::collections::BTreeMap;
 use std::io::{Read, Seek, SeekFrom};
@@ -78,6 +78,9 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     let Some(section) = summary_section(&mut file, file_len)? else {
         return Ok(None);
     };
+    if let Some(e) = section.bad_crc {
+        return Err(e);
+    }
     let mut records = SummaryRecords::default();
     records.parse(&section.bytes, section.start)?;
     if !records.statistics {
@@ -110,23 +113,26 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     Ok(Some(out))
 }
 
-/// The summary section's bytes and where they start.
+/// The summary section's bytes, where they start, and the error when its CRC is not the footer's.
 struct Section {
     start: u64,
     bytes: Vec<u8>,
+    bad_crc: Option<ReadError>,
 }
 
-/// The summary section (from `summary_start` to the footer), its CRC checked; `None` when the footer says
-/// there is none or it is larger than the reader accepts.
-fn summary_section(file: &mut std::fs::File, file_len: u64) -> Result<Option<Section>, ReadError> {
+/// The summary section (from `summary_start` to the footer); `None` when the footer says there is none
+/// or it is larger than the reader accepts.
+fn summary_section(
+    file: &mut (impl Read + Seek),
+    file_len: u64,
+) -> Result<Option<Section>, ReadError> {
     if file_len < MAGIC_LEN + FOOTER_LEN + MAGIC_LEN {
         return Err(corrupt(format!(
             "{file_len} bytes: too short for an MCAP file with a footer"
         )));
     }
     let end = bytes_at(file, file_len, file_len - MAGIC_LEN, MAGIC_LEN)?;
-    let Some((footer, footer_at)) = early_metadata::footer(file, file_len).filter(|_| end == MAGIC)
-    else {
+    let Some((footer, footer_at)) = footer(file, file_len).filter(|_| end == MAGIC) else {
         return Err(corrupt(
             "no MCAP footer and end magic at the end of the file (truncated?)".into(),
         ));
@@ -146,20 +152,49 @@ fn summary_section(file: &mut std::fs::File, file_len: u64) -> Result<Option<Sec
     // The summary CRC covers the summary and the footer up to its CRC field.
     let crc_end = footer_at + FOOTER_LEN - 4;
     let mut bytes = bytes_at(file, file_len, summary_start, crc_end - summary_start)?;
-    if footer.summary_crc != 0 {
-        let computed = crc32fast::hash(&bytes);
-        if computed != footer.summary_crc {
-            return Err(corrupt(format!(
-                "corrupt summary section: CRC {computed:#010x} does not match the stored {:#010x}",
-                footer.summary_crc
-            )));
-        }
-    }
+    let computed = crc32fast::hash(&bytes);
+    let bad_crc = (footer.summary_crc != 0 && computed != footer.summary_crc).then(|| {
+        corrupt(format!(
+            "corrupt summary section: CRC {computed:#010x} does not match the stored {:#010x}",
+            footer.summary_crc
+        ))
+    });
     bytes.truncate(usize::try_from(footer_at - summary_start).unwrap_or(0));
     Ok(Some(Section {
         start: summary_start,
         bytes,
+        bad_crc,
     }))
+}
+
+/// The footer of the MCAP file of `len` bytes and where it starts, if it has a readable one.
+fn footer(source: &mut (impl Read + Seek), len: u64) -> Option<(Footer, u64)> {
+    let at = len.checked_sub(MAGIC_LEN + FOOTER_LEN)?;
+    let bytes = bytes_at(source, len, at, FOOTER_LEN).ok()?;
+    match Cursor::new(&bytes).record().ok()? {
+        (op::FOOTER, body) if body.len() as u64 == FOOTER_LEN - PREFIX_LEN => {
+            Some((Footer::parse_body(body).ok()?, at))
+        }
+        _ => None,
+    }
+}
+
+/// The (offset, length) of the summary's first [`MAX_EARLY`] MetadataIndex records, its CRC unchecked
+/// (a malformed entry is skipped, a record running past the summary ends the list); `None` when the
+/// file has no summary that the reader accepts.
+pub(crate) fn metadata_indexes(
+    source: &mut (impl Read + Seek),
+    len: u64,
+) -> Option<Vec<(u64, u64)>> {
+    let section = summary_section(source, len).ok()??;
+    let mut c = Cursor::new(&section.bytes);
+    let mut found = Vec::new();
+    while let Ok((opcode, body)) = c.record() {
+        if opcode == op::METADATA_INDEX && found.len() < MAX_EARLY {
+            found.extend(MetadataIndex::parse_body(body).map(|i| (i.offset, i.length)));
+        }
+    }
+    Some(found)
 }
 
 /// What the summary's records say, gathered while they are parsed.
@@ -231,8 +266,8 @@ impl SummaryRecords {
 }
 
 /// Reads `length` bytes at `offset`, checked against the file's size and the largest record accepted.
-fn bytes_at(
-    file: &mut std::fs::File,
+pub(crate) fn bytes_at(
+    file: &mut (impl Read + Seek),
     file_len: u64,
     offset: u64,
     length: u64,
