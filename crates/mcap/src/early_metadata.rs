@@ -1,28 +1,16 @@
 //! Before the stream: the file's metadata records, wherever they sit, and what its ends look like.
 //!
-//! MCAP lets a writer put metadata records anywhere in the data section: `coin-log record` writes its run
-//! record before the first chunk, but the Python `mcap` writer with small chunks and the TypeScript
-//! `@mcap/core` writer may write it after chunks of messages. A reader that must know the metadata before
-//! it can interpret a message therefore looks for them first:
+//! MCAP lets metadata records sit anywhere in the data section (the Python writer with small chunks and
+//! `@mcap/core` put them after chunks of messages), and a reader must know them before it can interpret
+//! a message. They are found through the summary's MetadataIndex records, one seek each, or, without
+//! them, by a scan of the top-level records that reads each 9-byte prefix and seeks past the body
+//! (metadata never sit inside chunks). Both read each byte at most once, and what they keep counts
+//! against the budget ([`Lookahead::too_large`]). The records go to the visitor before the first
+//! message; the stream recognises them by offset. Hence a seekable source: buffering the messages until
+//! a late metadata record arrives could hold the whole file.
 //!
-//! 1. through the summary: the footer gives the summary's start, the summary's MetadataIndex records give
-//!    each metadata record's offset and length, and each record is read there (one seek each);
-//! 2. without a summary or a metadata index (a file written by a streaming recorder, or cut short), by a
-//!    scan of the top-level records that reads each record's 9-byte prefix and seeks past its body, reading
-//!    only metadata bodies in full. Metadata records never sit inside chunks (the spec allows only schemas,
-//!    channels and messages there), so chunks are skipped unread and the scan costs a few reads per chunk.
-//!
-//! Both are bounded by the file: the summary is read once, metadata records are read only where they do
-//! not overlap one already read, and the scan visits each byte at most once. What they keep counts
-//! against the reader's budget (`budget`): a metadata record larger than the largest record the reader
-//! accepts, or more metadata than it keeps, ends the search with [`Lookahead::too_large`]. The records found are passed
-//! to the visitor before the first message; the stream then recognises them by offset and does not pass
-//! them again. A seekable source is required: a pipe cannot be read twice, and buffering the messages
-//! until a late metadata record arrives would hold the whole file in memory for a file whose metadata
-//! comes last.
-//!
-//! Nothing here is trusted: a record that is not what the index says is ignored (the stream's checks of
-//! the indexes against the records report it), an I/O error ends the search (the stream reports it).
+//! Nothing here is trusted: a record that is not what the index says sends the search to the scan, an
+//! I/O error ends it; the stream reports both.
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::digest::Digest;
@@ -35,38 +23,29 @@ use std::io::{self, Read, Seek, SeekFrom};
 /// Most metadata records passed on ahead of the stream (further ones come with the stream).
 pub(crate) const MAX_EARLY: usize = 1024;
 
-/// One metadata record found ahead of the stream.
+/// One metadata record found ahead of the stream, its offset, and its body's digest (to recognise it in
+/// the stream).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct FoundMetadata {
-    /// Offset of the record (its opcode) in the file.
     pub(crate) at: u64,
-    /// The digest of its body, to recognise it in the stream.
     pub(crate) digest: Digest,
-    /// The record.
     pub(crate) record: Metadata,
 }
 
 /// How the search ended without reaching the end of the data section.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum ScanEnd {
-    /// The file ends inside the record that starts at this offset (or exactly where one should start).
-    Cut {
-        /// The record's offset.
-        at: u64,
-        /// The length it claims, when its prefix is whole.
-        claimed: Option<u64>,
-    },
-    /// The record at this offset is not a well-formed metadata record or has an impossible length.
-    Malformed {
-        /// The record's offset.
-        at: u64,
-    },
+    /// The file ends inside the record at `at` (or exactly where one should start); `claimed`: its
+    /// length, when its prefix is whole.
+    Cut { at: u64, claimed: Option<u64> },
+    /// The record at `at` is not a well-formed metadata record or has an impossible length.
+    Malformed { at: u64 },
 }
 
 /// What was learned before the stream.
 #[derive(Debug, Default)]
 pub(crate) struct Lookahead {
-    /// The metadata records found, in file order.
+    /// In file order.
     pub(crate) metadata: Vec<FoundMetadata>,
     /// The first bytes of the file are the MCAP magic, or its beginning when the file is shorter.
     pub(crate) magic_prefix: bool,
@@ -76,7 +55,7 @@ pub(crate) struct Lookahead {
     pub(crate) indexed: bool,
     /// Where the scan stopped early, when it ran and did.
     pub(crate) scan_end: Option<ScanEnd>,
-    /// The metadata found exceeds the reader's budget (the search stopped there).
+    /// The metadata found exceeds the budget (the search stopped there).
     pub(crate) too_large: Option<ReadError>,
 }
 
@@ -94,28 +73,25 @@ pub(crate) fn find(source: &mut (impl Read + Seek), len: u64, kept: &mut Kept) -
     // The end magic is a second copy: a file of 8 to 15 bytes holds only the first.
     p.ends_with_magic = len >= 2 * MAGIC_LEN
         && bytes_at(source, len, len - MAGIC_LEN, MAGIC_LEN).is_ok_and(|tail| tail == MAGIC);
-    if p.ends_with_magic {
-        if let Some(indexes) = metadata_indexes(source, len) {
-            if !indexes.is_empty() {
-                // Counted aside: if the index proves untrustworthy, the scan counts them again.
-                let mut found = kept.clone();
-                match read_indexed(source, len, indexes, &mut found) {
-                    Ok(Some(metadata)) => {
-                        p.indexed = true;
-                        p.metadata = metadata;
-                        *kept = found;
-                        return p;
-                    }
-                    Err(e) => {
-                        p.too_large = Some(e);
-                        return p;
-                    }
-                    // An index entry that points at no metadata record of its length (e.g. @mcap/core
-                    // 2.2's unchunked writer records the offset of the messages it still buffers): the
-                    // index cannot be trusted to list them all; the scan finds them where they are.
-                    Ok(None) => {}
-                }
+    let indexes = p.ends_with_magic.then(|| metadata_indexes(source, len));
+    if let Some(indexes) = indexes.flatten().filter(|i| !i.is_empty()) {
+        // Counted aside: if the index proves untrustworthy, the scan counts them again.
+        let mut found = kept.clone();
+        match read_indexed(source, len, indexes, &mut found) {
+            Ok(Some(metadata)) => {
+                p.indexed = true;
+                p.metadata = metadata;
+                *kept = found;
+                return p;
             }
+            Err(e) => {
+                p.too_large = Some(e);
+                return p;
+            }
+            // An index entry that points at no metadata record of its length (e.g. @mcap/core 2.2's
+            // unchunked writer records the offset of the messages it still buffers): the scan finds
+            // them where they are.
+            Ok(None) => {}
         }
     }
     scan(source, len, &mut p, kept);

@@ -1,15 +1,11 @@
-//! The reading half of the reader's pipeline: a worker thread reads the file (the `mcap` crate's sans-io
-//! `LinearReader` splits it into records and checks the magic, the data and summary CRCs and the end),
-//! decompresses each chunk whole and checks its size and CRC, and hands the records over in batches
-//! through a bounded channel, while the calling thread walks them and runs the visitor.
+//! The reading half of the reader's pipeline: a worker thread runs the `mcap` crate's sans-io
+//! `LinearReader` (records, magic, data and summary CRCs, the end), decompresses each chunk whole and
+//! checks its size and CRC, and hands the records over in batches through a bounded channel.
 //!
-//! A batch holds copies of top-level records and decompressed chunks back to back, and a list of
-//! [`Event`]s pointing into them, in file order; errors travel as events in their place, so the consumer
-//! sees exactly the sequence a single-threaded reader would. Memory stays bounded (see `budget`): at most
-//! [`POOL`] batches exist, handed over once their bytes and events reach [`BATCH_BYTES`]; the producer
-//! fills a batch with a record or chunk larger than that only when every other batch is back, and
-//! shrinks it when it returns. When the consumer stops (an error, or its visitor breaks) it drops its
-//! receiver and the worker ends at its next send.
+//! A batch holds record bodies and decompressed chunks back to back, and [`Event`]s pointing into them in
+//! file order; errors travel as events in their place. At most [`POOL`] batches exist (see `budget`); one
+//! larger than [`BATCH_BYTES`] is filled only when every other batch is back, and shrunk when it returns.
+//! When the consumer stops it drops its receiver, and the worker ends at its next send.
 
 use crate::budget::MAX_RECORD_BYTES;
 use crate::records::{ChunkRecord, Record, WireError};
@@ -20,12 +16,11 @@ use std::io::{self, Read};
 use std::ops::Range;
 use std::sync::mpsc::{Receiver, SyncSender};
 
-/// Bytes asked of the file per read (larger reads than the reader's minimum requests).
+/// Bytes asked of the file per read.
 const READ_BLOCK: usize = 1 << 18;
 /// A batch is handed over once its bytes and events reach this (about one decompressed chunk).
 const BATCH_BYTES: usize = 1 << 20;
-/// What an event counts towards [`BATCH_BYTES`]: its size, so that a flood of empty records fills
-/// batches as surely as large ones.
+/// What an event counts towards [`BATCH_BYTES`], so that a flood of empty records fills batches too.
 const EVENT_COST: usize = std::mem::size_of::<Event>();
 /// Batches in the channel between the threads: enough to keep both busy.
 pub(crate) const QUEUE: usize = 4;
@@ -202,16 +197,15 @@ pub(crate) fn produce(
             }
             Ok(LinearReadEvent::Record { opcode, data }) => {
                 let event = if opcode == op::CHUNK {
-                    match chunk(data, &mut batches, &mut decompressor) {
-                        Some(event) => event,
-                        None => return,
-                    }
+                    chunk(data, &mut batches, &mut decompressor)
                 } else {
-                    if batches.room_for(data.len() as u64).is_none() {
-                        return;
-                    }
-                    let body = batches.current.push(data);
-                    Event::Record { opcode, body }
+                    batches.room_for(data.len() as u64).map(|()| Event::Record {
+                        opcode,
+                        body: batches.current.push(data),
+                    })
+                };
+                let Some(event) = event else {
+                    return;
                 };
                 let stop = matches!(event, Event::BadChunk { .. });
                 batches.current.events.push(event);

@@ -1,21 +1,12 @@
-//! The streaming MCAP reader: one pass over the file, in memory bounded by the reader's budget
-//! ([`READ_MEMORY_BOUND`](crate::READ_MEMORY_BOUND)), never by the file's length or by what it claims.
+//! The streaming MCAP reader: one pass over the file, in memory bounded by
+//! [`READ_MEMORY_BOUND`](crate::READ_MEMORY_BOUND). A worker thread (`prefetch`) reads, decompresses and
+//! checks chunks; this thread walks the records in file order, keeping what the structural checks need
+//! as running digests rather than lists.
 //!
-//! Reading is a two-thread pipeline (the private `prefetch` module): a worker runs the mcap crate's sans-io
-//! `LinearReader` over the file (chunks whole, so that file offsets are known), decompresses each chunk
-//! and checks its size and CRC, and hands the records over in batches; this thread walks them in file
-//! order. Along the way it keeps what the structural checks need as running digests rather than lists:
-//! per chunk and channel a hash of the (log time, offset) pairs its message index must list, a hash of
-//! every chunk's index entry, the real counts for the statistics record, the summary's groups for the
-//! summary offsets. Every length is checked against the file's size and the budget before anything is
-//! allocated for it.
-//!
-//! Ours rather than the `mcap` crate's readers: on the 7 M-message workload of `bench throughput`
-//! (`crates/bench/benches/crate_vs_ours.rs`, its "read" race, file in the page cache, medians of 3 alternating rounds
-//! at load 7 on 2 cores) this reader, every check included, took 1.31 s; the crate's sans-io
-//! `LinearReader` with `mcap::parse_record` on every record, checking nothing beyond CRCs, 2.34 s, and
-//! `mcap::MessageStream` over the file in memory 2.33 s. The crate's `LinearReader` still splits the file
-//! into records here; the pipeline, the chunk decompression (bounded) and the record parsing are ours.
+//! Ours rather than the `mcap` crate's readers: on the 7 M-message workload (crate_vs_ours' "read" race,
+//! file in the page cache, medians of 3 alternating rounds at load 7 on 2 cores) this reader, every check
+//! included, took 1.31 s; the crate's sans-io `LinearReader` (which still splits the file into records
+//! here) with `mcap::parse_record`, checking only CRCs, 2.34 s, and `mcap::MessageStream` 2.33 s.
 
 use crate::budget::{self, Kept, MAX_RECORD_BYTES};
 use crate::digest::Digest;
@@ -40,8 +31,7 @@ use std::sync::mpsc::{self, Receiver, SyncSender};
 
 /// How many metadata records and summary groups are remembered for the index checks (more are counted).
 const MAX_REMEMBERED: usize = 1024;
-/// A record claiming more than this (1 TiB) is not one any writer makes: a file cut inside it is not the
-/// prefix of a plausible MCAP, so it is reported as corrupt rather than truncated.
+/// A file cut inside a record claiming more than this (1 TiB) is reported as corrupt, not truncated.
 const PLAUSIBLE_RECORD: u64 = 1 << 40;
 
 /// What the caller does with records.
@@ -75,8 +65,8 @@ pub enum ReadErrorKind {
     Truncated,
     /// A CRC, a length or a record is wrong.
     Corrupt,
-    /// A record, a chunk, or its schemas, channels and metadata together, are larger than this reader
-    /// accepts ([`MAX_RECORD_BYTES`](crate::MAX_RECORD_BYTES)): reading on would exceed its memory budget.
+    /// A record, a chunk, or its schemas, channels and metadata together, exceed
+    /// [`MAX_RECORD_BYTES`](crate::MAX_RECORD_BYTES).
     TooLarge,
     /// The visitor stopped reading.
     Stopped,
@@ -147,12 +137,11 @@ struct IndexDigest {
     digest: Digest,
 }
 
-/// One chunk while it and its message indexes are read.
+/// One chunk while it and its message indexes are read: the chunk index entry they make, to compare
+/// with the summary's, and the offset of the next record in the decompressed records.
 #[derive(Debug)]
 struct ChunkBook {
-    /// The chunk index entry the chunk and its message indexes make, to compare with the summary's.
     index: ChunkIndex,
-    /// Offset of the next record in the decompressed records.
     offset: u64,
     min_time: Option<u64>,
     max_time: u64,
@@ -184,11 +173,9 @@ fn index_digest(i: &ChunkIndex) -> Digest {
 #[derive(Debug, Default)]
 struct Book {
     s: Structure,
-    /// What was found before the stream (the file's ends; the metadata are passed on early).
     ahead: Lookahead,
     /// Digests of the metadata records passed on early, by offset: the stream does not pass them again.
     early: BTreeMap<u64, Digest>,
-    /// The schemas, channels and metadata kept or handed over, against the budget.
     kept: Kept,
     pos: u64,
     in_summary: bool,
@@ -200,7 +187,7 @@ struct Book {
     chunk_index_digest: Digest,
     chunk_indexes: u64,
     channel_counts: BTreeMap<u16, u64>,
-    /// The schemas, by id: the digest of their record and the schema, for the channels that name them.
+    /// The digest of each schema's record, and the schema for the channels that name it.
     schemas: BTreeMap<u16, (Digest, Schema<'static>)>,
     channels: BTreeMap<u16, Digest>,
     /// (offset, length, name digest) of metadata records and of metadata index entries.
@@ -257,8 +244,7 @@ pub fn read(path: &Path, visitor: &mut impl Visitor) -> (Structure, Option<ReadE
     read_with_progress(path, visitor, &|_| {})
 }
 
-/// [`read`], calling `progress` with the number of bytes read from the file so far (from the reading
-/// thread, at every block of a few hundred KiB), e.g. for a progress bar.
+/// [`read`], calling `progress` (from the reading thread) with the bytes read so far.
 pub fn read_with_progress(
     path: &Path,
     visitor: &mut impl Visitor,
@@ -278,7 +264,7 @@ pub fn read_with_progress(
     }
 }
 
-/// A reader that reports how far into the file it is (bytes read, or the position after a seek).
+/// A reader that reports its position.
 struct Counting<'a, R> {
     inner: R,
     read: u64,
@@ -302,9 +288,8 @@ impl<R: Seek> Seek for Counting<'_, R> {
     }
 }
 
-/// Reads an MCAP file of `len` bytes from `source` (see [`read`]). The source must be seekable: the
-/// metadata records are looked up (through the summary, or by a scan of the top-level records) before the
-/// stream starts at byte 0.
+/// Reads an MCAP file of `len` bytes from `source` (see [`read`]), seekable so that the metadata records
+/// can be looked up before the stream.
 pub fn read_from(
     mut source: impl Read + Seek + Send,
     len: u64,
@@ -377,10 +362,8 @@ fn read_into(
         let worker = scope.spawn(move || {
             prefetch::produce(file, file_len, to_consumer, recycled);
         });
-        // `consume` owns the receiving end: when it returns early (an error, or the visitor stopped) or
-        // unwinds, the receiver is dropped, so a worker blocked sending into the full queue wakes with an
-        // error and ends, and this scope can join it. Holding the receiver here instead would leave both
-        // threads waiting for each other.
+        // `consume` owns the receiver, so that when it returns early or unwinds, a worker blocked on the
+        // full queue wakes with an error and ends, and this scope can join it.
         let result = consume(batches, to_producer, visitor, book);
         match worker.join() {
             Ok(()) => result,
@@ -392,8 +375,7 @@ fn read_into(
     })
 }
 
-/// The checking half of the pipeline: walks the worker's batches in file order. Takes both ends of its
-/// channels by value, so that they close when it returns (see [`read_into`]).
+/// The checking half of the pipeline: walks the worker's batches in file order.
 fn consume(
     batches: Receiver<Batch>,
     to_producer: SyncSender<Batch>,
@@ -666,20 +648,16 @@ impl Book {
     ) -> Result<(), ReadError> {
         let mut c = Cursor::new(records);
         while !c.rest().is_empty() {
+            let (at, offset) = self
+                .chunk
+                .as_ref()
+                .map_or((0, 0), |c| (c.index.chunk_start_offset, c.offset));
             let (opcode, data) = c.record().map_err(|e| {
-                let at = self
-                    .chunk
-                    .as_ref()
-                    .map_or(0, |c| c.index.chunk_start_offset);
                 corrupt(format!(
                     "corrupt chunk at byte {at}: a record inside it runs past its end ({e})"
                 ))
                 .after(format!("judged the {} messages read", self.s.messages))
             })?;
-            let (at, offset) = self
-                .chunk
-                .as_ref()
-                .map_or((0, 0), |c| (c.index.chunk_start_offset, c.offset));
             if let Some(c) = self.chunk.as_mut() {
                 c.offset += PREFIX_LEN + data.len() as u64;
             }

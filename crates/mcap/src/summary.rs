@@ -1,15 +1,9 @@
 //! What a file says about itself without reading its data section: the header's library, the summary
-//! section (statistics, schemas, channels, chunk indexes, metadata indexes) and the metadata records the
-//! metadata indexes point at. A few seeks and a few KiB of reading, whatever the file's length, so that
-//! `coin-log info` is instant on a file of gigabytes.
-//!
-//! The summary is taken as the file states it, its CRC checked; nothing here checks it against the data
-//! section (the streaming [`read`](super::read) does that). Records are parsed by the crate's one codec
-//! (bounds-checked), every length is checked against the file size before anything is allocated for it,
-//! and the summary section and the metadata records it indexes are held to the reader's budget. On the
-//! 7 M-message workload's file this takes 0.13 ms (with its seeks), `mcap::Summary::read` and
-//! `mcap::read::metadata` 0.28 ms over the file already in memory (`crates/bench/benches/crate_vs_ours.rs`' "summary"
-//! race, medians of 3 rounds of 101 reads); the crate's parsers also reserve what a length claims.
+//! section and the metadata records it indexes, in a few seeks whatever the file's length. The summary
+//! is taken as stated (its CRC checked; the streaming [`read`](super::read) checks it against the data),
+//! and held to the reader's budget. On the 7 M-message workload's file this took 0.13 ms with its seeks,
+//! `mcap::Summary::read` and `mcap::read::metadata` 0.28 ms over the file in memory (crate_vs_ours'
+//! "summary" race, medians of 3 rounds of 101 reads).
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::early_metadata::{self, MAX_EARLY};
@@ -64,8 +58,7 @@ pub struct Summary {
 }
 
 /// Reads the summary of the MCAP file at `path`. `Ok(None)` when the file has no summary section, its
-/// summary has no statistics record, or it is larger than the largest record the reader accepts (then
-/// only a streaming pass can tell what the file holds).
+/// summary has no statistics record, or it is larger than the largest record the reader accepts.
 ///
 /// # Errors
 /// [`ReadError`] if the file cannot be read, is not MCAP, or its footer, summary (CRC included) or a

@@ -1,15 +1,11 @@
-//! A pipelined, deterministic, chunked MCAP writer: the calling thread appends messages to an
-//! uncompressed chunk while earlier chunks are compressed whole on a worker thread. Every record is
-//! encoded by the crate's one codec (`records`).
+//! A pipelined, deterministic, chunked MCAP writer ([`McapWriter`]).
 //!
-//! Written here rather than taken from `mcap::Writer` (0.26), which streams every record through a
-//! streaming zstd context on the calling thread and cannot hand a finished chunk away and go on. On the
-//! 7 M-message workload of `bench throughput` (`crates/bench/benches/crate_vs_ours.rs`, its "write" race, in memory,
-//! zstd level 1, 1 MiB chunks, medians of 3 alternating rounds at load 7 on 2 cores), this writer took
-//! 3.81 s with 1 worker (2.94 s with 2), `mcap::Writer` 6.07 s with `compression_threads(0)`, 5.93 s with
-//! 1 and 7.72 s with 2: 1.56 to 2.03 times as long. It would also change every recording's bytes.
-//!
-//! [`McapWriter`]'s doc describes the pipeline, why the bytes are deterministic, and the file's layout.
+//! Ours rather than `mcap::Writer` (0.26), which streams every record through a zstd context on the
+//! calling thread and cannot hand a finished chunk away. On the 7 M-message workload (crate_vs_ours'
+//! "write" race: in memory, zstd level 1, 1 MiB chunks, medians of 3 alternating rounds at load 7 on 2
+//! cores) this writer took 3.81 s with 1 worker (2.94 s with 2), `mcap::Writer` 6.07, 5.93 and 7.72 s
+//! with 0, 1 and 2 compression threads: 1.56 to 2.03 times as long. It would also change every
+//! recording's bytes.
 
 use crate::records::{ChunkRecord, MessageRecord, Record, Tail, MAGIC};
 use mcap::records::{
@@ -23,26 +19,20 @@ use std::mem;
 use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
 use std::thread::JoinHandle;
 
-/// The default of [`WriterOptions::chunk_size`] \[bytes of uncompressed records\]: the `mcap` crate's
-/// default, large enough for good compression and few index records, small enough that a reader seeking
-/// to a time decompresses little.
+/// The default of [`WriterOptions::chunk_size`] \[bytes of uncompressed records\], as the `mcap`
+/// crate's.
 pub const DEFAULT_CHUNK_SIZE: usize = 1 << 20;
 
-/// The zstd level of [`Compression::Zstd`] chunks (fixed: the writer has no other). Level 1 is both
-/// faster and smaller than zstd's default level 3 on coin-log's JSON chunks (measured on the seven-channel
-/// wobble run: 3.9× vs 3.5× smaller, about 1.3× faster; the shortest round-trip digits leave little for
-/// level 3's longer matches to find).
+/// The zstd level of [`Compression::Zstd`] chunks: faster and smaller than zstd's default level 3 on
+/// coin-log's JSON (seven-channel wobble run: 3.9× vs 3.5× smaller, about 1.3× faster).
 pub const ZSTD_LEVEL: i32 = 1;
 
-/// lz4 level: 0 is lz4's fast default, as in the `mcap` crate.
+/// lz4's fast default, as in the `mcap` crate.
 const LZ4_LEVEL: u32 = 0;
 
-/// Chunks a worker may hold (one being compressed, one queued) before the calling thread waits: enough
-/// to keep the worker busy, few enough that memory stays a few chunk sizes.
+/// Chunks a worker may hold (one being compressed, one queued) before the calling thread waits.
 const IN_FLIGHT_PER_WORKER: usize = 2;
 
-/// Buffer between the writer and the output, so that small records (indexes, headers) are not one
-/// system call each.
 const OUTPUT_BUFFER: usize = 1 << 16;
 
 coin_log_names::named_enum! {
@@ -144,8 +134,7 @@ pub enum WriteError {
 struct ChunkMeta {
     /// (earliest, latest) log time, None before the first message.
     bounds: Option<(u64, u64)>,
-    /// Per channel (index = id − 1), the entries of its message index: (log time, offset of the Message
-    /// record in the uncompressed chunk).
+    /// Per channel (index = id − 1), its message index.
     indexes: Vec<MessageIndex>,
 }
 
@@ -158,23 +147,20 @@ impl ChunkMeta {
     }
 }
 
-/// A chunk on its way to a worker and back.
+/// A chunk on its way to a worker and back: its records, and them compressed (empty for
+/// [`Compression::None`]).
 struct Job {
-    /// The uncompressed records.
     records: Vec<u8>,
-    /// The compressed records (empty for [`Compression::None`]).
     compressed: Vec<u8>,
 }
 
-/// A worker's answer.
+/// A worker's answer, with the CRC-32 of `job.records`.
 struct Done {
     job: Job,
-    /// CRC-32 of `job.records`.
     crc: u32,
     result: io::Result<()>,
 }
 
-/// One compression thread and its two channels.
 struct Worker {
     jobs: Option<Sender<Job>>,
     done: Option<Receiver<Done>>,
@@ -243,11 +229,11 @@ fn compress_chunks(compression: Compression, jobs: &Receiver<Job>, done: &Sender
     }
 }
 
-/// Compresses whole chunks exactly as the writer's workers do (one call per chunk, one thread), so that
-/// a benchmark can time the compression bound on the same code.
+/// Compresses whole chunks as the writer's workers do, public so that a benchmark can time compression
+/// alone.
 pub struct ChunkCompressor {
     compression: Compression,
-    /// Created at the first zstd chunk and kept: its context is reused from chunk to chunk.
+    /// Created at the first zstd chunk, then reused.
     zstd: Option<zstd::bulk::Compressor<'static>>,
 }
 
@@ -294,8 +280,7 @@ impl ChunkCompressor {
     }
 }
 
-/// The output: counts bytes (offsets for the indexes) and keeps a running CRC-32 (the data section's,
-/// then the summary's).
+/// The output, its position and a running CRC-32 (the data section's, then the summary's).
 struct Output<W: Write> {
     inner: BufWriter<W>,
     position: u64,
@@ -313,38 +298,19 @@ impl<W: Write> Output<W> {
 
 /// A chunked, indexed MCAP writer whose chunks are compressed on worker threads.
 ///
-/// # Pipeline
-/// - The calling thread appends Message records to a plain `Vec<u8>` (the chunk's uncompressed records),
-///   noting per channel (`log_time`, offset in the chunk) for the message indexes, and the chunk's time
-///   bounds.
-/// - When the chunk reaches [`WriterOptions::chunk_size`] bytes it goes to a compression worker over a
-///   `std::sync::mpsc` channel. The worker computes its CRC-32 and compresses it in one call (zstd's bulk
-///   API at [`ZSTD_LEVEL`], single-threaded; an lz4 frame as the `mcap` crate writes one; or nothing),
-///   and sends both buffers back; they are reused, so the steady state allocates nothing per chunk
-///   (lz4's encoder context excepted).
-/// - The calling thread writes finished chunks, in order, each followed by its MessageIndex records, as
-///   their results come back. The file never leaves the calling thread: a borrowed `&mut Cursor` or
-///   `BufWriter<&mut File>` works (nothing needs to be `Send + 'static`), and an I/O error surfaces from
-///   the call that met it. A compression error or a lost worker surfaces from the next call that
-///   collects a chunk ([`write_message`](Self::write_message), [`write_metadata`](Self::write_metadata) or
-///   [`finish`](Self::finish)); after any error every call fails and the file is unusable.
-/// - At most two chunks per worker (one being compressed, one queued) are in flight: the calling thread
-///   waits for the oldest beyond that, so memory is bounded whatever the length of the run.
+/// The calling thread appends Message records to the open chunk, noting its message index entries and
+/// time bounds. A full chunk ([`WriterOptions::chunk_size`]) goes to a worker, which computes its CRC and
+/// compresses it in one call; buffers are reused. The calling thread writes finished chunks in order (so
+/// the output need not be `Send`), with at most two per worker in flight. Chunk boundaries depend only on
+/// the bytes written and each chunk is compressed alone with fixed parameters, so neither the worker
+/// count nor timing changes a byte. An I/O error surfaces from the call that met it, a compression error
+/// or a lost worker from the next call that collects a chunk; after any error every call fails.
 ///
-/// # Determinism
-/// Chunk boundaries depend only on the bytes written; each chunk is compressed independently with fixed
-/// parameters by one thread; chunks are written in the order they were filled. Neither the worker count
-/// nor timing changes a byte.
-///
-/// # Layout ([MCAP spec](https://mcap.dev/spec))
-/// Magic; Header (profile, library); the data section: chunks (Schema and Channel records inside the
-/// chunk that holds the channel's first message, before it), each followed by its MessageIndex records,
-/// and Metadata records between chunks (the open chunk is written first); DataEnd with the CRC-32 of
-/// everything before it; the summary section: Schemas, Channels, Statistics, ChunkIndexes,
-/// MetadataIndexes, each group listed by a SummaryOffset record; Footer with the summary CRC; magic.
-///
-/// Call [`finish`](Self::finish) to complete the file; dropping the writer without it stops the workers
-/// and leaves an incomplete file.
+/// Layout: magic; Header; chunks (a channel's Schema and Channel records in the chunk of its first
+/// message), each followed by its MessageIndex records, and Metadata records between chunks; DataEnd
+/// (data CRC); summary: Schemas, Channels, Statistics, ChunkIndexes, MetadataIndexes, each group listed
+/// by a SummaryOffset record; Footer (summary CRC); magic. Call [`finish`](Self::finish) to complete
+/// the file; dropping the writer without it leaves the file incomplete.
 #[must_use = "an MCAP file is complete only after `finish`"]
 pub struct McapWriter<W: Write> {
     out: Output<W>,
