@@ -207,6 +207,13 @@ pub(crate) fn corrupt(detail: String) -> ReadError {
     ReadError::new(ReadErrorKind::Corrupt, detail)
 }
 
+pub(crate) fn not_mcap() -> ReadError {
+    ReadError::new(
+        ReadErrorKind::NotMcap,
+        "not an MCAP file (it does not start with the MCAP magic bytes)",
+    )
+}
+
 pub(crate) fn io_error(e: std::io::Error) -> ReadError {
     ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"))
 }
@@ -457,10 +464,7 @@ impl Book {
         let read = format!("judged the {messages} messages read");
         match e {
             McapError::BadMagic if at == MAGIC_LEN && messages == 0 && !self.data_end_seen => {
-                ReadError::new(
-                    ReadErrorKind::NotMcap,
-                    "not an MCAP file (it does not start with the MCAP magic bytes)",
-                )
+                not_mcap()
             }
             McapError::UnexpectedEof if at <= MAGIC_LEN && !self.ahead.magic_prefix => {
                 ReadError::new(

@@ -7,7 +7,7 @@
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::early_metadata::{self, MAX_EARLY};
-use crate::reader::{self, corrupt, io_error, ReadError, ReadErrorKind};
+use crate::reader::{self, corrupt, io_error, not_mcap, ReadError};
 use crate::records::{self, Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
 use mcap::records::{op, Channel, ChunkIndex, Footer, Header, MetadataIndex, Statistics};
 use mcap::Schema;
@@ -281,17 +281,12 @@ pub(crate) fn bytes_at(
 /// The magic and the header record's `library`; `None` when the file starts with the magic but not
 /// with a whole header record (the streaming pass says what is wrong).
 fn header_library(file: &mut std::fs::File, file_len: u64) -> Result<Option<String>, ReadError> {
-    let mut start = [0u8; (MAGIC_LEN + PREFIX_LEN) as usize];
-    let n = usize::try_from(file_len.min(start.len() as u64)).unwrap_or(0);
-    file.read_exact(&mut start[..n]).map_err(io_error)?;
-    let magic = n.min(MAGIC.len());
+    let start = bytes_at(file, file_len, 0, file_len.min(MAGIC_LEN + PREFIX_LEN))?;
+    let magic = start.len().min(MAGIC.len());
     if start[..magic] != MAGIC[..magic] {
-        return Err(ReadError::new(
-            ReadErrorKind::NotMcap,
-            "not an MCAP file (it does not start with the MCAP magic bytes)",
-        ));
+        return Err(not_mcap());
     }
-    match records::prefix(&start[magic..n]) {
+    match records::prefix(&start[magic..]) {
         Some((op::HEADER, len)) if len <= MAX_RECORD_BYTES => {
             let body = bytes_at(file, file_len, MAGIC_LEN + PREFIX_LEN, len)?;
             let header = Header::parse_body(&body)
