@@ -293,12 +293,6 @@ impl DissipativeCoin {
         let rates = self.rates(s.theta, s.omega_x, s.omega_y, s.omega_z);
         reaction_with(&self.coin, s, rates.acceleration)
     }
-
-    /// The power P at a state (eq (34)).
-    #[must_use]
-    pub fn power(&self, s: &State) -> f64 {
-        self.dissipation.power(s.theta, s.omega_y)
-    }
 }
 
 /// How the coin moves: conservative (eqs (14)–(19)) or with a dissipative couple (eqs (30)–(34)). The
@@ -309,6 +303,18 @@ pub enum Dynamics {
     Conservative(Coin),
     /// A dissipative couple: E + W is conserved.
     Dissipative(DissipativeCoin),
+}
+
+impl From<Coin> for Dynamics {
+    fn from(coin: Coin) -> Self {
+        Self::Conservative(coin)
+    }
+}
+
+impl From<DissipativeCoin> for Dynamics {
+    fn from(coin: DissipativeCoin) -> Self {
+        Self::Dissipative(coin)
+    }
 }
 
 impl Dynamics {
