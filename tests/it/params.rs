@@ -30,7 +30,6 @@ fn names(errors: &[ParamError]) -> Vec<&'static str> {
         .iter()
         .map(|e| match e {
             ParamError::NotPositive { name, .. } => *name,
-            ParamError::InertiaSpec(_) => "inertia spec",
         })
         .collect()
 }

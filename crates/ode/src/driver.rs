@@ -27,7 +27,7 @@ const EVENT_SAMPLE_GAP: f64 = 2e-9;
 
 /// Scalar functions g_i(t, y) whose crossing from > 0 to ≤ 0 ends a run (flat landing, lift-off, ...).
 pub trait EventFunctions<const N: usize> {
-    /// Number of functions (≤ [`MAX_EVENTS`]).
+    /// Number of functions (at most `MAX_EVENTS` = 8).
     fn count(&self) -> usize;
     /// Writes g_i(t, y) into `out[..count]`.
     fn evaluate(&self, t: f64, y: &[f64; N], out: &mut [f64]);

@@ -446,18 +446,12 @@ pub fn boundary(coin: &Coin, theta0: f64) -> Vec<BoundaryPoint> {
 }
 
 /// The boundary point (θ₀, ω_Z0, ω_Y0) with the branch whose root ω_Y0 is.
-fn on_branch(coin: &Coin, theta0: f64, omega_z0: f64, omega_y0: f64) -> BoundaryPoint {
-    let distance = |b: Branch| (steady_omega_y(coin, theta0, omega_z0, b) - omega_y0).abs();
-    let branch = if distance(Branch::Plus) <= distance(Branch::Minus) {
-        Branch::Plus
-    } else {
-        Branch::Minus
-    };
+pub(super) fn on_branch(coin: &Coin, theta0: f64, omega_z0: f64, omega_y0: f64) -> BoundaryPoint {
     BoundaryPoint {
         theta0,
         omega_z0,
         omega_y0,
-        branch,
+        branch: Branch::nearest(coin, theta0, omega_z0, omega_y0),
     }
 }
 
@@ -500,45 +494,6 @@ pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
             })
         })
         .collect()
-}
-
-/// The ω_Z0 in [lo, hi] where σ² changes sign on `branch` at lean θ₀, by root finding on the closed form
-/// σ²(θ₀, ω_Z0) (eq (21)): sign changes over `samples` equal steps, each bisected to adjacent floats. An
-/// independent route to the boundary of [`boundary`].
-#[must_use]
-pub fn sign_changes(
-    coin: &Coin,
-    theta0: f64,
-    branch: Branch,
-    (lo, hi): (f64, f64),
-    samples: usize,
-) -> Vec<f64> {
-    let sigma2 = |w: f64| {
-        let wy = steady_omega_y(coin, theta0, w, branch);
-        steady_sigma_squared(coin, theta0, wy, w)
-    };
-    let mut out = Vec::new();
-    let at = |j: usize| {
-        #[allow(clippy::cast_precision_loss)]
-        let x = j as f64 / samples.max(1) as f64;
-        lo + (hi - lo) * x
-    };
-    let mut previous = (at(0), sigma2(at(0)));
-    for j in 1..=samples {
-        let w = at(j);
-        let v = sigma2(w);
-        if (v < 0.0) != (previous.1 < 0.0) {
-            let negative_first = previous.1 < 0.0;
-            let (a, b) = crate::model::quadrature::bisect(
-                |x| (sigma2(x) < 0.0) == negative_first,
-                previous.0,
-                w,
-            );
-            out.push(0.5 * (a + b));
-        }
-        previous = (w, v);
-    }
-    out
 }
 
 /// A few round leans below the highest closure (steps of 1, 2 or 5 × 10ⁿ, about six of them) at which

@@ -5,7 +5,7 @@
 //! Cells of one θ₀ column with the same colour are drawn as one rectangle, so the file stays small
 //! (a 200 × 200 map of the thin disk on both branches is about 2,000 rectangles, not 80,000).
 
-use super::map::{boundary, BoundaryPoint, MapError, MapPoint, StabilityMap};
+use super::map::{boundary, on_branch, BoundaryPoint, MapError, MapPoint, StabilityMap};
 use super::steady::Stability;
 use crate::model::Branch;
 use crate::palette::{MARGINAL, STABLE, UNSTABLE};
@@ -204,13 +204,7 @@ fn boundary_lines(
             (-c.theta0, c.omega_z0, -c.omega_y0),
             (-c.theta0, -c.omega_z0, c.omega_y0),
         ] {
-            let branch_here = boundary_branch(coin, theta, omega, omega_y);
-            folds.push(BoundaryPoint {
-                theta0: theta,
-                omega_z0: omega,
-                omega_y0: omega_y,
-                branch: branch_here,
-            });
+            folds.push(on_branch(coin, theta, omega, omega_y));
             leans.push(theta);
         }
     }
@@ -249,17 +243,6 @@ fn boundary_lines(
     lines.extend(open.into_iter().flatten());
     lines.retain(|l| l.len() > 1);
     lines
-}
-
-/// The branch whose root ω_Y0 is, at (θ₀, ω_Z0).
-fn boundary_branch(coin: &crate::model::Coin, theta: f64, omega_z: f64, omega_y: f64) -> Branch {
-    let distance =
-        |b: Branch| (crate::model::steady_omega_y(coin, theta, omega_z, b) - omega_y).abs();
-    if distance(Branch::Plus) <= distance(Branch::Minus) {
-        Branch::Plus
-    } else {
-        Branch::Minus
-    }
 }
 
 /// The colour scales and what the lines and dots are.

@@ -62,8 +62,7 @@ pub fn coefficient_for(
 
 /// ε(α) = |α̇| / (α σ): the slow-change rate α̇ = −C sin^p α / cos α against the nutation frequency σ of the
 /// centre-fixed motion at α (physics §5). The slow-change approximation needs ε ≪ 1.
-#[must_use]
-pub fn slow_change_ratio(coin: &Coin, law: &Dissipation, alpha: f64) -> f64 {
+fn slow_change_ratio(coin: &Coin, law: &Dissipation, alpha: f64) -> f64 {
     let rate = slow_change_rate(coin, law) * alpha.sin().powf(law.angle_exponent()) / alpha.cos();
     let sigma = centre_fixed_sigma_squared(coin, FRAC_PI_2 - alpha).sqrt();
     rate / (alpha * sigma)

@@ -228,7 +228,7 @@ impl Collect {
                         .energy_drift
                         .get_or_insert_with(|| EnergyDrift::new(&params, e));
                     self.energy
-                        .push(t, (e - drift.reference()).abs() / drift.scale());
+                        .push(t, (e - drift.reference).abs() / drift.scale);
                 }
             }
             Channel::Invariants => {
@@ -236,9 +236,9 @@ impl Collect {
                     let drift = *self
                         .invariant_drift
                         .get_or_insert_with(|| InvariantDrift::new(&params, c1, c2));
-                    let (a, b) = drift.reference();
-                    self.c1.push(t, (c1 - a).abs() / drift.scale());
-                    self.c2.push(t, (c2 - b).abs() / drift.scale());
+                    let (a, b) = drift.reference;
+                    self.c1.push(t, (c1 - a).abs() / drift.scale);
+                    self.c2.push(t, (c2 - b).abs() / drift.scale);
                 }
             }
             Channel::Reaction => {

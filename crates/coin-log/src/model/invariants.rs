@@ -48,9 +48,7 @@
 //! Near flat, s = sin θ loses the relative precision of 1 − s (at θ = 1.5705, 1 − s ≈ 4.5e-8, so the
 //! rounding of s alone would cost 2e-9). [`Chaplygin::evaluate`] therefore never forms 1 − s: it uses
 //! x = cos²θ / (2(1 + |s|)) and ln x = ln cos²θ − ln(2(1 + |s|)), exact to a few ulp, and the flux p
-//! directly, so C1, C2 keep full precision up to the flat landing. Chebyshev fits or integrating the
-//! equation were the alternatives; the two series are exact, parameter-generic and cost about as much as a
-//! fit, with nothing to tabulate but 4 × 34 coefficients per side.
+//! directly, so C1, C2 keep full precision up to the flat landing.
 //!
 //! # Accuracy and cost
 //!
@@ -87,10 +85,7 @@ const TRUNCATION: f64 = 1e-18;
 const DECREASING_RUN: usize = 2;
 /// A hard bound on the series length (μ ≤ [`MU_MAX`] needs about 1000 at most).
 const MAX_TERMS: usize = 20_000;
-/// Largest μ accepted. Every real body has I_Z ≤ 2 I_X and so μ < 2. For large μ the solutions grow like
-/// exp(√μ |θ|) and the split moves so close to s = 1 that the series about s = 0 needs ~20 μ/… terms, so
-/// anything beyond this is refused rather than evaluated slowly or inaccurately. The tests cover μ = 20
-/// and μ = 100.
+/// Largest μ accepted (no real body comes near: see the module doc). The tests cover μ = 20 and μ = 100.
 pub const MU_MAX: f64 = 100.0;
 
 /// Why the integrals cannot be built for these parameters.

@@ -13,9 +13,6 @@ pub enum ParamError {
         /// The value that was given.
         value: f64,
     },
-    /// Both a shape and explicit inertias were given, or only one inertia.
-    #[error("{0}")]
-    InertiaSpec(String),
 }
 
 /// How the axisymmetric inertia is specified.

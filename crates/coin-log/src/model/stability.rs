@@ -2,7 +2,6 @@
 //! any steady motion (physics §9).
 
 use super::equations::Coin;
-use nalgebra::Matrix4;
 
 /// λ² of straight rolling at spin ω_Z0 (physics §5):
 /// λ² = (Mga − I_Z(I_Z + Ma²) ω_Z0² / I_X) / (I_X + Ma²). Positive: the tilt grows like e^{λt};
@@ -103,26 +102,6 @@ impl Linearisation {
     #[must_use]
     pub fn scale(&self) -> f64 {
         self.a.abs() + (self.b * self.d).abs() + (self.c * self.e).abs()
-    }
-
-    /// The 4 × 4 Jacobian of (θ̇, ω̇_X, ω̇_Y, ω̇_Z) with respect to (θ, ω_X, ω_Y, ω_Z).
-    #[must_use]
-    pub fn jacobian(&self) -> Matrix4<f64> {
-        #[rustfmt::skip]
-        let j = Matrix4::new(
-            0.0,    1.0,    0.0,    0.0,
-            self.a, 0.0,    self.b, self.c,
-            0.0,    self.d, 0.0,    0.0,
-            0.0,    self.e, 0.0,    0.0,
-        );
-        j
-    }
-
-    /// The eigenvalues of the Jacobian, the roots of λ²(λ² + σ²): 0, 0 and ±√(−σ²), as (re, im) pairs,
-    /// the two zeros first, then the pair with the positive real or imaginary part first.
-    #[must_use]
-    pub fn eigenvalues(&self) -> [(f64, f64); 4] {
-        eigenvalues(self.sigma_squared())
     }
 }
 
