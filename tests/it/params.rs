@@ -41,9 +41,7 @@ fn each_bad_value_of_each_field_is_an_error_naming_that_field() {
             let errors = with_field(field, bad).unwrap_err();
             println!("{field} = {bad}: {errors:?} (expected exactly one error naming `{field}`)");
             assert_eq!(names(&errors), vec![field]);
-            let ParamError::NotPositive { value, .. } = errors[0] else {
-                panic!("wrong variant {:?}", errors[0]);
-            };
+            let ParamError::NotPositive { value, .. } = errors[0];
             assert!(
                 value.to_bits() == bad.to_bits() || (value.is_nan() && bad.is_nan()),
                 "the error carries {value}, not the given {bad}"
