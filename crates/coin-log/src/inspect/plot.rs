@@ -17,10 +17,12 @@ use crate::format::{
 };
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
-use crate::palette::{BLUE, GREEN, GREY, ORANGE, RED};
+use crate::palette::{
+    legend_box, legend_line, svg_page, Area, DrawError, BLUE, GREEN, GREY, ORANGE, RED,
+};
 use crate::scene::SceneFile;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
-use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -424,8 +426,6 @@ fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (S
     )
 }
 
-type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
-
 fn draw(
     c: &Collect,
     run: &RunMetadata,
@@ -439,23 +439,18 @@ fn draw(
         .map(|r| (r.termination.name(), r.termination_time));
     // 2 % beyond the last time, so that the termination's mark stands clear of the frame.
     let t_max = 1.02 * c.last_t.max(end.map_or(0.0, |e| e.1)).max(1e-9);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+    svg_page(SIZE, |root| {
         let (top, body) = root.split_vertically(70);
         top.draw_text(
             &heading,
             &("sans-serif", 22).into_font().color(&BLACK),
             (20, 12),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         top.draw_text(
             &subheading,
             &("sans-serif", 14).into_font().color(&GREY),
             (20, 44),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let panels = body.split_evenly((3, 2));
         track(&panels[0], c)?;
         let time = TimeAxis { t_max, end };
@@ -486,24 +481,22 @@ fn draw(
             "|F| / N",
             &[("|F|/N", &c.ratio, BLUE)],
             mu,
-        )?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(svg)
+        )
+    })
+    .map_err(|e| e.to_string())
 }
 
 /// A panel that says why it is empty.
-fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), String> {
-    area.titled(title, ("sans-serif", 16))
-        .and_then(|a| a.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60)))
-        .map_err(|e| e.to_string())
+fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), DrawError> {
+    let area = area.titled(title, ("sans-serif", 16))?;
+    area.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60))
 }
 
-/// Range `lo..hi` widened by `pad` of its span on each side (a fixed span when it is empty).
-fn padded(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+/// Range `lo..hi` widened by 5 % of its span on each side (a fixed span when it is empty).
+fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
     let span = hi - lo;
     if span > 0.0 {
-        (lo - pad * span, hi + pad * span)
+        (lo - 0.05 * span, hi + 0.05 * span)
     } else {
         let w = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
         (lo - w, hi + w)
@@ -521,7 +514,7 @@ fn min_max<'a>(
 
 /// The path of the contact point and of the centre in the table plane: x across, z down the page,
 /// one length unit the same on both axes.
-fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
+fn track(area: &Area<'_>, c: &Collect) -> Result<(), DrawError> {
     let (contact, centre) = (c.contact.points(), c.centre.points());
     if contact.is_empty() && centre.is_empty() {
         return empty(
@@ -531,8 +524,8 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
         );
     }
     let all = || contact.iter().chain(&centre);
-    let (x0, x1) = padded_equal(min_max(all(), |p| p.0));
-    let (z0, z1) = padded_equal(min_max(all(), |p| p.1));
+    let (x0, x1) = padded(min_max(all(), |p| p.0));
+    let (z0, z1) = padded(min_max(all(), |p| p.1));
     // Equal axes: widen the shorter range to the plotting area's aspect ratio.
     let (label_x, label_y, margin) = (40u32, 60u32, 12u32);
     let (w, h) = area.dim_in_pixel();
@@ -541,20 +534,17 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
     let scale = ((x1 - x0) / plot_w).max((z1 - z0) / plot_h);
     let (xc, zc) = (0.5 * (x0 + x1), 0.5 * (z0 + z1));
     let (hx, hz) = (0.5 * scale * plot_w, 0.5 * scale * plot_h);
-    let err = |e: &dyn std::fmt::Display| e.to_string();
     let mut chart = ChartBuilder::on(area)
         .caption(PANELS[0], ("sans-serif", 16))
         .margin(margin)
         .x_label_area_size(label_x)
         .y_label_area_size(label_y)
-        .build_cartesian_2d(xc - hx..xc + hx, zc + hz..zc - hz)
-        .map_err(|e| err(&e))?;
+        .build_cartesian_2d(xc - hx..xc + hx, zc + hz..zc - hz)?;
     chart
         .configure_mesh()
         .x_desc("x")
         .y_desc("z (down the page: the view from above)")
-        .draw()
-        .map_err(|e| err(&e))?;
+        .draw()?;
     for (label, points, colour) in [
         ("contact track", &contact, BLUE),
         ("centre", &centre, ORANGE),
@@ -566,59 +556,34 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
             .draw_series(LineSeries::new(
                 points.iter().copied(),
                 colour.stroke_width(1),
-            ))
-            .map_err(|e| err(&e))?
+            ))?
             .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+            .legend(legend_line(colour, 2));
         let (first, last) = (points[0], points[points.len() - 1]);
-        chart
-            .draw_series([Circle::new(first, 4, colour.filled())])
-            .map_err(|e| err(&e))?;
-        chart
-            .draw_series([Cross::new(last, 6, RED.stroke_width(2))])
-            .map_err(|e| err(&e))?;
+        chart.draw_series([Circle::new(first, 4, colour.filled())])?;
+        chart.draw_series([Cross::new(last, 6, RED.stroke_width(2))])?;
     }
-    legend(&mut chart)
+    legend_box(&mut chart, SeriesLabelPosition::UpperRight)
 }
 
-/// `lo..hi` padded by 5 % (a unit span around a single value).
-fn padded_equal((lo, hi): (f64, f64)) -> (f64, f64) {
-    padded(lo, hi, 0.05)
-}
-
-fn legend<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
-) -> Result<(), String> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| e.to_string())
-}
+/// The axes of a time panel.
+type TimeChart<'a, 'b, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, Y>>;
 
 /// Each of `series` as a line through its `points` (values mapped by `value`), with its legend entry.
-fn draw_series<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
+fn draw_series<Y: Ranged<ValueType = f64>>(
+    chart: &mut TimeChart<'_, '_, Y>,
     series: &[(&str, &Envelope, RGBColor)],
     points: &[Vec<(f64, f64)>],
     value: impl Fn(f64) -> f64,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     for ((label, _, colour), points) in series.iter().zip(points) {
-        let colour = *colour;
         chart
             .draw_series(LineSeries::new(
                 points.iter().map(|&(t, v)| (t, value(v))),
                 colour.stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?
+            ))?
             .label(*label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+            .legend(legend_line(*colour, 2));
     }
     Ok(())
 }
@@ -638,7 +603,7 @@ impl TimeAxis<'_> {
         y_desc: &str,
         series: &[(&str, &Envelope, RGBColor)],
         line: Option<(&str, f64)>,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         if series.iter().all(|s| s.1.is_empty()) {
             return empty(area, title, "the channel this needs was not recorded");
         }
@@ -647,21 +612,14 @@ impl TimeAxis<'_> {
         if let Some((_, v)) = line {
             (lo, hi) = (lo.min(v), hi.max(v));
         }
-        let (y0, y1) = padded(lo, hi, 0.05);
-        let err = |e: &dyn std::fmt::Display| e.to_string();
+        let (y0, y1) = padded((lo, hi));
         let mut chart = ChartBuilder::on(area)
             .caption(title, ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(0.0..self.t_max, y0..y1)
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("t")
-            .y_desc(y_desc)
-            .draw()
-            .map_err(|e| err(&e))?;
+            .build_cartesian_2d(0.0..self.t_max, y0..y1)?;
+        chart.configure_mesh().x_desc("t").y_desc(y_desc).draw()?;
         draw_series(&mut chart, series, &points, |v| v)?;
         if let Some((label, v)) = line {
             chart
@@ -670,15 +628,12 @@ impl TimeAxis<'_> {
                     6,
                     4,
                     GREEN.stroke_width(2),
-                ))
-                .map_err(|e| err(&e))?
+                ))?
                 .label(format!("{label} = {v}"))
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2))
-                });
+                .legend(legend_line(GREEN, 2));
         }
         self.mark_end(&mut chart, y0, y1)?;
-        legend(&mut chart)
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 
     /// A panel of non-negative `series` on a log scale; zeros are drawn on the bottom edge, which sits a
@@ -688,7 +643,7 @@ impl TimeAxis<'_> {
         area: &Area<'_>,
         title: &str,
         series: &[(&str, &Envelope, RGBColor)],
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         if series.iter().all(|s| s.1.is_empty()) {
             return empty(area, title, "the channel this needs was not recorded");
         }
@@ -702,14 +657,12 @@ impl TimeAxis<'_> {
         } else {
             (1e-17, 1e-15)
         };
-        let err = |e: &dyn std::fmt::Display| e.to_string();
         let mut chart = ChartBuilder::on(area)
             .caption(title, ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(0.0..self.t_max, (floor..top).log_scale())
-            .map_err(|e| err(&e))?;
+            .build_cartesian_2d(0.0..self.t_max, (floor..top).log_scale())?;
         chart
             .configure_mesh()
             .x_desc("t")
@@ -719,20 +672,19 @@ impl TimeAxis<'_> {
                 "identically 0"
             })
             .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(|e| err(&e))?;
+            .draw()?;
         draw_series(&mut chart, series, &points, |v| v.max(floor))?;
         self.mark_end(&mut chart, floor, top)?;
-        legend(&mut chart)
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 
     /// The termination as a dashed red vertical line, labelled.
-    fn mark_end<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
+    fn mark_end<Y: Ranged<ValueType = f64>>(
         &self,
-        chart: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
+        chart: &mut TimeChart<'_, '_, Y>,
         y0: f64,
         y1: f64,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let Some((name, t)) = self.end else {
             return Ok(());
         };
@@ -742,10 +694,9 @@ impl TimeAxis<'_> {
                 5,
                 4,
                 RED.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
+            ))?
             .label(format!("{name} at t = {t}"))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+            .legend(legend_line(RED, 2));
         Ok(())
     }
 }
