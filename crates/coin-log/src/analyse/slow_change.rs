@@ -18,8 +18,7 @@ pub fn alpha_of(s: &State) -> f64 {
 /// C of the slow-change law d(sin α)/dt = −C sin^p α on the centre-fixed family (eqs (35)–(37)):
 /// E = (3/2) Mga sin α and P = κ (Mga/I_X)^(m/2) sin^p α, so C = κ (Mga/I_X)^(m/2) / ((3/2) Mga)
 /// [1/time].
-#[must_use]
-pub fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
+fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
     let p = coin.params();
     let mga = p.energy_scale();
     law.coefficient() * (mga / p.inertia_x()).powf(0.5 * law.m()) / (1.5 * mga)
