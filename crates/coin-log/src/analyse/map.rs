@@ -426,14 +426,8 @@ pub fn boundary(coin: &Coin, theta0: f64) -> Vec<BoundaryPoint> {
     let qa = 3.0 * ix * t * t + ma2;
     let qb = (3.0 * iz + ma2) * t - (iz + ma2) / t;
     let qc = iz * (iz + ma2) / ix;
-    let discriminant = qb * qb - 4.0 * qa * qc;
-    if discriminant < 0.0 {
-        return Vec::new();
-    }
-    // Stable quadratic formula: q = −(b + sgn(b)√D)/2, roots q/a and c/q.
-    let q = -0.5 * (qb + qb.signum() * discriminant.sqrt());
     let mut out = Vec::new();
-    for r in [q / qa, qc / q] {
+    for r in real_roots(qa, qb, qc) {
         let omega2 = mga * s / (r * (ix * t * r + iz + ma2));
         if !(omega2.is_finite() && omega2 > 0.0) {
             continue;
@@ -455,6 +449,17 @@ pub(super) fn on_branch(coin: &Coin, theta0: f64, omega_z0: f64, omega_y0: f64) 
     }
 }
 
+/// The real roots of a x² + b x + c (none when the discriminant is negative) by the stable quadratic
+/// formula: q = −(b + sgn(b)√D)/2, roots q/a and c/q.
+fn real_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
+    let d = b * b - 4.0 * a * c;
+    if d < 0.0 {
+        return Vec::new();
+    }
+    let q = -0.5 * (b + b.signum() * d.sqrt());
+    vec![q / a, c / q]
+}
+
 /// Where the two roots of P meet (its discriminant is zero), θ₀ > 0 and ω_Z0 > 0: the leans where a band
 /// of unstable circles closes (physics §9, eq (24)). The discriminant times tan²θ₀ is the quadratic
 /// (Ma⁴ − 6 I_Z Ma² − 3 I_Z²) u² − 2 (I_Z + Ma²)(3 I_Z + Ma² + 2 Ma² I_Z/I_X) u + (I_Z + Ma²)² in
@@ -467,16 +472,10 @@ pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
     let a = ma2 * ma2 - 6.0 * iz * ma2 - 3.0 * iz * iz;
     let b = -2.0 * k * (3.0 * iz + ma2 + 2.0 * ma2 * iz / ix);
     let c = k * k;
-    let roots: Vec<f64> = if a == 0.0 {
+    let roots = if a == 0.0 {
         vec![-c / b]
     } else {
-        let d = b * b - 4.0 * a * c;
-        if d < 0.0 {
-            Vec::new()
-        } else {
-            let q = -0.5 * (b + b.signum() * d.sqrt());
-            vec![q / a, c / q]
-        }
+        real_roots(a, b, c)
     };
     let mga = p.energy_scale();
     roots
