@@ -185,13 +185,8 @@ fn upright_departure(coin: &Coin, state: &State) -> f64 {
         .max(coin.params().time_unit() * state.omega_x.abs())
 }
 
-/// The absolute tolerance the integration works to: the scene's atol, but at most rtol·d for a state a
-/// departure d > 0 from upright (physics §12). Near the unstable upright the tilt grows like d·e^{λt} and
-/// the escape time ln(C/d)/λ needs the tilt integrated relative to itself: with atol ≥ d the step
-/// control sees no error at all (measured: the lift-off from θ₀ = 1e-12 at atol 1e-12, rtol 1e-10 is
-/// 7.2e-3 late; with rtol·d it is on the ln law to 1e-8, tests/it/escape_time.rs). Only where
-/// rtol·d < atol does anything change (d < 1e-2 at the defaults); the metadata keeps the scene's atol.
-/// Floored at the smallest subnormal, so that no weight is 0.
+/// The absolute tolerance the integration works to (physics §12, "Integration"): the scene's atol, but at
+/// most rtol·d for a departure d > 0 from upright, floored at the smallest subnormal so that no weight is 0.
 #[must_use]
 pub fn working_atol(config: &MethodConfig, coin: &Coin, initial: &State) -> f64 {
     let d = upright_departure(coin, initial);
@@ -202,10 +197,8 @@ pub fn working_atol(config: &MethodConfig, coin: &Coin, initial: &State) -> f64 
     }
 }
 
-/// Why an event time from `initial` is not to be trusted whatever the energy drift says, if it is not:
-/// a departure from upright below the smallest normal number, 2.2e-308, is subnormal and carries fewer
-/// than 53 bits (2^-1074/d relative), so neither it nor the tolerance rtol·d is what the escape time
-/// ln(C/d)/λ needs (physics §12). Measured, 1e-310 still lands on the ln law and 1e-320 does not.
+/// Why an event time from `initial` is not to be trusted whatever the energy drift says, if it is not: a
+/// departure from upright below 2.2e-308 is subnormal and carries fewer than 53 bits (physics §12).
 #[must_use]
 pub fn departure_doubt(coin: &Coin, initial: &State) -> Option<String> {
     let d = upright_departure(coin, initial);

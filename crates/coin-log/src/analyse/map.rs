@@ -1,12 +1,6 @@
 //! The stability map of the steady circles (format.md: analyse; physics §9): σ² over a grid of (θ₀, ω_Z0)
-//! on either branch of the steady family, the boundary σ² = 0 in closed form, where the band of unstable
-//! circles closes, and the built-in scenes' steady motions on the map.
-//!
-//! **The boundary in closed form** (physics §9, eqs (22)–(24)). For θ₀ ≠ 0 and ω_Z0 ≠ 0 the steady family
-//! turns σ² into a quadratic form in (ω_Y0, ω_Z0), so σ² = 0 fixes the ratio r = ω_Y0/ω_Z0 as a root of
-//! P(r) = (3 I_X tan²θ₀ + Ma²) r² + ((3 I_Z + Ma²) tan θ₀ − (I_Z + Ma²)/tan θ₀) r + I_Z (I_Z + Ma²)/I_X,
-//! and the family then fixes ω_Z0² = Mga sin θ₀ / (r (I_X tan θ₀ r + I_Z + Ma²)). The two roots of P meet,
-//! and the band closes, where its discriminant vanishes: a quadratic in tan²θ₀.
+//! on either branch of the steady family, the boundary σ² = 0 in closed form (eqs (22)–(24)), where the
+//! band of unstable circles closes, and the built-in scenes' steady motions on the map.
 
 use super::steady::{Stability, SteadyAnalysis};
 use crate::model::{

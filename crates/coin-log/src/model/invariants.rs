@@ -1,21 +1,6 @@
-//! Chaplygin–Appell integrals C1, C2 (physics §6): two conserved quantities besides the energy.
-//!
-//! With ω_X = θ̇, eqs (15)–(16) are linear in (ω_Y, ω_Z) with θ as the independent variable, and ω_Z solves
-//! Legendre's equation in s = sin θ,
-//!
-//! ```text
-//! (1 − s²) y″ − 2s y′ − μ y = 0,   k = (I_Z + Ma²)/(Ma²),   μ = I_Z Ma² / (I_X (I_Z + Ma²)),
-//! ```
-//!
-//! (thin disk μ = 4/3, hoop μ = 1). With y_e the even solution (y_e(0) = 1, y_e′(0) = 0) and y_o the odd one
-//! (y_o(0) = 0, y_o′(0) = 1), whose Wronskian is y_e y_o′ − y_o y_e′ = 1/cos²θ,
-//!
-//! ```text
-//! C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k
-//! C2 = cos θ y_e(s) ω_Y / k − cos²θ y_e′(s) ω_Z
-//! ```
-//!
-//! are constant along every motion.
+//! Chaplygin–Appell integrals C1, C2 (physics §6): C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k and
+//! C2 = cos θ y_e(s) ω_Y / k − cos²θ y_e′(s) ω_Z, with y_e, y_o the even and odd solutions of Legendre's
+//! equation (1 − s²) y″ − 2s y′ − μ y = 0 in s = sin θ.
 //!
 //! # Method
 //!

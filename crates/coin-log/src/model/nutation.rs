@@ -1,31 +1,14 @@
-//! The nutation of any motion by quadrature (physics §10): with E, C1 and C2 fixed, ω_Y and ω_Z are
-//! functions of θ alone (physics §6), so is θ̇² = f(θ), and the turning points, the nutation period and
-//! the heading advance per period are one-dimensional integrals.
+//! The nutation of any motion by quadrature (physics §10, §12): with E, C1 and C2 fixed, θ̇² = f(θ) and
+//! the turning points, the nutation period and the heading advance per period are one-dimensional
+//! integrals.
 //!
-//! # Method
-//!
-//! * **The reduced motion.** ω_Z(θ) = C1 y_e + C2 y_o and ω_Y(θ) = k (C1 p_e + C2 p_o)/cos θ (the 2 × 2
-//!   system of physics §6 inverted with its Wronskian, which makes its determinant 1), and
-//!   (I_X + Ma²) θ̇² = 2(E − U(θ)) with U(θ) = ½ I_X ω_Y² + ½ (I_Z + Ma²) ω_Z² + Mga cos θ, eq (25).
-//! * **θ̇² without cancellation.** dU/dθ = S(θ) = I_X tan θ ω_Y² + (I_Z + Ma²) ω_Y ω_Z − Mga sin θ, the
-//!   left-hand side of the steady family, eq (26). Within `SHORT_RANGE` of θ₀, U(θ) − U(θ₀) is the
-//!   16-point Gauss–Legendre integral of S rather than a difference of two values of U: near a steady
-//!   motion (or near upright) S is small, and so is the rounding of its integral, where the difference of
-//!   two O(U) numbers would carry ~1e-16·U. Measured on a 1e-6 tilt of straight rolling this turns a
-//!   1e-4 relative error of θ̇² into 1e-15.
-//! * **Turning points** by a geometric scan outwards from θ₀ (first step 1e-12 rad, doubling up to
-//!   1/128 rad), then bisection of the bracket to adjacent floating-point numbers.
-//! * **T and ΔΦ** with θ = θ_min + (θ_max − θ_min)(1 − cos u)/2, u ∈ [0, π]: then
-//!   dθ/√f = du/√g with g = f/((θ − θ_min)(θ_max − θ)) smooth and positive, and the integrand is a
-//!   smooth even periodic function of u, so the midpoint rule in u (Gauss–Chebyshev) converges
-//!   geometrically. The number of nodes is doubled from 32 until two estimates agree to 1e-14.
-//! * **Times to an event** (flat landing, lift-off) along the path from θ₀, leg by leg, by adaptive
-//!   Gauss–Legendre; a leg that starts or ends at a turning point r is integrated in v with
-//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there. A leg leaving a turning point close
-//!   to upright is done in closed form up to a matching angle and by quadrature beyond (physics §12):
-//!   the substitution alone cannot resolve the scale θ₀ ≲ 1e-25 of the ln(1/θ₀)/λ escape.
-//! * **N and |F|/N** are functions of θ on the orbit (θ̇² = f(θ), ω̇ from eqs (14)–(16)); their extremes
-//!   by a scan of 257 points and golden-section refinement.
+//! Beyond physics §10: U(θ) − U(θ₀) within `SHORT_RANGE` of θ₀, and f near a turning point once found,
+//! are 16-point Gauss–Legendre integrals of S = dU/dθ rather than differences of two O(U) values. Turning
+//! points are found by a geometric scan outwards from θ₀ and bisection to adjacent floats. Times to an
+//! event (flat landing, lift-off) are adaptive Gauss–Legendre integrals along the path, leg by leg, in v
+//! with θ = r + (θ₁ − r) v² from a turning point r; the escape from near upright is in closed form up to
+//! a matching angle (physics §12). The extremes of N and |F|/N: a scan of 257 points refined by golden
+//! section.
 
 use super::derived::{energy, reaction};
 use super::equations::Coin;
@@ -656,11 +639,8 @@ impl Reduced<'_> {
     }
 
     /// The escape from a turning point `turn` close to upright (|turn| ≤ [`MATCHING`]/64) out past the
-    /// matching angle θ_m = turn ± [`MATCHING`] (physics §12). With x = |θ − turn|, θ̇² = x g(x) and
-    /// g = p + q x + O(x²) (p = 2|S(turn)|/(I_X + Ma²), q ≈ λ² cos turn), so the time to θ_m is
-    /// (2/√q) asinh(√(q x_m/p)), which grows like ln(1/θ₀)/λ, and the rest is a regular quadrature.
-    /// Stopping g at x errs by O(x_m²) independently of θ₀ (θ_m²/(48λ) without spin); Richardson from
-    /// halving x_m removes it, and twice that change bounds what is left. `None` where it does not apply
+    /// matching angle θ_m = turn ± [`MATCHING`], eq (41) of physics §12, with θ̇² = x g(x),
+    /// g = p + q x + O(x²), x = |θ − turn|; Richardson from halving x_m. `None` where it does not apply
     /// (the quadrature in v resolves the singularity there: at θ₀ = 1e-5 within 2e-16 of the ln law).
     fn escape(&self, turn: f64, other: f64) -> Option<(f64, f64)> {
         let (span, direction) = ((other - turn).abs(), (other - turn).signum());
