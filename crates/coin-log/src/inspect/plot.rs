@@ -569,25 +569,6 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), DrawError> {
 /// The axes of a time panel.
 type TimeChart<'a, 'b, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, Y>>;
 
-/// Each of `series` as a line through its `points` (values mapped by `value`), with its legend entry.
-fn draw_series<Y: Ranged<ValueType = f64>>(
-    chart: &mut TimeChart<'_, '_, Y>,
-    series: &[(&str, &Envelope, RGBColor)],
-    points: &[Vec<(f64, f64)>],
-    value: impl Fn(f64) -> f64,
-) -> Result<(), DrawError> {
-    for ((label, _, colour), points) in series.iter().zip(points) {
-        chart
-            .draw_series(LineSeries::new(
-                points.iter().map(|&(t, v)| (t, value(v))),
-                colour.stroke_width(1),
-            ))?
-            .label(*label)
-            .legend(legend_line(*colour, 2));
-    }
-    Ok(())
-}
-
 /// The common time axis of the time panels, with the termination marked.
 struct TimeAxis<'a> {
     t_max: f64,
@@ -620,20 +601,7 @@ impl TimeAxis<'_> {
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..self.t_max, y0..y1)?;
         chart.configure_mesh().x_desc("t").y_desc(y_desc).draw()?;
-        draw_series(&mut chart, series, &points, |v| v)?;
-        if let Some((label, v)) = line {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    [(0.0, v), (self.t_max, v)],
-                    6,
-                    4,
-                    GREEN.stroke_width(2),
-                ))?
-                .label(format!("{label} = {v}"))
-                .legend(legend_line(GREEN, 2));
-        }
-        self.mark_end(&mut chart, y0, y1)?;
-        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+        self.finish(&mut chart, series, &points, |v| v, line, (y0, y1))
     }
 
     /// A panel of non-negative `series` on a log scale; zeros are drawn on the bottom edge, which sits a
@@ -673,31 +641,60 @@ impl TimeAxis<'_> {
             })
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()?;
-        draw_series(&mut chart, series, &points, |v| v.max(floor))?;
-        self.mark_end(&mut chart, floor, top)?;
-        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+        self.finish(
+            &mut chart,
+            series,
+            &points,
+            |v| v.max(floor),
+            None,
+            (floor, top),
+        )
     }
 
-    /// The termination as a dashed red vertical line, labelled.
-    fn mark_end<Y: Ranged<ValueType = f64>>(
+    /// Draws each of `series` as a line through its `points` (values mapped by `value`), the labelled
+    /// horizontal `line` if any, the termination as a dashed red vertical line over y0..y1, and the
+    /// legend.
+    fn finish<'a, 'b: 'a, Y: Ranged<ValueType = f64>>(
         &self,
-        chart: &mut TimeChart<'_, '_, Y>,
-        y0: f64,
-        y1: f64,
+        chart: &mut TimeChart<'a, 'b, Y>,
+        series: &[(&str, &Envelope, RGBColor)],
+        points: &[Vec<(f64, f64)>],
+        value: impl Fn(f64) -> f64,
+        line: Option<(&str, f64)>,
+        (y0, y1): (f64, f64),
     ) -> Result<(), DrawError> {
-        let Some((name, t)) = self.end else {
-            return Ok(());
-        };
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(t, y0), (t, y1)],
-                5,
-                4,
-                RED.stroke_width(2),
-            ))?
-            .label(format!("{name} at t = {t}"))
-            .legend(legend_line(RED, 2));
-        Ok(())
+        for ((label, _, colour), points) in series.iter().zip(points) {
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().map(|&(t, v)| (t, value(v))),
+                    colour.stroke_width(1),
+                ))?
+                .label(*label)
+                .legend(legend_line(*colour, 2));
+        }
+        if let Some((label, v)) = line {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, v), (self.t_max, v)],
+                    6,
+                    4,
+                    GREEN.stroke_width(2),
+                ))?
+                .label(format!("{label} = {v}"))
+                .legend(legend_line(GREEN, 2));
+        }
+        if let Some((name, t)) = self.end {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(t, y0), (t, y1)],
+                    5,
+                    4,
+                    RED.stroke_width(2),
+                ))?
+                .label(format!("{name} at t = {t}"))
+                .legend(legend_line(RED, 2));
+        }
+        legend_box(chart, SeriesLabelPosition::UpperRight)
     }
 }
 
