@@ -26,13 +26,14 @@ use crate::support::physics::check_relative;
 use crate::support::record::{coin_log, record_scene};
 use crate::support::writers::rewrite;
 use coin_log::analyse::linear::{displaced, kicked, nutation_frequency, straight_tilt_linear};
-use coin_log::analyse::map::{boundary, closures, edge_leans, sign_changes};
+use coin_log::analyse::map::{boundary, closures, edge_leans};
 use coin_log::analyse::Analysis;
 use coin_log::integrate::Method;
 use coin_log::model::nutation::Motion;
+use coin_log::model::quadrature::bisect;
 use coin_log::model::{
-    centre_fixed_sigma_squared, critical_spin, steady_sigma_squared, straight_lambda_squared,
-    Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
+    centre_fixed_sigma_squared, critical_spin, steady_omega_y, steady_sigma_squared,
+    straight_lambda_squared, Branch, Coin, CoinParams, Inertia, State, Steady, SteadyKind,
 };
 use coin_log::verify::{verify_file, CheckId, Options, Status};
 use coin_log_bench::nutation::{generic_motions, growth_rate, turning_points, GROWTH_START};
@@ -370,6 +371,40 @@ fn analyse_is_right_for_steady_circles_in_and_out_of_the_band() {
         let analysed = eig[0].as_f64().unwrap().abs() + eig[1].as_f64().unwrap().abs();
         check_relative("the non-zero eigenvalue's size", analysed, rate, 1e-8);
     }
+}
+
+/// The ω_Z0 in [lo, hi] where σ² changes sign on `branch` at lean θ₀, by root finding on the closed form
+/// σ²(θ₀, ω_Z0) (eq (21)): sign changes over `samples` equal steps, each bisected to adjacent floats. An
+/// independent route to the boundary of `boundary`.
+fn sign_changes(
+    coin: &Coin,
+    theta0: f64,
+    branch: Branch,
+    (lo, hi): (f64, f64),
+    samples: usize,
+) -> Vec<f64> {
+    let sigma2 = |w: f64| {
+        let wy = steady_omega_y(coin, theta0, w, branch);
+        steady_sigma_squared(coin, theta0, wy, w)
+    };
+    let mut out = Vec::new();
+    let at = |j: usize| {
+        #[allow(clippy::cast_precision_loss)]
+        let x = j as f64 / samples.max(1) as f64;
+        lo + (hi - lo) * x
+    };
+    let mut previous = (at(0), sigma2(at(0)));
+    for j in 1..=samples {
+        let w = at(j);
+        let v = sigma2(w);
+        if (v < 0.0) != (previous.1 < 0.0) {
+            let negative_first = previous.1 < 0.0;
+            let (a, b) = bisect(|x| (sigma2(x) < 0.0) == negative_first, previous.0, w);
+            out.push(0.5 * (a + b));
+        }
+        previous = (w, v);
+    }
+    out
 }
 
 #[test]

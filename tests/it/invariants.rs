@@ -8,9 +8,9 @@
 //! Richardson-extrapolated; the difference between the two runs is printed as the reference's own error.
 
 use crate::support::physics::wobble;
-use coin_log::integrate::{run_method, Flow, Method, MethodConfig, Rk4, RunEnd, RunSettings};
+use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunEnd, RunSettings};
 use coin_log::model::{energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
-use coin_log::simulation::{simulate, CoinEvents};
+use coin_log::simulation::CoinEvents;
 
 use std::f64::consts::FRAC_PI_6;
 
@@ -303,10 +303,16 @@ where
     let c0 = value(&initial.to_array());
     let scale = c0.c1.abs() + c0.c2.abs();
     let mut drift = 0.0_f64;
-    let outcome = simulate(
+    let rk4 = MethodConfig {
+        method: Method::Rk4,
+        rtol: 0.0,
+        atol: 0.0,
+        step: 2e-4,
+    };
+    let outcome = run_method(
+        &rk4,
         &coin,
-        &mut Rk4::new(2e-4),
-        initial,
+        &initial.to_array(),
         &RunSettings {
             t0: 0.0,
             t_end,

@@ -14,7 +14,7 @@ use coin_log::integrate::{run_method, Flow, MethodConfig, RunSettings};
 use coin_log::model::{energy, Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use coin_log::record::{self, Foxglove3d, FoxgloveBatch, RecordOptions, RecordSummary};
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
-use coin_log::simulation::{working_atol, CoinEvents, DissipativeEvents};
+use coin_log::simulation::{working_atol, CoinEvents};
 use coin_log_mcap::Compression;
 use std::io::Cursor;
 use std::sync::atomic::AtomicBool;
@@ -61,7 +61,7 @@ fn simulated_samples(scene: &Scene) -> Vec<(f64, [f64; STATE_LEN], Option<f64>)>
             });
         }
         Dynamics::Dissipative(coin) => {
-            let events = DissipativeEvents::new(coin, margin, mu);
+            let events = CoinEvents::new(coin, margin, mu);
             let mut y0 = [0.0; DISSIPATIVE_STATE_LEN];
             y0[..STATE_LEN].copy_from_slice(&scene.initial.to_array());
             let _ = run_method(&method, &coin, &y0, &settings, &events, |t, y| {

@@ -21,6 +21,17 @@ const STEP_NATURAL: f64 = 1e-3;
 /// Allowed deviation from the steady motion (scaled, see the module doc).
 const STEADY: f64 = 1e-9;
 
+/// Centre of the circle traced by the coin's centre, in the table plane (x, z), for a motion that starts
+/// from `start` (any φ₀, x₀, z₀): C = p₀ + (a ω_Z / φ̇)(sin φ₀, cos φ₀). `None` when φ̇ = 0.
+fn circle_centre(steady: &Steady, coin: &Coin, start: &State) -> Option<(f64, f64)> {
+    if steady.phi_dot == 0.0 {
+        return None;
+    }
+    let scale = coin.params().radius() * start.omega_z / steady.phi_dot;
+    let (sp, cp) = start.phi.sin_cos();
+    Some((start.x + scale * sp, start.z + scale * cp))
+}
+
 /// Integrates `kind` from a shifted start (φ₀ = 0.7, x₀ = a, z₀ = −2a, to exercise `circle_centre`)
 /// and returns the steady description for further checks.
 fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
@@ -37,7 +48,7 @@ fn stays_steady(label: &str, p: &CoinParams, kind: SteadyKind) -> Steady {
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let steps = (DURATION / STEP_NATURAL).round() as usize;
     let traj = physics::rk4_trajectory(&coin, &start.to_array(), h, steps, 10);
-    let centre_of_circle = steady.circle_centre(&coin, &start);
+    let centre_of_circle = circle_centre(&steady, &coin, &start);
     let (mut d_theta, mut d_omega, mut d_angles, mut d_centre, mut d_contact) =
         (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
     for (t, y) in &traj {

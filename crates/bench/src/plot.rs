@@ -1,10 +1,9 @@
-//! Work-precision diagrams as SVG (plotters' SVG backend only: no system fonts are needed, text is
-//! written as SVG `<text>` elements).
+//! Work-precision diagrams as SVG.
 
 use super::euler::EulerRow;
 use super::precision::PrecisionReport;
 use super::BenchError;
-use coin_log::palette::LINES as PALETTE;
+use coin_log::palette::{legend_box, legend_line, svg_page, DrawError, LINES as PALETTE};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
@@ -13,8 +12,6 @@ const SIZE: (u32, u32) = (800, 560);
 
 /// A diagram's axes, as the series are drawn on them.
 type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
-/// What drawing on the SVG backend can fail with.
-type DrawError = DrawingAreaErrorKind<std::io::Error>;
 
 /// The frame both diagrams share: a white page of [`SIZE`] with `caption` (text, font size), the axes
 /// over `(x0, x1, y0, y1)` labelled `(x, y)`, the series `draw` puts on them, and their legend at
@@ -27,38 +24,25 @@ fn diagram(
     legend: SeriesLabelPosition,
     draw: impl FnOnce(&mut Chart<'_, '_>) -> Result<(), DrawError>,
 ) -> Result<String, BenchError> {
-    let fail = |e: &DrawError| BenchError::Plot {
-        scene: scene.to_string(),
-        reason: e.to_string(),
-    };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let mut chart = ChartBuilder::on(&root)
+    svg_page(SIZE, |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(caption.0, ("sans-serif", caption.1))
             .margin(16)
             .x_label_area_size(44)
             .y_label_area_size(56)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| fail(&e))?;
+            .build_cartesian_2d(x0..x1, y0..y1)?;
         chart
             .configure_mesh()
             .x_desc(x_desc)
             .y_desc(y_desc)
-            .draw()
-            .map_err(|e| fail(&e))?;
-        draw(&mut chart).map_err(|e| fail(&e))?;
-        chart
-            .configure_series_labels()
-            .position(legend)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))?;
-    }
-    Ok(svg)
+            .draw()?;
+        draw(&mut chart)?;
+        legend_box(&mut chart, legend)
+    })
+    .map_err(|e| BenchError::Plot {
+        scene: scene.to_string(),
+        reason: e.to_string(),
+    })
 }
 
 /// The work-precision diagram of one scene: log10 state error against log10 wall time, one line per
@@ -86,9 +70,7 @@ pub fn work_precision_svg(report: &PrecisionReport) -> Result<String, BenchError
                         colour.stroke_width(2),
                     ))?
                     .label(label.clone())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                    });
+                    .legend(legend_line(colour, 2));
                 chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
             }
             Ok(())
@@ -177,9 +159,7 @@ pub fn euler_svg(rows: &[EulerRow]) -> Result<String, BenchError> {
                 chart
                     .draw_series(LineSeries::new(fit.iter().copied(), colour.stroke_width(4)))?
                     .label(label.clone())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(4))
-                    });
+                    .legend(legend_line(colour, 4));
             }
             Ok(())
         },

@@ -1,8 +1,9 @@
-//! The colours of every plot coin-log draws (`plot`, `analyse map`, the benchmark figures), so that a
-//! colour means one thing everywhere: Matplotlib's tab10 for lines, ColorBrewer's sequential blues and reds
-//! for the stability map's σ² > 0 and σ² < 0.
+//! The colours and the SVG page of every plot coin-log draws (`plot`, `analyse map`, the benchmark
+//! figures), so that a colour means one thing everywhere: Matplotlib's tab10 for lines, ColorBrewer's
+//! sequential blues and reds for the stability map's σ² > 0 and σ² < 0.
 
-use plotters::style::RGBColor;
+use plotters::coord::Shift;
+use plotters::prelude::*;
 
 /// Line colours in order (tab10): blue, orange, green, red, purple, brown.
 pub const LINES: [RGBColor; 6] = [
@@ -30,3 +31,49 @@ pub const STABLE: (RGBColor, RGBColor) = (RGBColor(222, 235, 247), RGBColor(8, 4
 pub const UNSTABLE: (RGBColor, RGBColor) = (RGBColor(254, 224, 210), RGBColor(165, 15, 21));
 /// The stability map's cells with σ² = 0 to rounding.
 pub const MARGINAL: RGBColor = RGBColor(150, 150, 150);
+
+/// A drawing area of an SVG page.
+pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+/// What drawing on an SVG page can fail with.
+pub type DrawError = DrawingAreaErrorKind<std::io::Error>;
+
+/// An SVG document of `size` pixels: a white page with what `draw` puts on it (plotters' SVG backend:
+/// no fonts are needed, text is written as SVG `<text>`).
+///
+/// # Errors
+/// The first error of `draw` or of the backend.
+pub fn svg_page(
+    size: (u32, u32),
+    draw: impl FnOnce(&Area<'_>) -> Result<(), DrawError>,
+) -> Result<String, DrawError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE)?;
+        draw(&root)?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// The legend of `chart`'s labelled series at `position`, on a light box with a black border.
+///
+/// # Errors
+/// The backend's.
+pub fn legend_box<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    position: SeriesLabelPosition,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+}
+
+/// A legend entry's sample: a line 20 px long in `colour`, `width` px wide.
+pub fn legend_line(colour: RGBColor, width: u32) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(width))
+}

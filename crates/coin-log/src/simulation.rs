@@ -6,12 +6,11 @@
 //! before the integration, so the conservative hot loop is exactly what it is without dissipation.
 
 use crate::integrate::{
-    self, run_method_bounded, Bounds, EventFunctions, Flow, MethodConfig, OdeSystem, RunOutcome,
-    RunSettings, Stepper,
+    run_method_bounded, Bounds, EventFunctions, Flow, MethodConfig, OdeSystem, RunOutcome,
+    RunSettings,
 };
 use crate::model::{
-    reaction, Coin, DissipativeCoin, Dynamics, Reaction, State, DISSIPATIVE_STATE_LEN, STATE_LEN,
-    WORK_INDEX,
+    Coin, DissipativeCoin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN, WORK_INDEX,
 };
 
 impl OdeSystem<STATE_LEN> for Coin {
@@ -34,9 +33,8 @@ impl OdeSystem<DISSIPATIVE_STATE_LEN> for DissipativeCoin {
 }
 
 /// The coin's eight state components of a dissipative state (θ, φ, ψ, ω, x, z), without W.
-#[must_use]
 #[inline]
-pub fn coin_part(y: &[f64; DISSIPATIVE_STATE_LEN]) -> [f64; STATE_LEN] {
+fn coin_part(y: &[f64; DISSIPATIVE_STATE_LEN]) -> [f64; STATE_LEN] {
     let mut out = [0.0; STATE_LEN];
     out.copy_from_slice(&y[..STATE_LEN]);
     out
@@ -54,20 +52,23 @@ pub enum PhysicalEvent {
 }
 
 /// Event functions of the coin: g_flat = π/2 − flat_margin − |θ|, g_lift = N / (Mg),
-/// g_slip = (μN − F) / (Mg) (only when μ is given). Each ends the run when it crosses from > 0 to ≤ 0.
+/// g_slip = (μN − F) / (Mg) (only when μ is given), with the reaction of the dynamics (eqs (31)–(33)
+/// with dissipation, physics §11). Each ends the run when it crosses from > 0 to ≤ 0. They watch the
+/// 8-component state of [`Coin`] and the 9-component one of [`DissipativeCoin`] alike.
 #[derive(Debug, Clone, Copy)]
 pub struct CoinEvents {
-    coin: Coin,
+    dynamics: Dynamics,
     flat_margin: f64,
     friction: Option<f64>,
 }
 
 impl CoinEvents {
-    /// Events for `coin`, flat landing at |θ| = π/2 − `flat_margin`, slip when `friction` (μ) is given.
+    /// Events for `dynamics`, flat landing at |θ| = π/2 − `flat_margin`, slip when `friction` (μ) is
+    /// given.
     #[must_use]
-    pub fn new(coin: Coin, flat_margin: f64, friction: Option<f64>) -> Self {
+    pub fn new(dynamics: impl Into<Dynamics>, flat_margin: f64, friction: Option<f64>) -> Self {
         Self {
-            coin,
+            dynamics: dynamics.into(),
             flat_margin,
             friction,
         }
@@ -82,9 +83,7 @@ impl CoinEvents {
             _ => PhysicalEvent::Slip,
         }
     }
-}
 
-impl CoinEvents {
     fn event_count(&self) -> usize {
         if self.friction.is_some() {
             3
@@ -93,11 +92,14 @@ impl CoinEvents {
         }
     }
 
-    /// The event functions at state `s` with its reaction `r`.
+    /// The event functions at state `s`.
     #[inline]
-    fn evaluate_with(&self, s: &State, r: &Reaction, out: &mut [f64]) {
+    fn evaluate_at(&self, s: &State, out: &mut [f64]) {
         out[0] = std::f64::consts::FRAC_PI_2 - self.flat_margin - s.theta.abs();
-        let weight = self.coin.params().mass() * self.coin.params().gravity();
+        // Beyond flat the reaction formulas are meaningless; the flat event comes first there anyway.
+        let r = self.dynamics.reaction(s);
+        let params = self.dynamics.coin().params();
+        let weight = params.mass() * params.gravity();
         out[1] = r.normal / weight;
         if let (Some(mu), Some(slot)) = (self.friction, out.get_mut(2)) {
             *slot = (mu * r.normal - r.friction) / weight;
@@ -111,42 +113,17 @@ impl EventFunctions<STATE_LEN> for CoinEvents {
     }
 
     fn evaluate(&self, _t: f64, y: &[f64; STATE_LEN], out: &mut [f64]) {
-        let s = State::from_array(y);
-        // Beyond flat the reaction formulas are meaningless; the flat event comes first there anyway.
-        let r = reaction(&self.coin, &s);
-        self.evaluate_with(&s, &r, out);
+        self.evaluate_at(&State::from_array(y), out);
     }
 }
 
-/// The events of the dissipative coin: those of [`CoinEvents`], with the reaction of eqs (31)–(33)
-/// (physics §11), on the 9-component state.
-#[derive(Debug, Clone, Copy)]
-pub struct DissipativeEvents {
-    events: CoinEvents,
-    coin: DissipativeCoin,
-}
-
-impl DissipativeEvents {
-    /// Events for `coin`, flat landing at |θ| = π/2 − `flat_margin`, slip when `friction` (μ) is given;
-    /// numbered as [`CoinEvents::event`] numbers them.
-    #[must_use]
-    pub fn new(coin: DissipativeCoin, flat_margin: f64, friction: Option<f64>) -> Self {
-        Self {
-            events: CoinEvents::new(*coin.coin(), flat_margin, friction),
-            coin,
-        }
-    }
-}
-
-impl EventFunctions<DISSIPATIVE_STATE_LEN> for DissipativeEvents {
+impl EventFunctions<DISSIPATIVE_STATE_LEN> for CoinEvents {
     fn count(&self) -> usize {
-        self.events.event_count()
+        self.event_count()
     }
 
     fn evaluate(&self, _t: f64, y: &[f64; DISSIPATIVE_STATE_LEN], out: &mut [f64]) {
-        let s = State::from_array(&coin_part(y));
-        let r = self.coin.reaction(&s);
-        self.events.evaluate_with(&s, &r, out);
+        self.evaluate_at(&State::from_array(&coin_part(y)), out);
     }
 }
 
@@ -174,14 +151,11 @@ pub fn run_dynamics<O>(
 where
     O: FnMut(f64, &[f64; STATE_LEN], Option<f64>) -> Flow,
 {
-    let coin = match dynamics {
-        Dynamics::Conservative(coin) => coin,
-        Dynamics::Dissipative(coin) => coin.coin(),
-    };
     let config = &MethodConfig {
-        atol: working_atol(config, coin, initial),
+        atol: working_atol(config, dynamics.coin(), initial),
         ..*config
     };
+    let events = CoinEvents::new(*dynamics, flat_margin, friction);
     match dynamics {
         Dynamics::Conservative(coin) => run_method_bounded(
             config,
@@ -189,45 +163,30 @@ where
             &initial.to_array(),
             settings,
             bounds,
-            &CoinEvents::new(*coin, flat_margin, friction),
+            &events,
             |t, y| observe(t, y, None),
         ),
         Dynamics::Dissipative(coin) => {
             let mut y0 = [0.0; DISSIPATIVE_STATE_LEN];
             y0[..STATE_LEN].copy_from_slice(&initial.to_array());
-            run_method_bounded(
-                config,
-                coin,
-                &y0,
-                settings,
-                bounds,
-                &DissipativeEvents::new(*coin, flat_margin, friction),
-                |t, y| observe(t, &coin_part(y), Some(y[WORK_INDEX])),
-            )
+            run_method_bounded(config, coin, &y0, settings, bounds, &events, |t, y| {
+                observe(t, &coin_part(y), Some(y[WORK_INDEX]))
+            })
         }
     }
 }
 
 /// The departure d = max(|θ|, τ|ω_X|) of `state` from upright (θ = 0, θ̇ = 0, whatever the spin), τ the
 /// time unit: the size of the state that grows away from the unstable upright (physics §5, §12).
-#[must_use]
-pub fn upright_departure(coin: &Coin, state: &State) -> f64 {
+fn upright_departure(coin: &Coin, state: &State) -> f64 {
     state
         .theta
         .abs()
         .max(coin.params().time_unit() * state.omega_x.abs())
 }
 
-/// The absolute tolerance the integration works to: the scene's atol, but at most rtol·d for a state a
-/// departure d > 0 from upright (physics §12). Near the unstable upright the tilt grows like d·e^{λt} and
-/// the escape time is ln(C/d)/λ: its error is the relative error of the tilt over λ, so the tilt must be
-/// integrated relative to itself. With atol ≥ d the step control sees no error at all (measured: the
-/// lift-off from θ₀ = 1e-12 at atol 1e-12, rtol 1e-10 is 7.2e-3 late, from 1e-50 340 late; with rtol·d
-/// it is on the ln law to 1e-8, tests/it/escape_time.rs). Weights atol + rtol|y| then stay within
-/// 2 rtol|y| of the tilt's, the accuracy every O(1) state gets. Only where rtol·d < atol does anything
-/// change (d < 1e-2 at the defaults), so every other scene integrates, and records, the same bytes; the
-/// metadata keeps the scene's atol, which verify's tolerances derive from (the effective one is tighter).
-/// Floored at the smallest subnormal, so that no weight is 0 (at d < 5e-314, rtol·d underflows).
+/// The absolute tolerance the integration works to (physics §12, "Integration"): the scene's atol, but at
+/// most rtol·d for a departure d > 0 from upright, floored at the smallest subnormal so that no weight is 0.
 #[must_use]
 pub fn working_atol(config: &MethodConfig, coin: &Coin, initial: &State) -> f64 {
     let d = upright_departure(coin, initial);
@@ -238,10 +197,8 @@ pub fn working_atol(config: &MethodConfig, coin: &Coin, initial: &State) -> f64 
     }
 }
 
-/// Why an event time from `initial` is not to be trusted whatever the energy drift says, if it is not:
-/// a departure from upright below the smallest normal number, 2.2e-308, is subnormal and carries fewer
-/// than 53 bits (2^-1074/d relative), so neither it nor the tolerance rtol·d is what the escape time
-/// ln(C/d)/λ needs (physics §12). Measured, 1e-310 still lands on the ln law and 1e-320 does not.
+/// Why an event time from `initial` is not to be trusted whatever the energy drift says, if it is not: a
+/// departure from upright below 2.2e-308 is subnormal and carries fewer than 53 bits (physics §12).
 #[must_use]
 pub fn departure_doubt(coin: &Coin, initial: &State) -> Option<String> {
     let d = upright_departure(coin, initial);
@@ -252,27 +209,4 @@ pub fn departure_doubt(coin: &Coin, initial: &State) -> Option<String> {
              integrated to the tolerance; start at least 2.2e-308 from upright"
         )
     })
-}
-
-/// Runs `stepper` on `coin` from `initial`, observing samples; a thin wrapper over [`integrate::run`].
-pub fn simulate<M, O>(
-    coin: &Coin,
-    stepper: &mut M,
-    initial: &State,
-    settings: &RunSettings,
-    events: &CoinEvents,
-    observe: O,
-) -> RunOutcome
-where
-    M: Stepper<STATE_LEN>,
-    O: FnMut(f64, &[f64; STATE_LEN]) -> integrate::Flow,
-{
-    integrate::run(
-        coin,
-        stepper,
-        &initial.to_array(),
-        settings,
-        events,
-        observe,
-    )
 }

@@ -4,9 +4,7 @@
 //! *Solving ODEs I*, 2nd ed., §II.5 "DOP853" and §II.6, p. 194). The coefficients below are those of
 //! `dop853.f` (module `coeffs`), given to 30 digits there and rounded to f64 here.
 //!
-//! Written by hand rather than taken from a crate: none offers dense output at arbitrary times together
-//! with event location hooks, work statistics, no per-step heap allocation and correct behaviour at
-//! rtol 1e-13. The dense output needs three extra stages; they are computed lazily, in
+//! The dense output needs three extra stages; they are computed lazily, in
 //! [`Stepper::prepare_interpolation`], only for steps in which a sample or an event is wanted, so
 //! stepping without samples costs 12 evaluations per step.
 
@@ -14,8 +12,10 @@
 // the source digit by digit; the compiler rounds them to the nearest f64.
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
-use super::control::{combine, cubic_dense_output, step_fraction, weight, Controller, StepSize};
-use super::{all_finite, OdeSystem, Stats, StepError, Stepper};
+use super::control::{
+    combine, continuous_extension, cubic_dense_output, weight, Controller, StepSize,
+};
+use super::{all_finite, Method, OdeSystem, StepError, Stepper, StepperState};
 
 /// Nodes c₁..c₁₆ (`c2..c16` of `dop853.f`; c₁₃ = 1 is the FSAL stage f(t + h, y₁)).
 const C: [f64; 16] = [
@@ -248,25 +248,18 @@ const CONTROLLER: Controller = Controller {
     beta: 0.04,
 };
 
-/// Order used by the initial step guess.
-const ORDER: i32 = 8;
-
 /// The Dormand–Prince 8(5,3) method with error control and 7th-order dense output.
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
     size: StepSize,
-    t: f64,
-    t_prev: f64,
-    y: [f64; N],
+    state: StepperState<N>,
     y_prev: [f64; N],
-    h_last: f64,
     /// Stages of the last accepted step: 0..=11 the method's, 12 = f(t, y) (FSAL), 13..=15 dense.
     k: [[f64; N]; 16],
     /// Coefficients of the continuous extension (`rcont` of `dop853.f`); rows 4..8 valid only when
     /// `dense_ready`.
     dense: [[f64; N]; 8],
     dense_ready: bool,
-    stats: Stats,
 }
 
 impl<const N: usize> Dop853<N> {
@@ -275,23 +268,12 @@ impl<const N: usize> Dop853<N> {
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
             size: StepSize::new(CONTROLLER, rtol, atol),
-            t: 0.0,
-            t_prev: 0.0,
-            y: [0.0; N],
+            state: StepperState::start(0.0, &[0.0; N], super::Stats::default()),
             y_prev: [0.0; N],
-            h_last: 0.0,
             k: [[0.0; N]; 16],
             dense: [[0.0; N]; 8],
             dense_ready: false,
-            stats: Stats::default(),
         }
-    }
-
-    /// Caps the step size (default: the whole span t_end − t0).
-    #[must_use]
-    pub fn with_max_step(mut self, max_step: f64) -> Self {
-        self.size.set_max_step(max_step);
-        self
     }
 }
 
@@ -303,52 +285,53 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         y0: &[f64; N],
         t_end: f64,
     ) -> Result<(), StepError> {
-        self.t = t0;
-        self.t_prev = t0;
-        self.y = *y0;
         self.y_prev = *y0;
-        self.h_last = 0.0;
-        self.size.start(t0, t_end);
-        self.stats = Stats::default();
         self.k = [[0.0; N]; 16];
-        sys.rhs(t0, y0, &mut self.k[12]);
-        self.k[0] = self.k[12];
-        self.stats.rhs_evaluations += 1;
         self.dense = [[0.0; N]; 8];
         self.dense[0] = *y0;
         self.dense_ready = true;
-        if !(all_finite(y0) && all_finite(&self.k[12])) {
-            return Err(StepError::NonFinite { t: t0 });
-        }
-        self.size.guess_first_step(sys, t0, y0, &self.k[12], ORDER);
-        self.stats.rhs_evaluations += 1;
-        Ok(())
+        let order = Method::Dop853.order();
+        let started = self.size.start(
+            &mut self.state,
+            sys,
+            (t0, y0),
+            t_end,
+            &mut self.k[12],
+            order,
+        );
+        self.k[0] = self.k[12];
+        started
     }
 
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
         let mut k = [[0.0; N]; 13];
         let mut y_new = [0.0; N];
         let mut non_finite = false;
+        let y = self.state.y;
         loop {
-            let Some((h, t_new)) = self.size.trial(self.t, t_limit, non_finite)? else {
+            let Some((h, t_new)) = self.size.trial(self.state.t, t_limit, non_finite)? else {
                 return Ok(());
             };
 
             k[0] = self.k[12];
             let mut y_stage = [0.0; N];
             for s in 1..12 {
-                combine(&self.y, h, A[s], &k, &mut y_stage);
-                let t_stage = if s == 11 { t_new } else { self.t + C[s] * h };
+                combine(&y, h, A[s], &k, &mut y_stage);
+                let t_stage = if s == 11 {
+                    t_new
+                } else {
+                    self.state.t + C[s] * h
+                };
                 sys.rhs(t_stage, &y_stage, &mut k[s]);
             }
-            combine(&self.y, h, A[12], &k, &mut y_new);
-            self.stats.rhs_evaluations += 11;
+            combine(&y, h, A[12], &k, &mut y_new);
+            self.state.stats.rhs_evaluations += 11;
 
             // Combined 5th/3rd-order error estimate (dop853.f, label 'error estimation').
             let mut err5 = 0.0;
             let mut err3 = 0.0;
             for i in 0..N {
-                let sk = weight(self.size.rtol, self.size.atol, self.y[i], y_new[i]);
+                let sk = weight(self.size.rtol, self.size.atol, y[i], y_new[i]);
                 let b_sum: f64 = A[12].iter().map(|&(j, b)| b * k[j][i]).sum();
                 let e3 = b_sum - BHH.iter().map(|&(j, b)| b * k[j][i]).sum::<f64>();
                 let e5: f64 = ER.iter().map(|&(j, e)| e * k[j][i]).sum();
@@ -364,37 +347,25 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
 
             let finite = err.is_finite() && all_finite(&y_new);
             if finite && err > 1.0 {
-                self.size.reject(h, err, &mut self.stats);
+                self.size.reject(h, err, &mut self.state);
                 continue;
             }
             if finite {
                 sys.rhs(t_new, &y_new, &mut k[12]);
-                self.stats.rhs_evaluations += 1;
+                self.state.stats.rhs_evaluations += 1;
             }
             if !finite || !all_finite(&k[12]) {
                 non_finite = true;
-                self.size.reject_non_finite(h, &mut self.stats);
+                self.size.reject_non_finite(h, &mut self.state);
                 continue;
             }
 
-            self.size.accept(h, err);
-            self.t_prev = self.t;
-            self.y_prev = self.y;
-            self.t = t_new;
-            self.h_last = h;
-            self.y = y_new;
+            self.size.accept(h, err, &mut self.state, (t_new, &y_new));
+            self.y_prev = y;
             self.k[..13].copy_from_slice(&k);
             // The cubic Hermite part of the dense output is free; the rest waits for a request.
-            cubic_dense_output(
-                h,
-                &self.y_prev,
-                &self.k[0],
-                &self.y,
-                &self.k[12],
-                &mut self.dense,
-            );
+            cubic_dense_output(h, &y, &k[0], &y_new, &k[12], &mut self.dense);
             self.dense_ready = false;
-            self.stats.steps += 1;
             return Ok(());
         }
     }
@@ -403,14 +374,14 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         if self.dense_ready {
             return;
         }
-        let h = self.h_last;
+        let h = self.size.h_last;
         let mut y_stage = [0.0; N];
         for s in 13..16 {
             let (done, rest) = self.k.split_at_mut(s);
             combine(&self.y_prev, h, A[s], done, &mut y_stage);
-            sys.rhs(self.t_prev + C[s] * h, &y_stage, &mut rest[0]);
+            sys.rhs(self.state.t_prev + C[s] * h, &y_stage, &mut rest[0]);
         }
-        self.stats.rhs_evaluations += 3;
+        self.state.stats.rhs_evaluations += 3;
         // A non-finite extra stage leaves the (finite) cubic Hermite part alone rather than pass NaN on.
         let finite = self.k[13..16].iter().all(all_finite);
         for (row, coefficients) in DENSE.iter().enumerate() {
@@ -422,31 +393,19 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         self.dense_ready = true;
     }
 
-    fn t(&self) -> f64 {
-        self.t
-    }
-    fn y(&self) -> &[f64; N] {
-        &self.y
-    }
-    fn t_previous(&self) -> f64 {
-        self.t_prev
+    fn state(&self) -> &StepperState<N> {
+        &self.state
     }
     /// 7th-order dense output (`contd8` of `dop853.f`) once [`Stepper::prepare_interpolation`] ran for
     /// this step; the cubic Hermite interpolant (its first four terms) before that.
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
-        let s = step_fraction(t, self.t_prev, self.h_last);
-        let s1 = 1.0 - s;
         let r = &self.dense;
-        for i in 0..N {
-            let high = if self.dense_ready {
+        continuous_extension(&self.state, self.size.h_last, r, t, out, |i, s, s1| {
+            if self.dense_ready {
                 r[4][i] + s * (r[5][i] + s1 * (r[6][i] + s * r[7][i]))
             } else {
                 0.0
-            };
-            out[i] = r[0][i] + s * (r[1][i] + s1 * (r[2][i] + s * (r[3][i] + s1 * high)));
-        }
-    }
-    fn stats(&self) -> Stats {
-        self.stats
+            }
+        });
     }
 }

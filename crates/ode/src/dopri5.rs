@@ -2,13 +2,11 @@
 //! 19–26) with the step-size control, Lund (PI) stabilisation, initial step and 4th-order continuous
 //! extension of Hairer's `dopri5.f` (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4–II.6,
 //! Table 5.2 and the dense output of §II.6, eq. (6.12)).
-//!
-//! Written by hand rather than taken from a crate: none offers dense output at arbitrary times together
-//! with event location hooks, work statistics, no per-step heap allocation and correct behaviour at
-//! rtol 1e-13 (see also [`Dop853`](super::Dop853)).
 
-use super::control::{combine, cubic_dense_output, step_fraction, weight, Controller, StepSize};
-use super::{all_finite, OdeSystem, Stats, StepError, Stepper};
+use super::control::{
+    combine, continuous_extension, cubic_dense_output, weight, Controller, StepSize,
+};
+use super::{all_finite, Method, OdeSystem, StepError, Stepper, StepperState};
 
 /// Nodes cᵢ (HNW I, Table 5.2).
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
@@ -70,21 +68,15 @@ const CONTROLLER: Controller = Controller {
     beta: 0.04,
 };
 
-/// Order used by the initial step guess (the propagated solution's order).
-const ORDER: i32 = 5;
-
 /// The Dormand–Prince 5(4) pair with error control and 4th-order dense output.
 #[derive(Debug, Clone)]
 pub struct Dopri5<const N: usize> {
     size: StepSize,
-    t: f64,
-    t_prev: f64,
-    y: [f64; N],
+    state: StepperState<N>,
+    /// f(t, y), the FSAL stage.
     f: [f64; N],
-    h_last: f64,
     /// Coefficients r₁..r₅ of the continuous extension over the last step (`rcont` of `dopri5.f`).
     dense: [[f64; N]; 5],
-    stats: Stats,
 }
 
 impl<const N: usize> Dopri5<N> {
@@ -93,21 +85,10 @@ impl<const N: usize> Dopri5<N> {
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
             size: StepSize::new(CONTROLLER, rtol, atol),
-            t: 0.0,
-            t_prev: 0.0,
-            y: [0.0; N],
+            state: StepperState::start(0.0, &[0.0; N], super::Stats::default()),
             f: [0.0; N],
-            h_last: 0.0,
             dense: [[0.0; N]; 5],
-            stats: Stats::default(),
         }
-    }
-
-    /// Caps the step size (default: the whole span t_end − t0).
-    #[must_use]
-    pub fn with_max_step(mut self, max_step: f64) -> Self {
-        self.size.set_max_step(max_step);
-        self
     }
 }
 
@@ -119,46 +100,40 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         y0: &[f64; N],
         t_end: f64,
     ) -> Result<(), StepError> {
-        self.t = t0;
-        self.t_prev = t0;
-        self.y = *y0;
-        self.h_last = 0.0;
-        self.size.start(t0, t_end);
-        self.stats = Stats::default();
-        sys.rhs(t0, y0, &mut self.f);
-        self.stats.rhs_evaluations += 1;
         for (i, row) in self.dense.iter_mut().enumerate() {
             *row = if i == 0 { *y0 } else { [0.0; N] };
         }
-        if !(all_finite(y0) && all_finite(&self.f)) {
-            return Err(StepError::NonFinite { t: t0 });
-        }
-        self.size.guess_first_step(sys, t0, y0, &self.f, ORDER);
-        self.stats.rhs_evaluations += 1;
-        Ok(())
+        let order = Method::Dopri5.order();
+        self.size
+            .start(&mut self.state, sys, (t0, y0), t_end, &mut self.f, order)
     }
 
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
         let mut k = [[0.0; N]; 7];
         let mut y_stage = [0.0; N];
         let mut non_finite = false;
+        let y = self.state.y;
         loop {
-            let Some((h, t_new)) = self.size.trial(self.t, t_limit, non_finite)? else {
+            let Some((h, t_new)) = self.size.trial(self.state.t, t_limit, non_finite)? else {
                 return Ok(());
             };
 
             k[0] = self.f;
             for s in 1..7 {
-                combine(&self.y, h, A[s], &k, &mut y_stage);
-                let t_stage = if s == 6 { t_new } else { self.t + C[s] * h };
+                combine(&y, h, A[s], &k, &mut y_stage);
+                let t_stage = if s == 6 {
+                    t_new
+                } else {
+                    self.state.t + C[s] * h
+                };
                 sys.rhs(t_stage, &y_stage, &mut k[s]);
             }
             // y_stage now holds the 5th-order solution at t_new, k[6] = f(t_new, y_new) (FSAL).
-            self.stats.rhs_evaluations += 6;
+            self.state.stats.rhs_evaluations += 6;
 
             let mut err = 0.0;
             for i in 0..N {
-                let sk = weight(self.size.rtol, self.size.atol, self.y[i], y_stage[i]);
+                let sk = weight(self.size.rtol, self.size.atol, y[i], y_stage[i]);
                 let e: f64 = E.iter().map(|&(j, e)| e * k[j][i]).sum();
                 err += (h * e / sk).powi(2);
             }
@@ -167,48 +142,30 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
 
             if !err.is_finite() || !all_finite(&y_stage) || !all_finite(&k[6]) {
                 non_finite = true;
-                self.size.reject_non_finite(h, &mut self.stats);
+                self.size.reject_non_finite(h, &mut self.state);
                 continue;
             }
             if err > 1.0 {
-                self.size.reject(h, err, &mut self.stats);
+                self.size.reject(h, err, &mut self.state);
                 continue;
             }
 
             // Accepted: continuous extension (dopri5.f, after label 'dense output').
-            cubic_dense_output(h, &self.y, &k[0], &y_stage, &k[6], &mut self.dense);
+            cubic_dense_output(h, &y, &k[0], &y_stage, &k[6], &mut self.dense);
             for (i, r4) in self.dense[4].iter_mut().enumerate() {
                 *r4 = h * D.iter().map(|&(j, d)| d * k[j][i]).sum::<f64>();
             }
-            self.size.accept(h, err);
-            self.t_prev = self.t;
-            self.t = t_new;
-            self.h_last = h;
-            self.y = y_stage;
+            self.size.accept(h, err, &mut self.state, (t_new, &y_stage));
             self.f = k[6];
-            self.stats.steps += 1;
             return Ok(());
         }
     }
 
-    fn t(&self) -> f64 {
-        self.t
-    }
-    fn y(&self) -> &[f64; N] {
-        &self.y
-    }
-    fn t_previous(&self) -> f64 {
-        self.t_prev
+    fn state(&self) -> &StepperState<N> {
+        &self.state
     }
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
-        let s = step_fraction(t, self.t_prev, self.h_last);
-        let s1 = 1.0 - s;
         let r = &self.dense;
-        for i in 0..N {
-            out[i] = r[0][i] + s * (r[1][i] + s1 * (r[2][i] + s * (r[3][i] + s1 * r[4][i])));
-        }
-    }
-    fn stats(&self) -> Stats {
-        self.stats
+        continuous_extension(&self.state, self.size.h_last, r, t, out, |i, _, _| r[4][i]);
     }
 }

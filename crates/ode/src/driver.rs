@@ -5,34 +5,29 @@ use super::{OdeSystem, Stats, StepError, Stepper};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Largest number of event functions a system may declare.
-pub const MAX_EVENTS: usize = 8;
+const MAX_EVENTS: usize = 8;
 
-/// Event time resolution: the bracket is shrunk below this (relative to max(1, |t|)); the issue asks for
-/// ≤ 1e-10 and bisection to 1e-13 costs a few dozen cheap interpolations per event.
+/// Event time resolution (relative to max(1, |t|)): a few dozen cheap interpolations per event.
 const EVENT_TIME_TOLERANCE: f64 = 1e-13;
 
 /// Points inside each step at which the event functions are also evaluated, so that one that dips to 0
-/// and back within a step is not missed: a coin released without spin at θ0 = 0.5 lost contact (N < 0) for
-/// 0.10 time units inside one dop853 step of 0.17, and the run went on as if rolling. Three probes catch a
-/// dip longer than a quarter of the step, at three interpolations and event evaluations a step (no extra
-/// stages: see `dip_in_step`).
-pub const EVENT_PROBES: usize = 3;
+/// and back within a step is not missed (N < 0 for 0.10 time units inside one dop853 step of 0.17 went
+/// unseen without them). Three catch a dip longer than a quarter of the step.
+const EVENT_PROBES: usize = 3;
 
 /// How near 0, in steps' worth of its change, an event function must end a step to be probed inside it
-/// (`dip_in_step`). 1 selects every parabolic dip between steps of one length; at rtol 1e-3 on `lift-off`
-/// (steps of changing length) it missed the dip, which 2 finds. 4 probed so many steps near a flat
-/// landing's margin that a run with few samples took 15 % longer (2.11 s against 1.82 s); 2 is within
-/// noise (1.41 s against 1.38 s, medians of 3).
+/// (`dip_in_step`). 1 missed a dip at rtol 1e-3 on `lift-off`; 4 cost 15 % on a run with few samples;
+/// 2 is within noise.
 const PROBE_REACH: f64 = 2.0;
 
 /// Grid samples within this time before an event are dropped in favour of the sample at the event, so
 /// that no two samples round to the same nanosecond (format.md: log_time = round(t·10⁹), strictly
 /// increasing per channel).
-pub const EVENT_SAMPLE_GAP: f64 = 2e-9;
+const EVENT_SAMPLE_GAP: f64 = 2e-9;
 
 /// Scalar functions g_i(t, y) whose crossing from > 0 to ≤ 0 ends a run (flat landing, lift-off, ...).
 pub trait EventFunctions<const N: usize> {
-    /// Number of functions (≤ [`MAX_EVENTS`]).
+    /// Number of functions (at most `MAX_EVENTS` = 8).
     fn count(&self) -> usize;
     /// Writes g_i(t, y) into `out[..count]`.
     fn evaluate(&self, t: f64, y: &[f64; N], out: &mut [f64]);
@@ -121,34 +116,8 @@ fn sample_time(settings: &RunSettings, k: u64) -> f64 {
 }
 
 /// Integrates `sys` from `y0`, calling `observe(t, y)` at every sample time, until t_end, an event, a
-/// failure, or `observe` returns [`Flow::Stop`].
+/// failure, `observe` returns [`Flow::Stop`], the step budget is spent or the stop flag is raised.
 pub fn run<const N: usize, S, M, E, O>(
-    sys: &S,
-    stepper: &mut M,
-    y0: &[f64; N],
-    settings: &RunSettings,
-    events: &E,
-    observe: O,
-) -> RunOutcome
-where
-    S: OdeSystem<N>,
-    M: Stepper<N>,
-    E: EventFunctions<N>,
-    O: FnMut(f64, &[f64; N]) -> Flow,
-{
-    run_bounded(
-        sys,
-        stepper,
-        y0,
-        settings,
-        &Bounds::default(),
-        events,
-        observe,
-    )
-}
-
-/// [`run`] within `bounds`: also ends when the step budget is spent or the stop flag is raised.
-pub fn run_bounded<const N: usize, S, M, E, O>(
     sys: &S,
     stepper: &mut M,
     y0: &[f64; N],
@@ -183,7 +152,7 @@ where
     let termination = run.start(y0).err().unwrap_or_else(|| run.steps());
     RunOutcome {
         termination,
-        stats: run.stepper.stats(),
+        stats: run.stepper.state().stats,
         t_last: run.t_last,
     }
 }
@@ -250,7 +219,7 @@ where
             }
             self.steps += 1;
             self.dense_ready = false;
-            let t_new = self.stepper.t();
+            let t_new = self.stepper.state().t;
             let event = self.event_in_step(t_new);
             if let Some(end) = self.samples_up_to(t_new, event) {
                 return end;
@@ -262,7 +231,7 @@ where
             if t_new >= self.settings.t_end {
                 // Unreachable in practice (the grid loop emits t_end); kept so t_end is always sampled.
                 if self.t_last < self.settings.t_end {
-                    let _ = (self.observe)(self.settings.t_end, self.stepper.y());
+                    let _ = (self.observe)(self.settings.t_end, &self.stepper.state().y);
                     self.t_last = self.settings.t_end;
                 }
                 return RunEnd::Completed;
@@ -283,7 +252,7 @@ where
         }
         match self.bounds.max_steps {
             Some(max) if self.steps >= max => Some(RunEnd::Failed(StepError::BudgetSpent {
-                t: self.stepper.t(),
+                t: self.stepper.state().t,
                 steps: self.steps,
             })),
             _ => None,
@@ -301,8 +270,8 @@ where
     fn event_in_step(&mut self, t_new: f64) -> Option<(usize, f64)> {
         let n = self.n_events;
         self.events
-            .evaluate(t_new, self.stepper.y(), &mut self.g_new[..n]);
-        let (t_old, mut event): (f64, Option<(usize, f64)>) = (self.stepper.t_previous(), None);
+            .evaluate(t_new, &self.stepper.state().y, &mut self.g_new[..n]);
+        let (t_old, mut event): (f64, Option<(usize, f64)>) = (self.stepper.state().t_prev, None);
         for i in 0..n {
             if self.g_old[i] > 0.0 && self.g_new[i] <= 0.0 {
                 self.prepare_dense();
@@ -333,8 +302,7 @@ where
     /// are probed: a parabola dipping below 0 between two ends at m > 0 moved by more than 8m in the
     /// step before (of the same length), so min(g_old, g_new) ≤ [`PROBE_REACH`] · max(|Δg| now, |Δg|
     /// in the step before) selects every such dip with room to spare, and leaves out the steps of a
-    /// rolling coin far from every event (probing all of them cost 20 % on a run with few samples: 2.12 s
-    /// against 1.77 s).
+    /// rolling coin far from every event (probing every step cost 20 %).
     fn dip_in_step(&mut self, t_old: f64, t_new: f64) -> Option<(usize, f64)> {
         let n = self.n_events;
         let mut near = [false; MAX_EVENTS];
@@ -396,7 +364,7 @@ where
             }
             #[allow(clippy::float_cmp)] // exact: a grid time that is the step's end uses y itself
             let flow = if t_k == t_new {
-                (self.observe)(t_k, self.stepper.y())
+                (self.observe)(t_k, &self.stepper.state().y)
             } else {
                 self.prepare_dense();
                 self.stepper.interpolate(t_k, &mut self.buffer);

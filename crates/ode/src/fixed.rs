@@ -2,30 +2,24 @@
 //! t0 + n·h and the two ends of the last accepted step with their derivatives, from which the cubic
 //! Hermite dense output interpolates.
 
-use super::{all_finite, hermite_interpolate, OdeSystem, StepError};
+use super::{all_finite, OdeSystem, Stats, StepError, StepperState};
 
 /// Clock and last step of a fixed-step method. Only the stages differ between methods: they read the
-/// start of the step (`t`, `y`, `f`), and hand the new state to [`FixedSteps::accept`].
+/// start of the step (`state.t`, `state.y`, `f`), and hand the new state to [`FixedSteps::accept`].
 #[derive(Debug, Clone)]
 pub(crate) struct FixedSteps<const N: usize> {
-    /// The fixed step.
     h: f64,
     /// Start of the run.
     t0: f64,
     /// Full steps taken since `t0`.
     n: u64,
-    /// Time at the end of the last accepted step.
-    pub t: f64,
-    /// Time at the start of the last accepted step.
-    pub t_prev: f64,
-    /// State at `t`.
-    pub y: [f64; N],
+    pub state: StepperState<N>,
     /// f(t, y).
     pub f: [f64; N],
     /// State at `t_prev`.
-    pub y_prev: [f64; N],
+    y_prev: [f64; N],
     /// f(t_prev, y_prev).
-    pub f_prev: [f64; N],
+    f_prev: [f64; N],
 }
 
 impl<const N: usize> FixedSteps<N> {
@@ -35,9 +29,7 @@ impl<const N: usize> FixedSteps<N> {
             h,
             t0: 0.0,
             n: 0,
-            t: 0.0,
-            t_prev: 0.0,
-            y: [0.0; N],
+            state: StepperState::start(0.0, &[0.0; N], Stats::default()),
             f: [0.0; N],
             y_prev: [0.0; N],
             f_prev: [0.0; N],
@@ -54,11 +46,13 @@ impl<const N: usize> FixedSteps<N> {
         t0: f64,
         y0: &[f64; N],
     ) -> Result<(), StepError> {
+        let stats = Stats {
+            rhs_evaluations: 1,
+            ..Stats::default()
+        };
         self.t0 = t0;
         self.n = 0;
-        self.t = t0;
-        self.t_prev = t0;
-        self.y = *y0;
+        self.state = StepperState::start(t0, y0, stats);
         self.y_prev = *y0;
         sys.rhs(t0, y0, &mut self.f);
         self.f_prev = self.f;
@@ -83,7 +77,7 @@ impl<const N: usize> FixedSteps<N> {
     }
 
     /// Accepts the step to (`t_new`, `y_new`) returned by [`FixedSteps::next_end`], evaluating
-    /// f(t_new, y_new) (one right-hand side evaluation).
+    /// f(t_new, y_new) (one right-hand side evaluation, counted).
     ///
     /// # Errors
     /// [`StepError::NonFinite`] (at the start of the step, which is kept) if y_new or its derivative is
@@ -97,14 +91,13 @@ impl<const N: usize> FixedSteps<N> {
     ) -> Result<(), StepError> {
         let mut f_new = [0.0; N];
         sys.rhs(t_new, y_new, &mut f_new);
+        self.state.stats.rhs_evaluations += 1;
         if !(all_finite(y_new) && all_finite(&f_new)) {
-            return Err(StepError::NonFinite { t: self.t });
+            return Err(StepError::NonFinite { t: self.state.t });
         }
-        self.t_prev = self.t;
-        self.y_prev = self.y;
+        self.y_prev = self.state.y;
         self.f_prev = self.f;
-        self.t = t_new;
-        self.y = *y_new;
+        self.state.advance(t_new, y_new);
         self.f = f_new;
         if full {
             self.n += 1;
@@ -112,18 +105,21 @@ impl<const N: usize> FixedSteps<N> {
         Ok(())
     }
 
-    /// Cubic Hermite dense output inside the last step.
+    /// Cubic Hermite dense output inside the last step (O(h⁴) local error, matching rk4 and gauss4).
     #[inline]
     pub fn interpolate(&self, t: f64, out: &mut [f64; N]) {
-        hermite_interpolate(
-            self.t_prev,
-            self.t - self.t_prev,
-            &self.y_prev,
-            &self.f_prev,
-            &self.y,
-            &self.f,
-            t,
-            out,
-        );
+        let (t0, y0, f0) = (self.state.t_prev, &self.y_prev, &self.f_prev);
+        let (y1, f1) = (&self.state.y, &self.f);
+        let h = self.state.t - t0;
+        let s = if h == 0.0 { 0.0 } else { (t - t0) / h };
+        let s2 = s * s;
+        let s3 = s2 * s;
+        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+        let h10 = s3 - 2.0 * s2 + s;
+        let h01 = -2.0 * s3 + 3.0 * s2;
+        let h11 = s3 - s2;
+        for i in 0..N {
+            out[i] = h00 * y0[i] + h * h10 * f0[i] + h01 * y1[i] + h * h11 * f1[i];
+        }
     }
 }

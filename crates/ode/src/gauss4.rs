@@ -13,7 +13,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::fixed::FixedSteps;
-use super::{OdeSystem, Stats, StepError, Stepper};
+use super::{OdeSystem, StepError, Stepper, StepperState};
 use nalgebra::{DMatrix, DVector, Dyn, SMatrix, LU};
 
 /// √3/6, the half-distance of the Gauss nodes from 1/2.
@@ -62,7 +62,6 @@ pub struct Gauss4<const N: usize> {
     h_lu: f64,
     /// Newton right-hand side / correction, length 2N.
     work: DVector<f64>,
-    stats: Stats,
 }
 
 impl<const N: usize> Gauss4<N> {
@@ -78,25 +77,25 @@ impl<const N: usize> Gauss4<N> {
             lu: None,
             h_lu: 0.0,
             work: DVector::zeros(2 * N),
-            stats: Stats::default(),
         }
     }
 
     /// J ≈ ∂f/∂y at (t, y) by forward differences from the known f(t, y); N evaluations.
     fn update_jacobian<S: OdeSystem<N>>(&mut self, sys: &S) {
-        let mut y = self.steps.y;
+        let (t, y0) = (self.steps.state.t, self.steps.state.y);
+        let mut y = y0;
         let mut f = [0.0; N];
         for j in 0..N {
-            let delta = JACOBIAN_INCREMENT * self.steps.y[j].abs().max(1.0);
-            y[j] = self.steps.y[j] + delta;
-            let delta = y[j] - self.steps.y[j]; // the increment actually representable
-            sys.rhs(self.steps.t, &y, &mut f);
+            let delta = JACOBIAN_INCREMENT * y0[j].abs().max(1.0);
+            y[j] = y0[j] + delta;
+            let delta = y[j] - y0[j]; // the increment actually representable
+            sys.rhs(t, &y, &mut f);
             for i in 0..N {
                 self.jacobian[(i, j)] = (f[i] - self.steps.f[i]) / delta;
             }
-            y[j] = self.steps.y[j];
+            y[j] = y0[j];
         }
-        self.stats.rhs_evaluations += N as u64;
+        self.steps.state.stats.rhs_evaluations += N as u64;
         self.jacobian_stale = false;
         self.h_lu = 0.0;
     }
@@ -161,14 +160,15 @@ impl<const N: usize> Gauss4<N> {
         let mut stage_f = [[0.0; N]; 2];
         let mut previous_norm = f64::INFINITY;
         let mut y_stage = [0.0; N];
+        let (t, y) = (self.steps.state.t, self.steps.state.y);
         for iteration in 1..=MAX_ITERATIONS {
             for a in 0..2 {
                 for i in 0..N {
-                    y_stage[i] = self.steps.y[i] + z[a][i];
+                    y_stage[i] = y[i] + z[a][i];
                 }
-                sys.rhs(self.steps.t + C[a] * h, &y_stage, &mut stage_f[a]);
+                sys.rhs(t + C[a] * h, &y_stage, &mut stage_f[a]);
             }
-            self.stats.rhs_evaluations += 2;
+            self.steps.state.stats.rhs_evaluations += 2;
             for a in 0..2 {
                 for i in 0..N {
                     let residual =
@@ -192,7 +192,7 @@ impl<const N: usize> Gauss4<N> {
                 for i in 0..N {
                     let dz = self.work[a * N + i];
                     z[a][i] += dz;
-                    norm = norm.max(dz.abs() / self.steps.y[i].abs().max(1.0));
+                    norm = norm.max(dz.abs() / y[i].abs().max(1.0));
                 }
             }
             if !norm.is_finite() {
@@ -237,16 +237,13 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         self.h_z_last = 0.0;
         self.jacobian_stale = true;
         self.h_lu = 0.0;
-        self.stats = Stats {
-            rhs_evaluations: 1,
-            ..Stats::default()
-        };
         self.steps.start(sys, t0, y0)
     }
 
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
         let end = self.steps.next_end(t_limit);
-        let h = end.0 - self.steps.t;
+        let t = self.steps.state.t;
+        let h = end.0 - t;
         // First attempt with the kept Jacobian; if it fails, once more with a fresh one.
         let mut failure = (0, f64::NAN);
         let mut solution = None;
@@ -276,10 +273,10 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         }
         let Some(z) = solution else {
             if failure.1.is_nan() {
-                return Err(StepError::NonFinite { t: self.steps.t });
+                return Err(StepError::NonFinite { t });
             }
             return Err(StepError::NewtonFailure {
-                t: self.steps.t,
+                t,
                 h,
                 iterations: failure.0,
                 residual: failure.1,
@@ -290,29 +287,18 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         // without two more evaluations (HLW, §VIII.6.3).
         let mut y_new = [0.0; N];
         for i in 0..N {
-            y_new[i] = self.steps.y[i] + SQRT3 * (z[1][i] - z[0][i]);
+            y_new[i] = self.steps.state.y[i] + SQRT3 * (z[1][i] - z[0][i]);
         }
-        self.stats.rhs_evaluations += 1; // f(t_new, y_new), in `accept`
         self.steps.accept(sys, end, &y_new)?;
         self.z_last = z;
         self.h_z_last = h;
-        self.stats.steps += 1;
         Ok(())
     }
 
-    fn t(&self) -> f64 {
-        self.steps.t
-    }
-    fn y(&self) -> &[f64; N] {
-        &self.steps.y
-    }
-    fn t_previous(&self) -> f64 {
-        self.steps.t_prev
+    fn state(&self) -> &StepperState<N> {
+        &self.steps.state
     }
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
         self.steps.interpolate(t, out);
-    }
-    fn stats(&self) -> Stats {
-        self.stats
     }
 }

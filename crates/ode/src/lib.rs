@@ -13,19 +13,14 @@ mod dopri5;
 mod driver;
 mod fixed;
 mod gauss4;
-mod hermite;
 mod method;
 mod rk4;
 
 pub use coin_log_names::UnknownName;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
-pub use driver::{
-    run, run_bounded, Bounds, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings,
-    MAX_EVENTS,
-};
+pub use driver::{run, Bounds, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings};
 pub use gauss4::Gauss4;
-pub use hermite::hermite_interpolate;
 pub use method::{run_method, run_method_bounded, Method, MethodConfig};
 pub use rk4::Rk4;
 
@@ -48,43 +43,28 @@ pub struct Stats {
     pub rejected_steps: u64,
 }
 
-/// Why a step could not be taken. Every variant carries the time it happened at.
+/// Why a step could not be taken. Every variant carries the time it happened at; its message names
+/// each field.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum StepError {
-    /// The state or its derivative became NaN or infinite.
+    /// The state or its derivative became NaN or infinite (`t`: the last finite state's time).
     #[error("non-finite state at t = {t}")]
-    NonFinite {
-        /// Time of the last finite state.
-        t: f64,
-    },
+    NonFinite { t: f64 },
     /// The adaptive step size fell below what the time's floating-point spacing allows.
     #[error(
         "step size underflow at t = {t} (h = {h:e}); the problem is too stiff or singular here"
     )]
-    StepSizeUnderflow {
-        /// Time.
-        t: f64,
-        /// Last attempted step.
-        h: f64,
-    },
+    StepSizeUnderflow { t: f64, h: f64 },
     /// The run's step budget ([`Bounds::max_steps`]) was spent before its end.
     #[error("the step budget of {steps} steps was spent at t = {t}")]
-    BudgetSpent {
-        /// Time reached.
-        t: f64,
-        /// Steps taken (the budget).
-        steps: u64,
-    },
-    /// The implicit stage equations did not converge.
+    BudgetSpent { t: f64, steps: u64 },
+    /// The implicit stage equations did not converge (`t`: the start of the step).
     #[error("stage equations did not converge at t = {t} (h = {h:e}, residual {residual:e} after {iterations} iterations); reduce the step")]
     NewtonFailure {
-        /// Time at the start of the step.
         t: f64,
-        /// Step.
         h: f64,
-        /// Iterations made.
         iterations: u32,
-        /// Last residual norm.
         residual: f64,
     },
 }
@@ -109,25 +89,51 @@ pub trait Stepper<const N: usize> {
     /// A [`StepError`]; the stepper then still holds the last good step.
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError>;
 
-    /// Time at the end of the last accepted step.
-    fn t(&self) -> f64;
-    /// State at the end of the last accepted step.
-    fn y(&self) -> &[f64; N];
-    /// Time at the start of the last accepted step.
-    fn t_previous(&self) -> f64;
+    /// Where the stepper stands.
+    fn state(&self) -> &StepperState<N>;
     /// Makes the full dense output of the last step available, for methods that compute it lazily
     /// (dop853's three extra stages). [`run`] calls it before the first [`Stepper::interpolate`] in a
     /// step; without it, such methods interpolate at lower order. Default: nothing to do.
     fn prepare_interpolation<S: OdeSystem<N>>(&mut self, _sys: &S) {}
-    /// Dense output: the solution at `t` in [`t_previous`, `t`], written into `out`.
+    /// Dense output: the solution at `t` in [t_prev, t] of the last step, written into `out`.
     fn interpolate(&self, t: f64, out: &mut [f64; N]);
-    /// Work counters so far.
-    fn stats(&self) -> Stats;
 }
 
-/// Checks that every component is finite.
-#[must_use]
+/// The last accepted step of a [`Stepper`] and its work so far.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepperState<const N: usize> {
+    /// Time at the end of the last accepted step.
+    pub t: f64,
+    /// Time at its start.
+    pub t_prev: f64,
+    /// State at `t`.
+    pub y: [f64; N],
+    /// Work counters.
+    pub stats: Stats,
+}
+
+impl<const N: usize> StepperState<N> {
+    /// At (t0, y0) with `stats`.
+    fn start(t0: f64, y0: &[f64; N], stats: Stats) -> Self {
+        Self {
+            t: t0,
+            t_prev: t0,
+            y: *y0,
+            stats,
+        }
+    }
+
+    /// Moves to the end (t_new, y_new) of an accepted step.
+    #[inline]
+    fn advance(&mut self, t_new: f64, y_new: &[f64; N]) {
+        self.t_prev = self.t;
+        self.t = t_new;
+        self.y = *y_new;
+        self.stats.steps += 1;
+    }
+}
+
 #[inline]
-pub fn all_finite<const N: usize>(y: &[f64; N]) -> bool {
+pub(crate) fn all_finite<const N: usize>(y: &[f64; N]) -> bool {
     y.iter().all(|v| v.is_finite())
 }

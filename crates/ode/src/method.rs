@@ -1,6 +1,6 @@
 //! The user-facing choice of integrator (format.md: record) and the one dispatch from it to a stepper.
 
-use super::driver::{run_bounded, Bounds, EventFunctions, Flow, RunOutcome, RunSettings};
+use super::driver::{run, Bounds, EventFunctions, Flow, RunOutcome, RunSettings};
 use super::{Dop853, Dopri5, Gauss4, OdeSystem, Rk4};
 
 coin_log_names::named_enum! {
@@ -78,7 +78,7 @@ where
     )
 }
 
-/// [`run_method`] within `bounds`; see [`run_bounded`].
+/// [`run_method`] within `bounds`; see [`run`](super::run).
 pub fn run_method_bounded<const N: usize, S, E, O>(
     config: &MethodConfig,
     sys: &S,
@@ -96,7 +96,7 @@ where
     // One call per stepper type; a closure cannot take the stepper, whose type differs per arm.
     macro_rules! run_with {
         ($stepper:expr) => {
-            run_bounded(sys, &mut $stepper, y0, settings, bounds, events, observe)
+            run(sys, &mut $stepper, y0, settings, bounds, events, observe)
         };
     }
     match config.method {

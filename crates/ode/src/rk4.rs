@@ -2,13 +2,12 @@
 //! §II.1, Table 1.2), fixed step, with cubic Hermite dense output.
 
 use super::fixed::FixedSteps;
-use super::{OdeSystem, Stats, StepError, Stepper};
+use super::{OdeSystem, StepError, Stepper, StepperState};
 
 /// Classical RK4 with a fixed step `h`. The last step is shortened to land on `t_limit`.
 #[derive(Debug, Clone)]
 pub struct Rk4<const N: usize> {
     steps: FixedSteps<N>,
-    stats: Stats,
 }
 
 impl<const N: usize> Rk4<N> {
@@ -17,7 +16,6 @@ impl<const N: usize> Rk4<N> {
     pub fn new(h: f64) -> Self {
         Self {
             steps: FixedSteps::new(h),
-            stats: Stats::default(),
         }
     }
 }
@@ -30,16 +28,12 @@ impl<const N: usize> Stepper<N> for Rk4<N> {
         y0: &[f64; N],
         _t_end: f64,
     ) -> Result<(), StepError> {
-        self.stats = Stats {
-            rhs_evaluations: 1,
-            ..Stats::default()
-        };
         self.steps.start(sys, t0, y0)
     }
 
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
         let end = self.steps.next_end(t_limit);
-        let (t, y, k1) = (self.steps.t, &self.steps.y, &self.steps.f);
+        let (t, y, k1) = (self.steps.state.t, &self.steps.state.y, &self.steps.f);
         let h = end.0 - t;
         let mut k2 = [0.0; N];
         let mut k3 = [0.0; N];
@@ -61,26 +55,14 @@ impl<const N: usize> Stepper<N> for Rk4<N> {
         for i in 0..N {
             y_new[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
-        // Three stages here and f(t_new, y_new) in `accept`.
-        self.stats.rhs_evaluations += 4;
-        self.steps.accept(sys, end, &y_new)?;
-        self.stats.steps += 1;
-        Ok(())
+        self.steps.state.stats.rhs_evaluations += 3;
+        self.steps.accept(sys, end, &y_new)
     }
 
-    fn t(&self) -> f64 {
-        self.steps.t
-    }
-    fn y(&self) -> &[f64; N] {
-        &self.steps.y
-    }
-    fn t_previous(&self) -> f64 {
-        self.steps.t_prev
+    fn state(&self) -> &StepperState<N> {
+        &self.steps.state
     }
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
         self.steps.interpolate(t, out);
-    }
-    fn stats(&self) -> Stats {
-        self.stats
     }
 }

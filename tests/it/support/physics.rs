@@ -73,7 +73,7 @@ pub fn rk4_trajectory<const N: usize, S: OdeSystem<N>>(
     for k in 1..=steps {
         stepper.step(sys, f64::MAX).unwrap();
         if k % every == 0 {
-            out.push((stepper.t(), *stepper.y()));
+            out.push((stepper.state().t, stepper.state().y));
         }
     }
     out

@@ -23,11 +23,7 @@ use coin_log::scene::{file_from_table, set_value, Scene};
 use coin_log::simulation::CoinEvents;
 // `record_circle`'s (the independent readers' tests).
 #[cfg(feature = "external-readers")]
-use coin_log::{
-    integrate::Rk4,
-    record::{Foxglove3d, FoxgloveBatch},
-    simulation::simulate,
-};
+use coin_log::record::{Foxglove3d, FoxgloveBatch};
 use std::collections::BTreeMap;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
@@ -280,11 +276,16 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
     let events = CoinEvents::new(coin, 1e-4, None);
     let chaplygin = Chaplygin::new(coin.params()).unwrap();
     let e0 = energy(&coin, &steady.state).total;
-    let mut rk4 = Rk4::new(1e-3);
-    simulate(
+    let rk4 = MethodConfig {
+        method: Method::Rk4,
+        rtol: 0.0,
+        atol: 0.0,
+        step: 1e-3,
+    };
+    run_method(
+        &rk4,
         &coin,
-        &mut rk4,
-        &steady.state,
+        &steady.state.to_array(),
         &settings,
         &events,
         |t, y| {

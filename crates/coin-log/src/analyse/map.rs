@@ -1,12 +1,6 @@
 //! The stability map of the steady circles (format.md: analyse; physics §9): σ² over a grid of (θ₀, ω_Z0)
-//! on either branch of the steady family, the boundary σ² = 0 in closed form, where the band of unstable
-//! circles closes, and the built-in scenes' steady motions on the map.
-//!
-//! **The boundary in closed form** (physics §9, eqs (22)–(24)). For θ₀ ≠ 0 and ω_Z0 ≠ 0 the steady family
-//! turns σ² into a quadratic form in (ω_Y0, ω_Z0), so σ² = 0 fixes the ratio r = ω_Y0/ω_Z0 as a root of
-//! P(r) = (3 I_X tan²θ₀ + Ma²) r² + ((3 I_Z + Ma²) tan θ₀ − (I_Z + Ma²)/tan θ₀) r + I_Z (I_Z + Ma²)/I_X,
-//! and the family then fixes ω_Z0² = Mga sin θ₀ / (r (I_X tan θ₀ r + I_Z + Ma²)). The two roots of P meet,
-//! and the band closes, where its discriminant vanishes: a quadratic in tan²θ₀.
+//! on either branch of the steady family, the boundary σ² = 0 in closed form (eqs (22)–(24)), where the
+//! band of unstable circles closes, and the built-in scenes' steady motions on the map.
 
 use super::steady::{Stability, SteadyAnalysis};
 use crate::model::{
@@ -426,14 +420,8 @@ pub fn boundary(coin: &Coin, theta0: f64) -> Vec<BoundaryPoint> {
     let qa = 3.0 * ix * t * t + ma2;
     let qb = (3.0 * iz + ma2) * t - (iz + ma2) / t;
     let qc = iz * (iz + ma2) / ix;
-    let discriminant = qb * qb - 4.0 * qa * qc;
-    if discriminant < 0.0 {
-        return Vec::new();
-    }
-    // Stable quadratic formula: q = −(b + sgn(b)√D)/2, roots q/a and c/q.
-    let q = -0.5 * (qb + qb.signum() * discriminant.sqrt());
     let mut out = Vec::new();
-    for r in [q / qa, qc / q] {
+    for r in real_roots(qa, qb, qc) {
         let omega2 = mga * s / (r * (ix * t * r + iz + ma2));
         if !(omega2.is_finite() && omega2 > 0.0) {
             continue;
@@ -446,19 +434,24 @@ pub fn boundary(coin: &Coin, theta0: f64) -> Vec<BoundaryPoint> {
 }
 
 /// The boundary point (θ₀, ω_Z0, ω_Y0) with the branch whose root ω_Y0 is.
-fn on_branch(coin: &Coin, theta0: f64, omega_z0: f64, omega_y0: f64) -> BoundaryPoint {
-    let distance = |b: Branch| (steady_omega_y(coin, theta0, omega_z0, b) - omega_y0).abs();
-    let branch = if distance(Branch::Plus) <= distance(Branch::Minus) {
-        Branch::Plus
-    } else {
-        Branch::Minus
-    };
+pub(super) fn on_branch(coin: &Coin, theta0: f64, omega_z0: f64, omega_y0: f64) -> BoundaryPoint {
     BoundaryPoint {
         theta0,
         omega_z0,
         omega_y0,
-        branch,
+        branch: Branch::nearest(coin, theta0, omega_z0, omega_y0),
     }
+}
+
+/// The real roots of a x² + b x + c (none when the discriminant is negative) by the stable quadratic
+/// formula: q = −(b + sgn(b)√D)/2, roots q/a and c/q.
+fn real_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
+    let d = b * b - 4.0 * a * c;
+    if d < 0.0 {
+        return Vec::new();
+    }
+    let q = -0.5 * (b + b.signum() * d.sqrt());
+    vec![q / a, c / q]
 }
 
 /// Where the two roots of P meet (its discriminant is zero), θ₀ > 0 and ω_Z0 > 0: the leans where a band
@@ -473,16 +466,10 @@ pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
     let a = ma2 * ma2 - 6.0 * iz * ma2 - 3.0 * iz * iz;
     let b = -2.0 * k * (3.0 * iz + ma2 + 2.0 * ma2 * iz / ix);
     let c = k * k;
-    let roots: Vec<f64> = if a == 0.0 {
+    let roots = if a == 0.0 {
         vec![-c / b]
     } else {
-        let d = b * b - 4.0 * a * c;
-        if d < 0.0 {
-            Vec::new()
-        } else {
-            let q = -0.5 * (b + b.signum() * d.sqrt());
-            vec![q / a, c / q]
-        }
+        real_roots(a, b, c)
     };
     let mga = p.energy_scale();
     roots
@@ -500,45 +487,6 @@ pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
             })
         })
         .collect()
-}
-
-/// The ω_Z0 in [lo, hi] where σ² changes sign on `branch` at lean θ₀, by root finding on the closed form
-/// σ²(θ₀, ω_Z0) (eq (21)): sign changes over `samples` equal steps, each bisected to adjacent floats. An
-/// independent route to the boundary of [`boundary`].
-#[must_use]
-pub fn sign_changes(
-    coin: &Coin,
-    theta0: f64,
-    branch: Branch,
-    (lo, hi): (f64, f64),
-    samples: usize,
-) -> Vec<f64> {
-    let sigma2 = |w: f64| {
-        let wy = steady_omega_y(coin, theta0, w, branch);
-        steady_sigma_squared(coin, theta0, wy, w)
-    };
-    let mut out = Vec::new();
-    let at = |j: usize| {
-        #[allow(clippy::cast_precision_loss)]
-        let x = j as f64 / samples.max(1) as f64;
-        lo + (hi - lo) * x
-    };
-    let mut previous = (at(0), sigma2(at(0)));
-    for j in 1..=samples {
-        let w = at(j);
-        let v = sigma2(w);
-        if (v < 0.0) != (previous.1 < 0.0) {
-            let negative_first = previous.1 < 0.0;
-            let (a, b) = crate::model::quadrature::bisect(
-                |x| (sigma2(x) < 0.0) == negative_first,
-                previous.0,
-                w,
-            );
-            out.push(0.5 * (a + b));
-        }
-        previous = (w, v);
-    }
-    out
 }
 
 /// A few round leans below the highest closure (steps of 1, 2 or 5 × 10ⁿ, about six of them) at which

@@ -17,7 +17,7 @@ use crate::model::invariants::Chaplygin;
 use crate::model::nutation::{Motion, NutationError, Orbit};
 use crate::model::{Coin, InvariantsError, State, Steady};
 use crate::scene::{InitialSpec, Scene};
-use serde::Serialize;
+use serde_json::json;
 use thiserror::Error;
 
 /// Why a motion cannot be analysed.
@@ -119,7 +119,8 @@ impl Analysis {
         })
     }
 
-    /// The object of `coin-log analyse --json` (format.md: analyse --json).
+    /// The object of `coin-log analyse --json` (format.md: analyse --json): the contract's keys, then
+    /// the extensions.
     #[must_use]
     pub fn json(&self) -> serde_json::Value {
         let o = &self.orbit;
@@ -131,32 +132,32 @@ impl Analysis {
             } => (Some(period), Some(precession), Some(spin_advance)),
             _ => (None, None, None),
         };
-        let json = AnalysisJson {
-            energy: o.energy,
-            c1: o.c1,
-            c2: o.c2,
-            theta_min: o.theta_min,
-            theta_max: o.theta_max,
-            period,
-            precession,
-            max_friction_ratio: o.max_friction_ratio.map(|e| e.value),
-            min_normal: o.min_normal.value,
-            steady: self.steady.as_ref().map(SteadyJson::from),
-            motion: motion_name(&o.motion),
-            spin_advance,
-            flat_landing_time: match o.motion {
-                Motion::FlatLanding { time, .. } => Some(time),
-                _ => None,
-            },
-            lift_off_time: o.lift_off.map(|e| e.time),
-            lift_off_theta: o.lift_off.map(|e| e.theta),
-            normal_stays_positive: self.normal_stays_positive(),
-            friction: self.friction,
-            slips: self.slips(),
-            quadrature_error: o.error,
-            base_steady: self.base_steady.as_ref().map(SteadyJson::from),
+        let flat_landing_time = match o.motion {
+            Motion::FlatLanding { time, .. } => Some(time),
+            _ => None,
         };
-        serde_json::to_value(json).unwrap_or(serde_json::Value::Null)
+        json!({
+            "energy": o.energy,
+            "c1": o.c1,
+            "c2": o.c2,
+            "theta_min": o.theta_min,
+            "theta_max": o.theta_max,
+            "period": period,
+            "precession": precession,
+            "max_friction_ratio": o.max_friction_ratio.map(|e| e.value),
+            "min_normal": o.min_normal.value,
+            "steady": self.steady.as_ref().map(steady_json),
+            "motion": motion_name(&o.motion),
+            "spin_advance": spin_advance,
+            "flat_landing_time": flat_landing_time,
+            "lift_off_time": o.lift_off.map(|e| e.time),
+            "lift_off_theta": o.lift_off.map(|e| e.theta),
+            "normal_stays_positive": self.normal_stays_positive(),
+            "friction": self.friction,
+            "slips": self.slips(),
+            "quadrature_error": o.error,
+            "base_steady": self.base_steady.as_ref().map(steady_json),
+        })
     }
 }
 
@@ -170,73 +171,29 @@ pub fn motion_name(motion: &Motion) -> &'static str {
     }
 }
 
-/// The `analyse --json` object, keys in the contract's order, then the extensions.
-#[derive(Serialize)]
-struct AnalysisJson {
-    energy: f64,
-    c1: f64,
-    c2: f64,
-    theta_min: f64,
-    theta_max: f64,
-    period: Option<f64>,
-    precession: Option<f64>,
-    max_friction_ratio: Option<f64>,
-    min_normal: f64,
-    steady: Option<SteadyJson>,
-    motion: &'static str,
-    spin_advance: Option<f64>,
-    flat_landing_time: Option<f64>,
-    lift_off_time: Option<f64>,
-    lift_off_theta: Option<f64>,
-    normal_stays_positive: bool,
-    friction: Option<f64>,
-    slips: Option<bool>,
-    quadrature_error: f64,
-    base_steady: Option<SteadyJson>,
-}
-
 /// The contract's `steady` object, then the extensions.
-#[derive(Serialize)]
-struct SteadyJson {
-    kind: &'static str,
-    omega_y: f64,
-    phi_dot: f64,
-    psi_dot: f64,
-    r_g: Option<f64>,
-    r_c: Option<f64>,
-    sigma_squared: f64,
-    eigenvalues: Vec<[f64; 2]>,
-    verdict: &'static str,
-    branch: Option<&'static str>,
-    normal: f64,
-    friction: f64,
-    nutation_period: Option<f64>,
-    e_folding_time: Option<f64>,
-}
-
-impl From<&SteadyAnalysis> for SteadyJson {
-    fn from(s: &SteadyAnalysis) -> Self {
-        // +0.0 for the zero eigenvalues and parts (JSON would show −0.0 as "-0.0").
-        let clean = |x: f64| if x == 0.0 { 0.0 } else { x };
-        Self {
-            kind: s.kind.name(),
-            omega_y: s.omega_y,
-            phi_dot: s.phi_dot,
-            psi_dot: s.psi_dot,
-            r_g: s.r_g,
-            r_c: s.r_c,
-            sigma_squared: s.sigma_squared,
-            eigenvalues: s
-                .eigenvalues
-                .iter()
-                .map(|&(re, im)| [clean(re), clean(im)])
-                .collect(),
-            verdict: s.verdict.name(),
-            branch: s.branch.map(crate::model::Branch::name),
-            normal: s.normal,
-            friction: s.friction,
-            nutation_period: s.nutation_period(),
-            e_folding_time: s.e_folding_time(),
-        }
-    }
+fn steady_json(s: &SteadyAnalysis) -> serde_json::Value {
+    // +0.0 for the zero eigenvalues and parts (JSON would show −0.0 as "-0.0").
+    let clean = |x: f64| if x == 0.0 { 0.0 } else { x };
+    let eigenvalues: Vec<[f64; 2]> = s
+        .eigenvalues
+        .iter()
+        .map(|&(re, im)| [clean(re), clean(im)])
+        .collect();
+    json!({
+        "kind": s.kind.name(),
+        "omega_y": s.omega_y,
+        "phi_dot": s.phi_dot,
+        "psi_dot": s.psi_dot,
+        "r_g": s.r_g,
+        "r_c": s.r_c,
+        "sigma_squared": s.sigma_squared,
+        "eigenvalues": eigenvalues,
+        "verdict": s.verdict.name(),
+        "branch": s.branch.map(crate::model::Branch::name),
+        "normal": s.normal,
+        "friction": s.friction,
+        "nutation_period": s.nutation_period(),
+        "e_folding_time": s.e_folding_time(),
+    })
 }

@@ -1,14 +1,13 @@
-//! The stability map as SVG (plotters' SVG backend only: no fonts are needed, text is written as SVG
-//! `<text>`): one panel per branch, each grid cell coloured by the sign and size of σ², the boundary
-//! σ² = 0 in closed form, ω_c of straight rolling, and the scenes' steady motions.
+//! The stability map as SVG: one panel per branch, each grid cell coloured by the sign and size of σ²,
+//! the boundary σ² = 0 in closed form, ω_c of straight rolling, and the scenes' steady motions.
 //!
 //! Cells of one θ₀ column with the same colour are drawn as one rectangle, so the file stays small
 //! (a 200 × 200 map of the thin disk on both branches is about 2,000 rectangles, not 80,000).
 
-use super::map::{boundary, BoundaryPoint, MapError, MapPoint, StabilityMap};
+use super::map::{boundary, on_branch, BoundaryPoint, MapError, MapPoint, StabilityMap};
 use super::steady::Stability;
 use crate::model::Branch;
-use crate::palette::{MARGINAL, STABLE, UNSTABLE};
+use crate::palette::{svg_page, Area, DrawError, MARGINAL, STABLE, UNSTABLE};
 use plotters::prelude::*;
 
 /// Size of one panel and of the legend strip \[px\].
@@ -28,28 +27,21 @@ impl StabilityMap {
     /// # Errors
     /// [`MapError::Plot`] if drawing fails (it does not for a validated grid).
     pub fn svg(&self) -> Result<String, MapError> {
-        let fail = |e: &dyn std::fmt::Display| MapError::Plot(e.to_string());
         let branches = self.options.branches.list();
         let panels = u32::try_from(branches.len()).unwrap_or(1);
-        let size = (PANEL.0 * panels, PANEL.1 + LEGEND);
-        let mut svg = String::new();
-        {
-            let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| fail(&e))?;
+        svg_page((PANEL.0 * panels, PANEL.1 + LEGEND), |root| {
             let (top, bottom) = root.split_vertically(PANEL.1);
             let areas = top.split_evenly((1, branches.len()));
             for (area, &branch) in areas.iter().zip(branches) {
-                panel(self, area, branch).map_err(|e| fail(&e))?;
+                panel(self, area, branch)?;
             }
-            legend(self, &bottom).map_err(|e| fail(&e))?;
-            root.present().map_err(|e| fail(&e))?;
-        }
-        Ok(svg)
+            legend(self, &bottom)
+        })
+        .map_err(|e| MapError::Plot(e.to_string()))
     }
 }
 
-type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
-type DrawResult = Result<(), DrawingAreaErrorKind<std::io::Error>>;
+type DrawResult = Result<(), DrawError>;
 
 /// The plotted ranges: the grid's cells, and θ₀ = 0 (where straight rolling and the upright spin sit).
 fn ranges(map: &StabilityMap) -> ((f64, f64), (f64, f64)) {
@@ -204,13 +196,7 @@ fn boundary_lines(
             (-c.theta0, c.omega_z0, -c.omega_y0),
             (-c.theta0, -c.omega_z0, c.omega_y0),
         ] {
-            let branch_here = boundary_branch(coin, theta, omega, omega_y);
-            folds.push(BoundaryPoint {
-                theta0: theta,
-                omega_z0: omega,
-                omega_y0: omega_y,
-                branch: branch_here,
-            });
+            folds.push(on_branch(coin, theta, omega, omega_y));
             leans.push(theta);
         }
     }
@@ -249,17 +235,6 @@ fn boundary_lines(
     lines.extend(open.into_iter().flatten());
     lines.retain(|l| l.len() > 1);
     lines
-}
-
-/// The branch whose root ω_Y0 is, at (θ₀, ω_Z0).
-fn boundary_branch(coin: &crate::model::Coin, theta: f64, omega_z: f64, omega_y: f64) -> Branch {
-    let distance =
-        |b: Branch| (crate::model::steady_omega_y(coin, theta, omega_z, b) - omega_y).abs();
-    if distance(Branch::Plus) <= distance(Branch::Minus) {
-        Branch::Plus
-    } else {
-        Branch::Minus
-    }
 }
 
 /// The colour scales and what the lines and dots are.

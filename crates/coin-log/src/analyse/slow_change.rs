@@ -18,8 +18,7 @@ pub fn alpha_of(s: &State) -> f64 {
 /// C of the slow-change law d(sin α)/dt = −C sin^p α on the centre-fixed family (eqs (35)–(37)):
 /// E = (3/2) Mga sin α and P = κ (Mga/I_X)^(m/2) sin^p α, so C = κ (Mga/I_X)^(m/2) / ((3/2) Mga)
 /// [1/time].
-#[must_use]
-pub fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
+fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
     let p = coin.params();
     let mga = p.energy_scale();
     law.coefficient() * (mga / p.inertia_x()).powf(0.5 * law.m()) / (1.5 * mga)
@@ -62,8 +61,7 @@ pub fn coefficient_for(
 
 /// ε(α) = |α̇| / (α σ): the slow-change rate α̇ = −C sin^p α / cos α against the nutation frequency σ of the
 /// centre-fixed motion at α (physics §5). The slow-change approximation needs ε ≪ 1.
-#[must_use]
-pub fn slow_change_ratio(coin: &Coin, law: &Dissipation, alpha: f64) -> f64 {
+fn slow_change_ratio(coin: &Coin, law: &Dissipation, alpha: f64) -> f64 {
     let rate = slow_change_rate(coin, law) * alpha.sin().powf(law.angle_exponent()) / alpha.cos();
     let sigma = centre_fixed_sigma_squared(coin, FRAC_PI_2 - alpha).sqrt();
     rate / (alpha * sigma)

@@ -2,7 +2,7 @@
 //! stability (physics §4, §9).
 
 use crate::model::{
-    eigenvalues, reaction, steady_omega_y, steady_sigma_squared, Branch, Coin, Linearisation,
+    eigenvalues, rates_and_radii, reaction, steady_sigma_squared, Branch, Coin, Linearisation,
     State, Steady, SteadyFamily, SteadyKind,
 };
 
@@ -75,16 +75,7 @@ impl SteadyAnalysis {
     pub fn of_state(coin: &Coin, state: &State, given: Option<&Steady>) -> Self {
         let (theta, wy, wz) = (state.theta, state.omega_y, state.omega_z);
         let (kind, branch) = given.map_or_else(|| classify(coin, state), |s| named(s.kind));
-        let a = coin.params().radius();
-        let (st, ct) = theta.sin_cos();
-        let (r_g, r_c) = match kind {
-            SteadyFamily::Straight => (None, None),
-            SteadyFamily::SpinUpright => (Some(0.0), Some(0.0)),
-            SteadyFamily::CentreFixed | SteadyFamily::Circle => {
-                let signed = wz * ct / wy;
-                (Some(a * signed.abs()), Some(a * (signed + st).abs()))
-            }
-        };
+        let (phi_dot, psi_dot, r_g, r_c) = rates_and_radii(coin, kind, state);
         let r = reaction(coin, state);
         let sigma_squared = steady_sigma_squared(coin, theta, wy, wz);
         let sigma_scale = Linearisation::at(coin, theta, wy, wz).scale();
@@ -92,8 +83,8 @@ impl SteadyAnalysis {
             kind,
             branch,
             omega_y: wy,
-            phi_dot: wy / ct,
-            psi_dot: wz + wy * st / ct,
+            phi_dot,
+            psi_dot,
             r_g,
             r_c,
             normal: r.normal,
@@ -151,11 +142,8 @@ fn classify(coin: &Coin, state: &State) -> (SteadyFamily, Option<Branch>) {
     if wz == 0.0 {
         return (SteadyFamily::CentreFixed, Some(sign(wy)));
     }
-    let distance = |b: Branch| (steady_omega_y(coin, theta, wz, b) - wy).abs();
-    let branch = if distance(Branch::Plus) <= distance(Branch::Minus) {
-        Branch::Plus
-    } else {
-        Branch::Minus
-    };
-    (SteadyFamily::Circle, Some(branch))
+    (
+        SteadyFamily::Circle,
+        Some(Branch::nearest(coin, theta, wz, wy)),
+    )
 }

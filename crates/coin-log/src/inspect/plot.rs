@@ -17,10 +17,12 @@ use crate::format::{
 };
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{CoinParams, Inertia};
-use crate::palette::{BLUE, GREEN, GREY, ORANGE, RED};
+use crate::palette::{
+    legend_box, legend_line, svg_page, Area, DrawError, BLUE, GREEN, GREY, ORANGE, RED,
+};
 use crate::scene::SceneFile;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
-use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -228,7 +230,7 @@ impl Collect {
                         .energy_drift
                         .get_or_insert_with(|| EnergyDrift::new(&params, e));
                     self.energy
-                        .push(t, (e - drift.reference()).abs() / drift.scale());
+                        .push(t, (e - drift.reference).abs() / drift.scale);
                 }
             }
             Channel::Invariants => {
@@ -236,9 +238,9 @@ impl Collect {
                     let drift = *self
                         .invariant_drift
                         .get_or_insert_with(|| InvariantDrift::new(&params, c1, c2));
-                    let (a, b) = drift.reference();
-                    self.c1.push(t, (c1 - a).abs() / drift.scale());
-                    self.c2.push(t, (c2 - b).abs() / drift.scale());
+                    let (a, b) = drift.reference;
+                    self.c1.push(t, (c1 - a).abs() / drift.scale);
+                    self.c2.push(t, (c2 - b).abs() / drift.scale);
                 }
             }
             Channel::Reaction => {
@@ -423,8 +425,6 @@ fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (S
     )
 }
 
-type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
-
 fn draw(
     c: &Collect,
     run: &RunMetadata,
@@ -438,23 +438,18 @@ fn draw(
         .map(|r| (r.termination.name(), r.termination_time));
     // 2 % beyond the last time, so that the termination's mark stands clear of the frame.
     let t_max = 1.02 * c.last_t.max(end.map_or(0.0, |e| e.1)).max(1e-9);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+    svg_page(SIZE, |root| {
         let (top, body) = root.split_vertically(70);
         top.draw_text(
             &heading,
             &("sans-serif", 22).into_font().color(&BLACK),
             (20, 12),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         top.draw_text(
             &subheading,
             &("sans-serif", 14).into_font().color(&GREY),
             (20, 44),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let panels = body.split_evenly((3, 2));
         track(&panels[0], c)?;
         let time = TimeAxis { t_max, end };
@@ -485,24 +480,22 @@ fn draw(
             "|F| / N",
             &[("|F|/N", &c.ratio, BLUE)],
             mu,
-        )?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(svg)
+        )
+    })
+    .map_err(|e| e.to_string())
 }
 
 /// A panel that says why it is empty.
-fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), String> {
-    area.titled(title, ("sans-serif", 16))
-        .and_then(|a| a.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60)))
-        .map_err(|e| e.to_string())
+fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), DrawError> {
+    let area = area.titled(title, ("sans-serif", 16))?;
+    area.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60))
 }
 
-/// Range `lo..hi` widened by `pad` of its span on each side (a fixed span when it is empty).
-fn padded(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+/// Range `lo..hi` widened by 5 % of its span on each side (a fixed span when it is empty).
+fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
     let span = hi - lo;
     if span > 0.0 {
-        (lo - pad * span, hi + pad * span)
+        (lo - 0.05 * span, hi + 0.05 * span)
     } else {
         let w = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
         (lo - w, hi + w)
@@ -520,7 +513,7 @@ fn min_max<'a>(
 
 /// The path of the contact point and of the centre in the table plane: x across, z down the page,
 /// one length unit the same on both axes.
-fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
+fn track(area: &Area<'_>, c: &Collect) -> Result<(), DrawError> {
     let (contact, centre) = (c.contact.points(), c.centre.points());
     if contact.is_empty() && centre.is_empty() {
         return empty(
@@ -530,8 +523,8 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
         );
     }
     let all = || contact.iter().chain(&centre);
-    let (x0, x1) = padded_equal(min_max(all(), |p| p.0));
-    let (z0, z1) = padded_equal(min_max(all(), |p| p.1));
+    let (x0, x1) = padded(min_max(all(), |p| p.0));
+    let (z0, z1) = padded(min_max(all(), |p| p.1));
     // Equal axes: widen the shorter range to the plotting area's aspect ratio.
     let (label_x, label_y, margin) = (40u32, 60u32, 12u32);
     let (w, h) = area.dim_in_pixel();
@@ -540,20 +533,17 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
     let scale = ((x1 - x0) / plot_w).max((z1 - z0) / plot_h);
     let (xc, zc) = (0.5 * (x0 + x1), 0.5 * (z0 + z1));
     let (hx, hz) = (0.5 * scale * plot_w, 0.5 * scale * plot_h);
-    let err = |e: &dyn std::fmt::Display| e.to_string();
     let mut chart = ChartBuilder::on(area)
         .caption(PANELS[0], ("sans-serif", 16))
         .margin(margin)
         .x_label_area_size(label_x)
         .y_label_area_size(label_y)
-        .build_cartesian_2d(xc - hx..xc + hx, zc + hz..zc - hz)
-        .map_err(|e| err(&e))?;
+        .build_cartesian_2d(xc - hx..xc + hx, zc + hz..zc - hz)?;
     chart
         .configure_mesh()
         .x_desc("x")
         .y_desc("z (down the page: the view from above)")
-        .draw()
-        .map_err(|e| err(&e))?;
+        .draw()?;
     for (label, points, colour) in [
         ("contact track", &contact, BLUE),
         ("centre", &centre, ORANGE),
@@ -565,62 +555,18 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), String> {
             .draw_series(LineSeries::new(
                 points.iter().copied(),
                 colour.stroke_width(1),
-            ))
-            .map_err(|e| err(&e))?
+            ))?
             .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+            .legend(legend_line(colour, 2));
         let (first, last) = (points[0], points[points.len() - 1]);
-        chart
-            .draw_series([Circle::new(first, 4, colour.filled())])
-            .map_err(|e| err(&e))?;
-        chart
-            .draw_series([Cross::new(last, 6, RED.stroke_width(2))])
-            .map_err(|e| err(&e))?;
+        chart.draw_series([Circle::new(first, 4, colour.filled())])?;
+        chart.draw_series([Cross::new(last, 6, RED.stroke_width(2))])?;
     }
-    legend(&mut chart)
+    legend_box(&mut chart, SeriesLabelPosition::UpperRight)
 }
 
-/// `lo..hi` padded by 5 % (a unit span around a single value).
-fn padded_equal((lo, hi): (f64, f64)) -> (f64, f64) {
-    padded(lo, hi, 0.05)
-}
-
-fn legend<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
-) -> Result<(), String> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| e.to_string())
-}
-
-/// Each of `series` as a line through its `points` (values mapped by `value`), with its legend entry.
-fn draw_series<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
-    series: &[(&str, &Envelope, RGBColor)],
-    points: &[Vec<(f64, f64)>],
-    value: impl Fn(f64) -> f64,
-) -> Result<(), String> {
-    for ((label, _, colour), points) in series.iter().zip(points) {
-        let colour = *colour;
-        chart
-            .draw_series(LineSeries::new(
-                points.iter().map(|&(t, v)| (t, value(v))),
-                colour.stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?
-            .label(*label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-    }
-    Ok(())
-}
+/// The axes of a time panel.
+type TimeChart<'a, 'b, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, Y>>;
 
 /// The common time axis of the time panels, with the termination marked.
 struct TimeAxis<'a> {
@@ -637,7 +583,7 @@ impl TimeAxis<'_> {
         y_desc: &str,
         series: &[(&str, &Envelope, RGBColor)],
         line: Option<(&str, f64)>,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         if series.iter().all(|s| s.1.is_empty()) {
             return empty(area, title, "the channel this needs was not recorded");
         }
@@ -646,38 +592,15 @@ impl TimeAxis<'_> {
         if let Some((_, v)) = line {
             (lo, hi) = (lo.min(v), hi.max(v));
         }
-        let (y0, y1) = padded(lo, hi, 0.05);
-        let err = |e: &dyn std::fmt::Display| e.to_string();
+        let (y0, y1) = padded((lo, hi));
         let mut chart = ChartBuilder::on(area)
             .caption(title, ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(0.0..self.t_max, y0..y1)
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("t")
-            .y_desc(y_desc)
-            .draw()
-            .map_err(|e| err(&e))?;
-        draw_series(&mut chart, series, &points, |v| v)?;
-        if let Some((label, v)) = line {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    [(0.0, v), (self.t_max, v)],
-                    6,
-                    4,
-                    GREEN.stroke_width(2),
-                ))
-                .map_err(|e| err(&e))?
-                .label(format!("{label} = {v}"))
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2))
-                });
-        }
-        self.mark_end(&mut chart, y0, y1)?;
-        legend(&mut chart)
+            .build_cartesian_2d(0.0..self.t_max, y0..y1)?;
+        chart.configure_mesh().x_desc("t").y_desc(y_desc).draw()?;
+        self.finish(&mut chart, series, &points, |v| v, line, (y0, y1))
     }
 
     /// A panel of non-negative `series` on a log scale; zeros are drawn on the bottom edge, which sits a
@@ -687,7 +610,7 @@ impl TimeAxis<'_> {
         area: &Area<'_>,
         title: &str,
         series: &[(&str, &Envelope, RGBColor)],
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         if series.iter().all(|s| s.1.is_empty()) {
             return empty(area, title, "the channel this needs was not recorded");
         }
@@ -701,14 +624,12 @@ impl TimeAxis<'_> {
         } else {
             (1e-17, 1e-15)
         };
-        let err = |e: &dyn std::fmt::Display| e.to_string();
         let mut chart = ChartBuilder::on(area)
             .caption(title, ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(0.0..self.t_max, (floor..top).log_scale())
-            .map_err(|e| err(&e))?;
+            .build_cartesian_2d(0.0..self.t_max, (floor..top).log_scale())?;
         chart
             .configure_mesh()
             .x_desc("t")
@@ -718,34 +639,61 @@ impl TimeAxis<'_> {
                 "identically 0"
             })
             .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(|e| err(&e))?;
-        draw_series(&mut chart, series, &points, |v| v.max(floor))?;
-        self.mark_end(&mut chart, floor, top)?;
-        legend(&mut chart)
+            .draw()?;
+        self.finish(
+            &mut chart,
+            series,
+            &points,
+            |v| v.max(floor),
+            None,
+            (floor, top),
+        )
     }
 
-    /// The termination as a dashed red vertical line, labelled.
-    fn mark_end<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
+    /// Draws each of `series` as a line through its `points` (values mapped by `value`), the labelled
+    /// horizontal `line` if any, the termination as a dashed red vertical line over y0..y1, and the
+    /// legend.
+    fn finish<'a, 'b: 'a, Y: Ranged<ValueType = f64>>(
         &self,
-        chart: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
-        y0: f64,
-        y1: f64,
-    ) -> Result<(), String> {
-        let Some((name, t)) = self.end else {
-            return Ok(());
-        };
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(t, y0), (t, y1)],
-                5,
-                4,
-                RED.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
-            .label(format!("{name} at t = {t}"))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
-        Ok(())
+        chart: &mut TimeChart<'a, 'b, Y>,
+        series: &[(&str, &Envelope, RGBColor)],
+        points: &[Vec<(f64, f64)>],
+        value: impl Fn(f64) -> f64,
+        line: Option<(&str, f64)>,
+        (y0, y1): (f64, f64),
+    ) -> Result<(), DrawError> {
+        for ((label, _, colour), points) in series.iter().zip(points) {
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().map(|&(t, v)| (t, value(v))),
+                    colour.stroke_width(1),
+                ))?
+                .label(*label)
+                .legend(legend_line(*colour, 2));
+        }
+        if let Some((label, v)) = line {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(0.0, v), (self.t_max, v)],
+                    6,
+                    4,
+                    GREEN.stroke_width(2),
+                ))?
+                .label(format!("{label} = {v}"))
+                .legend(legend_line(GREEN, 2));
+        }
+        if let Some((name, t)) = self.end {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(t, y0), (t, y1)],
+                    5,
+                    4,
+                    RED.stroke_width(2),
+                ))?
+                .label(format!("{name} at t = {t}"))
+                .legend(legend_line(RED, 2));
+        }
+        legend_box(chart, SeriesLabelPosition::UpperRight)
     }
 }
 

@@ -6,7 +6,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Orientation q = q(e_y, φ) · q(e_x, θ) · q(e_z, ψ) (physics §1: spin ψ about z, then lean θ about x, then
 /// heading φ about y; rotation matrix eq (7)), a dimensionless unit quaternion acting on the coin lying in
-/// the x–y plane with normal +z (world frame, y up). Computed from the unwrapped angles, so it is continuous in time and not
+/// the x–y plane with normal +z (world frame, y up). From the unwrapped angles: continuous in time, not
 /// forced to w ≥ 0. Its components (i, j, k, w) are Foxglove's (x, y, z, w).
 ///
 /// ```
@@ -25,9 +25,7 @@ pub fn orientation(s: &State) -> UnitQuaternion<f64> {
     let x = x1 * cs + y1 * ss;
     let y = y1 * cs - x1 * ss;
     let z = w1 * ss + z1 * cs;
-    // Wrapped as it is, not renormalised and not built as a product of `from_axis_angle` factors: the
-    // recorded components must keep these exact floating-point operations (the committed datasets are
-    // compared byte for byte), and a product of unit quaternions is unit to round-off anyway.
+    // Not renormalised: the recorded components keep these exact operations (datasets compare bytes).
     UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z))
 }
 

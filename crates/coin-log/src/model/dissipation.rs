@@ -6,7 +6,7 @@
 //! system [`DissipativeCoin`], chosen once before the integration starts.
 
 use super::derived::{reaction_with, Reaction};
-use super::equations::{AngularAcceleration, Coin};
+use super::equations::{kinematics, AngularAcceleration, Coin};
 use super::state::{State, STATE_LEN};
 use thiserror::Error;
 
@@ -176,11 +176,7 @@ impl Dissipation {
     #[must_use]
     #[inline]
     pub fn power(&self, theta: f64, omega_y: f64) -> f64 {
-        self.power_trig(theta.cos(), omega_y)
-    }
-
-    #[inline]
-    fn power_trig(&self, cos_t: f64, omega_y: f64) -> f64 {
+        let cos_t = theta.cos();
         let phi_dot = omega_y / cos_t;
         self.coefficient * phi_dot.abs().powf(self.m) * cos_t.powf(-self.k)
     }
@@ -269,20 +265,11 @@ impl DissipativeCoin {
         y: &[f64; DISSIPATIVE_STATE_LEN],
         dydt: &mut [f64; DISSIPATIVE_STATE_LEN],
     ) {
-        let [theta, phi, _psi, wx, wy, wz, _x, _z, _w] = *y;
-        let rates = self.rates(theta, wx, wy, wz);
-        let (sin_t, cos_t) = theta.sin_cos();
-        let (sin_p, cos_p) = phi.sin_cos();
-        let tan_t = sin_t / cos_t;
-        let a = self.coin.params().radius();
-        dydt[0] = wx; // (17)
-        dydt[1] = wy / cos_t; // (18)
-        dydt[2] = wz + wy * tan_t; // (19)
+        let rates = self.rates(y[0], y[3], y[4], y[5]);
+        kinematics(self.coin.params().radius(), y, dydt);
         dydt[3] = rates.acceleration.x; // (31)
         dydt[4] = rates.acceleration.y; // (32)
         dydt[5] = rates.acceleration.z; // (33)
-        dydt[6] = a * (-wz * cos_p + wx * cos_t * sin_p);
-        dydt[7] = a * (wz * sin_p + wx * cos_t * cos_p);
         dydt[WORK_INDEX] = rates.power; // (34)
     }
 
@@ -292,12 +279,6 @@ impl DissipativeCoin {
     pub fn reaction(&self, s: &State) -> Reaction {
         let rates = self.rates(s.theta, s.omega_x, s.omega_y, s.omega_z);
         reaction_with(&self.coin, s, rates.acceleration)
-    }
-
-    /// The power P at a state (eq (34)).
-    #[must_use]
-    pub fn power(&self, s: &State) -> f64 {
-        self.dissipation.power(s.theta, s.omega_y)
     }
 }
 
@@ -309,6 +290,18 @@ pub enum Dynamics {
     Conservative(Coin),
     /// A dissipative couple: E + W is conserved.
     Dissipative(DissipativeCoin),
+}
+
+impl From<Coin> for Dynamics {
+    fn from(coin: Coin) -> Self {
+        Self::Conservative(coin)
+    }
+}
+
+impl From<DissipativeCoin> for Dynamics {
+    fn from(coin: DissipativeCoin) -> Self {
+        Self::Dissipative(coin)
+    }
 }
 
 impl Dynamics {

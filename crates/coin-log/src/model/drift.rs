@@ -31,12 +31,35 @@ impl Worst {
     }
 }
 
-/// Running energy drift from a reference E₀.
+/// Running drift of conserved quantities from their reference value `R`: [`EnergyDrift`] or
+/// [`InvariantDrift`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EnergyDrift {
-    e0: f64,
-    scale: f64,
+pub struct Drift<R> {
+    /// The reference value: E₀, or (C1₀, C2₀).
+    pub reference: R,
+    /// The scale the deviations are divided by.
+    pub scale: f64,
     worst: Worst,
+}
+
+/// Running energy drift from a reference E₀.
+pub type EnergyDrift = Drift<f64>;
+
+/// Running drift of the Chaplygin–Appell integrals from a reference (C1₀, C2₀).
+pub type InvariantDrift = Drift<(f64, f64)>;
+
+impl<R> Drift<R> {
+    /// max |deviation| / scale so far (0 before any observation).
+    #[must_use]
+    pub fn value(&self) -> f64 {
+        self.worst.value
+    }
+
+    /// When the largest deviation happened.
+    #[must_use]
+    pub fn worst_time(&self) -> f64 {
+        self.worst.t
+    }
 }
 
 impl EnergyDrift {
@@ -51,7 +74,7 @@ impl EnergyDrift {
     #[must_use]
     pub fn new(params: &CoinParams, e0: f64) -> Self {
         Self {
-            e0,
+            reference: e0,
             scale: e0.abs().max(params.energy_scale()),
             worst: Worst::default(),
         }
@@ -60,41 +83,8 @@ impl EnergyDrift {
     /// Accounts for the energy `e` at time `t`.
     #[inline]
     pub fn observe(&mut self, t: f64, e: f64) {
-        self.worst.offer((e - self.e0).abs() / self.scale, t);
+        self.worst.offer((e - self.reference).abs() / self.scale, t);
     }
-
-    /// The reference E₀.
-    #[must_use]
-    pub fn reference(&self) -> f64 {
-        self.e0
-    }
-
-    /// The scale max(|E₀|, M g a) the deviations are divided by.
-    #[must_use]
-    pub fn scale(&self) -> f64 {
-        self.scale
-    }
-
-    /// max |E − E₀| / scale so far (0 before any observation).
-    #[must_use]
-    pub fn value(&self) -> f64 {
-        self.worst.value
-    }
-
-    /// When the largest deviation happened.
-    #[must_use]
-    pub fn worst_time(&self) -> f64 {
-        self.worst.t
-    }
-}
-
-/// Running drift of the Chaplygin–Appell integrals from a reference (C1₀, C2₀).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct InvariantDrift {
-    c0: (f64, f64),
-    scale: f64,
-    natural_scale: bool,
-    worst: Worst,
 }
 
 impl InvariantDrift {
@@ -109,16 +99,13 @@ impl InvariantDrift {
     #[must_use]
     pub fn new(params: &CoinParams, c1: f64, c2: f64) -> Self {
         let sum = c1.abs() + c2.abs();
-        let natural_scale = sum == 0.0;
-        let scale = if natural_scale {
-            1.0 / params.time_unit()
-        } else {
-            sum
-        };
         Self {
-            c0: (c1, c2),
-            scale,
-            natural_scale,
+            reference: (c1, c2),
+            scale: if sum == 0.0 {
+                1.0 / params.time_unit()
+            } else {
+                sum
+            },
             worst: Worst::default(),
         }
     }
@@ -126,39 +113,15 @@ impl InvariantDrift {
     /// Accounts for (C1, C2) at time `t`.
     #[inline]
     pub fn observe(&mut self, t: f64, c1: f64, c2: f64) {
-        let (c10, c20) = self.c0;
+        let (c10, c20) = self.reference;
         let d = (c1 - c10).abs().max((c2 - c20).abs());
         self.worst.offer(d / self.scale, t);
-    }
-
-    /// The reference (C1₀, C2₀).
-    #[must_use]
-    pub fn reference(&self) -> (f64, f64) {
-        self.c0
-    }
-
-    /// The scale the deviations are divided by.
-    #[must_use]
-    pub fn scale(&self) -> f64 {
-        self.scale
     }
 
     /// True when C1₀ = C2₀ = 0 and the scale is √(g/a).
     #[must_use]
     pub fn natural_scale(&self) -> bool {
-        self.natural_scale
-    }
-
-    /// max |C − C₀| / scale so far.
-    #[must_use]
-    pub fn value(&self) -> f64 {
-        self.worst.value
-    }
-
-    /// When the largest deviation happened.
-    #[must_use]
-    pub fn worst_time(&self) -> f64 {
-        self.worst.t
+        self.reference.0.abs() + self.reference.1.abs() == 0.0
     }
 }
 
@@ -183,16 +146,16 @@ mod tests {
         // E₀ = 10 > Mga = 8: relative to E₀.
         let mut e = EnergyDrift::new(&p, -10.0);
         e.observe(0.0, -9.0);
-        assert_eq!(e.scale(), 10.0);
+        assert_eq!(e.scale, 10.0);
         assert_eq!(e.value(), 0.1);
         // E₀ = 1 < Mga = 8: relative to Mga.
-        assert_eq!(EnergyDrift::new(&p, 1.0).scale(), 8.0);
+        assert_eq!(EnergyDrift::new(&p, 1.0).scale, 8.0);
         let c = InvariantDrift::new(&p, 0.25, -0.5);
         assert!(!c.natural_scale());
-        assert_eq!(c.scale(), 0.75);
+        assert_eq!(c.scale, 0.75);
         // C₀ = 0: √(g/a) = 4.
         let mut z = InvariantDrift::new(&p, 0.0, -0.0);
-        assert_eq!(z.scale(), 4.0);
+        assert_eq!(z.scale, 4.0);
         z.observe(3.0, 0.0, 2.0);
         assert_eq!((z.value(), z.worst_time()), (0.5, 3.0));
     }

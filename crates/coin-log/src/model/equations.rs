@@ -98,30 +98,33 @@ impl Coin {
         }
     }
 
-    /// The right-hand side: eqs (14)–(19) and the centre's velocity
-    /// ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ), ż = a(ω_Z sin φ + ω_X cos θ cos φ) (physics §2).
-    /// Writes into a caller-owned buffer; no allocation.
+    /// The right-hand side: eqs (14)–(19) and the centre's velocity (physics §2). Writes into a
+    /// caller-owned buffer; no allocation.
     #[inline]
     pub fn derivative(&self, y: &[f64; STATE_LEN], dydt: &mut StateRate) {
-        // Plain arrays rather than nalgebra's SVector: this is the hot path of every integrator, and the
-        // integrators' interface (`OdeSystem`) is `[f64; N]`. Measured with `cargo bench --bench rhs`
-        // (criterion; the same body on `SVector<f64, 8>` in and out, side by side in one run, three rounds,
-        // on a loaded 2-core machine): fastest samples 27.4–27.9 ns per evaluation with arrays against
-        // 27.5–28.1 ns with SVector, medians 54–102 ns against 60–88 ns (load-dominated). nalgebra would
-        // cost nothing measurable here; the arrays stay because they are the interface of every stepper.
-        let [theta, phi, _psi, wx, wy, wz, _x, _z] = *y;
-        let (sin_t, cos_t) = theta.sin_cos();
-        let (sin_p, cos_p) = phi.sin_cos();
-        let tan_t = sin_t / cos_t;
-        let acc = self.angular_acceleration_trig(sin_t, tan_t, wx, wy, wz);
-        let a = self.params.radius();
-        dydt[0] = wx; // (17)
-        dydt[1] = wy / cos_t; // (18)
-        dydt[2] = wz + wy * tan_t; // (19)
+        // Plain arrays, the steppers' interface: nalgebra's SVector measured the same (27.4–27.9 ns per
+        // evaluation against 27.5–28.1 ns, `cargo bench --bench rhs`).
+        let (sin_t, tan_t) = kinematics(self.params.radius(), y, dydt);
+        let acc = self.angular_acceleration_trig(sin_t, tan_t, y[3], y[4], y[5]);
         dydt[3] = acc.x; // (14)
         dydt[4] = acc.y; // (15)
         dydt[5] = acc.z; // (16)
-        dydt[6] = a * (-wz * cos_p + wx * cos_t * sin_p);
-        dydt[7] = a * (wz * sin_p + wx * cos_t * cos_p);
     }
+}
+
+/// The rows of the right-hand side that no couple changes (physics §2, §11), for a coin of radius `a`:
+/// eqs (17)–(19) and the centre's velocity ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ),
+/// ż = a(ω_Z sin φ + ω_X cos θ cos φ). Returns (sin θ, tan θ) for the accelerations.
+#[inline]
+pub(super) fn kinematics<const N: usize>(a: f64, y: &[f64; N], dydt: &mut [f64; N]) -> (f64, f64) {
+    let (theta, phi, wx, wy, wz) = (y[0], y[1], y[3], y[4], y[5]);
+    let (sin_t, cos_t) = theta.sin_cos();
+    let (sin_p, cos_p) = phi.sin_cos();
+    let tan_t = sin_t / cos_t;
+    dydt[0] = wx; // (17)
+    dydt[1] = wy / cos_t; // (18)
+    dydt[2] = wz + wy * tan_t; // (19)
+    dydt[6] = a * (-wz * cos_p + wx * cos_t * sin_p);
+    dydt[7] = a * (wz * sin_p + wx * cos_t * cos_p);
+    (sin_t, tan_t)
 }

@@ -1,21 +1,6 @@
-//! Chaplygin–Appell integrals C1, C2 (physics §6): two conserved quantities besides the energy.
-//!
-//! With ω_X = θ̇, eqs (15)–(16) are linear in (ω_Y, ω_Z) with θ as the independent variable, and ω_Z solves
-//! Legendre's equation in s = sin θ,
-//!
-//! ```text
-//! (1 − s²) y″ − 2s y′ − μ y = 0,   k = (I_Z + Ma²)/(Ma²),   μ = I_Z Ma² / (I_X (I_Z + Ma²)),
-//! ```
-//!
-//! (thin disk μ = 4/3, hoop μ = 1). With y_e the even solution (y_e(0) = 1, y_e′(0) = 0) and y_o the odd one
-//! (y_o(0) = 0, y_o′(0) = 1), whose Wronskian is y_e y_o′ − y_o y_e′ = 1/cos²θ,
-//!
-//! ```text
-//! C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k
-//! C2 = cos θ y_e(s) ω_Y / k − cos²θ y_e′(s) ω_Z
-//! ```
-//!
-//! are constant along every motion.
+//! Chaplygin–Appell integrals C1, C2 (physics §6): C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k and
+//! C2 = cos θ y_e(s) ω_Y / k − cos²θ y_e′(s) ω_Z, with y_e, y_o the even and odd solutions of Legendre's
+//! equation (1 − s²) y″ − 2s y′ − μ y = 0 in s = sin θ.
 //!
 //! # Method
 //!
@@ -48,9 +33,7 @@
 //! Near flat, s = sin θ loses the relative precision of 1 − s (at θ = 1.5705, 1 − s ≈ 4.5e-8, so the
 //! rounding of s alone would cost 2e-9). [`Chaplygin::evaluate`] therefore never forms 1 − s: it uses
 //! x = cos²θ / (2(1 + |s|)) and ln x = ln cos²θ − ln(2(1 + |s|)), exact to a few ulp, and the flux p
-//! directly, so C1, C2 keep full precision up to the flat landing. Chebyshev fits or integrating the
-//! equation were the alternatives; the two series are exact, parameter-generic and cost about as much as a
-//! fit, with nothing to tabulate but 4 × 34 coefficients per side.
+//! directly, so C1, C2 keep full precision up to the flat landing.
 //!
 //! # Accuracy and cost
 //!
@@ -87,10 +70,7 @@ const TRUNCATION: f64 = 1e-18;
 const DECREASING_RUN: usize = 2;
 /// A hard bound on the series length (μ ≤ [`MU_MAX`] needs about 1000 at most).
 const MAX_TERMS: usize = 20_000;
-/// Largest μ accepted. Every real body has I_Z ≤ 2 I_X and so μ < 2. For large μ the solutions grow like
-/// exp(√μ |θ|) and the split moves so close to s = 1 that the series about s = 0 needs ~20 μ/… terms, so
-/// anything beyond this is refused rather than evaluated slowly or inaccurately. The tests cover μ = 20
-/// and μ = 100.
+/// Largest μ accepted (no real body comes near: see the module doc). The tests cover μ = 20 and μ = 100.
 pub const MU_MAX: f64 = 100.0;
 
 /// Why the integrals cannot be built for these parameters.

@@ -1,31 +1,14 @@
-//! The nutation of any motion by quadrature (physics §10): with E, C1 and C2 fixed, ω_Y and ω_Z are
-//! functions of θ alone (physics §6), so is θ̇² = f(θ), and the turning points, the nutation period and
-//! the heading advance per period are one-dimensional integrals.
+//! The nutation of any motion by quadrature (physics §10, §12): with E, C1 and C2 fixed, θ̇² = f(θ) and
+//! the turning points, the nutation period and the heading advance per period are one-dimensional
+//! integrals.
 //!
-//! # Method
-//!
-//! * **The reduced motion.** ω_Z(θ) = C1 y_e + C2 y_o and ω_Y(θ) = k (C1 p_e + C2 p_o)/cos θ (the 2 × 2
-//!   system of physics §6 inverted with its Wronskian, which makes its determinant 1), and
-//!   (I_X + Ma²) θ̇² = 2(E − U(θ)) with U(θ) = ½ I_X ω_Y² + ½ (I_Z + Ma²) ω_Z² + Mga cos θ, eq (25).
-//! * **θ̇² without cancellation.** dU/dθ = S(θ) = I_X tan θ ω_Y² + (I_Z + Ma²) ω_Y ω_Z − Mga sin θ, the
-//!   left-hand side of the steady family, eq (26). Within [`SHORT_RANGE`] of θ₀, U(θ) − U(θ₀) is the
-//!   16-point Gauss–Legendre integral of S rather than a difference of two values of U: near a steady
-//!   motion (or near upright) S is small, and so is the rounding of its integral, where the difference of
-//!   two O(U) numbers would carry ~1e-16·U. Measured on a 1e-6 tilt of straight rolling this turns a
-//!   1e-4 relative error of θ̇² into 1e-15.
-//! * **Turning points** by a geometric scan outwards from θ₀ (first step 1e-12 rad, doubling up to
-//!   1/128 rad), then bisection of the bracket to adjacent floating-point numbers.
-//! * **T and ΔΦ** with θ = θ_min + (θ_max − θ_min)(1 − cos u)/2, u ∈ [0, π]: then
-//!   dθ/√f = du/√g with g = f/((θ − θ_min)(θ_max − θ)) smooth and positive, and the integrand is a
-//!   smooth even periodic function of u, so the midpoint rule in u (Gauss–Chebyshev) converges
-//!   geometrically. The number of nodes is doubled from 32 until two estimates agree to 1e-14.
-//! * **Times to an event** (flat landing, lift-off) along the path from θ₀, leg by leg, by adaptive
-//!   Gauss–Legendre; a leg that starts or ends at a turning point r is integrated in v with
-//!   θ = r + (θ₁ − r) v², which removes the 1/√ singularity there. A leg leaving a turning point close
-//!   to upright is done in closed form up to a matching angle and by quadrature beyond (physics §12):
-//!   the substitution alone cannot resolve the scale θ₀ ≲ 1e-25 of the ln(1/θ₀)/λ escape.
-//! * **N and |F|/N** are functions of θ on the orbit (θ̇² = f(θ), ω̇ from eqs (14)–(16)); their extremes
-//!   by a scan of 257 points and golden-section refinement.
+//! Beyond physics §10: U(θ) − U(θ₀) within `SHORT_RANGE` of θ₀, and f near a turning point once found,
+//! are 16-point Gauss–Legendre integrals of S = dU/dθ rather than differences of two O(U) values. Turning
+//! points are found by a geometric scan outwards from θ₀ and bisection to adjacent floats. Times to an
+//! event (flat landing, lift-off) are adaptive Gauss–Legendre integrals along the path, leg by leg, in v
+//! with θ = r + (θ₁ − r) v² from a turning point r; the escape from near upright is in closed form up to
+//! a matching angle (physics §12). The extremes of N and |F|/N: a scan of 257 points refined by golden
+//! section.
 
 use super::derived::{energy, reaction};
 use super::equations::Coin;
@@ -36,11 +19,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use thiserror::Error;
 
 /// |θ − θ₀| within which U(θ) − U(θ₀) is integrated from S (see the module doc) \[rad\].
-pub const SHORT_RANGE: f64 = 0.02;
+const SHORT_RANGE: f64 = 0.02;
 /// Order of the Gauss–Legendre rule of that integral.
 const SHORT_RULE: usize = 16;
 /// A state is steady when ω_X and S(θ₀) are both below this fraction of their natural scales (64 ulp).
-pub const STEADY_TOLERANCE: f64 = 64.0 * f64::EPSILON;
+const STEADY_TOLERANCE: f64 = 64.0 * f64::EPSILON;
 /// First step of the turning-point scan \[rad\].
 const FIRST_STEP: f64 = 1e-12;
 /// Largest step of the turning-point scan \[rad\].
@@ -78,7 +61,7 @@ pub enum NutationError {
 /// What the motion does.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Motion {
-    /// ω_X = 0 and the steady family holds (to [`STEADY_TOLERANCE`]): θ stays where it is.
+    /// ω_X = 0 and the steady family holds (to `STEADY_TOLERANCE`): θ stays where it is.
     Steady,
     /// θ oscillates between two turning points.
     Periodic {
@@ -216,8 +199,7 @@ impl Orbit {
 
 /// S(θ) = I_X tan θ ω_Y² + (I_Z + Ma²) ω_Y ω_Z − Mga sin θ and the sum of the magnitudes of its terms:
 /// (I_X + Ma²) ω̇_X = −S (eq (14)); S = 0 is the steady family (physics §4).
-#[must_use]
-pub fn steady_residual(coin: &Coin, theta: f64, omega_y: f64, omega_z: f64) -> (f64, f64) {
+fn steady_residual(coin: &Coin, theta: f64, omega_y: f64, omega_z: f64) -> (f64, f64) {
     let p = coin.params();
     let (st, ct) = theta.sin_cos();
     let terms = [
@@ -258,6 +240,17 @@ struct Leg {
     to: f64,
     from_turns: bool,
     to_turns: bool,
+}
+
+impl Leg {
+    fn new(from: f64, to: f64, from_turns: bool, to_turns: bool) -> Self {
+        Self {
+            from,
+            to,
+            from_turns,
+            to_turns,
+        }
+    }
 }
 
 /// The motion reduced to θ alone, for one state's E, C1, C2.
@@ -386,6 +379,21 @@ impl<'a> Reduced<'a> {
         }
     }
 
+    /// 1/|θ̇| at θ.
+    fn inverse_rate(&self, theta: f64) -> f64 {
+        1.0 / self.theta_dot_squared(theta).max(0.0).sqrt()
+    }
+
+    /// |f′| = |2S/(I_X + Ma²)| at θ: how fast θ̇² opens from a turning point there.
+    fn turn_slope(&self, theta: f64) -> f64 {
+        (2.0 * self.slope(theta) / self.lever).abs()
+    }
+
+    /// N on the orbit at θ.
+    fn normal(&self, theta: f64) -> f64 {
+        reaction(self.coin, &self.state(theta)).normal
+    }
+
     /// The direction θ moves in at t = 0: the sign of ω_X0, or of θ̈ = −S/(I_X + Ma²) when ω_X0 = 0.
     fn direction(&self) -> f64 {
         if self.omega_x0 != 0.0 {
@@ -433,30 +441,11 @@ impl<'a> Reduced<'a> {
         self.anchor_at(forward, backward);
         let from_turns = self.omega_x0 == 0.0;
         let (legs, motion, error) = match (forward, backward) {
-            (End::Flat(flat), _) => {
-                let leg = Leg {
-                    from: self.theta0,
-                    to: flat,
-                    from_turns,
-                    to_turns: false,
-                };
-                self.landing(&[leg])
-            }
-            (End::Turn(turn), End::Flat(flat)) => {
-                let first = Leg {
-                    from: self.theta0,
-                    to: turn,
-                    from_turns,
-                    to_turns: true,
-                };
-                let second = Leg {
-                    from: turn,
-                    to: flat,
-                    from_turns: true,
-                    to_turns: false,
-                };
-                self.landing(&[first, second])
-            }
+            (End::Flat(flat), _) => self.landing(&[Leg::new(self.theta0, flat, from_turns, false)]),
+            (End::Turn(turn), End::Flat(flat)) => self.landing(&[
+                Leg::new(self.theta0, turn, from_turns, true),
+                Leg::new(turn, flat, true, false),
+            ]),
             (End::Turn(a), End::Turn(b)) => self.periodic(a, b),
         };
         orbit.motion = motion;
@@ -512,18 +501,8 @@ impl<'a> Reduced<'a> {
             (lo, hi)
         };
         let legs = vec![
-            Leg {
-                from: self.theta0,
-                to: ahead,
-                from_turns: self.omega_x0 == 0.0,
-                to_turns: true,
-            },
-            Leg {
-                from: ahead,
-                to: behind,
-                from_turns: true,
-                to_turns: true,
-            },
+            Leg::new(self.theta0, ahead, self.omega_x0 == 0.0, true),
+            Leg::new(ahead, behind, true, true),
         ];
         (
             legs,
@@ -543,7 +522,7 @@ impl Reduced<'_> {
     fn period_integrals(&self, lo: f64, hi: f64) -> (f64, f64, f64, f64) {
         let width = hi - lo;
         // g → f′/(hi − lo) at the ends, f′ = −2S/(I_X + Ma²): the limit where rounding leaves f ≤ 0.
-        let end_g = [lo, hi].map(|t| (2.0 * self.slope(t) / self.lever).abs() / width);
+        let end_g = [lo, hi].map(|t| self.turn_slope(t) / width);
         let sums = |n: usize| {
             let (mut time, mut heading, mut spin, mut heading_scale, mut f_max) =
                 (0.0, 0.0, 0.0, 0.0, 0.0_f64);
@@ -644,7 +623,7 @@ impl Reduced<'_> {
             (true, false) => self.leaving_turning_point(leg.from, leg.to),
             (false, true) => self.leaving_turning_point(leg.to, leg.from),
             (false, false) => {
-                let f = |theta: f64| 1.0 / self.theta_dot_squared(theta).max(0.0).sqrt();
+                let f = |theta: f64| self.inverse_rate(theta);
                 let (a, b) = (leg.from.min(leg.to), leg.from.max(leg.to));
                 let r = self.adaptive.integrate(&f, a, b, TRAVEL_RTOL);
                 (r.value, r.error)
@@ -660,19 +639,15 @@ impl Reduced<'_> {
     }
 
     /// The escape from a turning point `turn` close to upright (|turn| ≤ [`MATCHING`]/64) out past the
-    /// matching angle θ_m = turn ± [`MATCHING`] (physics §12). With x = |θ − turn|, θ̇² = x g(x) and
-    /// g = p + q x + O(x²) (p = 2|S(turn)|/(I_X + Ma²), q ≈ λ² cos turn), so the time to θ_m is
-    /// (2/√q) asinh(√(q x_m/p)), which grows like ln(1/θ₀)/λ, and the rest is a regular quadrature.
-    /// The error of stopping g at x: θ̇⁻¹ changes by O(x²) relative (O(x³) of g for an upright that is
-    /// symmetric, θ_m²/(48λ) without spin), an O(x_m²) error independent of θ₀, removed by Richardson
-    /// from halving x_m and bounded by twice that change. `None` where it does not apply (the quadrature in v resolves the
-    /// singularity there: measured at θ₀ = 1e-5, within 2e-16 of the ln law; below 1e-25 it cannot).
+    /// matching angle θ_m = turn ± [`MATCHING`], eq (41) of physics §12, with θ̇² = x g(x),
+    /// g = p + q x + O(x²), x = |θ − turn|; Richardson from halving x_m. `None` where it does not apply
+    /// (the quadrature in v resolves the singularity there: at θ₀ = 1e-5 within 2e-16 of the ln law).
     fn escape(&self, turn: f64, other: f64) -> Option<(f64, f64)> {
         let (span, direction) = ((other - turn).abs(), (other - turn).signum());
         if turn.abs() > MATCHING / 64.0 || span <= 2.0 * MATCHING {
             return None;
         }
-        let p = (2.0 * self.slope(turn) / self.lever).abs();
+        let p = self.turn_slope(turn);
         let g = |x: f64| self.theta_dot_squared(turn + direction * x) / x;
         // q = g′(0) by Richardson from the secants at two small x: the O(x) and O(x²) terms of the
         // secant cancel to O(x₁x₂) ~ 1e-13 relative; rounding of g − p adds ~1e-15 (1 + p/(q x)).
@@ -694,7 +669,7 @@ impl Reduced<'_> {
         };
         let time_from = |x: f64| {
             let at = turn + direction * x;
-            let f = |theta: f64| 1.0 / self.theta_dot_squared(theta).max(0.0).sqrt();
+            let f = |theta: f64| self.inverse_rate(theta);
             let r = self
                 .adaptive
                 .integrate(&f, at.min(other), at.max(other), TRAVEL_RTOL);
@@ -721,7 +696,7 @@ impl Reduced<'_> {
         if span == 0.0 {
             return (0.0, 0.0);
         }
-        let slope = (2.0 * self.slope(turn) / self.lever).abs();
+        let slope = self.turn_slope(turn);
         let f = |v: f64| {
             let theta = turn + span * v * v;
             // Near the turning point f = −2 span v² mean(S)/(I_X + Ma²): the factor v² cancels.
@@ -742,8 +717,7 @@ impl Reduced<'_> {
 
     /// The smallest N and the largest |F|/N over [θ_min, θ_max].
     fn extremes(&self, orbit: &mut Orbit) {
-        let normal = |theta: f64| reaction(self.coin, &self.state(theta)).normal;
-        orbit.min_normal = extreme(orbit.theta_min, orbit.theta_max, |t| -normal(t));
+        orbit.min_normal = extreme(orbit.theta_min, orbit.theta_max, |t| -self.normal(t));
         orbit.min_normal.value = -orbit.min_normal.value;
         orbit.max_friction_ratio = (orbit.min_normal.value > 0.0).then(|| {
             extreme(orbit.theta_min, orbit.theta_max, |t| {
@@ -755,8 +729,7 @@ impl Reduced<'_> {
 
     /// The first place along `legs` where N reaches 0, and when.
     fn lift_off(&self, legs: &[Leg]) -> Option<Event> {
-        let normal = |theta: f64| reaction(self.coin, &self.state(theta)).normal;
-        if normal(self.theta0) <= 0.0 {
+        if self.normal(self.theta0) <= 0.0 {
             return Some(Event {
                 theta: self.theta0,
                 time: 0.0,
@@ -769,8 +742,8 @@ impl Reduced<'_> {
             for j in 1..=scan {
                 #[allow(clippy::cast_precision_loss)]
                 let theta = leg.from + (leg.to - leg.from) * j as f64 / scan as f64;
-                if normal(theta) <= 0.0 {
-                    let (_, at) = bisect(|t| normal(t) > 0.0, previous, theta);
+                if self.normal(theta) <= 0.0 {
+                    let (_, at) = bisect(|t| self.normal(t) > 0.0, previous, theta);
                     let part = Leg {
                         to: at,
                         to_turns: false,

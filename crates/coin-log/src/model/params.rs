@@ -2,20 +2,14 @@
 
 use thiserror::Error;
 
-/// A problem with one body parameter: the field, its value and the allowed range.
+/// A body parameter that is NaN, infinite, zero or negative.
 #[derive(Debug, Clone, PartialEq, Error)]
-pub enum ParamError {
-    /// A parameter is NaN, infinite, zero or negative.
-    #[error("`{name}` = {value} is not allowed: it must be a finite number > 0")]
-    NotPositive {
-        /// Name of the field (`mass`, `radius`, `gravity`, `inertia_x`, `inertia_z`).
-        name: &'static str,
-        /// The value that was given.
-        value: f64,
-    },
-    /// Both a shape and explicit inertias were given, or only one inertia.
-    #[error("{0}")]
-    InertiaSpec(String),
+#[error("`{name}` = {value} is not allowed: it must be a finite number > 0")]
+pub struct ParamError {
+    /// Name of the field (`mass`, `radius`, `gravity`, `inertia_x`, `inertia_z`).
+    pub name: &'static str,
+    /// The value that was given.
+    pub value: f64,
 }
 
 /// How the axisymmetric inertia is specified.
@@ -48,7 +42,7 @@ pub struct CoinParams {
 
 fn positive(name: &'static str, value: f64, errors: &mut Vec<ParamError>) {
     if !(value.is_finite() && value > 0.0) {
-        errors.push(ParamError::NotPositive { name, value });
+        errors.push(ParamError { name, value });
     }
 }
 

@@ -1,10 +1,6 @@
 //! One-dimensional quadrature and root finding for the nutation integrals (physics §10): Gauss–Legendre
-//! rules, an adaptive Gauss–Legendre integrator, and bisection on a bracket.
-//!
-//! Written here rather than taken from a crate: the rules are twenty lines (Newton on the three-term
-//! recurrence, as in Abramowitz & Stegun 25.4.29), the integrands are cheap closures, and no quadrature
-//! crate in the dependency tree offers an error-controlled adaptive rule that compares two Gauss rules per
-//! panel without allocation per call.
+//! rules, an adaptive Gauss–Legendre integrator, and bisection on a bracket; no crate in the dependency
+//! tree offers an adaptive rule that compares two Gauss rules per panel without allocating per call.
 
 /// Nodes and weights of n-point Gauss–Legendre quadrature on [−1, 1] (Newton on P_n from Chebyshev
 /// guesses; Abramowitz & Stegun 25.4.29). The nodes come in decreasing order.
@@ -47,7 +43,7 @@ const FINE: usize = 20;
 const MAX_DEPTH: u32 = 24;
 /// A halved panel whose two halves together still differ by more than this fraction of the whole
 /// panel's difference is noise-limited (see [`Adaptive`]).
-pub const NOISE_RATIO: f64 = 0.25;
+const NOISE_RATIO: f64 = 0.25;
 /// The two rules of a noise-limited panel agree to this fraction of ∫|f| over it.
 const NOISE_FLOOR: f64 = 1e-10;
 /// Most integrand evaluations of one [`Adaptive::integrate`]; past it every panel is accepted as it is.
@@ -57,7 +53,7 @@ const MAX_EVALUATIONS: usize = 200_000;
 /// estimates differ by more than the tolerance's share is halved. For integrands that are analytic on
 /// the panel the 20-point rule is then far more accurate than the difference says, so the difference is
 /// an error bound in practice. Halving a panel of an analytic integrand shrinks the difference by orders
-/// of magnitude; where it does not shrink by at least [`NOISE_RATIO`], the difference is the integrand's
+/// of magnitude; where it does not shrink by at least `NOISE_RATIO`, the difference is the integrand's
 /// rounding noise, which no further halving removes, and the panel is accepted.
 #[derive(Debug, Clone)]
 pub struct Adaptive {

@@ -2,7 +2,6 @@
 //! any steady motion (physics §9).
 
 use super::equations::Coin;
-use nalgebra::Matrix4;
 
 /// λ² of straight rolling at spin ω_Z0 (physics §5):
 /// λ² = (Mga − I_Z(I_Z + Ma²) ω_Z0² / I_X) / (I_X + Ma²). Positive: the tilt grows like e^{λt};
@@ -46,19 +45,9 @@ pub fn centre_fixed_sigma_squared(coin: &Coin, theta0: f64) -> f64 {
     p.energy_scale() * (p.ma2() * c / p.inertia_x() + 3.0 * s * s / c) / (p.inertia_x() + p.ma2())
 }
 
-/// The reduced system of eqs (14)–(17) linearised about a state with ω_X = 0 (physics §9).
-///
-/// The state vector is (θ, ω_X, ω_Y, ω_Z); φ, ψ, x, z do not enter the right-hand sides and drop out. At
-/// ω_X = 0 the Jacobian has the pattern
-///
-/// ```text
-///     ⎛ 0  1  0  0 ⎞        A = ∂ω̇_X/∂θ,  B = ∂ω̇_X/∂ω_Y,  C = ∂ω̇_X/∂ω_Z      (eq (14))
-/// J = ⎜ A  0  B  C ⎟        D = ∂ω̇_Y/∂ω_X = ω_Y tan θ + (I_Z/I_X) ω_Z        (eq (15))
-///     ⎜ 0  D  0  0 ⎟        E = ∂ω̇_Z/∂ω_X = Ma² ω_Y/(I_Z + Ma²)              (eq (16))
-///     ⎝ 0  E  0  0 ⎠
-/// ```
-///
-/// whose characteristic polynomial is λ²(λ² + σ²) with σ² = −(A + BD + CE), eq (20).
+/// The reduced system of eqs (14)–(17) linearised about a state with ω_X = 0: the entries A … E of its
+/// Jacobian in (θ, ω_X, ω_Y, ω_Z), eq (20) of physics §9, whose characteristic polynomial is
+/// λ²(λ² + σ²) with σ² = −(A + BD + CE).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Linearisation {
     /// ∂ω̇_X/∂θ = (Mga cos θ − I_X ω_Y² / cos²θ)/(I_X + Ma²).
@@ -103,26 +92,6 @@ impl Linearisation {
     #[must_use]
     pub fn scale(&self) -> f64 {
         self.a.abs() + (self.b * self.d).abs() + (self.c * self.e).abs()
-    }
-
-    /// The 4 × 4 Jacobian of (θ̇, ω̇_X, ω̇_Y, ω̇_Z) with respect to (θ, ω_X, ω_Y, ω_Z).
-    #[must_use]
-    pub fn jacobian(&self) -> Matrix4<f64> {
-        #[rustfmt::skip]
-        let j = Matrix4::new(
-            0.0,    1.0,    0.0,    0.0,
-            self.a, 0.0,    self.b, self.c,
-            0.0,    self.d, 0.0,    0.0,
-            0.0,    self.e, 0.0,    0.0,
-        );
-        j
-    }
-
-    /// The eigenvalues of the Jacobian, the roots of λ²(λ² + σ²): 0, 0 and ±√(−σ²), as (re, im) pairs,
-    /// the two zeros first, then the pair with the positive real or imaginary part first.
-    #[must_use]
-    pub fn eigenvalues(&self) -> [(f64, f64); 4] {
-        eigenvalues(self.sigma_squared())
     }
 }
 

@@ -18,6 +18,19 @@ coin_log_names::named_enum! {
     }
 }
 
+impl Branch {
+    /// The root of the steady family at (θ, ω_Z) nearest to `omega_y` (+ on a tie).
+    #[must_use]
+    pub fn nearest(coin: &Coin, theta: f64, omega_z: f64, omega_y: f64) -> Self {
+        let distance = |b: Self| (steady_omega_y(coin, theta, omega_z, b) - omega_y).abs();
+        if distance(Self::Plus) <= distance(Self::Minus) {
+            Self::Plus
+        } else {
+            Self::Minus
+        }
+    }
+}
+
 coin_log_names::named_enum! {
     /// The four families of steady motion by name: the `kind` of a scene's `initial.steady` and the
     /// `steady_kind` of a recording's metadata (physics §4, §5).
@@ -225,18 +238,7 @@ impl Steady {
             omega_z,
             ..State::default()
         };
-        let (st, ct) = theta.sin_cos();
-        let phi_dot = omega_y / ct;
-        let psi_dot = omega_z + omega_y * st / ct;
-        let (r_g, r_c) = match kind {
-            SteadyKind::Straight { .. } => (None, None),
-            SteadyKind::SpinUpright { .. } => (Some(0.0), Some(0.0)),
-            // R_G = a|ω_Z cos θ / ω_Y|, R_C = a|ω_Z cos θ / ω_Y + sin θ| (physics §4.3; item 2 with ω_Z = 0).
-            SteadyKind::CentreFixed { .. } | SteadyKind::Circle { .. } => {
-                let signed = omega_z * ct / omega_y;
-                (Some(a * signed.abs()), Some(a * (signed + st).abs()))
-            }
-        };
+        let (phi_dot, psi_dot, r_g, r_c) = rates_and_radii(coin, kind.family(), &state);
         Ok(Self {
             kind,
             state,
@@ -246,16 +248,26 @@ impl Steady {
             r_c,
         })
     }
+}
 
-    /// Centre of the circle traced by the coin's centre, in the table plane (x, z), for a motion that
-    /// starts from `start` (any φ₀, x₀, z₀): C = p₀ + (a ω_Z / φ̇)(sin φ₀, cos φ₀). `None` when φ̇ = 0.
-    #[must_use]
-    pub fn circle_centre(&self, coin: &Coin, start: &State) -> Option<(f64, f64)> {
-        if self.phi_dot == 0.0 {
-            return None;
+/// φ̇ = ω_Y / cos θ and ψ̇ = ω_Z + ω_Y tan θ (eqs (18)–(19)), and the radii R_G = a|ω_Z cos θ / ω_Y| and
+/// R_C = a|ω_Z cos θ / ω_Y + sin θ| of the circles of the centre and the contact point (physics §4.3;
+/// `None` for straight rolling, 0 for the upright spin) of the steady motion `state` of `family`.
+pub(crate) fn rates_and_radii(
+    coin: &Coin,
+    family: SteadyFamily,
+    state: &State,
+) -> (f64, f64, Option<f64>, Option<f64>) {
+    let (wy, wz) = (state.omega_y, state.omega_z);
+    let a = coin.params().radius();
+    let (st, ct) = state.theta.sin_cos();
+    let (r_g, r_c) = match family {
+        SteadyFamily::Straight => (None, None),
+        SteadyFamily::SpinUpright => (Some(0.0), Some(0.0)),
+        SteadyFamily::CentreFixed | SteadyFamily::Circle => {
+            let signed = wz * ct / wy;
+            (Some(a * signed.abs()), Some(a * (signed + st).abs()))
         }
-        let scale = coin.params().radius() * start.omega_z / self.phi_dot;
-        let (sp, cp) = start.phi.sin_cos();
-        Some((start.x + scale * sp, start.z + scale * cp))
-    }
+    };
+    (wy / ct, wz + wy * st / ct, r_g, r_c)
 }

@@ -74,7 +74,7 @@ impl EnergyCheck {
             return CheckResult::skip(CheckId::Energy, reason);
         };
         let drift = energy_drift.value();
-        let agreement = self.agreement.value / energy_drift.scale();
+        let agreement = self.agreement.value / energy_drift.scale;
         let mut measures = vec![(drift, tol.energy, "drift")];
         if self.stored > 0 {
             measures.push((agreement, RECOMPUTE_TOLERANCE, "agreement"));

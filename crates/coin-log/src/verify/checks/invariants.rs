@@ -56,7 +56,7 @@ impl InvariantsCheck {
             );
         };
         let drift = invariant_drift.value();
-        let agreement = self.agreement.value / invariant_drift.scale();
+        let agreement = self.agreement.value / invariant_drift.scale;
         let scale = if invariant_drift.natural_scale() {
             "√(g/a), since C1_0 = C2_0 = 0"
         } else {

@@ -10,6 +10,8 @@ pub mod nutation;
 pub mod steady;
 pub mod validity;
 
+pub use crate::model::drift::Worst as Max;
+
 use super::samples::Sample;
 use crate::format::{ResultMetadata, RunMetadata};
 use crate::model::invariants::Chaplygin;
@@ -96,24 +98,5 @@ pub fn fmt_num(x: f64) -> String {
             .to_string()
     } else {
         format!("{x:.2e}")
-    }
-}
-
-/// A running maximum that remembers when it happened.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Max {
-    /// The maximum so far (NaN wins: a NaN residual is a failure).
-    pub value: f64,
-    /// Time of the maximum.
-    pub t: f64,
-}
-
-impl Max {
-    /// Offers a value at time t.
-    pub fn offer(&mut self, value: f64, t: f64) {
-        if value > self.value || (value.is_nan() && !self.value.is_nan()) {
-            self.value = value;
-            self.t = t;
-        }
     }
 }
