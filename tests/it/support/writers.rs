@@ -11,8 +11,8 @@ use coin_log::format::messages::{
     ReactionMessage, WorkMessage,
 };
 use coin_log::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, Topic, MESSAGE_ENCODING, RESULT_METADATA_NAME,
-    RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, Encoding, ResultMetadata, Topic, MESSAGE_ENCODING,
+    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
 };
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunEnd, RunSettings};
 use coin_log::model::{
@@ -268,7 +268,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         metadata: BTreeMap::from([("format_version".to_string(), "1".to_string())]),
     })
     .unwrap();
-    let mut fox = Foxglove3d::new(&coin, 0.05, true, true);
+    let mut fox = Foxglove3d::new(&coin, 0.05, &[Channel::Tf, Channel::Scene], Encoding::Json);
     let mut batch = FoxgloveBatch::default();
     let mut sequence = 0u32;
     let mut damaged = false;

@@ -26,7 +26,8 @@
 //! quaternion, contact point, height, reaction and invariants against their inputs) repeat the recorder's
 //! arithmetic on the same numbers, so they are held to [`RECOMPUTE_TOLERANCE`].
 
-use crate::integrate::Method;
+use crate::integrate::{Method, MethodConfig};
+use crate::model::CoinParams;
 
 /// Unit roundoff of f64, 2⁻⁵³: what one rounding costs, relative (the limits of a scene, the rounding
 /// `record` predicts).
@@ -92,6 +93,21 @@ pub struct RunAccuracy {
 }
 
 impl RunAccuracy {
+    /// A run integrated by `method` on a coin of `params`, over `span` with rates up to `max_omega`.
+    #[must_use]
+    pub fn new(method: &MethodConfig, params: &CoinParams, span: f64, max_omega: f64) -> Self {
+        Self {
+            integrator: method.method,
+            rtol: method.rtol,
+            atol: method.atol,
+            step: method.step,
+            radius: params.radius(),
+            time_unit: params.time_unit(),
+            span,
+            max_omega,
+        }
+    }
+
     /// ε of the module doc: from rtol and atol for adaptive methods, from the step alone for fixed-step
     /// ones.
     #[must_use]

@@ -1,45 +1,9 @@
-//! Foxglove's 3D view of the coin (docs/format.md: Frames and Foxglove output).
-//!
-//! A Foxglove-lineage viewer, after a seek, restores only the latest message of each topic and forgets every
-//! drawn object (and, on a backward seek, every transform). So each thing the view needs has a topic whose
-//! latest message alone draws it:
-//!
-//! # Frames (`tf` channel, physical units)
-//! - `world`: Foxglove's convention, z up; the root.
-//! - `table`: the physics frame (physics §1: the table is the z–x plane, y up). Its transform from `world` is
-//!   the static rotation by +90° about x, q_T = (sin 45°, 0, 0, cos 45°) ([`TABLE_ROTATION`]): note x →
-//!   world x, y (up) → world z, z → world −y; proper (det +1), so the note's quaternion needs no change.
-//!   Published at t = 0 as the first message of `/tf` (the contract) and on `/tf_static`, its own topic,
-//!   whose one message comes back after every seek.
-//! - `coin`: translation = centre (x, a cos θ, z) in `table`, rotation = q of [`orientation`]; in the `coin`
-//!   frame the coin is a cylinder whose axis is z (physics §8 item 5). On `/tf` at **every data sample**:
-//!   the viewer interpolates between transforms along the shortest arc, so at a lower rate a coin turning
-//!   by more than π between two transforms would be drawn spinning backwards.
-//!
-//! # The drawing (`scene` channel, units of a)
-//! Everything drawn is in display units, lengths divided by the radius a, so that one layout (camera
-//! distance, line widths) suits every coin: the 500-yen coin (a = 13.25 mm) looks like the unit coin. For
-//! a = 1 the drawing coincides with the physical frames. At the display rate [`SCENE_RATE`] (≈ 30 per time
-//! unit of simulation time, one time unit being one second of log time), at the first sample and at the
-//! last:
-//! - `/scene/follow`: the frame `coin_level` ([`FOLLOW_FRAME`]), child of `world`, at the coin's centre
-//!   (x/a, −z/a, cos θ) with the identity rotation: a level frame that moves with the coin, for the camera
-//!   to follow (the `coin` frame tilts and spins, and a camera riding on it ends up under the table).
-//! - `/scene`: the coin, entity `coin` in `coin_level`, posed with the coin's orientation in `world`
-//!   (q_T · q): a cylinder {2, 2, thickness} with a stripe on each face (dark red on +z, dark blue on −z)
-//!   so that spin and the face that is up both show.
-//! - `/scene/table`: the table, entity `table` in `world`: a slab 2·[`TABLE_HALF_SIDE`] wide just below the
-//!   plane with grid lines every 1 (darker every 5) fixed to the table, so that motion shows. Its centre is
-//!   a multiple of [`TABLE_SNAP`] near the coin; it is republished only when the coin has moved more than
-//!   [`TABLE_SNAP`] from it, so the coin always has ≥ 20 a of table around it.
-//! - `/scene/track/<L>`: the contact track as levels of a binary counter ([`track`]): the latest message of
-//!   every level together draw the whole path from t = 0 to the latest update, simplified within
-//!   [`track::MAX_TOLERANCE`] (0.01 a).
-//!
-//! All timestamps `{sec, nsec}` are the log time of the sample ([`crate::format::log_time`]).
-//!
-//! With the opt-in `rerun` channel, each drawing update also gives the same coin, table and track in the
-//! types Rerun's MCAP importer draws ([`rerun`]).
+//! Foxglove's 3D view of the coin (docs/format.md: Frames and Foxglove output): after a seek a viewer keeps
+//! only the latest message of each topic, so each thing the view needs has a topic whose latest message
+//! alone draws it. Frames (`tf`, physical units): `world` (z up) → `table` (the physics frame, y up,
+//! [`TABLE_ROTATION`]) → `coin`. The drawing (`scene`, units of a, at [`SCENE_RATE`]): `/scene/follow`
+//! ([`FOLLOW_FRAME`]), `/scene` (the coin), `/scene/table`, and the track's levels ([`track`]); the opt-in
+//! `rerun` channel draws them again for Rerun ([`rerun`]).
 
 mod json;
 mod proto;
@@ -49,7 +13,6 @@ pub mod track;
 use crate::format::messages::NonFiniteField;
 use crate::format::{Channel, Encoding, Topic, FRAME_TRANSFORM, SCENE_UPDATE, TRACK_LEVELS};
 use crate::model::{contact_point, orientation, Coin, State};
-use json::{check, Writer};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::ops::Range;
 use track::Track;
@@ -94,8 +57,6 @@ const TRACK_WIDTH: f64 = 3.0;
 /// Every GRID_MAJOR-th grid line is a major one.
 const GRID_MAJOR: i32 = 5;
 
-const IDENTITY_POSE: &[u8] =
-    br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
 /// A colour (r, g, b, a) in 0..1, as both encodings write it.
 type Rgba = [f64; 4];
 const COIN_RGBA: Rgba = [0.85, 0.65, 0.2, 1.0];
@@ -105,6 +66,28 @@ const GRID_RGBA: [Rgba; 2] = [[0.66, 0.66, 0.63, 1.0], [0.45, 0.45, 0.43, 1.0]];
 const TRACK_RGBA: Rgba = [0.1, 0.35, 0.9, 1.0];
 
 pub use proto::MAX_SECONDS as PROTOBUF_MAX_SECONDS;
+
+/// Calls the writer `$f` of `$encoding`: [`json`] and [`proto`] have the same writers.
+macro_rules! encode {
+    ($encoding:expr, $f:ident($($arg:expr),*)) => {
+        match $encoding {
+            Encoding::Json => json::$f($($arg),*),
+            Encoding::Protobuf => proto::$f($($arg),*),
+        }
+    };
+}
+
+/// `Err` naming `field` of `schema` unless every value is finite (neither encoding carries the others).
+fn finite(schema: &'static str, field: &'static str, values: &[f64]) -> Result<(), NonFiniteField> {
+    match values.iter().find(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(&value) => Err(NonFiniteField {
+            schema,
+            field,
+            value,
+        }),
+    }
+}
 
 /// The coin's two face marks, posed with the coin's orientation `r`: (centre in `coin_level`, size, colour),
 /// the top (+z) face's first. A bar 0.85 × 0.12 just outside each face, `0.2 · thickness` thick (at least
@@ -142,7 +125,7 @@ fn grid_segments(centre: [f64; 2], major: bool) -> impl Iterator<Item = ([f64; 2
         })
 }
 
-/// The Foxglove messages due at one sample, in one reused buffer.
+/// The messages due at one sample, in one reused buffer.
 #[derive(Debug, Default)]
 pub struct FoxgloveBatch {
     bytes: Vec<u8>,
@@ -157,25 +140,10 @@ impl FoxgloveBatch {
     }
 
     /// Appends one message on `topic`, written by `write`.
-    ///
-    /// # Errors
-    /// Whatever `write` returns; the batch is then left without the message.
-    pub fn push(
-        &mut self,
-        topic: Topic,
-        write: impl FnOnce(&mut Vec<u8>) -> Result<(), NonFiniteField>,
-    ) -> Result<(), NonFiniteField> {
+    pub fn push(&mut self, topic: Topic, write: impl FnOnce(&mut Vec<u8>)) {
         let start = self.bytes.len();
-        match write(&mut self.bytes) {
-            Ok(()) => {
-                self.messages.push((topic, start..self.bytes.len()));
-                Ok(())
-            }
-            Err(e) => {
-                self.bytes.truncate(start);
-                Err(e)
-            }
-        }
+        write(&mut self.bytes);
+        self.messages.push((topic, start..self.bytes.len()));
     }
 
     /// The messages, in the order they were pushed.
@@ -183,18 +151,6 @@ impl FoxgloveBatch {
         self.messages
             .iter()
             .map(|(c, r)| (*c, &self.bytes[r.clone()]))
-    }
-
-    /// Number of messages in the batch.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.messages.len()
-    }
-
-    /// True when the batch holds no message.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.messages.is_empty()
     }
 }
 
@@ -212,66 +168,37 @@ pub struct Foxglove3d {
     started: bool,
     /// round(t · SCENE_RATE) of the last scene update.
     last_scene_slot: u64,
-    /// The latest sample's log time and state, and whether it had a scene update (for [`Self::finish`]).
-    last_log_time: u64,
-    last_state: State,
-    last_had_scene: bool,
     /// Table centre (display units), once drawn.
     table: Option<[f64; 2]>,
     track: Track,
     /// Whether the latest message of each track level drew a line (else it deleted it, or there was none).
     drawn: [bool; TRACK_LEVELS],
-    /// The `rerun` channel's output, when recorded.
+    /// The `rerun` channel's output, when recorded (drawn with the scene, so only when `scene` is).
     rerun: Option<rerun::Rerun3d>,
 }
 
 impl Foxglove3d {
-    /// Output for `coin` drawn `thickness` (fraction of a) thick; `tf` and `scene` say which channels are on.
+    /// Output for `coin` drawn `thickness` (fraction of a) thick, of those of `channels` it writes (`tf`,
+    /// `scene`, `rerun`), in `encoding` (`rerun` is Protobuf whatever the encoding: the recorder refuses it
+    /// in JSON).
     #[must_use]
-    pub fn new(coin: &Coin, thickness: f64, tf: bool, scene: bool) -> Self {
-        Self::with_encoding(coin, thickness, tf, scene, Encoding::Json)
-    }
-
-    /// [`Self::new`] writing its messages in `encoding`.
-    #[must_use]
-    pub fn with_encoding(
-        coin: &Coin,
-        thickness: f64,
-        tf: bool,
-        scene: bool,
-        encoding: Encoding,
-    ) -> Self {
+    pub fn new(coin: &Coin, thickness: f64, channels: &[Channel], encoding: Encoding) -> Self {
+        let scene = channels.contains(&Channel::Scene);
         Self {
             coin: *coin,
             encoding,
             inv_a: 1.0 / coin.params().radius(),
             thickness,
-            tf,
+            tf: channels.contains(&Channel::Tf),
             scene,
             started: false,
             last_scene_slot: 0,
-            last_log_time: 0,
-            last_state: State::default(),
-            last_had_scene: false,
             table: None,
             track: Track::default(),
             drawn: [false; TRACK_LEVELS],
-            rerun: None,
+            rerun: (scene && channels.contains(&Channel::Rerun))
+                .then(|| rerun::Rerun3d::new(thickness)),
         }
-    }
-
-    /// The output with the `rerun` channel too (drawn with the scene, so only when `scene` is on;
-    /// Protobuf messages whatever the encoding: the recorder refuses `rerun` in JSON).
-    #[must_use]
-    pub fn with_rerun(mut self) -> Self {
-        self.rerun = self.scene.then(|| rerun::Rerun3d::new(self.thickness));
-        self
-    }
-
-    /// True when neither `/tf` nor `/scene` is recorded (nothing to compute).
-    #[must_use]
-    pub fn is_off(&self) -> bool {
-        !self.tf && !self.scene
     }
 
     /// Appends to `out` the messages due at the sample (t, s), whose log time is `log_time` ns; `last` marks
@@ -291,29 +218,29 @@ impl Foxglove3d {
         last: bool,
         out: &mut FoxgloveBatch,
     ) -> Result<(), NonFiniteField> {
-        if self.is_off() {
-            return Ok(());
-        }
         let first = !self.started;
+        let encoding = self.encoding;
         if self.tf {
+            let translation = [s.x, self.coin.params().radius() * s.theta.cos(), s.z];
+            let q = orientation(s);
+            finite(FRAME_TRANSFORM, "translation", &translation)?;
+            finite(FRAME_TRANSFORM, "rotation", q.coords.as_slice())?;
             let tf = Topic::Main(Channel::Tf);
-            let table = match self.encoding {
-                Encoding::Json => write_table_transform,
-                Encoding::Protobuf => proto::table_transform,
-            };
             if first {
-                out.push(tf, |buf| table(buf, log_time))?;
+                out.push(tf, |buf| encode!(encoding, table_transform(buf, log_time)));
             }
-            out.push(tf, |buf| self.write_coin_transform(buf, log_time, s))?;
+            out.push(tf, |buf| {
+                encode!(encoding, coin_transform(buf, log_time, translation, &q));
+            });
             if first {
-                out.push(Topic::TfStatic, |buf| table(buf, log_time))?;
+                out.push(Topic::TfStatic, |buf| {
+                    encode!(encoding, table_transform(buf, log_time));
+                });
             }
         }
-        self.last_had_scene = false;
         if self.scene {
             let c = contact_point(&self.coin, s);
-            check(SCENE_UPDATE, "lines.points.x", c.x)?;
-            check(SCENE_UPDATE, "lines.points.y", c.z)?;
+            finite(SCENE_UPDATE, "lines.points", &[c.x, c.z])?;
             self.track.add(c.x * self.inv_a, -c.z * self.inv_a);
             if let Some(r) = &mut self.rerun {
                 r.contact([c.x * self.inv_a, -c.z * self.inv_a]);
@@ -325,22 +252,6 @@ impl Foxglove3d {
             }
         }
         self.started = true;
-        self.last_log_time = log_time;
-        self.last_state = *s;
-        Ok(())
-    }
-
-    /// Ends the output: if the latest sample had no drawing update (a recorder that learns only after the
-    /// fact that a sample was the last one), appends one at that sample's log time, so the view shows the
-    /// final state and the whole track. Does nothing otherwise, or if no sample was given.
-    ///
-    /// # Errors
-    /// [`NonFiniteField`] if a value is not finite.
-    pub fn finish(&mut self, out: &mut FoxgloveBatch) -> Result<(), NonFiniteField> {
-        if self.scene && self.started && !self.last_had_scene {
-            let s = self.last_state;
-            self.push_drawing(self.last_log_time, &s, out)?;
-        }
         Ok(())
     }
 
@@ -353,24 +264,19 @@ impl Foxglove3d {
         out: &mut FoxgloveBatch,
     ) -> Result<(), NonFiniteField> {
         let centre = [s.x * self.inv_a, -s.z * self.inv_a, s.theta.cos()];
-        let protobuf = self.encoding == Encoding::Protobuf;
-        out.push(Topic::SceneFollow, |buf| {
-            if protobuf {
-                proto::follow_transform(buf, log_time, centre)
-            } else {
-                write_follow_transform(buf, log_time, centre)
-            }
-        })?;
         let rotation = TABLE_ROTATION * orientation(s);
+        let (encoding, thickness) = (self.encoding, self.thickness);
+        finite(SCENE_UPDATE, "pose.position", &centre)?;
+        finite(SCENE_UPDATE, "pose.orientation", rotation.coords.as_slice())?;
+        finite(SCENE_UPDATE, "cylinders.size.z", &[thickness])?;
+        out.push(Topic::SceneFollow, |buf| {
+            encode!(encoding, follow_transform(buf, log_time, centre));
+        });
         out.push(Topic::Main(Channel::Scene), |buf| {
-            if protobuf {
-                proto::coin(buf, log_time, &rotation, self.thickness)
-            } else {
-                self.write_coin(buf, log_time, &rotation)
-            }
-        })?;
+            encode!(encoding, coin(buf, log_time, &rotation, thickness));
+        });
         if let Some(r) = &mut self.rerun {
-            r.coin(log_time, &rotation, out)?;
+            r.coin(log_time, &rotation, out);
         }
         let moved = match self.table {
             Some(t) if (centre[0] - t[0]).abs().max((centre[1] - t[1]).abs()) <= TABLE_SNAP => None,
@@ -378,17 +284,10 @@ impl Foxglove3d {
         };
         if let Some(table) = moved {
             out.push(Topic::SceneTable, |buf| {
-                if protobuf {
-                    proto::table(buf, log_time, table)
-                } else {
-                    write_table(buf, log_time, table)
-                }
-            })?;
+                encode!(encoding, table(buf, log_time, table));
+            });
             if self.rerun.is_some() {
-                out.push(Topic::RerunTable, |buf| {
-                    rerun::table(buf, log_time, table);
-                    Ok(())
-                })?;
+                out.push(Topic::RerunTable, |buf| rerun::table(buf, log_time, table));
             }
             self.table = Some(table);
         }
@@ -398,9 +297,8 @@ impl Foxglove3d {
             }
         }
         if let Some(r) = &mut self.rerun {
-            r.track(log_time, out)?;
+            r.track(log_time, out);
         }
-        self.last_had_scene = true;
         Ok(())
     }
 
@@ -414,208 +312,20 @@ impl Foxglove3d {
         // level < TRACK_LEVELS = 16 fits in a u8.
         let topic = Topic::SceneTrack(u8::try_from(level).unwrap_or(u8::MAX));
         let points = self.track.level(level);
-        let protobuf = self.encoding == Encoding::Protobuf;
+        let encoding = self.encoding;
         if !points.is_empty() {
-            out.push(topic, |buf| {
-                if protobuf {
-                    proto::track(buf, log_time, points)
-                } else {
-                    write_track(buf, log_time, points)
-                }
-            })?;
+            for p in points {
+                finite(SCENE_UPDATE, "lines.points", &[p.x, p.y])?;
+            }
+            out.push(topic, |buf| encode!(encoding, track(buf, log_time, points)));
         } else if self.drawn[level] {
             out.push(topic, |buf| {
-                if protobuf {
-                    proto::track_deletion(buf, log_time);
-                } else {
-                    write_track_deletion(buf, log_time);
-                }
-                Ok(())
-            })?;
+                encode!(encoding, track_deletion(buf, log_time))
+            });
         }
         self.drawn[level] = !points.is_empty();
         Ok(())
     }
-
-    fn write_coin_transform(
-        &self,
-        buf: &mut Vec<u8>,
-        log_time: u64,
-        s: &State,
-    ) -> Result<(), NonFiniteField> {
-        let a = self.coin.params().radius();
-        let q = orientation(s);
-        if self.encoding == Encoding::Protobuf {
-            return proto::coin_transform(buf, log_time, [s.x, a * s.theta.cos(), s.z], &q);
-        }
-        let mut w = Writer::new(buf, FRAME_TRANSFORM);
-        w.raw(b"{\"timestamp\":");
-        w.time(log_time);
-        w.raw(
-            b",\"parent_frame_id\":\"table\",\"child_frame_id\":\"coin\",\"translation\":{\"x\":",
-        );
-        w.num("translation.x", s.x)?;
-        w.raw(b",\"y\":");
-        w.num("translation.y", a * s.theta.cos())?;
-        w.raw(b",\"z\":");
-        w.num("translation.z", s.z)?;
-        w.raw(b"},\"rotation\":");
-        w.quaternion(&q)?;
-        w.raw(b"}");
-        Ok(())
-    }
-
-    /// `/scene`: the coin in `coin_level`, posed with its orientation `r` in `world`: a cylinder with its axis
-    /// along the body's z, and a stripe on each face.
-    fn write_coin(
-        &self,
-        buf: &mut Vec<u8>,
-        log_time: u64,
-        r: &UnitQuaternion<f64>,
-    ) -> Result<(), NonFiniteField> {
-        let h = self.thickness;
-        check(SCENE_UPDATE, "cylinders.size.z", h)?;
-        let mut w = Writer::new(buf, SCENE_UPDATE);
-        w.raw(b"{\"deletions\":[],\"entities\":[");
-        w.entity_head(log_time, FOLLOW_FRAME, b"coin", None, true);
-        w.raw(b"\"cubes\":[");
-        for (i, (position, size, colour)) in coin_marks(r, h).iter().enumerate() {
-            if i > 0 {
-                w.raw(b",");
-            }
-            w.raw(b"{\"pose\":");
-            w.pose(position, r)?;
-            w.raw(b",\"size\":");
-            w.vector3("cubes.size", size[0], size[1], size[2])?;
-            w.raw(b",\"color\":");
-            w.color(*colour);
-            w.raw(b"}");
-        }
-        w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
-        w.pose(&Vector3::zeros(), r)?;
-        w.raw(b",\"size\":");
-        w.vector3("cylinders.size", 2.0, 2.0, h)?;
-        w.raw(b",\"bottom_scale\":1,\"top_scale\":1,\"color\":");
-        w.color(COIN_RGBA);
-        w.raw(b"}],\"lines\":[],");
-        w.entity_tail();
-        w.raw(b"]}");
-        Ok(())
-    }
-}
-
-/// `/tf` and `/tf_static` world → table (static, [`TABLE_ROTATION`]).
-fn write_table_transform(buf: &mut Vec<u8>, log_time: u64) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, FRAME_TRANSFORM);
-    w.raw(b"{\"timestamp\":");
-    w.time(log_time);
-    w.raw(b",\"parent_frame_id\":\"world\",\"child_frame_id\":\"table\",\"translation\":{\"x\":0,\"y\":0,\"z\":0},\"rotation\":");
-    w.quaternion(&TABLE_ROTATION)?;
-    w.raw(b"}");
-    Ok(())
-}
-
-/// `/scene/follow` world → coin_level: translation `centre` (display units), no rotation.
-fn write_follow_transform(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    centre: [f64; 3],
-) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, FRAME_TRANSFORM);
-    w.raw(b"{\"timestamp\":");
-    w.time(log_time);
-    w.raw(b",\"parent_frame_id\":\"world\",\"child_frame_id\":\"coin_level\",\"translation\":");
-    w.vector3("translation", centre[0], centre[1], centre[2])?;
-    w.raw(b",\"rotation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}");
-    Ok(())
-}
-
-/// `/scene/table`: the slab centred on `centre` (display units) and its grid, in `world`.
-fn write_table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, SCENE_UPDATE);
-    w.raw(b"{\"deletions\":[],\"entities\":[");
-    w.entity_head(log_time, WORLD_FRAME, b"table", None, true);
-    w.raw(b"\"cubes\":[{\"pose\":{\"position\":");
-    w.vector3(
-        "cubes.pose.position",
-        centre[0],
-        centre[1],
-        TABLE_TOP - 0.5 * TABLE_THICKNESS,
-    )?;
-    w.raw(b",\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"size\":");
-    let side = 2.0 * TABLE_HALF_SIDE;
-    w.vector3("cubes.size", side, side, TABLE_THICKNESS)?;
-    w.raw(b",\"color\":");
-    w.color(TABLE_RGBA);
-    w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
-    for major in [false, true] {
-        if major {
-            w.raw(b",");
-        }
-        write_grid(&mut w, centre, major)?;
-    }
-    w.raw(b"],");
-    w.entity_tail();
-    w.raw(b"]}");
-    Ok(())
-}
-
-/// One `LinePrimitive` (a line list) of the table's grid: the minor lines (every 1) or the major ones (every
-/// [`GRID_MAJOR`]), across the slab in both directions, at the grid height.
-fn write_grid(w: &mut Writer, centre: [f64; 2], major: bool) -> Result<(), NonFiniteField> {
-    w.raw(b"{\"type\":2,\"pose\":{\"position\":{\"x\":0,\"y\":0,\"z\":");
-    w.num("lines.pose.position.z", GRID_HEIGHT)?;
-    w.raw(b"},\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"thickness\":");
-    w.num("lines.thickness", GRID_WIDTHS[usize::from(major)])?;
-    w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, (a, b)) in grid_segments(centre, major).enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
-        w.point(a[0], a[1])?;
-        w.raw(b",");
-        w.point(b[0], b[1])?;
-    }
-    w.raw(b"],\"color\":");
-    w.color(GRID_RGBA[usize::from(major)]);
-    w.raw(b",\"colors\":[],\"indices\":[]}");
-    Ok(())
-}
-
-/// `/scene/track/<L>`: the level's points as one line strip, entity `track` in `world`.
-fn write_track(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    points: &[track::TrackPoint],
-) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, SCENE_UPDATE);
-    w.raw(b"{\"deletions\":[],\"entities\":[");
-    w.entity_head(log_time, WORLD_FRAME, b"track", None, true);
-    w.raw(b"\"cubes\":[],\"spheres\":[],\"cylinders\":[],\"lines\":[{\"type\":0,\"pose\":");
-    w.raw(IDENTITY_POSE);
-    w.raw(b",\"thickness\":");
-    w.num("lines.thickness", TRACK_WIDTH)?;
-    w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, p) in points.iter().enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
-        w.point(p.x, p.y)?;
-    }
-    w.raw(b"],\"color\":");
-    w.color(TRACK_RGBA);
-    w.raw(b",\"colors\":[],\"indices\":[]}],");
-    w.entity_tail();
-    w.raw(b"]}");
-    Ok(())
-}
-
-/// `/scene/track/<L>` when the level is empty: the deletion of its line.
-fn write_track_deletion(buf: &mut Vec<u8>, log_time: u64) {
-    let mut w = Writer::new(buf, SCENE_UPDATE);
-    w.raw(b"{\"deletions\":[{\"timestamp\":");
-    w.time(log_time);
-    w.raw(b",\"type\":0,\"id\":\"track\"}],\"entities\":[]}");
 }
 
 /// The display slot of simulation time t: round(t · SCENE_RATE). Rounding (not flooring) makes a data rate
@@ -682,7 +392,7 @@ mod tests {
         duration: f64,
         state: impl Fn(f64) -> State,
     ) -> Messages {
-        let mut fox = Foxglove3d::new(coin, 0.05, true, true);
+        let mut fox = Foxglove3d::new(coin, 0.05, &[Channel::Tf, Channel::Scene], Encoding::Json);
         let mut batch = FoxgloveBatch::default();
         let mut out = Vec::new();
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
@@ -872,7 +582,7 @@ mod tests {
         // frame (in the coin frame: the rim point (0, −a, 0) before spin ψ, i.e. rotated back by ψ) onto the
         // model's contact point (physics §3): checks the frame against an independent formula.
         let coin = unit_coin();
-        let mut fox = Foxglove3d::new(&coin, 0.05, true, false);
+        let mut fox = Foxglove3d::new(&coin, 0.05, &[Channel::Tf], Encoding::Json);
         let mut batch = FoxgloveBatch::default();
         let mut worst: f64 = 0.0;
         for k in 0..50 {
@@ -1202,7 +912,7 @@ mod tests {
     #[test]
     fn a_coin_spinning_in_place_draws_no_track() {
         let coin = unit_coin();
-        let mut fox = Foxglove3d::new(&coin, 0.05, false, true);
+        let mut fox = Foxglove3d::new(&coin, 0.05, &[Channel::Scene], Encoding::Json);
         let mut batch = FoxgloveBatch::default();
         for k in 0..200 {
             let t = f64::from(k) * 0.01;
@@ -1224,11 +934,11 @@ mod tests {
     #[test]
     fn non_finite_values_are_refused_and_leave_the_batch_alone() {
         let coin = unit_coin();
-        let mut fox = Foxglove3d::new(&coin, 0.05, true, true);
+        let mut fox = Foxglove3d::new(&coin, 0.05, &[Channel::Tf, Channel::Scene], Encoding::Json);
         let mut batch = FoxgloveBatch::default();
         fox.sample(0.0, 0, &state_at(0.0), false, &mut batch)
             .unwrap();
-        let before = batch.len();
+        let before = batch.iter().count();
         let bad = State {
             psi: f64::NAN,
             ..state_at(0.01)
@@ -1238,7 +948,7 @@ mod tests {
             .unwrap_err();
         println!("{err}");
         assert_eq!(err.schema, FRAME_TRANSFORM);
-        assert_eq!(batch.len(), before);
+        assert_eq!(batch.iter().count(), before);
         let bad = State {
             x: f64::INFINITY,
             ..state_at(0.02)
@@ -1246,7 +956,7 @@ mod tests {
         assert!(fox
             .sample(0.02, 20_000_000, &bad, false, &mut batch)
             .is_err());
-        let mut drawing = Foxglove3d::new(&coin, 0.05, false, true);
+        let mut drawing = Foxglove3d::new(&coin, 0.05, &[Channel::Scene], Encoding::Json);
         let err = drawing
             .sample(
                 0.0,
@@ -1263,52 +973,11 @@ mod tests {
     }
 
     #[test]
-    fn finish_adds_the_final_drawing_only_when_the_last_sample_had_none() {
-        let coin = unit_coin();
-        let mut batch = FoxgloveBatch::default();
-        // Samples to t = 0.06, none flagged `last` (the recorder learns of the end afterwards).
-        let mut fox = Foxglove3d::new(&coin, 0.05, false, true);
-        let mut drawn = Vec::new();
-        for k in 0..=6 {
-            let t = f64::from(k) * 0.01;
-            batch.clear();
-            fox.sample(t, log_time(t).unwrap(), &state_at(t), false, &mut batch)
-                .unwrap();
-            drawn.push(batch.len());
-        }
-        batch.clear();
-        fox.finish(&mut batch).unwrap();
-        let topics: Vec<Topic> = batch.iter().map(|(t, _)| t).collect();
-        println!("messages per sample {drawn:?}, finish added {topics:?}");
-        // t = 0.06: round(1.8) = 2 = the slot of t = 0.05 (round(1.5) = 2), so no update at 0.06.
-        assert_eq!(drawn[6], 0);
-        assert_eq!(
-            &topics[..2],
-            &[Topic::SceneFollow, Topic::Main(Channel::Scene)]
-        );
-        assert!(
-            topics.iter().any(|t| matches!(t, Topic::SceneTrack(_))),
-            "the final piece of track is published"
-        );
-        let (_, bytes) = batch.iter().nth(1).unwrap();
-        let v: Value = serde_json::from_slice(bytes).unwrap();
-        assert_eq!(time_of(&entities(&v)[0]), 60_000_000);
-        // After a sample flagged `last`, finish adds nothing.
-        batch.clear();
-        fox.sample(0.07, 70_000_000, &state_at(0.07), true, &mut batch)
-            .unwrap();
-        batch.clear();
-        fox.finish(&mut batch).unwrap();
-        assert!(batch.is_empty());
-    }
-
-    #[test]
     fn nothing_is_written_when_both_channels_are_off() {
-        let mut fox = Foxglove3d::new(&unit_coin(), 0.05, false, false);
-        assert!(fox.is_off());
+        let mut fox = Foxglove3d::new(&unit_coin(), 0.05, &[], Encoding::Json);
         let mut batch = FoxgloveBatch::default();
         fox.sample(0.0, 0, &state_at(0.0), true, &mut batch)
             .unwrap();
-        assert!(batch.is_empty());
+        assert!(batch.iter().next().is_none());
     }
 }

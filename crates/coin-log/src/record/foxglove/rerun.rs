@@ -21,7 +21,6 @@ use super::{
     TABLE_TOP, TRACK_RGBA, WORLD_FRAME,
 };
 use super::{FoxgloveBatch, Topic};
-use crate::format::messages::NonFiniteField;
 use crate::format::Channel;
 use foxglove::messages::packed_element_field::NumericType;
 use foxglove::messages::{PackedElementField, PointCloud, Pose, Vector3, VoxelGrid};
@@ -101,40 +100,25 @@ impl Rerun3d {
     }
 
     /// A drawing update's coin: the URDF at the first, then `coin_level` → `coin_body` with rotation `r`.
-    ///
-    /// # Errors
-    /// [`NonFiniteField`] if `r` is not finite.
-    pub fn coin(
-        &mut self,
-        log_time: u64,
-        r: &UnitQuaternion<f64>,
-        out: &mut FoxgloveBatch,
-    ) -> Result<(), NonFiniteField> {
+    pub fn coin(&mut self, log_time: u64, r: &UnitQuaternion<f64>, out: &mut FoxgloveBatch) {
         if !self.started {
             let urdf = urdf(self.thickness);
-            out.push(Topic::RerunRobot, |buf| {
-                cdr_string(buf, &urdf);
-                Ok(())
-            })?;
+            out.push(Topic::RerunRobot, |buf| cdr_string(buf, &urdf));
             self.started = true;
         }
         out.push(Topic::Main(Channel::Rerun), |buf| {
-            transform(log_time, FOLLOW_FRAME, BODY_FRAME, [0.0; 3], r)?.encode_raw(buf);
-            Ok(())
-        })
+            transform(log_time, FOLLOW_FRAME, BODY_FRAME, [0.0; 3], r).encode_raw(buf);
+        });
     }
 
     /// A drawing update's track: the points kept since the previous update and the latest contact point,
     /// if the coin moved at all.
-    ///
-    /// # Errors
-    /// None today (the points were checked finite by the Foxglove track); the signature is the batch's.
-    pub fn track(&mut self, log_time: u64, out: &mut FoxgloveBatch) -> Result<(), NonFiniteField> {
+    pub fn track(&mut self, log_time: u64, out: &mut FoxgloveBatch) {
         if let Some(p) = self.latest.filter(|&p| Some(p) != self.kept) {
             self.keep(p);
         }
         if self.pending.is_empty() {
-            return Ok(());
+            return;
         }
         let data = std::mem::take(&mut self.pending);
         out.push(Topic::RerunTrack, |buf| {
@@ -152,8 +136,7 @@ impl Rerun3d {
                 data: data.into(),
             }
             .encode_raw(buf);
-            Ok(())
-        })
+        });
     }
 }
 
@@ -288,7 +271,7 @@ mod tests {
         for k in 0..=100 {
             r.contact([f64::from(k) * 1e-3, 0.0]);
         }
-        r.track(0, &mut out).unwrap();
+        r.track(0, &mut out);
         let (topic, bytes) = out.iter().next().unwrap();
         assert_eq!(topic, Topic::RerunTrack);
         let cloud = PointCloud::decode(bytes).unwrap();
@@ -306,7 +289,7 @@ mod tests {
         // No motion, no message.
         out.clear();
         r.contact([0.1, 0.0]);
-        r.track(1, &mut out).unwrap();
-        assert!(out.is_empty());
+        r.track(1, &mut out);
+        assert!(out.iter().next().is_none());
     }
 }
