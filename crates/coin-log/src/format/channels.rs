@@ -17,32 +17,22 @@ pub const MESSAGE_ENCODING: &str = Encoding::Json.message_encoding();
 coin_log_names::named_enum! {
     /// A recordable channel; the name is the one of scene files and `--channels`. `work` and `rerun` are
     /// last here (both opt-in), but in a file `work` is written, and registered, with the other
-    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table).
+    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table, which says what each
+    /// carries).
+    #[allow(missing_docs)]
     #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
     pub enum Channel: "channel" {
-        /// ω in the lean frame.
         Omega = "omega",
-        /// θ, φ, ψ.
         Angles = "angles",
-        /// Orientation quaternion.
         Quaternion = "quaternion",
-        /// Centre position.
         Position = "position",
-        /// Contact point.
         Contact = "contact",
-        /// Reaction of the table.
         Reaction = "reaction",
-        /// Energy.
         Energy = "energy",
-        /// Chaplygin integrals C1, C2.
         Invariants = "invariants",
-        /// Foxglove frame transforms.
         Tf = "tf",
-        /// Foxglove scene (coin and track).
         Scene = "scene",
-        /// Dissipated work W and the balance E + W (only with dissipation, physics §11).
         Work = "work",
-        /// The coin, table and track as geometry Rerun's MCAP importer draws (opt-in, Protobuf only).
         Rerun = "rerun",
     }
 }

@@ -1,30 +1,11 @@
-//! Default tolerances of `verify`, derived from how the log was integrated (format.md: verify, Tolerances).
-//! They live in the format because `record` uses them too: its summary says an event is not to be trusted
-//! when the energy drift at the event is above the tolerance `verify` will judge the file by.
+//! Default tolerances of `verify`, derived from how the log was integrated (format.md: verify, Tolerances,
+//! where the formulas are explained). They live in the format because `record` uses them too. With
+//! τ = √(a/g), T the span, Ω = max(max|ω|, 1/τ):
 //!
-//! Let τ = √(a/g) be the time unit, T the recorded span, Ω = max(max|ω|, 1/τ) over the run, and
-//!
-//!   ε = max(rtol, atol / a)                          for adaptive methods (dopri5, dop853),
-//!   ε = (h Ω)^p                                      for fixed-step methods of order p with step h
-//!                                                    (rk4 and gauss4: p = 4; the order of `Method`),
-//!
-//! the accuracy the integrator was asked for, per unit time. Only the settings the method uses count: a
-//! fixed-step method ignores rtol and atol and an adaptive one the step, so they cannot loosen (or tighten)
-//! the tolerances. Then
-//!
-//!   energy drift tolerance        = min(1e-6, max(1e-12, 100 ε (1 + T/τ)))
-//!   residual tolerance            = min(1e-6, max(1e-10, 1000 ε (1 + T/τ)))   (constraint, steady)
-//!   nutation tolerance            = min(1e-6, max(1e-11, 100 ε))              (relative, T and ΔΦ)
-//!
-//! The factor 1 + T/τ lets errors grow linearly with the run's length, as they do for non-symplectic
-//! methods (the nutation tolerance has no such factor: it judges a period, an average over the run, whose
-//! relative error is the integrator's relative error per unit time, ε, not its accumulation); the floors
-//! are what rounding alone produces (sums of ~1e-16 errors, and finite differences that
-//! divide them by the sample interval); the ceilings are the contract's: a tolerance is never looser than
-//! 1e-6, whatever the integrator settings. `--energy-tol` and `--residual-tol` replace the defaults.
-//! Recomputations of a stored quantity from other stored values (energy against `/coin/energy`, the
-//! quaternion, contact point, height, reaction and invariants against their inputs) repeat the recorder's
-//! arithmetic on the same numbers, so they are held to [`RECOMPUTE_TOLERANCE`].
+//!   ε = max(rtol, atol / a)      adaptive methods;   ε = (h Ω)^p   fixed-step methods of order p
+//!   energy drift tolerance       = min(1e-6, max(1e-12, 100 ε (1 + T/τ)))
+//!   residual tolerance           = min(1e-6, max(1e-10, 1000 ε (1 + T/τ)))   (constraint, steady)
+//!   nutation tolerance           = min(1e-6, max(1e-11, 100 ε))              (relative, T and ΔΦ)
 
 use crate::integrate::{Method, MethodConfig};
 use crate::model::CoinParams;
@@ -57,38 +38,28 @@ pub const RECOMPUTE_TOLERANCE: f64 = 1e-12;
 /// Relative tolerance of N ≥ 0 and |F| ≤ μN, in units of Mg (rounding only).
 pub const VALIDITY_TOLERANCE: f64 = 1e-12;
 
-/// The tolerances one file is judged with.
+/// The tolerances one file is judged with, and the ε they were derived from (the module doc's formulas).
+#[allow(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerances {
-    /// Energy drift max|E − E₀| / max(|E₀|, Mga).
     pub energy: f64,
-    /// Constraint residual relative to a·max|ω|, and the steady residuals.
     pub residual: f64,
-    /// Relative error of the measured nutation period and heading advance (before the quadrature's and
-    /// the interpolation's shares are added).
     pub nutation: f64,
-    /// The accuracy ε the defaults were derived from.
     pub epsilon: f64,
 }
 
-/// How the log was integrated, as far as the tolerances need it.
+/// How the log was integrated, as far as the tolerances need it: the symbols of the module doc's formulas
+/// (h = `step`, a = `radius`, τ = `time_unit`, T = `span`, max|ω| = `max_omega`).
+#[allow(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunAccuracy {
-    /// The integrator (`metadata.integrator`).
     pub integrator: Method,
-    /// rtol (adaptive methods).
     pub rtol: f64,
-    /// atol (adaptive methods).
     pub atol: f64,
-    /// Fixed step h (fixed-step methods).
     pub step: f64,
-    /// Radius a.
     pub radius: f64,
-    /// Time unit τ.
     pub time_unit: f64,
-    /// Recorded span T.
     pub span: f64,
-    /// max|ω| over the run.
     pub max_omega: f64,
 }
 

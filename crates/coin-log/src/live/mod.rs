@@ -1,16 +1,8 @@
-//! Live view (`coin-log live`, format.md: live): a recording served to Foxglove while it is simulated, over
-//! the Foxglove WebSocket protocol (the `foxglove` crate's server; subprotocols `foxglove.sdk.v1` and
-//! `foxglove.sdk.v1.1`), paced so that simulated time advances at a chosen multiple of wall time.
-//!
-//! [`LiveServer`] owns the WebSocket server; [`LiveTap`] is the recorder's [`Tap`](crate::record::Tap): one
-//! raw channel per topic with the file's schema and encodings, and every message logged with its log time,
-//! byte for byte the message the file gets. The server is latched: a viewer that subscribes to a topic
-//! (late, or after a topic first appeared) is sent the topic's latest messages (those of its latest log
-//! time) at once, so that `/tf_static`,
-//! the table and the track levels, written rarely, reach every viewer, and a viewer connecting after the run
-//! sees its final state.
-//!
-//! Built only with the cargo feature `live` (it brings tokio and tungstenite in through `foxglove`).
+//! Live view (`coin-log live`, format.md: live): a recording served to Foxglove over its WebSocket protocol
+//! while it is simulated, paced against the wall clock (cargo feature `live`). [`LiveServer`] owns the
+//! server; [`LiveTap`] is the recorder's [`Tap`](crate::record::Tap), logging every message byte for byte as
+//! the file gets it. The server is latched: a viewer that subscribes late is sent each topic's latest
+//! messages at once, so that `/tf_static`, the table and the track levels, written rarely, reach it.
 
 mod tap;
 

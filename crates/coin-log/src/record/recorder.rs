@@ -1,15 +1,8 @@
-//! Scene → MCAP: integrates a [`Scene`] and streams its samples into an MCAP writer (format.md: Channels,
-//! Metadata).
-//!
-//! The file is chunked (zstd by default), indexed, with statistics, summary offsets and CRCs; the `coin-log`
-//! metadata record comes before the first message and `coin-log.result` after the last. It is written by
-//! [`McapWriter`], which compresses chunks on [`COMPRESSION_THREADS`] worker threads while this thread
-//! integrates. Nothing in it depends on the machine: the bytes do not depend on the worker count or on
-//! timing, there are no timestamps, and channels are registered in the order of their first message.
-//!
-//! Hot path: per sample only the requested quantities are computed; each message is formatted
-//! into one reused buffer and written with a precomputed channel id. Samples are written one sample late
-//! so that the last one can be flagged as last (the 3D scene then shows the final state).
+//! Scene → MCAP: integrates a [`Scene`] and streams its samples into an MCAP writer (format.md: Files,
+//! Channels, Metadata). [`McapWriter`] compresses chunks on [`COMPRESSION_THREADS`] workers while this
+//! thread integrates; the bytes depend on neither. Per sample only the requested quantities are computed,
+//! and samples are written one sample late so that the last one can be flagged as last (the 3D scene then
+//! shows the final state).
 
 use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};

@@ -1,19 +1,6 @@
-//! The `rerun` channel (docs/format.md: Rerun geometry): the coin, the table and the track again, in the
-//! types Rerun's MCAP importer (0.41) turns into geometry, since it draws no `foxglove.SceneUpdate`. Opt-in:
-//! Foxglove draws none of it and it costs file size. Display units and frames as in [`super`]:
-//! - `/rerun/robot_description`, once: a URDF, robot `coin_shape` (not `coin`, whose entity paths `/coin/*`
-//!   the `coin_log.*` topics take), link `coin_body`: a cylinder of radius 1 and the thickness, and the two
-//!   face marks of `/scene` as boxes. Rerun's `urdf` decoder reads it only as ROS 2 `std_msgs/msg/String`
-//!   in CDR, so this one topic is CDR in any file.
-//! - `/rerun/coin_body`, at each drawing update: `coin_level` → `coin_body`, the rotation of `/scene`'s
-//!   cylinder (q_T · q), a zero translation that is written (Rerun's `rrd verify` refuses a missing one).
-//!   The URDF's link moves with it: Rerun places geometry through the tree of every transform topic.
-//! - `/rerun/table`: the table as a `foxglove.VoxelGrid` in `world`, one layer of checkered 1 × 1 cells
-//!   over the slab of `/scene/table`, whenever that moves.
-//! - `/rerun/track`: a `foxglove.PointCloud` in `world` with the contact points since the previous update,
-//!   [`TRACK_SPACING`] apart and always the contact point of the update itself (so the newest point is the
-//!   contact at that time). Rerun shows a point cloud at its time only: its blueprint
-//!   (`scripts/rerun_blueprint.py`) shows every message from t = 0 to the cursor, which draws the whole track.
+//! The `rerun` channel (docs/format.md: Rerun geometry): the coin (a URDF moved by `/rerun/coin_body`),
+//! the table (a voxel grid) and the track (point clouds) again, in the types Rerun's MCAP importer turns
+//! into geometry, since it draws no `foxglove.SceneUpdate`. Display units and frames as in [`super`].
 
 use super::proto::{identity, timestamp, transform};
 use super::{

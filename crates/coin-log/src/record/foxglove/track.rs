@@ -1,31 +1,15 @@
 //! The contact track as levels of a binary counter, so that the latest message of each track topic alone
-//! (all a viewer keeps after a seek) draws the whole path up to the latest display update.
+//! draws the whole path up to the latest display update (format.md: Frames and Foxglove output, The track's
+//! levels): at update n only level (trailing zero bits of n) changes, taking the levels below it.
 //!
-//! # Levels
-//! Display updates are numbered n = 0, 1, 2, ... Level L holds the piece of the path from update
-//! m_{L+1} to update m_L, where m_L = ⌊n / 2^L⌋ · 2^L: the binary digits of n cut [0, n] into pieces, one per
-//! level, so the levels' latest contents together cover [0, n] exactly, end to end. At update n ≥ 1 only
-//! level j = (number of trailing zero bits of n) changes: it takes the pieces of the levels below it and
-//! the points since the previous update, and those levels become empty. Level [`TOP`] is never emptied:
-//! at every 2^TOP-th update it takes everything before it (one message then carries the whole path up to
-//! there, which keeps the number of topics fixed for any duration).
-//!
-//! Bytes: level L publishes once every 2^(L+1) updates a piece of 2^L updates, so each level costs about half
-//! the simplified path and the track costs ≈ (levels in use)/2 times the simplified path, O(N log N) for N
-//! updates, instead of O(N²) for republishing the whole path.
-//!
-//! # Simplification
-//! Each level's content is simplified by Douglas–Peucker with a tolerance that grows with the level (older
-//! parts coarser, [`tolerance`]). Re-simplifying a simplified polyline would add up the errors, so every
-//! segment carries a bound on the distance of the original points it stands for: when points P_a..P_b are
-//! replaced by the segment [P_a, P_b], the original points of the old segment (P_{k−1}, P_k) lie within
-//! E_k of it, and the old segment lies within max(d(P_{k−1}), d(P_k)) of the new one (the distance to a
-//! segment is convex), so the new bound is max_k E_k + max(d(P_{k−1}), d(P_k)). A segment is accepted when
-//! its bound is within the level's tolerance; every original point therefore stays within
-//! [`MAX_TOLERANCE`] of the published track, whatever the number of merges.
-//!
-//! Points are the contact points in display units (units of the radius a), rounded to a grid of
-//! [`QUANTUM`] (the JSON stays short); a point equal to the previous one is skipped.
+//! Each level is simplified by Douglas–Peucker with a tolerance that grows with the level ([`tolerance`]).
+//! Re-simplifying a simplified polyline would add up the errors, so every segment carries a bound on the
+//! distance of the original points it stands for: when points P_a..P_b are replaced by the segment
+//! [P_a, P_b], the original points of the old segment (P_{k−1}, P_k) lie within E_k of it, and the old
+//! segment lies within max(d(P_{k−1}), d(P_k)) of the new one (the distance to a segment is convex), so the
+//! new bound is max_k E_k + max(d(P_{k−1}), d(P_k)). A segment is accepted when its bound is within the
+//! level's tolerance; every original point therefore stays within [`MAX_TOLERANCE`] of the published
+//! track, whatever the number of merges. Points are rounded to [`QUANTUM`]; a repeated point is skipped.
 
 use crate::format::TRACK_LEVELS;
 
