@@ -11,8 +11,8 @@ use coin_log::format::messages::{
     ReactionMessage, WorkMessage,
 };
 use coin_log::format::{
-    log_time, schema_bytes, Channel, Encoding, ResultMetadata, Topic, MESSAGE_ENCODING,
-    RESULT_METADATA_NAME, RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, Encoding, ResultMetadata, Topic, RESULT_METADATA_NAME,
+    RUN_METADATA_NAME,
 };
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunEnd, RunSettings};
 use coin_log::model::{
@@ -192,14 +192,19 @@ pub fn add_channel<W: Write + Seek>(
         Some(id) => *id,
         None => {
             let id = w
-                .add_schema(name, SCHEMA_ENCODING, &schema_of(name))
+                .add_schema(name, Encoding::Json.schema_encoding(), &schema_of(name))
                 .unwrap();
             schemas.insert(name, id);
             id
         }
     };
-    w.add_channel(schema, c.name(), MESSAGE_ENCODING, &BTreeMap::new())
-        .unwrap()
+    w.add_channel(
+        schema,
+        c.name(),
+        Encoding::Json.message_encoding(),
+        &BTreeMap::new(),
+    )
+    .unwrap()
 }
 
 /// Writes one message on channel `channel_id`, its publish time equal to its log time `lt`.

@@ -9,11 +9,6 @@ use super::messages::{
 use super::Encoding;
 use std::fmt;
 
-/// Schema encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const SCHEMA_ENCODING: &str = Encoding::Json.schema_encoding();
-/// Message encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const MESSAGE_ENCODING: &str = Encoding::Json.message_encoding();
-
 coin_log_names::named_enum! {
     /// A recordable channel; the name is the one of scene files and `--channels`. `work` and `rerun` are
     /// last here (both opt-in), but in a file `work` is written, and registered, with the other
@@ -123,25 +118,14 @@ impl Channel {
 /// and Foxglove output).
 pub const TRACK_LEVELS: usize = 16;
 
+macro_rules! track_topics {
+    ($($level:literal)*) => {
+        [$(concat!("/scene/track/", $level)),*]
+    };
+}
+
 /// The track topics, level by level.
-const TRACK_TOPICS: [&str; TRACK_LEVELS] = [
-    "/scene/track/0",
-    "/scene/track/1",
-    "/scene/track/2",
-    "/scene/track/3",
-    "/scene/track/4",
-    "/scene/track/5",
-    "/scene/track/6",
-    "/scene/track/7",
-    "/scene/track/8",
-    "/scene/track/9",
-    "/scene/track/10",
-    "/scene/track/11",
-    "/scene/track/12",
-    "/scene/track/13",
-    "/scene/track/14",
-    "/scene/track/15",
-];
+const TRACK_TOPICS: [&str; TRACK_LEVELS] = track_topics!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
 
 /// An MCAP topic of the format. Every channel writes its main topic ([`Channel::topic`]); the two Foxglove
 /// channels write more, so that a viewer that restores only the latest message of each topic after a seek

@@ -15,9 +15,7 @@ mod termination;
 mod time;
 pub mod tolerances;
 
-pub use channels::{
-    schema_data, Channel, Topic, MESSAGE_ENCODING, ROS_STRING, SCHEMA_ENCODING, TRACK_LEVELS,
-};
+pub use channels::{schema_data, Channel, Topic, ROS_STRING, TRACK_LEVELS};
 pub use encoding::Encoding;
 pub use messages::{schema_bytes, FRAME_TRANSFORM, SCENE_UPDATE};
 pub use metadata::{

@@ -43,28 +43,16 @@ pub enum LiveError {
 #[derive(Default)]
 struct Latest {
     log_time: u64,
-    /// The messages, in `buffers[..len]` (buffers are reused).
-    buffers: Vec<Vec<u8>>,
-    len: usize,
+    messages: Vec<Vec<u8>>,
 }
 
 impl Latest {
     fn keep(&mut self, log_time: u64, data: &[u8]) {
         if log_time != self.log_time {
             self.log_time = log_time;
-            self.len = 0;
+            self.messages.clear();
         }
-        if self.len == self.buffers.len() {
-            self.buffers.push(Vec::new());
-        }
-        let buffer = &mut self.buffers[self.len];
-        buffer.clear();
-        buffer.extend_from_slice(data);
-        self.len += 1;
-    }
-
-    fn messages(&self) -> &[Vec<u8>] {
-        &self.buffers[..self.len]
+        self.messages.push(data.to_vec());
     }
 }
 
@@ -105,7 +93,7 @@ impl ServerListener for Latch {
     fn on_subscribe(&self, client: Client, channel: ChannelView) {
         let channels = self.lock();
         if let Some((raw, Some(latest))) = channels.get(&channel.id()) {
-            for data in latest.messages() {
+            for data in &latest.messages {
                 raw.log_with_meta_to_sink(
                     data,
                     PartialMetadata::with_log_time(latest.log_time),
