@@ -6,6 +6,8 @@
 //!   energy drift tolerance       = min(1e-6, max(1e-12, 100 ε (1 + T/τ)))
 //!   residual tolerance           = min(1e-6, max(1e-10, 1000 ε (1 + T/τ)))   (constraint, steady)
 //!   nutation tolerance           = min(1e-6, max(1e-11, 100 ε))              (relative, T and ΔΦ)
+//!
+//! The factors are safety margins, the floors what rounding alone produces, the ceilings the contract's.
 
 use crate::integrate::{Method, MethodConfig};
 use crate::model::CoinParams;
@@ -13,24 +15,6 @@ use crate::model::CoinParams;
 /// Unit roundoff of f64, 2⁻⁵³: what one rounding costs, relative (the limits of a scene, the rounding
 /// `record` predicts).
 pub const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
-/// Contract ceiling of the energy drift tolerance.
-pub const ENERGY_CEILING: f64 = 1e-6;
-/// Contract ceiling of the constraint (and steady) residual tolerance.
-pub const RESIDUAL_CEILING: f64 = 1e-6;
-/// Smallest default energy tolerance: accumulated rounding of E over long runs.
-pub const ENERGY_FLOOR: f64 = 1e-12;
-/// Smallest default residual tolerance: rounding of positions amplified by the finite difference.
-pub const RESIDUAL_FLOOR: f64 = 1e-10;
-/// Safety factor between ε(1 + T/τ) and the energy drift tolerance.
-pub const ENERGY_FACTOR: f64 = 100.0;
-/// Safety factor between ε(1 + T/τ) and the residual tolerance (finite differences amplify noise).
-pub const RESIDUAL_FACTOR: f64 = 1000.0;
-/// Contract ceiling of the nutation tolerance.
-pub const NUTATION_CEILING: f64 = 1e-6;
-/// Smallest default nutation tolerance: the rounding of crossing times a few ulp of t apart, averaged.
-pub const NUTATION_FLOOR: f64 = 1e-11;
-/// Safety factor between ε and the nutation tolerance.
-pub const NUTATION_FACTOR: f64 = 100.0;
 /// Relative tolerance of a stored quantity against its recomputation from other stored values: the same
 /// formula on the same numbers agrees to a few ulps; 1e-12 (≈ 4500 ε_machine) leaves room for a recorder
 /// that orders its arithmetic differently.
@@ -114,21 +98,9 @@ impl Tolerances {
         let growth = 1.0 + (run.span / run.time_unit).max(0.0);
         let clamp = |x: f64, lo: f64, hi: f64| if x.is_nan() { hi } else { x.max(lo).min(hi) };
         Self {
-            energy: energy.unwrap_or_else(|| {
-                clamp(
-                    ENERGY_FACTOR * epsilon * growth,
-                    ENERGY_FLOOR,
-                    ENERGY_CEILING,
-                )
-            }),
-            residual: residual.unwrap_or_else(|| {
-                clamp(
-                    RESIDUAL_FACTOR * epsilon * growth,
-                    RESIDUAL_FLOOR,
-                    RESIDUAL_CEILING,
-                )
-            }),
-            nutation: clamp(NUTATION_FACTOR * epsilon, NUTATION_FLOOR, NUTATION_CEILING),
+            energy: energy.unwrap_or_else(|| clamp(100.0 * epsilon * growth, 1e-12, 1e-6)),
+            residual: residual.unwrap_or_else(|| clamp(1000.0 * epsilon * growth, 1e-10, 1e-6)),
+            nutation: clamp(100.0 * epsilon, 1e-11, 1e-6),
             epsilon,
         }
     }
@@ -155,7 +127,7 @@ mod tests {
     #[test]
     fn defaults_are_never_looser_than_the_contract_ceilings() {
         let t = Tolerances::derive(&run("dop853", 1e-3, 1e4), None, None);
-        assert_eq!((t.energy, t.residual), (ENERGY_CEILING, RESIDUAL_CEILING));
+        assert_eq!((t.energy, t.residual), (1e-6, 1e-6));
     }
 
     #[test]

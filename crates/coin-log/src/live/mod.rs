@@ -12,11 +12,9 @@ use foxglove::websocket::{ChannelView, Client, ServerListener};
 use foxglove::{ChannelId, Context, PartialMetadata, RawChannel, WebSocketServer};
 use std::collections::HashMap;
 use std::io::{Seek, SeekFrom, Write};
-use std::net::{IpAddr, Ipv4Addr};
+use std::net::IpAddr;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-/// The default address: this machine only.
-pub const DEFAULT_HOST: IpAddr = IpAddr::V4(Ipv4Addr::LOCALHOST);
 /// The default port (the Foxglove app's default for a WebSocket connection).
 pub const DEFAULT_PORT: u16 = 8765;
 /// Messages queued per viewer before the oldest are dropped. The server's default (1024) is a few dozen

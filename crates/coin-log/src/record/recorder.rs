@@ -82,19 +82,6 @@ pub enum RecordError {
     },
 }
 
-/// The writer options of every coin-log file (chunked, indexed, statistics, summary offsets and CRCs are
-/// always on in [`McapWriter`]).
-#[must_use]
-fn write_options(options: &RecordOptions) -> WriterOptions {
-    WriterOptions {
-        workers: COMPRESSION_THREADS,
-        ..WriterOptions::new(
-            options.compression,
-            format!("coin-log/{}", env!("CARGO_PKG_VERSION")),
-        )
-    }
-}
-
 /// Why writing a sample stopped the run.
 enum SampleError {
     Write(WriteError),
@@ -680,7 +667,12 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         } else {
             None
         };
-        let mut writer = McapWriter::new(writer, &write_options(options))?;
+        let library = format!("coin-log/{}", env!("CARGO_PKG_VERSION"));
+        let write_options = WriterOptions {
+            workers: COMPRESSION_THREADS,
+            ..WriterOptions::new(options.compression, library)
+        };
+        let mut writer = McapWriter::new(writer, &write_options)?;
         writer.write_metadata(RUN_METADATA_NAME, &scene.run_metadata().to_map())?;
         Ok(Self {
             out: Output {

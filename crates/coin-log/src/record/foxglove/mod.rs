@@ -3,11 +3,11 @@
 //! alone draws it. Frames (`tf`, physical units): `world` (z up) → `table` (the physics frame, y up,
 //! [`TABLE_ROTATION`]) → `coin`. The drawing (`scene`, units of a, at [`SCENE_RATE`]): `/scene/follow`
 //! ([`FOLLOW_FRAME`]), `/scene` (the coin), `/scene/table`, and the track's levels ([`track`]); the opt-in
-//! `rerun` channel draws them again for Rerun ([`rerun`]).
+//! `rerun` channel draws them again for Rerun.
 
 mod json;
 mod proto;
-pub mod rerun;
+mod rerun;
 pub mod track;
 
 use crate::format::messages::NonFiniteField;
@@ -291,8 +291,8 @@ impl Foxglove3d {
             }
             self.table = Some(table);
         }
-        if let Some(change) = self.track.update() {
-            for level in (0..=change.level).rev() {
+        if let Some(changed) = self.track.update() {
+            for level in (0..=changed).rev() {
                 self.push_track_level(level, log_time, out)?;
             }
         }

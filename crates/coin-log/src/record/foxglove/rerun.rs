@@ -52,8 +52,6 @@ pub struct Rerun3d {
 }
 
 impl Rerun3d {
-    /// The output for a coin drawn `thickness` (fraction of a) thick.
-    #[must_use]
     pub fn new(thickness: f64) -> Self {
         Self {
             thickness,

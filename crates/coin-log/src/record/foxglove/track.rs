@@ -34,27 +34,19 @@ pub fn tolerance(level: usize) -> f64 {
     (MIN_TOLERANCE * 2f64.powf(f64::from(steps) / 3.0)).min(MAX_TOLERANCE)
 }
 
-/// A point of a level's polyline and the error bound of the segment that ends at it (0 for the first).
+/// A point of a level's polyline (display units) and the error bound of the segment that ends at it (0 for
+/// the first).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TrackPoint {
-    /// x, display units.
+pub(crate) struct TrackPoint {
     pub x: f64,
-    /// y, display units.
     pub y: f64,
     /// Bound on the distance of the original points of the segment ending here, display units.
     pub err: f64,
 }
 
-/// What changed at an update: `level` has new content (or is empty), and every level below it is empty.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TrackChange {
-    /// The level that took the new points.
-    pub level: usize,
-}
-
 /// The track's levels and the points not yet in any level.
 #[derive(Debug, Clone)]
-pub struct Track {
+pub(crate) struct Track {
     levels: Vec<Vec<TrackPoint>>,
     /// Points since the previous update.
     pending: Vec<TrackPoint>,
@@ -115,9 +107,9 @@ impl Track {
     }
 
     /// Closes a display update: moves the points since the previous one into the level the update's number
-    /// selects (module docs) and empties the levels below it. Returns `None` at the first update (which
-    /// only fixes the start of the path).
-    pub fn update(&mut self) -> Option<TrackChange> {
+    /// selects (module docs) and empties the levels below it. Returns that level (it has new content, or is
+    /// empty), or `None` at the first update (which only fixes the start of the path).
+    pub fn update(&mut self) -> Option<usize> {
         let n = self.updates;
         self.updates += 1;
         if n == 0 {
@@ -157,7 +149,7 @@ impl Track {
             self.end = Some(*p);
         }
         self.merged = merged;
-        Some(TrackChange { level: j })
+        Some(j)
     }
 
     /// Douglas–Peucker of `points` with carried error bounds (module docs), into `out`.
@@ -295,9 +287,7 @@ mod tests {
                 points.push(p);
                 i += 1;
             }
-            if let Some(c) = track.update() {
-                changed.push(c.level);
-            }
+            changed.extend(track.update());
             let line = chain(&track);
             if n == 0 {
                 assert!(line.is_empty());
