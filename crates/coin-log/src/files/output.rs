@@ -456,11 +456,6 @@ impl Output {
         OutputError::system("write", &self.target, source)
     }
 
-    /// Checks the target again (something may have appeared there meanwhile).
-    fn recheck(&self) -> Result<(), OutputError> {
-        check_target(&self.target, &self.policy).map(|_| ())
-    }
-
     /// Syncs the finished file, makes it readable and moves it into place. If the target no longer takes
     /// it or the move fails, the file is kept under its temporary name and the error says where.
     ///
@@ -473,7 +468,8 @@ impl Output {
             .sync_all()
             .map_err(|source| self.write_error(source))?;
         make_readable(self.temp.as_file());
-        let reason = match self.recheck() {
+        // Checked again: something may have appeared there meanwhile.
+        let reason = match check(&self.target, &self.policy) {
             Err(e @ OutputError::Exists { .. }) => {
                 format!("{e} (it appeared while the file was written, and was left alone)")
             }
@@ -596,7 +592,7 @@ impl OutputFolder {
     /// [`OutputError`] as for [`Output::commit`].
     pub fn commit(mut self) -> Result<(), OutputError> {
         for output in &self.outputs {
-            output.recheck()?;
+            check(&output.target, &output.policy)?;
         }
         for output in std::mem::take(&mut self.outputs) {
             output.commit()?;

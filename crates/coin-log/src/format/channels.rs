@@ -256,12 +256,6 @@ impl Topic {
     }
 }
 
-impl From<Channel> for Topic {
-    fn from(channel: Channel) -> Self {
-        Self::Main(channel)
-    }
-}
-
 impl fmt::Display for Topic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())

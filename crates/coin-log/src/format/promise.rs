@@ -43,7 +43,7 @@ pub enum Cause {
     /// together, exceeds the tolerance's floor.
     Rounding {
         /// The steps.
-        fixed: Option<FixedSteps>,
+        fixed: FixedSteps,
     },
 }
 
@@ -76,22 +76,12 @@ impl fmt::Display for Shortfall {
                  {:.1e} verify judges by; tighten --rtol/--atol (dopri5, dop853) or --step (rk4, gauss4)",
                 self.predicted, self.tolerance
             ),
-            Cause::Rounding { fixed } => {
-                let FixedSteps {
-                    steps,
-                    sample_interval,
-                } = fixed.unwrap_or(FixedSteps {
-                    steps: 0.0,
-                    sample_interval: 0.0,
-                });
-                write!(
-                    f,
-                    "{steps:.1e} fixed steps with samples {sample_interval:.1e} apart leave rounding of \
-                     about {:.1e}, above the tolerance {:.1e} verify judges by; take a larger --step \
-                     (fewer steps) or a lower --rate",
-                    self.predicted, self.tolerance
-                )
-            }
+            Cause::Rounding { fixed } => write!(
+                f,
+                "{:.1e} fixed steps with samples {:.1e} apart leave rounding of about {:.1e}, above the \
+                 tolerance {:.1e} verify judges by; take a larger --step (fewer steps) or a lower --rate",
+                fixed.steps, fixed.sample_interval, self.predicted, self.tolerance
+            ),
         }
     }
 }
@@ -120,12 +110,9 @@ pub fn shortfalls(run: &RunAccuracy, fixed: Option<FixedSteps>) -> Vec<Shortfall
         DIFFERENCE_GAIN * UNIT_ROUNDOFF / (f.sample_interval * omega)
     });
     let accumulated = GROWTH_SHARE * growth;
-    let cause = |share: f64, rounding: f64| {
-        if share >= rounding {
-            Cause::Accuracy { epsilon }
-        } else {
-            Cause::Rounding { fixed }
-        }
+    let cause = |share: f64, rounding: f64| match fixed {
+        Some(fixed) if share < rounding => Cause::Rounding { fixed },
+        _ => Cause::Accuracy { epsilon },
     };
     [
         (
