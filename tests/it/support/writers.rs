@@ -183,10 +183,9 @@ pub fn tool_schema(name: &str) -> Vec<u8> {
 pub fn add_channel<W: Write + Seek>(
     w: &mut mcap::Writer<W>,
     schemas: &mut BTreeMap<&'static str, u16>,
-    c: impl Into<Topic>,
+    c: Topic,
     schema_of: &dyn Fn(&str) -> Vec<u8>,
 ) -> u16 {
-    let c: Topic = c.into();
     let name = c.schema_name();
     let schema = match schemas.get(name) {
         Some(id) => *id,
@@ -264,7 +263,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         .map(|c| {
             (
                 Topic::Main(c),
-                add_channel(&mut w, &mut schemas, c, &tool_schema),
+                add_channel(&mut w, &mut schemas, Topic::Main(c), &tool_schema),
             )
         })
         .collect();
@@ -456,7 +455,12 @@ pub fn record(spec: &Spec, path: &Path) {
     let ids: Vec<(Channel, u16)> = spec
         .channels
         .iter()
-        .map(|c| (*c, add_channel(&mut w, &mut schemas, *c, &tool_schema)))
+        .map(|&c| {
+            (
+                c,
+                add_channel(&mut w, &mut schemas, Topic::Main(c), &tool_schema),
+            )
+        })
         .collect();
     let chaplygin = Chaplygin::new(coin.params()).unwrap();
     let mut sequence = 0u32;

@@ -25,7 +25,6 @@ use crate::model::{
 use crate::scene::Scene;
 use crate::simulation::{departure_doubt, run_dynamics};
 use coin_log_mcap::{Compression, McapWriter, WriteError, WriterOptions};
-use nalgebra::Vector3;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -379,8 +378,8 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             };
             self.stage(Channel::Quaternion, |b| m.write(encoding, b))?;
         }
-        let points: [(Channel, fn(&Coin, &State) -> Vector3<f64>); 2] = [
-            (Channel::Position, centre),
+        let points = [
+            (Channel::Position, centre as fn(&_, &_) -> _),
             (Channel::Contact, contact_point),
         ];
         for (channel, point) in points {
