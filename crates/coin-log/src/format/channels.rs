@@ -127,11 +127,8 @@ macro_rules! track_topics {
 /// The track topics, level by level.
 const TRACK_TOPICS: [&str; TRACK_LEVELS] = track_topics!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
 
-/// An MCAP topic of the format. Every channel writes its main topic ([`Channel::topic`]); the two Foxglove
-/// channels write more, so that a viewer that restores only the latest message of each topic after a seek
-/// still has every frame and the whole track: `tf` also writes `/tf_static`, and `scene` writes
-/// `/scene/follow`, `/scene/table` and the track levels `/scene/track/<level>`. `rerun` writes, beside its
-/// `/rerun/coin_body`, the coin's shape, the table and the track in the types Rerun's importer draws.
+/// An MCAP topic of the format: every channel's main topic ([`Channel::topic`]), and the extra topics of
+/// `tf`, `scene` and `rerun` (format.md: Frames and Foxglove output, Rerun geometry).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Topic {
     /// The channel's main topic.

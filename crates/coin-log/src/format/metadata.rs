@@ -148,10 +148,11 @@ trait OptionalKeys: Sized {
     ) -> Result<Self, MetadataError>;
 }
 
-impl OptionalKeys for Option<f64> {
+/// A value written only when there: its key, by its [`Value`].
+impl<T: Value> OptionalKeys for Option<T> {
     fn write(&self, key: &'static str, map: &mut BTreeMap<String, String>) {
         if let Some(v) = self {
-            map.insert(key.to_string(), number_string(*v));
+            map.insert(key.to_string(), v.write());
         }
     }
     fn read(
@@ -162,21 +163,6 @@ impl OptionalKeys for Option<f64> {
         map.contains_key(key)
             .then(|| read(record, map, key))
             .transpose()
-    }
-}
-
-impl OptionalKeys for Option<String> {
-    fn write(&self, key: &'static str, map: &mut BTreeMap<String, String>) {
-        if let Some(v) = self {
-            map.insert(key.to_string(), v.clone());
-        }
-    }
-    fn read(
-        _: &'static str,
-        map: &BTreeMap<String, String>,
-        key: &'static str,
-    ) -> Result<Self, MetadataError> {
-        Ok(map.get(key).cloned())
     }
 }
 

@@ -280,7 +280,10 @@ impl Foxglove3d {
         }
         let moved = match self.table {
             Some(t) if (centre[0] - t[0]).abs().max((centre[1] - t[1]).abs()) <= TABLE_SNAP => None,
-            _ => Some([snap(centre[0]), snap(centre[1])]),
+            _ => Some([
+                round_to(centre[0], TABLE_SNAP),
+                round_to(centre[1], TABLE_SNAP),
+            ]),
         };
         if let Some(table) = moved {
             out.push(Topic::SceneTable, |buf| {
@@ -340,7 +343,7 @@ fn scene_slot(t: f64) -> u64 {
     }
 }
 
-/// `v` rounded to the nearest multiple of [`TABLE_SNAP`] (−0 as 0).
-fn snap(v: f64) -> f64 {
-    (v / TABLE_SNAP).round() * TABLE_SNAP + 0.0
+/// `v` rounded to the nearest multiple of `step` (−0 as 0).
+fn round_to(v: f64, step: f64) -> f64 {
+    (v / step).round() * step + 0.0
 }

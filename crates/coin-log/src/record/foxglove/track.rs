@@ -11,6 +11,7 @@
 //! level's tolerance; every original point therefore stays within [`MAX_TOLERANCE`] of the published
 //! track, whatever the number of merges. Points are rounded to [`QUANTUM`]; a repeated point is skipped.
 
+use super::round_to;
 use crate::format::TRACK_LEVELS;
 
 /// The highest level; it is never emptied.
@@ -80,17 +81,12 @@ impl Default for Track {
     }
 }
 
-/// `v` on the [`QUANTUM`] grid (−0 written as 0).
-fn quantize(v: f64) -> f64 {
-    (v / QUANTUM).round() * QUANTUM + 0.0
-}
-
 impl Track {
     /// Adds the contact point (x, y) in display units, unless it rounds to the previous one.
     pub fn add(&mut self, x: f64, y: f64) {
         let p = TrackPoint {
-            x: quantize(x),
-            y: quantize(y),
+            x: round_to(x, QUANTUM),
+            y: round_to(y, QUANTUM),
             err: 0.0,
         };
         if self.last.is_some_and(|q| q.x == p.x && q.y == p.y) {
