@@ -41,7 +41,7 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
     let policy = Policy {
         overwrite: args.overwrite,
         flag: "--out",
-        example: "plot.svg",
+        example: "plot.svg".into(),
         protect: None,
     };
     // Before reading: a bad target costs nothing.

@@ -329,14 +329,13 @@ pub(super) fn prepare_output(
     source: &SceneSource,
     signals: &Signals,
 ) -> anyhow::Result<Output> {
-    let example = format!("{}.mcap", source.stem);
     let policy = Policy {
         overwrite,
         flag: "-o",
-        example: &example,
+        example: format!("{}.mcap", source.stem).into(),
         protect: source
             .path
-            .as_deref()
+            .clone()
             .map(|p| (p, "the scene file being recorded")),
     };
     // Locked while the temporary file is created, so that a second signal finds it to delete.

@@ -7,8 +7,8 @@ use crate::support::record::{read_back, record_to_memory, schema_file, validate_
 use crate::support::writers::{message_json_with, COIN_CHANNELS};
 use crate::support::FailingWriter;
 use coin_log::format::{
-    log_time, Channel, ResultMetadata, RunMetadata, Termination, Topic, RESULT_METADATA_NAME,
-    RUN_METADATA_NAME,
+    log_time, Channel, Encoding, ResultMetadata, RunMetadata, Termination, Topic,
+    RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use coin_log::integrate::{run_method, Flow, MethodConfig, RunSettings};
 use coin_log::model::{energy, Chaplygin, Dynamics, State, DISSIPATIVE_STATE_LEN, STATE_LEN};
@@ -82,7 +82,7 @@ fn expected_messages(scene: &Scene) -> Vec<(Topic, u64, Vec<u8>)> {
     let coin = scene.coin();
     let samples = simulated_samples(scene);
     let (tf, scene_on) = (scene.records(Channel::Tf), scene.records(Channel::Scene));
-    let mut foxglove = Foxglove3d::new(&coin, scene.thickness, tf, scene_on);
+    let mut foxglove = Foxglove3d::new(&coin, scene.thickness, &scene.channels, Encoding::Json);
     let mut batch = FoxgloveBatch::default();
     let chaplygin = Chaplygin::new(&scene.params).unwrap();
     let e0 = energy(&coin, &State::from_array(&samples[0].1)).total;

@@ -1,12 +1,7 @@
-//! CSV as every table of coin-log is written (`export`, `analyse map`, the benchmarks): RFC 4180's
-//! quoting, one rule for every field: a field holding a comma, a double quote, a CR or an LF is put in
-//! double quotes with its quotes doubled; every other field is written as it is. Lines end with LF.
-//! Numbers are written in the shortest form that reads back to the same f64 (ryu), which never needs
-//! quoting.
-//!
-//! A small helper rather than the `csv` crate: the tables are written a line at a time from numbers
-//! (export streams millions of rows through one reused buffer), where the crate's `Serialize` rows
-//! would add a crate and a row type per table for the same bytes.
+//! CSV as every table of coin-log is written (`export`, `analyse map`, the benchmarks): RFC 4180's quoting
+//! (a field holding a comma, a double quote, a CR or an LF is quoted, its quotes doubled), LF line ends, and
+//! numbers in their shortest round-trip form. A small helper rather than the `csv` crate: export streams
+//! millions of rows through one reused line, where the crate would add a row type per table.
 
 use std::borrow::Cow;
 

@@ -1,13 +1,6 @@
 //! coin-log: a coin rolling without slipping on a horizontal table, simulated to many digits and recorded
-//! as MCAP datasets for Foxglove.
-//!
-//! The physics is that of `docs/physics.md` (cited as "physics §n" and "eq (n)"): a thin axisymmetric body in
-//! rim contact with a flat table, no slip. The file format is `docs/format.md`. Dependencies point one way
-//! (docs/architecture.md): [`model`] → [`integrate`] → [`simulation`] → [`format`](mod@format) → [`scene`] →
-//! [`record`] / [`verify`] / [`analyse`] / [`inspect`] → `live` (cargo feature `live`); files are read and
-//! written through the `coin-log-mcap` crate below them all, and the `coin-log-bench` crate and the `coin-log`
-//! binary sit on top. [`files`] (what an input path may be, how an output is written) and [`csv`] use
-//! nothing of the crate.
+//! as MCAP datasets for Foxglove. The physics is `docs/physics.md` (cited as "physics §n" and "eq (n)"), the
+//! file format `docs/format.md`, and the modules' dependencies `docs/architecture.md`.
 
 pub use coin_log_ode as integrate;
 

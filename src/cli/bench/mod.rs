@@ -115,10 +115,10 @@ fn create_dir(out: &Path, files: &[String]) -> anyhow::Result<()> {
 }
 
 /// The result files replace an earlier run's (never a link, pipe or device: files::output).
-const POLICY: Policy<'static> = Policy {
+const POLICY: Policy = Policy {
     overwrite: true,
     flag: "--out",
-    example: "bench-results",
+    example: std::borrow::Cow::Borrowed("bench-results"),
     protect: None,
 };
 

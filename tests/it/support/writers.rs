@@ -11,8 +11,8 @@ use coin_log::format::messages::{
     ReactionMessage, WorkMessage,
 };
 use coin_log::format::{
-    log_time, schema_bytes, Channel, ResultMetadata, Topic, MESSAGE_ENCODING, RESULT_METADATA_NAME,
-    RUN_METADATA_NAME, SCHEMA_ENCODING,
+    log_time, schema_bytes, Channel, Encoding, ResultMetadata, Topic, RESULT_METADATA_NAME,
+    RUN_METADATA_NAME,
 };
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, NoEvents, RunEnd, RunSettings};
 use coin_log::model::{
@@ -179,23 +179,27 @@ pub fn tool_schema(name: &str) -> Vec<u8> {
 pub fn add_channel<W: Write + Seek>(
     w: &mut mcap::Writer<W>,
     schemas: &mut BTreeMap<&'static str, u16>,
-    c: impl Into<Topic>,
+    c: Topic,
     schema_of: &dyn Fn(&str) -> Vec<u8>,
 ) -> u16 {
-    let c: Topic = c.into();
     let name = c.schema_name();
     let schema = match schemas.get(name) {
         Some(id) => *id,
         None => {
             let id = w
-                .add_schema(name, SCHEMA_ENCODING, &schema_of(name))
+                .add_schema(name, Encoding::Json.schema_encoding(), &schema_of(name))
                 .unwrap();
             schemas.insert(name, id);
             id
         }
     };
-    w.add_channel(schema, c.name(), MESSAGE_ENCODING, &BTreeMap::new())
-        .unwrap()
+    w.add_channel(
+        schema,
+        c.name(),
+        Encoding::Json.message_encoding(),
+        &BTreeMap::new(),
+    )
+    .unwrap()
 }
 
 /// Writes one message on channel `channel_id`, its publish time equal to its log time `lt`.
@@ -255,7 +259,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         .map(|c| {
             (
                 Topic::Main(c),
-                add_channel(&mut w, &mut schemas, c, &tool_schema),
+                add_channel(&mut w, &mut schemas, Topic::Main(c), &tool_schema),
             )
         })
         .collect();
@@ -264,7 +268,7 @@ pub fn record_circle(path: &Path, duration: f64, damage: Damage) {
         metadata: BTreeMap::from([("format_version".to_string(), "1".to_string())]),
     })
     .unwrap();
-    let mut fox = Foxglove3d::new(&coin, 0.05, true, true);
+    let mut fox = Foxglove3d::new(&coin, 0.05, &[Channel::Tf, Channel::Scene], Encoding::Json);
     let mut batch = FoxgloveBatch::default();
     let mut sequence = 0u32;
     let mut damaged = false;
@@ -452,7 +456,12 @@ pub fn record(spec: &Spec, path: &Path) {
     let ids: Vec<(Channel, u16)> = spec
         .channels
         .iter()
-        .map(|c| (*c, add_channel(&mut w, &mut schemas, *c, &tool_schema)))
+        .map(|&c| {
+            (
+                c,
+                add_channel(&mut w, &mut schemas, Topic::Main(c), &tool_schema),
+            )
+        })
         .collect();
     let chaplygin = Chaplygin::new(coin.params()).unwrap();
     let mut sequence = 0u32;

@@ -1,10 +1,6 @@
-//! What a path given as an input may be (format.md: Commands, Inputs and outputs). Every input is a regular
-//! file, looked at before it is opened, so a named pipe, a device (`/dev/zero`, `/dev/urandom`), a socket
-//! or a folder is refused with the reason instead of blocking or being read without end; a symbolic link
-//! is followed to what it names. A scene or sweep file is read whole and must be at most
-//! [`SCENE_MAX_BYTES`]; an MCAP file is read in bounded memory by its reader, which seeks (to the summary
-//! and metadata), so it cannot be a stream. Standard input is offered nowhere: `-` is refused with that
-//! reason.
+//! What a path given as an input may be (format.md: Commands, Inputs and outputs): a regular file, looked at
+//! before it is opened, so that nothing blocks or reads without end. An MCAP file is read by seeking, so it
+//! cannot be a stream.
 
 use super::output::kind_of;
 use std::fs::{self, File, Metadata};

@@ -1,13 +1,5 @@
-//! The files coin-log reads and writes, by one policy for every command (format.md: Commands, Inputs and
-//! outputs).
-//!
-//! - [`input`]: what a path given as an input may be: a regular file (never a pipe, device, socket or
-//!   folder, whose reads may block or never end), and for a scene no larger than [`input::SCENE_MAX_BYTES`].
-//!   Standard input is not offered, and `-` says so.
-//! - [`output`]: how an output is written: into an owner-only temporary file beside the target, moved into
-//!   place by rename once finished and synced, never over anything but a regular file, never over an
-//!   existing one unless the command allows it; a finished file whose move fails is kept, and named.
-//! - [`shown`]: a path as every message prints it, its control characters escaped.
+//! The files coin-log reads ([`input`]: regular files only, bounded) and writes ([`output`]: a temporary file
+//! moved into place), by one policy for every command (format.md: Commands, Inputs and outputs).
 
 pub mod input;
 pub mod output;

@@ -1,36 +1,29 @@
-//! How every output is written (format.md: Commands, Inputs and outputs). A file is written to a temporary
-//! file beside its target (owner-only while it is written) and moved into place by rename once finished
-//! and synced, so a reader never sees half a file and a failure leaves the old file (or none). A rename replaces whatever has the
-//! target's name, so the target must be absent or, when the command allows replacing (`--overwrite`), a
-//! regular file: never a symbolic link (the link itself would become a plain file), a named pipe, a device
-//! (`/dev/null`), a socket or a folder, and never a file the command protects (the scene being recorded).
-//! Targets are looked at with `symlink_metadata` (lstat), which never follows a link, and never opened, so
-//! a pipe cannot block. Everything is checked before any work is done, and again just before the move; if
-//! the move fails, the finished file is kept under its temporary name, which the error gives.
-//!
-//! [`OutputFolder`] does the same for several files in one folder (`export`, `man`): every file is checked
-//! before any is moved, and an output that is dropped unfinished removes its temporary files and the
-//! folders it created.
+//! How every output is written (format.md: Commands, Inputs and outputs): into an owner-only temporary file
+//! beside the target, moved into place by rename once finished and synced. A rename replaces whatever has
+//! the target's name, so targets are looked at with `symlink_metadata` (never following a link, never
+//! opening a pipe), before any work and again just before the move. [`OutputFolder`] does the same for
+//! several files in one folder.
 
 use super::shown;
+use std::borrow::Cow;
 use std::fs::{self, File, Metadata, OpenOptions};
 use std::io::{self, ErrorKind, Write};
 use std::path::{Path, PathBuf};
 use tempfile::NamedTempFile;
 
 /// What may be at a target, and how messages tell the user to name another.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Policy<'a> {
+#[derive(Debug, Clone, Default)]
+pub struct Policy {
     /// An existing regular file may be replaced (`--overwrite`, or a command that always replaces its own
     /// files).
     pub overwrite: bool,
     /// The flag that names the target (`-o`, `--out`), for the fixes messages suggest.
-    pub flag: &'a str,
+    pub flag: &'static str,
     /// A file name to suggest instead of a folder or a special file (`wobble.mcap`).
-    pub example: &'a str,
+    pub example: Cow<'static, str>,
     /// A file the output must never replace, however reached (another path, a hard or symbolic link),
     /// and what it is: `(scene, "the scene file being recorded")`.
-    pub protect: Option<(&'a Path, &'a str)>,
+    pub protect: Option<(PathBuf, &'static str)>,
 }
 
 /// Why an output cannot be written, or was not moved into place. `fix` says what to do instead.
@@ -175,7 +168,7 @@ enum Refused {
     Exists,
 }
 
-impl Policy<'_> {
+impl Policy {
     /// What to do instead of writing to `target`, refused as `refused`. Without an example the target is a
     /// file of an output folder (`export`, `man`): the fix is another folder.
     fn fix(&self, refused: Refused, target: &Path) -> String {
@@ -191,7 +184,7 @@ impl Policy<'_> {
         match refused {
             Refused::Folder => format!(
                 "give a file name, e.g. {flag} {}",
-                shown(&target.join(self.example))
+                shown(&target.join(&*self.example))
             ),
             Refused::Special => format!("choose a file path, e.g. {flag} {}", self.example),
             Refused::Protected => format!("choose another output, e.g. {flag} {}", self.example),
@@ -266,7 +259,11 @@ fn check_target(target: &Path, policy: &Policy) -> Result<Option<Metadata>, Outp
             fix,
         });
     }
-    if let Some((_, what)) = policy.protect.filter(|(file, _)| same_file(&meta, file)) {
+    if let Some((_, what)) = policy
+        .protect
+        .as_ref()
+        .filter(|(file, _)| same_file(&meta, file))
+    {
         let (what, fix) = (what.to_string(), policy.fix(Refused::Protected, target));
         return Err(OutputError::Protected { path, what, fix });
     }
@@ -388,10 +385,7 @@ pub fn check(target: &Path, policy: &Policy) -> Result<(), OutputError> {
 pub struct Output {
     target: PathBuf,
     temp: NamedTempFile,
-    overwrite: bool,
-    flag: String,
-    example: String,
-    protect: Option<(PathBuf, String)>,
+    policy: Policy,
 }
 
 impl Output {
@@ -422,12 +416,7 @@ impl Output {
         Ok(Self {
             target: target.to_path_buf(),
             temp,
-            overwrite: policy.overwrite,
-            flag: policy.flag.to_string(),
-            example: policy.example.to_string(),
-            protect: policy
-                .protect
-                .map(|(p, w)| (p.to_path_buf(), w.to_string())),
+            policy: policy.clone(),
         })
     }
 
@@ -467,23 +456,6 @@ impl Output {
         OutputError::system("write", &self.target, source)
     }
 
-    fn policy(&self) -> Policy<'_> {
-        Policy {
-            overwrite: self.overwrite,
-            flag: &self.flag,
-            example: &self.example,
-            protect: self
-                .protect
-                .as_ref()
-                .map(|(p, w)| (p.as_path(), w.as_str())),
-        }
-    }
-
-    /// Checks the target again (something may have appeared there meanwhile).
-    fn recheck(&self) -> Result<(), OutputError> {
-        check_target(&self.target, &self.policy()).map(|_| ())
-    }
-
     /// Syncs the finished file, makes it readable and moves it into place. If the target no longer takes
     /// it or the move fails, the file is kept under its temporary name and the error says where.
     ///
@@ -496,13 +468,14 @@ impl Output {
             .sync_all()
             .map_err(|source| self.write_error(source))?;
         make_readable(self.temp.as_file());
-        let reason = match self.recheck() {
+        // Checked again: something may have appeared there meanwhile.
+        let reason = match check(&self.target, &self.policy) {
             Err(e @ OutputError::Exists { .. }) => {
                 format!("{e} (it appeared while the file was written, and was left alone)")
             }
             Err(e) => e.to_string(),
             Ok(()) => {
-                let moved = if self.overwrite {
+                let moved = if self.policy.overwrite {
                     self.temp.persist(&self.target).map(drop)
                 } else {
                     self.temp.persist_noclobber(&self.target).map(drop)
@@ -601,8 +574,7 @@ impl OutputFolder {
         let policy = Policy {
             overwrite: self.overwrite,
             flag: "--out",
-            example: "",
-            protect: None,
+            ..Policy::default()
         };
         let mut output = Output::create(&self.dir.join(name), &policy)?;
         let file = output
@@ -620,7 +592,7 @@ impl OutputFolder {
     /// [`OutputError`] as for [`Output::commit`].
     pub fn commit(mut self) -> Result<(), OutputError> {
         for output in &self.outputs {
-            output.recheck()?;
+            check(&output.target, &output.policy)?;
         }
         for output in std::mem::take(&mut self.outputs) {
             output.commit()?;
@@ -644,11 +616,11 @@ mod tests {
     use super::{Output, OutputFolder, Policy};
     use std::io::Write;
 
-    fn policy(overwrite: bool) -> Policy<'static> {
+    fn policy(overwrite: bool) -> Policy {
         Policy {
             overwrite,
             flag: "-o",
-            example: "x.txt",
+            example: "x.txt".into(),
             protect: None,
         }
     }

@@ -9,40 +9,25 @@ use super::messages::{
 use super::Encoding;
 use std::fmt;
 
-/// Schema encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const SCHEMA_ENCODING: &str = Encoding::Json.schema_encoding();
-/// Message encoding of every channel in the default encoding, JSON ([`Encoding::Json`]).
-pub const MESSAGE_ENCODING: &str = Encoding::Json.message_encoding();
-
 coin_log_names::named_enum! {
     /// A recordable channel; the name is the one of scene files and `--channels`. `work` and `rerun` are
     /// last here (both opt-in), but in a file `work` is written, and registered, with the other
-    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table).
+    /// `coin_log.*` channels before `/tf` and `/scene` (format.md's channel table, which says what each
+    /// carries).
+    #[allow(missing_docs)]
     #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
     pub enum Channel: "channel" {
-        /// ω in the lean frame.
         Omega = "omega",
-        /// θ, φ, ψ.
         Angles = "angles",
-        /// Orientation quaternion.
         Quaternion = "quaternion",
-        /// Centre position.
         Position = "position",
-        /// Contact point.
         Contact = "contact",
-        /// Reaction of the table.
         Reaction = "reaction",
-        /// Energy.
         Energy = "energy",
-        /// Chaplygin integrals C1, C2.
         Invariants = "invariants",
-        /// Foxglove frame transforms.
         Tf = "tf",
-        /// Foxglove scene (coin and track).
         Scene = "scene",
-        /// Dissipated work W and the balance E + W (only with dissipation, physics §11).
         Work = "work",
-        /// The coin, table and track as geometry Rerun's MCAP importer draws (opt-in, Protobuf only).
         Rerun = "rerun",
     }
 }
@@ -133,31 +118,17 @@ impl Channel {
 /// and Foxglove output).
 pub const TRACK_LEVELS: usize = 16;
 
-/// The track topics, level by level.
-const TRACK_TOPICS: [&str; TRACK_LEVELS] = [
-    "/scene/track/0",
-    "/scene/track/1",
-    "/scene/track/2",
-    "/scene/track/3",
-    "/scene/track/4",
-    "/scene/track/5",
-    "/scene/track/6",
-    "/scene/track/7",
-    "/scene/track/8",
-    "/scene/track/9",
-    "/scene/track/10",
-    "/scene/track/11",
-    "/scene/track/12",
-    "/scene/track/13",
-    "/scene/track/14",
-    "/scene/track/15",
-];
+macro_rules! track_topics {
+    ($($level:literal)*) => {
+        [$(concat!("/scene/track/", $level)),*]
+    };
+}
 
-/// An MCAP topic of the format. Every channel writes its main topic ([`Channel::topic`]); the two Foxglove
-/// channels write more, so that a viewer that restores only the latest message of each topic after a seek
-/// still has every frame and the whole track: `tf` also writes `/tf_static`, and `scene` writes
-/// `/scene/follow`, `/scene/table` and the track levels `/scene/track/<level>`. `rerun` writes, beside its
-/// `/rerun/coin_body`, the coin's shape, the table and the track in the types Rerun's importer draws.
+/// The track topics, level by level.
+const TRACK_TOPICS: [&str; TRACK_LEVELS] = track_topics!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+
+/// An MCAP topic of the format: every channel's main topic ([`Channel::topic`]), and the extra topics of
+/// `tf`, `scene` and `rerun` (format.md: Frames and Foxglove output, Rerun geometry).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Topic {
     /// The channel's main topic.
@@ -279,12 +250,6 @@ impl Topic {
     #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         Self::all().find(|t| t.name() == name)
-    }
-}
-
-impl From<Channel> for Topic {
-    fn from(channel: Channel) -> Self {
-        Self::Main(channel)
     }
 }
 

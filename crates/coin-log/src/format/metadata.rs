@@ -148,10 +148,11 @@ trait OptionalKeys: Sized {
     ) -> Result<Self, MetadataError>;
 }
 
-impl OptionalKeys for Option<f64> {
+/// A value written only when there: its key, by its [`Value`].
+impl<T: Value> OptionalKeys for Option<T> {
     fn write(&self, key: &'static str, map: &mut BTreeMap<String, String>) {
         if let Some(v) = self {
-            map.insert(key.to_string(), number_string(*v));
+            map.insert(key.to_string(), v.write());
         }
     }
     fn read(
@@ -162,21 +163,6 @@ impl OptionalKeys for Option<f64> {
         map.contains_key(key)
             .then(|| read(record, map, key))
             .transpose()
-    }
-}
-
-impl OptionalKeys for Option<String> {
-    fn write(&self, key: &'static str, map: &mut BTreeMap<String, String>) {
-        if let Some(v) = self {
-            map.insert(key.to_string(), v.clone());
-        }
-    }
-    fn read(
-        _: &'static str,
-        map: &BTreeMap<String, String>,
-        key: &'static str,
-    ) -> Result<Self, MetadataError> {
-        Ok(map.get(key).cloned())
     }
 }
 
@@ -270,77 +256,45 @@ macro_rules! record {
 }
 
 record! {
-    /// The `coin-log` record: what was simulated and how.
+    /// The `coin-log` record: what was simulated and how; its keys are format.md's (Metadata records).
+    #[allow(missing_docs)]
     pub struct RunMetadata = RUN_METADATA_NAME {
-        /// `format_version` ("1").
         pub format_version: String,
-        /// `tool_version`: the crate version.
         pub tool_version: String,
-        /// `scene`: the resolved scene as TOML.
         pub scene: String,
-        /// M.
         pub mass: f64,
-        /// a.
         pub radius: f64,
-        /// g.
         pub gravity: f64,
-        /// I_X.
         pub inertia_x: f64,
-        /// I_Z.
         pub inertia_z: f64,
-        /// μ, if given.
         pub friction: Option<f64>,
-        /// √(a/g).
         pub time_unit: f64,
-        /// The integrator.
         pub integrator: Method,
-        /// rtol.
         pub rtol: f64,
-        /// atol.
         pub atol: f64,
-        /// Fixed step (the value used by fixed-step methods; recorded for all).
         pub step: f64,
-        /// Samples per time unit.
         pub rate: f64,
-        /// The steady motion the whole run should stay on (`none` when the scene is not an unperturbed steady
-        /// motion).
         pub steady_kind: Option<SteadyFamily>,
-        /// Steady φ̇.
         pub phi_dot: Option<f64>,
-        /// Steady ψ̇.
         pub psi_dot: Option<f64>,
-        /// Steady R_G.
         pub r_g: Option<f64>,
-        /// Steady R_C.
         pub r_c: Option<f64>,
         optional:
-        /// The dissipation law (physics §11): keys `dissipation` (the model), `dissipation_coefficient`
-        /// (κ), `dissipation_m`, `dissipation_k`, written only when there is one. A file without them is
-        /// conservative.
         pub dissipation: Option<Dissipation>,
     }
 }
 
 record! {
-    /// The `coin-log.result` record: how the run ended.
+    /// The `coin-log.result` record: how the run ended; its keys are format.md's (Metadata records).
+    #[allow(missing_docs)]
     pub struct ResultMetadata = RESULT_METADATA_NAME {
-        /// Accepted steps.
         pub steps: u64,
-        /// RHS evaluations.
         pub rhs_evaluations: u64,
-        /// Rejected steps.
         pub rejected_steps: u64,
-        /// How the run ended.
         pub termination: Termination,
-        /// Time the run ended.
         pub termination_time: f64,
         optional:
-        /// α = π/2 − |θ| at the last sample (`termination_alpha`), written only with dissipation: how
-        /// flat the coin was when the run ended (physics §11).
         pub termination_alpha: Option<f64>,
-        /// The checks `verify` is expected to fail with its default tolerances (`expected_to_fail`, check ids
-        /// comma-separated), written only when there are some: the settings could not meet them
-        /// ([`crate::format::promise`]).
         pub expected_to_fail: Option<String>,
     }
 }

@@ -1,14 +1,7 @@
-//! The file format, typed: everything a coin-log MCAP file contains that `scene`, `record` and `verify` must
-//! agree on (docs/format.md). The channels with their topics and schemas ([`channels`]); the schemas and
-//! the `coin_log.*` message types with their JSON form ([`messages`], read back by [`json`]) and their Protobuf form ([`protobuf`], the two [`Encoding`]s); the two metadata
-//! records with typed values ([`metadata`]); how a run ended ([`Termination`]); and the one conversion from
-//! simulation time to log time ([`log_time`]); and the tolerances a file is judged by, derived from its
-//! recorded integrator settings ([`tolerances`]), and what they will accept, predicted from the settings
-//! ([`promise`]).
-//!
-//! It knows the physics' vocabulary (integrator [`Method`](crate::integrate::Method), steady
-//! [`SteadyFamily`](crate::model::SteadyFamily), [`Branch`](crate::model::Branch), physical events) but
-//! nothing about scenes, the recorder or the checks, which all import it.
+//! The file format, typed (docs/format.md): everything a coin-log MCAP file contains that `scene`, `record`
+//! and `verify` must agree on: channels and topics, message types in both [`Encoding`]s, metadata records,
+//! [`Termination`], [`log_time`], and the [`tolerances`] a file is judged by with what they will accept
+//! ([`promise`]). It knows the physics' vocabulary but nothing of scenes, the recorder or the checks.
 
 pub mod channels;
 mod encoding;
@@ -22,9 +15,7 @@ mod termination;
 mod time;
 pub mod tolerances;
 
-pub use channels::{
-    schema_data, Channel, Topic, MESSAGE_ENCODING, ROS_STRING, SCHEMA_ENCODING, TRACK_LEVELS,
-};
+pub use channels::{schema_data, Channel, Topic, ROS_STRING, TRACK_LEVELS};
 pub use encoding::Encoding;
 pub use messages::{schema_bytes, FRAME_TRANSFORM, SCENE_UPDATE};
 pub use metadata::{

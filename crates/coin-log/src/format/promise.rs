@@ -1,23 +1,13 @@
 //! What `verify`'s default tolerances will accept, predicted from a run's settings before it runs, so that
-//! `record` promises only what `verify` will grant (format.md: Tolerances, What record promises).
+//! `record` promises only what `verify` will grant (format.md: What record promises). Where a clamp of the
+//! tolerances bites, their safety factor is gone, and the prediction uses what the errors actually reach:
 //!
-//! The tolerances ([`super::tolerances`]) allow 100 ε (1 + T/τ) for the drifts and 1000 ε (1 + T/τ) for the
-//! residuals, safety factors over what the integrator was asked for, but they are clamped: never looser
-//! than the ceilings (1e-6), never tighter than the floors (rounding). Where a clamp bites, the safety
-//! factor is gone and the prediction has to be made from what the errors actually reach:
-//!
-//!   drifts and residuals   ≈ [`GROWTH_SHARE`] · ε (1 + T/τ)     (the integrator's share of its budget)
+//!   drifts and residuals   ≈ [`GROWTH_SHARE`] · ε (1 + T/τ)
 //!   nutation (relative)    ≈ [`NUTATION_SHARE`] · ε
 //!   rounding of n steps    ≈ [`ROUNDING_SHARE`] · n · 2⁻⁵³       (fixed-step methods; n = T/h)
 //!   rounding differenced   ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ / (Δt Ω)  (fixed-step methods, constraint)
 //!
-//! The last is the constraint's finite difference over samples Δt apart dividing the rounding that each
-//! fixed step leaves on the sample it ends on (Ω = max(max|ω|, 1/τ)); an adaptive method's samples are
-//! interpolated within a step, and at the highest rate its constraint passed (measured below).
-//!
-//! A check whose predicted error is above its tolerance is expected to fail. The shares are measured
-//! (below); `tests/it/record_verify_agreement.rs` sweeps the corners of every integrator and checks that no
-//! run predicted to pass fails.
+//! `tests/it/record_verify_agreement.rs` checks that no run predicted to pass fails.
 
 use super::tolerances::{RunAccuracy, Tolerances, UNIT_ROUNDOFF};
 use std::fmt;
@@ -53,7 +43,7 @@ pub enum Cause {
     /// together, exceeds the tolerance's floor.
     Rounding {
         /// The steps.
-        fixed: Option<FixedSteps>,
+        fixed: FixedSteps,
     },
 }
 
@@ -86,22 +76,12 @@ impl fmt::Display for Shortfall {
                  {:.1e} verify judges by; tighten --rtol/--atol (dopri5, dop853) or --step (rk4, gauss4)",
                 self.predicted, self.tolerance
             ),
-            Cause::Rounding { fixed } => {
-                let FixedSteps {
-                    steps,
-                    sample_interval,
-                } = fixed.unwrap_or(FixedSteps {
-                    steps: 0.0,
-                    sample_interval: 0.0,
-                });
-                write!(
-                    f,
-                    "{steps:.1e} fixed steps with samples {sample_interval:.1e} apart leave rounding of \
-                     about {:.1e}, above the tolerance {:.1e} verify judges by; take a larger --step \
-                     (fewer steps) or a lower --rate",
-                    self.predicted, self.tolerance
-                )
-            }
+            Cause::Rounding { fixed } => write!(
+                f,
+                "{:.1e} fixed steps with samples {:.1e} apart leave rounding of about {:.1e}, above the \
+                 tolerance {:.1e} verify judges by; take a larger --step (fewer steps) or a lower --rate",
+                fixed.steps, fixed.sample_interval, self.predicted, self.tolerance
+            ),
         }
     }
 }
@@ -130,12 +110,9 @@ pub fn shortfalls(run: &RunAccuracy, fixed: Option<FixedSteps>) -> Vec<Shortfall
         DIFFERENCE_GAIN * UNIT_ROUNDOFF / (f.sample_interval * omega)
     });
     let accumulated = GROWTH_SHARE * growth;
-    let cause = |share: f64, rounding: f64| {
-        if share >= rounding {
-            Cause::Accuracy { epsilon }
-        } else {
-            Cause::Rounding { fixed }
-        }
+    let cause = |share: f64, rounding: f64| match fixed {
+        Some(fixed) if share < rounding => Cause::Rounding { fixed },
+        _ => Cause::Accuracy { epsilon },
     };
     [
         (

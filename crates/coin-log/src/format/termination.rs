@@ -5,26 +5,19 @@ use crate::integrate::{self, StepError};
 use crate::simulation::{CoinEvents, PhysicalEvent};
 
 coin_log_names::named_enum! {
-    /// How a run ended; the name is the one written in the metadata, in the order of the format's table.
+    /// How a run ended; the name is the one written in the metadata, in the order of the format's table
+    /// (format.md: Metadata records), which says what each means.
+    #[allow(missing_docs)]
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
     pub enum Termination: "termination" {
-        /// The duration was reached.
         Completed = "completed",
-        /// |θ| reached π/2 − flat_margin: the coin lands flat (physics §7).
         FlatLanding = "flat-landing",
-        /// N reached 0: the coin would leave the table.
         LiftOff = "lift-off",
-        /// |F| reached μN: the coin would slip.
         Slip = "slip",
-        /// The user stopped the run (SIGINT, SIGTERM, SIGHUP).
         Interrupted = "interrupted",
-        /// The adaptive step size fell below what floating point resolves.
         StepSizeUnderflow = "step-size-underflow",
-        /// The state or a derived quantity became NaN or infinite.
         NonFinite = "non-finite",
-        /// The implicit stage equations did not converge.
         NewtonFailure = "newton-failure",
-        /// The adaptive integrator spent its step budget (`run.max_steps`) before the duration.
         StepBudgetSpent = "step-budget-spent",
     }
 }

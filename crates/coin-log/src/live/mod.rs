@@ -1,16 +1,8 @@
-//! Live view (`coin-log live`, format.md: live): a recording served to Foxglove while it is simulated, over
-//! the Foxglove WebSocket protocol (the `foxglove` crate's server; subprotocols `foxglove.sdk.v1` and
-//! `foxglove.sdk.v1.1`), paced so that simulated time advances at a chosen multiple of wall time.
-//!
-//! [`LiveServer`] owns the WebSocket server; [`LiveTap`] is the recorder's [`Tap`](crate::record::Tap): one
-//! raw channel per topic with the file's schema and encodings, and every message logged with its log time,
-//! byte for byte the message the file gets. The server is latched: a viewer that subscribes to a topic
-//! (late, or after a topic first appeared) is sent the topic's latest messages (those of its latest log
-//! time) at once, so that `/tf_static`,
-//! the table and the track levels, written rarely, reach every viewer, and a viewer connecting after the run
-//! sees its final state.
-//!
-//! Built only with the cargo feature `live` (it brings tokio and tungstenite in through `foxglove`).
+//! Live view (`coin-log live`, format.md: live): a recording served to Foxglove over its WebSocket protocol
+//! while it is simulated, paced against the wall clock (cargo feature `live`). [`LiveServer`] owns the
+//! server; [`LiveTap`] is the recorder's [`Tap`](crate::record::Tap), logging every message byte for byte as
+//! the file gets it. The server is latched: a viewer that subscribes late is sent each topic's latest
+//! messages at once, so that `/tf_static`, the table and the track levels, written rarely, reach it.
 
 mod tap;
 
@@ -20,11 +12,9 @@ use foxglove::websocket::{ChannelView, Client, ServerListener};
 use foxglove::{ChannelId, Context, PartialMetadata, RawChannel, WebSocketServer};
 use std::collections::HashMap;
 use std::io::{Seek, SeekFrom, Write};
-use std::net::{IpAddr, Ipv4Addr};
+use std::net::IpAddr;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-/// The default address: this machine only.
-pub const DEFAULT_HOST: IpAddr = IpAddr::V4(Ipv4Addr::LOCALHOST);
 /// The default port (the Foxglove app's default for a WebSocket connection).
 pub const DEFAULT_PORT: u16 = 8765;
 /// Messages queued per viewer before the oldest are dropped. The server's default (1024) is a few dozen
@@ -51,28 +41,16 @@ pub enum LiveError {
 #[derive(Default)]
 struct Latest {
     log_time: u64,
-    /// The messages, in `buffers[..len]` (buffers are reused).
-    buffers: Vec<Vec<u8>>,
-    len: usize,
+    messages: Vec<Vec<u8>>,
 }
 
 impl Latest {
     fn keep(&mut self, log_time: u64, data: &[u8]) {
         if log_time != self.log_time {
             self.log_time = log_time;
-            self.len = 0;
+            self.messages.clear();
         }
-        if self.len == self.buffers.len() {
-            self.buffers.push(Vec::new());
-        }
-        let buffer = &mut self.buffers[self.len];
-        buffer.clear();
-        buffer.extend_from_slice(data);
-        self.len += 1;
-    }
-
-    fn messages(&self) -> &[Vec<u8>] {
-        &self.buffers[..self.len]
+        self.messages.push(data.to_vec());
     }
 }
 
@@ -113,7 +91,7 @@ impl ServerListener for Latch {
     fn on_subscribe(&self, client: Client, channel: ChannelView) {
         let channels = self.lock();
         if let Some((raw, Some(latest))) = channels.get(&channel.id()) {
-            for data in latest.messages() {
+            for data in &latest.messages {
                 raw.log_with_meta_to_sink(
                     data,
                     PartialMetadata::with_log_time(latest.log_time),

@@ -213,23 +213,16 @@ impl<F: FnMut(LiveEvent)> LiveTap<'_, F> {
     /// and never get that topic (seen in about one loopback test run in five). Channels made before the
     /// URL is announced are in every viewer's first advertisement.
     pub fn announce_topics(&mut self, channels: &[Channel], encoding: Encoding) {
-        for topic in Topic::all().filter(|t| channels.contains(&t.channel())) {
-            let Some((schema_encoding, schema, message_encoding)) = topic.wire(encoding) else {
-                continue;
-            };
-            self.channel(&ChannelDeclaration {
-                topic,
-                schema_name: topic.schema_name(),
-                schema_encoding,
-                schema,
-                message_encoding,
-            });
+        for topic in
+            Topic::all().filter(|t| channels.contains(&t.channel()) && t.wire(encoding).is_some())
+        {
+            self.channel(&ChannelDeclaration::new(topic, encoding));
         }
     }
 }
 
 impl<F: FnMut(LiveEvent)> Tap for LiveTap<'_, F> {
-    fn channel(&mut self, info: &ChannelDeclaration<'_>) {
+    fn channel(&mut self, info: &ChannelDeclaration) {
         if self.channels[info.topic.index()].is_some() {
             return;
         }

@@ -1,19 +1,11 @@
 //! How many messages and bytes a scene will record, without recording it (`record --dry-run`, and the
-//! warning before a recording larger than 1 GiB).
-//!
-//! Messages follow from the sampling rules (format.md: Samples): one per sample on every `coin_log.*`
-//! channel, one more on `/tf` (the static table transform), and about [`SCENE_RATE`] updates per time unit
-//! on `/scene` (at the first sample, whenever round(t·30) moves on, and at the last). A run that ends at
-//! an event writes fewer; the estimate is that of the full duration.
-//!
-//! Bytes follow from the format: each `coin_log.*` message is its keys and punctuation plus
-//! [`TIME_CHARS`] for `t` and [`NUMBER_CHARS`] for every other number (shortest round-trip decimals of
-//! generic doubles have 17 significant digits, a sign, a point and sometimes an exponent); each message
-//! record adds [`RECORD_OVERHEAD`] bytes inside its chunk and a [`INDEX_ENTRY`]-byte message index entry
-//! outside it. The chunks' bytes shrink by the compression's typical ratio ([`compression_ratio`]). The
-//! constants were calibrated on real recordings of `wobble`, `circle-plus`, `high-spin`, `topple`,
-//! `five-hundred-yen` and `long-horizon` with each compression, where the estimate falls within
-//! [`ACCURACY`] of the file's size (a test keeps it so).
+//! warning before a recording larger than 1 GiB). Messages follow from the sampling rules (format.md:
+//! Samples), for the full duration. Bytes follow from the format: each `coin_log.*` message is its keys and
+//! punctuation plus [`TIME_CHARS`] for `t` and [`NUMBER_CHARS`] for every other number, plus the record's
+//! overhead and index entry; the chunks shrink by the compression's typical ratio. The constants were
+//! calibrated on real recordings of `wobble`, `circle-plus`, `high-spin`, `topple`, `five-hundred-yen` and
+//! `long-horizon` with each compression, where the estimate falls within [`ACCURACY`] of the file's size
+//! (a test keeps it so).
 
 use super::foxglove::SCENE_RATE;
 use crate::format::{schema_data, Channel, Encoding};
@@ -68,16 +60,14 @@ pub fn compression_ratio(compression: Compression, encoding: Encoding) -> f64 {
     }
 }
 
-/// What a scene will write.
+/// What a scene will write: the fields of `record --dry-run --json` (format.md: Dry run and the size
+/// estimate); `per_channel` in the channel table's order.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
-    /// Samples (time points).
     pub samples: u64,
-    /// Messages, all channels.
     pub messages: u64,
-    /// Messages per recorded channel, in the channel table's order.
     pub per_channel: Vec<(Channel, u64)>,
-    /// The file's size \[bytes\].
     pub bytes: u64,
 }
 

@@ -1,6 +1,5 @@
-//! Writing MCAP recordings: the recorder that integrates a scene straight into a file (load → resolve →
-//! simulate/write → persist; the CLI does the loading and persisting) through [`coin_log_mcap::McapWriter`],
-//! and the Foxglove 3D output. What goes into the file is defined by [`crate::format`].
+//! Writing MCAP recordings: the recorder that integrates a scene straight into a file, and the Foxglove 3D
+//! output. What goes into the file is defined by [`crate::format`].
 
 pub mod estimate;
 pub mod foxglove;

@@ -1,15 +1,8 @@
-//! Scene → MCAP: integrates a [`Scene`] and streams its samples into an MCAP writer (format.md: Channels,
-//! Metadata).
-//!
-//! The file is chunked (zstd by default), indexed, with statistics, summary offsets and CRCs; the `coin-log`
-//! metadata record comes before the first message and `coin-log.result` after the last. It is written by
-//! [`McapWriter`], which compresses chunks on [`COMPRESSION_THREADS`] worker threads while this thread
-//! integrates. Nothing in it depends on the machine: the bytes do not depend on the worker count or on
-//! timing, there are no timestamps, and channels are registered in the order of their first message.
-//!
-//! Hot path: per sample only the requested quantities are computed; each message is formatted
-//! into one reused buffer and written with a precomputed channel id. Samples are written one sample late
-//! so that the last one can be flagged as last (the 3D scene then shows the final state).
+//! Scene → MCAP: integrates a [`Scene`] and streams its samples into an MCAP writer (format.md: Files,
+//! Channels, Metadata). [`McapWriter`] compresses chunks on [`COMPRESSION_THREADS`] workers while this
+//! thread integrates; the bytes depend on neither. Per sample only the requested quantities are computed,
+//! and samples are written one sample late so that the last one can be flagged as last (the 3D scene then
+//! shows the final state).
 
 use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};
@@ -88,19 +81,6 @@ pub enum RecordError {
     },
 }
 
-/// The writer options of every coin-log file (chunked, indexed, statistics, summary offsets and CRCs are
-/// always on in [`McapWriter`]).
-#[must_use]
-fn write_options(options: &RecordOptions) -> WriterOptions {
-    WriterOptions {
-        workers: COMPRESSION_THREADS,
-        ..WriterOptions::new(
-            options.compression,
-            format!("coin-log/{}", env!("CARGO_PKG_VERSION")),
-        )
-    }
-}
-
 /// Why writing a sample stopped the run.
 enum SampleError {
     Write(WriteError),
@@ -125,7 +105,7 @@ impl From<TimeError> for SampleError {
 
 /// A topic's channel as the file declares it: what a [`Tap`] needs to announce it elsewhere.
 #[derive(Debug, Clone, Copy)]
-pub struct ChannelDeclaration<'a> {
+pub struct ChannelDeclaration {
     /// The topic.
     pub topic: Topic,
     /// Schema name (e.g. `coin_log.Energy`).
@@ -133,9 +113,29 @@ pub struct ChannelDeclaration<'a> {
     /// Schema encoding (`jsonschema` or `protobuf`).
     pub schema_encoding: &'static str,
     /// The schema's bytes, as written to the file.
-    pub schema: &'a [u8],
+    pub schema: &'static [u8],
     /// Message encoding (`json` or `protobuf`).
     pub message_encoding: &'static str,
+}
+
+impl ChannelDeclaration {
+    /// `topic`'s channel in a file of `encoding` ([`Topic::wire`]; an empty schema if it has none there:
+    /// every topic has one in each encoding of its channel, a test checks it).
+    #[must_use]
+    pub fn new(topic: Topic, encoding: Encoding) -> Self {
+        let (schema_encoding, schema, message_encoding) = topic.wire(encoding).unwrap_or((
+            encoding.schema_encoding(),
+            &[],
+            encoding.message_encoding(),
+        ));
+        Self {
+            topic,
+            schema_name: topic.schema_name(),
+            schema_encoding,
+            schema,
+            message_encoding,
+        }
+    }
 }
 
 /// Sees the recording as it is written (e.g. `coin-log live` serves it to a viewer): each topic's channel
@@ -143,7 +143,7 @@ pub struct ChannelDeclaration<'a> {
 /// simulation's thread, so a tap that blocks (to pace the run in real time) slows the run.
 pub trait Tap {
     /// A topic's channel, once, before its first message.
-    fn channel(&mut self, info: &ChannelDeclaration<'_>);
+    fn channel(&mut self, info: &ChannelDeclaration);
     /// A message, after it went to the file.
     fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]);
 }
@@ -151,7 +151,7 @@ pub trait Tap {
 /// A tap lent to a recording, so that the caller reads its state afterwards.
 impl<T: Tap + ?Sized> Tap for &mut T {
     #[inline]
-    fn channel(&mut self, info: &ChannelDeclaration<'_>) {
+    fn channel(&mut self, info: &ChannelDeclaration) {
         (**self).channel(info);
     }
     #[inline]
@@ -166,7 +166,7 @@ pub struct NoTap;
 
 impl Tap for NoTap {
     #[inline]
-    fn channel(&mut self, _: &ChannelDeclaration<'_>) {}
+    fn channel(&mut self, _: &ChannelDeclaration) {}
     #[inline]
     fn message(&mut self, _: Topic, _: u64, _: &[u8]) {}
 }
@@ -199,28 +199,21 @@ impl<W: Write + Seek, T: Tap> Output<W, T> {
         Ok(())
     }
 
+    /// Registers `topic`'s channel (`start` refused a channel the file's encoding cannot carry).
     #[cold]
     fn register(&mut self, topic: Topic) -> Result<u16, WriteError> {
-        let schema_name = topic.schema_name();
-        // Every topic has a schema in each encoding of its channel (a test checks it), and `start` refused
-        // a channel the file's encoding cannot carry.
-        let (schema_encoding, data, message_encoding) = topic.wire(self.encoding).unwrap_or((
-            self.encoding.schema_encoding(),
-            &[],
-            self.encoding.message_encoding(),
-        ));
-        let schema_id = self.writer.add_schema(schema_name, schema_encoding, data)?;
-        let id =
+        let info = ChannelDeclaration::new(topic, self.encoding);
+        let schema_id =
             self.writer
-                .add_channel(schema_id, topic.name(), message_encoding, &BTreeMap::new())?;
+                .add_schema(info.schema_name, info.schema_encoding, info.schema)?;
+        let id = self.writer.add_channel(
+            schema_id,
+            topic.name(),
+            info.message_encoding,
+            &BTreeMap::new(),
+        )?;
         self.ids[topic.index()] = Some(id);
-        self.tap.channel(&ChannelDeclaration {
-            topic,
-            schema_name,
-            schema_encoding,
-            schema: data,
-            message_encoding,
-        });
+        self.tap.channel(&info);
         Ok(id)
     }
 }
@@ -274,12 +267,9 @@ struct Sampler<W: Write + Seek, T: Tap> {
     /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
     dynamics: Dynamics,
     on: [bool; Channel::ALL.len()],
-    /// The formatted messages of the current sample, back to back.
-    buffer: Vec<u8>,
-    /// (channel, start, end) of each message in `buffer`.
-    staged: [(Channel, usize, usize); Channel::ALL.len()],
-    staged_len: usize,
-    foxglove: Option<(Foxglove3d, FoxgloveBatch)>,
+    /// The messages of the current sample, written once all are formatted.
+    batch: FoxgloveBatch,
+    foxglove: Foxglove3d,
     /// C1, C2, only when the `invariants` channel is recorded.
     chaplygin: Option<Chaplygin>,
     drift: Drift,
@@ -295,18 +285,17 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         self.on[channel as usize]
     }
 
-    /// Formats one message into the sample's buffer; it is written once the whole sample is formatted.
+    /// Formats one message into the sample's batch (an error abandons the sample).
     #[inline]
     fn stage(
         &mut self,
         channel: Channel,
         format: impl FnOnce(&mut Vec<u8>) -> Result<(), NonFiniteField>,
     ) -> Result<(), SampleError> {
-        let start = self.buffer.len();
-        format(&mut self.buffer)?;
-        self.staged[self.staged_len] = (channel, start, self.buffer.len());
-        self.staged_len += 1;
-        Ok(())
+        let mut formatted = Ok(());
+        self.batch
+            .push(Topic::Main(channel), |b| formatted = format(b));
+        Ok(formatted?)
     }
 
     /// Writes the sample (t, y) with the dissipated work W of a dissipative run: all its messages or, if
@@ -320,26 +309,16 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     ) -> Result<(), SampleError> {
         let ns = log_time(t)?;
         let s = State::from_array(y);
-        self.buffer.clear();
-        self.staged_len = 0;
+        self.batch.clear();
         self.stage_kinematics(t, &s)?;
         let (total, invariants) = self.stage_dynamics(t, &s)?;
         let total = match work {
             Some(w) => self.stage_work(t, total, w)?,
             None => total,
         };
-        if let Some((foxglove, batch)) = &mut self.foxglove {
-            batch.clear();
-            foxglove.sample(t, ns, &s, last, batch)?;
-        }
-        for &(channel, start, end) in &self.staged[..self.staged_len] {
-            self.out
-                .write(Topic::Main(channel), ns, &self.buffer[start..end])?;
-        }
-        if let Some((_, batch)) = &self.foxglove {
-            for (topic, data) in batch.iter() {
-                self.out.write(topic, ns, data)?;
-            }
+        self.foxglove.sample(t, ns, &s, last, &mut self.batch)?;
+        for (topic, data) in self.batch.iter() {
+            self.out.write(topic, ns, data)?;
         }
         self.track(t, &s, total, invariants);
         self.drift.last_work = work;
@@ -399,25 +378,21 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             };
             self.stage(Channel::Quaternion, |b| m.write(encoding, b))?;
         }
-        if self.on(Channel::Position) {
-            let c = centre(&coin, s);
-            let m = Position {
-                t,
-                x: c.x,
-                y: c.y,
-                z: c.z,
-            };
-            self.stage(Channel::Position, |b| m.write(encoding, b))?;
-        }
-        if self.on(Channel::Contact) {
-            let c = contact_point(&coin, s);
-            let m = Position {
-                t,
-                x: c.x,
-                y: c.y,
-                z: c.z,
-            };
-            self.stage(Channel::Contact, |b| m.write(encoding, b))?;
+        let points = [
+            (Channel::Position, centre as fn(&_, &_) -> _),
+            (Channel::Contact, contact_point),
+        ];
+        for (channel, point) in points {
+            if self.on(channel) {
+                let c = point(&coin, s);
+                let m = Position {
+                    t,
+                    x: c.x,
+                    y: c.y,
+                    z: c.z,
+                };
+                self.stage(channel, |b| m.write(encoding, b))?;
+            }
         }
         Ok(())
     }
@@ -535,22 +510,22 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
         Some(SampleError::Failure(f)) => (f.termination(), outcome.t_last, Some(f)),
         None => ending(&outcome.termination, outcome.t_last),
     };
-    let accuracy = accuracy(scene, sampler.drift.max_omega, termination_time);
+    let accuracy = RunAccuracy::new(
+        &scene.run.method,
+        &scene.params,
+        termination_time,
+        sampler.drift.max_omega,
+    );
     let tolerance = Tolerances::derive(&accuracy, None, None).energy;
     let shortfalls = promise::shortfalls(&accuracy, fixed_steps(scene, termination_time));
-    let mut summary = sampler.finish(
+    let doubt = departure_doubt(&scene.coin(), &scene.initial).filter(|_| termination.is_event());
+    sampler.finish(
         outcome.stats,
         (termination, termination_time),
         failure,
         shortfalls,
-    )?;
-    summary.energy_tolerance = tolerance;
-    let doubt = departure_doubt(&scene.coin(), &scene.initial).filter(|_| termination.is_event());
-    summary.event_trusted = termination
-        .is_event()
-        .then_some(summary.energy_drift <= tolerance && doubt.is_none());
-    summary.event_doubt = doubt;
-    Ok(summary)
+        (tolerance, doubt),
+    )
 }
 
 /// The checks `verify` is expected to fail on a recording of `scene`, predicted before it runs from the
@@ -561,7 +536,8 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
     let s = &scene.initial;
     let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
     let span = scene.run.duration;
-    promise::shortfalls(&accuracy(scene, omega, span), fixed_steps(scene, span))
+    let accuracy = RunAccuracy::new(&scene.run.method, &scene.params, span, omega);
+    promise::shortfalls(&accuracy, fixed_steps(scene, span))
 }
 
 /// The steps a fixed-step method takes over `span`; `None` for adaptive methods.
@@ -571,24 +547,6 @@ fn fixed_steps(scene: &Scene, span: f64) -> Option<promise::FixedSteps> {
         steps: (span / m.step).ceil(),
         sample_interval: scene.run.sample_interval(),
     })
-}
-
-/// How `scene` is integrated, as `verify` will derive its tolerances from it (format.md: Tolerances), over
-/// `span` with rates up to `max_omega`.
-#[must_use]
-pub fn accuracy(scene: &Scene, max_omega: f64, span: f64) -> RunAccuracy {
-    let m = &scene.run.method;
-    let p = &scene.params;
-    RunAccuracy {
-        integrator: m.method,
-        rtol: m.rtol,
-        atol: m.atol,
-        step: m.step,
-        radius: p.radius(),
-        time_unit: p.time_unit(),
-        span,
-        max_omega,
-    }
 }
 
 /// How the integration ended, as the file records it: termination, its time, and the failure if any.
@@ -708,19 +666,13 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         } else {
             None
         };
-        let mut writer = McapWriter::new(writer, &write_options(options))?;
+        let library = format!("coin-log/{}", env!("CARGO_PKG_VERSION"));
+        let write_options = WriterOptions {
+            workers: COMPRESSION_THREADS,
+            ..WriterOptions::new(options.compression, library)
+        };
+        let mut writer = McapWriter::new(writer, &write_options)?;
         writer.write_metadata(RUN_METADATA_NAME, &scene.run_metadata().to_map())?;
-        let (tf, scene_on) = (on[Channel::Tf as usize], on[Channel::Scene as usize]);
-        let foxglove = (tf || scene_on).then(|| {
-            let fox =
-                Foxglove3d::with_encoding(&coin, scene.thickness, tf, scene_on, options.encoding);
-            let fox = if on[Channel::Rerun as usize] {
-                fox.with_rerun()
-            } else {
-                fox
-            };
-            (fox, FoxgloveBatch::default())
-        });
         Ok(Self {
             out: Output {
                 writer,
@@ -733,10 +685,8 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             coin,
             dynamics,
             on,
-            buffer: Vec::with_capacity(1024),
-            staged: [(Channel::Omega, 0, 0); Channel::ALL.len()],
-            staged_len: 0,
-            foxglove,
+            batch: FoxgloveBatch::default(),
+            foxglove: Foxglove3d::new(&coin, scene.thickness, &scene.channels, options.encoding),
             chaplygin,
             energy0: None,
             samples: 0,
@@ -744,13 +694,15 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         })
     }
 
-    /// Closes the file: `coin-log.result` metadata, summary section, flush; returns the summary.
+    /// Closes the file: `coin-log.result` metadata, summary section, flush; returns the summary, with the
+    /// energy tolerance `verify` will derive and why an event is in doubt, if it is.
     fn finish(
         self,
         stats: integrate::Stats,
         (termination, termination_time): (Termination, f64),
         failure: Option<Failure>,
         shortfalls: Vec<Shortfall>,
+        (energy_tolerance, event_doubt): (f64, Option<String>),
     ) -> Result<RecordSummary, RecordError> {
         let Self {
             mut out,
@@ -774,6 +726,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         )?;
         let (mut inner, bytes) = out.writer.finish()?;
         inner.flush()?;
+        let energy_drift = drift.energy.value();
         Ok(RecordSummary {
             samples,
             messages: out.messages,
@@ -782,12 +735,14 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
             termination,
             termination_time,
             failure,
-            energy_drift: drift.energy.value(),
+            energy_drift,
             invariant_drift: drift.invariants.map(|d| d.value()),
             steady_residual: drift.steady.map(|_| drift.steady_residual),
-            energy_tolerance: f64::NAN,
-            event_trusted: None,
-            event_doubt: None,
+            energy_tolerance,
+            event_trusted: termination
+                .is_event()
+                .then_some(energy_drift <= energy_tolerance && event_doubt.is_none()),
+            event_doubt,
             dissipated_work: drift.last_work,
             termination_alpha: drift.termination_alpha(),
             shortfalls,

@@ -82,21 +82,8 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
     let s = &scene.initial;
     let omega = Vector3::new(s.omega_x, s.omega_y, s.omega_z).norm();
     let rate = omega.max((s.omega_y / s.theta.cos()).abs());
-    let tol = Tolerances::derive(
-        &RunAccuracy {
-            integrator: run.method.method,
-            rtol: run.method.rtol,
-            atol: run.method.atol,
-            step: run.method.step,
-            radius: scene.params.radius(),
-            time_unit: scene.params.time_unit(),
-            span: run.duration,
-            max_omega: omega,
-        },
-        None,
-        None,
-    )
-    .residual;
+    let accuracy = RunAccuracy::new(&run.method, &scene.params, run.duration, omega);
+    let tol = Tolerances::derive(&accuracy, None, None).residual;
     let h = run.sample_interval();
     if constraint::resolves(h, rate, tol) {
         return None;

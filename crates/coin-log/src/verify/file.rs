@@ -19,7 +19,7 @@ use crate::format::messages::{
 use crate::format::protobuf::{self, MessageDecoder};
 use crate::format::{
     log_time, schema_bytes, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
-    FRAME_TRANSFORM, MESSAGE_ENCODING, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
+    FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
@@ -417,9 +417,7 @@ impl Visitor for Judge {
                 }
                 let expected = match fixed {
                     Some(_) => ROS_STRING_WIRE.2,
-                    None => judged
-                        .encoding
-                        .map_or(MESSAGE_ENCODING, |e| e.message_encoding()),
+                    None => judged.encoding.unwrap_or_default().message_encoding(),
                 };
                 if message_encoding != expected {
                     self.problems.push_with(|| {

@@ -1,56 +1,43 @@
-//! The JSON of the Foxglove messages, written piece by piece into a reused buffer: literals, checked numbers
-//! (shortest round-trip decimals, never NaN), `{sec, nsec}` times, and the common parts of a `SceneEntity`.
-//! By hand rather than through serde because the transform of every sample is on the recorder's hot path and
-//! must refuse non-finite numbers instead of writing `null`.
+//! The JSON form of the Foxglove messages, written piece by piece (by hand rather than through serde: each
+//! call site decides whether a number is a literal, and the transform of every sample is on the hot path).
+//! The values were checked finite by [`super::Foxglove3d`]. Signatures as in [`super::proto`].
 
-use crate::format::messages::{push_number, NonFiniteField};
+use super::track::TrackPoint;
+use super::{
+    coin_marks, grid_segments, Rgba, COIN_FRAME, COIN_RGBA, FOLLOW_FRAME, GRID_HEIGHT, GRID_RGBA,
+    GRID_WIDTHS, TABLE_FRAME, TABLE_HALF_SIDE, TABLE_RGBA, TABLE_ROTATION, TABLE_THICKNESS,
+    TABLE_TOP, TRACK_RGBA, TRACK_WIDTH, WORLD_FRAME,
+};
+use crate::format::messages::push_number;
 use nalgebra::{UnitQuaternion, Vector3};
 
-/// `Err` naming `field` of `schema` unless `value` is finite.
-pub(super) fn check(
-    schema: &'static str,
-    field: &'static str,
-    value: f64,
-) -> Result<(), NonFiniteField> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(NonFiniteField {
-            schema,
-            field,
-            value,
-        })
-    }
-}
+const IDENTITY_POSE: &[u8] =
+    br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
 
-/// Appends JSON pieces to a buffer: raw literals, checked numbers, times.
-pub(super) struct Writer<'a> {
+/// Appends JSON pieces to a buffer: raw literals, numbers, times.
+struct Writer<'a> {
     buf: &'a mut Vec<u8>,
     ryu: ryu::Buffer,
-    schema: &'static str,
 }
 
 impl<'a> Writer<'a> {
-    pub(super) fn new(buf: &'a mut Vec<u8>, schema: &'static str) -> Self {
+    fn new(buf: &'a mut Vec<u8>) -> Self {
         Self {
             buf,
             ryu: ryu::Buffer::new(),
-            schema,
         }
     }
 
-    pub(super) fn raw(&mut self, bytes: &[u8]) {
+    fn raw(&mut self, bytes: &[u8]) {
         self.buf.extend_from_slice(bytes);
     }
 
-    pub(super) fn num(&mut self, field: &'static str, value: f64) -> Result<(), NonFiniteField> {
-        check(self.schema, field, value)?;
+    fn num(&mut self, value: f64) {
         push_number(self.buf, value, &mut self.ryu);
-        Ok(())
     }
 
     /// A `Color` {r, g, b, a}, each component's shortest decimal, whole ones without `.0` (`"a":1`).
-    pub(super) fn color(&mut self, rgba: super::Rgba) {
+    fn color(&mut self, rgba: Rgba) {
         let keys: [&[u8]; 4] = [b"{\"r\":", b",\"g\":", b",\"b\":", b",\"a\":"];
         for (key, v) in keys.into_iter().zip(rgba) {
             self.buf.extend_from_slice(key);
@@ -61,7 +48,7 @@ impl<'a> Writer<'a> {
         self.buf.push(b'}');
     }
 
-    pub(super) fn uint(&mut self, mut n: u64) {
+    fn uint(&mut self, mut n: u64) {
         let mut digits = [0u8; 20];
         let mut i = digits.len();
         loop {
@@ -77,7 +64,7 @@ impl<'a> Writer<'a> {
     }
 
     /// `{"sec":S,"nsec":N}` of a log time in ns.
-    pub(super) fn time(&mut self, log_time: u64) {
+    fn time(&mut self, log_time: u64) {
         self.raw(b"{\"sec\":");
         self.uint(log_time / 1_000_000_000);
         self.raw(b",\"nsec\":");
@@ -85,92 +72,203 @@ impl<'a> Writer<'a> {
         self.raw(b"}");
     }
 
-    pub(super) fn vector3(
-        &mut self,
-        field: &'static str,
-        x: f64,
-        y: f64,
-        z: f64,
-    ) -> Result<(), NonFiniteField> {
+    fn vector3(&mut self, x: f64, y: f64, z: f64) {
         self.raw(b"{\"x\":");
-        self.num(field, x)?;
+        self.num(x);
         self.raw(b",\"y\":");
-        self.num(field, y)?;
+        self.num(y);
         self.raw(b",\"z\":");
-        self.num(field, z)?;
+        self.num(z);
         self.raw(b"}");
-        Ok(())
     }
 
     /// Foxglove's `{x, y, z, w}` are the quaternion's (i, j, k, w).
-    pub(super) fn quaternion(&mut self, q: &UnitQuaternion<f64>) -> Result<(), NonFiniteField> {
+    fn quaternion(&mut self, q: &UnitQuaternion<f64>) {
         self.raw(b"{\"x\":");
-        self.num("rotation.x", q.i)?;
+        self.num(q.i);
         self.raw(b",\"y\":");
-        self.num("rotation.y", q.j)?;
+        self.num(q.j);
         self.raw(b",\"z\":");
-        self.num("rotation.z", q.k)?;
+        self.num(q.k);
         self.raw(b",\"w\":");
-        self.num("rotation.w", q.w)?;
+        self.num(q.w);
         self.raw(b"}");
-        Ok(())
     }
 
     /// A `Pose`: `position` and the rotation `q` as `orientation`.
-    pub(super) fn pose(
-        &mut self,
-        position: &Vector3<f64>,
-        q: &UnitQuaternion<f64>,
-    ) -> Result<(), NonFiniteField> {
+    fn pose(&mut self, position: &Vector3<f64>, q: &UnitQuaternion<f64>) {
         self.raw(b"{\"position\":");
-        self.vector3("pose.position", position.x, position.y, position.z)?;
-        self.raw(b",\"orientation\":{\"x\":");
-        self.num("pose.orientation.x", q.i)?;
-        self.raw(b",\"y\":");
-        self.num("pose.orientation.y", q.j)?;
-        self.raw(b",\"z\":");
-        self.num("pose.orientation.z", q.k)?;
-        self.raw(b",\"w\":");
-        self.num("pose.orientation.w", q.w)?;
-        self.raw(b"}}");
-        Ok(())
+        self.vector3(position.x, position.y, position.z);
+        self.raw(b",\"orientation\":");
+        self.quaternion(q);
+        self.raw(b"}");
     }
 
     /// A `Point3` (x, y, 0) of a line.
-    pub(super) fn point(&mut self, x: f64, y: f64) -> Result<(), NonFiniteField> {
+    fn point(&mut self, x: f64, y: f64) {
         self.raw(b"{\"x\":");
-        self.num("lines.points.x", x)?;
+        self.num(x);
         self.raw(b",\"y\":");
-        self.num("lines.points.y", y)?;
+        self.num(y);
         self.raw(b",\"z\":0}");
-        Ok(())
     }
 
-    /// An entity up to its `"arrows":[],`; the caller writes cubes, spheres, cylinders and lines (each
-    /// followed by a comma), then [`Self::entity_tail`].
-    pub(super) fn entity_head(
-        &mut self,
-        log_time: u64,
-        frame: &str,
-        id: &[u8],
-        id_number: Option<u64>,
-        frame_locked: bool,
-    ) {
+    /// A `FrameTransform` up to its `"translation":`.
+    fn transform_head(&mut self, log_time: u64, parent: &str, child: &str) {
         self.raw(b"{\"timestamp\":");
+        self.time(log_time);
+        self.raw(b",\"parent_frame_id\":\"");
+        self.raw(parent.as_bytes());
+        self.raw(b"\",\"child_frame_id\":\"");
+        self.raw(child.as_bytes());
+        self.raw(b"\",\"translation\":");
+    }
+
+    /// A `SceneUpdate` of one entity up to its `"arrows":[],`; the caller writes cubes, spheres, cylinders
+    /// and lines (each followed by a comma), then [`Self::entity_tail`].
+    fn entity_head(&mut self, log_time: u64, frame: &str, id: &[u8]) {
+        self.raw(b"{\"deletions\":[],\"entities\":[{\"timestamp\":");
         self.time(log_time);
         self.raw(b",\"frame_id\":\"");
         self.raw(frame.as_bytes());
         self.raw(b"\",\"id\":\"");
         self.raw(id);
-        if let Some(n) = id_number {
-            self.uint(n);
-        }
-        self.raw(b"\",\"lifetime\":{\"sec\":0,\"nsec\":0},\"frame_locked\":");
-        self.raw(if frame_locked { b"true" } else { b"false" });
+        self.raw(b"\",\"lifetime\":{\"sec\":0,\"nsec\":0},\"frame_locked\":true");
         self.raw(b",\"metadata\":[],\"arrows\":[],");
     }
 
-    pub(super) fn entity_tail(&mut self) {
-        self.raw(b"\"triangles\":[],\"texts\":[],\"models\":[]}");
+    fn entity_tail(&mut self) {
+        self.raw(b"\"triangles\":[],\"texts\":[],\"models\":[]}]}");
     }
+}
+
+/// `/tf` and `/tf_static` world → table (static, [`TABLE_ROTATION`]).
+pub(super) fn table_transform(buf: &mut Vec<u8>, log_time: u64) {
+    let mut w = Writer::new(buf);
+    w.transform_head(log_time, WORLD_FRAME, TABLE_FRAME);
+    w.raw(b"{\"x\":0,\"y\":0,\"z\":0},\"rotation\":");
+    w.quaternion(&TABLE_ROTATION);
+    w.raw(b"}");
+}
+
+/// `/tf` table → coin: the centre `translation` and the orientation `q`.
+pub(super) fn coin_transform(
+    buf: &mut Vec<u8>,
+    log_time: u64,
+    translation: [f64; 3],
+    q: &UnitQuaternion<f64>,
+) {
+    let mut w = Writer::new(buf);
+    w.transform_head(log_time, TABLE_FRAME, COIN_FRAME);
+    w.vector3(translation[0], translation[1], translation[2]);
+    w.raw(b",\"rotation\":");
+    w.quaternion(q);
+    w.raw(b"}");
+}
+
+/// `/scene/follow` world → coin_level: translation `centre` (display units), no rotation.
+pub(super) fn follow_transform(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 3]) {
+    let mut w = Writer::new(buf);
+    w.transform_head(log_time, WORLD_FRAME, FOLLOW_FRAME);
+    w.vector3(centre[0], centre[1], centre[2]);
+    w.raw(b",\"rotation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}");
+}
+
+/// `/scene`: the coin in `coin_level`, posed with its orientation `r` in `world`: a cylinder with its axis
+/// along the body's z, `thickness` thick, and a stripe on each face.
+pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, thickness: f64) {
+    let mut w = Writer::new(buf);
+    w.entity_head(log_time, FOLLOW_FRAME, b"coin");
+    w.raw(b"\"cubes\":[");
+    for (i, (position, size, colour)) in coin_marks(r, thickness).iter().enumerate() {
+        if i > 0 {
+            w.raw(b",");
+        }
+        w.raw(b"{\"pose\":");
+        w.pose(position, r);
+        w.raw(b",\"size\":");
+        w.vector3(size[0], size[1], size[2]);
+        w.raw(b",\"color\":");
+        w.color(*colour);
+        w.raw(b"}");
+    }
+    w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
+    w.pose(&Vector3::zeros(), r);
+    w.raw(b",\"size\":");
+    w.vector3(2.0, 2.0, thickness);
+    w.raw(b",\"bottom_scale\":1,\"top_scale\":1,\"color\":");
+    w.color(COIN_RGBA);
+    w.raw(b"}],\"lines\":[],");
+    w.entity_tail();
+}
+
+/// `/scene/table`: the slab centred on `centre` (display units) and its grid, in `world`.
+pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
+    let mut w = Writer::new(buf);
+    w.entity_head(log_time, WORLD_FRAME, b"table");
+    w.raw(b"\"cubes\":[{\"pose\":{\"position\":");
+    w.vector3(centre[0], centre[1], TABLE_TOP - 0.5 * TABLE_THICKNESS);
+    w.raw(b",\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"size\":");
+    let side = 2.0 * TABLE_HALF_SIDE;
+    w.vector3(side, side, TABLE_THICKNESS);
+    w.raw(b",\"color\":");
+    w.color(TABLE_RGBA);
+    w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
+    for major in [false, true] {
+        if major {
+            w.raw(b",");
+        }
+        grid(&mut w, centre, major);
+    }
+    w.raw(b"],");
+    w.entity_tail();
+}
+
+/// One `LinePrimitive` (a line list) of the table's grid: the minor or the major lines, at the grid height.
+fn grid(w: &mut Writer, centre: [f64; 2], major: bool) {
+    w.raw(b"{\"type\":2,\"pose\":{\"position\":{\"x\":0,\"y\":0,\"z\":");
+    w.num(GRID_HEIGHT);
+    w.raw(b"},\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"thickness\":");
+    w.num(GRID_WIDTHS[usize::from(major)]);
+    w.raw(b",\"scale_invariant\":true,\"points\":[");
+    for (i, (a, b)) in grid_segments(centre, major).enumerate() {
+        if i > 0 {
+            w.raw(b",");
+        }
+        w.point(a[0], a[1]);
+        w.raw(b",");
+        w.point(b[0], b[1]);
+    }
+    w.raw(b"],\"color\":");
+    w.color(GRID_RGBA[usize::from(major)]);
+    w.raw(b",\"colors\":[],\"indices\":[]}");
+}
+
+/// `/scene/track/<L>`: the level's points as one line strip, entity `track` in `world`.
+pub(super) fn track(buf: &mut Vec<u8>, log_time: u64, points: &[TrackPoint]) {
+    let mut w = Writer::new(buf);
+    w.entity_head(log_time, WORLD_FRAME, b"track");
+    w.raw(b"\"cubes\":[],\"spheres\":[],\"cylinders\":[],\"lines\":[{\"type\":0,\"pose\":");
+    w.raw(IDENTITY_POSE);
+    w.raw(b",\"thickness\":");
+    w.num(TRACK_WIDTH);
+    w.raw(b",\"scale_invariant\":true,\"points\":[");
+    for (i, p) in points.iter().enumerate() {
+        if i > 0 {
+            w.raw(b",");
+        }
+        w.point(p.x, p.y);
+    }
+    w.raw(b"],\"color\":");
+    w.color(TRACK_RGBA);
+    w.raw(b",\"colors\":[],\"indices\":[]}],");
+    w.entity_tail();
+}
+
+/// `/scene/track/<L>` when the level is empty: the deletion of its line.
+pub(super) fn track_deletion(buf: &mut Vec<u8>, log_time: u64) {
+    let mut w = Writer::new(buf);
+    w.raw(b"{\"deletions\":[{\"timestamp\":");
+    w.time(log_time);
+    w.raw(b",\"type\":0,\"id\":\"track\"}],\"entities\":[]}");
 }

@@ -1,55 +1,18 @@
-//! Foxglove's 3D view of the coin (docs/format.md: Frames and Foxglove output).
-//!
-//! A Foxglove-lineage viewer, after a seek, restores only the latest message of each topic and forgets every
-//! drawn object (and, on a backward seek, every transform). So each thing the view needs has a topic whose
-//! latest message alone draws it:
-//!
-//! # Frames (`tf` channel, physical units)
-//! - `world`: Foxglove's convention, z up; the root.
-//! - `table`: the physics frame (physics §1: the table is the z–x plane, y up). Its transform from `world` is
-//!   the static rotation by +90° about x, q_T = (sin 45°, 0, 0, cos 45°) ([`TABLE_ROTATION`]): note x →
-//!   world x, y (up) → world z, z → world −y; proper (det +1), so the note's quaternion needs no change.
-//!   Published at t = 0 as the first message of `/tf` (the contract) and on `/tf_static`, its own topic,
-//!   whose one message comes back after every seek.
-//! - `coin`: translation = centre (x, a cos θ, z) in `table`, rotation = q of [`orientation`]; in the `coin`
-//!   frame the coin is a cylinder whose axis is z (physics §8 item 5). On `/tf` at **every data sample**:
-//!   the viewer interpolates between transforms along the shortest arc, so at a lower rate a coin turning
-//!   by more than π between two transforms would be drawn spinning backwards.
-//!
-//! # The drawing (`scene` channel, units of a)
-//! Everything drawn is in display units, lengths divided by the radius a, so that one layout (camera
-//! distance, line widths) suits every coin: the 500-yen coin (a = 13.25 mm) looks like the unit coin. For
-//! a = 1 the drawing coincides with the physical frames. At the display rate [`SCENE_RATE`] (≈ 30 per time
-//! unit of simulation time, one time unit being one second of log time), at the first sample and at the
-//! last:
-//! - `/scene/follow`: the frame `coin_level` ([`FOLLOW_FRAME`]), child of `world`, at the coin's centre
-//!   (x/a, −z/a, cos θ) with the identity rotation: a level frame that moves with the coin, for the camera
-//!   to follow (the `coin` frame tilts and spins, and a camera riding on it ends up under the table).
-//! - `/scene`: the coin, entity `coin` in `coin_level`, posed with the coin's orientation in `world`
-//!   (q_T · q): a cylinder {2, 2, thickness} with a stripe on each face (dark red on +z, dark blue on −z)
-//!   so that spin and the face that is up both show.
-//! - `/scene/table`: the table, entity `table` in `world`: a slab 2·[`TABLE_HALF_SIDE`] wide just below the
-//!   plane with grid lines every 1 (darker every 5) fixed to the table, so that motion shows. Its centre is
-//!   a multiple of [`TABLE_SNAP`] near the coin; it is republished only when the coin has moved more than
-//!   [`TABLE_SNAP`] from it, so the coin always has ≥ 20 a of table around it.
-//! - `/scene/track/<L>`: the contact track as levels of a binary counter ([`track`]): the latest message of
-//!   every level together draw the whole path from t = 0 to the latest update, simplified within
-//!   [`track::MAX_TOLERANCE`] (0.01 a).
-//!
-//! All timestamps `{sec, nsec}` are the log time of the sample ([`crate::format::log_time`]).
-//!
-//! With the opt-in `rerun` channel, each drawing update also gives the same coin, table and track in the
-//! types Rerun's MCAP importer draws ([`rerun`]).
+//! Foxglove's 3D view of the coin (docs/format.md: Frames and Foxglove output): after a seek a viewer keeps
+//! only the latest message of each topic, so each thing the view needs has a topic whose latest message
+//! alone draws it. Frames (`tf`, physical units): `world` (z up) → `table` (the physics frame, y up,
+//! [`TABLE_ROTATION`]) → `coin`. The drawing (`scene`, units of a, at [`SCENE_RATE`]): `/scene/follow`
+//! ([`FOLLOW_FRAME`]), `/scene` (the coin), `/scene/table`, and the track's levels ([`track`]); the opt-in
+//! `rerun` channel draws them again for Rerun.
 
 mod json;
 mod proto;
-pub mod rerun;
+mod rerun;
 pub mod track;
 
 use crate::format::messages::NonFiniteField;
 use crate::format::{Channel, Encoding, Topic, FRAME_TRANSFORM, SCENE_UPDATE, TRACK_LEVELS};
 use crate::model::{contact_point, orientation, Coin, State};
-use json::{check, Writer};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::ops::Range;
 use track::Track;
@@ -94,8 +57,6 @@ const TRACK_WIDTH: f64 = 3.0;
 /// Every GRID_MAJOR-th grid line is a major one.
 const GRID_MAJOR: i32 = 5;
 
-const IDENTITY_POSE: &[u8] =
-    br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
 /// A colour (r, g, b, a) in 0..1, as both encodings write it.
 type Rgba = [f64; 4];
 const COIN_RGBA: Rgba = [0.85, 0.65, 0.2, 1.0];
@@ -105,6 +66,28 @@ const GRID_RGBA: [Rgba; 2] = [[0.66, 0.66, 0.63, 1.0], [0.45, 0.45, 0.43, 1.0]];
 const TRACK_RGBA: Rgba = [0.1, 0.35, 0.9, 1.0];
 
 pub use proto::MAX_SECONDS as PROTOBUF_MAX_SECONDS;
+
+/// Calls the writer `$f` of `$encoding`: [`json`] and [`proto`] have the same writers.
+macro_rules! encode {
+    ($encoding:expr, $f:ident($($arg:expr),*)) => {
+        match $encoding {
+            Encoding::Json => json::$f($($arg),*),
+            Encoding::Protobuf => proto::$f($($arg),*),
+        }
+    };
+}
+
+/// `Err` naming `field` of `schema` unless every value is finite (neither encoding carries the others).
+fn finite(schema: &'static str, field: &'static str, values: &[f64]) -> Result<(), NonFiniteField> {
+    match values.iter().find(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(&value) => Err(NonFiniteField {
+            schema,
+            field,
+            value,
+        }),
+    }
+}
 
 /// The coin's two face marks, posed with the coin's orientation `r`: (centre in `coin_level`, size, colour),
 /// the top (+z) face's first. A bar 0.85 × 0.12 just outside each face, `0.2 · thickness` thick (at least
@@ -142,7 +125,7 @@ fn grid_segments(centre: [f64; 2], major: bool) -> impl Iterator<Item = ([f64; 2
         })
 }
 
-/// The Foxglove messages due at one sample, in one reused buffer.
+/// The messages due at one sample, in one reused buffer.
 #[derive(Debug, Default)]
 pub struct FoxgloveBatch {
     bytes: Vec<u8>,
@@ -157,25 +140,10 @@ impl FoxgloveBatch {
     }
 
     /// Appends one message on `topic`, written by `write`.
-    ///
-    /// # Errors
-    /// Whatever `write` returns; the batch is then left without the message.
-    pub fn push(
-        &mut self,
-        topic: Topic,
-        write: impl FnOnce(&mut Vec<u8>) -> Result<(), NonFiniteField>,
-    ) -> Result<(), NonFiniteField> {
+    pub fn push(&mut self, topic: Topic, write: impl FnOnce(&mut Vec<u8>)) {
         let start = self.bytes.len();
-        match write(&mut self.bytes) {
-            Ok(()) => {
-                self.messages.push((topic, start..self.bytes.len()));
-                Ok(())
-            }
-            Err(e) => {
-                self.bytes.truncate(start);
-                Err(e)
-            }
-        }
+        write(&mut self.bytes);
+        self.messages.push((topic, start..self.bytes.len()));
     }
 
     /// The messages, in the order they were pushed.
@@ -183,18 +151,6 @@ impl FoxgloveBatch {
         self.messages
             .iter()
             .map(|(c, r)| (*c, &self.bytes[r.clone()]))
-    }
-
-    /// Number of messages in the batch.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.messages.len()
-    }
-
-    /// True when the batch holds no message.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.messages.is_empty()
     }
 }
 
@@ -212,66 +168,37 @@ pub struct Foxglove3d {
     started: bool,
     /// round(t · SCENE_RATE) of the last scene update.
     last_scene_slot: u64,
-    /// The latest sample's log time and state, and whether it had a scene update (for [`Self::finish`]).
-    last_log_time: u64,
-    last_state: State,
-    last_had_scene: bool,
     /// Table centre (display units), once drawn.
     table: Option<[f64; 2]>,
     track: Track,
     /// Whether the latest message of each track level drew a line (else it deleted it, or there was none).
     drawn: [bool; TRACK_LEVELS],
-    /// The `rerun` channel's output, when recorded.
+    /// The `rerun` channel's output, when recorded (drawn with the scene, so only when `scene` is).
     rerun: Option<rerun::Rerun3d>,
 }
 
 impl Foxglove3d {
-    /// Output for `coin` drawn `thickness` (fraction of a) thick; `tf` and `scene` say which channels are on.
+    /// Output for `coin` drawn `thickness` (fraction of a) thick, of those of `channels` it writes (`tf`,
+    /// `scene`, `rerun`), in `encoding` (`rerun` is Protobuf whatever the encoding: the recorder refuses it
+    /// in JSON).
     #[must_use]
-    pub fn new(coin: &Coin, thickness: f64, tf: bool, scene: bool) -> Self {
-        Self::with_encoding(coin, thickness, tf, scene, Encoding::Json)
-    }
-
-    /// [`Self::new`] writing its messages in `encoding`.
-    #[must_use]
-    pub fn with_encoding(
-        coin: &Coin,
-        thickness: f64,
-        tf: bool,
-        scene: bool,
-        encoding: Encoding,
-    ) -> Self {
+    pub fn new(coin: &Coin, thickness: f64, channels: &[Channel], encoding: Encoding) -> Self {
+        let scene = channels.contains(&Channel::Scene);
         Self {
             coin: *coin,
             encoding,
             inv_a: 1.0 / coin.params().radius(),
             thickness,
-            tf,
+            tf: channels.contains(&Channel::Tf),
             scene,
             started: false,
             last_scene_slot: 0,
-            last_log_time: 0,
-            last_state: State::default(),
-            last_had_scene: false,
             table: None,
             track: Track::default(),
             drawn: [false; TRACK_LEVELS],
-            rerun: None,
+            rerun: (scene && channels.contains(&Channel::Rerun))
+                .then(|| rerun::Rerun3d::new(thickness)),
         }
-    }
-
-    /// The output with the `rerun` channel too (drawn with the scene, so only when `scene` is on;
-    /// Protobuf messages whatever the encoding: the recorder refuses `rerun` in JSON).
-    #[must_use]
-    pub fn with_rerun(mut self) -> Self {
-        self.rerun = self.scene.then(|| rerun::Rerun3d::new(self.thickness));
-        self
-    }
-
-    /// True when neither `/tf` nor `/scene` is recorded (nothing to compute).
-    #[must_use]
-    pub fn is_off(&self) -> bool {
-        !self.tf && !self.scene
     }
 
     /// Appends to `out` the messages due at the sample (t, s), whose log time is `log_time` ns; `last` marks
@@ -291,29 +218,29 @@ impl Foxglove3d {
         last: bool,
         out: &mut FoxgloveBatch,
     ) -> Result<(), NonFiniteField> {
-        if self.is_off() {
-            return Ok(());
-        }
         let first = !self.started;
+        let encoding = self.encoding;
         if self.tf {
+            let translation = [s.x, self.coin.params().radius() * s.theta.cos(), s.z];
+            let q = orientation(s);
+            finite(FRAME_TRANSFORM, "translation", &translation)?;
+            finite(FRAME_TRANSFORM, "rotation", q.coords.as_slice())?;
             let tf = Topic::Main(Channel::Tf);
-            let table = match self.encoding {
-                Encoding::Json => write_table_transform,
-                Encoding::Protobuf => proto::table_transform,
-            };
             if first {
-                out.push(tf, |buf| table(buf, log_time))?;
+                out.push(tf, |buf| encode!(encoding, table_transform(buf, log_time)));
             }
-            out.push(tf, |buf| self.write_coin_transform(buf, log_time, s))?;
+            out.push(tf, |buf| {
+                encode!(encoding, coin_transform(buf, log_time, translation, &q));
+            });
             if first {
-                out.push(Topic::TfStatic, |buf| table(buf, log_time))?;
+                out.push(Topic::TfStatic, |buf| {
+                    encode!(encoding, table_transform(buf, log_time));
+                });
             }
         }
-        self.last_had_scene = false;
         if self.scene {
             let c = contact_point(&self.coin, s);
-            check(SCENE_UPDATE, "lines.points.x", c.x)?;
-            check(SCENE_UPDATE, "lines.points.y", c.z)?;
+            finite(SCENE_UPDATE, "lines.points", &[c.x, c.z])?;
             self.track.add(c.x * self.inv_a, -c.z * self.inv_a);
             if let Some(r) = &mut self.rerun {
                 r.contact([c.x * self.inv_a, -c.z * self.inv_a]);
@@ -325,22 +252,6 @@ impl Foxglove3d {
             }
         }
         self.started = true;
-        self.last_log_time = log_time;
-        self.last_state = *s;
-        Ok(())
-    }
-
-    /// Ends the output: if the latest sample had no drawing update (a recorder that learns only after the
-    /// fact that a sample was the last one), appends one at that sample's log time, so the view shows the
-    /// final state and the whole track. Does nothing otherwise, or if no sample was given.
-    ///
-    /// # Errors
-    /// [`NonFiniteField`] if a value is not finite.
-    pub fn finish(&mut self, out: &mut FoxgloveBatch) -> Result<(), NonFiniteField> {
-        if self.scene && self.started && !self.last_had_scene {
-            let s = self.last_state;
-            self.push_drawing(self.last_log_time, &s, out)?;
-        }
         Ok(())
     }
 
@@ -353,54 +264,44 @@ impl Foxglove3d {
         out: &mut FoxgloveBatch,
     ) -> Result<(), NonFiniteField> {
         let centre = [s.x * self.inv_a, -s.z * self.inv_a, s.theta.cos()];
-        let protobuf = self.encoding == Encoding::Protobuf;
-        out.push(Topic::SceneFollow, |buf| {
-            if protobuf {
-                proto::follow_transform(buf, log_time, centre)
-            } else {
-                write_follow_transform(buf, log_time, centre)
-            }
-        })?;
         let rotation = TABLE_ROTATION * orientation(s);
+        let (encoding, thickness) = (self.encoding, self.thickness);
+        finite(SCENE_UPDATE, "pose.position", &centre)?;
+        finite(SCENE_UPDATE, "pose.orientation", rotation.coords.as_slice())?;
+        finite(SCENE_UPDATE, "cylinders.size.z", &[thickness])?;
+        out.push(Topic::SceneFollow, |buf| {
+            encode!(encoding, follow_transform(buf, log_time, centre));
+        });
         out.push(Topic::Main(Channel::Scene), |buf| {
-            if protobuf {
-                proto::coin(buf, log_time, &rotation, self.thickness)
-            } else {
-                self.write_coin(buf, log_time, &rotation)
-            }
-        })?;
+            encode!(encoding, coin(buf, log_time, &rotation, thickness));
+        });
         if let Some(r) = &mut self.rerun {
-            r.coin(log_time, &rotation, out)?;
+            r.coin(log_time, &rotation, out);
         }
         let moved = match self.table {
             Some(t) if (centre[0] - t[0]).abs().max((centre[1] - t[1]).abs()) <= TABLE_SNAP => None,
-            _ => Some([snap(centre[0]), snap(centre[1])]),
+            _ => Some([
+                round_to(centre[0], TABLE_SNAP),
+                round_to(centre[1], TABLE_SNAP),
+            ]),
         };
         if let Some(table) = moved {
             out.push(Topic::SceneTable, |buf| {
-                if protobuf {
-                    proto::table(buf, log_time, table)
-                } else {
-                    write_table(buf, log_time, table)
-                }
-            })?;
+                encode!(encoding, table(buf, log_time, table));
+            });
             if self.rerun.is_some() {
-                out.push(Topic::RerunTable, |buf| {
-                    rerun::table(buf, log_time, table);
-                    Ok(())
-                })?;
+                out.push(Topic::RerunTable, |buf| rerun::table(buf, log_time, table));
             }
             self.table = Some(table);
         }
-        if let Some(change) = self.track.update() {
-            for level in (0..=change.level).rev() {
+        if let Some(changed) = self.track.update() {
+            for level in (0..=changed).rev() {
                 self.push_track_level(level, log_time, out)?;
             }
         }
         if let Some(r) = &mut self.rerun {
-            r.track(log_time, out)?;
+            r.track(log_time, out);
         }
-        self.last_had_scene = true;
         Ok(())
     }
 
@@ -414,208 +315,20 @@ impl Foxglove3d {
         // level < TRACK_LEVELS = 16 fits in a u8.
         let topic = Topic::SceneTrack(u8::try_from(level).unwrap_or(u8::MAX));
         let points = self.track.level(level);
-        let protobuf = self.encoding == Encoding::Protobuf;
+        let encoding = self.encoding;
         if !points.is_empty() {
-            out.push(topic, |buf| {
-                if protobuf {
-                    proto::track(buf, log_time, points)
-                } else {
-                    write_track(buf, log_time, points)
-                }
-            })?;
+            for p in points {
+                finite(SCENE_UPDATE, "lines.points", &[p.x, p.y])?;
+            }
+            out.push(topic, |buf| encode!(encoding, track(buf, log_time, points)));
         } else if self.drawn[level] {
             out.push(topic, |buf| {
-                if protobuf {
-                    proto::track_deletion(buf, log_time);
-                } else {
-                    write_track_deletion(buf, log_time);
-                }
-                Ok(())
-            })?;
+                encode!(encoding, track_deletion(buf, log_time))
+            });
         }
         self.drawn[level] = !points.is_empty();
         Ok(())
     }
-
-    fn write_coin_transform(
-        &self,
-        buf: &mut Vec<u8>,
-        log_time: u64,
-        s: &State,
-    ) -> Result<(), NonFiniteField> {
-        let a = self.coin.params().radius();
-        let q = orientation(s);
-        if self.encoding == Encoding::Protobuf {
-            return proto::coin_transform(buf, log_time, [s.x, a * s.theta.cos(), s.z], &q);
-        }
-        let mut w = Writer::new(buf, FRAME_TRANSFORM);
-        w.raw(b"{\"timestamp\":");
-        w.time(log_time);
-        w.raw(
-            b",\"parent_frame_id\":\"table\",\"child_frame_id\":\"coin\",\"translation\":{\"x\":",
-        );
-        w.num("translation.x", s.x)?;
-        w.raw(b",\"y\":");
-        w.num("translation.y", a * s.theta.cos())?;
-        w.raw(b",\"z\":");
-        w.num("translation.z", s.z)?;
-        w.raw(b"},\"rotation\":");
-        w.quaternion(&q)?;
-        w.raw(b"}");
-        Ok(())
-    }
-
-    /// `/scene`: the coin in `coin_level`, posed with its orientation `r` in `world`: a cylinder with its axis
-    /// along the body's z, and a stripe on each face.
-    fn write_coin(
-        &self,
-        buf: &mut Vec<u8>,
-        log_time: u64,
-        r: &UnitQuaternion<f64>,
-    ) -> Result<(), NonFiniteField> {
-        let h = self.thickness;
-        check(SCENE_UPDATE, "cylinders.size.z", h)?;
-        let mut w = Writer::new(buf, SCENE_UPDATE);
-        w.raw(b"{\"deletions\":[],\"entities\":[");
-        w.entity_head(log_time, FOLLOW_FRAME, b"coin", None, true);
-        w.raw(b"\"cubes\":[");
-        for (i, (position, size, colour)) in coin_marks(r, h).iter().enumerate() {
-            if i > 0 {
-                w.raw(b",");
-            }
-            w.raw(b"{\"pose\":");
-            w.pose(position, r)?;
-            w.raw(b",\"size\":");
-            w.vector3("cubes.size", size[0], size[1], size[2])?;
-            w.raw(b",\"color\":");
-            w.color(*colour);
-            w.raw(b"}");
-        }
-        w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
-        w.pose(&Vector3::zeros(), r)?;
-        w.raw(b",\"size\":");
-        w.vector3("cylinders.size", 2.0, 2.0, h)?;
-        w.raw(b",\"bottom_scale\":1,\"top_scale\":1,\"color\":");
-        w.color(COIN_RGBA);
-        w.raw(b"}],\"lines\":[],");
-        w.entity_tail();
-        w.raw(b"]}");
-        Ok(())
-    }
-}
-
-/// `/tf` and `/tf_static` world → table (static, [`TABLE_ROTATION`]).
-fn write_table_transform(buf: &mut Vec<u8>, log_time: u64) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, FRAME_TRANSFORM);
-    w.raw(b"{\"timestamp\":");
-    w.time(log_time);
-    w.raw(b",\"parent_frame_id\":\"world\",\"child_frame_id\":\"table\",\"translation\":{\"x\":0,\"y\":0,\"z\":0},\"rotation\":");
-    w.quaternion(&TABLE_ROTATION)?;
-    w.raw(b"}");
-    Ok(())
-}
-
-/// `/scene/follow` world → coin_level: translation `centre` (display units), no rotation.
-fn write_follow_transform(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    centre: [f64; 3],
-) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, FRAME_TRANSFORM);
-    w.raw(b"{\"timestamp\":");
-    w.time(log_time);
-    w.raw(b",\"parent_frame_id\":\"world\",\"child_frame_id\":\"coin_level\",\"translation\":");
-    w.vector3("translation", centre[0], centre[1], centre[2])?;
-    w.raw(b",\"rotation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}");
-    Ok(())
-}
-
-/// `/scene/table`: the slab centred on `centre` (display units) and its grid, in `world`.
-fn write_table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, SCENE_UPDATE);
-    w.raw(b"{\"deletions\":[],\"entities\":[");
-    w.entity_head(log_time, WORLD_FRAME, b"table", None, true);
-    w.raw(b"\"cubes\":[{\"pose\":{\"position\":");
-    w.vector3(
-        "cubes.pose.position",
-        centre[0],
-        centre[1],
-        TABLE_TOP - 0.5 * TABLE_THICKNESS,
-    )?;
-    w.raw(b",\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"size\":");
-    let side = 2.0 * TABLE_HALF_SIDE;
-    w.vector3("cubes.size", side, side, TABLE_THICKNESS)?;
-    w.raw(b",\"color\":");
-    w.color(TABLE_RGBA);
-    w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
-    for major in [false, true] {
-        if major {
-            w.raw(b",");
-        }
-        write_grid(&mut w, centre, major)?;
-    }
-    w.raw(b"],");
-    w.entity_tail();
-    w.raw(b"]}");
-    Ok(())
-}
-
-/// One `LinePrimitive` (a line list) of the table's grid: the minor lines (every 1) or the major ones (every
-/// [`GRID_MAJOR`]), across the slab in both directions, at the grid height.
-fn write_grid(w: &mut Writer, centre: [f64; 2], major: bool) -> Result<(), NonFiniteField> {
-    w.raw(b"{\"type\":2,\"pose\":{\"position\":{\"x\":0,\"y\":0,\"z\":");
-    w.num("lines.pose.position.z", GRID_HEIGHT)?;
-    w.raw(b"},\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"thickness\":");
-    w.num("lines.thickness", GRID_WIDTHS[usize::from(major)])?;
-    w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, (a, b)) in grid_segments(centre, major).enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
-        w.point(a[0], a[1])?;
-        w.raw(b",");
-        w.point(b[0], b[1])?;
-    }
-    w.raw(b"],\"color\":");
-    w.color(GRID_RGBA[usize::from(major)]);
-    w.raw(b",\"colors\":[],\"indices\":[]}");
-    Ok(())
-}
-
-/// `/scene/track/<L>`: the level's points as one line strip, entity `track` in `world`.
-fn write_track(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    points: &[track::TrackPoint],
-) -> Result<(), NonFiniteField> {
-    let mut w = Writer::new(buf, SCENE_UPDATE);
-    w.raw(b"{\"deletions\":[],\"entities\":[");
-    w.entity_head(log_time, WORLD_FRAME, b"track", None, true);
-    w.raw(b"\"cubes\":[],\"spheres\":[],\"cylinders\":[],\"lines\":[{\"type\":0,\"pose\":");
-    w.raw(IDENTITY_POSE);
-    w.raw(b",\"thickness\":");
-    w.num("lines.thickness", TRACK_WIDTH)?;
-    w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, p) in points.iter().enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
-        w.point(p.x, p.y)?;
-    }
-    w.raw(b"],\"color\":");
-    w.color(TRACK_RGBA);
-    w.raw(b",\"colors\":[],\"indices\":[]}],");
-    w.entity_tail();
-    w.raw(b"]}");
-    Ok(())
-}
-
-/// `/scene/track/<L>` when the level is empty: the deletion of its line.
-fn write_track_deletion(buf: &mut Vec<u8>, log_time: u64) {
-    let mut w = Writer::new(buf, SCENE_UPDATE);
-    w.raw(b"{\"deletions\":[{\"timestamp\":");
-    w.time(log_time);
-    w.raw(b",\"type\":0,\"id\":\"track\"}],\"entities\":[]}");
 }
 
 /// The display slot of simulation time t: round(t · SCENE_RATE). Rounding (not flooring) makes a data rate
@@ -630,685 +343,7 @@ fn scene_slot(t: f64) -> u64 {
     }
 }
 
-/// `v` rounded to the nearest multiple of [`TABLE_SNAP`] (−0 as 0).
-fn snap(v: f64) -> f64 {
-    (v / TABLE_SNAP).round() * TABLE_SNAP + 0.0
-}
-
-#[cfg(test)]
-mod tests {
-    // Unit tests of the Foxglove output: schemas, frames, the drawing's geometry against the model, rates,
-    // the table, the track's levels, scale invariance, non-finite values.
-
-    use super::track::{segment_distance, MAX_TOLERANCE, QUANTUM};
-    use super::*;
-    use crate::format::log_time;
-    use crate::format::schema_bytes;
-    use crate::model::{centre, CoinParams, Inertia};
-    use nalgebra::Vector3;
-    use serde_json::Value;
-
-    fn unit_coin() -> Coin {
-        Coin::new(CoinParams::unit_disk())
-    }
-
-    /// A coin leaning at θ = 0.3, heading turning at 0.5 rad per time unit, centre on a circle of radius 4
-    /// (lengths in units of `a`): enough motion for a track; not a solution of the equations (the output does
-    /// not need one).
-    fn state_scaled(t: f64, a: f64) -> State {
-        State {
-            theta: 0.3,
-            phi: 0.5 * t,
-            psi: 2.0 * t,
-            omega_x: 0.0,
-            omega_y: 0.4,
-            omega_z: 1.0,
-            x: 4.0 * a * (0.5 * t).cos(),
-            z: 4.0 * a * (0.5 * t).sin(),
-        }
-    }
-
-    fn state_at(t: f64) -> State {
-        state_scaled(t, 1.0)
-    }
-
-    /// (topic, log time, JSON) of each message.
-    type Messages = Vec<(Topic, u64, Value)>;
-
-    /// Records `state(t)` for `coin` at `rate` for `duration` into (topic, log time, JSON) triples.
-    fn record_with(
-        coin: &Coin,
-        rate: f64,
-        duration: f64,
-        state: impl Fn(f64) -> State,
-    ) -> Messages {
-        let mut fox = Foxglove3d::new(coin, 0.05, true, true);
-        let mut batch = FoxgloveBatch::default();
-        let mut out = Vec::new();
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let n = (duration * rate).round() as u64;
-        for k in 0..=n {
-            #[allow(clippy::cast_precision_loss)]
-            let t = k as f64 / rate;
-            let lt = log_time(t).unwrap();
-            batch.clear();
-            fox.sample(t, lt, &state(t), k == n, &mut batch).unwrap();
-            for (c, bytes) in batch.iter() {
-                let v: Value = serde_json::from_slice(bytes).unwrap_or_else(|e| {
-                    panic!(
-                        "{c} message is not JSON ({e}): {}",
-                        String::from_utf8_lossy(bytes)
-                    )
-                });
-                out.push((c, lt, v));
-            }
-        }
-        out
-    }
-
-    fn record(rate: f64, duration: f64) -> Messages {
-        record_with(&unit_coin(), rate, duration, state_at)
-    }
-
-    /// A small JSON Schema checker for the subset the official Foxglove schemas use: type, properties,
-    /// required, items, minimum/maximum, oneOf of constants. Returns the first violation.
-    fn violation(schema: &Value, v: &Value, path: &str) -> Option<String> {
-        if let Some(options) = schema.get("oneOf").and_then(Value::as_array) {
-            if !options.iter().any(|o| o.get("const") == Some(v)) {
-                return Some(format!("{path}: {v} is none of the allowed constants"));
-            }
-        }
-        let ok = match schema.get("type").and_then(Value::as_str) {
-            None => true,
-            Some("object") => v.is_object(),
-            Some("array") => v.is_array(),
-            Some("string") => v.is_string(),
-            Some("boolean") => v.is_boolean(),
-            Some("number") => v.is_number(),
-            Some("integer") => v.is_u64() || v.is_i64(),
-            Some(other) => panic!("schema type {other} not handled"),
-        };
-        if !ok {
-            return Some(format!("{path}: {v} is not of type {}", schema["type"]));
-        }
-        if let (Some(min), Some(x)) = (schema.get("minimum").and_then(Value::as_f64), v.as_f64()) {
-            if x < min {
-                return Some(format!("{path}: {x} < minimum {min}"));
-            }
-        }
-        if let (Some(max), Some(x)) = (schema.get("maximum").and_then(Value::as_f64), v.as_f64()) {
-            if x > max {
-                return Some(format!("{path}: {x} > maximum {max}"));
-            }
-        }
-        if let Some(required) = schema.get("required").and_then(Value::as_array) {
-            for r in required {
-                let r = r.as_str().unwrap();
-                if v.get(r).is_none() {
-                    return Some(format!("{path}: required field `{r}` missing"));
-                }
-            }
-        }
-        if let Some(props) = schema.get("properties").and_then(Value::as_object) {
-            for (k, sub) in props {
-                if let Some(x) = v.get(k) {
-                    if let Some(e) = violation(sub, x, &format!("{path}.{k}")) {
-                        return Some(e);
-                    }
-                }
-            }
-            for k in v.as_object().unwrap().keys() {
-                if !props.contains_key(k) {
-                    return Some(format!("{path}: field `{k}` is not in the schema"));
-                }
-            }
-        }
-        if let (Some(items), Some(arr)) = (schema.get("items"), v.as_array()) {
-            for (i, x) in arr.iter().enumerate() {
-                if let Some(e) = violation(items, x, &format!("{path}[{i}]")) {
-                    return Some(e);
-                }
-            }
-        }
-        None
-    }
-
-    fn entities(v: &Value) -> &Vec<Value> {
-        v["entities"].as_array().unwrap()
-    }
-
-    fn number(v: &Value) -> f64 {
-        v.as_f64().unwrap()
-    }
-
-    fn time_of(entity: &Value) -> u64 {
-        entity["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
-            + entity["timestamp"]["nsec"].as_u64().unwrap()
-    }
-
-    fn quaternion(v: &Value) -> UnitQuaternion<f64> {
-        UnitQuaternion::new_unchecked(Quaternion::new(
-            number(&v["w"]),
-            number(&v["x"]),
-            number(&v["y"]),
-            number(&v["z"]),
-        ))
-    }
-
-    #[test]
-    fn every_message_is_json_that_satisfies_the_official_schema() {
-        let messages = record(100.0, 3.0);
-        for (topic, _, v) in &messages {
-            let schema: Value =
-                serde_json::from_slice(schema_bytes(topic.schema_name()).unwrap()).unwrap();
-            if let Some(e) = violation(&schema, v, topic.schema_name()) {
-                panic!("{topic}: {e}\nmessage: {v}");
-            }
-        }
-        let topics: std::collections::BTreeSet<Topic> = messages.iter().map(|m| m.0).collect();
-        println!(
-            "{} messages on {} topics checked against foxglove.* schemas",
-            messages.len(),
-            topics.len()
-        );
-        assert!(messages.len() > 300);
-    }
-
-    #[test]
-    fn the_static_table_transform_comes_first_on_tf_and_once_on_its_own_topic() {
-        let messages = record(100.0, 1.0);
-        let tables: Vec<(usize, Topic)> = messages
-            .iter()
-            .enumerate()
-            .filter(|(_, (_, _, v))| v.get("child_frame_id") == Some(&Value::from("table")))
-            .map(|(i, (t, _, _))| (i, *t))
-            .collect();
-        assert_eq!(
-            tables,
-            vec![(0, Topic::Main(Channel::Tf)), (2, Topic::TfStatic)],
-            "world → table first on /tf and once on /tf_static"
-        );
-        let first_drawing = messages
-            .iter()
-            .position(|(c, _, _)| c.channel() == Channel::Scene)
-            .unwrap();
-        assert!(first_drawing > 2);
-        for i in [0, 2] {
-            assert_eq!(messages[i].2["parent_frame_id"], "world");
-            assert_eq!(messages[i].1, 0);
-        }
-        let coin_tfs = messages
-            .iter()
-            .filter(|(_, _, v)| v.get("child_frame_id") == Some(&Value::from("coin")))
-            .count();
-        println!("coin transforms: measured {coin_tfs}, expected 101 (one per sample)");
-        assert_eq!(coin_tfs, 101);
-    }
-
-    #[test]
-    fn the_table_rotation_is_proper_and_takes_the_note_up_axis_to_foxglove_up() {
-        let q = TABLE_ROTATION;
-        let cases = [
-            ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
-            ([1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
-            ([0.0, 0.0, 1.0], [0.0, -1.0, 0.0]),
-        ];
-        for (from, to) in cases {
-            let r = q.transform_vector(&Vector3::from(from));
-            for i in 0..3 {
-                assert!(
-                    (r[i] - to[i]).abs() < 1e-15,
-                    "{from:?} → {r:?}, expected {to:?}"
-                );
-            }
-        }
-        println!("|q| = {} (expected 1, tolerance 1e-15)", q.norm());
-        assert!((q.norm() - 1.0).abs() < 1e-15);
-    }
-
-    #[test]
-    fn the_coin_frame_puts_the_rim_point_minus_a_e_y_on_the_contact_point() {
-        // Translation + rotation of /tf table → coin must carry the coin-frame point c = −a e_Y of the lean
-        // frame (in the coin frame: the rim point (0, −a, 0) before spin ψ, i.e. rotated back by ψ) onto the
-        // model's contact point (physics §3): checks the frame against an independent formula.
-        let coin = unit_coin();
-        let mut fox = Foxglove3d::new(&coin, 0.05, true, false);
-        let mut batch = FoxgloveBatch::default();
-        let mut worst: f64 = 0.0;
-        for k in 0..50 {
-            let t = f64::from(k) * 0.37;
-            let s = state_at(t);
-            batch.clear();
-            fox.sample(t, log_time(t).unwrap(), &s, false, &mut batch)
-                .unwrap();
-            let v: Value = batch
-                .iter()
-                .map(|(_, bytes)| serde_json::from_slice::<Value>(bytes).unwrap())
-                .find(|v| v["child_frame_id"] == "coin")
-                .unwrap();
-            let tr = &v["translation"];
-            let q = quaternion(&v["rotation"]);
-            // q = q_lean · q(e_z, ψ), so the coin-frame vector that q takes to −a e_Y is the rotation of
-            // (0, −1, 0) by −ψ about z: (−sin ψ, −cos ψ, 0).
-            let (sp, cp) = s.psi.sin_cos();
-            let rim = q.transform_vector(&Vector3::new(-sp, -cp, 0.0));
-            let c = contact_point(&coin, &s);
-            let g = centre(&coin, &s);
-            let got = [
-                number(&tr["x"]) + rim[0],
-                number(&tr["y"]) + rim[1],
-                number(&tr["z"]) + rim[2],
-            ];
-            assert!((number(&tr["y"]) - g.y).abs() <= 1e-15);
-            for (a, b) in got.iter().zip([c.x, c.y, c.z]) {
-                worst = worst.max((a - b).abs());
-            }
-        }
-        println!("contact point from /tf vs model: max error {worst:e}, tolerance 1e-12");
-        assert!(worst < 1e-12);
-    }
-
-    /// Per display update: (log time, follow translation, coin entity).
-    fn drawings(messages: &Messages) -> Vec<(u64, [f64; 3], Value)> {
-        let mut out = Vec::new();
-        let mut follow = None;
-        for (topic, lt, v) in messages {
-            match topic {
-                Topic::SceneFollow => {
-                    assert_eq!(v["parent_frame_id"], "world");
-                    assert_eq!(v["child_frame_id"], FOLLOW_FRAME);
-                    assert_eq!(
-                        v["rotation"],
-                        serde_json::json!({"x": 0, "y": 0, "z": 0, "w": 1}),
-                        "the follow frame stays level"
-                    );
-                    let tr = &v["translation"];
-                    follow = Some([number(&tr["x"]), number(&tr["y"]), number(&tr["z"])]);
-                }
-                Topic::Main(Channel::Scene) => {
-                    let coin = entities(v).iter().find(|e| e["id"] == "coin").unwrap();
-                    out.push((
-                        *lt,
-                        follow.take().expect("follow frame first"),
-                        coin.clone(),
-                    ));
-                }
-                _ => {}
-            }
-        }
-        out
-    }
-
-    #[test]
-    fn the_drawn_coin_sits_on_the_contact_point_in_units_of_a() {
-        // The drawn coin: centre = the follow frame's translation, orientation = the entity's pose. Its rim
-        // point −e_Y (the contact, physics §3) must be the model's contact point divided by a, carried into
-        // `world` by the table rotation: (x_c/a, −z_c/a, 0). Checked at every display update, for a = 1 and
-        // for the 500-yen coin's a = 0.01325 with the same motion in units of a.
-        for a in [1.0, 0.013_25] {
-            let params = CoinParams::new(7e-3, a, 9.81, Inertia::ThinDisk).unwrap();
-            let coin = Coin::new(params);
-            let messages = record_with(&coin, 100.0, 3.0, |t| state_scaled(t, a));
-            let mut worst: f64 = 0.0;
-            let updates = drawings(&messages);
-            for (lt, follow, e) in &updates {
-                assert_eq!(e["frame_id"], FOLLOW_FRAME);
-                let r = quaternion(&e["cylinders"][0]["pose"]["orientation"]);
-                #[allow(clippy::cast_precision_loss)]
-                let t = *lt as f64 * 1e-9;
-                let s = state_scaled(t, a);
-                let (sp, cp) = s.psi.sin_cos();
-                let rim = r.transform_vector(&Vector3::new(-sp, -cp, 0.0));
-                let c = contact_point(&coin, &s);
-                let expected = [c.x / a, -c.z / a, 0.0];
-                for i in 0..3 {
-                    worst = worst.max((follow[i] + rim[i] - expected[i]).abs());
-                }
-            }
-            println!("a = {a}: {} updates, drawn contact vs model: max error {worst:e} (tolerance 1e-12)", updates.len());
-            assert!(worst < 1e-12);
-        }
-    }
-
-    #[test]
-    fn the_coin_entity_is_a_cylinder_with_a_mark_outside_each_face() {
-        let messages = record(100.0, 0.5);
-        let (lt, _, coin) = &drawings(&messages)[0];
-        assert_eq!(coin["frame_locked"], true);
-        assert_eq!(coin["lifetime"], serde_json::json!({"sec": 0, "nsec": 0}));
-        assert_eq!(time_of(coin), *lt);
-        let cyl = &coin["cylinders"][0];
-        assert_eq!(coin["cylinders"].as_array().unwrap().len(), 1);
-        assert_eq!(
-            cyl["size"],
-            serde_json::json!({"x": 2.0, "y": 2.0, "z": 0.05})
-        );
-        assert_eq!(cyl["bottom_scale"], 1);
-        assert_eq!(cyl["top_scale"], 1);
-        for ch in ["r", "g", "b", "a"] {
-            assert!((0.0..=1.0).contains(&number(&cyl["color"][ch])));
-        }
-        let r = quaternion(&cyl["pose"]["orientation"]);
-        let normal = r.transform_vector(&Vector3::z());
-        let cubes = coin["cubes"].as_array().unwrap();
-        assert_eq!(cubes.len(), 2);
-        // Each mark's centre, along the coin's normal: outside the top (+) and bottom (−) faces at ±0.025.
-        let along: Vec<f64> = cubes
-            .iter()
-            .map(|c| {
-                let p = &c["pose"]["position"];
-                Vector3::new(number(&p["x"]), number(&p["y"]), number(&p["z"])).dot(&normal)
-            })
-            .collect();
-        assert!(
-            along[0] > 0.025 && along[1] < -0.025,
-            "marks outside both faces: {along:?}"
-        );
-    }
-
-    #[test]
-    fn drawing_updates_come_at_about_thirty_per_time_unit_whatever_the_data_rate() {
-        for rate in [30.0, 45.0, 100.0, 1000.0] {
-            let messages = record(rate, 4.0);
-            let times: Vec<u64> = messages
-                .iter()
-                .filter(|(c, _, _)| *c == Topic::Main(Channel::Scene))
-                .map(|(_, t, _)| *t)
-                .collect();
-            let n = times.len();
-            println!("rate {rate}: {n} drawing updates over 4 time units, expected 121 ± 1");
-            assert!((120..=122).contains(&n), "rate {rate}: {n}");
-            assert_eq!(times[0], 0);
-            assert_eq!(*times.last().unwrap(), 4_000_000_000);
-            let max_gap = times.windows(2).map(|w| w[1] - w[0]).max().unwrap();
-            assert!(max_gap <= 50_000_000, "rate {rate}: gap {max_gap} ns");
-            let follows = messages
-                .iter()
-                .filter(|m| m.0 == Topic::SceneFollow)
-                .count();
-            assert_eq!(follows, n, "one follow transform per drawing update");
-        }
-    }
-
-    #[test]
-    fn the_table_stays_under_the_coin_and_its_grid_is_fixed_to_the_table() {
-        // A coin running off fast along x: the table must follow in steps of TABLE_SNAP, keep the coin at
-        // least TABLE_HALF_SIDE − TABLE_SNAP from its edge, and draw grid lines on whole display units only
-        // (so they stay put on the table while the slab moves).
-        let coin = unit_coin();
-        let run = |t: f64| State {
-            x: 37.0 * t,
-            z: 3.0 * t,
-            ..state_at(t)
-        };
-        let messages = record_with(&coin, 100.0, 4.0, run);
-        // Tables drawn and follow-frame positions, by log time.
-        let mut tables: Vec<(u64, [f64; 2])> = Vec::new();
-        let mut follows: Vec<(u64, [f64; 2])> = Vec::new();
-        for (topic, lt, v) in &messages {
-            match topic {
-                Topic::SceneTable => {
-                    let e = &entities(v)[0];
-                    assert_eq!(e["frame_id"], WORLD_FRAME);
-                    let p = &e["cubes"][0]["pose"]["position"];
-                    tables.push((*lt, [number(&p["x"]), number(&p["y"])]));
-                    for line in e["lines"].as_array().unwrap() {
-                        assert_eq!(line["type"], 2, "a line list");
-                        for q in line["points"].as_array().unwrap() {
-                            for k in ["x", "y"] {
-                                assert_eq!(number(&q[k]).fract(), 0.0, "grid on whole units: {q}");
-                            }
-                        }
-                    }
-                }
-                Topic::SceneFollow => {
-                    let tr = &v["translation"];
-                    follows.push((*lt, [number(&tr["x"]), number(&tr["y"])]));
-                }
-                _ => {}
-            }
-        }
-        let mut closest_edge = f64::INFINITY;
-        for (lt, p) in &follows {
-            let (_, t) = tables
-                .iter()
-                .rev()
-                .find(|(tl, _)| tl <= lt)
-                .expect("the table is drawn at the first update");
-            let d = (p[0] - t[0]).abs().max((p[1] - t[1]).abs());
-            closest_edge = closest_edge.min(TABLE_HALF_SIDE - d);
-        }
-        let moves = tables.len();
-        println!("table drawn {moves} times for 148 a of travel; closest the coin came to an edge: {closest_edge} a (≥ 20)");
-        assert!((14..=17).contains(&moves), "{moves}");
-        assert!(closest_edge >= TABLE_HALF_SIDE - TABLE_SNAP - 1e-9);
-    }
-
-    /// The latest message of every track topic up to log time `cut`: the line each one draws, if any.
-    fn latest_track_lines(messages: &Messages, cut: u64) -> Vec<(usize, Vec<[f64; 2]>)> {
-        let mut latest: std::collections::BTreeMap<usize, &Value> =
-            std::collections::BTreeMap::new();
-        for (topic, lt, v) in messages {
-            if let Topic::SceneTrack(level) = topic {
-                if *lt <= cut {
-                    latest.insert(usize::from(*level), v);
-                }
-            }
-        }
-        latest
-            .into_iter()
-            .filter_map(|(level, v)| {
-                let e = entities(v).first()?;
-                assert_eq!(e["id"], "track");
-                assert_eq!(e["frame_id"], WORLD_FRAME);
-                let points = e["lines"][0]["points"].as_array().unwrap();
-                Some((
-                    level,
-                    points
-                        .iter()
-                        .map(|p| [number(&p["x"]), number(&p["y"])])
-                        .collect(),
-                ))
-            })
-            .collect()
-    }
-
-    #[test]
-    fn after_any_cut_the_latest_track_messages_draw_the_path_from_the_start() {
-        let coin = unit_coin();
-        let messages = record(100.0, 9.0);
-        let mut checked = 0;
-        for cut_k in (7..=900).step_by(13) {
-            let cut = log_time(f64::from(cut_k) * 0.01).unwrap();
-            let mut lines = latest_track_lines(&messages, cut);
-            lines.sort_by_key(|l| std::cmp::Reverse(l.0));
-            let chain: Vec<[f64; 2]> = lines.iter().fold(Vec::new(), |mut acc, (level, l)| {
-                if let Some(last) = acc.last() {
-                    assert_eq!(
-                        last, &l[0],
-                        "level {level} starts where the level above ends"
-                    );
-                    acc.extend_from_slice(&l[1..]);
-                } else {
-                    acc.extend_from_slice(l);
-                }
-                acc
-            });
-            // The latest drawing update at or before the cut.
-            let last_update = messages
-                .iter()
-                .filter(|(t, lt, _)| *t == Topic::Main(Channel::Scene) && *lt <= cut)
-                .map(|m| m.1)
-                .max()
-                .unwrap();
-            let c0 = contact_point(&coin, &state_at(0.0));
-            #[allow(clippy::cast_precision_loss)]
-            let cn = contact_point(&coin, &state_at(last_update as f64 * 1e-9));
-            let (first, last) = (chain[0], chain[chain.len() - 1]);
-            assert!((first[0] - c0.x).abs() <= QUANTUM && (first[1] + c0.z).abs() <= QUANTUM);
-            assert!((last[0] - cn.x).abs() <= QUANTUM && (last[1] + cn.z).abs() <= QUANTUM);
-            // Every sample's contact point up to the last update lies on the drawn track.
-            for k in 0..=cut_k {
-                let t = f64::from(k) * 0.01;
-                if log_time(t).unwrap() > last_update {
-                    break;
-                }
-                let c = contact_point(&coin, &state_at(t));
-                let d = chain
-                    .windows(2)
-                    .map(|w| segment_distance([c.x, -c.z], w[0], w[1]))
-                    .fold(f64::INFINITY, f64::min);
-                assert!(d <= MAX_TOLERANCE + QUANTUM, "t = {t}: {d} from the track");
-            }
-            checked += 1;
-        }
-        println!(
-            "{checked} cut times: the latest track messages cover the path to the latest update"
-        );
-    }
-
-    #[test]
-    fn the_drawing_is_the_same_for_any_radius_in_units_of_a() {
-        // The same motion in units of a, for a = 1 and a = 0.01325: every drawing message carries the same
-        // numbers (to round-off), so one layout suits both.
-        let unit = record(100.0, 2.0);
-        let params = CoinParams::new(7e-3, 0.013_25, 9.81, Inertia::ThinDisk).unwrap();
-        let yen = record_with(&Coin::new(params), 100.0, 2.0, |t| {
-            state_scaled(t, 0.013_25)
-        });
-        let drawing = |m: &Messages| -> Vec<(Topic, String)> {
-            m.iter()
-                .filter(|(t, _, _)| t.channel() == Channel::Scene)
-                .map(|(t, _, v)| (*t, v.to_string()))
-                .collect()
-        };
-        let (u, y) = (drawing(&unit), drawing(&yen));
-        assert_eq!(u.len(), y.len());
-        let mut differing = 0;
-        for ((tu, vu), (ty, vy)) in u.iter().zip(&y) {
-            assert_eq!(tu, ty);
-            if vu != vy {
-                differing += 1;
-                // Only the follow translation may differ, by round-off of x·a/a.
-                assert_eq!(*tu, Topic::SceneFollow, "{vu}\n{vy}");
-            }
-        }
-        println!(
-            "{} drawing messages, {differing} differ in round-off only",
-            u.len()
-        );
-    }
-
-    #[test]
-    fn a_coin_spinning_in_place_draws_no_track() {
-        let coin = unit_coin();
-        let mut fox = Foxglove3d::new(&coin, 0.05, false, true);
-        let mut batch = FoxgloveBatch::default();
-        for k in 0..200 {
-            let t = f64::from(k) * 0.01;
-            let s = State {
-                phi: 2.0 * t,
-                omega_y: 2.0,
-                ..State::default()
-            };
-            batch.clear();
-            fox.sample(t, log_time(t).unwrap(), &s, k == 199, &mut batch)
-                .unwrap();
-            for (topic, _) in batch.iter() {
-                assert_eq!(topic.channel(), Channel::Scene, "tf is off");
-                assert!(!matches!(topic, Topic::SceneTrack(_)), "no track");
-            }
-        }
-    }
-
-    #[test]
-    fn non_finite_values_are_refused_and_leave_the_batch_alone() {
-        let coin = unit_coin();
-        let mut fox = Foxglove3d::new(&coin, 0.05, true, true);
-        let mut batch = FoxgloveBatch::default();
-        fox.sample(0.0, 0, &state_at(0.0), false, &mut batch)
-            .unwrap();
-        let before = batch.len();
-        let bad = State {
-            psi: f64::NAN,
-            ..state_at(0.01)
-        };
-        let err = fox
-            .sample(0.01, 10_000_000, &bad, false, &mut batch)
-            .unwrap_err();
-        println!("{err}");
-        assert_eq!(err.schema, FRAME_TRANSFORM);
-        assert_eq!(batch.len(), before);
-        let bad = State {
-            x: f64::INFINITY,
-            ..state_at(0.02)
-        };
-        assert!(fox
-            .sample(0.02, 20_000_000, &bad, false, &mut batch)
-            .is_err());
-        let mut drawing = Foxglove3d::new(&coin, 0.05, false, true);
-        let err = drawing
-            .sample(
-                0.0,
-                0,
-                &State {
-                    theta: f64::NAN,
-                    ..state_at(0.0)
-                },
-                false,
-                &mut batch,
-            )
-            .unwrap_err();
-        assert_eq!(err.schema, SCENE_UPDATE);
-    }
-
-    #[test]
-    fn finish_adds_the_final_drawing_only_when_the_last_sample_had_none() {
-        let coin = unit_coin();
-        let mut batch = FoxgloveBatch::default();
-        // Samples to t = 0.06, none flagged `last` (the recorder learns of the end afterwards).
-        let mut fox = Foxglove3d::new(&coin, 0.05, false, true);
-        let mut drawn = Vec::new();
-        for k in 0..=6 {
-            let t = f64::from(k) * 0.01;
-            batch.clear();
-            fox.sample(t, log_time(t).unwrap(), &state_at(t), false, &mut batch)
-                .unwrap();
-            drawn.push(batch.len());
-        }
-        batch.clear();
-        fox.finish(&mut batch).unwrap();
-        let topics: Vec<Topic> = batch.iter().map(|(t, _)| t).collect();
-        println!("messages per sample {drawn:?}, finish added {topics:?}");
-        // t = 0.06: round(1.8) = 2 = the slot of t = 0.05 (round(1.5) = 2), so no update at 0.06.
-        assert_eq!(drawn[6], 0);
-        assert_eq!(
-            &topics[..2],
-            &[Topic::SceneFollow, Topic::Main(Channel::Scene)]
-        );
-        assert!(
-            topics.iter().any(|t| matches!(t, Topic::SceneTrack(_))),
-            "the final piece of track is published"
-        );
-        let (_, bytes) = batch.iter().nth(1).unwrap();
-        let v: Value = serde_json::from_slice(bytes).unwrap();
-        assert_eq!(time_of(&entities(&v)[0]), 60_000_000);
-        // After a sample flagged `last`, finish adds nothing.
-        batch.clear();
-        fox.sample(0.07, 70_000_000, &state_at(0.07), true, &mut batch)
-            .unwrap();
-        batch.clear();
-        fox.finish(&mut batch).unwrap();
-        assert!(batch.is_empty());
-    }
-
-    #[test]
-    fn nothing_is_written_when_both_channels_are_off() {
-        let mut fox = Foxglove3d::new(&unit_coin(), 0.05, false, false);
-        assert!(fox.is_off());
-        let mut batch = FoxgloveBatch::default();
-        fox.sample(0.0, 0, &state_at(0.0), true, &mut batch)
-            .unwrap();
-        assert!(batch.is_empty());
-    }
+/// `v` rounded to the nearest multiple of `step` (−0 as 0).
+fn round_to(v: f64, step: f64) -> f64 {
+    (v / step).round() * step + 0.0
 }

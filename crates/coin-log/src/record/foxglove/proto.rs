@@ -1,8 +1,6 @@
-//! The Protobuf form of the Foxglove messages: the same frames and drawing as the JSON writers of
-//! [`super`], built as the `foxglove` crate's message types (Foxglove's published schemas) and encoded by
-//! prost. The geometry comes from the same helpers as the JSON ([`super::coin_marks`],
-//! [`super::grid_segments`], the colour constants), and a test decodes both encodings of a run and
-//! compares them field by field.
+//! The Protobuf form of the Foxglove messages: the `foxglove` crate's message types (Foxglove's published
+//! schemas) encoded by prost, with the geometry of [`super::json`] (a test compares the two field by field).
+//! The values were checked finite by [`super::Foxglove3d`].
 
 use super::track::TrackPoint;
 use super::{
@@ -10,8 +8,6 @@ use super::{
     TABLE_HALF_SIDE, TABLE_RGBA, TABLE_ROTATION, TABLE_THICKNESS, TABLE_TOP, TRACK_RGBA,
     TRACK_WIDTH, WORLD_FRAME,
 };
-use crate::format::messages::NonFiniteField;
-use crate::format::{FRAME_TRANSFORM, SCENE_UPDATE};
 use foxglove::messages::{
     line_primitive, scene_entity_deletion, Color, CubePrimitive, CylinderPrimitive, Duration,
     FrameTransform, LinePrimitive, Point3, Pose, Quaternion, SceneEntity, SceneEntityDeletion,
@@ -31,24 +27,6 @@ pub(super) fn timestamp(log_time: u64) -> Timestamp {
 
 /// The longest run, in time units (= seconds of log time), whose timestamps fit Foxglove's u32 seconds.
 pub const MAX_SECONDS: f64 = 4_294_967_295.0;
-
-/// Every number of a message must be finite (as in JSON): `Err` naming the first that is not.
-struct Finite {
-    schema: &'static str,
-}
-
-impl Finite {
-    fn check(&self, field: &'static str, values: &[f64]) -> Result<(), NonFiniteField> {
-        match values.iter().find(|v| !v.is_finite()) {
-            None => Ok(()),
-            Some(&value) => Err(NonFiniteField {
-                schema: self.schema,
-                field,
-                value,
-            }),
-        }
-    }
-}
 
 fn vector3(x: f64, y: f64, z: f64) -> Option<Vector3> {
     Some(Vector3 { x, y, z })
@@ -86,32 +64,26 @@ pub(super) fn transform(
     child: &str,
     translation: [f64; 3],
     rotation: &UnitQuaternion<f64>,
-) -> Result<FrameTransform, NonFiniteField> {
-    let f = Finite {
-        schema: FRAME_TRANSFORM,
-    };
-    f.check("translation", &translation)?;
-    f.check("rotation", rotation.coords.as_slice())?;
-    Ok(FrameTransform {
+) -> FrameTransform {
+    FrameTransform {
         timestamp: Some(timestamp(log_time)),
         parent_frame_id: parent.to_string(),
         child_frame_id: child.to_string(),
         translation: vector3(translation[0], translation[1], translation[2]),
         rotation: quaternion(rotation),
-    })
+    }
 }
 
 /// `/tf` and `/tf_static` world → table.
-pub(super) fn table_transform(buf: &mut Vec<u8>, log_time: u64) -> Result<(), NonFiniteField> {
+pub(super) fn table_transform(buf: &mut Vec<u8>, log_time: u64) {
     transform(
         log_time,
         WORLD_FRAME,
         super::TABLE_FRAME,
         [0.0; 3],
         &TABLE_ROTATION,
-    )?
+    )
     .encode_raw(buf);
-    Ok(())
 }
 
 /// `/tf` table → coin: the centre `translation` and the orientation `q`.
@@ -120,33 +92,27 @@ pub(super) fn coin_transform(
     log_time: u64,
     translation: [f64; 3],
     q: &UnitQuaternion<f64>,
-) -> Result<(), NonFiniteField> {
+) {
     transform(
         log_time,
         super::TABLE_FRAME,
         super::COIN_FRAME,
         translation,
         q,
-    )?
+    )
     .encode_raw(buf);
-    Ok(())
 }
 
 /// `/scene/follow` world → coin_level.
-pub(super) fn follow_transform(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    centre: [f64; 3],
-) -> Result<(), NonFiniteField> {
+pub(super) fn follow_transform(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 3]) {
     transform(
         log_time,
         WORLD_FRAME,
         FOLLOW_FRAME,
         centre,
         &UnitQuaternion::identity(),
-    )?
+    )
     .encode_raw(buf);
-    Ok(())
 }
 
 /// An entity with the fields every drawn one shares (no lifetime: it stays until replaced).
@@ -169,20 +135,9 @@ fn update(entity: SceneEntity) -> SceneUpdate {
 }
 
 /// `/scene`: the coin posed with `r`, `thickness` thick, and its two face marks.
-pub(super) fn coin(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    r: &UnitQuaternion<f64>,
-    thickness: f64,
-) -> Result<(), NonFiniteField> {
-    let f = Finite {
-        schema: SCENE_UPDATE,
-    };
-    f.check("cylinders.size.z", &[thickness])?;
-    f.check("pose.orientation", r.coords.as_slice())?;
+pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, thickness: f64) {
     let mut e = entity(log_time, FOLLOW_FRAME, "coin");
     for (position, size, rgba) in coin_marks(r, thickness) {
-        f.check("cubes.pose.position", position.as_slice())?;
         e.cubes.push(CubePrimitive {
             pose: Some(Pose {
                 position: vector3(position.x, position.y, position.z),
@@ -203,19 +158,10 @@ pub(super) fn coin(
         color: color(COIN_RGBA),
     });
     update(e).encode_raw(buf);
-    Ok(())
 }
 
 /// `/scene/table`: the slab centred on `centre` and its grid.
-pub(super) fn table(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    centre: [f64; 2],
-) -> Result<(), NonFiniteField> {
-    let f = Finite {
-        schema: SCENE_UPDATE,
-    };
-    f.check("cubes.pose.position", &centre)?;
+pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     let mut e = entity(log_time, WORLD_FRAME, "table");
     let side = 2.0 * TABLE_HALF_SIDE;
     e.cubes.push(CubePrimitive {
@@ -255,27 +201,18 @@ pub(super) fn table(
         });
     }
     update(e).encode_raw(buf);
-    Ok(())
 }
 
 /// `/scene/track/<L>`: the level's points as one line strip.
-pub(super) fn track(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    points: &[TrackPoint],
-) -> Result<(), NonFiniteField> {
-    let f = Finite {
-        schema: SCENE_UPDATE,
-    };
-    let mut line = Vec::with_capacity(points.len());
-    for p in points {
-        f.check("lines.points", &[p.x, p.y])?;
-        line.push(Point3 {
+pub(super) fn track(buf: &mut Vec<u8>, log_time: u64, points: &[TrackPoint]) {
+    let line = points
+        .iter()
+        .map(|p| Point3 {
             x: p.x,
             y: p.y,
             z: 0.0,
-        });
-    }
+        })
+        .collect();
     let mut e = entity(log_time, WORLD_FRAME, "track");
     e.lines.push(LinePrimitive {
         r#type: line_primitive::Type::LineStrip as i32,
@@ -288,7 +225,6 @@ pub(super) fn track(
         indices: Vec::new(),
     });
     update(e).encode_raw(buf);
-    Ok(())
 }
 
 /// `/scene/track/<L>` when the level is empty: the deletion of its line.

@@ -1,19 +1,6 @@
-//! The `rerun` channel (docs/format.md: Rerun geometry): the coin, the table and the track again, in the
-//! types Rerun's MCAP importer (0.41) turns into geometry, since it draws no `foxglove.SceneUpdate`. Opt-in:
-//! Foxglove draws none of it and it costs file size. Display units and frames as in [`super`]:
-//! - `/rerun/robot_description`, once: a URDF, robot `coin_shape` (not `coin`, whose entity paths `/coin/*`
-//!   the `coin_log.*` topics take), link `coin_body`: a cylinder of radius 1 and the thickness, and the two
-//!   face marks of `/scene` as boxes. Rerun's `urdf` decoder reads it only as ROS 2 `std_msgs/msg/String`
-//!   in CDR, so this one topic is CDR in any file.
-//! - `/rerun/coin_body`, at each drawing update: `coin_level` → `coin_body`, the rotation of `/scene`'s
-//!   cylinder (q_T · q), a zero translation that is written (Rerun's `rrd verify` refuses a missing one).
-//!   The URDF's link moves with it: Rerun places geometry through the tree of every transform topic.
-//! - `/rerun/table`: the table as a `foxglove.VoxelGrid` in `world`, one layer of checkered 1 × 1 cells
-//!   over the slab of `/scene/table`, whenever that moves.
-//! - `/rerun/track`: a `foxglove.PointCloud` in `world` with the contact points since the previous update,
-//!   [`TRACK_SPACING`] apart and always the contact point of the update itself (so the newest point is the
-//!   contact at that time). Rerun shows a point cloud at its time only: its blueprint
-//!   (`scripts/rerun_blueprint.py`) shows every message from t = 0 to the cursor, which draws the whole track.
+//! The `rerun` channel (docs/format.md: Rerun geometry): the coin (a URDF moved by `/rerun/coin_body`),
+//! the table (a voxel grid) and the track (point clouds) again, in the types Rerun's MCAP importer turns
+//! into geometry, since it draws no `foxglove.SceneUpdate`. Display units and frames as in [`super`].
 
 use super::proto::{identity, timestamp, transform};
 use super::{
@@ -21,7 +8,6 @@ use super::{
     TABLE_TOP, TRACK_RGBA, WORLD_FRAME,
 };
 use super::{FoxgloveBatch, Topic};
-use crate::format::messages::NonFiniteField;
 use crate::format::Channel;
 use foxglove::messages::packed_element_field::NumericType;
 use foxglove::messages::{PackedElementField, PointCloud, Pose, Vector3, VoxelGrid};
@@ -66,8 +52,6 @@ pub struct Rerun3d {
 }
 
 impl Rerun3d {
-    /// The output for a coin drawn `thickness` (fraction of a) thick.
-    #[must_use]
     pub fn new(thickness: f64) -> Self {
         Self {
             thickness,
@@ -101,40 +85,25 @@ impl Rerun3d {
     }
 
     /// A drawing update's coin: the URDF at the first, then `coin_level` → `coin_body` with rotation `r`.
-    ///
-    /// # Errors
-    /// [`NonFiniteField`] if `r` is not finite.
-    pub fn coin(
-        &mut self,
-        log_time: u64,
-        r: &UnitQuaternion<f64>,
-        out: &mut FoxgloveBatch,
-    ) -> Result<(), NonFiniteField> {
+    pub fn coin(&mut self, log_time: u64, r: &UnitQuaternion<f64>, out: &mut FoxgloveBatch) {
         if !self.started {
             let urdf = urdf(self.thickness);
-            out.push(Topic::RerunRobot, |buf| {
-                cdr_string(buf, &urdf);
-                Ok(())
-            })?;
+            out.push(Topic::RerunRobot, |buf| cdr_string(buf, &urdf));
             self.started = true;
         }
         out.push(Topic::Main(Channel::Rerun), |buf| {
-            transform(log_time, FOLLOW_FRAME, BODY_FRAME, [0.0; 3], r)?.encode_raw(buf);
-            Ok(())
-        })
+            transform(log_time, FOLLOW_FRAME, BODY_FRAME, [0.0; 3], r).encode_raw(buf);
+        });
     }
 
     /// A drawing update's track: the points kept since the previous update and the latest contact point,
     /// if the coin moved at all.
-    ///
-    /// # Errors
-    /// None today (the points were checked finite by the Foxglove track); the signature is the batch's.
-    pub fn track(&mut self, log_time: u64, out: &mut FoxgloveBatch) -> Result<(), NonFiniteField> {
+    pub fn track(&mut self, log_time: u64, out: &mut FoxgloveBatch) {
         if let Some(p) = self.latest.filter(|&p| Some(p) != self.kept) {
             self.keep(p);
         }
         if self.pending.is_empty() {
-            return Ok(());
+            return;
         }
         let data = std::mem::take(&mut self.pending);
         out.push(Topic::RerunTrack, |buf| {
@@ -152,8 +121,7 @@ impl Rerun3d {
                 data: data.into(),
             }
             .encode_raw(buf);
-            Ok(())
-        })
+        });
     }
 }
 
@@ -288,7 +256,7 @@ mod tests {
         for k in 0..=100 {
             r.contact([f64::from(k) * 1e-3, 0.0]);
         }
-        r.track(0, &mut out).unwrap();
+        r.track(0, &mut out);
         let (topic, bytes) = out.iter().next().unwrap();
         assert_eq!(topic, Topic::RerunTrack);
         let cloud = PointCloud::decode(bytes).unwrap();
@@ -306,7 +274,7 @@ mod tests {
         // No motion, no message.
         out.clear();
         r.contact([0.1, 0.0]);
-        r.track(1, &mut out).unwrap();
-        assert!(out.is_empty());
+        r.track(1, &mut out);
+        assert!(out.iter().next().is_none());
     }
 }

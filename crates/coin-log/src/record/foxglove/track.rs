@@ -1,32 +1,17 @@
 //! The contact track as levels of a binary counter, so that the latest message of each track topic alone
-//! (all a viewer keeps after a seek) draws the whole path up to the latest display update.
+//! draws the whole path up to the latest display update (format.md: Frames and Foxglove output, The track's
+//! levels): at update n only level (trailing zero bits of n) changes, taking the levels below it.
 //!
-//! # Levels
-//! Display updates are numbered n = 0, 1, 2, ... Level L holds the piece of the path from update
-//! m_{L+1} to update m_L, where m_L = ⌊n / 2^L⌋ · 2^L: the binary digits of n cut [0, n] into pieces, one per
-//! level, so the levels' latest contents together cover [0, n] exactly, end to end. At update n ≥ 1 only
-//! level j = (number of trailing zero bits of n) changes: it takes the pieces of the levels below it and
-//! the points since the previous update, and those levels become empty. Level [`TOP`] is never emptied:
-//! at every 2^TOP-th update it takes everything before it (one message then carries the whole path up to
-//! there, which keeps the number of topics fixed for any duration).
-//!
-//! Bytes: level L publishes once every 2^(L+1) updates a piece of 2^L updates, so each level costs about half
-//! the simplified path and the track costs ≈ (levels in use)/2 times the simplified path, O(N log N) for N
-//! updates, instead of O(N²) for republishing the whole path.
-//!
-//! # Simplification
-//! Each level's content is simplified by Douglas–Peucker with a tolerance that grows with the level (older
-//! parts coarser, [`tolerance`]). Re-simplifying a simplified polyline would add up the errors, so every
-//! segment carries a bound on the distance of the original points it stands for: when points P_a..P_b are
-//! replaced by the segment [P_a, P_b], the original points of the old segment (P_{k−1}, P_k) lie within
-//! E_k of it, and the old segment lies within max(d(P_{k−1}), d(P_k)) of the new one (the distance to a
-//! segment is convex), so the new bound is max_k E_k + max(d(P_{k−1}), d(P_k)). A segment is accepted when
-//! its bound is within the level's tolerance; every original point therefore stays within
-//! [`MAX_TOLERANCE`] of the published track, whatever the number of merges.
-//!
-//! Points are the contact points in display units (units of the radius a), rounded to a grid of
-//! [`QUANTUM`] (the JSON stays short); a point equal to the previous one is skipped.
+//! Each level is simplified by Douglas–Peucker with a tolerance that grows with the level ([`tolerance`]).
+//! Re-simplifying a simplified polyline would add up the errors, so every segment carries a bound on the
+//! distance of the original points it stands for: when points P_a..P_b are replaced by the segment
+//! [P_a, P_b], the original points of the old segment (P_{k−1}, P_k) lie within E_k of it, and the old
+//! segment lies within max(d(P_{k−1}), d(P_k)) of the new one (the distance to a segment is convex), so the
+//! new bound is max_k E_k + max(d(P_{k−1}), d(P_k)). A segment is accepted when its bound is within the
+//! level's tolerance; every original point therefore stays within [`MAX_TOLERANCE`] of the published
+//! track, whatever the number of merges. Points are rounded to [`QUANTUM`]; a repeated point is skipped.
 
+use super::round_to;
 use crate::format::TRACK_LEVELS;
 
 /// The highest level; it is never emptied.
@@ -50,27 +35,19 @@ pub fn tolerance(level: usize) -> f64 {
     (MIN_TOLERANCE * 2f64.powf(f64::from(steps) / 3.0)).min(MAX_TOLERANCE)
 }
 
-/// A point of a level's polyline and the error bound of the segment that ends at it (0 for the first).
+/// A point of a level's polyline (display units) and the error bound of the segment that ends at it (0 for
+/// the first).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TrackPoint {
-    /// x, display units.
+pub(crate) struct TrackPoint {
     pub x: f64,
-    /// y, display units.
     pub y: f64,
     /// Bound on the distance of the original points of the segment ending here, display units.
     pub err: f64,
 }
 
-/// What changed at an update: `level` has new content (or is empty), and every level below it is empty.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TrackChange {
-    /// The level that took the new points.
-    pub level: usize,
-}
-
 /// The track's levels and the points not yet in any level.
 #[derive(Debug, Clone)]
-pub struct Track {
+pub(crate) struct Track {
     levels: Vec<Vec<TrackPoint>>,
     /// Points since the previous update.
     pending: Vec<TrackPoint>,
@@ -104,17 +81,12 @@ impl Default for Track {
     }
 }
 
-/// `v` on the [`QUANTUM`] grid (−0 written as 0).
-fn quantize(v: f64) -> f64 {
-    (v / QUANTUM).round() * QUANTUM + 0.0
-}
-
 impl Track {
     /// Adds the contact point (x, y) in display units, unless it rounds to the previous one.
     pub fn add(&mut self, x: f64, y: f64) {
         let p = TrackPoint {
-            x: quantize(x),
-            y: quantize(y),
+            x: round_to(x, QUANTUM),
+            y: round_to(y, QUANTUM),
             err: 0.0,
         };
         if self.last.is_some_and(|q| q.x == p.x && q.y == p.y) {
@@ -131,9 +103,9 @@ impl Track {
     }
 
     /// Closes a display update: moves the points since the previous one into the level the update's number
-    /// selects (module docs) and empties the levels below it. Returns `None` at the first update (which
-    /// only fixes the start of the path).
-    pub fn update(&mut self) -> Option<TrackChange> {
+    /// selects (module docs) and empties the levels below it. Returns that level (it has new content, or is
+    /// empty), or `None` at the first update (which only fixes the start of the path).
+    pub fn update(&mut self) -> Option<usize> {
         let n = self.updates;
         self.updates += 1;
         if n == 0 {
@@ -173,7 +145,7 @@ impl Track {
             self.end = Some(*p);
         }
         self.merged = merged;
-        Some(TrackChange { level: j })
+        Some(j)
     }
 
     /// Douglas–Peucker of `points` with carried error bounds (module docs), into `out`.
@@ -311,9 +283,7 @@ mod tests {
                 points.push(p);
                 i += 1;
             }
-            if let Some(c) = track.update() {
-                changed.push(c.level);
-            }
+            changed.extend(track.update());
             let line = chain(&track);
             if n == 0 {
                 assert!(line.is_empty());
