@@ -1,18 +1,31 @@
-//! Reading the numeric fields of a `coin_log.*` message whatever its encoding: the one entry point of the
-//! readers that take any coin-log file (`export`, `plot`). `verify` uses the same two decoders with its
-//! typed messages.
+//! Reading the numeric fields of a `coin_log.*` message whatever its encoding and its schema's version:
+//! the one decoder of `verify`, `export` and `plot`.
 
-use super::json::{read_fields, FieldsError};
-use super::protobuf::{MessageDecoder, SchemaError};
+use super::json::{parse_numbers_into, read_fields, FieldsError};
+use super::messages::{Message, MessageType};
+use super::protobuf::{descriptor_set, MessageDecoder, SchemaError};
 use super::Encoding;
 
 /// How to read a channel's messages into f64s, from its schema.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum FieldReader {
-    /// JSON objects (strict: every field, no other, each a finite number).
-    Json,
-    /// Protobuf messages, by the field numbers of the stored descriptor.
-    Protobuf(MessageDecoder),
+pub struct FieldReader {
+    fields: &'static [&'static str],
+    /// The decoder of a Protobuf schema; `None` reads JSON (strict: every field, no other, each a finite
+    /// number).
+    protobuf: Option<MessageDecoder>,
+}
+
+/// Which version of its type a stored `coin_log.*` schema is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Version {
+    /// This tool's.
+    Ours,
+    /// Another that declares the current fields.
+    Other,
+    /// The type's first, without the fields added since: its messages are read with the first fields.
+    First,
+    /// A JSON Schema the messages cannot conform to (why); they are read with the current fields.
+    Nonconforming(String),
 }
 
 /// A schema whose messages cannot be read as numbers.
@@ -27,48 +40,129 @@ pub enum ReaderError {
 }
 
 impl FieldReader {
-    /// The reader of a channel whose schema is `schema_name`, stored with `schema_encoding` and bytes
-    /// `schema_data`, for `fields`.
+    /// The reader of JSON messages with `fields`.
+    #[must_use]
+    pub fn json(fields: &'static [&'static str]) -> Self {
+        Self {
+            fields,
+            protobuf: None,
+        }
+    }
+
+    /// The reader of a channel of type `t` whose schema is stored with `schema_encoding` and bytes
+    /// `data`, and the schema's version.
     ///
     /// # Errors
     /// [`ReaderError`] for another schema encoding, or a descriptor without the type or a field.
     pub fn new(
         schema_encoding: &str,
-        schema_name: &str,
-        schema_data: &[u8],
-        fields: &[&'static str],
-    ) -> Result<Self, ReaderError> {
+        t: &MessageType,
+        data: &[u8],
+    ) -> Result<(Self, Version), ReaderError> {
+        let added = t.fields != t.first_fields;
         match Encoding::from_schema_encoding(schema_encoding) {
-            Some(Encoding::Json) => Ok(Self::Json),
-            Some(Encoding::Protobuf) => Ok(Self::Protobuf(MessageDecoder::new(
-                schema_data,
-                schema_name,
-                fields,
-            )?)),
+            Some(Encoding::Json) => Ok(if data == t.json_schema {
+                (Self::json(t.fields), Version::Ours)
+            } else {
+                match validates(data, t.fields) {
+                    Ok(()) => (Self::json(t.fields), Version::Other),
+                    Err(_) if added && validates(data, t.first_fields).is_ok() => {
+                        (Self::json(t.first_fields), Version::First)
+                    }
+                    Err(e) => (Self::json(t.fields), Version::Nonconforming(e)),
+                }
+            }),
+            Some(Encoding::Protobuf) => {
+                let reader = |fields| {
+                    MessageDecoder::new(data, t.schema, fields).map(|d| Self {
+                        fields,
+                        protobuf: Some(d),
+                    })
+                };
+                match reader(t.fields) {
+                    Ok(r) if descriptor_set(t.schema) == Some(data) => Ok((r, Version::Ours)),
+                    Ok(r) => Ok((r, Version::Other)),
+                    Err(e) => match reader(t.first_fields) {
+                        Ok(r) if added => Ok((r, Version::First)),
+                        _ => Err(e.into()),
+                    },
+                }
+            }
             None => Err(ReaderError::Encoding(schema_encoding.to_string())),
         }
     }
 
-    /// The encoding it reads.
+    /// The fields it reads, in schema order.
     #[must_use]
-    pub fn encoding(&self) -> Encoding {
-        match self {
-            Self::Json => Encoding::Json,
-            Self::Protobuf(_) => Encoding::Protobuf,
-        }
+    pub fn fields(&self) -> &'static [&'static str] {
+        self.fields
     }
 
-    /// Reads one message into `out` in the order of `fields` (`out.len() == fields.len()`, the fields the
-    /// reader was made for).
+    /// Reads one message into `out` in the order of [`Self::fields`] (`out.len()` = their number).
     ///
     /// # Errors
     /// [`FieldsError`] naming what is wrong with the message.
-    pub fn read(&self, data: &[u8], fields: &[&str], out: &mut [f64]) -> Result<(), FieldsError> {
-        match self {
-            Self::Json => read_fields(data, fields, out),
-            Self::Protobuf(d) => d.read(data, out),
+    pub fn read(&self, data: &[u8], out: &mut [f64]) -> Result<(), FieldsError> {
+        match &self.protobuf {
+            Some(d) => d.read(data, out),
+            None => read_fields(data, self.fields, out),
         }
     }
+
+    /// Reads one message strictly into its type `M`: the recorder's own JSON form on the fast path, any
+    /// other (or an error) by serde_json. `first` says the schema is the first version of its type.
+    ///
+    /// # Errors
+    /// What is wrong with the message.
+    pub fn read_message<M: Message>(&self, data: &[u8], first: bool) -> Result<M, String> {
+        let mut v = [0.0; 8];
+        let v_fields = &mut v[..self.fields.len()];
+        match &self.protobuf {
+            Some(d) => d
+                .read(data, v_fields)
+                .map_err(|e| format!("the message {e}"))?,
+            None if parse_numbers_into(data, self.fields, v_fields) => {}
+            None => return serde_json::from_slice(data).map_err(|e| e.to_string()),
+        }
+        Ok(M::from_values(&v, first))
+    }
+}
+
+/// Whether a JSON schema of another version validates the messages of a type with `fields`: a message
+/// read strictly has exactly `fields`, each a number, so it conforms to the schema when the schema
+/// requires none but `fields`, types each of them (where it types it) as a number, and does not forbid
+/// (`additionalProperties: false`) one it leaves out.
+fn validates(data: &[u8], fields: &[&str]) -> Result<(), String> {
+    use serde_json::Value;
+    let v: Value = serde_json::from_slice(data).map_err(|e| format!("is not JSON: {e}"))?;
+    if let Some(t) = v.get("type") {
+        if t.as_str() != Some("object") {
+            return Err(format!("types the messages as {t}, not an object"));
+        }
+    }
+    let props = v.get("properties").and_then(Value::as_object);
+    let required = v.get("required").and_then(Value::as_array);
+    for r in required.into_iter().flatten() {
+        let r = r
+            .as_str()
+            .ok_or("has a `required` entry that is not a string")?;
+        if !fields.contains(&r) {
+            return Err(format!("requires `{r}`, which the messages lack"));
+        }
+    }
+    let closed = v.get("additionalProperties") == Some(&Value::Bool(false));
+    for f in fields {
+        match props.and_then(|p| p.get(*f)) {
+            Some(p) => match p.get("type") {
+                None => {}
+                Some(t) if t.as_str() == Some("number") => {}
+                Some(t) => return Err(format!("types `{f}` as {t}, the messages have a number")),
+            },
+            None if closed => return Err(format!("forbids `{f}`, which the messages have")),
+            None => {}
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -89,23 +183,19 @@ mod tests {
         let mut outs = Vec::new();
         for &e in Encoding::ALL {
             let schema = schema_data(Position::SCHEMA, e).unwrap();
-            let r = FieldReader::new(
-                e.schema_encoding(),
-                Position::SCHEMA,
-                schema,
-                Position::FIELDS,
-            )
-            .unwrap();
-            assert_eq!(r.encoding(), e);
+            let (r, version) =
+                FieldReader::new(e.schema_encoding(), &Position::TYPE, schema).unwrap();
+            assert_eq!(version, Version::Ours);
+            assert_eq!(r.protobuf.is_some(), e == Encoding::Protobuf);
             let mut buf = Vec::new();
             m.write(e, &mut buf).unwrap();
             let mut out = [0.0; 4];
-            r.read(&buf, Position::FIELDS, &mut out).unwrap();
+            r.read(&buf, &mut out).unwrap();
             outs.push(out.map(f64::to_bits));
         }
         assert_eq!(outs[0], outs[1]);
         assert_eq!(
-            FieldReader::new("ros2msg", Position::SCHEMA, b"", Position::FIELDS)
+            FieldReader::new("ros2msg", &Position::TYPE, b"")
                 .unwrap_err()
                 .to_string(),
             "its schema encoding \"ros2msg\" is neither \"jsonschema\" nor \"protobuf\""

@@ -13,18 +13,10 @@
 
 use std::collections::BTreeMap;
 
-/// Parses `data` as the object `{"fields[0]":n0,"fields[1]":n1,...}` into `out` (same length as
-/// `fields`), or `None` if it has any other form.
+/// Parses `data` as the object `{"fields[0]":n0,"fields[1]":n1,...}` into `out` (`out.len() ==
+/// fields.len()`) and returns true, or returns false (with `out` partly written) if it has any other form.
 #[must_use]
-pub fn parse_numbers<const N: usize>(data: &[u8], fields: &[&str; N]) -> Option<[f64; N]> {
-    let mut out = [0.0; N];
-    parse_numbers_into(data, fields, &mut out).then_some(out)
-}
-
-/// [`parse_numbers`] for a field list of any length: fills `out` (`out.len() == fields.len()`) and
-/// returns true, or returns false (with `out` partly written) if `data` has any other form.
-#[must_use]
-fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool {
+pub(crate) fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool {
     if out.len() != fields.len() {
         return false;
     }
@@ -204,6 +196,11 @@ mod tests {
 
     const F: [&str; 3] = ["t", "x", "y"];
 
+    fn parse_numbers(data: &[u8]) -> Option<[f64; 3]> {
+        let mut out = [0.0; 3];
+        parse_numbers_into(data, &F, &mut out).then_some(out)
+    }
+
     #[test]
     fn the_recorders_form_parses_bit_for_bit() {
         for x in [0.1, -2.5e-300, 1e21, 5e-324, f64::MAX, -0.0, 0.3 + 0.6] {
@@ -212,7 +209,7 @@ mod tests {
                 ryu::Buffer::new().format_finite(x),
                 ryu::Buffer::new().format_finite(-x)
             );
-            let v = parse_numbers(text.as_bytes(), &F).unwrap();
+            let v = parse_numbers(text.as_bytes()).unwrap();
             assert_eq!(v[1].to_bits(), x.to_bits(), "{text}");
             assert_eq!(v[2].to_bits(), (-x).to_bits(), "{text}");
         }
@@ -240,10 +237,10 @@ mod tests {
             r#"{"t":1,"x":2,"y":3"#,
             "",
         ] {
-            assert!(parse_numbers(text.as_bytes(), &F).is_none(), "{text}");
+            assert!(parse_numbers(text.as_bytes()).is_none(), "{text}");
         }
         assert_eq!(
-            parse_numbers(br#"{"t":-0.5E+2,"x":0,"y":12e-1}"#, &F),
+            parse_numbers(br#"{"t":-0.5E+2,"x":0,"y":12e-1}"#),
             Some([-50.0, 0.0, 1.2])
         );
     }

@@ -216,12 +216,6 @@ impl MessageDecoder {
         })
     }
 
-    /// The fields it reads, in order.
-    #[must_use]
-    pub fn fields(&self) -> &[&'static str] {
-        &self.fields
-    }
-
     /// Reads one message into `out` (`out.len()` = the number of fields). A field the message leaves out is
     /// 0 (proto3: a writer may omit zeros); a declared field it does not read is skipped.
     ///

@@ -20,7 +20,6 @@ use super::seconds_text;
 use crate::csv;
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;
-use crate::format::json::read_fields;
 use crate::format::Channel;
 use crate::format::Encoding;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
@@ -127,12 +126,11 @@ pub enum ExportError {
 
 /// What each channel id is exported as.
 enum Target {
-    /// A `coin_log.*` channel: its fields, and its table (per channel) or its place in the wide row.
+    /// A `coin_log.*` channel: its table (per channel) or its place in the wide row, and the index of
+    /// its reader in `Exporter::readers`.
     Flat {
         channel: Channel,
-        fields: &'static [&'static str],
         table: Option<usize>,
-        /// Index of its reader in `Exporter::readers`.
         reader: usize,
     },
     /// `/tf`, flattened into its table; Protobuf or JSON.
@@ -309,39 +307,32 @@ impl<W: Write> Exporter<'_, W> {
                 ),
             );
         }
-        let fields = channel.fields().filter(|f| f.first() == Some(&"t"));
-        let reader = match fields.map(|f| FieldReader::new(encoding, schema, data, f)) {
-            Some(Ok(r)) => {
-                self.readers.push(r);
-                self.readers.len() - 1
-            }
-            Some(Err(e)) => return self.skip(topic, &e.to_string()),
-            None => 0,
-        };
-        match (fields, channel, self.layout) {
-            (Some(fields), _, Layout::PerChannel) => {
-                let columns = fields.iter().map(ToString::to_string).collect();
-                let name = format!("{}.csv", channel.name());
-                match self.open_table(&name, topic, columns) {
-                    Some(table) => Target::Flat {
-                        channel,
-                        fields,
-                        table: Some(table),
-                        reader,
-                    },
-                    None => Target::Skip,
-                }
-            }
-            (Some(fields), _, Layout::Wide) => Target::Flat {
-                channel,
-                fields,
-                table: None,
-                reader,
-            },
-            (None, _, _) => self.skip(
+        let Some(t) = channel.message_type() else {
+            return self.skip(
                 topic,
                 "display geometry (the coin, the table, pieces of the track); the track's points are /coin/contact",
-            ),
+            );
+        };
+        let reader = match FieldReader::new(encoding, t, data) {
+            Ok((r, _)) => r,
+            Err(e) => return self.skip(topic, &e.to_string()),
+        };
+        let table = match self.layout {
+            Layout::PerChannel => {
+                let columns = reader.fields().iter().map(ToString::to_string).collect();
+                let name = format!("{}.csv", channel.name());
+                match self.open_table(&name, topic, columns) {
+                    Some(table) => Some(table),
+                    None => return Target::Skip,
+                }
+            }
+            Layout::Wide => None,
+        };
+        self.readers.push(reader);
+        Target::Flat {
+            channel,
+            table,
+            reader: self.readers.len() - 1,
         }
     }
 
@@ -368,15 +359,14 @@ impl<W: Write> Exporter<'_, W> {
         &mut self,
         h: &MessageHeader,
         data: &[u8],
-        (channel, fields, table, reader): (Channel, &'static [&'static str], Option<usize>, usize),
+        channel: Channel,
+        table: Option<usize>,
+        reader: usize,
     ) {
+        let reader = &self.readers[reader];
         self.values.clear();
-        self.values.resize(fields.len(), 0.0);
-        let read = match self.readers.get(reader) {
-            Some(r) => r.read(data, fields, &mut self.values),
-            None => read_fields(data, fields, &mut self.values),
-        };
-        if let Err(e) = read {
+        self.values.resize(reader.fields().len(), 0.0);
+        if let Err(e) = reader.read(data, &mut self.values) {
             return self.fail(ExportError::Message {
                 topic: channel.topic().to_string(),
                 log_time: h.log_time,
@@ -479,8 +469,8 @@ impl<W: Write> Exporter<'_, W> {
                 .values()
                 .filter_map(|(_, t)| match t {
                     Target::Flat {
-                        channel, fields, ..
-                    } => Some((*channel, *fields)),
+                        channel, reader, ..
+                    } => Some((*channel, self.readers[*reader].fields())),
                     _ => None,
                 })
                 .collect();
@@ -586,13 +576,12 @@ impl<W: Write> Visitor for Exporter<'_, W> {
                 _,
                 Target::Flat {
                     channel,
-                    fields,
                     table,
                     reader,
                 },
             )) => {
-                let flat = (*channel, *fields, *table, *reader);
-                self.flat(h, data, flat);
+                let (channel, table, reader) = (*channel, *table, *reader);
+                self.flat(h, data, channel, table, reader);
             }
             Some((_, Target::Tf { table, protobuf })) => {
                 let (table, protobuf) = (*table, *protobuf);

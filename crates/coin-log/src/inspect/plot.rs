@@ -11,7 +11,6 @@
 
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;
-use crate::format::json::read_fields;
 use crate::format::{
     Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
@@ -175,9 +174,8 @@ impl Fields<'_> {
 /// Everything the page draws, gathered in one pass.
 #[derive(Default)]
 struct Collect {
-    /// The field reader of each plotted channel id.
-    readers: BTreeMap<u16, FieldReader>,
-    channels: BTreeMap<u16, Channel>,
+    /// The channel and field reader of each plotted channel id.
+    readers: BTreeMap<u16, (Channel, FieldReader)>,
     run: Option<Result<RunMetadata, String>>,
     result: Option<ResultMetadata>,
     params: Option<CoinParams>,
@@ -286,13 +284,12 @@ impl Visitor for Collect {
         let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) else {
             return;
         };
-        let Some(fields) = c.fields() else {
+        let Some(t) = c.message_type() else {
             return;
         };
-        match FieldReader::new(encoding, schema, data, fields) {
-            Ok(r) => {
-                self.readers.insert(id, r);
-                self.channels.insert(id, c);
+        match FieldReader::new(encoding, t, data) {
+            Ok((r, _)) => {
+                self.readers.insert(id, (c, r));
             }
             Err(e) => {
                 self.problem.get_or_insert_with(|| format!("{topic}: {e}"));
@@ -311,20 +308,14 @@ impl Visitor for Collect {
         if self.run.is_none() {
             return ControlFlow::Break(());
         }
-        let Some(&channel) = self.channels.get(&h.channel_id) else {
+        let Some((channel, reader)) = self.readers.get(&h.channel_id) else {
             return ControlFlow::Continue(());
         };
-        let Some(names) = channel.fields() else {
-            return ControlFlow::Continue(());
-        };
+        let (channel, names) = (*channel, reader.fields());
         let mut values = std::mem::take(&mut self.values);
         values.clear();
         values.resize(names.len(), 0.0);
-        let read = match self.readers.get(&h.channel_id) {
-            Some(r) => r.read(data, names, &mut values),
-            None => read_fields(data, names, &mut values),
-        };
-        match read {
+        match reader.read(data, &mut values) {
             Ok(()) => self.observe(
                 channel,
                 &Fields {

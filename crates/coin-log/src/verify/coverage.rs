@@ -11,7 +11,7 @@
 //! high-spin scenes keep their rates).
 
 use super::checks::constraint;
-use super::tolerances::{RunAccuracy, Tolerances};
+use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
 use crate::scene::Scene;
 use nalgebra::Vector3;

@@ -9,11 +9,11 @@
 
 use super::{fmt_num, worst, Context, Max};
 use crate::format::messages::{drift_eps, friction_ratio};
+use crate::format::tolerances::RECOMPUTE_TOLERANCE;
 use crate::model::orientation;
 use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
 use nalgebra::Quaternion;
 
 /// Running state of the consistency check.

@@ -17,9 +17,9 @@
 //! windows look unresolved.
 
 use super::{fmt_num, Max};
+use crate::format::tolerances::Tolerances;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::Tolerances;
 use nalgebra::Vector3;
 
 /// Central difference weights for f′(0)·h at offsets 1..4 (antisymmetric), 8th order.

@@ -10,12 +10,12 @@
 //! estimate plus the meter's bound on its interpolation error ([`TurningPoints::interpolation_error`]).
 
 use super::{fmt_num, worst, Context};
+use crate::format::tolerances::Tolerances;
 use crate::model::nutation::{Motion, Orbit};
 use crate::model::{State, TurningPoints};
 use crate::scene::defaults;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::Tolerances;
 
 /// Fewest samples per nutation period for the crossings to be interpolated.
 const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;

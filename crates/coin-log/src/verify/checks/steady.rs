@@ -3,12 +3,12 @@
 //! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
 
 use super::{fmt_num, worst, Context, Max};
+use crate::format::tolerances::Tolerances;
 use crate::format::RunMetadata;
 use crate::model::{Coin, Steady};
 use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::Tolerances;
 use nalgebra::{Matrix3, Vector3};
 
 /// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.

@@ -3,10 +3,10 @@
 //! at the event, is where the inequality becomes an equality.
 
 use super::{fmt_num, Context, Max};
+use crate::format::tolerances::VALIDITY_TOLERANCE;
 use crate::format::Termination;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::VALIDITY_TOLERANCE;
 
 /// One sample's margins: N/(Mg) and (|F| − μN)/(Mg).
 #[derive(Debug, Clone, Copy)]
