@@ -142,8 +142,8 @@ impl Judge {
         r: &FieldReader,
         data: &[u8],
         first: bool,
-        log_time: u64,
-    ) -> Result<Sample, String> {
+        s: &mut Sample,
+    ) -> Result<(), String> {
         fn read<M: Message>(
             r: &FieldReader,
             data: &[u8],
@@ -156,10 +156,6 @@ impl Judge {
             *slot = Some(m);
             Ok((m.t(), m.is_complete()))
         }
-        let mut s = Sample {
-            log_time,
-            ..Sample::default()
-        };
         let (t, complete) = match c {
             Channel::Omega => read(r, data, first, &mut s.omega),
             Channel::Angles => read(r, data, first, &mut s.angles),
@@ -182,7 +178,7 @@ impl Judge {
             });
         }
         s.t = t;
-        Ok(s)
+        Ok(())
     }
 
     fn run_metadata(&mut self, entries: &BTreeMap<String, String>) {
@@ -434,14 +430,15 @@ impl Visitor for Judge {
         channel.last = Some(lt);
         match &channel.kind {
             Kind::Coin(c, reader) => {
-                let s = match Self::parse(*c, reader, data, channel.first_version, lt) {
-                    Ok(s) => s,
-                    Err(e) => {
-                        self.problems
-                            .push_with(|| format!("{topic}: message at {lt} ns {e}"));
-                        return ControlFlow::Continue(());
-                    }
+                let mut s = Sample {
+                    log_time: lt,
+                    ..Sample::default()
                 };
+                if let Err(e) = Self::parse(*c, reader, data, channel.first_version, &mut s) {
+                    self.problems
+                        .push_with(|| format!("{topic}: message at {lt} ns {e}"));
+                    return ControlFlow::Continue(());
+                }
                 match log_time(s.t) {
                     Ok(expected) if expected == lt => {}
                     Ok(expected) => {
@@ -456,7 +453,7 @@ impl Visitor for Judge {
                 let Some(ctx) = self.ctx.as_ref() else {
                     return ControlFlow::Break(());
                 };
-                self.assembler.push(*c, s, &mut |s| checks.observe(s, ctx));
+                self.assembler.push(*c, &s, &mut |s| checks.observe(s, ctx));
             }
             Kind::Foxglove(schema) => {
                 if let Err(e) = foxglove_message(channel.encoding, schema, data) {
@@ -770,17 +767,13 @@ mod tests {
         m.write_json(&mut buf).unwrap();
         let (reaction, first) = (ReactionMessage::FIELDS, ReactionMessage::FIRST_FIELDS);
         let parse = |fields, data, first| {
-            Judge::parse(
-                Channel::Reaction,
-                &FieldReader::json(fields),
-                data,
-                first,
-                7,
-            )
+            let mut s = Sample::default();
+            let r = FieldReader::json(fields);
+            Judge::parse(Channel::Reaction, &r, data, first, &mut s).map(|()| s)
         };
         let s = parse(reaction, &buf, false).unwrap();
         assert_eq!(s.t.to_bits(), 0.5_f64.to_bits());
-        assert_eq!((s.log_time, s.reaction), (7, Some(m)));
+        assert_eq!(s.reaction, Some(m));
         // The same message read as the first version (no friction_ratio in its schema) has a field too
         // many; one without it is read without it.
         assert_eq!(
@@ -797,8 +790,9 @@ mod tests {
             let text: Vec<String> = t.fields.iter().map(|f| format!("\"{f}\":1")).collect();
             let text = format!("{{{}}}", text.join(","));
             let r = FieldReader::json(t.fields);
+            let mut s = Sample::default();
             assert!(
-                Judge::parse(*c, &r, text.as_bytes(), false, 0).is_ok(),
+                Judge::parse(*c, &r, text.as_bytes(), false, &mut s).is_ok(),
                 "{text}"
             );
         }

@@ -61,17 +61,20 @@ impl Sample {
         })
     }
 
-    /// Fills each channel that `o` has and `self` lacks.
-    fn merge(&mut self, o: &Sample) {
-        self.omega = self.omega.or(o.omega);
-        self.angles = self.angles.or(o.angles);
-        self.quaternion = self.quaternion.or(o.quaternion);
-        self.position = self.position.or(o.position);
-        self.contact = self.contact.or(o.contact);
-        self.reaction = self.reaction.or(o.reaction);
-        self.energy = self.energy.or(o.energy);
-        self.invariants = self.invariants.or(o.invariants);
-        self.work = self.work.or(o.work);
+    /// Takes `channel`'s message from `o`.
+    fn set(&mut self, channel: Channel, o: &Sample) {
+        match channel {
+            Channel::Omega => self.omega = o.omega,
+            Channel::Angles => self.angles = o.angles,
+            Channel::Quaternion => self.quaternion = o.quaternion,
+            Channel::Position => self.position = o.position,
+            Channel::Contact => self.contact = o.contact,
+            Channel::Reaction => self.reaction = o.reaction,
+            Channel::Energy => self.energy = o.energy,
+            Channel::Invariants => self.invariants = o.invariants,
+            Channel::Work => self.work = o.work,
+            Channel::Tf | Channel::Scene | Channel::Rerun => {}
+        }
     }
 }
 
@@ -95,9 +98,9 @@ impl Assembler {
         self.declared & (1 << channel as u16) != 0
     }
 
-    /// Adds `one`, a sample of one channel's message; calls `out` with every sample that can no longer
-    /// grow.
-    pub fn push(&mut self, channel: Channel, one: Sample, out: &mut impl FnMut(&Sample)) {
+    /// Adds `one`, a sample of `channel`'s message alone; calls `out` with every sample that can no
+    /// longer grow.
+    pub fn push(&mut self, channel: Channel, one: &Sample, out: &mut impl FnMut(&Sample)) {
         let (bit, log_time) = (1u16 << channel as u16, one.log_time);
         self.declared |= bit;
         self.last[channel as usize] = Some(log_time);
@@ -107,7 +110,7 @@ impl Assembler {
                 let s = &mut self.pending[i];
                 if s.present & bit == 0 {
                     s.present |= bit;
-                    s.merge(&one);
+                    s.set(channel, one);
                 }
             }
             _ => {
@@ -116,7 +119,7 @@ impl Assembler {
                     at,
                     Sample {
                         present: bit,
-                        ..one
+                        ..*one
                     },
                 );
             }
