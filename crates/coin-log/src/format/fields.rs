@@ -10,6 +10,8 @@ use super::Encoding;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FieldReader {
     fields: &'static [&'static str],
+    /// It reads a schema of its type's first version (without the fields added since).
+    first: bool,
     /// The decoder of a Protobuf schema; `None` reads JSON (strict: every field, no other, each a finite
     /// number).
     protobuf: Option<MessageDecoder>,
@@ -31,29 +33,25 @@ pub enum Version {
 /// A schema whose messages cannot be read as numbers.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ReaderError {
-    /// Neither `jsonschema` nor `protobuf`.
     #[error("its schema encoding {0:?} is neither \"jsonschema\" nor \"protobuf\"")]
     Encoding(String),
-    /// A Protobuf descriptor that does not describe the fields.
     #[error("its Protobuf schema {0}")]
     Descriptor(#[from] SchemaError),
 }
 
 impl FieldReader {
-    /// The reader of JSON messages with `fields`.
+    /// The reader of JSON messages of type `t`, of its first version if `first`.
     #[must_use]
-    pub fn json(fields: &'static [&'static str]) -> Self {
+    pub fn json(t: &MessageType, first: bool) -> Self {
         Self {
-            fields,
+            fields: if first { t.first_fields } else { t.fields },
+            first,
             protobuf: None,
         }
     }
 
     /// The reader of a channel of type `t` whose schema is stored with `schema_encoding` and bytes
     /// `data`, and the schema's version.
-    ///
-    /// # Errors
-    /// [`ReaderError`] for another schema encoding, or a descriptor without the type or a field.
     pub fn new(
         schema_encoding: &str,
         t: &MessageType,
@@ -61,28 +59,33 @@ impl FieldReader {
     ) -> Result<(Self, Version), ReaderError> {
         let added = t.fields != t.first_fields;
         match Encoding::from_schema_encoding(schema_encoding) {
-            Some(Encoding::Json) => Ok(if data == t.json_schema {
-                (Self::json(t.fields), Version::Ours)
-            } else {
-                match validates(data, t.fields) {
-                    Ok(()) => (Self::json(t.fields), Version::Other),
-                    Err(_) if added && validates(data, t.first_fields).is_ok() => {
-                        (Self::json(t.first_fields), Version::First)
+            Some(Encoding::Json) => {
+                let version = if data == t.json_schema {
+                    Version::Ours
+                } else {
+                    match validates(data, t.fields) {
+                        Ok(()) => Version::Other,
+                        Err(_) if added && validates(data, t.first_fields).is_ok() => {
+                            Version::First
+                        }
+                        Err(e) => Version::Nonconforming(e),
                     }
-                    Err(e) => (Self::json(t.fields), Version::Nonconforming(e)),
-                }
-            }),
+                };
+                Ok((Self::json(t, version == Version::First), version))
+            }
             Some(Encoding::Protobuf) => {
-                let reader = |fields| {
+                let reader = |first: bool| {
+                    let fields = if first { t.first_fields } else { t.fields };
                     MessageDecoder::new(data, t.schema, fields).map(|d| Self {
                         fields,
+                        first,
                         protobuf: Some(d),
                     })
                 };
-                match reader(t.fields) {
+                match reader(false) {
                     Ok(r) if descriptor_set(t.schema) == Some(data) => Ok((r, Version::Ours)),
                     Ok(r) => Ok((r, Version::Other)),
-                    Err(e) => match reader(t.first_fields) {
+                    Err(e) => match reader(true) {
                         Ok(r) if added => Ok((r, Version::First)),
                         _ => Err(e.into()),
                     },
@@ -92,16 +95,12 @@ impl FieldReader {
         }
     }
 
-    /// The fields it reads, in schema order.
     #[must_use]
     pub fn fields(&self) -> &'static [&'static str] {
         self.fields
     }
 
     /// Reads one message into `out` in the order of [`Self::fields`] (`out.len()` = their number).
-    ///
-    /// # Errors
-    /// [`FieldsError`] naming what is wrong with the message.
     pub fn read(&self, data: &[u8], out: &mut [f64]) -> Result<(), FieldsError> {
         match &self.protobuf {
             Some(d) => d.read(data, out),
@@ -110,21 +109,30 @@ impl FieldReader {
     }
 
     /// Reads one message strictly into its type `M`: the recorder's own JSON form on the fast path, any
-    /// other (or an error) by serde_json. `first` says the schema is the first version of its type.
-    ///
-    /// # Errors
-    /// What is wrong with the message.
-    pub fn read_message<M: Message>(&self, data: &[u8], first: bool) -> Result<M, String> {
+    /// other (or an error) by serde_json. `Err` says what is wrong with it, also when it does not have
+    /// exactly the fields of its schema's version.
+    pub fn read_message<M: Message>(&self, data: &[u8]) -> Result<M, String> {
         let mut v = [0.0; 8];
         let v_fields = &mut v[..self.fields.len()];
-        match &self.protobuf {
-            Some(d) => d
-                .read(data, v_fields)
-                .map_err(|e| format!("the message {e}"))?,
-            None if parse_numbers_into(data, self.fields, v_fields) => {}
-            None => return serde_json::from_slice(data).map_err(|e| e.to_string()),
+        let m = match &self.protobuf {
+            Some(d) => {
+                d.read(data, v_fields)
+                    .map_err(|e| format!("does not parse: the message {e}"))?;
+                M::from_values(&v, self.first)
+            }
+            None if parse_numbers_into(data, self.fields, v_fields) => {
+                M::from_values(&v, self.first)
+            }
+            None => serde_json::from_slice(data).map_err(|e| format!("does not parse: {e}"))?,
+        };
+        if m.is_complete() == self.first {
+            return Err(if self.first {
+                "has fields its schema (the first version) does not declare".into()
+            } else {
+                "lacks fields its schema requires".into()
+            });
         }
-        Ok(M::from_values(&v, first))
+        Ok(m)
     }
 }
 

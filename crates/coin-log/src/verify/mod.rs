@@ -1,16 +1,13 @@
-//! `coin-log verify`: judge a stored log from the file alone (format.md: verify).
-//!
-//! The parameters come from the file's `coin-log` metadata; the physics is recomputed from the stored
-//! channels, never re-simulated. The file is read once, as a stream ([`coin_log_mcap::read`]), in memory
-//! bounded by its largest record: messages are parsed into their strict types, grouped by log time into
-//! samples ([`samples`]), and each check keeps running maxima and a short window ([`checks`]). Tolerances
-//! follow from the recorded integrator settings ([`crate::format::tolerances`]).
+//! `coin-log verify`: judge a stored log from the file alone (format.md: verify). The physics is
+//! recomputed from the stored channels with the parameters of the file's `coin-log` metadata, never
+//! re-simulated, in one streaming pass in memory bounded by the largest record: messages are grouped by
+//! log time into samples, and each check keeps running maxima and a short window.
 
-pub mod checks;
+mod checks;
 mod coverage;
 mod file;
-pub mod report;
-pub mod samples;
+mod report;
+mod samples;
 
 pub use coverage::coverage;
 pub use file::{verify_bytes, verify_file, verify_file_with_progress};

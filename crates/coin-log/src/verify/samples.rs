@@ -15,30 +15,19 @@ use std::collections::VecDeque;
 /// Most samples waiting for their other channels.
 const MAX_PENDING: usize = 4096;
 
-/// The stored values at one log time.
+/// The stored values at one log time \[ns\]; `t` is the first message's.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Sample {
-    /// Log time \[ns\].
     pub log_time: u64,
-    /// Simulation time (of the first message of the sample).
     pub t: f64,
-    /// ω.
     pub omega: Option<AngularVelocity>,
-    /// θ, φ, ψ.
     pub angles: Option<Angles>,
-    /// q.
     pub quaternion: Option<QuaternionMessage>,
-    /// Centre.
     pub position: Option<Position>,
-    /// Contact point.
     pub contact: Option<Position>,
-    /// R, F, N.
     pub reaction: Option<ReactionMessage>,
-    /// E.
     pub energy: Option<EnergyMessage>,
-    /// C1, C2.
     pub invariants: Option<InvariantsMessage>,
-    /// W, E + W.
     pub work: Option<WorkMessage>,
     pub(super) present: u16,
 }
