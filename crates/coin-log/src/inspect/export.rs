@@ -1,20 +1,6 @@
-//! `coin-log export`: a file's channels as CSV tables, in one streaming pass (memory bounded by a few
-//! records and one write buffer per table, whatever the file's length).
-//!
-//! - **Per channel** (the default): one table per `coin_log.*` channel, named after the channel
-//!   (`omega.csv`, `angles.csv`, ...), its header the message's fields in schema order ([`Channel::fields`],
-//!   so a field added to the format appears without a change here), one row per message.
-//! - **Wide**: one table `samples.csv` joined on the sample time: `t`, then `<channel>.<field>` for every
-//!   `coin_log.*` channel present at the first sample, one row per sample.
-//! - `/tf` (per channel only) is flattened into `tf.csv`, and so are the other frame-transform topics
-//!   (`/tf_static` into `tf_static.csv`, `/scene/follow` into `scene_follow.csv`): `t`, the two frame ids, translation and
-//!   rotation. `/scene` is skipped: it holds display geometry (the coin, the table, pieces of the track),
-//!   and the track's points are `/coin/contact`; so are the `rerun` channel's topics, the same drawing for
-//!   Rerun.
-//!
-//! Numbers are written in the shortest form that reads back to the same f64 (ryu) after an exact read
-//! ([`crate::format::json`]), so every value equals the file's bit for bit. Timestamps of `/tf` are
-//! written as the exact decimal of their nanoseconds.
+//! `coin-log export` (docs/format.md: export): a file's channels as CSV tables in one streaming pass, in
+//! memory bounded by a few records and one write buffer per table. Every value is read exactly and
+//! written by ryu, so it equals the file's bit for bit.
 
 use super::seconds_text;
 use crate::csv;
@@ -93,38 +79,28 @@ pub struct ExportSummary {
 }
 
 /// Why an export stopped. Tables opened before it may hold part of the data: the caller discards them.
-#[derive(Debug, thiserror::Error)]
-pub enum ExportError {
-    /// The file could not be read (to its end).
-    #[error("{0}")]
-    Read(String),
-    /// A message does not have its schema's form.
-    #[error("{topic}: the message at log time {log_time} ns {reason}")]
-    Message {
-        /// Topic.
-        topic: String,
-        /// Its log time \[ns\].
-        log_time: u64,
-        /// What is wrong.
-        reason: String,
-    },
-    /// The messages cannot be joined into one row per sample.
-    #[error("cannot join the channels into one table: {0}; export one table per channel instead (without --wide)")]
-    Join(String),
-    /// No channel of the file makes a table.
-    #[error("nothing to export: {0}")]
-    Nothing(String),
-    /// A table could not be written.
-    #[error("writing `{table}`: {source}")]
-    Write {
-        /// The table's name.
-        table: String,
-        /// The I/O error.
-        source: io::Error,
-    },
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ExportError(pub String);
+
+fn written(table: &str, e: &io::Error) -> ExportError {
+    ExportError(format!("writing `{table}`: {e}"))
 }
 
-/// What each channel id is exported as.
+fn message(topic: &str, log_time: u64, reason: impl std::fmt::Display) -> ExportError {
+    ExportError(format!(
+        "{topic}: the message at log time {log_time} ns {reason}"
+    ))
+}
+
+fn join_failed(e: &str) -> ExportError {
+    ExportError(format!(
+        "cannot join the channels into one table: {e}; export one table per channel instead (without --wide)"
+    ))
+}
+
+/// What each channel id is exported as./// What each channel id is exported as.
+#[derive(Clone, Copy)]
 enum Target {
     /// A `coin_log.*` channel: its table (per channel) or its place in the wide row, and the index of
     /// its reader in `Exporter::readers`.
@@ -165,7 +141,7 @@ struct Exporter<'a, W: Write> {
     open: &'a mut dyn FnMut(&str) -> io::Result<W>,
     /// The field readers of the flat channels.
     readers: Vec<FieldReader>,
-    targets: BTreeMap<u16, (String, Target)>,
+    targets: BTreeMap<u16, Target>,
     tables: Vec<Open<W>>,
     skipped: Vec<Skipped>,
     wide: Wide,
@@ -212,7 +188,7 @@ pub fn export<W: Write>(
             ),
             _ => err.detail,
         };
-        return Err(ExportError::Read(detail));
+        return Err(ExportError(detail));
     }
     e.finish()
 }
@@ -220,24 +196,18 @@ pub fn export<W: Write>(
 impl<W: Write> Exporter<'_, W> {
     /// Opens table `name` with `columns` and writes its header.
     fn open_table(&mut self, name: &str, topic: &str, columns: Vec<String>) -> Option<usize> {
-        let writer = match (self.open)(name) {
-            Ok(w) => w,
-            Err(source) => {
-                self.fail(ExportError::Write {
-                    table: name.to_string(),
-                    source,
-                });
+        let opened = (self.open)(name).and_then(|w| {
+            let mut out = BufWriter::with_capacity(BUFFER, w);
+            out.write_all(csv::record(&columns).as_bytes())
+                .map(|()| out)
+        });
+        let out = match opened {
+            Ok(out) => out,
+            Err(e) => {
+                self.fail(written(name, &e));
                 return None;
             }
         };
-        let mut out = BufWriter::with_capacity(BUFFER, writer);
-        if let Err(source) = out.write_all(csv::record(&columns).as_bytes()) {
-            self.fail(ExportError::Write {
-                table: name.to_string(),
-                source,
-            });
-            return None;
-        }
         self.tables.push(Open {
             out,
             table: Table {
@@ -349,9 +319,9 @@ impl<W: Write> Exporter<'_, W> {
     fn write_line(&mut self, table: usize) {
         let open = &mut self.tables[table];
         open.table.rows += 1;
-        if let Err(source) = open.out.write_all(self.line.finish().as_bytes()) {
-            let table = open.table.name.clone();
-            self.fail(ExportError::Write { table, source });
+        if let Err(e) = open.out.write_all(self.line.finish().as_bytes()) {
+            let e = written(&open.table.name, &e);
+            self.fail(e);
         }
     }
 
@@ -367,11 +337,7 @@ impl<W: Write> Exporter<'_, W> {
         self.values.clear();
         self.values.resize(reader.fields().len(), 0.0);
         if let Err(e) = reader.read(data, &mut self.values) {
-            return self.fail(ExportError::Message {
-                topic: channel.topic().to_string(),
-                log_time: h.log_time,
-                reason: e.to_string(),
-            });
+            return self.fail(message(channel.topic(), h.log_time, e));
         }
         match table {
             Some(table) => self.write_numbers(table),
@@ -388,11 +354,8 @@ impl<W: Write> Exporter<'_, W> {
         let m: FrameTransform = match m {
             Ok(m) => m,
             Err(e) => {
-                return self.fail(ExportError::Message {
-                    topic: Channel::Tf.topic().to_string(),
-                    log_time: h.log_time,
-                    reason: format!("is not a foxglove.FrameTransform: {e}"),
-                })
+                let reason = format!("is not a foxglove.FrameTransform: {e}");
+                return self.fail(message(Channel::Tf.topic(), h.log_time, reason));
             }
         };
         let ns = m
@@ -454,7 +417,7 @@ impl<W: Write> Exporter<'_, W> {
             None
         };
         if let Some(e) = err {
-            self.fail(ExportError::Join(e));
+            self.fail(join_failed(&e));
         }
     }
 
@@ -467,7 +430,7 @@ impl<W: Write> Exporter<'_, W> {
             let channels: Vec<(Channel, &'static [&'static str])> = self
                 .targets
                 .values()
-                .filter_map(|(_, t)| match t {
+                .filter_map(|t| match t {
                     Target::Flat {
                         channel, reader, ..
                     } => Some((*channel, self.readers[*reader].fields())),
@@ -499,7 +462,7 @@ impl<W: Write> Exporter<'_, W> {
                 c.topic(),
                 row.log_time
             );
-            return self.fail(ExportError::Join(e));
+            return self.fail(join_failed(&e));
         }
         self.line.clear();
         self.line.number(row.t);
@@ -543,15 +506,12 @@ impl<W: Write> Exporter<'_, W> {
                     skipped.join("; ")
                 )
             };
-            return Err(ExportError::Nothing(why));
+            return Err(ExportError(format!("nothing to export: {why}")));
         }
         let mut tables = Vec::new();
         for open in self.tables {
             let Open { mut out, table } = open;
-            out.flush().map_err(|source| ExportError::Write {
-                table: table.name.clone(),
-                source,
-            })?;
+            out.flush().map_err(|e| written(&table.name, &e))?;
             tables.push(table);
         }
         Ok(ExportSummary {
@@ -565,36 +525,24 @@ impl<W: Write> Exporter<'_, W> {
 impl<W: Write> Visitor for Exporter<'_, W> {
     fn channel(&mut self, id: u16, topic: &str, _: &str, schema: Option<&Schema<'_>>) {
         let target = self.target(topic, schema);
-        self.targets.insert(id, (topic.to_string(), target));
+        self.targets.insert(id, target);
     }
     fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {}
     fn library(&mut self, _: &str) {}
     fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         self.messages += 1;
-        match self.targets.get(&h.channel_id) {
-            Some((
-                _,
-                Target::Flat {
-                    channel,
-                    table,
-                    reader,
-                },
-            )) => {
-                let (channel, table, reader) = (*channel, *table, *reader);
-                self.flat(h, data, channel, table, reader);
-            }
-            Some((_, Target::Tf { table, protobuf })) => {
-                let (table, protobuf) = (*table, *protobuf);
-                self.tf(h, data, table, protobuf);
-            }
-            Some((_, Target::Skip)) => {}
+        match self.targets.get(&h.channel_id).copied() {
+            Some(Target::Flat {
+                channel,
+                table,
+                reader,
+            }) => self.flat(h, data, channel, table, reader),
+            Some(Target::Tf { table, protobuf }) => self.tf(h, data, table, protobuf),
+            Some(Target::Skip) => {}
             None => {
-                let id = h.channel_id;
-                self.fail(ExportError::Message {
-                    topic: format!("channel {id}"),
-                    log_time: h.log_time,
-                    reason: "is on a channel that no channel record declares".into(),
-                });
+                let topic = format!("channel {}", h.channel_id);
+                let reason = "is on a channel that no channel record declares";
+                self.fail(message(&topic, h.log_time, reason));
             }
         }
         if self.error.is_some() {

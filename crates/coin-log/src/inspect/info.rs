@@ -1,11 +1,7 @@
-//! `coin-log info`: what a file holds, from the file alone. The channels (topic, schema, message count,
-//! rate), the time range, the body and run settings and the stored scene from the `coin-log` metadata,
-//! the termination from `coin-log.result`, the file's size and compression and the version that wrote it.
-//!
-//! The summary section is read when the file has one ([`coin_log_mcap::read_summary`]: a few seeks, instant on
-//! a file of gigabytes); a file without one (an unfinished recording, another writer) is read in one
-//! streaming pass ([`coin_log_mcap::read`]), and a file that breaks off part way is described up to the break.
-//! The summary is taken as the file states it: `verify` is what checks it.
+//! `coin-log info` (docs/format.md: info): what a file holds, from the file alone: from its summary
+//! section when it has one ([`coin_log_mcap::read_summary`], a few seeks), else from one streaming pass
+//! that describes a file breaking off part way up to the break. The summary is taken as the file states
+//! it: `verify` is what checks it.
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;

@@ -1,13 +1,6 @@
-//! `coin-log plot`: a one-page SVG overview of a recording, read in one streaming pass.
-//!
-//! Six panels: the contact track and the centre's path seen from above (equal axes, z pointing down the
-//! page as in Foxglove's top view), θ(t), the energy drift |E − E₀| / max(|E₀|, Mga) and the invariant
-//! drift |C − C₀| / (|C1₀| + |C2₀|) on log scales (the scales of `model::drift`), N/(Mg), and |F|/N with
-//! μ when the file has one. The termination is marked on every time axis and named in the title.
-//!
-//! Memory stays bounded whatever the file's length: each time series keeps at most [`POINTS`] buckets
-//! with the minimum and maximum of the samples in each (so no spike is lost), and the paths keep every
-//! k-th point with k doubling as needed.
+//! `coin-log plot` (docs/format.md: plot): a one-page SVG overview of a recording, read in one streaming
+//! pass. Memory stays bounded whatever the file's length: each time series keeps at most [`POINTS`]
+//! min/max buckets (so no spike is lost), and the paths keep every k-th point with k doubling as needed.
 
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;

@@ -101,7 +101,6 @@ pub fn min_rate(rate: f64, tol: f64) -> f64 {
     1.0 / h
 }
 
-/// Running state of the constraint check.
 #[derive(Debug, Clone)]
 pub struct ConstraintCheck {
     window: [Entry; WINDOW],
@@ -131,7 +130,6 @@ impl Default for ConstraintCheck {
 }
 
 impl ConstraintCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, a: f64) {
         let (Some(w), Some(ang), Some(p)) = (s.omega, s.angles, s.position) else {
             self.len = 0;
@@ -215,7 +213,6 @@ impl ConstraintCheck {
         bucket.residual.offer(residual.norm(), centre.t);
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, a: f64, tol: &Tolerances) -> CheckResult {
         if self.samples < WINDOW as u64 {

@@ -24,7 +24,6 @@ const INTERPOLATION_SHARE: f64 = 0.1;
 /// Smallest θ range worth measuring \[rad\]: below it the crossings of ω_X are the integrator's noise.
 const MIN_AMPLITUDE: f64 = 1e-8;
 
-/// Running state of the nutation check.
 #[derive(Debug, Default, Clone)]
 pub struct NutationCheck {
     initial: Option<State>,
@@ -32,7 +31,6 @@ pub struct NutationCheck {
 }
 
 impl NutationCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Some(state) = s.state() else {
             return;

@@ -29,7 +29,6 @@ pub struct ValidityCheck {
 }
 
 impl ValidityCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let (normal, friction) = if let Some(r) = s.reaction {
             (r.normal, r.friction)
@@ -72,7 +71,6 @@ impl ValidityCheck {
         }
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, ctx: &Context) -> CheckResult {
         let mut this = self.clone();
