@@ -3,8 +3,8 @@
 
 use super::json::{parse_numbers_into, read_fields, FieldsError};
 use super::messages::{Message, MessageType};
-use super::protobuf::{descriptor_set, MessageDecoder, SchemaError};
-use super::Encoding;
+use super::protobuf::{MessageDecoder, SchemaError};
+use super::{schema_data, Encoding};
 
 /// How to read a channel's messages into f64s, from its schema.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -57,41 +57,37 @@ impl FieldReader {
         t: &MessageType,
         data: &[u8],
     ) -> Result<(Self, Version), ReaderError> {
+        let encoding = Encoding::from_schema_encoding(schema_encoding)
+            .ok_or_else(|| ReaderError::Encoding(schema_encoding.to_string()))?;
+        let ours = schema_data(t.schema, encoding) == Some(data);
         let added = t.fields != t.first_fields;
-        match Encoding::from_schema_encoding(schema_encoding) {
-            Some(Encoding::Json) => {
-                let version = if data == t.json_schema {
-                    Version::Ours
-                } else {
-                    match validates(data, t.fields) {
-                        Ok(()) => Version::Other,
-                        Err(_) if added && validates(data, t.first_fields).is_ok() => {
-                            Version::First
-                        }
-                        Err(e) => Version::Nonconforming(e),
-                    }
-                };
-                Ok((Self::json(t, version == Version::First), version))
-            }
-            Some(Encoding::Protobuf) => {
-                let reader = |first: bool| {
-                    let fields = if first { t.first_fields } else { t.fields };
-                    MessageDecoder::new(data, t.schema, fields).map(|d| Self {
-                        fields,
-                        first,
-                        protobuf: Some(d),
-                    })
-                };
-                match reader(false) {
-                    Ok(r) if descriptor_set(t.schema) == Some(data) => Ok((r, Version::Ours)),
-                    Ok(r) => Ok((r, Version::Other)),
-                    Err(e) => match reader(true) {
-                        Ok(r) if added => Ok((r, Version::First)),
-                        _ => Err(e.into()),
-                    },
+        if encoding == Encoding::Json {
+            let version = if ours {
+                Version::Ours
+            } else {
+                match validates(data, t.fields) {
+                    Ok(()) => Version::Other,
+                    Err(_) if added && validates(data, t.first_fields).is_ok() => Version::First,
+                    Err(e) => Version::Nonconforming(e),
                 }
-            }
-            None => Err(ReaderError::Encoding(schema_encoding.to_string())),
+            };
+            return Ok((Self::json(t, version == Version::First), version));
+        }
+        let reader = |first: bool| {
+            let fields = if first { t.first_fields } else { t.fields };
+            MessageDecoder::new(data, t.schema, fields).map(|d| Self {
+                fields,
+                first,
+                protobuf: Some(d),
+            })
+        };
+        match reader(false) {
+            Ok(r) if ours => Ok((r, Version::Ours)),
+            Ok(r) => Ok((r, Version::Other)),
+            Err(e) => match reader(true) {
+                Ok(r) if added => Ok((r, Version::First)),
+                _ => Err(e.into()),
+            },
         }
     }
 

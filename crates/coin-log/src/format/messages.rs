@@ -1,11 +1,7 @@
-//! The schemas of the format (format.md: Channels and fields): the names and JSON Schemas of Foxglove's two
-//! schemas and of the `coin_log.*` message types, which are declared here. Each type deserialises strictly
-//! (unknown or missing fields rejected) for `verify`, and writes itself as compact JSON straight into a
-//! reused buffer for the recorder's hot path: shortest round-trip floats (ryu), fields in the schema's
-//! order, no allocation.
-//!
-//! Hand-written rather than `serde_json::to_writer` because the recorder formats tens of millions of
-//! messages and must refuse non-finite numbers (JSON has no NaN) instead of writing `null`.
+//! The schemas of the format (format.md: Channels and fields): the `coin_log.*` message types, declared
+//! here, and Foxglove's schema names. Each type deserialises strictly (unknown or missing fields
+//! rejected) and writes itself straight into a reused buffer (ryu's shortest round-trip floats, in schema
+//! order), refusing the non-finite numbers serde_json would write as `null`.
 
 use super::encoding::Encoding;
 use serde::Deserialize;

@@ -30,7 +30,7 @@ const EIGHTH_DIFFERENCE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 
 /// samples (φ̇ ∝ 1/(t + d)) judged resolved erred by 1.2e-6 against a tolerance of 4e-7.
 const SINGULAR_GROWTH: f64 = 3.0;
 /// Window length.
-const WINDOW: usize = 9;
+pub(crate) const WINDOW: usize = 9;
 /// Relative spread of sample intervals accepted as equal spacing.
 const SPACING_TOLERANCE: f64 = 1e-6;
 /// Safety factor on the truncation estimate (hΩ)⁸/630.
