@@ -30,8 +30,8 @@ use std::path::Path;
 enum Kind {
     /// A `coin_log.*` channel and how its messages are read.
     Coin(Channel, FieldReader),
-    /// A Foxglove channel and its schema name.
-    Foxglove(&'static str),
+    /// A Foxglove channel, its schema name and its messages' encoding.
+    Foxglove(&'static str, Encoding),
     Unknown,
 }
 
@@ -40,8 +40,6 @@ struct ChannelState {
     kind: Kind,
     topic: String,
     last: Option<u64>,
-    /// The messages' encoding (its schema's).
-    encoding: Encoding,
 }
 
 /// The physics checks' running state.
@@ -334,7 +332,7 @@ impl Visitor for Judge {
                         let json = || FieldReader::json(m, judged.first_version);
                         Kind::Coin(c, reader.unwrap_or_else(json))
                     }
-                    None => Kind::Foxglove(t.schema_name()),
+                    None => Kind::Foxglove(t.schema_name(), judged.encoding.unwrap_or_default()),
                 }
             }
         };
@@ -346,7 +344,6 @@ impl Visitor for Judge {
             kind,
             topic: topic.to_string(),
             last: None,
-            encoding: judged.encoding.unwrap_or_default(),
         });
     }
 
@@ -428,8 +425,8 @@ impl Visitor for Judge {
                 };
                 self.assembler.push(*c, &s, &mut |s| checks.observe(s, ctx));
             }
-            Kind::Foxglove(schema) => {
-                if let Err(e) = foxglove_message(channel.encoding, schema, data) {
+            Kind::Foxglove(schema, encoding) => {
+                if let Err(e) = foxglove_message(*encoding, schema, data) {
                     self.problems
                         .push_with(|| format!("{topic}: message at {lt} ns {e}"));
                 }
