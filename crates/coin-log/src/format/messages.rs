@@ -205,10 +205,7 @@ macro_rules! message {
 
             /// Appends this message in Protobuf to `buf`: every field as a double numbered by its place in the
             /// schema (t = 1), zeros included; an added field only when it is `Some`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
-            pub fn write_protobuf(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+            pub(crate) fn write_protobuf(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
                 self.check_finite()?;
                 let mut number = 0_u32;
                 $(

@@ -106,12 +106,6 @@ impl FileInfo {
         }
     }
 
-    /// The stored scene's TOML text (the `scene` value of the `coin-log` record).
-    #[must_use]
-    pub fn scene_toml(&self) -> Option<&str> {
-        self.run.as_ref().ok().map(|r| r.scene.as_str())
-    }
-
     /// The contract's JSON object of this file (format.md: info --json), `path` as given.
     #[must_use]
     pub fn json<'a>(&'a self, path: &'a str) -> impl Serialize + 'a {
@@ -163,7 +157,7 @@ impl FileInfo {
                 rhs_evaluations: r.rhs_evaluations,
                 rejected_steps: r.rejected_steps,
             }),
-            scene: self.scene_toml(),
+            scene: run.map(|r| r.scene.as_str()),
             problem: self.problem.as_deref(),
         }
     }
