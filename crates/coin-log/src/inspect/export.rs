@@ -306,15 +306,6 @@ impl<W: Write> Exporter<'_, W> {
         }
     }
 
-    /// Writes the numbers in `self.values` as one CSV row of table `table`.
-    fn write_numbers(&mut self, table: usize) {
-        self.line.clear();
-        for v in &self.values {
-            self.line.number(*v);
-        }
-        self.write_line(table);
-    }
-
     /// Ends `self.line` and writes it as a row of table `table`.
     fn write_line(&mut self, table: usize) {
         let open = &mut self.tables[table];
@@ -339,10 +330,14 @@ impl<W: Write> Exporter<'_, W> {
         if let Err(e) = reader.read(data, &mut self.values) {
             return self.fail(message(channel.topic(), h.log_time, e));
         }
-        match table {
-            Some(table) => self.write_numbers(table),
-            None => self.join(h.log_time, channel),
+        let Some(table) = table else {
+            return self.join(h.log_time, channel);
+        };
+        self.line.clear();
+        for v in &self.values {
+            self.line.number(*v);
         }
+        self.write_line(table);
     }
 
     fn tf(&mut self, h: &MessageHeader, data: &[u8], table: usize, protobuf: bool) {
