@@ -1,30 +1,14 @@
-//! Reading the `coin_log.*` messages' JSON back (the writing side is [`super::messages`]).
-//!
-//! The fast path is a flat JSON object of numbers in exactly the form the recorder writes
-//! (`{"t":0.001,"x":1.5,...}`: the schema's fields in order, no whitespace). Anything else (other order,
-//! whitespace, escapes, unknown or missing fields, a number outside JSON's grammar or beyond f64) gives
-//! `None`, and the caller parses with serde_json, which accepts every valid form and explains every
-//! error: strictness is unchanged, only the common case is faster. Numbers are converted by
-//! `str::parse::<f64>`, which rounds correctly, so the recorder's shortest round-trip decimals come back
-//! bit for bit; serde_json is built with `float_roundtrip`, so its slow path is exact too.
-//!
-//! [`read_fields`] does both for a field list known only at run time (`coin-log export` reads every
-//! channel of the format through it, whatever fields it has).
+//! Reading the `coin_log.*` messages' JSON back (the writing side is [`super::messages`]). The fast path
+//! takes the exact form the recorder writes (`{"t":0.001,"x":1.5,...}`: the schema's fields in order, no
+//! whitespace); any other form falls back to serde_json (built with `float_roundtrip`), which accepts every
+//! valid form and explains every error. Both round correctly, so values come back bit for bit.
 
 use std::collections::BTreeMap;
 
-/// Parses `data` as the object `{"fields[0]":n0,"fields[1]":n1,...}` into `out` (same length as
-/// `fields`), or `None` if it has any other form.
+/// Parses `data` as the object `{"fields[0]":n0,"fields[1]":n1,...}` into `out` (`out.len() ==
+/// fields.len()`) and returns true, or returns false (with `out` partly written) if it has any other form.
 #[must_use]
-pub fn parse_numbers<const N: usize>(data: &[u8], fields: &[&str; N]) -> Option<[f64; N]> {
-    let mut out = [0.0; N];
-    parse_numbers_into(data, fields, &mut out).then_some(out)
-}
-
-/// [`parse_numbers`] for a field list of any length: fills `out` (`out.len() == fields.len()`) and
-/// returns true, or returns false (with `out` partly written) if `data` has any other form.
-#[must_use]
-fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool {
+pub(crate) fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) -> bool {
     if out.len() != fields.len() {
         return false;
     }
@@ -81,9 +65,6 @@ pub enum FieldsError {
 /// Reads the flat object `data` into `out` in the order of `fields` (`out.len() == fields.len()`),
 /// whatever the order, spacing or escapes of the text: the fast path first, then serde_json. Every field
 /// must be present, a finite number, and no other field may be.
-///
-/// # Errors
-/// [`FieldsError`] naming the first field that is missing, extra or not a number.
 pub fn read_fields(data: &[u8], fields: &[&str], out: &mut [f64]) -> Result<(), FieldsError> {
     if parse_numbers_into(data, fields, out) {
         return Ok(());
@@ -121,7 +102,7 @@ const EXACT_INTEGER: u64 = 1 << 53;
 ///
 /// Clinger's fast path when the digits form an integer m < 2⁵³ and the power of ten is at most 10²²:
 /// m and 10ᵏ are exact, so one IEEE multiplication or division rounds correctly. Otherwise the standard
-/// library's correctly rounded parser reads the text.
+/// library's correctly rounded parser reads the text (alone, it costs `verify` 6 % more CPU, measured).
 fn number(s: &[u8]) -> Option<(f64, usize)> {
     let mut i = usize::from(s.first() == Some(&b'-'));
     let mut mantissa: u64 = 0;
@@ -204,6 +185,11 @@ mod tests {
 
     const F: [&str; 3] = ["t", "x", "y"];
 
+    fn parse_numbers(data: &[u8]) -> Option<[f64; 3]> {
+        let mut out = [0.0; 3];
+        parse_numbers_into(data, &F, &mut out).then_some(out)
+    }
+
     #[test]
     fn the_recorders_form_parses_bit_for_bit() {
         for x in [0.1, -2.5e-300, 1e21, 5e-324, f64::MAX, -0.0, 0.3 + 0.6] {
@@ -212,7 +198,7 @@ mod tests {
                 ryu::Buffer::new().format_finite(x),
                 ryu::Buffer::new().format_finite(-x)
             );
-            let v = parse_numbers(text.as_bytes(), &F).unwrap();
+            let v = parse_numbers(text.as_bytes()).unwrap();
             assert_eq!(v[1].to_bits(), x.to_bits(), "{text}");
             assert_eq!(v[2].to_bits(), (-x).to_bits(), "{text}");
         }
@@ -240,10 +226,10 @@ mod tests {
             r#"{"t":1,"x":2,"y":3"#,
             "",
         ] {
-            assert!(parse_numbers(text.as_bytes(), &F).is_none(), "{text}");
+            assert!(parse_numbers(text.as_bytes()).is_none(), "{text}");
         }
         assert_eq!(
-            parse_numbers(br#"{"t":-0.5E+2,"x":0,"y":12e-1}"#, &F),
+            parse_numbers(br#"{"t":-0.5E+2,"x":0,"y":12e-1}"#),
             Some([-50.0, 0.0, 1.2])
         );
     }

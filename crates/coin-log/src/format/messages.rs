@@ -1,11 +1,7 @@
-//! The schemas of the format (format.md: Channels and fields): the names and JSON Schemas of Foxglove's two
-//! schemas and of the `coin_log.*` message types, which are declared here. Each type deserialises strictly
-//! (unknown or missing fields rejected) for `verify`, and writes itself as compact JSON straight into a
-//! reused buffer for the recorder's hot path: shortest round-trip floats (ryu), fields in the schema's
-//! order, no allocation.
-//!
-//! Hand-written rather than `serde_json::to_writer` because the recorder formats tens of millions of
-//! messages and must refuse non-finite numbers (JSON has no NaN) instead of writing `null`.
+//! The schemas of the format (format.md: Channels and fields): the `coin_log.*` message types, declared
+//! here, and Foxglove's schema names. Each type deserialises strictly (unknown or missing fields
+//! rejected) and writes itself straight into a reused buffer (ryu's shortest round-trip floats, in schema
+//! order), refusing the non-finite numbers serde_json would write as `null`.
 
 use super::encoding::Encoding;
 use serde::Deserialize;
@@ -78,6 +74,8 @@ pub struct MessageType {
     pub schema: &'static str,
     /// Field names in schema order (the JSON keys, `t` first; Protobuf field number = position + 1).
     pub fields: &'static [&'static str],
+    /// Field names of the schema's first version (before any field added since).
+    pub first_fields: &'static [&'static str],
     /// The JSON Schema, the bytes of `schemas/<schema>.json` embedded at build time.
     pub json_schema: &'static [u8],
 }
@@ -133,6 +131,18 @@ pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
     }
 }
 
+/// What the readers need of every `coin_log.*` message type.
+pub trait Message: Copy + serde::de::DeserializeOwned {
+    /// The message of the field values `v` in schema order (0 past its end); without the added fields
+    /// when `first` (a schema of the type's first version).
+    fn from_values(v: &[f64], first: bool) -> Self;
+    /// Whether every field of the current schema is present (false for a message of a file written
+    /// before an `added` field).
+    fn is_complete(&self) -> bool;
+    /// Simulation time.
+    fn t(&self) -> f64;
+}
+
 /// Defines a message type. Fields listed under `added` came with a later version of the schema (docs/format.md
 /// says which): they are `Option<f64>`, `None` in messages of files written before them, and the recorder
 /// always writes them.
@@ -162,6 +172,7 @@ macro_rules! message {
             pub const TYPE: MessageType = MessageType {
                 schema: $schema,
                 fields: Self::FIELDS,
+                first_fields: Self::FIRST_FIELDS,
                 json_schema: include_bytes!(concat!("../../../../schemas/", $schema, ".json")),
             };
 
@@ -194,10 +205,7 @@ macro_rules! message {
 
             /// Appends this message in Protobuf to `buf`: every field as a double numbered by its place in the
             /// schema (t = 1), zeros included; an added field only when it is `Some`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
-            pub fn write_protobuf(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+            pub(crate) fn write_protobuf(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
                 self.check_finite()?;
                 let mut number = 0_u32;
                 $(
@@ -243,16 +251,23 @@ macro_rules! message {
                 Ok(())
             }
 
-            /// Whether every field of the current schema is present (false for a message of a file written
-            /// before an `added` field).
-            #[must_use]
-            pub fn is_complete(&self) -> bool {
+        }
+
+        impl Message for $name {
+            #[allow(unused_variables)]
+            fn from_values(v: &[f64], first: bool) -> Self {
+                let mut it = v.iter().copied();
+                Self {
+                    $($field: it.next().unwrap_or(0.0),)+
+                    $($($added: (!first).then(|| it.next().unwrap_or(0.0)),)+)?
+                }
+            }
+
+            fn is_complete(&self) -> bool {
                 true $($(&& self.$added.is_some())+)?
             }
 
-            /// Simulation time of the message.
-            #[must_use]
-            pub fn time(&self) -> f64 {
+            fn t(&self) -> f64 {
                 self.t
             }
         }
@@ -422,6 +437,24 @@ mod tests {
             EnergyMessage::FIRST_FIELDS,
             &["t", "total", "kinetic", "potential"]
         );
+    }
+
+    /// The readers' fast path reads the fields in the order the recorder writes them.
+    #[test]
+    fn the_fields_are_in_schema_order() {
+        for (fields, expected) in [
+            (AngularVelocity::FIELDS, &["t", "x", "y", "z"][..]),
+            (Position::FIELDS, &["t", "x", "y", "z"]),
+            (Angles::FIELDS, &["t", "theta", "phi", "psi", "phi_dot"]),
+            (QuaternionMessage::FIELDS, &["t", "x", "y", "z", "w"]),
+            (InvariantsMessage::FIELDS, &["t", "c1", "c2"]),
+            (
+                ReactionMessage::FIELDS,
+                &["t", "x", "y", "z", "friction", "normal", "friction_ratio"],
+            ),
+        ] {
+            assert_eq!(fields, expected);
+        }
     }
 
     #[test]

@@ -5,7 +5,7 @@
 
 pub mod channels;
 mod encoding;
-pub mod fields;
+pub(crate) mod fields;
 pub mod json;
 pub mod messages;
 pub mod metadata;

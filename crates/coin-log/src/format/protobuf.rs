@@ -1,17 +1,7 @@
 //! The Protobuf form of the format (docs/format.md: Encodings): the schemas as serialized
-//! `FileDescriptorSet`s, the wire form of the `coin_log.*` messages, and a decoder that reads any
-//! `coin_log.*` message by the descriptor a file stores.
-//!
-//! - `coin_log.*`: one message of `double` fields per type, numbered 1, 2, … in the order of the JSON
-//!   Schema's fields (t = 1), proto3, package `coin_log`. The `.proto` files in `schemas/` are their source
-//!   text (a test checks they declare exactly these fields); the descriptor is built here with
-//!   `prost-types`, so no `protoc` is needed. Every field is written, zeros included (proto3 readers accept
-//!   them), so −0.0 keeps its sign.
-//! - `foxglove.*`: the descriptor sets the `foxglove` crate ships, the ones Foxglove publishes.
-//!
-//! The encoder writes each `double` as its key and 8 little-endian bytes with prost's encoding functions;
-//! the decoder walks the same wire format (prost's key and varint decoding) field by field into a slice of
-//! f64, like the JSON fast path ([`super::json`]): a generated message struct per type would add nothing.
+//! `FileDescriptorSet`s (the `coin_log.*` ones built with `prost-types` as protoc describes
+//! `schemas/*.proto`, so no `protoc` is needed; the `foxglove.*` ones as the `foxglove` crate ships them),
+//! and a decoder that reads a `coin_log.*` message field by field by the numbers of a stored descriptor.
 
 use super::json::FieldsError;
 use super::messages::{FRAME_TRANSFORM, MESSAGE_TYPES, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID};
@@ -156,9 +146,6 @@ pub struct MessageDecoder {
 impl MessageDecoder {
     /// A decoder for the messages of `schema_name` as `descriptor_set` declares it, reading `fields`
     /// (which it must declare as singular doubles; it may declare more).
-    ///
-    /// # Errors
-    /// [`SchemaError`] if the bytes are not a descriptor set, or it lacks the type or a field.
     pub fn new(
         descriptor_set: &[u8],
         schema_name: &str,
@@ -216,18 +203,8 @@ impl MessageDecoder {
         })
     }
 
-    /// The fields it reads, in order.
-    #[must_use]
-    pub fn fields(&self) -> &[&'static str] {
-        &self.fields
-    }
-
     /// Reads one message into `out` (`out.len()` = the number of fields). A field the message leaves out is
     /// 0 (proto3: a writer may omit zeros); a declared field it does not read is skipped.
-    ///
-    /// # Errors
-    /// [`FieldsError`] if the bytes are not a valid message of the type, carry a field number the
-    /// descriptor does not declare, or a value that is not a finite number.
     pub fn read(&self, data: &[u8], out: &mut [f64]) -> Result<(), FieldsError> {
         let bad = |what: String| FieldsError::NotProtobuf(what);
         out.iter_mut().for_each(|v| *v = 0.0);

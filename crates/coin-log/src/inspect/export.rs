@@ -1,26 +1,11 @@
-//! `coin-log export`: a file's channels as CSV tables, in one streaming pass (memory bounded by a few
-//! records and one write buffer per table, whatever the file's length).
-//!
-//! - **Per channel** (the default): one table per `coin_log.*` channel, named after the channel
-//!   (`omega.csv`, `angles.csv`, ...), its header the message's fields in schema order ([`Channel::fields`],
-//!   so a field added to the format appears without a change here), one row per message.
-//! - **Wide**: one table `samples.csv` joined on the sample time: `t`, then `<channel>.<field>` for every
-//!   `coin_log.*` channel present at the first sample, one row per sample.
-//! - `/tf` (per channel only) is flattened into `tf.csv`, and so are the other frame-transform topics
-//!   (`/tf_static` into `tf_static.csv`, `/scene/follow` into `scene_follow.csv`): `t`, the two frame ids, translation and
-//!   rotation. `/scene` is skipped: it holds display geometry (the coin, the table, pieces of the track),
-//!   and the track's points are `/coin/contact`; so are the `rerun` channel's topics, the same drawing for
-//!   Rerun.
-//!
-//! Numbers are written in the shortest form that reads back to the same f64 (ryu) after an exact read
-//! ([`crate::format::json`]), so every value equals the file's bit for bit. Timestamps of `/tf` are
-//! written as the exact decimal of their nanoseconds.
+//! `coin-log export` (docs/format.md: export): a file's channels as CSV tables in one streaming pass, in
+//! memory bounded by a few records and one write buffer per table. Every value is read exactly and
+//! written by ryu, so it equals the file's bit for bit.
 
 use super::seconds_text;
 use crate::csv;
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;
-use crate::format::json::read_fields;
 use crate::format::Channel;
 use crate::format::Encoding;
 use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
@@ -94,45 +79,34 @@ pub struct ExportSummary {
 }
 
 /// Why an export stopped. Tables opened before it may hold part of the data: the caller discards them.
-#[derive(Debug, thiserror::Error)]
-pub enum ExportError {
-    /// The file could not be read (to its end).
-    #[error("{0}")]
-    Read(String),
-    /// A message does not have its schema's form.
-    #[error("{topic}: the message at log time {log_time} ns {reason}")]
-    Message {
-        /// Topic.
-        topic: String,
-        /// Its log time \[ns\].
-        log_time: u64,
-        /// What is wrong.
-        reason: String,
-    },
-    /// The messages cannot be joined into one row per sample.
-    #[error("cannot join the channels into one table: {0}; export one table per channel instead (without --wide)")]
-    Join(String),
-    /// No channel of the file makes a table.
-    #[error("nothing to export: {0}")]
-    Nothing(String),
-    /// A table could not be written.
-    #[error("writing `{table}`: {source}")]
-    Write {
-        /// The table's name.
-        table: String,
-        /// The I/O error.
-        source: io::Error,
-    },
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ExportError(pub String);
+
+fn written(table: &str, e: &io::Error) -> ExportError {
+    ExportError(format!("writing `{table}`: {e}"))
 }
 
-/// What each channel id is exported as.
+fn message(topic: &str, log_time: u64, reason: impl std::fmt::Display) -> ExportError {
+    ExportError(format!(
+        "{topic}: the message at log time {log_time} ns {reason}"
+    ))
+}
+
+fn join_failed(e: &str) -> ExportError {
+    ExportError(format!(
+        "cannot join the channels into one table: {e}; export one table per channel instead (without --wide)"
+    ))
+}
+
+/// What each channel id is exported as./// What each channel id is exported as.
+#[derive(Clone, Copy)]
 enum Target {
-    /// A `coin_log.*` channel: its fields, and its table (per channel) or its place in the wide row.
+    /// A `coin_log.*` channel: its table (per channel) or its place in the wide row, and the index of
+    /// its reader in `Exporter::readers`.
     Flat {
         channel: Channel,
-        fields: &'static [&'static str],
         table: Option<usize>,
-        /// Index of its reader in `Exporter::readers`.
         reader: usize,
     },
     /// `/tf`, flattened into its table; Protobuf or JSON.
@@ -167,7 +141,7 @@ struct Exporter<'a, W: Write> {
     open: &'a mut dyn FnMut(&str) -> io::Result<W>,
     /// The field readers of the flat channels.
     readers: Vec<FieldReader>,
-    targets: BTreeMap<u16, (String, Target)>,
+    targets: BTreeMap<u16, Target>,
     tables: Vec<Open<W>>,
     skipped: Vec<Skipped>,
     wide: Wide,
@@ -214,7 +188,7 @@ pub fn export<W: Write>(
             ),
             _ => err.detail,
         };
-        return Err(ExportError::Read(detail));
+        return Err(ExportError(detail));
     }
     e.finish()
 }
@@ -222,24 +196,18 @@ pub fn export<W: Write>(
 impl<W: Write> Exporter<'_, W> {
     /// Opens table `name` with `columns` and writes its header.
     fn open_table(&mut self, name: &str, topic: &str, columns: Vec<String>) -> Option<usize> {
-        let writer = match (self.open)(name) {
-            Ok(w) => w,
-            Err(source) => {
-                self.fail(ExportError::Write {
-                    table: name.to_string(),
-                    source,
-                });
+        let opened = (self.open)(name).and_then(|w| {
+            let mut out = BufWriter::with_capacity(BUFFER, w);
+            out.write_all(csv::record(&columns).as_bytes())
+                .map(|()| out)
+        });
+        let out = match opened {
+            Ok(out) => out,
+            Err(e) => {
+                self.fail(written(name, &e));
                 return None;
             }
         };
-        let mut out = BufWriter::with_capacity(BUFFER, writer);
-        if let Err(source) = out.write_all(csv::record(&columns).as_bytes()) {
-            self.fail(ExportError::Write {
-                table: name.to_string(),
-                source,
-            });
-            return None;
-        }
         self.tables.push(Open {
             out,
             table: Table {
@@ -309,58 +277,42 @@ impl<W: Write> Exporter<'_, W> {
                 ),
             );
         }
-        let fields = channel.fields().filter(|f| f.first() == Some(&"t"));
-        let reader = match fields.map(|f| FieldReader::new(encoding, schema, data, f)) {
-            Some(Ok(r)) => {
-                self.readers.push(r);
-                self.readers.len() - 1
-            }
-            Some(Err(e)) => return self.skip(topic, &e.to_string()),
-            None => 0,
-        };
-        match (fields, channel, self.layout) {
-            (Some(fields), _, Layout::PerChannel) => {
-                let columns = fields.iter().map(ToString::to_string).collect();
-                let name = format!("{}.csv", channel.name());
-                match self.open_table(&name, topic, columns) {
-                    Some(table) => Target::Flat {
-                        channel,
-                        fields,
-                        table: Some(table),
-                        reader,
-                    },
-                    None => Target::Skip,
-                }
-            }
-            (Some(fields), _, Layout::Wide) => Target::Flat {
-                channel,
-                fields,
-                table: None,
-                reader,
-            },
-            (None, _, _) => self.skip(
+        let Some(t) = channel.message_type() else {
+            return self.skip(
                 topic,
                 "display geometry (the coin, the table, pieces of the track); the track's points are /coin/contact",
-            ),
+            );
+        };
+        let reader = match FieldReader::new(encoding, t, data) {
+            Ok((r, _)) => r,
+            Err(e) => return self.skip(topic, &e.to_string()),
+        };
+        let table = match self.layout {
+            Layout::PerChannel => {
+                let columns = reader.fields().iter().map(ToString::to_string).collect();
+                let name = format!("{}.csv", channel.name());
+                match self.open_table(&name, topic, columns) {
+                    Some(table) => Some(table),
+                    None => return Target::Skip,
+                }
+            }
+            Layout::Wide => None,
+        };
+        self.readers.push(reader);
+        Target::Flat {
+            channel,
+            table,
+            reader: self.readers.len() - 1,
         }
-    }
-
-    /// Writes the numbers in `self.values` as one CSV row of table `table`.
-    fn write_numbers(&mut self, table: usize) {
-        self.line.clear();
-        for v in &self.values {
-            self.line.number(*v);
-        }
-        self.write_line(table);
     }
 
     /// Ends `self.line` and writes it as a row of table `table`.
     fn write_line(&mut self, table: usize) {
         let open = &mut self.tables[table];
         open.table.rows += 1;
-        if let Err(source) = open.out.write_all(self.line.finish().as_bytes()) {
-            let table = open.table.name.clone();
-            self.fail(ExportError::Write { table, source });
+        if let Err(e) = open.out.write_all(self.line.finish().as_bytes()) {
+            let e = written(&open.table.name, &e);
+            self.fail(e);
         }
     }
 
@@ -368,25 +320,24 @@ impl<W: Write> Exporter<'_, W> {
         &mut self,
         h: &MessageHeader,
         data: &[u8],
-        (channel, fields, table, reader): (Channel, &'static [&'static str], Option<usize>, usize),
+        channel: Channel,
+        table: Option<usize>,
+        reader: usize,
     ) {
+        let reader = &self.readers[reader];
         self.values.clear();
-        self.values.resize(fields.len(), 0.0);
-        let read = match self.readers.get(reader) {
-            Some(r) => r.read(data, fields, &mut self.values),
-            None => read_fields(data, fields, &mut self.values),
+        self.values.resize(reader.fields().len(), 0.0);
+        if let Err(e) = reader.read(data, &mut self.values) {
+            return self.fail(message(channel.topic(), h.log_time, e));
+        }
+        let Some(table) = table else {
+            return self.join(h.log_time, channel);
         };
-        if let Err(e) = read {
-            return self.fail(ExportError::Message {
-                topic: channel.topic().to_string(),
-                log_time: h.log_time,
-                reason: e.to_string(),
-            });
+        self.line.clear();
+        for v in &self.values {
+            self.line.number(*v);
         }
-        match table {
-            Some(table) => self.write_numbers(table),
-            None => self.join(h.log_time, channel),
-        }
+        self.write_line(table);
     }
 
     fn tf(&mut self, h: &MessageHeader, data: &[u8], table: usize, protobuf: bool) {
@@ -398,11 +349,8 @@ impl<W: Write> Exporter<'_, W> {
         let m: FrameTransform = match m {
             Ok(m) => m,
             Err(e) => {
-                return self.fail(ExportError::Message {
-                    topic: Channel::Tf.topic().to_string(),
-                    log_time: h.log_time,
-                    reason: format!("is not a foxglove.FrameTransform: {e}"),
-                })
+                let reason = format!("is not a foxglove.FrameTransform: {e}");
+                return self.fail(message(Channel::Tf.topic(), h.log_time, reason));
             }
         };
         let ns = m
@@ -464,7 +412,7 @@ impl<W: Write> Exporter<'_, W> {
             None
         };
         if let Some(e) = err {
-            self.fail(ExportError::Join(e));
+            self.fail(join_failed(&e));
         }
     }
 
@@ -477,10 +425,10 @@ impl<W: Write> Exporter<'_, W> {
             let channels: Vec<(Channel, &'static [&'static str])> = self
                 .targets
                 .values()
-                .filter_map(|(_, t)| match t {
+                .filter_map(|t| match t {
                     Target::Flat {
-                        channel, fields, ..
-                    } => Some((*channel, *fields)),
+                        channel, reader, ..
+                    } => Some((*channel, self.readers[*reader].fields())),
                     _ => None,
                 })
                 .collect();
@@ -509,7 +457,7 @@ impl<W: Write> Exporter<'_, W> {
                 c.topic(),
                 row.log_time
             );
-            return self.fail(ExportError::Join(e));
+            return self.fail(join_failed(&e));
         }
         self.line.clear();
         self.line.number(row.t);
@@ -553,15 +501,12 @@ impl<W: Write> Exporter<'_, W> {
                     skipped.join("; ")
                 )
             };
-            return Err(ExportError::Nothing(why));
+            return Err(ExportError(format!("nothing to export: {why}")));
         }
         let mut tables = Vec::new();
         for open in self.tables {
             let Open { mut out, table } = open;
-            out.flush().map_err(|source| ExportError::Write {
-                table: table.name.clone(),
-                source,
-            })?;
+            out.flush().map_err(|e| written(&table.name, &e))?;
             tables.push(table);
         }
         Ok(ExportSummary {
@@ -575,35 +520,22 @@ impl<W: Write> Exporter<'_, W> {
 impl<W: Write> Visitor for Exporter<'_, W> {
     fn channel(&mut self, id: u16, topic: &str, _: &str, schema: Option<&Schema<'_>>) {
         let target = self.target(topic, schema);
-        self.targets.insert(id, (topic.to_string(), target));
+        self.targets.insert(id, target);
     }
     fn message(&mut self, h: &MessageHeader, data: &[u8]) -> ControlFlow<()> {
         self.messages += 1;
-        match self.targets.get(&h.channel_id) {
-            Some((
-                _,
-                Target::Flat {
-                    channel,
-                    fields,
-                    table,
-                    reader,
-                },
-            )) => {
-                let flat = (*channel, *fields, *table, *reader);
-                self.flat(h, data, flat);
-            }
-            Some((_, Target::Tf { table, protobuf })) => {
-                let (table, protobuf) = (*table, *protobuf);
-                self.tf(h, data, table, protobuf);
-            }
-            Some((_, Target::Skip)) => {}
+        match self.targets.get(&h.channel_id).copied() {
+            Some(Target::Flat {
+                channel,
+                table,
+                reader,
+            }) => self.flat(h, data, channel, table, reader),
+            Some(Target::Tf { table, protobuf }) => self.tf(h, data, table, protobuf),
+            Some(Target::Skip) => {}
             None => {
-                let id = h.channel_id;
-                self.fail(ExportError::Message {
-                    topic: format!("channel {id}"),
-                    log_time: h.log_time,
-                    reason: "is on a channel that no channel record declares".into(),
-                });
+                let topic = format!("channel {}", h.channel_id);
+                let reason = "is on a channel that no channel record declares";
+                self.fail(message(&topic, h.log_time, reason));
             }
         }
         if self.error.is_some() {

@@ -1,11 +1,7 @@
-//! `coin-log info`: what a file holds, from the file alone. The channels (topic, schema, message count,
-//! rate), the time range, the body and run settings and the stored scene from the `coin-log` metadata,
-//! the termination from `coin-log.result`, the file's size and compression and the version that wrote it.
-//!
-//! The summary section is read when the file has one ([`coin_log_mcap::read_summary`]: a few seeks, instant on
-//! a file of gigabytes); a file without one (an unfinished recording, another writer) is read in one
-//! streaming pass ([`coin_log_mcap::read`]), and a file that breaks off part way is described up to the break.
-//! The summary is taken as the file states it: `verify` is what checks it.
+//! `coin-log info` (docs/format.md: info): what a file holds, from the file alone: from its summary
+//! section when it has one ([`coin_log_mcap::read_summary`], a few seeks), else from one streaming pass
+//! that describes a file breaking off part way up to the break. The summary is taken as the file states
+//! it: `verify` is what checks it.
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
@@ -110,12 +106,6 @@ impl FileInfo {
         }
     }
 
-    /// The stored scene's TOML text (the `scene` value of the `coin-log` record).
-    #[must_use]
-    pub fn scene_toml(&self) -> Option<&str> {
-        self.run.as_ref().ok().map(|r| r.scene.as_str())
-    }
-
     /// The contract's JSON object of this file (format.md: info --json), `path` as given.
     #[must_use]
     pub fn json<'a>(&'a self, path: &'a str) -> impl Serialize + 'a {
@@ -167,7 +157,7 @@ impl FileInfo {
                 rhs_evaluations: r.rhs_evaluations,
                 rejected_steps: r.rejected_steps,
             }),
-            scene: self.scene_toml(),
+            scene: run.map(|r| r.scene.as_str()),
             problem: self.problem.as_deref(),
         }
     }

@@ -1,10 +1,7 @@
 //! What a user does with a recording after it is written (format.md: info, export, plot): see what is in
-//! it ([`info`]), get its channels out as tables ([`export`]), draw a one-page overview ([`plot`]).
-//!
-//! Everything here reads files with [`coin_log_mcap`] (the summary section when the file has one, else
-//! one streaming pass in bounded memory) and interprets them with [`crate::format`]: the channel list and
-//! each channel's message fields drive the tables, so a channel or field added to the format is exported
-//! without a change here. Nothing here judges a file; that is `verify`'s job.
+//! it ([`info`]), get its channels out as tables ([`export`]), draw a one-page overview ([`plot`]). The
+//! format's channel list and message fields drive the reading, so a channel or field added to the format
+//! needs no change here. Nothing here judges a file; that is `verify`'s job.
 
 pub mod export;
 pub mod info;

@@ -1,17 +1,9 @@
-//! `coin-log plot`: a one-page SVG overview of a recording, read in one streaming pass.
-//!
-//! Six panels: the contact track and the centre's path seen from above (equal axes, z pointing down the
-//! page as in Foxglove's top view), θ(t), the energy drift |E − E₀| / max(|E₀|, Mga) and the invariant
-//! drift |C − C₀| / (|C1₀| + |C2₀|) on log scales (the scales of `model::drift`), N/(Mg), and |F|/N with
-//! μ when the file has one. The termination is marked on every time axis and named in the title.
-//!
-//! Memory stays bounded whatever the file's length: each time series keeps at most [`POINTS`] buckets
-//! with the minimum and maximum of the samples in each (so no spike is lost), and the paths keep every
-//! k-th point with k doubling as needed.
+//! `coin-log plot` (docs/format.md: plot): a one-page SVG overview of a recording, read in one streaming
+//! pass. Memory stays bounded whatever the file's length: each time series keeps at most [`POINTS`]
+//! min/max buckets (so no spike is lost), and the paths keep every k-th point with k doubling as needed.
 
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;
-use crate::format::json::read_fields;
 use crate::format::{
     Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
@@ -177,9 +169,8 @@ impl Fields<'_> {
 /// Everything the page draws, gathered in one pass.
 #[derive(Default)]
 struct Collect {
-    /// The field reader of each plotted channel id.
-    readers: BTreeMap<u16, FieldReader>,
-    channels: BTreeMap<u16, Channel>,
+    /// The channel and field reader of each plotted channel id.
+    readers: BTreeMap<u16, (Channel, FieldReader)>,
     run: Option<Result<RunMetadata, String>>,
     result: Option<ResultMetadata>,
     params: Option<CoinParams>,
@@ -288,13 +279,12 @@ impl Visitor for Collect {
         let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) else {
             return;
         };
-        let Some(fields) = c.fields() else {
+        let Some(t) = c.message_type() else {
             return;
         };
-        match FieldReader::new(encoding, schema, data, fields) {
-            Ok(r) => {
-                self.readers.insert(id, r);
-                self.channels.insert(id, c);
+        match FieldReader::new(encoding, t, data) {
+            Ok((r, _)) => {
+                self.readers.insert(id, (c, r));
             }
             Err(e) => {
                 self.problem.get_or_insert_with(|| format!("{topic}: {e}"));
@@ -312,20 +302,14 @@ impl Visitor for Collect {
         if self.run.is_none() {
             return ControlFlow::Break(());
         }
-        let Some(&channel) = self.channels.get(&h.channel_id) else {
+        let Some((channel, reader)) = self.readers.get(&h.channel_id) else {
             return ControlFlow::Continue(());
         };
-        let Some(names) = channel.fields() else {
-            return ControlFlow::Continue(());
-        };
+        let (channel, names) = (*channel, reader.fields());
         let mut values = std::mem::take(&mut self.values);
         values.clear();
         values.resize(names.len(), 0.0);
-        let read = match self.readers.get(&h.channel_id) {
-            Some(r) => r.read(data, names, &mut values),
-            None => read_fields(data, names, &mut values),
-        };
-        match read {
+        match reader.read(data, &mut values) {
             Ok(()) => self.observe(
                 channel,
                 &Fields {

@@ -11,13 +11,10 @@
 //! high-spin scenes keep their rates).
 
 use super::checks::constraint;
-use super::tolerances::{RunAccuracy, Tolerances};
+use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
 use crate::scene::Scene;
 use nalgebra::Vector3;
-
-/// Samples the constraint's finite difference needs in a row.
-const WINDOW: f64 = 9.0;
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
 /// and what to change; empty when `verify` will be able to judge the recording.
@@ -74,9 +71,10 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
     }
     let run = &scene.run;
     let samples = (run.duration * run.rate).floor() + 1.0;
-    if samples < WINDOW {
+    if samples < constraint::WINDOW as f64 {
         return Some(format!(
-            "needs {WINDOW} evenly spaced samples in a row and the run has {samples} on its sampling grid; raise --rate or --duration"
+            "needs {} evenly spaced samples in a row and the run has {samples} on its sampling grid; raise --rate or --duration",
+            constraint::WINDOW
         ));
     }
     let s = &scene.initial;

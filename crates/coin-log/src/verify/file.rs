@@ -7,35 +7,31 @@ use super::checks::{
     validity::ValidityCheck, Context, RunStats,
 };
 use super::report::{CheckId, CheckResult, FileReport, Status, Verdict};
-use super::samples::{Assembler, Sample, Slot, Value};
-use super::tolerances::{RunAccuracy, Tolerances};
+use super::samples::{Assembler, Sample};
 use super::Options;
 use crate::format::channels::ROS_STRING_WIRE;
-use crate::format::json;
-use crate::format::messages::{
-    Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
-    ReactionMessage, WorkMessage, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID,
-};
-use crate::format::protobuf::{self, MessageDecoder};
+use crate::format::fields::{FieldReader, ReaderError, Version};
+use crate::format::messages::{message_type, Message, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID};
+use crate::format::tolerances::{RunAccuracy, Tolerances, RECOMPUTE_TOLERANCE};
 use crate::format::{
-    log_time, schema_bytes, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
+    log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
 use crate::model::invariants::Chaplygin;
 use crate::model::{Coin, CoinParams, Dynamics, Inertia};
 use crate::scene::{self, Scene};
-use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
 use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
-use std::rc::Rc;
 
 /// What a channel id stands for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 enum Kind {
-    Coin(Slot),
-    Foxglove,
+    /// A `coin_log.*` channel and how its messages are read.
+    Coin(Channel, FieldReader),
+    /// A Foxglove channel, its schema name and its messages' encoding.
+    Foxglove(&'static str, Encoding),
     Unknown,
 }
 
@@ -44,12 +40,6 @@ struct ChannelState {
     kind: Kind,
     topic: String,
     last: Option<u64>,
-    /// The channel's schema is the first version of its type (messages without the fields added since).
-    first_version: bool,
-    /// The messages' encoding (its schema's), and for a Protobuf `coin_log.*` channel the decoder its
-    /// schema's descriptor gives.
-    encoding: Encoding,
-    decoder: Option<Rc<MessageDecoder>>,
 }
 
 /// The physics checks' running state.
@@ -89,69 +79,9 @@ fn invariants_of(ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> 
     }
 }
 
-/// Schema names of the `coin_log.*` types and their fields (current version, first version), for schemas of
-/// another version.
-type Fields = (&'static [&'static str], &'static [&'static str]);
-
-fn fields_of(schema: &str) -> Option<Fields> {
-    Some(match schema {
-        AngularVelocity::SCHEMA => (AngularVelocity::FIELDS, AngularVelocity::FIRST_FIELDS),
-        Angles::SCHEMA => (Angles::FIELDS, Angles::FIRST_FIELDS),
-        QuaternionMessage::SCHEMA => (QuaternionMessage::FIELDS, QuaternionMessage::FIRST_FIELDS),
-        Position::SCHEMA => (Position::FIELDS, Position::FIRST_FIELDS),
-        ReactionMessage::SCHEMA => (ReactionMessage::FIELDS, ReactionMessage::FIRST_FIELDS),
-        EnergyMessage::SCHEMA => (EnergyMessage::FIELDS, EnergyMessage::FIRST_FIELDS),
-        InvariantsMessage::SCHEMA => (InvariantsMessage::FIELDS, InvariantsMessage::FIRST_FIELDS),
-        WorkMessage::SCHEMA => (WorkMessage::FIELDS, WorkMessage::FIRST_FIELDS),
-        _ => return None,
-    })
-}
-
-/// Whether a JSON schema of another version validates the messages of a type with `fields`: the integrity
-/// check parses every message strictly into its type, so a message that parses has exactly `fields`, each a
-/// number, and it conforms to the schema when the schema requires none but `fields`, types each of them
-/// (where it types it) as a number, and does not forbid (`additionalProperties: false`) one it leaves out.
-fn validates(data: &[u8], fields: &[&str]) -> Result<(), String> {
-    use serde_json::Value;
-    let v: Value = serde_json::from_slice(data).map_err(|e| format!("is not JSON: {e}"))?;
-    if let Some(t) = v.get("type") {
-        if t.as_str() != Some("object") {
-            return Err(format!("types the messages as {t}, not an object"));
-        }
-    }
-    let props = v.get("properties").and_then(Value::as_object);
-    let required = v.get("required").and_then(Value::as_array);
-    for r in required.into_iter().flatten() {
-        let r = r
-            .as_str()
-            .ok_or("has a `required` entry that is not a string")?;
-        if !fields.contains(&r) {
-            return Err(format!("requires `{r}`, which the messages lack"));
-        }
-    }
-    let closed = v.get("additionalProperties") == Some(&Value::Bool(false));
-    for f in fields {
-        match props.and_then(|p| p.get(*f)) {
-            Some(p) => match p.get("type") {
-                None => {}
-                Some(t) if t.as_str() == Some("number") => {}
-                Some(t) => return Err(format!("types `{f}` as {t}, the messages have a number")),
-            },
-            None if closed => return Err(format!("forbids `{f}`, which the messages have")),
-            None => {}
-        }
-    }
-    Ok(())
-}
-
-/// Whether a message of a Foxglove channel is valid in its encoding: JSON text, or a Protobuf message of
-/// its Foxglove type.
-fn foxglove_message(
-    encoding: Encoding,
-    channel_id: u16,
-    channels: &[Option<ChannelState>],
-    data: &[u8],
-) -> Result<(), String> {
+/// Whether a message of a Foxglove channel of schema `schema` is valid in its encoding: JSON text, or a
+/// Protobuf message of its Foxglove type.
+fn foxglove_message(encoding: Encoding, schema: &str, data: &[u8]) -> Result<(), String> {
     use foxglove::messages::{FrameTransform, PointCloud, SceneUpdate, VoxelGrid};
     use prost::Message;
     match encoding {
@@ -159,15 +89,11 @@ fn foxglove_message(
             .map(|_| ())
             .map_err(|e| format!("is not JSON: {e}")),
         Encoding::Protobuf => {
-            let topic = channels
-                .get(usize::from(channel_id))
-                .and_then(Option::as_ref)
-                .and_then(|c| Topic::from_name(&c.topic));
-            let decoded = match topic.map(Topic::schema_name) {
-                Some(FRAME_TRANSFORM) => FrameTransform::decode(data).map(|_| ()),
-                Some(POINT_CLOUD) => PointCloud::decode(data).map(|_| ()),
-                Some(VOXEL_GRID) => VoxelGrid::decode(data).map(|_| ()),
-                Some(SCENE_UPDATE) => SceneUpdate::decode(data).map(|_| ()),
+            let decoded = match schema {
+                FRAME_TRANSFORM => FrameTransform::decode(data).map(|_| ()),
+                POINT_CLOUD => PointCloud::decode(data).map(|_| ()),
+                VOXEL_GRID => VoxelGrid::decode(data).map(|_| ()),
+                SCENE_UPDATE => SceneUpdate::decode(data).map(|_| ()),
                 _ => Ok(()),
             };
             decoded.map_err(|e| format!("is not a valid Protobuf message of its type: {e}"))
@@ -182,8 +108,8 @@ struct SchemaJudged {
     encoding: Option<Encoding>,
     /// It is the first version of a `coin_log.*` type.
     first_version: bool,
-    /// The decoder of a Protobuf `coin_log.*` schema.
-    decoder: Option<Rc<MessageDecoder>>,
+    /// The reader of a Protobuf `coin_log.*` schema.
+    reader: Option<FieldReader>,
 }
 
 /// The visitor that judges one log while it streams by.
@@ -202,68 +128,32 @@ struct Judge {
 }
 
 impl Judge {
-    /// Parses a `coin_log.*` message strictly: the recorder's own form on the fast path ([`json`]), any
-    /// other form (or an error) by serde_json. `first` says the file's schema is the type's first version
-    /// (without the fields added since); the returned flag says whether the message has every field of the
-    /// current version.
-    fn parse(
-        slot: Slot,
-        data: &[u8],
-        first: bool,
-        decoder: Option<&MessageDecoder>,
-    ) -> Result<(f64, Value, bool), String> {
-        /// `$ty { fields in schema order } added { later fields }` read by the Protobuf decoder, or the JSON
-        /// fast path, else by serde.
-        macro_rules! typed {
-            ($variant:ident, $ty:ident { $($f:ident),+ } $(added { $($g:ident),+ })?) => {{
-                if let Some(d) = decoder {
-                    let mut v = [0.0_f64; 8];
-                    let n = d.fields().len().min(v.len());
-                    d.read(data, &mut v[..n]).map_err(|e| format!("the message {e}"))?;
-                    let mut it = v.into_iter();
-                    $(let $f = it.next().unwrap_or(0.0);)+
-                    $($(let $g = (!first).then(|| it.next().unwrap_or(0.0));)+)?
-                    let m = $ty { $($f,)+ $($($g,)+)? };
-                    return Ok((m.t, Value::$variant(m), m.is_complete()));
-                }
-                let fast = if first {
-                    json::parse_numbers(data, &[$(stringify!($f)),+])
-                        .map(|[$($f),+]| $ty { $($f,)+ $($($g: None,)+)? })
-                } else {
-                    json::parse_numbers(data, &[$(stringify!($f)),+ $($(, stringify!($g))+)?])
-                        .map(|[$($f),+ $($(, $g)+)?]| $ty { $($f,)+ $($($g: Some($g),)+)? })
-                };
-                let m: $ty = match fast {
-                    Some(m) => m,
-                    None => serde_json::from_slice(data).map_err(|e| e.to_string())?,
-                };
-                (m.t, Value::$variant(m), m.is_complete())
-            }};
+    /// Reads a message of `coin_log.*` channel `c` strictly into its field of `s`, and `s.t`.
+    fn parse(c: Channel, r: &FieldReader, data: &[u8], s: &mut Sample) -> Result<(), String> {
+        fn read<M: Message>(
+            r: &FieldReader,
+            data: &[u8],
+            slot: &mut Option<M>,
+        ) -> Result<f64, String> {
+            let m: M = r.read_message(data)?;
+            *slot = Some(m);
+            Ok(m.t())
         }
-        Ok(match slot {
-            Slot::Omega => typed!(Omega, AngularVelocity { t, x, y, z }),
-            Slot::Angles => typed!(Angles, Angles { t, theta, phi, psi } added { phi_dot }),
-            Slot::Quaternion => typed!(Quaternion, QuaternionMessage { t, x, y, z, w }),
-            Slot::Position => typed!(Position, Position { t, x, y, z }),
-            Slot::Contact => typed!(Contact, Position { t, x, y, z }),
-            Slot::Reaction => typed!(
-                Reaction,
-                ReactionMessage { t, x, y, z, friction, normal } added { friction_ratio }
-            ),
-            Slot::Energy => typed!(
-                Energy,
-                EnergyMessage { t, total, kinetic, potential } added { change, drift_eps }
-            ),
-            Slot::Invariants => typed!(Invariants, InvariantsMessage { t, c1, c2 }),
-            Slot::Work => typed!(
-                Work,
-                WorkMessage {
-                    t,
-                    dissipated,
-                    balance
-                }
-            ),
-        })
+        s.t = match c {
+            Channel::Omega => read(r, data, &mut s.omega),
+            Channel::Angles => read(r, data, &mut s.angles),
+            Channel::Quaternion => read(r, data, &mut s.quaternion),
+            Channel::Position => read(r, data, &mut s.position),
+            Channel::Contact => read(r, data, &mut s.contact),
+            Channel::Reaction => read(r, data, &mut s.reaction),
+            Channel::Energy => read(r, data, &mut s.energy),
+            Channel::Invariants => read(r, data, &mut s.invariants),
+            Channel::Work => read(r, data, &mut s.work),
+            Channel::Tf | Channel::Scene | Channel::Rerun => {
+                Err("is not a coin_log message".into())
+            }
+        }?;
+        Ok(())
     }
 
     fn run_metadata(&mut self, entries: &BTreeMap<String, String>) {
@@ -386,7 +276,7 @@ impl Visitor for Judge {
     ) {
         // A topic of fixed wire form (the CDR robot description) is judged by that form, not by the file's.
         let fixed = Topic::from_name(topic).filter(|t| *t == Topic::RerunRobot);
-        let judged = match (schema, fixed) {
+        let mut judged = match (schema, fixed) {
             (Some(s), Some(_)) => {
                 let (encoding, data, _) = ROS_STRING_WIRE;
                 if (s.encoding.as_str(), &s.data[..]) != (encoding, data) {
@@ -424,25 +314,21 @@ impl Visitor for Judge {
                         format!("topic `{topic}` has message encoding {message_encoding:?}, not {expected:?} as its schema's encoding says")
                     });
                 }
-                match t.channel() {
-                    Channel::Omega => Kind::Coin(Slot::Omega),
-                    Channel::Angles => Kind::Coin(Slot::Angles),
-                    Channel::Quaternion => Kind::Coin(Slot::Quaternion),
-                    Channel::Position => Kind::Coin(Slot::Position),
-                    Channel::Contact => Kind::Coin(Slot::Contact),
-                    Channel::Reaction => Kind::Coin(Slot::Reaction),
-                    Channel::Energy => Kind::Coin(Slot::Energy),
-                    Channel::Invariants => Kind::Coin(Slot::Invariants),
-                    Channel::Work => Kind::Coin(Slot::Work),
+                match t.channel().message_type() {
                     // The robot description is CDR, whatever the file's encoding: its schema is judged.
-                    Channel::Rerun if fixed.is_some() => Kind::Unknown,
-                    Channel::Tf | Channel::Scene | Channel::Rerun => Kind::Foxglove,
+                    _ if fixed.is_some() => Kind::Unknown,
+                    Some(m) => {
+                        let c = t.channel();
+                        self.assembler.declare(c);
+                        // A JSON channel is read as its own type, whatever type its schema names.
+                        let reader = judged.reader.take();
+                        let json = || FieldReader::json(m, judged.first_version);
+                        Kind::Coin(c, reader.unwrap_or_else(json))
+                    }
+                    None => Kind::Foxglove(t.schema_name(), judged.encoding.unwrap_or_default()),
                 }
             }
         };
-        if let Kind::Coin(slot) = kind {
-            self.assembler.declare(slot);
-        }
         let i = usize::from(id);
         if self.channels.len() <= i {
             self.channels.resize(i + 1, None);
@@ -451,9 +337,6 @@ impl Visitor for Judge {
             kind,
             topic: topic.to_string(),
             last: None,
-            first_version: judged.first_version,
-            encoding: judged.encoding.unwrap_or_default(),
-            decoder: judged.decoder,
         });
     }
 
@@ -486,18 +369,17 @@ impl Visitor for Judge {
             });
             return ControlFlow::Continue(());
         };
-        let lt = h.log_time;
+        let (lt, topic) = (h.log_time, &channel.topic);
         if h.publish_time != lt {
-            let (topic, p) = (channel.topic.clone(), h.publish_time);
+            let p = h.publish_time;
             self.problems
                 .push_with(|| format!("{topic}: publish_time {p} differs from log_time {lt}"));
         }
         if let Some(last) = channel.last {
             // One coin_log message per sample: strictly increasing. /tf and /scene may carry several
             // messages at one time (the static world → table transform and the coin's at t = 0).
-            let strict = matches!(channel.kind, Kind::Coin(_));
+            let strict = matches!(channel.kind, Kind::Coin(..));
             if lt < last || (strict && lt == last) {
-                let topic = channel.topic.clone();
                 let what = if strict {
                     "increasing"
                 } else {
@@ -509,37 +391,35 @@ impl Visitor for Judge {
             }
         }
         channel.last = Some(lt);
-        let (kind, first, encoding) = (channel.kind, channel.first_version, channel.encoding);
-        let decoder = channel.decoder.clone();
-        match kind {
-            Kind::Coin(slot) => {
-                let Some((t, value)) = self.parse_checked(slot, first, decoder.as_deref(), h, data)
-                else {
-                    return ControlFlow::Continue(());
+        match &channel.kind {
+            Kind::Coin(c, reader) => {
+                let mut s = Sample {
+                    log_time: lt,
+                    ..Sample::default()
                 };
-                match log_time(t) {
+                if let Err(e) = Self::parse(*c, reader, data, &mut s) {
+                    self.problems
+                        .push_with(|| format!("{topic}: message at {lt} ns {e}"));
+                    return ControlFlow::Continue(());
+                }
+                match log_time(s.t) {
                     Ok(expected) if expected == lt => {}
                     Ok(expected) => {
-                        let topic = self.topic(h.channel_id);
+                        let t = s.t;
                         self.problems.push_with(|| {
                             format!("{topic}: log_time {lt} ns is not round(t·1e9) = {expected} ns for t = {t}")
                         });
                     }
-                    Err(e) => {
-                        let topic = self.topic(h.channel_id);
-                        self.problems.push_with(|| format!("{topic}: {e}"));
-                    }
+                    Err(e) => self.problems.push_with(|| format!("{topic}: {e}")),
                 }
                 let checks = &mut self.checks;
                 let Some(ctx) = self.ctx.as_ref() else {
                     return ControlFlow::Break(());
                 };
-                self.assembler
-                    .push(slot, lt, t, value, &mut |s| checks.observe(s, ctx));
+                self.assembler.push(*c, &s, &mut |s| checks.observe(s, ctx));
             }
-            Kind::Foxglove => {
-                if let Err(e) = foxglove_message(encoding, h.channel_id, &self.channels, data) {
-                    let topic = self.topic(h.channel_id);
+            Kind::Foxglove(schema, encoding) => {
+                if let Err(e) = foxglove_message(*encoding, schema, data) {
                     self.problems
                         .push_with(|| format!("{topic}: message at {lt} ns {e}"));
                 }
@@ -551,82 +431,6 @@ impl Visitor for Judge {
 }
 
 impl Judge {
-    /// [`Self::parse`], recording a problem when the message does not parse or does not have exactly the
-    /// fields of its schema's version.
-    fn parse_checked(
-        &mut self,
-        slot: Slot,
-        first: bool,
-        decoder: Option<&MessageDecoder>,
-        h: &MessageHeader,
-        data: &[u8],
-    ) -> Option<(f64, Value)> {
-        let lt = h.log_time;
-        match Self::parse(slot, data, first, decoder) {
-            Ok((_, _, complete)) if complete == first => {
-                let topic = self.topic(h.channel_id);
-                let what = if first {
-                    "has fields its schema (the first version) does not declare"
-                } else {
-                    "lacks fields its schema requires"
-                };
-                self.problems
-                    .push_with(|| format!("{topic}: message at {lt} ns {what}"));
-                None
-            }
-            Ok((t, value, _)) => Some((t, value)),
-            Err(e) => {
-                let topic = self.topic(h.channel_id);
-                self.problems
-                    .push_with(|| format!("{topic}: message at {lt} ns does not parse: {e}"));
-                None
-            }
-        }
-    }
-
-    /// Checks a Protobuf schema: a `coin_log.*` type's descriptor must declare its fields (the current
-    /// version's, or the first's) as doubles, and gives the decoder of its messages; a Foxglove type's is
-    /// taken as it is.
-    fn protobuf_schema(&mut self, name: &str, data: &[u8], judged: &mut SchemaJudged) {
-        let ours = protobuf::descriptor_set(name);
-        let Some((fields, first)) = fields_of(name) else {
-            match ours {
-                Some(ours) if ours == data => {}
-                Some(_) => self.notes.push(format!(
-                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
-                )),
-                None => self
-                    .problems
-                    .push_with(|| format!("schema `{name}` is not one of coin-log's")),
-            }
-            return;
-        };
-        let decoder = match MessageDecoder::new(data, name, fields) {
-            Ok(d) => d,
-            Err(e) => match MessageDecoder::new(data, name, first) {
-                Ok(d) if fields != first => {
-                    judged.first_version = true;
-                    self.notes.push(format!(
-                        "schema `{name}` is the first version of the type, without the fields added since ({})",
-                        fields[first.len()..].join(", ")
-                    ));
-                    d
-                }
-                _ => {
-                    self.problems
-                        .push_with(|| format!("schema `{name}` (protobuf) {e}"));
-                    return;
-                }
-            },
-        };
-        if ours != Some(data) && !judged.first_version {
-            self.notes.push(format!(
-                "schema `{name}` is another version than this tool's; its messages are read by the field numbers it declares"
-            ));
-        }
-        judged.decoder = Some(Rc::new(decoder));
-    }
-
     /// Judges a channel's schema: its encoding, and its bytes against this tool's (or the versions its
     /// messages may follow).
     fn schema(&mut self, schema: &Schema<'_>) -> SchemaJudged {
@@ -635,60 +439,62 @@ impl Judge {
             schema.encoding.as_str(),
             &schema.data[..],
         );
-        let mut judged = SchemaJudged::default();
-        match Encoding::from_schema_encoding(encoding) {
-            Some(Encoding::Json) => judged.encoding = Some(Encoding::Json),
-            Some(Encoding::Protobuf) => {
-                judged.encoding = Some(Encoding::Protobuf);
-                self.protobuf_schema(name, data, &mut judged);
-                return judged;
-            }
-            None => {
-                self.problems.push_with(|| {
-                    format!(
-                        "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
-                        Encoding::Json.schema_encoding(),
-                        Encoding::Protobuf.schema_encoding()
-                    )
-                });
-                return judged;
-            }
-        }
-        match schema_bytes(name) {
-            Some(ours) if ours == data => {}
-            Some(_) => match fields_of(name) {
-                Some((fields, first)) => match validates(data, fields) {
-                    Ok(()) => self.notes.push(format!(
-                        "schema `{name}` is another version than this tool's; the messages conform to it"
-                    )),
-                    Err(e) if fields != first && validates(data, first).is_ok() => {
-                        judged.first_version = true;
-                        self.notes.push(format!(
-                            "schema `{name}` is the first version of the type, without the fields added since ({})",
-                            fields[first.len()..].join(", ")
-                        ));
-                        let _ = e;
-                    }
-                    Err(e) => self.problems.push_with(|| {
-                        format!("schema `{name}` is another version than this tool's and {e}")
-                    }),
-                },
-                None => self.notes.push(format!(
+        let Some(e) = Encoding::from_schema_encoding(encoding) else {
+            self.problems.push_with(|| {
+                format!(
+                    "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
+                    Encoding::Json.schema_encoding(),
+                    Encoding::Protobuf.schema_encoding()
+                )
+            });
+            return SchemaJudged::default();
+        };
+        let mut judged = SchemaJudged {
+            encoding: Some(e),
+            ..SchemaJudged::default()
+        };
+        let Some(t) = message_type(name) else {
+            match schema_data(name, e) {
+                Some(ours) if ours == data => {}
+                Some(_) => self.notes.push(format!(
                     "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
                 )),
-            },
-            None => self
-                .problems
-                .push_with(|| format!("schema `{name}` is not one of coin-log's")),
+                None => self
+                    .problems
+                    .push_with(|| format!("schema `{name}` is not one of coin-log's")),
+            }
+            return judged;
+        };
+        let (reader, version) = match FieldReader::new(encoding, t, data) {
+            Ok(r) => r,
+            Err(ReaderError::Descriptor(e)) => {
+                self.problems
+                    .push_with(|| format!("schema `{name}` (protobuf) {e}"));
+                return judged;
+            }
+            Err(ReaderError::Encoding(_)) => return judged,
+        };
+        match version {
+            Version::Ours => {}
+            Version::Other if e == Encoding::Json => self.notes.push(format!(
+                "schema `{name}` is another version than this tool's; the messages conform to it"
+            )),
+            Version::Other => self.notes.push(format!(
+                "schema `{name}` is another version than this tool's; its messages are read by the field numbers it declares"
+            )),
+            Version::First => {
+                judged.first_version = true;
+                self.notes.push(format!(
+                    "schema `{name}` is the first version of the type, without the fields added since ({})",
+                    t.fields[t.first_fields.len()..].join(", ")
+                ));
+            }
+            Version::Nonconforming(why) => self.problems.push_with(|| {
+                format!("schema `{name}` is another version than this tool's and {why}")
+            }),
         }
+        judged.reader = (e == Encoding::Protobuf).then_some(reader);
         judged
-    }
-
-    fn topic(&self, id: u16) -> String {
-        self.channels
-            .get(usize::from(id))
-            .and_then(Option::as_ref)
-            .map_or_else(String::new, |c| c.topic.clone())
     }
 }
 
@@ -702,14 +508,15 @@ fn unusable(path: &str, problem: String) -> FileReport {
     }
 }
 
-/// Judges one file (see [`super::verify_file`]).
+/// Judges one file. Never fails: an unreadable file is a report with exit code 2 and the reason in
+/// [`FileReport::problem`].
+#[must_use]
 pub fn verify_file(path: &Path, options: &Options) -> FileReport {
-    let mut judge = Judge::default();
-    let (structure, error) = coin_log_mcap::read(path, &mut judge);
-    verdict(path.display().to_string(), judge, structure, error, options)
+    verify_file_with_progress(path, options, &|_| {})
 }
 
-/// Judges one file, reporting the bytes read (see [`super::verify_file_with_progress`]).
+/// [`verify_file`], calling `progress` with the bytes read so far (from the reading thread).
+#[must_use]
 pub fn verify_file_with_progress(
     path: &Path,
     options: &Options,
@@ -720,7 +527,8 @@ pub fn verify_file_with_progress(
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 
-/// Judges an MCAP held in memory (see [`super::verify_bytes`]).
+/// Judges an MCAP file held in memory, named `name` in the report (for tests and fuzzing).
+#[must_use]
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();
     let source = std::io::Cursor::new(bytes);
@@ -823,7 +631,7 @@ impl Judge {
             self.problems
                 .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
         }
-        if ctx.run.dissipation.is_none() && self.assembler.declared(Slot::Work) {
+        if ctx.run.dissipation.is_none() && self.assembler.declared(Channel::Work) {
             self.problems.push_with(|| {
                 "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
             });
@@ -905,10 +713,10 @@ fn missing_required(results: &[CheckResult]) -> Option<String> {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use crate::format::messages::ReactionMessage;
 
-    /// The fast path only pays off if it reads the fields in the order the recorder writes them.
     #[test]
-    fn the_fast_path_reads_what_the_recorder_writes() {
+    fn a_message_reads_as_the_version_of_its_schema() {
         let mut buf = Vec::new();
         let m = ReactionMessage {
             t: 0.5,
@@ -920,45 +728,33 @@ mod tests {
             friction_ratio: Some(4.0),
         };
         m.write_json(&mut buf).unwrap();
+        let parse = |data, first| {
+            let mut s = Sample::default();
+            let r = FieldReader::json(&ReactionMessage::TYPE, first);
+            Judge::parse(Channel::Reaction, &r, data, &mut s).map(|()| s)
+        };
+        let s = parse(&buf, false).unwrap();
+        assert_eq!(s.t.to_bits(), 0.5_f64.to_bits());
+        assert_eq!(s.reaction, Some(m));
+        // The same message read as the first version (no friction_ratio in its schema) has a field too
+        // many; one without it is read without it.
         assert_eq!(
-            ReactionMessage::FIELDS,
-            ["t", "x", "y", "z", "friction", "normal", "friction_ratio"]
+            parse(&buf, true).unwrap_err(),
+            "has fields its schema (the first version) does not declare"
         );
-        let (t, v, complete) = Judge::parse(Slot::Reaction, &buf, false, None).unwrap();
-        assert_eq!(t.to_bits(), 0.5_f64.to_bits());
-        assert!(matches!(v, Value::Reaction(r) if r == m));
-        assert!(complete);
-        // The same message read as the first version (no friction_ratio in its schema) is not complete
-        // only if it lacks the field: this one has it, so the caller flags it.
-        let (_, _, complete) = Judge::parse(Slot::Reaction, &buf, true, None).unwrap();
-        assert!(complete);
         let old = br#"{"t":0.5,"x":0.1,"y":-0.2,"z":1e-17,"friction":3.0,"normal":0.75}"#;
-        let (_, v, complete) = Judge::parse(Slot::Reaction, old, true, None).unwrap();
-        assert!(!complete);
-        assert!(matches!(v, Value::Reaction(r) if r.friction_ratio.is_none()));
-        for (slot, fields) in [
-            (Slot::Omega, AngularVelocity::FIELDS),
-            (Slot::Angles, Angles::FIELDS),
-            (Slot::Quaternion, QuaternionMessage::FIELDS),
-            (Slot::Position, Position::FIELDS),
-            (Slot::Energy, EnergyMessage::FIELDS),
-            (Slot::Invariants, InvariantsMessage::FIELDS),
-        ] {
-            let text: Vec<String> = fields.iter().map(|f| format!("\"{f}\":1")).collect();
-            let text = format!("{{{}}}", text.join(","));
-            let fields_fast: &[&str] = match slot {
-                Slot::Omega | Slot::Position => &["t", "x", "y", "z"],
-                Slot::Angles => &["t", "theta", "phi", "psi", "phi_dot"],
-                Slot::Quaternion => &["t", "x", "y", "z", "w"],
-                Slot::Energy => &["t", "total", "kinetic", "potential", "change", "drift_eps"],
-                _ => &["t", "c1", "c2"],
+        let s = parse(old, true).unwrap();
+        assert!(s.reaction.unwrap().friction_ratio.is_none());
+        for c in Channel::ALL {
+            let Some(t) = c.message_type() else {
+                continue;
             };
-            assert_eq!(fields, fields_fast, "{slot:?}");
+            let text: Vec<String> = t.fields.iter().map(|f| format!("\"{f}\":1")).collect();
+            let text = format!("{{{}}}", text.join(","));
+            let r = FieldReader::json(t, false);
+            let mut s = Sample::default();
             assert!(
-                matches!(
-                    Judge::parse(slot, text.as_bytes(), false, None),
-                    Ok((_, _, true))
-                ),
+                Judge::parse(*c, &r, text.as_bytes(), &mut s).is_ok(),
                 "{text}"
             );
         }

@@ -88,22 +88,21 @@ impl CheckResult {
     }
 }
 
-/// The overall status of one file (format.md: verify, Output).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Verdict {
-    /// Every check that ran passed, and the required ones ran (exit 0).
-    #[serde(rename = "ok")]
-    Ok,
-    /// A check failed (exit 1).
-    #[serde(rename = "failed")]
-    Failed,
-    /// No check failed, but the required checks could not run: `energy`, or both `constraint` and
-    /// `steady` (exit 1, as a failure, for scripts that only read the exit code).
-    #[serde(rename = "cannot-verify")]
-    CannotVerify,
-    /// The file is unreadable, truncated, corrupt, not MCAP or not a coin-log file (exit 2).
-    #[serde(rename = "unusable")]
-    Unusable,
+coin_log_names::named_enum! {
+    /// The overall status of one file (format.md: verify, Output).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+    #[serde(rename_all = "kebab-case")]
+    pub enum Verdict: "verdict" {
+        /// Every check that ran passed, and the required ones ran (exit 0).
+        Ok = "ok",
+        /// A check failed (exit 1).
+        Failed = "failed",
+        /// No check failed, but the required checks could not run: `energy`, or both `constraint` and
+        /// `steady` (exit 1, as a failure, for scripts that only read the exit code).
+        CannotVerify = "cannot-verify",
+        /// The file is unreadable, truncated, corrupt, not MCAP or not a coin-log file (exit 2).
+        Unusable = "unusable",
+    }
 }
 
 impl Verdict {
@@ -166,5 +165,24 @@ impl Report {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         self.files.iter().map(|f| f.exit_code).max().unwrap_or(0)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_json_names_are_the_names() {
+        for v in Verdict::ALL {
+            assert_eq!(serde_json::to_value(v).unwrap(), v.name());
+        }
+        for c in CheckId::ALL {
+            assert_eq!(serde_json::to_value(c).unwrap(), c.name());
+        }
+        for s in Status::ALL {
+            assert_eq!(serde_json::to_value(s).unwrap(), s.name());
+        }
     }
 }

@@ -8,87 +8,28 @@ use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,
     ReactionMessage, WorkMessage,
 };
+use crate::format::Channel;
 use crate::model::State;
 use std::collections::VecDeque;
 
 /// Most samples waiting for their other channels.
 const MAX_PENDING: usize = 4096;
 
-/// Index of each `coin_log.*` channel in a sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Slot {
-    /// `/coin/omega`.
-    Omega = 0,
-    /// `/coin/angles`.
-    Angles = 1,
-    /// `/coin/quaternion`.
-    Quaternion = 2,
-    /// `/coin/position`.
-    Position = 3,
-    /// `/coin/contact`.
-    Contact = 4,
-    /// `/coin/reaction`.
-    Reaction = 5,
-    /// `/coin/energy`.
-    Energy = 6,
-    /// `/coin/invariants`.
-    Invariants = 7,
-    /// `/coin/work` (dissipative runs).
-    Work = 8,
-}
-
-/// Number of slots.
-pub const SLOTS: usize = 9;
-
-/// A parsed message of one slot.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Value {
-    /// ω.
-    Omega(AngularVelocity),
-    /// θ, φ, ψ.
-    Angles(Angles),
-    /// q.
-    Quaternion(QuaternionMessage),
-    /// Centre.
-    Position(Position),
-    /// Contact point.
-    Contact(Position),
-    /// R, F, N.
-    Reaction(ReactionMessage),
-    /// E.
-    Energy(EnergyMessage),
-    /// C1, C2.
-    Invariants(InvariantsMessage),
-    /// W, E + W.
-    Work(WorkMessage),
-}
-
-/// The stored values at one log time.
+/// The stored values at one log time \[ns\]; `t` is the first message's.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Sample {
-    /// Log time \[ns\].
     pub log_time: u64,
-    /// Simulation time (of the first message of the sample).
     pub t: f64,
-    /// ω.
     pub omega: Option<AngularVelocity>,
-    /// θ, φ, ψ.
     pub angles: Option<Angles>,
-    /// q.
     pub quaternion: Option<QuaternionMessage>,
-    /// Centre.
     pub position: Option<Position>,
-    /// Contact point.
     pub contact: Option<Position>,
-    /// R, F, N.
     pub reaction: Option<ReactionMessage>,
-    /// E.
     pub energy: Option<EnergyMessage>,
-    /// C1, C2.
     pub invariants: Option<InvariantsMessage>,
-    /// W, E + W.
     pub work: Option<WorkMessage>,
-    present: u16,
+    pub(super) present: u16,
 }
 
 impl Sample {
@@ -109,17 +50,19 @@ impl Sample {
         })
     }
 
-    fn set(&mut self, value: Value) {
-        match value {
-            Value::Omega(m) => self.omega = Some(m),
-            Value::Angles(m) => self.angles = Some(m),
-            Value::Quaternion(m) => self.quaternion = Some(m),
-            Value::Position(m) => self.position = Some(m),
-            Value::Contact(m) => self.contact = Some(m),
-            Value::Reaction(m) => self.reaction = Some(m),
-            Value::Energy(m) => self.energy = Some(m),
-            Value::Invariants(m) => self.invariants = Some(m),
-            Value::Work(m) => self.work = Some(m),
+    /// Takes `channel`'s message from `o`.
+    fn set(&mut self, channel: Channel, o: &Sample) {
+        match channel {
+            Channel::Omega => self.omega = o.omega,
+            Channel::Angles => self.angles = o.angles,
+            Channel::Quaternion => self.quaternion = o.quaternion,
+            Channel::Position => self.position = o.position,
+            Channel::Contact => self.contact = o.contact,
+            Channel::Reaction => self.reaction = o.reaction,
+            Channel::Energy => self.energy = o.energy,
+            Channel::Invariants => self.invariants = o.invariants,
+            Channel::Work => self.work = o.work,
+            Channel::Tf | Channel::Scene | Channel::Rerun => {}
         }
     }
 }
@@ -128,63 +71,56 @@ impl Sample {
 #[derive(Debug, Default)]
 pub struct Assembler {
     pending: VecDeque<Sample>,
-    last: [Option<u64>; SLOTS],
+    last: [Option<u64>; Channel::ALL.len()],
     declared: u16,
 }
 
 impl Assembler {
-    /// Marks a slot as present in the file (its channel record was read).
-    pub fn declare(&mut self, slot: Slot) {
-        self.declared |= 1 << slot as u16;
+    /// Marks a channel as present in the file (its channel record was read).
+    pub fn declare(&mut self, channel: Channel) {
+        self.declared |= 1 << channel as u16;
     }
 
-    /// True when the slot's channel is in the file.
+    /// True when the channel is in the file.
     #[must_use]
-    pub fn declared(&self, slot: Slot) -> bool {
-        self.declared & (1 << slot as u16) != 0
+    pub fn declared(&self, channel: Channel) -> bool {
+        self.declared & (1 << channel as u16) != 0
     }
 
-    /// Adds one message; calls `out` with every sample that can no longer grow.
-    pub fn push(
-        &mut self,
-        slot: Slot,
-        log_time: u64,
-        t: f64,
-        value: Value,
-        out: &mut impl FnMut(&Sample),
-    ) {
-        let bit = 1u16 << slot as u16;
+    /// Adds `one`, a sample of `channel`'s message alone; calls `out` with every sample that can no
+    /// longer grow.
+    pub fn push(&mut self, channel: Channel, one: &Sample, out: &mut impl FnMut(&Sample)) {
+        let (bit, log_time) = (1u16 << channel as u16, one.log_time);
         self.declared |= bit;
-        self.last[slot as usize] = Some(log_time);
+        self.last[channel as usize] = Some(log_time);
         let position = self.pending.iter().rposition(|s| s.log_time <= log_time);
         match position {
             Some(i) if self.pending[i].log_time == log_time => {
                 let s = &mut self.pending[i];
                 if s.present & bit == 0 {
                     s.present |= bit;
-                    s.set(value);
+                    s.set(channel, one);
                 }
             }
             _ => {
-                let mut s = Sample {
-                    log_time,
-                    t,
-                    present: bit,
-                    ..Sample::default()
-                };
-                s.set(value);
                 let at = position.map_or(0, |i| i + 1);
-                self.pending.insert(at, s);
+                self.pending.insert(
+                    at,
+                    Sample {
+                        present: bit,
+                        ..*one
+                    },
+                );
             }
         }
         self.flush_ready(out);
     }
 
     fn flush_ready(&mut self, out: &mut impl FnMut(&Sample)) {
-        // A sample is final when every declared slot has moved past it (each channel's log times
-        // increase), or when all declared slots are in and a later sample has begun (a channel record
+        // A sample is final when every declared channel has moved past it (each channel's log times
+        // increase), or when all declared channels are in and a later sample has begun (a channel record
         // may be written just before its first message, so "all declared" alone can be premature).
-        let horizon = (0..SLOTS)
+        let horizon = (0..Channel::ALL.len())
             .filter(|i| self.declared & (1 << i) != 0)
             .map(|i| self.last[i].unwrap_or(0))
             .min()

@@ -9,14 +9,13 @@
 
 use super::{fmt_num, worst, Context, Max};
 use crate::format::messages::{drift_eps, friction_ratio};
+use crate::format::tolerances::RECOMPUTE_TOLERANCE;
 use crate::model::orientation;
 use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::RECOMPUTE_TOLERANCE;
 use nalgebra::Quaternion;
 
-/// Running state of the consistency check.
 #[derive(Debug, Default, Clone)]
 pub struct ConsistencyCheck {
     quaternion: Max,
@@ -38,7 +37,6 @@ pub struct ConsistencyCheck {
 const ADDED: [&str; 4] = ["phi_dot", "friction_ratio", "energy change", "drift_eps"];
 
 impl ConsistencyCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let p = ctx.coin.params();
         let a = p.radius();
@@ -133,63 +131,37 @@ impl ConsistencyCheck {
         }
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self) -> CheckResult {
-        let mut measures = Vec::new();
-        let mut parts = Vec::new();
-        let tol = RECOMPUTE_TOLERANCE;
-        if self.counts[0] > 0 {
-            measures.push((self.quaternion.value, tol, "quaternion"));
-            measures.push((self.norm.value, tol, "quaternion norm"));
-            parts.push(format!(
-                "q vs angles {} (t = {}), | |q| - 1 | {}",
-                fmt_num(self.quaternion.value),
-                fmt_num(self.quaternion.t),
-                fmt_num(self.norm.value)
-            ));
-        }
-        if self.counts[1] > 0 {
-            measures.push((self.height.value, tol, "height"));
-            parts.push(format!(
-                "|y - a cos θ|/a {} (t = {})",
-                fmt_num(self.height.value),
-                fmt_num(self.height.t)
-            ));
-        }
-        if self.counts[2] > 0 {
-            measures.push((self.contact.value, tol, "contact"));
-            parts.push(format!(
-                "contact vs centre + c {} (t = {})",
-                fmt_num(self.contact.value),
-                fmt_num(self.contact.t)
-            ));
-        }
-        if self.counts[3] > 0 {
-            measures.push((self.reaction.value, tol, "reaction"));
-            parts.push(format!(
-                "R vs recomputed {} (t = {})",
-                fmt_num(self.reaction.value),
-                fmt_num(self.reaction.t)
-            ));
-        }
+        let (c, q, n) = (self.counts, &self.quaternion, &self.norm);
+        let (h, k, r) = (&self.height, &self.contact, &self.reaction);
+        // (samples, value, time of the worst, label, what the reason calls it)
+        let mut entries = vec![
+            (c[0], q.value, Some(q.t), "quaternion", "q vs angles"),
+            (c[0], n.value, None, "quaternion norm", "| |q| - 1 |"),
+            (c[1], h.value, Some(h.t), "height", "|y - a cos θ|/a"),
+            (c[2], k.value, Some(k.t), "contact", "contact vs centre + c"),
+            (c[3], r.value, Some(r.t), "reaction", "R vs recomputed"),
+        ];
         for ((m, count), label) in self.added.iter().zip(self.added_counts).zip(ADDED) {
-            if count > 0 {
-                measures.push((m.value, tol, label));
-                parts.push(format!(
-                    "{label} {} (t = {})",
-                    fmt_num(m.value),
-                    fmt_num(m.t)
-                ));
-            }
+            entries.push((count, m.value, Some(m.t), label, label));
         }
         if let Some(offset) = self.initial {
-            measures.push((offset, tol, "initial state"));
-            parts.push(format!(
-                "t = 0 vs the stored scene's initial state {}",
-                fmt_num(offset)
-            ));
+            let what = "t = 0 vs the stored scene's initial state";
+            entries.push((1, offset, None, "initial state", what));
         }
+        entries.retain(|e| e.0 > 0);
+        let measures: Vec<_> = entries
+            .iter()
+            .map(|e| (e.1, RECOMPUTE_TOLERANCE, e.3))
+            .collect();
+        let parts: Vec<String> = entries
+            .iter()
+            .map(|(_, value, t, _, what)| match t {
+                Some(t) => format!("{what} {} (t = {})", fmt_num(*value), fmt_num(*t)),
+                None => format!("{what} {}", fmt_num(*value)),
+            })
+            .collect();
         let Some((value, tolerance, which)) = worst(&measures) else {
             return CheckResult::skip(
                 CheckId::Consistency,

@@ -17,9 +17,9 @@
 //! windows look unresolved.
 
 use super::{fmt_num, Max};
+use crate::format::tolerances::Tolerances;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::Tolerances;
 use nalgebra::Vector3;
 
 /// Central difference weights for f′(0)·h at offsets 1..4 (antisymmetric), 8th order.
@@ -30,7 +30,7 @@ const EIGHTH_DIFFERENCE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 
 /// samples (φ̇ ∝ 1/(t + d)) judged resolved erred by 1.2e-6 against a tolerance of 4e-7.
 const SINGULAR_GROWTH: f64 = 3.0;
 /// Window length.
-const WINDOW: usize = 9;
+pub(crate) const WINDOW: usize = 9;
 /// Relative spread of sample intervals accepted as equal spacing.
 const SPACING_TOLERANCE: f64 = 1e-6;
 /// Safety factor on the truncation estimate (hΩ)⁸/630.
@@ -101,7 +101,6 @@ pub fn min_rate(rate: f64, tol: f64) -> f64 {
     1.0 / h
 }
 
-/// Running state of the constraint check.
 #[derive(Debug, Clone)]
 pub struct ConstraintCheck {
     window: [Entry; WINDOW],
@@ -131,7 +130,6 @@ impl Default for ConstraintCheck {
 }
 
 impl ConstraintCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, a: f64) {
         let (Some(w), Some(ang), Some(p)) = (s.omega, s.angles, s.position) else {
             self.len = 0;
@@ -215,7 +213,6 @@ impl ConstraintCheck {
         bucket.residual.offer(residual.norm(), centre.t);
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, a: f64, tol: &Tolerances) -> CheckResult {
         if self.samples < WINDOW as u64 {

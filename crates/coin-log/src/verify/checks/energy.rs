@@ -7,11 +7,11 @@
 //! equal E recomputed plus the stored W. Without `/coin/work` a dissipative file's energy cannot be judged.
 
 use super::{fmt_num, worst, Context, Max};
+use crate::format::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
 use crate::model::drift::EnergyDrift;
 use crate::model::energy;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
 
 /// Running state of the energy check.
 #[derive(Debug, Default, Clone)]

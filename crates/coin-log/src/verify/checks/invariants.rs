@@ -2,11 +2,11 @@
 //! drift = max|C − C₀| / (|C1₀| + |C2₀|) (format.md), and agreement with `/coin/invariants` when stored.
 
 use super::{fmt_num, worst, Max};
+use crate::format::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
 use crate::model::drift::InvariantDrift;
 use crate::model::CoinParams;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
 
 /// Running state of the invariants check, given a way to evaluate (C1, C2) from (θ, ω_Y, ω_Z).
 #[derive(Debug, Default, Clone)]

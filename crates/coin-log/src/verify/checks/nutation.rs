@@ -10,12 +10,12 @@
 //! estimate plus the meter's bound on its interpolation error ([`TurningPoints::interpolation_error`]).
 
 use super::{fmt_num, worst, Context};
+use crate::format::tolerances::Tolerances;
 use crate::model::nutation::{Motion, Orbit};
 use crate::model::{State, TurningPoints};
 use crate::scene::defaults;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::Tolerances;
 
 /// Fewest samples per nutation period for the crossings to be interpolated.
 const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
@@ -24,7 +24,6 @@ const INTERPOLATION_SHARE: f64 = 0.1;
 /// Smallest θ range worth measuring \[rad\]: below it the crossings of ω_X are the integrator's noise.
 const MIN_AMPLITUDE: f64 = 1e-8;
 
-/// Running state of the nutation check.
 #[derive(Debug, Default, Clone)]
 pub struct NutationCheck {
     initial: Option<State>,
@@ -32,7 +31,6 @@ pub struct NutationCheck {
 }
 
 impl NutationCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Some(state) = s.state() else {
             return;

@@ -3,12 +3,12 @@
 //! contact point must have the radii R_G and R_C of the metadata (fitted by least squares).
 
 use super::{fmt_num, worst, Context, Max};
+use crate::format::tolerances::Tolerances;
 use crate::format::RunMetadata;
 use crate::model::{Coin, Steady};
 use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::Tolerances;
 use nalgebra::{Matrix3, Vector3};
 
 /// Smallest heading range over which a circle is fitted \[rad\]: shorter arcs make the radius ill-conditioned.
@@ -17,9 +17,6 @@ const MIN_ARC: f64 = 0.5;
 /// The steady motion a log's scene asks for, or why the check does not apply. The stored scene (`scene`,
 /// read by the same typed parser and validation as `record` uses) names it; the motion is rebuilt for the
 /// metadata's body.
-///
-/// # Errors
-/// A sentence saying why there is no steady motion to compare with.
 pub fn plan(
     coin: &Coin,
     run: &RunMetadata,
@@ -103,7 +100,6 @@ impl CircleFit {
     }
 }
 
-/// Running state of the steady check.
 #[derive(Debug, Default, Clone)]
 pub struct SteadyCheck {
     acceleration: Max,
@@ -117,7 +113,6 @@ pub struct SteadyCheck {
 }
 
 impl SteadyCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Ok(steady) = &ctx.steady else { return };
         let (Some(w), Some(a)) = (s.omega, s.angles) else {
@@ -148,7 +143,6 @@ impl SteadyCheck {
         }
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, ctx: &Context, tol: &Tolerances) -> CheckResult {
         let steady = match &ctx.steady {

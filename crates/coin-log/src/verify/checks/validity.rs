@@ -3,10 +3,10 @@
 //! at the event, is where the inequality becomes an equality.
 
 use super::{fmt_num, Context, Max};
+use crate::format::tolerances::VALIDITY_TOLERANCE;
 use crate::format::Termination;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
-use crate::verify::tolerances::VALIDITY_TOLERANCE;
 
 /// One sample's margins: N/(Mg) and (|F| − μN)/(Mg).
 #[derive(Debug, Clone, Copy)]
@@ -29,7 +29,6 @@ pub struct ValidityCheck {
 }
 
 impl ValidityCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let (normal, friction) = if let Some(r) = s.reaction {
             (r.normal, r.friction)
@@ -72,7 +71,6 @@ impl ValidityCheck {
         }
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, ctx: &Context) -> CheckResult {
         let mut this = self.clone();
