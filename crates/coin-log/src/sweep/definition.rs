@@ -341,3 +341,60 @@ impl From<&Random> for RandomJson {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Sweep;
+
+    /// The identity of a sweep with every part (set, zipped and spaced axes, each distribution, output)
+    /// is pinned: a changed identity would refuse to resume every existing sweep folder.
+    #[test]
+    fn the_identity_of_a_fixed_sweep_is_pinned() {
+        let text = r#"
+description = "pinned"
+base = "wobble"
+set = { "run.duration" = 2.0 }
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 0.3, 3]
+zip = "a"
+[[axis]]
+key = "body.mass"
+values = [1.0, 2, 3.5]
+zip = "a"
+[[axis]]
+key = "run.rate"
+logspace = [1, 2, 2]
+[random]
+seed = 7
+count = 2
+[[random.draw]]
+key = "body.friction"
+uniform = [0.5, 1.0]
+[[random.draw]]
+key = "body.radius"
+log_uniform = [0.1, 10]
+[[random.draw]]
+key = "body.gravity"
+normal = { mean = 1.0, std = 0.1, min = 0.5 }
+[[random.draw]]
+key = "run.integrator"
+choice = ["rk4", "dop853"]
+[output]
+channels = ["omega", "angles"]
+encoding = "protobuf"
+compression = "lz4"
+verify = false
+"#;
+        let parse = |text| Sweep::parse(text, std::path::Path::new("."), "pinned.toml").unwrap();
+        let (full, bare) = (parse(text), parse("base = \"wobble\""));
+        assert_eq!(
+            full.identity(),
+            "e01b1e4c1a5af169210be07931b946d2c4c1dbbfdcf467140ef95d4fc2a68346"
+        );
+        assert_eq!(
+            bare.identity(),
+            "4f6db358526d76d6a7535fc24ea1bc8c826c6d112e71195f10acd01fe5d80011"
+        );
+    }
+}
