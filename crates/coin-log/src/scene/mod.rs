@@ -70,14 +70,6 @@ pub enum SceneError {
         /// What is wrong.
         reason: String,
     },
-    /// No built-in scene of that name.
-    #[error("no built-in scene `{name}` and no such file; built-in scenes: {valid}")]
-    UnknownPreset {
-        /// The name given.
-        name: String,
-        /// The valid names, comma-separated.
-        valid: String,
-    },
     /// Values out of range, missing or contradictory; every problem found (at least one).
     #[error("{0}")]
     Invalid(SceneProblems),

@@ -41,10 +41,6 @@ builtins!(
 /// and edits then change a built-in as they change a scene that never set those keys (`--integrator rk4`
 /// finds no rtol to warn about, a dissipation added with `--set` adds the `work` channel).
 #[must_use]
-#[allow(
-    clippy::too_many_lines,
-    reason = "a table: one match arm per built-in scene, each a literal scene"
-)]
 pub fn preset(name: &str) -> Option<SceneFile> {
     let text = NAMES.iter().position(|n| *n == name).map(|i| TEXTS[i])?;
     // Every file parses: a test reads each one.

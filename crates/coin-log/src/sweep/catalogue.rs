@@ -34,9 +34,6 @@ coin_log_names::named_enum! {
     }
 }
 
-/// The columns before the swept keys.
-pub const LEADING_COLUMNS: [&str; 1] = ["index"];
-
 /// The columns after the swept keys.
 pub const TRAILING_COLUMNS: [&str; 20] = [
     "status",
@@ -61,19 +58,12 @@ pub const TRAILING_COLUMNS: [&str; 20] = [
     "wall_time_s",
 ];
 
-/// The one column that depends on the machine.
-pub const WALL_TIME_COLUMN: &str = "wall_time_s";
-
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
 #[must_use]
 pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
-    let keys = keys.map(str::to_string);
-    let fixed = |c: &[&str]| c.iter().map(|c| (*c).to_string()).collect::<Vec<_>>();
-    fixed(&LEADING_COLUMNS)
-        .into_iter()
-        .chain(keys)
-        .chain(fixed(&TRAILING_COLUMNS))
-        .collect()
+    let trailing = TRAILING_COLUMNS.into_iter();
+    let columns = std::iter::once("index").chain(keys).chain(trailing);
+    columns.map(str::to_string).collect()
 }
 
 /// What `analyse` predicts for a run's initial state, by quadrature of the conservative motion

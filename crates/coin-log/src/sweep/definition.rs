@@ -8,7 +8,7 @@ use crate::files::{self, InputKind};
 use crate::format::Encoding;
 use crate::record::foxglove::PROTOBUF_MAX_SECONDS;
 use crate::record::RecordOptions;
-use crate::scene::{self, FlagOverrides, Scene, SceneError};
+use crate::scene::{self, Scene, SceneError};
 use coin_log_mcap::Compression;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -147,12 +147,6 @@ impl Sweep {
         })
     }
 
-    /// Grid points: the product of the dimensions' lengths (1 without axes).
-    #[must_use]
-    pub fn grid_points(&self) -> u64 {
-        self.lengths().product()
-    }
-
     /// Each dimension's length, slowest first.
     pub(super) fn lengths(&self) -> impl DoubleEndedIterator<Item = u64> + ExactSizeIterator + '_ {
         self.dimensions
@@ -163,7 +157,7 @@ impl Sweep {
     /// How many runs: grid points × `random.count`.
     #[must_use]
     pub fn runs(&self) -> u64 {
-        self.grid_points() * self.random.as_ref().map_or(1, |r| r.count)
+        self.lengths().product::<u64>() * self.random.as_ref().map_or(1, |r| r.count)
     }
 
     /// The swept keys, each a catalogue column: the axes, then the draws, in the file's order.
@@ -230,7 +224,7 @@ impl Sweep {
     /// [`RunSceneError`] when the values give no valid scene.
     pub fn scene(&self, values: &[toml::Value]) -> Result<Scene, RunSceneError> {
         let file = scene::file_from_table(self.table(values)?)?;
-        let scene = scene::resolve(&file, &FlagOverrides::default())?;
+        let scene = Scene::from_file(&file)?;
         if self.settings.encoding == Encoding::Protobuf && scene.run.duration > PROTOBUF_MAX_SECONDS
         {
             return Err(RunSceneError::TooLongForProtobuf(scene.run.duration));

@@ -24,12 +24,12 @@ pub const CATALOGUE_FILE: &str = "catalogue.csv";
 /// The whole sweep's JSON: the plan and the counts.
 pub const SWEEP_JSON_FILE: &str = "sweep.json";
 /// What `format` says in the plan and `sweep.json`.
-pub const FORMAT_NAME: &str = "coin-log sweep";
+const FORMAT_NAME: &str = "coin-log sweep";
 /// The version of the sweep folder's layout (format.md: The sweep folder).
 pub const FORMAT_VERSION: &str = "1";
 /// The journal's first column, before the catalogue's: the file's modification time when its row was
 /// written, nanoseconds since 1970 (0 without a file).
-pub const MTIME_COLUMN: &str = "mtime_ns";
+const MTIME_COLUMN: &str = "mtime_ns";
 
 /// `run-<index>.mcap`, the index zero-padded to `width` digits.
 #[must_use]
@@ -93,7 +93,7 @@ pub struct ShardLock {
 
 /// The plan: the sweep as resolved, its identity, and what `collect` needs (runs, columns, file names).
 #[must_use]
-pub fn plan_json(sweep: &Sweep) -> serde_json::Value {
+fn plan_json(sweep: &Sweep) -> serde_json::Value {
     serde_json::json!({
         "format": FORMAT_NAME,
         "format_version": FORMAT_VERSION,

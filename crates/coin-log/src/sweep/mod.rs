@@ -16,27 +16,18 @@ mod file;
 mod folder;
 mod hash;
 mod preview;
-pub mod random;
+mod random;
 mod run;
-pub mod shard;
+mod shard;
 mod space;
 mod validate;
 
-pub use catalogue::{
-    columns, FailureKind, RunStatus, LEADING_COLUMNS, TRAILING_COLUMNS, WALL_TIME_COLUMN,
-};
 pub use collect::{collect, Collected};
-pub use definition::{
-    Axis, Draw, Random, RunSceneError, Settings, Sweep, CHANNELS_KEY, MAX_AXIS_VALUES, MAX_RUNS,
-};
+pub use definition::Sweep;
 pub use error::SweepError;
-pub use file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
-pub use folder::{
-    part_file_name, run_file_name, CATALOGUE_FILE, FORMAT_VERSION, PLAN_FILE, STATE_DIR,
-    SWEEP_JSON_FILE,
-};
-pub use hash::{sha256_file, sha256_hex};
+pub use hash::sha256_hex;
 pub use preview::{preview, Preview, MESSAGES_PER_SECOND, SAMPLED_RUNS};
+pub use random::word;
 pub use run::{run, Progress, RunOptions, SweepOutcome};
 pub use shard::{Shard, ShardError};
 pub use space::{linspace, logspace};

@@ -24,7 +24,7 @@ const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// Attempts a bounded normal draw makes before it gives up: the bounds would have to hold less than
 /// about one millionth of the distribution to reach it.
-pub const NORMAL_ATTEMPTS: u64 = 1_000_000;
+const NORMAL_ATTEMPTS: u64 = 1_000_000;
 
 /// splitmix64's output function: a bijection of u64 that mixes every bit into every other.
 fn mix(mut z: u64) -> u64 {

@@ -6,15 +6,15 @@
 use std::fmt;
 
 /// Slurm's job-array variables.
-pub const SLURM_TASK_ID: &str = "SLURM_ARRAY_TASK_ID";
+const SLURM_TASK_ID: &str = "SLURM_ARRAY_TASK_ID";
 /// The number of tasks of the array.
-pub const SLURM_TASK_COUNT: &str = "SLURM_ARRAY_TASK_COUNT";
+const SLURM_TASK_COUNT: &str = "SLURM_ARRAY_TASK_COUNT";
 /// The lowest task id.
-pub const SLURM_TASK_MIN: &str = "SLURM_ARRAY_TASK_MIN";
+const SLURM_TASK_MIN: &str = "SLURM_ARRAY_TASK_MIN";
 /// The highest task id.
-pub const SLURM_TASK_MAX: &str = "SLURM_ARRAY_TASK_MAX";
+const SLURM_TASK_MAX: &str = "SLURM_ARRAY_TASK_MAX";
 /// The index of a Kubernetes Indexed Job's pod (its count is the Job's `completions`, given by a flag).
-pub const KUBERNETES_INDEX: &str = "JOB_COMPLETION_INDEX";
+const KUBERNETES_INDEX: &str = "JOB_COMPLETION_INDEX";
 
 /// Shard `index` of `count`: the runs with run index ≡ `index` (mod `count`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
