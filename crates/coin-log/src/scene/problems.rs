@@ -171,12 +171,7 @@ impl<'a> ProblemCollector<'a> {
 
 /// A number as the user would write it (`-1`, `0.5`, `1e-9`, `NaN`, `inf`).
 pub(super) fn number(value: f64) -> String {
-    let magnitude = value.abs();
-    if value.is_finite() && value != 0.0 && !(1e-4..1e16).contains(&magnitude) {
-        ryu::Buffer::new().format_finite(value).to_string()
-    } else {
-        format!("{value}")
-    }
+    super::Short(value).to_string()
 }
 
 pub(super) fn numbers(values: &[f64]) -> String {

@@ -25,7 +25,7 @@ pub const MAX_RUNS: u64 = 1_000_000_000;
 pub const MAX_AXIS_VALUES: u64 = 1_000_000;
 
 /// One grid axis, its values expanded.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Axis {
     /// Dotted scene key.
     pub key: String,
@@ -251,68 +251,8 @@ impl Sweep {
     /// identity hashes.
     #[must_use]
     pub fn description_json(&self) -> serde_json::Value {
-        let description = Description {
-            description: &self.description,
-            base: &self.base,
-            base_scene: toml::to_string(&self.base_table).unwrap_or_default(),
-            set: self.set.iter().map(|(k, v)| (k.as_str(), v)).collect(),
-            axes: self.axes.iter().map(AxisJson::from).collect(),
-            random: self.random.as_ref().map(RandomJson::from),
-            output: &self.settings,
-        };
-        serde_json::to_value(description).unwrap_or(serde_json::Value::Null)
-    }
-
-    /// SHA-256 (hex) of the compact JSON of [`description_json`](Self::description_json): two sweeps
-    /// with the same identity make the same runs.
-    #[must_use]
-    pub fn identity(&self) -> String {
-        super::hash::sha256_hex(self.description_json().to_string().as_bytes())
-    }
-}
-
-/// The scene key `output.channels` sets.
-pub const CHANNELS_KEY: &str = "record.channels";
-
-#[derive(Serialize)]
-struct Description<'a> {
-    description: &'a str,
-    base: &'a str,
-    base_scene: String,
-    set: BTreeMap<&'a str, &'a toml::Value>,
-    axes: Vec<AxisJson<'a>>,
-    random: Option<RandomJson>,
-    output: &'a Settings,
-}
-
-#[derive(Serialize)]
-struct AxisJson<'a> {
-    key: &'a str,
-    values: &'a [toml::Value],
-    zip: Option<&'a str>,
-}
-
-impl<'a> From<&'a Axis> for AxisJson<'a> {
-    fn from(a: &'a Axis) -> Self {
-        Self {
-            key: &a.key,
-            values: &a.values,
-            zip: a.zip.as_deref(),
-        }
-    }
-}
-
-#[derive(Serialize)]
-struct RandomJson {
-    seed: u64,
-    count: u64,
-    draws: Vec<serde_json::Value>,
-}
-
-impl From<&Random> for RandomJson {
-    fn from(r: &Random) -> Self {
         let bound = |x: f64| x.is_finite().then_some(x);
-        let draws = r.draws.iter().map(|d| match d.distribution {
+        let draw = |d: &Draw| match d.distribution {
             Distribution::Uniform { lo, hi } => {
                 serde_json::json!({"key": d.key, "uniform": [lo, hi]})
             }
@@ -327,14 +267,34 @@ impl From<&Random> for RandomJson {
             } => serde_json::json!({"key": d.key,
                 "normal": {"mean": mean, "std": std, "min": bound(min), "max": bound(max)}}),
             Distribution::Choice { .. } => serde_json::json!({"key": d.key, "choice": d.choices}),
+        };
+        let random = self.random.as_ref().map(|r| {
+            let draws: Vec<_> = r.draws.iter().map(draw).collect();
+            serde_json::json!({"seed": r.seed, "count": r.count, "draws": draws})
         });
-        Self {
-            seed: r.seed,
-            count: r.count,
-            draws: draws.collect(),
-        }
+        let set: BTreeMap<&str, &toml::Value> =
+            self.set.iter().map(|(k, v)| (k.as_str(), v)).collect();
+        serde_json::json!({
+            "description": self.description,
+            "base": self.base,
+            "base_scene": toml::to_string(&self.base_table).unwrap_or_default(),
+            "set": set,
+            "axes": self.axes,
+            "random": random,
+            "output": self.settings,
+        })
+    }
+
+    /// SHA-256 (hex) of the compact JSON of [`description_json`](Self::description_json): two sweeps
+    /// with the same identity make the same runs.
+    #[must_use]
+    pub fn identity(&self) -> String {
+        super::hash::sha256_hex(self.description_json().to_string().as_bytes())
     }
 }
+
+/// The scene key `output.channels` sets.
+pub const CHANNELS_KEY: &str = "record.channels";
 
 #[cfg(test)]
 mod tests {
