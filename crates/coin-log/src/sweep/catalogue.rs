@@ -5,6 +5,7 @@
 
 use crate::format::metadata::number_string as number;
 use crate::format::Termination;
+use crate::record::RecordSummary;
 use crate::verify::Verdict;
 
 coin_log_names::named_enum! {
@@ -78,34 +79,13 @@ pub struct Prediction {
     pub termination: Termination,
 }
 
-/// What a recorded run's file and summary say.
+/// A recorded run: its file's name in the folder and SHA-256, `record`'s summary and `verify`'s verdict
+/// (when the sweep verifies).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recorded {
-    /// The file's name in the sweep's folder.
     pub file: String,
-    /// Its size.
-    pub bytes: u64,
-    /// Its SHA-256, hex.
     pub sha256: String,
-    /// How the run ended, and when.
-    pub termination: Termination,
-    /// The end time.
-    pub t_end: f64,
-    /// Samples written.
-    pub samples: u64,
-    /// Messages written.
-    pub messages: u64,
-    /// Accepted integrator steps.
-    pub steps: u64,
-    /// As `record --json`'s `energy_drift`.
-    pub energy_drift: f64,
-    /// As `record --json`'s `invariant_drift`.
-    pub invariant_drift: Option<f64>,
-    /// As `record --json`'s `steady_residual`.
-    pub steady_residual: Option<f64>,
-    /// As `record --json`'s `event_trusted`.
-    pub event_trusted: Option<bool>,
-    /// `verify`'s verdict, when the sweep verifies.
+    pub summary: RecordSummary,
     pub verify: Option<Verdict>,
 }
 
@@ -145,27 +125,28 @@ impl Row {
     #[must_use]
     pub fn fields(&self) -> Vec<String> {
         let r = self.recorded.as_ref();
+        let s = r.map(|r| &r.summary);
         let opt = |x: Option<f64>| x.map(number).unwrap_or_default();
         let p = self.prediction.as_ref();
         let mut fields = vec![self.index.to_string()];
         fields.extend(self.values.iter().cloned());
         fields.extend([
             self.status.name().to_string(),
-            text(r.map(|r| r.termination.name())),
-            opt(r.map(|r| r.t_end)),
+            text(s.map(|s| s.termination.name())),
+            opt(s.map(|s| s.termination_time)),
             text(r.map(|r| r.verify.map_or("off", verdict_name))),
             text(self.failure.map(|f| f.name())),
             one_line(&self.reason),
             text(r.map(|r| &r.file)),
-            text(r.map(|r| r.bytes)),
+            text(s.map(|s| s.bytes)),
             text(r.map(|r| &r.sha256)),
-            text(r.map(|r| r.samples)),
-            text(r.map(|r| r.messages)),
-            text(r.map(|r| r.steps)),
-            opt(r.map(|r| r.energy_drift)),
-            opt(r.and_then(|r| r.invariant_drift)),
-            opt(r.and_then(|r| r.steady_residual)),
-            text(r.and_then(|r| r.event_trusted)),
+            text(s.map(|s| s.samples)),
+            text(s.map(|s| s.messages)),
+            text(s.map(|s| s.stats.steps)),
+            opt(s.map(|s| s.energy_drift)),
+            opt(s.and_then(|s| s.invariant_drift)),
+            opt(s.and_then(|s| s.steady_residual)),
+            text(s.and_then(|s| s.event_trusted)),
             text(p.map(|p| p.motion)),
             text(p.and_then(|p| p.stability)),
             text(p.map(|p| p.termination.name())),

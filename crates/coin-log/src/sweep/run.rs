@@ -381,14 +381,15 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
     match record_and_check(sweep, folder, index, &scene, stop) {
         Ok(None) => None,
         Ok(Some(checked)) => {
-            let (status, failure, reason) = judge(&checked.summary, checked.report.as_ref());
+            let summary = &checked.recorded.summary;
+            let (status, failure, reason) = judge(summary, checked.report.as_ref());
             let row = Row {
                 index,
                 values: cells,
                 status,
                 failure,
                 reason,
-                recorded: Some(recorded(&checked, sweep.index_width(), index)),
+                recorded: Some(checked.recorded),
                 prediction,
                 wall_time: started.elapsed().as_secs_f64(),
             };
@@ -405,9 +406,8 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
 
 /// A recorded run, in place under its final name.
 struct Checked {
-    summary: RecordSummary,
+    recorded: Recorded,
     report: Option<FileReport>,
-    sha256: String,
     mtime_ns: u128,
     record_seconds: f64,
     verify_seconds: f64,
@@ -455,9 +455,13 @@ fn record_and_check(
     let (_, mtime_ns) = folder::size_and_mtime(&target)
         .ok_or_else(|| format!("`{name}` vanished once moved into place"))?;
     Ok(Some(Checked {
-        summary,
+        recorded: Recorded {
+            file: name,
+            sha256,
+            summary,
+            verify: report.as_ref().map(|r| r.verdict),
+        },
         report,
-        sha256,
         mtime_ns,
         record_seconds,
         verify_seconds,
@@ -473,25 +477,6 @@ fn error_chain(e: &dyn std::error::Error) -> String {
         source = s.source();
     }
     text
-}
-
-fn recorded(c: &Checked, width: usize, index: u64) -> Recorded {
-    let s = &c.summary;
-    Recorded {
-        file: folder::run_file_name(index, width),
-        bytes: s.bytes,
-        sha256: c.sha256.clone(),
-        termination: s.termination,
-        t_end: s.termination_time,
-        samples: s.samples,
-        messages: s.messages,
-        steps: s.stats.steps,
-        energy_drift: s.energy_drift,
-        invariant_drift: s.invariant_drift,
-        steady_residual: s.steady_residual,
-        event_trusted: s.event_trusted,
-        verify: c.report.as_ref().map(|r| r.verdict),
-    }
 }
 
 /// Finished, or failed with the kind and reason: a numerical failure first, then a verdict other than ok.
