@@ -60,7 +60,6 @@ pub const TRAILING_COLUMNS: [&str; 20] = [
 ];
 
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
-#[must_use]
 pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
     let trailing = TRAILING_COLUMNS.into_iter();
     let columns = std::iter::once("index").chain(keys).chain(trailing);
@@ -68,14 +67,12 @@ pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
 }
 
 /// What `analyse` predicts for a run's initial state, by quadrature of the conservative motion
-/// (format.md: The catalogue).
+/// (format.md: The catalogue): the motion, the stability of the steady motion the run starts on (or,
+/// perturbed, starts from) and how the run should end.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Prediction {
-    /// `steady`, `nutation` or `flat-landing`.
     pub motion: &'static str,
-    /// The linear stability of the steady motion the run starts on (or, perturbed, starts from).
     pub stability: Option<&'static str>,
-    /// How the run should end.
     pub termination: Termination,
 }
 
@@ -89,29 +86,21 @@ pub struct Recorded {
     pub verify: Option<Verdict>,
 }
 
-/// One run's row.
+/// One run's row: the swept keys' values as cells ([`cell`]), the failure's detail (empty for a finished
+/// run), and the wall time of the run (resolve, record, hash, verify) in seconds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
-    /// The run's index.
     pub index: u64,
-    /// The swept keys' values, as cells ([`cell`]).
     pub values: Vec<String>,
-    /// Finished or failed.
     pub status: RunStatus,
-    /// Why it failed.
     pub failure: Option<FailureKind>,
-    /// The failure's detail, one line (empty for a finished run).
     pub reason: String,
-    /// The file and summary, when the run was recorded.
     pub recorded: Option<Recorded>,
-    /// The prediction, when the scene is valid and conservative.
     pub prediction: Option<Prediction>,
-    /// Wall time of the run (resolve, record, hash, verify), seconds.
     pub wall_time: f64,
 }
 
 /// A swept value as a cell: numbers shortest, strings as they are, arrays and tables as TOML.
-#[must_use]
 pub fn cell(value: &toml::Value) -> String {
     match value {
         toml::Value::Float(x) => number(*x),
@@ -122,7 +111,6 @@ pub fn cell(value: &toml::Value) -> String {
 
 impl Row {
     /// The row's cells, in the order of [`columns`].
-    #[must_use]
     pub fn fields(&self) -> Vec<String> {
         let r = self.recorded.as_ref();
         let s = r.map(|r| &r.summary);
@@ -156,7 +144,6 @@ impl Row {
     }
 
     /// The row as one CSV line, without the line break.
-    #[must_use]
     pub fn line(&self) -> String {
         crate::csv::line(&self.fields())
     }
