@@ -31,3 +31,45 @@ pub use random::word;
 pub use run::{run, Progress, RunOptions, SweepOutcome};
 pub use shard::{Shard, ShardError};
 pub use space::{linspace, logspace};
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+
+/// Calls `work` on each of `items` on up to `jobs` threads until `stop` is set; `handle` gets the results
+/// on the calling thread as they come, in batches of those that came while it handled the previous one
+/// (so that one journal sync serves them all: the sweep is never slower than the disk syncs one row).
+fn on_threads<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    stop: &AtomicBool,
+    work: impl Fn(&T) -> Option<R> + Sync,
+    mut handle: impl FnMut(Vec<R>),
+) {
+    let next = AtomicUsize::new(0);
+    let (sender, receiver) = mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, items.len().max(1)) {
+            let sender = sender.clone();
+            let (next, work) = (&next, &work);
+            scope.spawn(move || {
+                while !stop.load(Ordering::SeqCst) {
+                    let Some(item) = items.get(next.fetch_add(1, Ordering::SeqCst)) else {
+                        break;
+                    };
+                    let Some(result) = work(item) else {
+                        continue;
+                    };
+                    if sender.send(result).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(sender);
+        for first in &receiver {
+            let mut batch = vec![first];
+            batch.extend(receiver.try_iter());
+            handle(batch);
+        }
+    });
+}
