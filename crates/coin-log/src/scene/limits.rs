@@ -8,7 +8,6 @@ use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::format::tolerances::UNIT_ROUNDOFF;
-use crate::integrate::Method;
 use crate::model::{energy, reaction, CoinParams, Inertia, State};
 
 /// Smallest scale (mass, length, inertia, energy, ...) a scene may have. Double precision holds normal
@@ -146,7 +145,7 @@ pub(super) fn check_scales(
     for (key, value) in &inputs {
         if !in_scale_range(value.log10()) {
             problems.push(
-                key,
+                *key,
                 number(*value),
                 format!("is outside 1e-150 … 1e150: {SCALE_WHY}"),
             );
@@ -204,12 +203,8 @@ fn check_derived_scales(body: &super::file::BodyFile, problems: &mut ProblemColl
     blamed.is_empty()
 }
 
-/// rtol and atol ranges that need no body (atol's ceiling needs the body: [`check_resolved`]); only for
-/// adaptive methods, which use them.
-pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut ProblemCollector) {
-    if !(method.is_some_and(Method::is_adaptive) && rtol.is_finite() && rtol > 0.0) {
-        return;
-    }
+/// The range of a positive rtol, for an adaptive method (atol's ceiling needs the body: [`check_atol`]).
+pub(super) fn check_rtol(rtol: f64, problems: &mut ProblemCollector) {
     if rtol < RTOL_MIN {
         problems.push(
             "run.rtol",
@@ -286,11 +281,8 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
     }
 }
 
-/// The sample rate against the 1 ns log-time base ([`max_rate`]).
+/// A positive sample rate against the 1 ns log-time base ([`max_rate`]), over a positive duration.
 pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollector) {
-    if !(rate.is_finite() && rate > 0.0 && duration.is_finite() && duration > 0.0) {
-        return;
-    }
     let max = max_rate(duration);
     if rate > max {
         problems.push(

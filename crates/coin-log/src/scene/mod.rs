@@ -20,6 +20,7 @@ pub use file::{
 };
 pub use notes::{compact, Note};
 pub use overrides::{apply_set, other_form, set_value, FlagOverrides};
+pub(crate) use problems::ProblemCollector;
 pub use problems::{Problem, SceneProblems};
 pub use readable::{float_literal, readable_toml, Short};
 pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
