@@ -47,6 +47,13 @@ pub fn preset(name: &str) -> Option<SceneFile> {
     super::parse_with_sets(text, &[]).ok().map(without_defaults)
 }
 
+/// True when a scene argument is written as a path rather than a built-in's name: it holds a path
+/// separator or ends in `.toml` (format.md: Commands).
+#[must_use]
+pub fn is_path(arg: &str) -> bool {
+    arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR) || arg.ends_with(".toml")
+}
+
 /// `file` without the keys whose value is the default (the inverse of [`super::Scene::to_file`]).
 fn without_defaults(mut file: SceneFile) -> SceneFile {
     fn drop_if<T: PartialEq>(slot: &mut Option<T>, default: &T) {

@@ -38,9 +38,6 @@ struct Found {
 }
 
 /// Merges the catalogue parts in `dir`, hashing the files on `jobs` threads.
-///
-/// # Errors
-/// [`SweepError`] when the folder holds no sweep, or a part or the catalogue cannot be read or written.
 pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepError> {
     let folder = Folder::existing(dir)?;
     let columns = folder.columns();

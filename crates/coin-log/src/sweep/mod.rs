@@ -1,12 +1,8 @@
-//! Datasets, not single files (format.md: Sweeps): a sweep file names a base scene and what varies (grid
-//! axes, random draws); `run` records every run of it (or of one shard) into a folder, `jobs` at once on
-//! threads of this process, each file byte for byte what `record` writes for the same resolved scene,
-//! verifies each, and writes a catalogue with one row per run; run again, it resumes. `collect` merges the
-//! catalogues of shards run on other machines.
-//!
-//! A run's values depend only on the sweep file and the run's index ([`Sweep::values`]): never on jobs,
-//! shards or machines. The library never prints and never starts a process: the CLI reads the
-//! environment for the shard, installs the signal handler that sets the stop flag, and draws the progress.
+//! Datasets, not single files (format.md: Sweeps): a sweep file names a base scene and what varies; `run`
+//! records (as `record` would), verifies and catalogues every run of it, or of one shard, into a folder on
+//! threads, and resumes when run again; `collect` merges the shards' catalogues. A run's values depend
+//! only on the sweep file and the run's index ([`Sweep::values`]). The CLI reads the shard's environment,
+//! installs the signal handler that sets the stop flag, and draws the progress.
 
 mod catalogue;
 mod collect;

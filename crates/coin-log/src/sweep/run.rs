@@ -98,10 +98,6 @@ struct Resumed {
 /// starting runs and ends the running recordings early; their files are discarded and the runs redone on
 /// resume. The sweep sets `stop` itself when it cannot write its journal. `progress` is called as runs
 /// end, on the calling thread. A run that fails is a row, not an error.
-///
-/// # Errors
-/// [`SweepError`] for a folder that cannot hold the sweep or a catalogue or journal that cannot be
-/// written.
 pub fn run(
     sweep: &Sweep,
     dir: &std::path::Path,

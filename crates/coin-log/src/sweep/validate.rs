@@ -103,6 +103,11 @@ fn array_text(values: &[toml::Value]) -> String {
     toml::Value::Array(values.to_vec()).to_string()
 }
 
+/// How problems name the fixed edit of `key`: `set."run.duration"`.
+fn set_name(key: &str) -> String {
+    format!("set.\"{key}\"")
+}
+
 /// True for a dotted key with no empty part.
 fn dotted(key: &str) -> bool {
     !key.trim().is_empty() && key.split('.').all(|p| !p.trim().is_empty())
@@ -112,10 +117,7 @@ impl Checker {
     /// The base scene as a table: a built-in by name, or a scene file by path.
     fn base(&mut self, base: &str, folder: &Path) -> Option<toml::Table> {
         let quoted = format!("\"{base}\"");
-        let is_path = base.contains('/')
-            || base.contains(std::path::MAIN_SEPARATOR)
-            || base.ends_with(".toml");
-        if !is_path {
+        if !presets::is_path(base) {
             if let Some(preset) = presets::preset(base) {
                 return toml::Table::try_from(&preset).ok();
             }
@@ -152,10 +154,9 @@ impl Checker {
     fn set(&mut self, set: &toml::Table) -> Vec<(String, toml::Value)> {
         let mut edits = Vec::new();
         for (key, value) in set {
-            let name = format!("set.\"{key}\"");
             if !dotted(key) {
                 self.problems.push(
-                    name,
+                    set_name(key),
                     value.to_string(),
                     "is not a dotted scene key like \"run.duration\"",
                 );
@@ -537,7 +538,7 @@ fn places(file: &SweepFile) -> Vec<Place> {
     let mut places: Vec<Place> = file
         .set
         .keys()
-        .map(|k| Place::new(k, format!("set.\"{k}\"")))
+        .map(|k| Place::new(k, set_name(k)))
         .collect();
     for (i, a) in file.axis.iter().enumerate() {
         let form = axis_forms(a)
@@ -603,7 +604,7 @@ impl Checker {
         for (key, value) in &sweep.set {
             if let Err(e) = fits(base, key, value) {
                 self.problems.push(
-                    format!("set.\"{key}\""),
+                    set_name(key),
                     value.to_string(),
                     format!("does not fit the scene: {e}"),
                 );
