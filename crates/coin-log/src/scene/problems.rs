@@ -146,7 +146,7 @@ impl<'a> ProblemCollector<'a> {
     pub(super) fn finite(&mut self, key: &str, value: f64) -> bool {
         let ok = value.is_finite();
         if !ok {
-            self.push(key, number(value), "is not a finite number");
+            self.push(key, number(value), NOT_FINITE);
         }
         ok
     }
@@ -184,6 +184,7 @@ impl<'a> ProblemCollector<'a> {
 
 /// Why a number that must be finite and > 0 is refused.
 pub(super) const POSITIVE: &str = "is outside (0, ∞): give a finite number > 0";
+pub(super) const NOT_FINITE: &str = "is not a finite number";
 
 pub(super) fn quoted(s: &str) -> String {
     format!("{s:?}")

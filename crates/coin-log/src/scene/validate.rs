@@ -6,10 +6,8 @@ use super::file::{
     SteadyFile,
 };
 use super::limits;
-use super::problems::{number, numbers, quoted, ProblemCollector, POSITIVE};
-use super::{
-    defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, SceneProblems, MAX_SAMPLES,
-};
+use super::problems::{number, numbers, quoted, ProblemCollector, NOT_FINITE, POSITIVE};
+use super::{defaults, InitialSpec, RunConfig, Scene, SceneError, SceneProblems, MAX_SAMPLES};
 use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
 use crate::model::{
@@ -63,22 +61,13 @@ pub(super) fn scene_from_file(
     let run_file = file.run.clone().unwrap_or_default();
     let flat_margin = run_file.flat_margin.unwrap_or(defaults::FLAT_MARGIN);
     let margin_ok = flat_margin.is_finite() && flat_margin > 0.0 && flat_margin < FRAC_PI_2;
+    let margin = margin_ok.then_some(flat_margin);
     let body = check_body(&file.body, &mut problems);
-    let initial = body.as_ref().and_then(|(params, ..)| {
-        check_initial(
-            &file.initial,
-            params,
-            margin_ok.then_some(flat_margin),
-            &mut problems,
-        )
-    });
+    let initial = (body.as_ref())
+        .and_then(|(params, ..)| check_initial(&file.initial, params, margin, &mut problems));
     // Without a valid body the initial state cannot be solved; still check what can be checked alone.
     if body.is_none() {
-        check_initial_alone(
-            &file.initial,
-            margin_ok.then_some(flat_margin),
-            &mut problems,
-        );
+        check_initial_alone(&file.initial, margin, &mut problems);
     }
     let dissipation = check_dissipation(file.body.dissipation.as_ref(), &mut problems);
     check_description(file.description.as_deref(), &mut problems);
@@ -114,17 +103,14 @@ pub(super) fn scene_from_file(
     if let Some(scene) = &scene {
         limits::check_resolved(scene, file, &mut problems);
     }
-    match (scene, SceneProblems::from_vec(problems.list)) {
-        (Some(scene), None) => Ok(scene),
-        (_, Some(list)) => Err(SceneError::Invalid(list)),
+    if problems.list.is_empty() {
+        if let Some(scene) = scene {
+            return Ok(scene);
+        }
         // Every check that rejects a part reports why; should one ever fail to, still say something.
-        (None, None) => Err(SceneError::Invalid(SceneProblems(vec![Problem {
-            key: "scene".into(),
-            value: String::new(),
-            reason: UNEXPLAINED.into(),
-            flag: None,
-        }]))),
+        problems.push("scene", "", UNEXPLAINED);
     }
+    Err(SceneError::Invalid(SceneProblems(problems.list)))
 }
 
 /// The reason given if a scene were refused without a problem (a bug; the fuzz targets look for it).
@@ -280,13 +266,7 @@ fn power_law_exponents(d: &DissipationFile, problems: &mut ProblemCollector) -> 
         "is outside [1, ∞): the couple P/|ω| ∝ |ω|^(m−1) must stay bounded as the coin stops",
         NEEDS,
     );
-    let k = problems.required(
-        "body.dissipation.k",
-        d.k,
-        |_| true,
-        "is not a finite number",
-        NEEDS,
-    );
+    let k = problems.required("body.dissipation.k", d.k, |_| true, NOT_FINITE, NEEDS);
     (m, k)
 }
 
@@ -430,7 +410,7 @@ fn initial_base(
 }
 
 /// `base` with the perturbation (θ, ω_X, ω_Y, ω_Z) added.
-pub(super) fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
+fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
     State {
         theta: base.theta + perturbation[0],
         omega_x: base.omega_x + perturbation[1],
@@ -517,13 +497,7 @@ fn steady_kind(
     let needs = format!("is missing: a \"{family}\" steady motion needs {needs}");
     let mut required = |name: &str, value: Option<f64>| {
         let key = format!("initial.steady.{name}");
-        problems.required(
-            &key,
-            value,
-            |_| true,
-            "is not a finite number",
-            needs.as_str(),
-        )
+        problems.required(&key, value, |_| true, NOT_FINITE, needs.as_str())
     };
     match family {
         SteadyFamily::Straight => SteadyKind::Straight {
@@ -699,7 +673,7 @@ fn used_settings(method: Method, rtol: f64, atol: f64, step: f64, rate: f64) -> 
 /// The largest step ≤ `step` that divides the sample interval into a whole number of steps, so that fixed
 /// steps land on the sample grid. A relative slack of 1e-12 keeps 0.01/0.001 = 10.000000000000002 at 10.
 #[allow(clippy::cast_precision_loss)]
-pub(super) fn fitted_step(step: f64, interval: f64) -> f64 {
+fn fitted_step(step: f64, interval: f64) -> f64 {
     let ratio = interval / step;
     let steps = (ratio * (1.0 - 1e-12)).ceil().max(1.0);
     interval / steps

@@ -56,8 +56,8 @@ const LOCK: ShardFile = ShardFile {
 
 impl ShardFile {
     pub fn name(&self, shard: Shard) -> String {
-        let (prefix, suffix) = (self.prefix, self.suffix);
-        format!("{prefix}{}-of-{}{suffix}", shard.index(), shard.count())
+        let (k, n) = (shard.index(), shard.count());
+        format!("{}{k}-of-{n}{}", self.prefix, self.suffix)
     }
 
     fn shard_of(&self, name: &str) -> Option<Shard> {
@@ -109,17 +109,14 @@ pub struct Folder {
     plan: serde_json::Value,
 }
 
-/// A run's modification time, nanoseconds since 1970 (0 when the system gives none).
-fn mtime_ns(meta: &fs::Metadata) -> u128 {
-    meta.modified()
-        .ok()
-        .and_then(|t| t.duration_since(UNIX_EPOCH).ok())
-        .map_or(0, |d| d.as_nanos())
-}
-
-/// The size and modification time of a file, if it is there.
+/// The size and modification time (ns since 1970, 0 when the system gives none) of a file, if it is there.
 pub fn size_and_mtime(path: &Path) -> Option<(u64, u128)> {
-    fs::metadata(path).ok().map(|m| (m.len(), mtime_ns(&m)))
+    let meta = fs::metadata(path).ok()?;
+    let since = meta
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(UNIX_EPOCH).ok());
+    Some((meta.len(), since.map_or(0, |d| d.as_nanos())))
 }
 
 impl Folder {
