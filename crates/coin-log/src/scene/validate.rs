@@ -473,7 +473,7 @@ fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut P
         if let Some(v) = value {
             if !allowed.contains(&name) {
                 problems.push(
-                    &format!("initial.steady.{name}"),
+                    format!("initial.steady.{name}"),
                     v,
                     format!(
                         "does not apply to a \"{family}\" steady motion, which takes: kind, {}",
