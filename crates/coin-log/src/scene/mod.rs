@@ -230,16 +230,12 @@ pub fn to_toml(file: &SceneFile) -> String {
 
 /// Parses scene TOML text and applies `--set` edits, giving the raw file (not yet validated).
 pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneError> {
+    let error = |e: toml::de::Error| SceneError::Parse(toml_message(&e));
     if sets.is_empty() {
         // Straight from the text: serde's message then points at the line.
-        return toml::from_str(text).map_err(|e| SceneError::Parse(toml_message(&e)));
+        return toml::from_str(text).map_err(error);
     }
-    let mut table: toml::Table =
-        toml::from_str(text).map_err(|e| SceneError::Parse(toml_message(&e)))?;
-    for set in sets {
-        apply_set(&mut table, set)?;
-    }
-    file_from_table(table)
+    with_sets(toml::from_str(text).map_err(error)?, sets)
 }
 
 /// A TOML parse error's message, trimmed, each quoted line cut to [`crate::files::SHOWN_CHARS`] characters
@@ -258,8 +254,12 @@ pub fn file_with_sets(file: &SceneFile, sets: &[String]) -> Result<SceneFile, Sc
     if sets.is_empty() {
         return Ok(file.clone());
     }
-    let mut table =
+    let table =
         toml::Table::try_from(file).map_err(|e| SceneError::Parse(e.to_string().trim().into()))?;
+    with_sets(table, sets)
+}
+
+fn with_sets(mut table: toml::Table, sets: &[String]) -> Result<SceneFile, SceneError> {
     for set in sets {
         apply_set(&mut table, set)?;
     }

@@ -82,16 +82,11 @@ impl<'a> ProblemCollector<'a> {
         reason: impl Into<String>,
     ) {
         let key = key.into();
-        let flag = self
-            .provenance
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map(|(_, f)| (*f).to_string());
         self.list.push(Problem {
+            flag: flag_of(self.provenance, &key).map(str::to_string),
             key,
             value: value.into(),
             reason: reason.into(),
-            flag,
         });
     }
 
@@ -153,33 +148,25 @@ impl<'a> ProblemCollector<'a> {
 
     /// A vector of three finite numbers.
     pub(super) fn vector3(&mut self, key: &str, value: &[f64]) -> Option<[f64; 3]> {
-        match value {
-            [x, y, z] => {
-                let ok = [*x, *y, *z].iter().all(|v| v.is_finite());
-                if ok {
-                    Some([*x, *y, *z])
-                } else {
-                    self.push(
-                        key,
-                        numbers(value),
-                        "has a non-finite component: give three finite numbers",
-                    );
-                    None
-                }
-            }
-            _ => {
-                self.push(
-                    key,
-                    numbers(value),
-                    format!(
-                        "has {} components: give three, [ω_X, ω_Y, ω_Z]",
-                        value.len()
-                    ),
-                );
-                None
-            }
-        }
+        let reason = match *value {
+            [x, y, z] if [x, y, z].iter().all(|v| v.is_finite()) => return Some([x, y, z]),
+            [_, _, _] => "has a non-finite component: give three finite numbers".to_string(),
+            _ => format!(
+                "has {} components: give three, [ω_X, ω_Y, ω_Z]",
+                value.len()
+            ),
+        };
+        self.push(key, numbers(value), reason);
+        None
     }
+}
+
+/// The flag that set `key`, in a provenance list of (key, flag).
+pub(super) fn flag_of(
+    provenance: &[(&'static str, &'static str)],
+    key: &str,
+) -> Option<&'static str> {
+    provenance.iter().find(|(k, _)| *k == key).map(|(_, f)| *f)
 }
 
 /// Why a number that must be finite and > 0 is refused.

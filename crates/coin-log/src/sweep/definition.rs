@@ -127,10 +127,15 @@ impl Sweep {
             .map(|d| self.axes[d[0]].values.len() as u64)
     }
 
+    /// Runs per grid point: `random.count`, or 1.
+    pub(super) fn per_point(&self) -> u64 {
+        self.random.as_ref().map_or(1, |r| r.count)
+    }
+
     /// How many runs: grid points × `random.count`.
     #[must_use]
     pub fn runs(&self) -> u64 {
-        self.lengths().product::<u64>() * self.random.as_ref().map_or(1, |r| r.count)
+        self.lengths().product::<u64>() * self.per_point()
     }
 
     /// The swept keys, each a catalogue column: the axes, then the draws, in the file's order.
@@ -146,8 +151,7 @@ impl Sweep {
     /// [`keys`](Self::keys): grid point ⌊index / count⌋ (its coordinates with the last dimension varying
     /// fastest), then the draws of run `index`; [`OutOfBounds`] when a bounded normal draw finds nothing.
     pub fn values(&self, index: u64) -> Result<Vec<toml::Value>, OutOfBounds> {
-        let count = self.random.as_ref().map_or(1, |r| r.count);
-        let mut point = index / count;
+        let mut point = index / self.per_point();
         let mut values = vec![toml::Value::Boolean(false); self.axes.len()];
         for (dimension, len) in self.dimensions.iter().zip(self.lengths()).rev() {
             // point % len < len, a length of a Vec: it fits usize.
@@ -157,12 +161,13 @@ impl Sweep {
                 values[axis] = self.axes[axis].values[at].clone();
             }
         }
-        for (j, draw) in self.random.iter().flat_map(|r| r.draws.iter().enumerate()) {
-            let seed = self.random.as_ref().map_or(0, |r| r.seed);
-            values.push(match draw.distribution.draw(seed, index, j as u64)? {
-                Drawn::Number(x) => toml::Value::Float(x),
-                Drawn::Choice(k) => draw.choices[k].clone(),
-            });
+        if let Some(r) = &self.random {
+            for (j, draw) in r.draws.iter().enumerate() {
+                values.push(match draw.distribution.draw(r.seed, index, j as u64)? {
+                    Drawn::Number(x) => toml::Value::Float(x),
+                    Drawn::Choice(k) => draw.choices[k].clone(),
+                });
+            }
         }
         Ok(values)
     }

@@ -653,9 +653,8 @@ impl Checker {
                 "gives {values} values in all, more than the {MAX_AXIS_VALUES} the axes may (sweep.json lists them): \
                  draw the densest keys at random ([[random.draw]]), or split the sweep"));
         }
-        let lengths = sweep.lengths();
-        let count = sweep.random.as_ref().map_or(1, |r| r.count);
-        let runs = lengths.chain([count]).try_fold(1u64, u64::checked_mul);
+        let mut factors = sweep.lengths().chain([sweep.per_point()]);
+        let runs = factors.try_fold(1u64, u64::checked_mul);
         if runs.is_none_or(|r| r > MAX_RUNS) {
             let what = runs.map_or_else(|| "more than 2⁶⁴".to_string(), |r| r.to_string());
             self.problems.push("axis", "", format!(
