@@ -18,18 +18,13 @@ pub enum SceneArg<'a> {
     File(&'a Path),
 }
 
-/// True when `arg` is written as a path rather than a name.
-fn looks_like_a_path(arg: &str) -> bool {
-    arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR) || arg.ends_with(".toml")
-}
-
 /// Classifies `arg` by the module's rule; notes on stderr a local file that a built-in name leaves unused.
 ///
 /// # Errors
 /// No built-in scene of that name and no such file.
 pub fn classify(arg: &str) -> anyhow::Result<SceneArg<'_>> {
     let path = Path::new(arg);
-    if looks_like_a_path(arg) || arg == "-" {
+    if presets::is_path(arg) || arg == "-" {
         return Ok(SceneArg::File(path));
     }
     if presets::preset(arg).is_some() {

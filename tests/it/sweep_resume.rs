@@ -148,7 +148,7 @@ fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
 fn delays(seed: u64, n: usize, range: std::ops::Range<u64>) -> Vec<u64> {
     (0..n as u64)
         .map(|i| {
-            let w = coin_log::sweep::random::word(seed, i, 0, 0);
+            let w = coin_log::sweep::word(seed, i, 0, 0);
             range.start + w % (range.end - range.start)
         })
         .collect()

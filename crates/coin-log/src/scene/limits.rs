@@ -1,59 +1,44 @@
 //! The limits a scene must respect beyond "finite and positive" (format.md: Scene files, Limits): what
 //! double precision, the 1 ns log-time base and the integrators can deliver. A scene outside them is refused
-//! before anything is written, naming the key, the value, the limit and why, instead of running into a
-//! NaN, a repeated log time, a run that never reaches its next sample, or numerical trouble that the
-//! summary would report as physics.
+//! before anything is written, naming the key, the value, the limit and why.
 
 use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::format::tolerances::UNIT_ROUNDOFF;
-use crate::integrate::Method;
 use crate::model::{energy, reaction, CoinParams, Inertia, State};
 
-/// Smallest scale (mass, length, inertia, energy, ...) a scene may have. Double precision holds normal
-/// numbers from 2.2e-308 to 1.8e308; the model multiplies and divides pairs of scales (μ = I_Z·Ma² /
-/// (I_X (I_Z + Ma²)) of C1, C2; squared forces |R|² ~ (Mg)² and speeds (aω)² ~ a g; E/(Mga)), so each scale
-/// must stay within 1e±150 for every such product, times the O(1)–O(1e8) dimensionless factors of the
-/// equations (tan θ up to 1e4 at the default flat margin, ωτ), to remain a normal number.
+/// Smallest scale (mass, length, inertia, energy, ...) a scene may have: the model multiplies and divides
+/// pairs of scales (I_Z·Ma² in C1, C2; |R|² ~ (Mg)²) times factors up to 1e8 (tan θ, ωτ), which stay
+/// normal doubles (2.2e-308 … 1.8e308) for scales within 1e±150.
 pub const SCALE_MIN: f64 = 1e-150;
 /// Largest scale; see [`SCALE_MIN`].
 pub const SCALE_MAX: f64 = 1e150;
 
-/// Smallest rtol: ten units of rounding (10·2⁻⁵²), the limit Hairer's DOP853 enforces ("tolerances are
-/// too small"). Below it the error estimate is rounding noise: `--rtol 1e-30 --atol 1e-30` made dop853
-/// shrink its step forever without reaching the first sample (measured: no sample in 60 s).
+/// Smallest rtol: ten units of rounding (10·2⁻⁵²), the limit Hairer's DOP853 enforces. Below it the error
+/// estimate is rounding noise: `--rtol 1e-30 --atol 1e-30` gave no sample in 60 s (measured).
 pub const RTOL_MIN: f64 = 10.0 * f64::EPSILON;
-/// Largest rtol. Error estimates of embedded pairs hold only asymptotically (small steps); 1e-3 is the
-/// loosest common default (MATLAB's ode45). Measured on `wobble` (dop853, 30 time units): rtol 1e-3 gives
-/// an energy drift of 2.0e-4 and completes; rtol 1 takes 22 steps of ~1.4 time units and reports a
-/// lift-off at t = 8.71 with a drift of 0.19, an artefact of the integration.
+/// Largest rtol, the loosest common default (MATLAB's ode45). On `wobble` (dop853, 30 time units) rtol
+/// 1e-3 drifts 2.0e-4 in energy; rtol 1 reports a lift-off at t = 8.71 that is an integration artefact.
 pub const RTOL_MAX: f64 = 1e-3;
 /// Largest atol, as a fraction of the smallest natural scale of the state: 1 rad for the angles, a for the
 /// centre, 1/τ for ω (the same 1e-3 as [`RTOL_MAX`]).
 pub const ATOL_MAX_FRACTION: f64 = 1e-3;
-/// Largest h·W for fixed-step methods, W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0: (h W)⁴ = 1e-3, the accuracy
-/// ε that `verify` derives for an order-4 method (format.md: Tolerances), so the same ceiling as
-/// [`RTOL_MAX`]. Measured on `wobble` (rk4, 30 time units, W = 1.54): h W = 0.19 drifts 2.5e-5 in energy,
-/// h W = 0.96 drifts 1.1e-2.
+/// Largest h·W for fixed-step methods, W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) at t = 0: (h W)⁴ = [`RTOL_MAX`], the
+/// accuracy `verify` derives for an order-4 method (format.md: Tolerances). On `wobble` (rk4, W = 1.54)
+/// h W = 0.19 drifts 2.5e-5 in energy, h W = 0.96 drifts 1.1e-2.
 pub const STEP_MAX_PRODUCT: f64 = 0.177_827_941_003_892_3; // 1e-3^(1/4)
-/// Largest duration × W: radians of the fastest motion a run may turn through. At ≥ 1/[`STEP_MAX_PRODUCT`]
-/// ≈ 5.6 steps per radian this is ≥ 5.6e10 steps, hours of work; beyond it a run (for instance with
-/// ω = 1e100) would not reach its next sample, so neither its progress nor Ctrl-C would ever be seen.
+/// Largest duration × W, radians of the fastest motion: ≥ 5.6e10 steps (1/[`STEP_MAX_PRODUCT`] a radian),
+/// hours of work; beyond it a run (ω = 1e100, say) would never reach its next sample, nor see Ctrl-C.
 pub const MAX_RADIANS: f64 = 1e10;
-/// Shortest duration: the log-time resolution, 1 ns (log_time = round(t·10⁹)). A shorter run's first and
-/// last samples would share a log time (or stand 1 ns apart after rounding only by luck), which
-/// `integrity` refuses; `--duration 5e-324` also left the integrator no step to take.
+/// Shortest duration: the log-time resolution, 1 ns (log_time = round(t·10⁹)); a shorter run's first and
+/// last samples would share a log time, which `integrity` refuses.
 pub const MIN_DURATION: f64 = 1e-9;
 
 /// The highest rate whose samples get strictly increasing log times (round(t·10⁹) ns) over `duration`.
-///
-/// Samples fall on t_k = k·(1/rate), computed in floating point: t_k·10⁹ carries an error of at most
-/// 3u·10⁹·t_k ns (u = 2⁻⁵³: the interval 1/rate, the product k·interval, the product with 10⁹). Two
-/// neighbours k, k+1 round to different nanoseconds when their computed distance is ≥ 1 ns, which holds
-/// when 10⁹/rate − 6u·10⁹·duration ≥ 1: rate ≤ 1 / (10⁻⁹ + 6u·duration), just under 10⁹ for any
-/// duration below ~10⁴. (The last sample, at the duration itself, keeps ≥ 2 ns from the grid point
-/// before it: the driver replaces a grid point within 2 ns of the end by the end.)
+/// t_k = k·(1/rate) carries an error ≤ 3u·10⁹·t_k ns (u = 2⁻⁵³), so neighbours round to different
+/// nanoseconds when 10⁹/rate − 6u·10⁹·duration ≥ 1: just under 10⁹ below durations of ~10⁴. (The driver
+/// replaces a grid point within 2 ns of the end by the end.)
 #[must_use]
 pub fn max_rate(duration: f64) -> f64 {
     1.0 / (1e-9 + 6.0 * UNIT_ROUNDOFF * duration.max(0.0))
@@ -146,9 +131,9 @@ pub(super) fn check_scales(
     for (key, value) in &inputs {
         if !in_scale_range(value.log10()) {
             problems.push(
-                key,
+                *key,
                 number(*value),
-                format!("is outside 1e-150 … 1e150: {SCALE_WHY}"),
+                format!("is outside {SCALE_MIN:e} … {SCALE_MAX:e}: {SCALE_WHY}"),
             );
             ok = false;
         }
@@ -195,7 +180,7 @@ fn check_derived_scales(body: &super::file::BodyFile, problems: &mut ProblemColl
             keys[*key],
             number(values[*key]),
             format!(
-                "with {} gives {}, outside 1e-150 … 1e150: {SCALE_WHY}",
+                "with {} gives {}, outside {SCALE_MIN:e} … {SCALE_MAX:e}: {SCALE_WHY}",
                 others.join(" and "),
                 scales.join(" and ")
             ),
@@ -204,12 +189,8 @@ fn check_derived_scales(body: &super::file::BodyFile, problems: &mut ProblemColl
     blamed.is_empty()
 }
 
-/// rtol and atol ranges that need no body (atol's ceiling needs the body: [`check_resolved`]); only for
-/// adaptive methods, which use them.
-pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut ProblemCollector) {
-    if !(method.is_some_and(Method::is_adaptive) && rtol.is_finite() && rtol > 0.0) {
-        return;
-    }
+/// The range of a positive rtol, for an adaptive method (atol's ceiling needs the body: [`check_atol`]).
+pub(super) fn check_rtol(rtol: f64, problems: &mut ProblemCollector) {
     if rtol < RTOL_MIN {
         problems.push(
             "run.rtol",
@@ -224,7 +205,7 @@ pub(super) fn check_rtol(method: Option<Method>, rtol: f64, problems: &mut Probl
         problems.push(
             "run.rtol",
             number(rtol),
-            "is above 1e-3: an adaptive method's error estimate does not hold at such tolerances, and its events (lift-off, slip) would be artefacts; use rtol ≤ 1e-3",
+            format!("is above {RTOL_MAX:e}: an adaptive method's error estimate does not hold at such tolerances, and its events (lift-off, slip) would be artefacts; use rtol ≤ {RTOL_MAX:e}"),
         );
     }
 }
@@ -236,7 +217,7 @@ pub(super) fn check_duration(duration: f64, problems: &mut ProblemCollector) {
         problems.push(
             "run.duration",
             number(duration),
-            "is below 1e-9, the log-time resolution (log times are whole nanoseconds, round(t·1e9), so the first and last samples would share one): use duration ≥ 1e-9",
+            format!("is below {MIN_DURATION:e}, the log-time resolution (log times are whole nanoseconds, round(t·1e9), so the first and last samples would share one): use duration ≥ {MIN_DURATION:e}"),
         );
     } else if crate::format::log_time(duration).is_err() {
         problems.push(
@@ -247,10 +228,10 @@ pub(super) fn check_duration(duration: f64, problems: &mut ProblemCollector) {
     }
 }
 
-/// The work of a fixed-step run, known before it starts: its step must advance time at t = duration (the
-/// largest t of the run, where floating point is coarsest), and it takes duration/step ≤ `run.max_steps`
-/// steps. (An adaptive run spends its budget as it goes: the driver stops it.)
-fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCollector) {
+/// A fixed-step run, known before it starts: its step must advance time at t = duration (the largest t
+/// of the run, where floating point is coarsest), it takes duration/step ≤ `run.max_steps` steps (an
+/// adaptive run spends its budget as it goes: the driver stops it), and step·W ≤ [`STEP_MAX_PRODUCT`].
+fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut ProblemCollector) {
     let run = &scene.run;
     let (h, duration) = (run.method.step, run.duration);
     let shown = number(given.unwrap_or(h));
@@ -263,7 +244,7 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
     if stuck {
         problems.push(
             "run.step",
-            shown,
+            &shown,
             format!(
                 "cannot advance time: t + step rounds back to t at t = duration = {} (the spacing of doubles there is {}), so the run would never end; use step ≥ {}",
                 number(duration),
@@ -274,7 +255,7 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
     } else if steps > max {
         problems.push(
             "run.step",
-            shown,
+            &shown,
             format!(
                 "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
                 power_of_ten(steps.log10()),
@@ -284,13 +265,29 @@ fn check_fixed_work(scene: &Scene, given: Option<f64>, problems: &mut ProblemCol
             ),
         );
     }
+    if h * w > STEP_MAX_PRODUCT {
+        let used = match given {
+            Some(g) if g != h => format!(" (used: {}, rounded to divide 1/rate)", number(h)),
+            _ => String::new(),
+        };
+        problems.push(
+            "run.step",
+            &shown,
+            format!(
+                "{used} is above 0.178/W = {}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {}",
+                short(STEP_MAX_PRODUCT / w, Round::Down),
+                short(w, Round::Nearest),
+                run.method.method,
+                short(STEP_MAX_PRODUCT / w, Round::Down)
+            )
+            .trim_start()
+            .to_string(),
+        );
+    }
 }
 
-/// The sample rate against the 1 ns log-time base ([`max_rate`]).
+/// A positive sample rate against the 1 ns log-time base ([`max_rate`]), over a positive duration.
 pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollector) {
-    if !(rate.is_finite() && rate > 0.0 && duration.is_finite() && duration > 0.0) {
-        return;
-    }
     let max = max_rate(duration);
     if rate > max {
         problems.push(
@@ -331,38 +328,14 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     if run.method.method.is_adaptive() {
         check_atol(scene, problems);
     } else {
-        check_fixed_work(scene, file.run.as_ref().and_then(|r| r.step), problems);
-    }
-    if !run.method.method.is_adaptive() && run.method.step * w > STEP_MAX_PRODUCT {
-        let given = file.run.as_ref().and_then(|r| r.step);
-        let used = if given.is_some_and(|h| h != run.method.step) {
-            format!(
-                " (used: {}, rounded to divide 1/rate)",
-                number(run.method.step)
-            )
-        } else {
-            String::new()
-        };
-        problems.push(
-            "run.step",
-            number(given.unwrap_or(run.method.step)),
-            format!(
-                "{used} is above 0.178/W = {}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {}",
-                short(STEP_MAX_PRODUCT / w, Round::Down),
-                short(w, Round::Nearest),
-                run.method.method,
-                short(STEP_MAX_PRODUCT / w, Round::Down)
-            )
-            .trim_start()
-            .to_string(),
-        );
+        check_fixed_step(scene, file.run.as_ref().and_then(|r| r.step), w, problems);
     }
     if run.duration * w > MAX_RADIANS {
         problems.push(
             "run.duration",
             number(run.duration),
             format!(
-                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than 1e10 (≥ 5.6e10 integrator steps): use duration ≤ {}, or slow the motion",
+                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than {MAX_RADIANS:e} (≥ 5.6e10 integrator steps): use duration ≤ {}, or slow the motion",
                 short(w, Round::Nearest),
                 short(run.duration * w, Round::Nearest),
                 short(MAX_RADIANS / w, Round::Down)
@@ -382,7 +355,7 @@ fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
             "run.atol",
             number(atol),
             format!(
-                "is above {}, 1e-3 of the smallest scale of the state (1 rad for the angles, a = {} for the centre, 1/τ = {} for ω): the error estimate would not hold; use atol ≤ {}",
+                "is above {}, {ATOL_MAX_FRACTION:e} of the smallest scale of the state (1 rad for the angles, a = {} for the centre, 1/τ = {} for ω): the error estimate would not hold; use atol ≤ {}",
                 short(max, Round::Down),
                 number(p.radius()),
                 short(1.0 / p.time_unit(), Round::Nearest),

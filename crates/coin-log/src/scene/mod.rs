@@ -1,9 +1,7 @@
-//! What to simulate (format.md: Scene files). Two stages: [`SceneFile`] mirrors the TOML exactly (unknown keys
-//! refused), [`Scene`] is the validated, resolved scene (defaults filled in, steady motions solved, the step
-//! fitted to the sampling grid). Only a [`Scene`] reaches the recorder.
-//!
-//! Loading goes: text or preset → TOML table → `--set KEY=VALUE` edits ([`apply_set`]) → [`SceneFile`] →
-//! explicit flags ([`FlagOverrides`]) → [`Scene::from_file`], which reports every problem at once.
+//! What to simulate (format.md: Scene files): [`SceneFile`] mirrors the TOML exactly, [`Scene`] is the
+//! validated, resolved scene that reaches the recorder. Loading goes: text or preset → TOML table →
+//! `--set` edits ([`apply_set`]) → [`SceneFile`] → flags ([`FlagOverrides`]) → [`resolve`], which reports
+//! every problem at once.
 
 mod file;
 pub mod limits;
@@ -19,9 +17,11 @@ pub use file::{
     SteadyFile,
 };
 pub use notes::{compact, Note};
-pub use overrides::{apply_set, other_form, set_value, FlagOverrides};
+pub(crate) use overrides::other_form;
+pub use overrides::{apply_set, set_value, FlagOverrides};
+pub(crate) use problems::ProblemCollector;
 pub use problems::{Problem, SceneProblems};
-pub use readable::{float_literal, readable_toml, Short};
+pub use readable::{readable_toml, Short};
 pub use validate::{DESCRIPTION_MAX_CHARS, UNEXPLAINED};
 
 use crate::format::{Channel, RunMetadata, FORMAT_VERSION};
@@ -40,10 +40,8 @@ pub mod defaults {
     pub const ATOL: f64 = 1e-12;
     /// Fixed step for rk4/gauss4, before being rounded down to divide 1/rate.
     pub const STEP: f64 = 1e-3;
-    /// Most integrator steps of a run (format.md: Limits): about 15 s of rk4 and a minute of dop853 here
-    /// (0.15 and 0.65 µs a step), 10⁴ times what the longest built-in scene takes with dop853 (~8 steps
-    /// per time unit), while the issue's `rk4 --step 1e-12 --duration 0.001` (1e9 steps, minutes for a
-    /// millisecond of motion) is refused.
+    /// Most integrator steps of a run (format.md: Limits): about 15 s of rk4 and a minute of dop853 (0.15
+    /// and 0.65 µs a step), 10⁴ times what the longest built-in scene takes with dop853.
     pub const MAX_STEPS: u64 = 100_000_000;
     /// Flat-landing margin \[rad\]: tan θ ≈ 1e4 there, still well inside double precision.
     pub const FLAT_MARGIN: f64 = 1e-4;
@@ -69,14 +67,6 @@ pub enum SceneError {
         arg: String,
         /// What is wrong.
         reason: String,
-    },
-    /// No built-in scene of that name.
-    #[error("no built-in scene `{name}` and no such file; built-in scenes: {valid}")]
-    UnknownPreset {
-        /// The name given.
-        name: String,
-        /// The valid names, comma-separated.
-        valid: String,
     },
     /// Values out of range, missing or contradictory; every problem found (at least one).
     #[error("{0}")]
@@ -147,10 +137,8 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Validates and resolves a scene file; reports every problem found.
-    ///
-    /// # Errors
-    /// [`SceneError::Invalid`] with one [`Problem`] per bad, missing or contradictory key.
+    /// Validates and resolves a scene file: [`SceneError::Invalid`] names every bad, missing or
+    /// contradictory key.
     pub fn from_file(file: &SceneFile) -> Result<Self, SceneError> {
         validate::scene_from_file(file, &[])
     }
@@ -241,26 +229,18 @@ pub fn to_toml(file: &SceneFile) -> String {
 }
 
 /// Parses scene TOML text and applies `--set` edits, giving the raw file (not yet validated).
-///
-/// # Errors
-/// [`SceneError::Parse`] for bad TOML or a key/type that does not fit; [`SceneError::Set`] for a bad edit.
 pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneError> {
+    let error = |e: toml::de::Error| SceneError::Parse(toml_message(&e));
     if sets.is_empty() {
         // Straight from the text: serde's message then points at the line.
-        return toml::from_str(text).map_err(|e| SceneError::Parse(toml_message(&e)));
+        return toml::from_str(text).map_err(error);
     }
-    let mut table: toml::Table =
-        toml::from_str(text).map_err(|e| SceneError::Parse(toml_message(&e)))?;
-    for set in sets {
-        apply_set(&mut table, set)?;
-    }
-    file_from_table(table)
+    with_sets(toml::from_str(text).map_err(error)?, sets)
 }
 
-/// A TOML parse error's message, trimmed, each quoted line cut to [`crate::files::SHOWN_CHARS`] characters:
-/// serde's message quotes the offending line, which in a crafted file held 200 000 characters.
-#[must_use]
-pub fn toml_message(e: &toml::de::Error) -> String {
+/// A TOML parse error's message, trimmed, each quoted line cut to [`crate::files::SHOWN_CHARS`] characters
+/// (serde's message quotes the offending line, however long).
+pub(crate) fn toml_message(e: &toml::de::Error) -> String {
     let text = e.to_string();
     let lines = text
         .trim()
@@ -270,25 +250,23 @@ pub fn toml_message(e: &toml::de::Error) -> String {
 }
 
 /// A preset (or any file) with `--set` edits applied.
-///
-/// # Errors
-/// As [`parse_with_sets`].
 pub fn file_with_sets(file: &SceneFile, sets: &[String]) -> Result<SceneFile, SceneError> {
     if sets.is_empty() {
         return Ok(file.clone());
     }
-    let mut table =
+    let table =
         toml::Table::try_from(file).map_err(|e| SceneError::Parse(e.to_string().trim().into()))?;
+    with_sets(table, sets)
+}
+
+fn with_sets(mut table: toml::Table, sets: &[String]) -> Result<SceneFile, SceneError> {
     for set in sets {
         apply_set(&mut table, set)?;
     }
     file_from_table(table)
 }
 
-/// A scene table (after edits) as a raw scene file, not yet validated.
-///
-/// # Errors
-/// [`SceneError::Parse`] for a key or type that does not fit (serde's message, on one line).
+/// A scene table (after edits) as a raw scene file, not yet validated (serde's message on one line).
 pub fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
     toml::Value::Table(table)
         .try_into::<SceneFile>()
@@ -297,18 +275,12 @@ pub fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
 
 /// Resolves a raw file with command-line flags on top into a validated scene; problems caused by a flag
 /// name the flag.
-///
-/// # Errors
-/// [`SceneError::Invalid`] listing every problem.
 pub fn resolve(file: &SceneFile, flags: &FlagOverrides) -> Result<Scene, SceneError> {
     resolve_with_notes(file, flags).map(|(scene, _)| scene)
 }
 
 /// [`resolve`], with what resolving did to what was asked: the settings the integrator ignores and a
 /// fixed step rounded to the sampling grid, for the user to be told.
-///
-/// # Errors
-/// [`SceneError::Invalid`] listing every problem.
 pub fn resolve_with_notes(
     file: &SceneFile,
     flags: &FlagOverrides,

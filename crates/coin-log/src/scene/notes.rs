@@ -3,6 +3,7 @@
 //! sampling grid.
 
 use super::file::SceneFile;
+use super::problems::flag_of;
 use super::{defaults, Scene};
 use crate::integrate::Method;
 use std::fmt;
@@ -96,7 +97,7 @@ pub(super) fn notes(
         .map(|(key, value)| Note::Ignored {
             key,
             value,
-            flag: provenance.iter().find(|(k, _)| *k == key).map(|(_, f)| *f),
+            flag: flag_of(provenance, key),
             method,
         })
         .collect();

@@ -7,6 +7,7 @@ use super::SceneError;
 /// Applies one `KEY=VALUE` to a scene table. KEY is a dotted path (`initial.steady.branch`); missing
 /// tables on the way are created. VALUE is parsed as a TOML value (`0.3`, `[1, 2, 3]`, `"hoop"`,
 /// `{ kind = "straight", omega_z = 1.0 }`), or taken as a bare string when it does not parse (`hoop`, `+`).
+/// Refused without `=`, with an empty key part, or through a part of the path that is not a table.
 ///
 /// ```
 /// let mut t = toml::Table::new();
@@ -15,10 +16,6 @@ use super::SceneError;
 /// assert_eq!(t["run"]["rate"].as_integer(), Some(250));
 /// assert_eq!(t["body"]["shape"].as_str(), Some("hoop"));
 /// ```
-///
-/// # Errors
-/// [`SceneError::Set`] when there is no `=`, the key is empty or has an empty part, or a part of the path
-/// is a value rather than a table.
 pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
     let Some((key, raw)) = arg.split_once('=') else {
         return Err(SceneError::Set {
@@ -44,10 +41,6 @@ pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
 /// coin_log::scene::set_value(&mut t, "initial.omega", toml::Value::from(vec![0.0, 0.2, 1.5])).unwrap();
 /// assert_eq!(t["initial"]["omega"].as_array().map(Vec::len), Some(3));
 /// ```
-///
-/// # Errors
-/// [`SceneError::Set`] (its `arg` the key) when the key is empty or has an empty part, or a part of the
-/// path is a value rather than a table.
 pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), SceneError> {
     let error = |reason: String| SceneError::Set {
         arg: key.to_string(),
@@ -89,11 +82,8 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
 }
 
 /// The keys that an edit of `key` removes: the other form of the same fact, which the scene may give one
-/// way only (format.md: `--set`). A shape stands for both inertias, and a steady motion for θ and ω: without
-/// this, `--set body.inertia_z=0.4` on a built-in scene, or a sweep axis over it, was refused as "given
-/// together with `body.shape`", and only replacing the whole `[body]` table got past it.
-#[must_use]
-pub fn other_form(key: &str) -> &'static [&'static str] {
+/// way only (format.md: `--set`). A shape stands for both inertias, and a steady motion for θ and ω.
+pub(crate) fn other_form(key: &str) -> &'static [&'static str] {
     match key {
         "body.shape" => &["body.inertia_x", "body.inertia_z"],
         "body.inertia_x" | "body.inertia_z" => &["body.shape"],
@@ -160,30 +150,22 @@ impl FlagOverrides {
         let mut file = file.clone();
         let mut provenance = Vec::new();
         let run = file.run.get_or_insert_with(RunFile::default);
-        let mut set = |slot: &mut Option<f64>, value: Option<f64>, key, flag| {
-            if let Some(v) = value {
-                *slot = Some(v);
-                provenance.push((key, flag));
-            }
-        };
-        set(
-            &mut run.duration,
-            self.duration,
-            "run.duration",
-            "--duration",
-        );
-        set(&mut run.rate, self.rate, "run.rate", "--rate");
-        set(&mut run.rtol, self.rtol, "run.rtol", "--rtol");
-        set(&mut run.atol, self.atol, "run.atol", "--atol");
-        set(&mut run.step, self.step, "run.step", "--step");
-        if let Some(n) = self.max_steps {
-            run.max_steps = Some(n);
-            provenance.push(("run.max_steps", "--max-steps"));
+        // `--flag` → `run.<field>`, the field of the same name in both.
+        macro_rules! set {
+            ($field:ident, $flag:literal) => {
+                if self.$field.is_some() {
+                    run.$field.clone_from(&self.$field);
+                    provenance.push((concat!("run.", stringify!($field)), $flag));
+                }
+            };
         }
-        if let Some(name) = &self.integrator {
-            run.integrator = Some(name.clone());
-            provenance.push(("run.integrator", "--integrator"));
-        }
+        set!(duration, "--duration");
+        set!(rate, "--rate");
+        set!(rtol, "--rtol");
+        set!(atol, "--atol");
+        set!(step, "--step");
+        set!(max_steps, "--max-steps");
+        set!(integrator, "--integrator");
         if let Some(channels) = &self.channels {
             file.record.get_or_insert_with(RecordFile::default).channels = Some(channels.clone());
             provenance.push(("record.channels", "--channels"));

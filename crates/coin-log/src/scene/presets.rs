@@ -41,14 +41,17 @@ builtins!(
 /// and edits then change a built-in as they change a scene that never set those keys (`--integrator rk4`
 /// finds no rtol to warn about, a dissipation added with `--set` adds the `work` channel).
 #[must_use]
-#[allow(
-    clippy::too_many_lines,
-    reason = "a table: one match arm per built-in scene, each a literal scene"
-)]
 pub fn preset(name: &str) -> Option<SceneFile> {
     let text = NAMES.iter().position(|n| *n == name).map(|i| TEXTS[i])?;
     // Every file parses: a test reads each one.
     super::parse_with_sets(text, &[]).ok().map(without_defaults)
+}
+
+/// True when a scene argument is written as a path rather than a built-in's name: it holds a path
+/// separator or ends in `.toml` (format.md: Commands).
+#[must_use]
+pub fn is_path(arg: &str) -> bool {
+    arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR) || arg.ends_with(".toml")
 }
 
 /// `file` without the keys whose value is the default (the inverse of [`super::Scene::to_file`]).

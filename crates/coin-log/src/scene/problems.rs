@@ -2,6 +2,7 @@
 //! collects every one ([`ProblemCollector`]) before it fails with all of them ([`SceneProblems`]).
 
 use std::fmt;
+use std::str::FromStr;
 
 /// One thing wrong with a scene: the key, the value found and what is allowed.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -30,53 +31,29 @@ impl fmt::Display for Problem {
     }
 }
 
-/// Every problem found in a scene: never empty, by construction (a first problem is required), so that an
-/// invalid scene always says what is wrong.
+/// Every problem found in a scene: never empty, by construction, so that an invalid scene always says
+/// what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct SceneProblems {
-    first: Problem,
-    rest: Vec<Problem>,
-}
+pub struct SceneProblems(pub(super) Vec<Problem>);
 
 impl SceneProblems {
-    /// A list of one problem.
-    #[must_use]
-    pub fn new(first: Problem) -> Self {
-        Self {
-            first,
-            rest: Vec::new(),
-        }
-    }
-
     /// The problems of `list`, or `None` when it is empty.
-    #[must_use]
-    pub fn from_vec(list: Vec<Problem>) -> Option<Self> {
-        let mut list = list.into_iter();
-        let first = list.next()?;
-        Some(Self {
-            first,
-            rest: list.collect(),
-        })
-    }
-
-    /// How many problems (at least one).
-    #[must_use]
-    pub fn count(&self) -> usize {
-        1 + self.rest.len()
+    pub(crate) fn from_vec(list: Vec<Problem>) -> Option<Self> {
+        (!list.is_empty()).then_some(Self(list))
     }
 
     /// The problems, in the order found.
     pub fn iter(&self) -> impl Iterator<Item = &Problem> {
-        std::iter::once(&self.first).chain(&self.rest)
+        self.0.iter()
     }
 }
 
 impl fmt::Display for SceneProblems {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.rest.is_empty() {
-            return self.first.fmt(f);
+        if let [one] = self.0.as_slice() {
+            return one.fmt(f);
         }
-        write!(f, "{} problems:", self.count())?;
+        write!(f, "{} problems:", self.0.len())?;
         for p in self.iter() {
             write!(f, "\n  {p}")?;
         }
@@ -85,30 +62,31 @@ impl fmt::Display for SceneProblems {
 }
 
 /// Collects problems, naming the flag that set a key when one did.
-pub(super) struct ProblemCollector<'a> {
-    pub(super) list: Vec<Problem>,
+pub(crate) struct ProblemCollector<'a> {
+    pub(crate) list: Vec<Problem>,
     provenance: &'a [(&'static str, &'static str)],
 }
 
 impl<'a> ProblemCollector<'a> {
-    pub(super) fn new(provenance: &'a [(&'static str, &'static str)]) -> Self {
+    pub(crate) fn new(provenance: &'a [(&'static str, &'static str)]) -> Self {
         Self {
             list: Vec::new(),
             provenance,
         }
     }
 
-    pub(super) fn push(&mut self, key: &str, value: String, reason: impl Into<String>) {
-        let flag = self
-            .provenance
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map(|(_, f)| (*f).to_string());
+    pub(crate) fn push(
+        &mut self,
+        key: impl Into<String>,
+        value: impl Into<String>,
+        reason: impl Into<String>,
+    ) {
+        let key = key.into();
         self.list.push(Problem {
-            key: key.to_string(),
-            value,
+            flag: flag_of(self.provenance, &key).map(str::to_string),
+            key,
+            value: value.into(),
             reason: reason.into(),
-            flag,
         });
     }
 
@@ -116,15 +94,45 @@ impl<'a> ProblemCollector<'a> {
         self.push(key, String::new(), reason);
     }
 
+    /// A required number: `value` when it is finite and `ok`, else NaN, `bad` or `missing` reported.
+    pub(super) fn required(
+        &mut self,
+        key: &str,
+        value: Option<f64>,
+        ok: impl Fn(f64) -> bool,
+        bad: &str,
+        missing: impl Into<String>,
+    ) -> f64 {
+        match value {
+            Some(v) if v.is_finite() && ok(v) => v,
+            Some(v) => {
+                self.push(key, number(v), bad);
+                f64::NAN
+            }
+            None => {
+                self.missing(key, missing);
+                f64::NAN
+            }
+        }
+    }
+
+    /// A name parsed, or `None` with the reason made of the error reported.
+    pub(super) fn parse<T: FromStr>(
+        &mut self,
+        key: &str,
+        name: &str,
+        reason: impl FnOnce(T::Err) -> String,
+    ) -> Option<T> {
+        name.parse()
+            .map_err(|e| self.push(key, quoted(name), reason(e)))
+            .ok()
+    }
+
     /// A required number that must be finite and > 0.
     pub(super) fn positive(&mut self, key: &str, value: f64) -> bool {
         let ok = value.is_finite() && value > 0.0;
         if !ok {
-            self.push(
-                key,
-                number(value),
-                "is outside (0, ∞): give a finite number > 0",
-            );
+            self.push(key, number(value), POSITIVE);
         }
         ok
     }
@@ -133,50 +141,45 @@ impl<'a> ProblemCollector<'a> {
     pub(super) fn finite(&mut self, key: &str, value: f64) -> bool {
         let ok = value.is_finite();
         if !ok {
-            self.push(key, number(value), "is not a finite number");
+            self.push(key, number(value), NOT_FINITE);
         }
         ok
     }
 
     /// A vector of three finite numbers.
     pub(super) fn vector3(&mut self, key: &str, value: &[f64]) -> Option<[f64; 3]> {
-        match value {
-            [x, y, z] => {
-                let ok = [*x, *y, *z].iter().all(|v| v.is_finite());
-                if ok {
-                    Some([*x, *y, *z])
-                } else {
-                    self.push(
-                        key,
-                        numbers(value),
-                        "has a non-finite component: give three finite numbers",
-                    );
-                    None
-                }
-            }
-            _ => {
-                self.push(
-                    key,
-                    numbers(value),
-                    format!(
-                        "has {} components: give three, [ω_X, ω_Y, ω_Z]",
-                        value.len()
-                    ),
-                );
-                None
-            }
-        }
+        let reason = match *value {
+            [x, y, z] if [x, y, z].iter().all(|v| v.is_finite()) => return Some([x, y, z]),
+            [_, _, _] => "has a non-finite component: give three finite numbers".to_string(),
+            _ => format!(
+                "has {} components: give three, [ω_X, ω_Y, ω_Z]",
+                value.len()
+            ),
+        };
+        self.push(key, numbers(value), reason);
+        None
     }
+}
+
+/// The flag that set `key`, in a provenance list of (key, flag).
+pub(super) fn flag_of(
+    provenance: &[(&'static str, &'static str)],
+    key: &str,
+) -> Option<&'static str> {
+    provenance.iter().find(|(k, _)| *k == key).map(|(_, f)| *f)
+}
+
+/// Why a number that must be finite and > 0 is refused.
+pub(super) const POSITIVE: &str = "is outside (0, ∞): give a finite number > 0";
+pub(super) const NOT_FINITE: &str = "is not a finite number";
+
+pub(super) fn quoted(s: &str) -> String {
+    format!("{s:?}")
 }
 
 /// A number as the user would write it (`-1`, `0.5`, `1e-9`, `NaN`, `inf`).
 pub(super) fn number(value: f64) -> String {
-    let magnitude = value.abs();
-    if value.is_finite() && value != 0.0 && !(1e-4..1e16).contains(&magnitude) {
-        ryu::Buffer::new().format_finite(value).to_string()
-    } else {
-        format!("{value}")
-    }
+    super::Short(value).to_string()
 }
 
 pub(super) fn numbers(values: &[f64]) -> String {

@@ -6,21 +6,15 @@ use super::file::{
     SteadyFile,
 };
 use super::limits;
-use super::problems::{number, numbers, ProblemCollector};
-use super::{
-    defaults, InitialSpec, Problem, RunConfig, Scene, SceneError, SceneProblems, MAX_SAMPLES,
-};
+use super::problems::{number, numbers, quoted, ProblemCollector, NOT_FINITE, POSITIVE};
+use super::{defaults, InitialSpec, RunConfig, Scene, SceneError, SceneProblems, MAX_SAMPLES};
 use crate::format::Channel;
 use crate::integrate::{Method, MethodConfig};
 use crate::model::{
-    Branch, Coin, CoinParams, Dissipation, DissipationModel, Inertia, State, Steady, SteadyFamily,
+    Coin, CoinParams, Dissipation, DissipationModel, Inertia, State, Steady, SteadyFamily,
     SteadyKind, MIN_RATE_EXPONENT,
 };
 use std::f64::consts::FRAC_PI_2;
-
-fn quoted(s: &str) -> String {
-    format!("{s:?}")
-}
 
 /// Longest scene description, in characters: one line of `coin-log scenes` and `info` (the longest
 /// built-in has 379).
@@ -67,22 +61,13 @@ pub(super) fn scene_from_file(
     let run_file = file.run.clone().unwrap_or_default();
     let flat_margin = run_file.flat_margin.unwrap_or(defaults::FLAT_MARGIN);
     let margin_ok = flat_margin.is_finite() && flat_margin > 0.0 && flat_margin < FRAC_PI_2;
+    let margin = margin_ok.then_some(flat_margin);
     let body = check_body(&file.body, &mut problems);
-    let initial = body.as_ref().and_then(|(params, ..)| {
-        check_initial(
-            &file.initial,
-            params,
-            margin_ok.then_some(flat_margin),
-            &mut problems,
-        )
-    });
+    let initial = (body.as_ref())
+        .and_then(|(params, ..)| check_initial(&file.initial, params, margin, &mut problems));
     // Without a valid body the initial state cannot be solved; still check what can be checked alone.
     if body.is_none() {
-        check_initial_alone(
-            &file.initial,
-            margin_ok.then_some(flat_margin),
-            &mut problems,
-        );
+        check_initial_alone(&file.initial, margin, &mut problems);
     }
     let dissipation = check_dissipation(file.body.dissipation.as_ref(), &mut problems);
     check_description(file.description.as_deref(), &mut problems);
@@ -118,17 +103,14 @@ pub(super) fn scene_from_file(
     if let Some(scene) = &scene {
         limits::check_resolved(scene, file, &mut problems);
     }
-    match (scene, SceneProblems::from_vec(problems.list)) {
-        (Some(scene), None) => Ok(scene),
-        (_, Some(list)) => Err(SceneError::Invalid(list)),
+    if problems.list.is_empty() {
+        if let Some(scene) = scene {
+            return Ok(scene);
+        }
         // Every check that rejects a part reports why; should one ever fail to, still say something.
-        (None, None) => Err(SceneError::Invalid(SceneProblems::new(Problem {
-            key: "scene".into(),
-            value: String::new(),
-            reason: UNEXPLAINED.into(),
-            flag: None,
-        }))),
+        problems.push("scene", "", UNEXPLAINED);
     }
+    Err(SceneError::Invalid(SceneProblems(problems.list)))
 }
 
 /// The reason given if a scene were refused without a problem (a bug; the fuzz targets look for it).
@@ -151,17 +133,9 @@ fn check_body(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Body> 
     if !ok || !limits::check_scales(body, inertia, problems) {
         return None;
     }
-    match CoinParams::new(body.mass, body.radius, body.gravity, inertia) {
-        Ok(params) => Some((params, inertia, body.friction, thickness)),
-        Err(errors) => {
-            // Unreachable after the checks above (each value positive, each scale in range); reported
-            // rather than dropped should it ever happen.
-            for e in errors {
-                problems.push("body", String::new(), e.to_string());
-            }
-            None
-        }
-    }
+    // Each value positive, each scale in range: the model accepts them (else UNEXPLAINED says so).
+    let params = CoinParams::new(body.mass, body.radius, body.gravity, inertia).ok()?;
+    Some((params, inertia, body.friction, thickness))
 }
 
 /// The inertia: a shape, or both moments (I_Z ≤ 2 I_X).
@@ -243,120 +217,56 @@ fn check_dissipation(
         return Some(None);
     };
     let before = problems.list.len();
-    let model = match d.model.parse::<DissipationModel>() {
-        Ok(m) => Some(m),
-        Err(e) => {
-            problems.push(
-                "body.dissipation.model",
-                quoted(&d.model),
-                format!(
-                    "is not a dissipation model: use one of {}",
-                    e.valid.join(", ")
-                ),
-            );
-            None
-        }
-    };
-    let coefficient = match d.coefficient {
-        Some(c) if c.is_finite() && c >= 0.0 => c,
-        Some(c) => {
-            problems.push(
-                "body.dissipation.coefficient",
-                number(c),
-                "is outside [0, ∞): give κ as a finite number ≥ 0, in the scene's units",
-            );
-            f64::NAN
-        }
-        None => {
-            problems.missing(
-                "body.dissipation.coefficient",
-                "is missing: give κ of P = κ |φ̇|^m (sin α)^(−k), e.g. coefficient = 1e-6",
-            );
-            f64::NAN
-        }
-    };
-    let (m, k) = match model.map(DissipationModel::exponents) {
-        Some(Some((m, k))) => {
-            preset_exponent_given(d, model, problems);
+    let model = problems.parse::<DissipationModel>("body.dissipation.model", &d.model, |e| {
+        format!(
+            "is not a dissipation model: use one of {}",
+            e.valid.join(", ")
+        )
+    });
+    let coefficient = problems.required(
+        "body.dissipation.coefficient",
+        d.coefficient,
+        |c| c >= 0.0,
+        "is outside [0, ∞): give κ as a finite number ≥ 0, in the scene's units",
+        "is missing: give κ of P = κ |φ̇|^m (sin α)^(−k), e.g. coefficient = 1e-6",
+    );
+    let (m, k) = match model.map(|model| (model, model.exponents())) {
+        // A preset fixes m and k: giving them is an error that names `power-law`.
+        Some((model, Some((m, k)))) => {
+            for (name, value) in [("m", d.m), ("k", d.k)] {
+                if let Some(v) = value {
+                    problems.push(
+                        format!("body.dissipation.{name}"),
+                        number(v),
+                        format!(
+                            "does not apply to model \"{model}\", which fixes m = {m}, k = {k}: use model = \"power-law\" to choose m and k"
+                        ),
+                    );
+                }
+            }
             (m, k)
         }
-        Some(None) => power_law_exponents(d, problems),
+        Some((_, None)) => power_law_exponents(d, problems),
         None => (f64::NAN, f64::NAN),
     };
     if problems.list.len() != before {
         return None;
     }
-    let model = model?;
-    match Dissipation::new(model, coefficient, m, k) {
-        Ok(law) => Some(Some(law)),
-        Err(e) => {
-            problems.push(
-                "body.dissipation",
-                format!("{{ model = \"{model}\" }}"),
-                format!("cannot be built: {e}"),
-            );
-            None
-        }
-    }
-}
-
-/// A preset fixes m and k: giving them is an error that names `power-law`.
-fn preset_exponent_given(
-    d: &DissipationFile,
-    model: Option<DissipationModel>,
-    problems: &mut ProblemCollector,
-) {
-    let Some(model) = model else { return };
-    let Some((m, k)) = model.exponents() else {
-        return;
-    };
-    for (name, value) in [("m", d.m), ("k", d.k)] {
-        if let Some(v) = value {
-            problems.push(
-                &format!("body.dissipation.{name}"),
-                number(v),
-                format!(
-                    "does not apply to model \"{model}\", which fixes m = {m}, k = {k}: use model = \"power-law\" to choose m and k"
-                ),
-            );
-        }
-    }
+    // Each value checked above as the model checks it (else UNEXPLAINED says so).
+    Dissipation::new(model?, coefficient, m, k).ok().map(Some)
 }
 
 /// `power-law`'s m ≥ 1 and k, both required.
 fn power_law_exponents(d: &DissipationFile, problems: &mut ProblemCollector) -> (f64, f64) {
-    let m = match d.m {
-        Some(m) if m.is_finite() && m >= MIN_RATE_EXPONENT => m,
-        Some(m) => {
-            problems.push(
-                "body.dissipation.m",
-                number(m),
-                "is outside [1, ∞): the couple P/|ω| ∝ |ω|^(m−1) must stay bounded as the coin stops",
-            );
-            f64::NAN
-        }
-        None => {
-            problems.missing(
-                "body.dissipation.m",
-                "is missing: model \"power-law\" needs m (≥ 1) and k",
-            );
-            f64::NAN
-        }
-    };
-    let k = match d.k {
-        Some(k) if k.is_finite() => k,
-        Some(k) => {
-            problems.push("body.dissipation.k", number(k), "is not a finite number");
-            f64::NAN
-        }
-        None => {
-            problems.missing(
-                "body.dissipation.k",
-                "is missing: model \"power-law\" needs m (≥ 1) and k",
-            );
-            f64::NAN
-        }
-    };
+    const NEEDS: &str = "is missing: model \"power-law\" needs m (≥ 1) and k";
+    let m = problems.required(
+        "body.dissipation.m",
+        d.m,
+        |m| m >= MIN_RATE_EXPONENT,
+        "is outside [1, ∞): the couple P/|ω| ∝ |ω|^(m−1) must stay bounded as the coin stops",
+        NEEDS,
+    );
+    let k = problems.required("body.dissipation.k", d.k, |_| true, NOT_FINITE, NEEDS);
     (m, k)
 }
 
@@ -367,19 +277,10 @@ fn check_initial_alone(
     problems: &mut ProblemCollector,
 ) {
     if let Some(theta) = initial.theta {
-        if problems.finite("initial.theta", theta) {
-            let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
-            if theta.abs() >= FRAC_PI_2 - margin {
-                problems.push("initial.theta", number(theta), lean_range(margin));
-            }
-        }
+        let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+        check_theta(theta, Some(margin), problems);
     }
-    for (key, value) in [
-        ("initial.phi", initial.phi),
-        ("initial.psi", initial.psi),
-        ("initial.x", initial.x),
-        ("initial.z", initial.z),
-    ] {
+    for (key, value) in offsets(initial) {
         if let Some(v) = value {
             problems.finite(key, v);
         }
@@ -396,54 +297,69 @@ fn check_initial(
     problems: &mut ProblemCollector,
 ) -> Option<Initial> {
     let before = problems.list.len();
-    let mut offsets = [0.0; 4]; // φ, ψ, x, z
-    for (slot, (key, value)) in offsets.iter_mut().zip([
-        ("initial.phi", initial.phi),
-        ("initial.psi", initial.psi),
-        ("initial.x", initial.x),
-        ("initial.z", initial.z),
-    ]) {
+    let mut shift = [0.0; 4];
+    for (slot, (key, value)) in shift.iter_mut().zip(offsets(initial)) {
         if let Some(v) = value {
             if problems.finite(key, v) {
                 *slot = v;
             }
         }
     }
-    let in_lean_range = |theta: f64| flat_margin.is_none_or(|m| theta.abs() < FRAC_PI_2 - m);
-    let margin_text = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
     let coin = Coin::new(*params);
-    let base = initial_base(initial, &coin, margin_text, &in_lean_range, problems);
+    let base = initial_base(initial, &coin, flat_margin, problems);
     let perturbation = initial
         .perturbation
         .as_ref()
         .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
     let (mut state, spec) = base?;
     let perturbation = perturbation?;
-    state.phi += offsets[0];
-    state.psi += offsets[1];
-    state.x += offsets[2];
-    state.z += offsets[3];
+    state.phi += shift[0];
+    state.psi += shift[1];
+    state.x += shift[2];
+    state.z += shift[3];
     let kicked = perturbed(&state, &perturbation);
-    if perturbation[0] != 0.0 && !in_lean_range(kicked.theta) {
+    if perturbation[0] != 0.0 && !leans_less_than_flat(kicked.theta, flat_margin) {
         problems.push(
             "initial.perturbation.theta",
             number(perturbation[0]),
             format!(
                 "takes theta to {}, which {}",
                 number(kicked.theta),
-                lean_range(margin_text)
+                lean_range(flat_margin.unwrap_or(defaults::FLAT_MARGIN))
             ),
         );
     }
     (problems.list.len() == before).then_some((state, spec, perturbation))
 }
 
+/// The offsets φ, ψ, x, z of `[initial]`, by key.
+fn offsets(initial: &InitialFile) -> [(&'static str, Option<f64>); 4] {
+    [
+        ("initial.phi", initial.phi),
+        ("initial.psi", initial.psi),
+        ("initial.x", initial.x),
+        ("initial.z", initial.z),
+    ]
+}
+
+/// |θ| < π/2 − margin, or the margin is not known (it is reported itself).
+fn leans_less_than_flat(theta: f64, flat_margin: Option<f64>) -> bool {
+    flat_margin.is_none_or(|m| theta.abs() < FRAC_PI_2 - m)
+}
+
+/// An explicit θ: finite, and leaning less than flat.
+fn check_theta(theta: f64, flat_margin: Option<f64>, problems: &mut ProblemCollector) {
+    if problems.finite("initial.theta", theta) && !leans_less_than_flat(theta, flat_margin) {
+        let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+        problems.push("initial.theta", number(theta), lean_range(margin));
+    }
+}
+
 /// The state before offsets and perturbation: an explicit (θ, ω) or a solved steady motion.
 fn initial_base(
     initial: &InitialFile,
     coin: &Coin,
-    margin_text: f64,
-    in_lean_range: &dyn Fn(f64) -> bool,
+    flat_margin: Option<f64>,
     problems: &mut ProblemCollector,
 ) -> Option<(State, InitialSpec)> {
     const EITHER: &str = "is given together with `initial.steady`: give either an explicit state (theta, omega) or a steady motion";
@@ -455,14 +371,11 @@ fn initial_base(
             if let Some(o) = omega {
                 problems.push("initial.omega", numbers(o), EITHER);
             }
-            check_steady(steady, coin, margin_text, in_lean_range, problems)
+            check_steady(steady, coin, flat_margin, problems)
                 .map(|s| (s.state, InitialSpec::Steady(s)))
         }
         (None, Some(theta), Some(omega)) => {
-            let theta_ok = problems.finite("initial.theta", theta);
-            if theta_ok && !in_lean_range(theta) {
-                problems.push("initial.theta", number(theta), lean_range(margin_text));
-            }
+            check_theta(theta, flat_margin, problems);
             problems
                 .vector3("initial.omega", omega)
                 .map(|[wx, wy, wz]| {
@@ -497,7 +410,7 @@ fn initial_base(
 }
 
 /// `base` with the perturbation (θ, ω_X, ω_Y, ω_Z) added.
-pub(super) fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
+fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
     State {
         theta: base.theta + perturbation[0],
         omega_x: base.omega_x + perturbation[1],
@@ -532,24 +445,15 @@ fn steady_keys(family: SteadyFamily) -> &'static [&'static str] {
 fn check_steady(
     steady: &SteadyFile,
     coin: &Coin,
-    margin: f64,
-    in_lean_range: &dyn Fn(f64) -> bool,
+    flat_margin: Option<f64>,
     problems: &mut ProblemCollector,
 ) -> Option<Steady> {
     let before = problems.list.len();
-    let family = match steady.kind.parse::<SteadyFamily>() {
-        Ok(f) => f,
-        Err(_) => {
-            problems.push(
-                "initial.steady.kind",
-                quoted(&steady.kind),
-                "is not a steady motion: use \"straight\", \"centre-fixed\", \"circle\" or \"spin-upright\"",
-            );
-            return None;
-        }
-    };
+    let family = problems.parse::<SteadyFamily>("initial.steady.kind", &steady.kind, |_| {
+        "is not a steady motion: use \"straight\", \"centre-fixed\", \"circle\" or \"spin-upright\"".into()
+    })?;
     check_steady_keys(steady, family, problems);
-    let kind = steady_kind(steady, family, margin, in_lean_range, problems);
+    let kind = steady_kind(steady, family, flat_margin, problems);
     if problems.list.len() != before {
         return None;
     }
@@ -569,7 +473,7 @@ fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut P
         if let Some(v) = value {
             if !allowed.contains(&name) {
                 problems.push(
-                    &format!("initial.steady.{name}"),
+                    format!("initial.steady.{name}"),
                     v,
                     format!(
                         "does not apply to a \"{family}\" steady motion, which takes: kind, {}",
@@ -586,29 +490,14 @@ fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut P
 fn steady_kind(
     steady: &SteadyFile,
     family: SteadyFamily,
-    margin: f64,
-    in_lean_range: &dyn Fn(f64) -> bool,
+    flat_margin: Option<f64>,
     problems: &mut ProblemCollector,
 ) -> SteadyKind {
-    let allowed = steady_keys(family);
-    let mut required = |name: &str, value: Option<f64>| -> f64 {
+    let needs = steady_keys(family).join(", ");
+    let needs = format!("is missing: a \"{family}\" steady motion needs {needs}");
+    let mut required = |name: &str, value: Option<f64>| {
         let key = format!("initial.steady.{name}");
-        match value {
-            Some(v) => {
-                problems.finite(&key, v);
-                v
-            }
-            None => {
-                problems.missing(
-                    &key,
-                    format!(
-                        "is missing: a \"{family}\" steady motion needs {}",
-                        allowed.join(", ")
-                    ),
-                );
-                0.0
-            }
-        }
+        problems.required(&key, value, |_| true, NOT_FINITE, needs.as_str())
     };
     match family {
         SteadyFamily::Straight => SteadyKind::Straight {
@@ -624,11 +513,14 @@ fn steady_kind(
             } else {
                 0.0
             };
-            let branch = steady_branch(steady, problems);
-            if theta.is_finite()
-                && (theta == 0.0 || !in_lean_range(theta))
-                && steady.theta.is_some()
-            {
+            let branch = steady.branch.as_deref().and_then(|name| {
+                problems.parse("initial.steady.branch", name, |_| {
+                    "is not a branch: use \"+\" or \"-\"".into()
+                })
+            });
+            let branch = branch.unwrap_or(defaults::BRANCH);
+            if theta.is_finite() && (theta == 0.0 || !leans_less_than_flat(theta, flat_margin)) {
+                let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
                 problems.push(
                     "initial.steady.theta",
                     number(theta),
@@ -647,21 +539,6 @@ fn steady_kind(
                 SteadyKind::CentreFixed { theta, branch }
             }
         }
-    }
-}
-
-/// `initial.steady.branch` (default `+`).
-fn steady_branch(steady: &SteadyFile, problems: &mut ProblemCollector) -> Branch {
-    match steady.branch.as_deref() {
-        None => defaults::BRANCH,
-        Some(name) => name.parse().unwrap_or_else(|_| {
-            problems.push(
-                "initial.steady.branch",
-                quoted(name),
-                "is not a branch: use \"+\" or \"-\"",
-            );
-            defaults::BRANCH
-        }),
     }
 }
 
@@ -703,24 +580,20 @@ fn check_run(
     problems: &mut ProblemCollector,
 ) -> Option<RunConfig> {
     let before = problems.list.len();
-    let duration = match run.duration {
-        Some(d) => {
-            if problems.positive("run.duration", d) {
-                limits::check_duration(d, problems);
-            }
-            d
-        }
-        None => {
-            problems.missing(
-                "run.duration",
-                "is missing: give the run's length in time units, e.g. duration = 20.0",
-            );
-            f64::NAN
-        }
-    };
+    let duration = problems.required(
+        "run.duration",
+        run.duration,
+        |d| d > 0.0,
+        POSITIVE,
+        "is missing: give the run's length in time units, e.g. duration = 20.0",
+    );
+    if duration.is_finite() {
+        limits::check_duration(duration, problems);
+    }
     let rate = run.rate.unwrap_or(defaults::RATE);
-    if problems.positive("run.rate", rate) && duration.is_finite() && duration * rate > MAX_SAMPLES
-    {
+    // Both finite and > 0 (a bad duration is NaN here).
+    let rate_ok = problems.positive("run.rate", rate) && duration.is_finite();
+    if rate_ok && duration * rate > MAX_SAMPLES {
         problems.push(
             "run.rate",
             number(rate),
@@ -732,24 +605,18 @@ fn check_run(
         );
     }
     let integrator = run.integrator.as_deref().unwrap_or(defaults::INTEGRATOR);
-    let method = match integrator.parse::<Method>() {
-        Ok(m) => Some(m),
-        Err(e) => {
-            problems.push(
-                "run.integrator",
-                quoted(integrator),
-                format!(
-                    "is not a known integrator: use one of {}",
-                    e.valid.join(", ")
-                ),
-            );
-            None
-        }
-    };
-    limits::check_rate(rate, duration, problems);
+    let method = problems.parse::<Method>("run.integrator", integrator, |e| {
+        format!(
+            "is not a known integrator: use one of {}",
+            e.valid.join(", ")
+        )
+    });
+    if rate_ok {
+        limits::check_rate(rate, duration, problems);
+    }
     let rtol = run.rtol.unwrap_or(defaults::RTOL);
-    if problems.positive("run.rtol", rtol) {
-        limits::check_rtol(method, rtol, problems);
+    if problems.positive("run.rtol", rtol) && method.is_some_and(Method::is_adaptive) {
+        limits::check_rtol(rtol, problems);
     }
     let atol = run.atol.unwrap_or(defaults::ATOL);
     problems.positive("run.atol", atol);
@@ -806,7 +673,7 @@ fn used_settings(method: Method, rtol: f64, atol: f64, step: f64, rate: f64) -> 
 /// The largest step ≤ `step` that divides the sample interval into a whole number of steps, so that fixed
 /// steps land on the sample grid. A relative slack of 1e-12 keeps 0.01/0.001 = 10.000000000000002 at 10.
 #[allow(clippy::cast_precision_loss)]
-pub(super) fn fitted_step(step: f64, interval: f64) -> f64 {
+fn fitted_step(step: f64, interval: f64) -> f64 {
     let ratio = interval / step;
     let steps = (ratio * (1.0 - 1e-12)).ceil().max(1.0);
     interval / steps
@@ -878,7 +745,7 @@ fn listed_channels(
     if names.is_empty() {
         problems.push(
             "record.channels",
-            "[]".into(),
+            "[]",
             format!("is empty: list at least one channel ({})", Channel::names()),
         );
     }
@@ -978,36 +845,22 @@ fn dissipation_file(d: &Dissipation) -> DissipationFile {
 }
 
 fn steady_file(kind: &SteadyKind) -> SteadyFile {
-    let branch = |b: &Branch| Some(b.to_string());
-    let name = kind.name().to_string();
-    match kind {
-        SteadyKind::Straight { omega_z } => SteadyFile {
-            kind: name,
-            omega_z: Some(*omega_z),
-            ..SteadyFile::default()
-        },
-        SteadyKind::SpinUpright { omega_y } => SteadyFile {
-            kind: name,
-            omega_y: Some(*omega_y),
-            ..SteadyFile::default()
-        },
-        SteadyKind::CentreFixed { theta, branch: b } => SteadyFile {
-            kind: name,
-            theta: Some(*theta),
-            branch: branch(b),
-            ..SteadyFile::default()
-        },
+    let (theta, omega_y, omega_z, branch) = match *kind {
+        SteadyKind::Straight { omega_z } => (None, None, Some(omega_z), None),
+        SteadyKind::SpinUpright { omega_y } => (None, Some(omega_y), None, None),
+        SteadyKind::CentreFixed { theta, branch } => (Some(theta), None, None, Some(branch)),
         SteadyKind::Circle {
             theta,
             omega_z,
-            branch: b,
-        } => SteadyFile {
-            kind: name,
-            theta: Some(*theta),
-            omega_z: Some(*omega_z),
-            branch: branch(b),
-            ..SteadyFile::default()
-        },
+            branch,
+        } => (Some(theta), None, Some(omega_z), Some(branch)),
+    };
+    SteadyFile {
+        kind: kind.name().to_string(),
+        theta,
+        omega_y,
+        omega_z,
+        branch: branch.map(|b| b.to_string()),
     }
 }
 

@@ -5,6 +5,7 @@
 
 use crate::format::metadata::number_string as number;
 use crate::format::Termination;
+use crate::record::RecordSummary;
 use crate::verify::Verdict;
 
 coin_log_names::named_enum! {
@@ -34,9 +35,6 @@ coin_log_names::named_enum! {
     }
 }
 
-/// The columns before the swept keys.
-pub const LEADING_COLUMNS: [&str; 1] = ["index"];
-
 /// The columns after the swept keys.
 pub const TRAILING_COLUMNS: [&str; 20] = [
     "status",
@@ -61,87 +59,48 @@ pub const TRAILING_COLUMNS: [&str; 20] = [
     "wall_time_s",
 ];
 
-/// The one column that depends on the machine.
-pub const WALL_TIME_COLUMN: &str = "wall_time_s";
-
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
-#[must_use]
 pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
-    let keys = keys.map(str::to_string);
-    let fixed = |c: &[&str]| c.iter().map(|c| (*c).to_string()).collect::<Vec<_>>();
-    fixed(&LEADING_COLUMNS)
-        .into_iter()
-        .chain(keys)
-        .chain(fixed(&TRAILING_COLUMNS))
-        .collect()
+    let trailing = TRAILING_COLUMNS.into_iter();
+    let columns = std::iter::once("index").chain(keys).chain(trailing);
+    columns.map(str::to_string).collect()
 }
 
 /// What `analyse` predicts for a run's initial state, by quadrature of the conservative motion
-/// (format.md: The catalogue).
+/// (format.md: The catalogue): the motion, the stability of the steady motion the run starts on (or,
+/// perturbed, starts from) and how the run should end.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Prediction {
-    /// `steady`, `nutation` or `flat-landing`.
     pub motion: &'static str,
-    /// The linear stability of the steady motion the run starts on (or, perturbed, starts from).
     pub stability: Option<&'static str>,
-    /// How the run should end.
     pub termination: Termination,
 }
 
-/// What a recorded run's file and summary say.
+/// A recorded run: its file's name in the folder and SHA-256, `record`'s summary and `verify`'s verdict
+/// (when the sweep verifies).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recorded {
-    /// The file's name in the sweep's folder.
     pub file: String,
-    /// Its size.
-    pub bytes: u64,
-    /// Its SHA-256, hex.
     pub sha256: String,
-    /// How the run ended, and when.
-    pub termination: Termination,
-    /// The end time.
-    pub t_end: f64,
-    /// Samples written.
-    pub samples: u64,
-    /// Messages written.
-    pub messages: u64,
-    /// Accepted integrator steps.
-    pub steps: u64,
-    /// As `record --json`'s `energy_drift`.
-    pub energy_drift: f64,
-    /// As `record --json`'s `invariant_drift`.
-    pub invariant_drift: Option<f64>,
-    /// As `record --json`'s `steady_residual`.
-    pub steady_residual: Option<f64>,
-    /// As `record --json`'s `event_trusted`.
-    pub event_trusted: Option<bool>,
-    /// `verify`'s verdict, when the sweep verifies.
+    pub summary: RecordSummary,
     pub verify: Option<Verdict>,
 }
 
-/// One run's row.
+/// One run's row: the swept keys' values as cells ([`cell`]), the failure's detail (empty for a finished
+/// run), and the wall time of the run (resolve, record, hash, verify) in seconds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
-    /// The run's index.
     pub index: u64,
-    /// The swept keys' values, as cells ([`cell`]).
     pub values: Vec<String>,
-    /// Finished or failed.
     pub status: RunStatus,
-    /// Why it failed.
     pub failure: Option<FailureKind>,
-    /// The failure's detail, one line (empty for a finished run).
     pub reason: String,
-    /// The file and summary, when the run was recorded.
     pub recorded: Option<Recorded>,
-    /// The prediction, when the scene is valid and conservative.
     pub prediction: Option<Prediction>,
-    /// Wall time of the run (resolve, record, hash, verify), seconds.
     pub wall_time: f64,
 }
 
 /// A swept value as a cell: numbers shortest, strings as they are, arrays and tables as TOML.
-#[must_use]
 pub fn cell(value: &toml::Value) -> String {
     match value {
         toml::Value::Float(x) => number(*x),
@@ -152,30 +111,30 @@ pub fn cell(value: &toml::Value) -> String {
 
 impl Row {
     /// The row's cells, in the order of [`columns`].
-    #[must_use]
     pub fn fields(&self) -> Vec<String> {
         let r = self.recorded.as_ref();
+        let s = r.map(|r| &r.summary);
         let opt = |x: Option<f64>| x.map(number).unwrap_or_default();
         let p = self.prediction.as_ref();
         let mut fields = vec![self.index.to_string()];
         fields.extend(self.values.iter().cloned());
         fields.extend([
             self.status.name().to_string(),
-            text(r.map(|r| r.termination.name())),
-            opt(r.map(|r| r.t_end)),
+            text(s.map(|s| s.termination.name())),
+            opt(s.map(|s| s.termination_time)),
             text(r.map(|r| r.verify.map_or("off", verdict_name))),
             text(self.failure.map(|f| f.name())),
             one_line(&self.reason),
             text(r.map(|r| &r.file)),
-            text(r.map(|r| r.bytes)),
+            text(s.map(|s| s.bytes)),
             text(r.map(|r| &r.sha256)),
-            text(r.map(|r| r.samples)),
-            text(r.map(|r| r.messages)),
-            text(r.map(|r| r.steps)),
-            opt(r.map(|r| r.energy_drift)),
-            opt(r.and_then(|r| r.invariant_drift)),
-            opt(r.and_then(|r| r.steady_residual)),
-            text(r.and_then(|r| r.event_trusted)),
+            text(s.map(|s| s.samples)),
+            text(s.map(|s| s.messages)),
+            text(s.map(|s| s.stats.steps)),
+            opt(s.map(|s| s.energy_drift)),
+            opt(s.and_then(|s| s.invariant_drift)),
+            opt(s.and_then(|s| s.steady_residual)),
+            text(s.and_then(|s| s.event_trusted)),
             text(p.map(|p| p.motion)),
             text(p.and_then(|p| p.stability)),
             text(p.map(|p| p.termination.name())),
@@ -185,7 +144,6 @@ impl Row {
     }
 
     /// The row as one CSV line, without the line break.
-    #[must_use]
     pub fn line(&self) -> String {
         crate::csv::line(&self.fields())
     }

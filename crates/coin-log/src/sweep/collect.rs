@@ -9,8 +9,7 @@ use super::hash::sha256_file;
 use crate::csv;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::AtomicBool;
 
 /// Missing runs listed by number before the rest are only counted.
 const LISTED_RANGES: usize = 20;
@@ -39,21 +38,12 @@ struct Found {
 }
 
 /// Merges the catalogue parts in `dir`, hashing the files on `jobs` threads.
-///
-/// # Errors
-/// [`SweepError`] when the folder holds no sweep, or a part or the catalogue cannot be read or written.
 pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepError> {
     let folder = Folder::existing(dir)?;
     let columns = folder.columns();
     let runs = folder.runs();
-    let mut parts: Vec<(super::shard::Shard, String)> = std::fs::read_dir(dir)
-        .map_err(SweepError::io("reading the sweep folder", dir))?
-        .flatten()
-        .filter_map(|e| {
-            let name = e.file_name().to_string_lossy().into_owned();
-            folder::shard_of_part(&name).map(|s| (s, name))
-        })
-        .collect();
+    let mut parts =
+        (folder::PART.list(dir)).map_err(SweepError::io("reading the sweep folder", dir))?;
     parts.sort_by_key(|(s, _)| (s.count(), s.index()));
     let mut problems = Vec::new();
     if let Some(shard) = folder.held_lock(|_| true) {
@@ -73,26 +63,18 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         read_part(&folder, name, &columns, runs, &mut rows, &mut problems)?;
     }
     problems.extend(missing(runs, &rows));
-    let at = |name: &str| columns.iter().position(|c| c == name).unwrap_or(0);
-    problems.extend(check_files(
-        &folder,
-        &rows,
-        [at("file"), at("bytes"), at("sha256")],
-        jobs,
-    ));
-    let status_at = at("status");
+    let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
+    problems.extend(check_files(&folder, &rows, at, jobs));
+    let status_at = folder.column("status");
     let failed = rows
         .values()
         .filter(|f| f.fields[status_at] == RunStatus::Failed.name())
         .count() as u64;
     let finished = rows.len() as u64 - failed;
-    let written = if problems.is_empty() {
-        let lines = rows.values().map(|f| csv::line(&f.fields));
-        let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
-        Some((catalogue, folder.write_summary(finished, failed, 0)?))
-    } else {
-        None
-    };
+    let lines = rows.values().map(|f| csv::line(&f.fields));
+    let written = (problems.is_empty())
+        .then(|| folder.write_whole(lines, [finished, failed, 0]))
+        .transpose()?;
     Ok(Collected {
         runs,
         parts: parts.into_iter().map(|(_, n)| n).collect(),
@@ -201,33 +183,25 @@ fn check_files(
         .values()
         .filter(|f| !f.fields[file_at].is_empty())
         .collect();
-    let next = AtomicUsize::new(0);
-    let problems = Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, with_files.len().max(1)) {
-            scope.spawn(|| {
-                while let Some(found) = with_files.get(next.fetch_add(1, Ordering::SeqCst)) {
-                    let f = &found.fields;
-                    let problem = match sha256_file(&folder.file(&f[file_at])) {
-                        Err(e) => Some(format!("`{}` (run {}) cannot be read: {e}", f[file_at], f[0])),
-                        Ok((_, len)) if len.to_string() != f[bytes_at] => Some(format!(
-                            "`{}` (run {}) has {len} bytes, its row {}: it was changed or cut; run its shard again to redo it",
-                            f[file_at], f[0], f[bytes_at])),
-                        Ok((sha, _)) if sha != f[sha_at] => Some(format!(
-                            "`{}` (run {}) does not match its row's SHA-256: it was changed; run its shard again to redo it",
-                            f[file_at], f[0])),
-                        Ok(_) => None,
-                    };
-                    if let Some(p) = problem {
-                        problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push((f[0].parse::<u64>().unwrap_or(0), p));
-                    }
-                }
-            });
-        }
-    });
-    let mut problems = problems
-        .into_inner()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let check = |found: &&Found| {
+        let f = &found.fields;
+        let problem = match sha256_file(&folder.file(&f[file_at])) {
+            Err(e) => format!("`{}` (run {}) cannot be read: {e}", f[file_at], f[0]),
+            Ok((_, len)) if len.to_string() != f[bytes_at] => format!(
+                "`{}` (run {}) has {len} bytes, its row {}: it was changed or cut; run its shard again to redo it",
+                f[file_at], f[0], f[bytes_at]
+            ),
+            Ok((sha, _)) if sha != f[sha_at] => format!(
+                "`{}` (run {}) does not match its row's SHA-256: it was changed; run its shard again to redo it",
+                f[file_at], f[0]
+            ),
+            Ok(_) => return None,
+        };
+        Some((f[0].parse::<u64>().unwrap_or(0), problem))
+    };
+    let mut problems = Vec::new();
+    let never = AtomicBool::new(false);
+    super::on_threads(&with_files, jobs, &never, check, |b| problems.extend(b));
     problems.sort();
     problems.into_iter().map(|(_, p)| p).collect()
 }

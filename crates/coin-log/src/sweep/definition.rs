@@ -8,7 +8,7 @@ use crate::files::{self, InputKind};
 use crate::format::Encoding;
 use crate::record::foxglove::PROTOBUF_MAX_SECONDS;
 use crate::record::RecordOptions;
-use crate::scene::{self, FlagOverrides, Scene, SceneError};
+use crate::scene::{self, Scene, SceneError};
 use coin_log_mcap::Compression;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -18,59 +18,43 @@ use std::path::Path;
 /// file names and the catalogue comfortably.
 pub const MAX_RUNS: u64 = 1_000_000_000;
 
-/// The most values the axes may give together. Each is expanded in memory and listed in `sweep.json`: a
-/// sweep of one axis of 10⁶ values peaks at 120 MB and 0.5 s to start (measured); one of 10⁹ asked for
-/// 32 GB and died before it checked anything. Denser samples of a key are random draws, which cost nothing
-/// until their run.
+/// The most values the axes may give together, each expanded in memory and listed in `sweep.json`: one
+/// axis of 10⁶ values peaks at 120 MB and 0.5 s to start, one of 10⁹ asked for 32 GB (measured).
 pub const MAX_AXIS_VALUES: u64 = 1_000_000;
 
-/// One grid axis, its values expanded.
-#[derive(Debug, Clone, PartialEq)]
+/// One grid axis, its values expanded; `zip` names the group it varies with.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Axis {
-    /// Dotted scene key.
     pub key: String,
-    /// The values, in order.
     pub values: Vec<toml::Value>,
-    /// The zip group it varies with, if any.
     pub zip: Option<String>,
 }
 
-/// One random draw.
+/// One random draw; `choices` holds a `choice` draw's values (empty otherwise).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Draw {
-    /// Dotted scene key.
     pub key: String,
-    /// What it samples.
     pub distribution: Distribution,
-    /// The values of a `choice` draw (empty otherwise).
     pub choices: Vec<toml::Value>,
 }
 
-/// `[random]`, validated.
+/// `[random]`, validated: `count` runs per grid point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Random {
-    /// The generator's seed.
     pub seed: u64,
-    /// Runs per grid point.
     pub count: u64,
-    /// The draws, in the file's order.
     pub draws: Vec<Draw>,
 }
 
-/// `[output]`, validated, with the defaults filled in.
+/// `[output]`, validated, with the defaults filled in; `channels` is `None` for the scenes' own lists.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Settings {
-    /// The channels every run records (as `record.channels`), or `None` for the scenes' own lists.
     pub channels: Option<Vec<String>>,
-    /// Message encoding.
     #[serde(serialize_with = "by_name")]
     pub encoding: Encoding,
-    /// Chunk compression.
     #[serde(serialize_with = "by_name")]
     pub compression: Compression,
-    /// Whether each file is verified after recording.
     pub verify: bool,
-    /// Whether the catalogue gets `analyse`'s prediction of each run.
     pub predict: bool,
 }
 
@@ -81,35 +65,29 @@ fn by_name<T: coin_log_names::Named, S: serde::Serializer>(v: &T, s: S) -> Resul
 /// A sweep, validated.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep {
-    /// One line.
-    pub description: String,
-    /// `base` as written.
-    pub base: String,
+    pub(crate) description: String,
+    pub(crate) base: String,
     /// The base scene as a table, before any edit.
-    pub base_table: toml::Table,
+    pub(crate) base_table: toml::Table,
     /// The fixed edits, in the order applied (sorted by key: a table before the keys inside it).
-    pub set: Vec<(String, toml::Value)>,
-    /// The grid axes, in the file's order.
-    pub axes: Vec<Axis>,
+    pub(crate) set: Vec<(String, toml::Value)>,
+    pub(crate) axes: Vec<Axis>,
     /// The grid's dimensions, slowest first: each a lone axis or a zip group (indexes into `axes`), at
     /// the place of its first axis.
-    pub dimensions: Vec<Vec<usize>>,
-    /// The random draws.
-    pub random: Option<Random>,
+    pub(crate) dimensions: Vec<Vec<usize>>,
+    pub(crate) random: Option<Random>,
     /// How runs are written.
     pub settings: Settings,
 }
 
-/// Why a run has no scene: its values give no valid scene, or a draw found nothing within its bounds.
+/// Why a run has no scene: a draw found nothing within its bounds, its values give no valid scene, or
+/// one longer than a Protobuf timestamp of Foxglove's schemas holds.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RunSceneError {
-    /// A bounded normal draw failed.
     #[error(transparent)]
     Draw(#[from] OutOfBounds),
-    /// The edited scene does not parse or validate.
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// Longer than a Protobuf timestamp of Foxglove's schemas holds.
     #[error(
         "run.duration = {0} is longer than {PROTOBUF_MAX_SECONDS} time units, the most Foxglove's Protobuf \
          timestamps hold: set output.encoding = \"json\", or shorten run.duration"
@@ -118,10 +96,8 @@ pub enum RunSceneError {
 }
 
 impl Sweep {
-    /// Reads and validates the sweep file at `path`; a base scene file is found relative to it.
-    ///
-    /// # Errors
-    /// [`SweepError::Read`], [`SweepError::Parse`] or [`SweepError::Invalid`] (every problem at once).
+    /// Reads and validates the sweep file at `path` (every problem at once); a base scene file is found
+    /// relative to it.
     pub fn load(path: &Path) -> Result<Self, SweepError> {
         let text = files::read_toml(path, InputKind::Sweep).map_err(|source| SweepError::Read {
             path: path.to_path_buf(),
@@ -133,9 +109,6 @@ impl Sweep {
 
     /// Validates sweep-file text; `folder` is where a base scene path starts from, `label` names the
     /// file in errors.
-    ///
-    /// # Errors
-    /// [`SweepError::Parse`] or [`SweepError::Invalid`].
     pub fn parse(text: &str, folder: &Path, label: &str) -> Result<Self, SweepError> {
         let file = toml::from_str(text).map_err(|e| SweepError::Parse {
             label: label.to_string(),
@@ -147,12 +120,6 @@ impl Sweep {
         })
     }
 
-    /// Grid points: the product of the dimensions' lengths (1 without axes).
-    #[must_use]
-    pub fn grid_points(&self) -> u64 {
-        self.lengths().product()
-    }
-
     /// Each dimension's length, slowest first.
     pub(super) fn lengths(&self) -> impl DoubleEndedIterator<Item = u64> + ExactSizeIterator + '_ {
         self.dimensions
@@ -160,10 +127,15 @@ impl Sweep {
             .map(|d| self.axes[d[0]].values.len() as u64)
     }
 
+    /// Runs per grid point: `random.count`, or 1.
+    pub(super) fn per_point(&self) -> u64 {
+        self.random.as_ref().map_or(1, |r| r.count)
+    }
+
     /// How many runs: grid points × `random.count`.
     #[must_use]
     pub fn runs(&self) -> u64 {
-        self.grid_points() * self.random.as_ref().map_or(1, |r| r.count)
+        self.lengths().product::<u64>() * self.per_point()
     }
 
     /// The swept keys, each a catalogue column: the axes, then the draws, in the file's order.
@@ -177,13 +149,9 @@ impl Sweep {
 
     /// The swept keys' values of run `index` (< [`runs`](Self::runs)), in the order of
     /// [`keys`](Self::keys): grid point ⌊index / count⌋ (its coordinates with the last dimension varying
-    /// fastest), then the draws of run `index`.
-    ///
-    /// # Errors
-    /// [`OutOfBounds`] when a bounded normal draw finds nothing within its bounds.
+    /// fastest), then the draws of run `index`; [`OutOfBounds`] when a bounded normal draw finds nothing.
     pub fn values(&self, index: u64) -> Result<Vec<toml::Value>, OutOfBounds> {
-        let count = self.random.as_ref().map_or(1, |r| r.count);
-        let mut point = index / count;
+        let mut point = index / self.per_point();
         let mut values = vec![toml::Value::Boolean(false); self.axes.len()];
         for (dimension, len) in self.dimensions.iter().zip(self.lengths()).rev() {
             // point % len < len, a length of a Vec: it fits usize.
@@ -193,22 +161,21 @@ impl Sweep {
                 values[axis] = self.axes[axis].values[at].clone();
             }
         }
-        for (j, draw) in self.random.iter().flat_map(|r| r.draws.iter().enumerate()) {
-            let seed = self.random.as_ref().map_or(0, |r| r.seed);
-            values.push(match draw.distribution.draw(seed, index, j as u64)? {
-                Drawn::Number(x) => toml::Value::Float(x),
-                Drawn::Choice(k) => draw.choices[k].clone(),
-            });
+        if let Some(r) = &self.random {
+            for (j, draw) in r.draws.iter().enumerate() {
+                values.push(match draw.distribution.draw(r.seed, index, j as u64)? {
+                    Drawn::Number(x) => toml::Value::Float(x),
+                    Drawn::Choice(k) => draw.choices[k].clone(),
+                });
+            }
         }
         Ok(values)
     }
 
-    /// The scene table of a run with these values: the base, then `set`, then the values, then
-    /// `output.channels` as `record.channels`.
-    ///
-    /// # Errors
-    /// [`SceneError::Set`] when a key runs through a value that is not a table.
-    pub fn table(&self, values: &[toml::Value]) -> Result<toml::Table, SceneError> {
+    /// The resolved, validated scene of a run with these values, exactly as `coin-log record` resolves
+    /// the same scene file: the base, then `set`, then the values, then `output.channels` as
+    /// `record.channels`.
+    pub fn scene(&self, values: &[toml::Value]) -> Result<Scene, RunSceneError> {
         let mut table = self.base_table.clone();
         for (key, value) in &self.set {
             scene::set_value(&mut table, key, value.clone())?;
@@ -220,17 +187,8 @@ impl Sweep {
             let list = channels.iter().map(|c| toml::Value::from(c.as_str()));
             scene::set_value(&mut table, CHANNELS_KEY, toml::Value::Array(list.collect()))?;
         }
-        Ok(table)
-    }
-
-    /// The resolved, validated scene of a run with these values, exactly as `coin-log record` resolves
-    /// the same scene file.
-    ///
-    /// # Errors
-    /// [`RunSceneError`] when the values give no valid scene.
-    pub fn scene(&self, values: &[toml::Value]) -> Result<Scene, RunSceneError> {
-        let file = scene::file_from_table(self.table(values)?)?;
-        let scene = scene::resolve(&file, &FlagOverrides::default())?;
+        let file = scene::file_from_table(table)?;
+        let scene = Scene::from_file(&file)?;
         if self.settings.encoding == Encoding::Protobuf && scene.run.duration > PROTOBUF_MAX_SECONDS
         {
             return Err(RunSceneError::TooLongForProtobuf(scene.run.duration));
@@ -238,9 +196,7 @@ impl Sweep {
         Ok(scene)
     }
 
-    /// How every run is written.
-    #[must_use]
-    pub fn record_options(&self) -> RecordOptions {
+    pub(super) fn record_options(&self) -> RecordOptions {
         RecordOptions {
             compression: self.settings.compression,
             encoding: self.settings.encoding,
@@ -248,77 +204,15 @@ impl Sweep {
     }
 
     /// Digits of the largest index: the width run indexes are zero-padded to in file names.
-    #[must_use]
-    pub fn index_width(&self) -> usize {
+    pub(super) fn index_width(&self) -> usize {
         self.runs().saturating_sub(1).to_string().len()
     }
 
     /// The sweep as resolved, the `sweep` object of `sweep.json` (format.md: sweep.json): what the
     /// identity hashes.
-    #[must_use]
-    pub fn description_json(&self) -> serde_json::Value {
-        let description = Description {
-            description: &self.description,
-            base: &self.base,
-            base_scene: toml::to_string(&self.base_table).unwrap_or_default(),
-            set: self.set.iter().map(|(k, v)| (k.as_str(), v)).collect(),
-            axes: self.axes.iter().map(AxisJson::from).collect(),
-            random: self.random.as_ref().map(RandomJson::from),
-            output: &self.settings,
-        };
-        serde_json::to_value(description).unwrap_or(serde_json::Value::Null)
-    }
-
-    /// SHA-256 (hex) of the compact JSON of [`description_json`](Self::description_json): two sweeps
-    /// with the same identity make the same runs.
-    #[must_use]
-    pub fn identity(&self) -> String {
-        super::hash::sha256_hex(self.description_json().to_string().as_bytes())
-    }
-}
-
-/// The scene key `output.channels` sets.
-pub const CHANNELS_KEY: &str = "record.channels";
-
-#[derive(Serialize)]
-struct Description<'a> {
-    description: &'a str,
-    base: &'a str,
-    base_scene: String,
-    set: BTreeMap<&'a str, &'a toml::Value>,
-    axes: Vec<AxisJson<'a>>,
-    random: Option<RandomJson>,
-    output: &'a Settings,
-}
-
-#[derive(Serialize)]
-struct AxisJson<'a> {
-    key: &'a str,
-    values: &'a [toml::Value],
-    zip: Option<&'a str>,
-}
-
-impl<'a> From<&'a Axis> for AxisJson<'a> {
-    fn from(a: &'a Axis) -> Self {
-        Self {
-            key: &a.key,
-            values: &a.values,
-            zip: a.zip.as_deref(),
-        }
-    }
-}
-
-#[derive(Serialize)]
-struct RandomJson {
-    seed: u64,
-    count: u64,
-    draws: Vec<serde_json::Value>,
-}
-
-impl From<&Random> for RandomJson {
-    fn from(r: &Random) -> Self {
+    pub(super) fn description_json(&self) -> serde_json::Value {
         let bound = |x: f64| x.is_finite().then_some(x);
-        let draws = r.draws.iter().map(|d| match d.distribution {
+        let draw = |d: &Draw| match d.distribution {
             Distribution::Uniform { lo, hi } => {
                 serde_json::json!({"key": d.key, "uniform": [lo, hi]})
             }
@@ -333,11 +227,87 @@ impl From<&Random> for RandomJson {
             } => serde_json::json!({"key": d.key,
                 "normal": {"mean": mean, "std": std, "min": bound(min), "max": bound(max)}}),
             Distribution::Choice { .. } => serde_json::json!({"key": d.key, "choice": d.choices}),
+        };
+        let random = self.random.as_ref().map(|r| {
+            let draws: Vec<_> = r.draws.iter().map(draw).collect();
+            serde_json::json!({"seed": r.seed, "count": r.count, "draws": draws})
         });
-        Self {
-            seed: r.seed,
-            count: r.count,
-            draws: draws.collect(),
-        }
+        let set: BTreeMap<&str, &toml::Value> =
+            self.set.iter().map(|(k, v)| (k.as_str(), v)).collect();
+        serde_json::json!({
+            "description": self.description,
+            "base": self.base,
+            "base_scene": toml::to_string(&self.base_table).unwrap_or_default(),
+            "set": set,
+            "axes": self.axes,
+            "random": random,
+            "output": self.settings,
+        })
+    }
+
+    /// SHA-256 (hex) of the compact JSON of [`description_json`](Self::description_json): two sweeps
+    /// with the same identity make the same runs.
+    pub(super) fn identity(&self) -> String {
+        super::hash::sha256_hex(self.description_json().to_string().as_bytes())
+    }
+}
+
+/// The scene key `output.channels` sets.
+pub(super) const CHANNELS_KEY: &str = "record.channels";
+
+#[cfg(test)]
+mod tests {
+    use super::Sweep;
+
+    /// The identity of a sweep with every part (set, zipped and spaced axes, each distribution, output)
+    /// is pinned: a changed identity would refuse to resume every existing sweep folder.
+    #[test]
+    fn the_identity_of_a_fixed_sweep_is_pinned() {
+        let text = r#"
+description = "pinned"
+base = "wobble"
+set = { "run.duration" = 2.0 }
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 0.3, 3]
+zip = "a"
+[[axis]]
+key = "body.mass"
+values = [1.0, 2, 3.5]
+zip = "a"
+[[axis]]
+key = "run.rate"
+logspace = [1, 2, 2]
+[random]
+seed = 7
+count = 2
+[[random.draw]]
+key = "body.friction"
+uniform = [0.5, 1.0]
+[[random.draw]]
+key = "body.radius"
+log_uniform = [0.1, 10]
+[[random.draw]]
+key = "body.gravity"
+normal = { mean = 1.0, std = 0.1, min = 0.5 }
+[[random.draw]]
+key = "run.integrator"
+choice = ["rk4", "dop853"]
+[output]
+channels = ["omega", "angles"]
+encoding = "protobuf"
+compression = "lz4"
+verify = false
+"#;
+        let parse = |text| Sweep::parse(text, std::path::Path::new("."), "pinned.toml").unwrap();
+        let (full, bare) = (parse(text), parse("base = \"wobble\""));
+        assert_eq!(
+            full.identity(),
+            "e01b1e4c1a5af169210be07931b946d2c4c1dbbfdcf467140ef95d4fc2a68346"
+        );
+        assert_eq!(
+            bare.identity(),
+            "4f6db358526d76d6a7535fc24ea1bc8c826c6d112e71195f10acd01fe5d80011"
+        );
     }
 }

@@ -53,15 +53,6 @@ pub enum SweepError {
 }
 
 impl SweepError {
-    /// True for a sweep file that cannot be used (exit 2 in the CLI), as opposed to a folder or I/O error.
-    #[must_use]
-    pub fn is_bad_sweep_file(&self) -> bool {
-        matches!(
-            self,
-            Self::Read { .. } | Self::Parse { .. } | Self::Invalid { .. }
-        )
-    }
-
     pub(super) fn folder(path: &std::path::Path) -> impl Fn(String) -> Self + '_ {
         |reason| Self::Folder {
             path: path.to_path_buf(),

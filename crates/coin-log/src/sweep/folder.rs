@@ -1,8 +1,6 @@
 //! The sweep's folder (format.md: The sweep folder): the run files, the catalogue (or its parts), the
-//! sweep's JSON, and the private state beside them in `.coin-log-sweep/`: the plan (the sweep's identity,
-//! written once) and one append-only journal per shard, a line per finished row, synced to disk as the
-//! runs end (rows that end during a sync share the next one), so that a crash or SIGKILL loses at most
-//! the runs in progress and the rows still being synced.
+//! sweep's JSON, and the private state in `.coin-log-sweep/`: the plan (written once) and one append-only
+//! journal per shard, synced as the runs end, so that a crash loses at most the runs in progress.
 
 use super::catalogue;
 use super::definition::Sweep;
@@ -15,36 +13,33 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::time::UNIX_EPOCH;
 
-/// The private state folder.
-pub const STATE_DIR: &str = ".coin-log-sweep";
+const STATE_DIR: &str = ".coin-log-sweep";
 /// The plan, in the state folder: the sweep as resolved and its identity.
-pub const PLAN_FILE: &str = "plan.json";
-/// The whole sweep's catalogue.
-pub const CATALOGUE_FILE: &str = "catalogue.csv";
+const PLAN_FILE: &str = "plan.json";
+const CATALOGUE_FILE: &str = "catalogue.csv";
 /// The whole sweep's JSON: the plan and the counts.
-pub const SWEEP_JSON_FILE: &str = "sweep.json";
+const SWEEP_JSON_FILE: &str = "sweep.json";
 /// What `format` says in the plan and `sweep.json`.
-pub const FORMAT_NAME: &str = "coin-log sweep";
+const FORMAT_NAME: &str = "coin-log sweep";
 /// The version of the sweep folder's layout (format.md: The sweep folder).
-pub const FORMAT_VERSION: &str = "1";
+const FORMAT_VERSION: &str = "1";
 /// The journal's first column, before the catalogue's: the file's modification time when its row was
 /// written, nanoseconds since 1970 (0 without a file).
-pub const MTIME_COLUMN: &str = "mtime_ns";
+const MTIME_COLUMN: &str = "mtime_ns";
 
 /// `run-<index>.mcap`, the index zero-padded to `width` digits.
-#[must_use]
 pub fn run_file_name(index: u64, width: usize) -> String {
     format!("run-{index:0width$}.mcap")
 }
 
 /// The name of a file that each shard has its own of: `<prefix>K-of-N<suffix>`.
-struct ShardFile {
+pub struct ShardFile {
     prefix: &'static str,
     suffix: &'static str,
 }
 
 /// A shard's catalogue, in the folder.
-const PART: ShardFile = ShardFile {
+pub const PART: ShardFile = ShardFile {
     prefix: "catalogue.part-",
     suffix: ".csv",
 };
@@ -60,9 +55,9 @@ const LOCK: ShardFile = ShardFile {
 };
 
 impl ShardFile {
-    fn name(&self, shard: Shard) -> String {
-        let (prefix, suffix) = (self.prefix, self.suffix);
-        format!("{prefix}{}-of-{}{suffix}", shard.index(), shard.count())
+    pub fn name(&self, shard: Shard) -> String {
+        let (k, n) = (shard.index(), shard.count());
+        format!("{}{k}-of-{n}{}", self.prefix, self.suffix)
     }
 
     fn shard_of(&self, name: &str) -> Option<Shard> {
@@ -70,18 +65,19 @@ impl ShardFile {
         let (k, n) = rest.split_once("-of-")?;
         Shard::new(k.parse().ok()?, n.parse().ok()?).ok()
     }
-}
 
-/// `catalogue.part-K-of-N.csv`.
-#[must_use]
-pub fn part_file_name(shard: Shard) -> String {
-    PART.name(shard)
-}
-
-/// The shard of a part's file name.
-#[must_use]
-pub fn shard_of_part(name: &str) -> Option<Shard> {
-    PART.shard_of(name)
+    /// The files of this kind in `dir`, with their shards, sorted by name.
+    pub fn list(&self, dir: &Path) -> io::Result<Vec<(Shard, String)>> {
+        let mut found: Vec<(Shard, String)> = fs::read_dir(dir)?
+            .flatten()
+            .filter_map(|e| {
+                let name = e.file_name().into_string().ok()?;
+                Some((self.shard_of(&name)?, name))
+            })
+            .collect();
+        found.sort_by(|a, b| a.1.cmp(&b.1));
+        Ok(found)
+    }
 }
 
 /// A shard's lock (an advisory `flock` on `.coin-log-sweep/lock-K-of-N`), held while a process makes
@@ -92,8 +88,7 @@ pub struct ShardLock {
 }
 
 /// The plan: the sweep as resolved, its identity, and what `collect` needs (runs, columns, file names).
-#[must_use]
-pub fn plan_json(sweep: &Sweep) -> serde_json::Value {
+fn plan_json(sweep: &Sweep) -> serde_json::Value {
     serde_json::json!({
         "format": FORMAT_NAME,
         "format_version": FORMAT_VERSION,
@@ -107,36 +102,26 @@ pub fn plan_json(sweep: &Sweep) -> serde_json::Value {
     })
 }
 
-/// A sweep folder, open.
+/// A sweep folder, open, and the plan it holds.
 #[derive(Debug, Clone)]
 pub struct Folder {
-    /// The folder.
-    pub path: PathBuf,
-    /// The plan it holds.
-    pub plan: serde_json::Value,
+    path: PathBuf,
+    plan: serde_json::Value,
 }
 
-/// A run's modification time, nanoseconds since 1970 (0 when the system gives none).
-fn mtime_ns(meta: &fs::Metadata) -> u128 {
-    meta.modified()
-        .ok()
-        .and_then(|t| t.duration_since(UNIX_EPOCH).ok())
-        .map_or(0, |d| d.as_nanos())
-}
-
-/// The size and modification time of a file, if it is there.
-#[must_use]
+/// The size and modification time (ns since 1970, 0 when the system gives none) of a file, if it is there.
 pub fn size_and_mtime(path: &Path) -> Option<(u64, u128)> {
-    fs::metadata(path).ok().map(|m| (m.len(), mtime_ns(&m)))
+    let meta = fs::metadata(path).ok()?;
+    let since = meta
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(UNIX_EPOCH).ok());
+    Some((meta.len(), since.map_or(0, |d| d.as_nanos())))
 }
 
 impl Folder {
     /// Opens `path` for `sweep`: creates it if missing; otherwise it must be empty or hold this same
     /// sweep (same identity, same tool version). Several shards may open one folder at once.
-    ///
-    /// # Errors
-    /// [`SweepError::Folder`] for a file, a folder with other content, another sweep's or another
-    /// version's folder; [`SweepError::Io`] when it cannot be created or read.
     pub fn open(path: &Path, sweep: &Sweep) -> Result<Self, SweepError> {
         let folder_error = SweepError::folder(path);
         if path.exists() && !path.is_dir() {
@@ -175,9 +160,6 @@ impl Folder {
     }
 
     /// Opens a folder that holds a sweep, for `collect`.
-    ///
-    /// # Errors
-    /// [`SweepError::Folder`] when it holds no sweep.
     pub fn existing(path: &Path) -> Result<Self, SweepError> {
         let plan_path = path.join(STATE_DIR).join(PLAN_FILE);
         if !plan_path.is_file() {
@@ -195,20 +177,15 @@ impl Folder {
         self.path.join(STATE_DIR)
     }
 
-    /// A run's file in the folder.
-    #[must_use]
     pub fn file(&self, name: &str) -> PathBuf {
         self.path.join(name)
     }
 
-    /// The runs in the plan.
-    #[must_use]
     pub fn runs(&self) -> u64 {
         self.plan["runs"].as_u64().unwrap_or(0)
     }
 
     /// The catalogue's columns in the plan.
-    #[must_use]
     pub fn columns(&self) -> Vec<String> {
         let columns = self.plan["columns"].as_array().into_iter().flatten();
         columns
@@ -216,31 +193,18 @@ impl Folder {
             .collect()
     }
 
-    /// A temporary file for run `index` (`.run-<index>.<random>.mcap.tmp`), moved to its final name when
-    /// the run is finished and deleted if it is dropped before.
-    ///
-    /// # Errors
-    /// The folder refuses it.
-    pub fn temp_file(&self, index: u64, width: usize) -> io::Result<tempfile::NamedTempFile> {
-        tempfile::Builder::new()
-            .prefix(&format!(".run-{index:0width$}."))
-            .suffix(".mcap.tmp")
-            .tempfile_in(&self.path)
+    /// The position of the catalogue's column `name`.
+    pub fn column(&self, name: &str) -> usize {
+        self.columns().iter().position(|c| c == name).unwrap_or(0)
     }
 
     /// Takes `shard`'s lock, so that no two processes make a run at once (the second would also delete
     /// the first's temporary files as stale). Refused while another process holds the lock of this shard
     /// or of one whose runs overlap it (`sweep` without `--shard` and shard 1/4, say). On a file system
     /// without locks, runs unlocked.
-    ///
-    /// # Errors
-    /// [`SweepError::Folder`] when another process holds such a lock; [`SweepError::Io`] when the lock
-    /// file cannot be opened.
     pub fn lock(&self, shard: Shard) -> Result<ShardLock, SweepError> {
         let path = self.state().join(LOCK.name(shard));
-        let file = files::absent_or_plain(&path)
-            .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
-            .map_err(SweepError::io("opening the shard's lock", &path))?;
+        let file = open_append(&path).map_err(SweepError::io("opening the shard's lock", &path))?;
         // A process looking whether the lock is held (below, or `collect`) holds it shared for a moment:
         // try again before calling the shard busy.
         for attempt in 1.. {
@@ -261,12 +225,10 @@ impl Folder {
 
     /// The first shard whose lock another process holds, among those `wanted` takes.
     pub fn held_lock(&self, wanted: impl Fn(Shard) -> bool) -> Option<Shard> {
-        let entries = fs::read_dir(self.state()).ok()?;
-        entries.flatten().find_map(|e| {
-            let other = LOCK
-                .shard_of(e.file_name().to_str()?)
-                .filter(|&s| wanted(s))?;
-            let file = files::open_regular(&e.path()).ok()?;
+        let locks = LOCK.list(&self.state()).ok()?;
+        let mut wanted = locks.into_iter().filter(|&(s, _)| wanted(s));
+        wanted.find_map(|(other, name)| {
+            let file = files::open_regular(&self.state().join(name)).ok()?;
             // Shared, so that two processes looking at once do not see each other; dropped at once.
             let held = matches!(file.try_lock_shared(), Err(fs::TryLockError::WouldBlock));
             held.then_some(other)
@@ -292,23 +254,24 @@ impl Folder {
         let Ok(entries) = fs::read_dir(&self.path) else {
             return;
         };
-        let mut own = vec![temp_prefix(&self.path.join(part_file_name(shard)))];
-        if shard.is_all() {
-            own = [CATALOGUE_FILE, SWEEP_JSON_FILE]
-                .map(|n| temp_prefix(&self.path.join(n)))
-                .into();
-        }
+        let own = if shard.is_all() {
+            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
+        } else {
+            vec![PART.name(shard)]
+        };
         for entry in entries.flatten() {
+            // `.NAME.<random>.tmp` (temp_beside): NAME is the file it was to become.
             let name = entry.file_name();
-            let name = name.to_string_lossy();
-            let run = name
-                .strip_prefix(".run-")
-                .filter(|_| name.ends_with(".mcap.tmp"))
-                .and_then(|rest| rest.split('.').next())
-                .and_then(|i| i.parse::<u64>().ok());
-            let catalogue =
-                name.ends_with(".tmp") && own.iter().any(|p| name.starts_with(p.as_str()));
-            if run.is_some_and(|i| shard.takes(i)) || catalogue {
+            let target = name.to_str().and_then(|n| {
+                let rest = n.strip_prefix('.')?.strip_suffix(".tmp")?;
+                rest.rsplit_once('.').map(|(target, _)| target)
+            });
+            let Some(target) = target else { continue };
+            let run = target
+                .strip_prefix("run-")
+                .and_then(|r| r.strip_suffix(".mcap"));
+            let run = run.and_then(|i| i.parse::<u64>().ok());
+            if run.is_some_and(|i| shard.takes(i)) || own.iter().any(|n| n == target) {
                 let _ = fs::remove_file(entry.path());
             }
         }
@@ -317,27 +280,15 @@ impl Folder {
     /// Every journal line of every shard, in the order written (journals by name): the rows, each with
     /// its file's recorded modification time. A last line without its line break (torn by a crash) and
     /// any line that does not parse are left out.
-    ///
-    /// # Errors
-    /// A journal that exists but cannot be read.
     pub fn journal_rows(&self) -> Result<Vec<JournalRow>, SweepError> {
         let width = 1 + self.columns().len();
-        let mut names: Vec<PathBuf> = fs::read_dir(self.state())
-            .map_err(SweepError::io(
-                "reading the sweep's state folder",
-                self.state(),
-            ))?
-            .flatten()
-            .map(|e| e.path())
-            .filter(|p| {
-                p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with(JOURNAL.prefix) && n.ends_with(JOURNAL.suffix))
-            })
-            .collect();
-        names.sort();
+        let journals = JOURNAL.list(&self.state()).map_err(SweepError::io(
+            "reading the sweep's state folder",
+            self.state(),
+        ))?;
         let mut rows = Vec::new();
-        for path in names {
+        for (_, name) in journals {
+            let path = self.state().join(name);
             let text =
                 files::read_regular(&path).map_err(SweepError::io("reading the journal", &path))?;
             let complete = text.rfind('\n').map_or("", |end| &text[..end]);
@@ -351,14 +302,9 @@ impl Folder {
     }
 
     /// The journal of `shard`, opened for appending (created with its header line if new).
-    ///
-    /// # Errors
-    /// It cannot be created or written.
     pub fn journal(&self, shard: Shard) -> Result<Journal, SweepError> {
         let path = self.state().join(JOURNAL.name(shard));
-        let file = files::absent_or_plain(&path)
-            .and_then(|()| OpenOptions::new().create(true).append(true).open(&path))
-            .map_err(SweepError::io("opening the journal", &path))?;
+        let file = open_append(&path).map_err(SweepError::io("opening the journal", &path))?;
         let last = last_byte(&file, &path).map_err(SweepError::io("reading the journal", &path))?;
         let mut journal = Journal { file, path };
         match last {
@@ -375,27 +321,23 @@ impl Folder {
         Ok(journal)
     }
 
-    /// Writes `sweep.json`: the plan with the counts (format.md: sweep.json).
-    ///
-    /// # Errors
-    /// The file cannot be written.
-    pub fn write_summary(
+    /// The whole sweep's catalogue of `lines`, then `sweep.json`: the plan with the counts (format.md:
+    /// sweep.json).
+    pub fn write_whole<S: AsRef<str>>(
         &self,
-        finished: u64,
-        failed: u64,
-        pending: u64,
-    ) -> Result<PathBuf, SweepError> {
+        lines: impl Iterator<Item = S>,
+        [finished, failed, pending]: [u64; 3],
+    ) -> Result<(PathBuf, PathBuf), SweepError> {
+        let catalogue = self.write_catalogue(CATALOGUE_FILE, lines)?;
         let mut json = self.plan.clone();
         json["counts"] =
             serde_json::json!({"finished": finished, "failed": failed, "pending": pending});
-        self.write_atomically(SWEEP_JSON_FILE, |w| writeln!(w, "{json}"))
+        let summary = self.write_atomically(SWEEP_JSON_FILE, |w| writeln!(w, "{json}"))?;
+        Ok((catalogue, summary))
     }
 
     /// A catalogue (or part) `name`: the header, then `lines`, each ending in a line break, streamed
     /// into place atomically.
-    ///
-    /// # Errors
-    /// The file cannot be written.
     pub fn write_catalogue<S: AsRef<str>>(
         &self,
         name: &str,
@@ -441,12 +383,12 @@ fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {
     Ok(Some(last[0]))
 }
 
-/// A journal line: the file's modification time when the row was written, and the row's fields.
+/// A journal line: the run's file's modification time when the row was written (ns since 1970, 0
+/// without a file), the run's index and the catalogue row's fields.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JournalRow {
-    /// Modification time of the run's file, ns since 1970 (0 without a file).
     pub mtime_ns: u128,
-    /// The catalogue row's fields.
+    pub index: u64,
     pub fields: Vec<String>,
 }
 
@@ -455,17 +397,12 @@ impl JournalRow {
         let mut fields = csv::split(line).filter(|f| f.len() == width)?;
         let mtime_ns = fields.first()?.parse().ok()?;
         fields.remove(0);
-        fields.first()?.parse::<u64>().ok()?;
-        Some(Self { mtime_ns, fields })
-    }
-
-    /// The run's index.
-    #[must_use]
-    pub fn index(&self) -> u64 {
-        self.fields
-            .first()
-            .and_then(|i| i.parse().ok())
-            .unwrap_or(u64::MAX)
+        let index = fields.first()?.parse().ok()?;
+        Some(Self {
+            mtime_ns,
+            index,
+            fields,
+        })
     }
 }
 
@@ -477,10 +414,8 @@ pub struct Journal {
 }
 
 impl Journal {
-    /// Appends rows (each with its file's modification time) and syncs them to disk before returning.
-    ///
-    /// # Errors
-    /// Writing or syncing failed (the last row may be torn: it is ignored when read back).
+    /// Appends rows (each with its file's modification time) and syncs them to disk before returning
+    /// (a row torn by a failure is ignored when read back).
     pub fn append(&mut self, rows: &[(u128, String)]) -> Result<(), SweepError> {
         if rows.is_empty() {
             return Ok(());
@@ -536,31 +471,35 @@ fn short(identity: &str) -> &str {
     identity.get(..12).unwrap_or(identity)
 }
 
+/// Opens `path` for appending, creating it; refused unless it is absent or a plain file.
+fn open_append(path: &Path) -> io::Result<File> {
+    files::absent_or_plain(path)?;
+    OpenOptions::new().create(true).append(true).open(path)
+}
+
 /// Writes `path` through a synced temporary file beside it, unless `path` exists (`AlreadyExists`).
 fn publish_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let temp = temp_beside(path, |w| w.write_all(bytes))?;
     temp.persist_noclobber(path).map(drop).map_err(|e| e.error)
 }
 
-/// `.NAME.`: the temporary files of `path` are named after it, so that a process cleans up only its own.
-fn temp_prefix(path: &Path) -> String {
-    let name = path
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    format!(".{name}.")
+/// An empty temporary file beside `path`, `.NAME.<random>.tmp`: named after it, so that a process
+/// cleans up only its own ([`Folder::remove_stale_temps`]).
+pub fn temp_file(path: &Path) -> io::Result<tempfile::NamedTempFile> {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(".tmp")
+        .tempfile_in(path.parent().unwrap_or_else(|| Path::new(".")))
 }
 
-/// A temporary file beside `path` (`.NAME.<random>.tmp`) holding what `write` wrote, flushed, synced and
+/// A temporary file beside `path` ([`temp_file`]) holding what `write` wrote, flushed, synced and
 /// readable.
 fn temp_beside(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<tempfile::NamedTempFile> {
-    let folder = path.parent().unwrap_or_else(|| Path::new("."));
-    let mut temp = tempfile::Builder::new()
-        .prefix(&temp_prefix(path))
-        .suffix(".tmp")
-        .tempfile_in(folder)?;
+    let mut temp = temp_file(path)?;
     {
         let mut buffered = io::BufWriter::new(temp.as_file_mut());
         write(&mut buffered)?;
@@ -587,8 +526,8 @@ mod tests {
     #[test]
     fn part_names_give_their_shard() {
         let s = Shard::new(2, 5).unwrap();
-        assert_eq!(shard_of_part(&part_file_name(s)), Some(s));
-        assert_eq!(shard_of_part("catalogue.part-5-of-5.csv"), None);
+        assert_eq!(PART.shard_of(&PART.name(s)), Some(s));
+        assert_eq!(PART.shard_of("catalogue.part-5-of-5.csv"), None);
         assert_eq!(run_file_name(7, 3), "run-007.mcap");
     }
 }

@@ -1,12 +1,8 @@
-//! Datasets, not single files (format.md: Sweeps): a sweep file names a base scene and what varies (grid
-//! axes, random draws); `run` records every run of it (or of one shard) into a folder, `jobs` at once on
-//! threads of this process, each file byte for byte what `record` writes for the same resolved scene,
-//! verifies each, and writes a catalogue with one row per run; run again, it resumes. `collect` merges the
-//! catalogues of shards run on other machines.
-//!
-//! A run's values depend only on the sweep file and the run's index ([`Sweep::values`]): never on jobs,
-//! shards or machines. The library never prints and never starts a process: the CLI reads the
-//! environment for the shard, installs the signal handler that sets the stop flag, and draws the progress.
+//! Datasets, not single files (format.md: Sweeps): a sweep file names a base scene and what varies; `run`
+//! records (as `record` would), verifies and catalogues every run of it, or of one shard, into a folder on
+//! threads, and resumes when run again; `collect` merges the shards' catalogues. A run's values depend
+//! only on the sweep file and the run's index ([`Sweep::values`]). The CLI reads the shard's environment,
+//! installs the signal handler that sets the stop flag, and draws the progress.
 
 mod catalogue;
 mod collect;
@@ -16,27 +12,60 @@ mod file;
 mod folder;
 mod hash;
 mod preview;
-pub mod random;
+mod random;
 mod run;
-pub mod shard;
+mod shard;
 mod space;
 mod validate;
 
-pub use catalogue::{
-    columns, FailureKind, RunStatus, LEADING_COLUMNS, TRAILING_COLUMNS, WALL_TIME_COLUMN,
-};
 pub use collect::{collect, Collected};
-pub use definition::{
-    Axis, Draw, Random, RunSceneError, Settings, Sweep, CHANNELS_KEY, MAX_AXIS_VALUES, MAX_RUNS,
-};
+pub use definition::Sweep;
 pub use error::SweepError;
-pub use file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
-pub use folder::{
-    part_file_name, run_file_name, CATALOGUE_FILE, FORMAT_VERSION, PLAN_FILE, STATE_DIR,
-    SWEEP_JSON_FILE,
-};
-pub use hash::{sha256_file, sha256_hex};
+pub use hash::sha256_hex;
 pub use preview::{preview, Preview, MESSAGES_PER_SECOND, SAMPLED_RUNS};
+pub use random::word;
 pub use run::{run, Progress, RunOptions, SweepOutcome};
 pub use shard::{Shard, ShardError};
 pub use space::{linspace, logspace};
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+
+/// Calls `work` on each of `items` on up to `jobs` threads until `stop` is set; `handle` gets the results
+/// on the calling thread as they come, in batches of those that came while it handled the previous one
+/// (so that one journal sync serves them all: the sweep is never slower than the disk syncs one row).
+fn on_threads<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    stop: &AtomicBool,
+    work: impl Fn(&T) -> Option<R> + Sync,
+    mut handle: impl FnMut(Vec<R>),
+) {
+    let next = AtomicUsize::new(0);
+    let (sender, receiver) = mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, items.len().max(1)) {
+            let sender = sender.clone();
+            let (next, work) = (&next, &work);
+            scope.spawn(move || {
+                while !stop.load(Ordering::SeqCst) {
+                    let Some(item) = items.get(next.fetch_add(1, Ordering::SeqCst)) else {
+                        break;
+                    };
+                    let Some(result) = work(item) else {
+                        continue;
+                    };
+                    if sender.send(result).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(sender);
+        for first in &receiver {
+            let mut batch = vec![first];
+            batch.extend(receiver.try_iter());
+            handle(batch);
+        }
+    });
+}

@@ -1,21 +1,6 @@
-//! The random draws of a sweep (format.md: Sweep files, Random draws): a counter-based generator, so that
-//! a run's values depend only on the seed, the run's index and the draw's index, never on the number of
-//! jobs, the shards or the order in which runs are done.
-//!
-//! Written out here, not taken from a crate, because its numbers are part of the contract: another tool
-//! must reproduce them from format.md, and a crate's algorithm may change between versions. With γ =
-//! 0x9e3779b97f4a7c15 and mix the finaliser of splitmix64 (Steele, Lea and Flood 2014; all arithmetic
-//! wrapping on u64):
-//!
-//! ```text
-//! mix(z)  = z ^= z >> 30; z *= 0xbf58476d1ce4e5b9; z ^= z >> 27; z *= 0x94d049bb133111eb; z ^ (z >> 31)
-//! step(h, x) = mix(h + γ + x)
-//! word(seed, run, draw, n) = step(step(step(seed, run), draw), n)
-//! u = (word >> 11) · 2⁻⁵³                  a uniform number in [0, 1), exact
-//! ```
-//!
-//! `n` counts the words one draw uses (0 for uniform, log-uniform and choice; 2a and 2a + 1 for attempt a
-//! of a normal draw).
+//! The random draws of a sweep: a counter-based generator from splitmix64, so that a run's values depend
+//! only on the seed, the run's index and the draw's index. Its numbers are part of the contract, written
+//! out here (not taken from a crate) as format.md defines them (Sweep files, Random draws, to the bit).
 
 use crate::format::metadata::number_string;
 
@@ -24,7 +9,7 @@ const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// Attempts a bounded normal draw makes before it gives up: the bounds would have to hold less than
 /// about one millionth of the distribution to reach it.
-pub const NORMAL_ATTEMPTS: u64 = 1_000_000;
+const NORMAL_ATTEMPTS: u64 = 1_000_000;
 
 /// splitmix64's output function: a bijection of u64 that mixes every bit into every other.
 fn mix(mut z: u64) -> u64 {
@@ -54,43 +39,25 @@ pub fn unit(word: u64) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Distribution {
     /// lo + (hi − lo)·u.
-    Uniform {
-        /// Lower bound.
-        lo: f64,
-        /// Upper bound.
-        hi: f64,
-    },
+    Uniform { lo: f64, hi: f64 },
     /// exp(ln lo + (ln hi − ln lo)·u).
-    LogUniform {
-        /// Lower bound, > 0.
-        lo: f64,
-        /// Upper bound.
-        hi: f64,
-    },
-    /// mean + std·z, z = √(−2 ln(1 − u₁))·cos(2π u₂) (Box–Muller), redrawn until within [min, max].
+    LogUniform { lo: f64, hi: f64 },
+    /// mean + std·z, z = √(−2 ln(1 − u₁))·cos(2π u₂) (Box–Muller), redrawn until within [min, max]
+    /// (±∞ when not given).
     Normal {
-        /// Mean.
         mean: f64,
-        /// Standard deviation, > 0.
         std: f64,
-        /// Lower bound (−∞ when not given).
         min: f64,
-        /// Upper bound (+∞ when not given).
         max: f64,
     },
     /// The k-th of `len` choices, k = ⌊(word >> 11)·len / 2⁵³⌋.
-    Choice {
-        /// How many choices.
-        len: usize,
-    },
+    Choice { len: usize },
 }
 
 /// What a draw gave: a number, or the index of a choice.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Drawn {
-    /// A uniform, log-uniform or normal number.
     Number(f64),
-    /// The index of the choice.
     Choice(usize),
 }
 
@@ -101,21 +68,14 @@ pub enum Drawn {
     number_string(*mean), number_string(*std), number_string(*min), number_string(*max)
 )]
 pub struct OutOfBounds {
-    /// Mean.
     pub mean: f64,
-    /// Standard deviation.
     pub std: f64,
-    /// Lower bound.
     pub min: f64,
-    /// Upper bound.
     pub max: f64,
 }
 
 impl Distribution {
     /// The value of draw `draw` of run `run`.
-    ///
-    /// # Errors
-    /// [`OutOfBounds`] when a bounded normal draw finds nothing within its bounds.
     pub fn draw(&self, seed: u64, run: u64, draw: u64) -> Result<Drawn, OutOfBounds> {
         let word = |n| word(seed, run, draw, n);
         Ok(match *self {

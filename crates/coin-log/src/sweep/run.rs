@@ -18,8 +18,7 @@ use crate::verify::{self, FileReport, Status, Verdict};
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Write buffer in front of each run's file (as `record`'s: the writer issues many small writes).
@@ -77,7 +76,8 @@ pub struct SweepOutcome {
     pub verify_seconds: f64,
 }
 
-/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume).
+/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume), with the
+/// seconds spent recording and verifying it.
 struct Done {
     row: Row,
     mtime_ns: u128,
@@ -85,39 +85,19 @@ struct Done {
     verify: f64,
 }
 
-impl Done {
-    fn without_file(row: Row) -> Self {
-        Self {
-            row,
-            mtime_ns: 0,
-            record: 0.0,
-            verify: 0.0,
-        }
-    }
-}
-
-/// What resume found: the rows to keep, the runs to do, and kept rows whose file was touched but not
-/// changed (to journal again with the new modification time).
+/// What resume found: the lines to keep and how many of them are failed rows, the runs to do, and kept
+/// rows whose file was touched but not changed (to journal again with the new modification time).
 struct Resumed {
-    held: BTreeMap<u64, Held>,
+    held: BTreeMap<u64, String>,
+    failed: u64,
     todo: Vec<u64>,
     refreshed: Vec<(u128, String)>,
-}
-
-/// A row held for the catalogue: its line and status.
-struct Held {
-    line: String,
-    status: RunStatus,
 }
 
 /// Runs `sweep` into the folder `dir` (or resumes it there). `stop` set (by a signal handler) stops
 /// starting runs and ends the running recordings early; their files are discarded and the runs redone on
 /// resume. The sweep sets `stop` itself when it cannot write its journal. `progress` is called as runs
-/// end, on the calling thread.
-///
-/// # Errors
-/// [`SweepError`] for a folder that cannot hold the sweep or a catalogue or journal that cannot be
-/// written. A run that fails is a row, not an error.
+/// end, on the calling thread. A run that fails is a row, not an error.
 pub fn run(
     sweep: &Sweep,
     dir: &std::path::Path,
@@ -129,16 +109,29 @@ pub fn run(
     let _lock = folder.lock(options.shard)?;
     let Resumed {
         held,
+        failed,
         todo,
         refreshed,
     } = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
     journal.append(&refreshed)?;
-    let mut tally = Tally::new(held, options.shard.len(sweep.runs()), todo.len() as u64);
+    let mut tally = Tally {
+        kept: held.len() as u64,
+        held,
+        progress: Progress {
+            runs: options.shard.len(sweep.runs()),
+            todo: todo.len() as u64,
+            done: 0,
+            failed,
+        },
+        record_seconds: 0.0,
+        verify_seconds: 0.0,
+    };
     progress(&tally.progress);
     let mut error = None;
-    pool(sweep, &folder, &todo, options.jobs, stop, |batch| {
+    let work = |&index: &u64| run_one(sweep, &folder, index, stop);
+    super::on_threads(&todo, options.jobs, stop, work, |batch| {
         let lines: Vec<(u128, String)> = batch.iter().map(|d| (d.mtime_ns, d.row.line())).collect();
         if let Err(e) = journal.append(&lines) {
             stop.store(true, Ordering::SeqCst);
@@ -153,135 +146,80 @@ pub fn run(
     if let Some(e) = error {
         return Err(e);
     }
-    let (catalogue, summary) = write_catalogue(sweep, &folder, options.shard, &tally.held)?;
-    Ok(tally.outcome(catalogue, summary, stop.load(Ordering::SeqCst)))
+    tally.finish(&folder, options.shard, stop)
 }
 
-/// The rows held for the catalogue and the counts, as the runs come in.
+/// The lines held for the catalogue and the counts, as the runs come in.
 struct Tally {
-    held: BTreeMap<u64, Held>,
+    held: BTreeMap<u64, String>,
     progress: Progress,
     kept: u64,
     record_seconds: f64,
     verify_seconds: f64,
 }
 
-/// How many of the held rows are failed.
-fn failed(held: &BTreeMap<u64, Held>) -> u64 {
-    held.values()
-        .filter(|h| h.status == RunStatus::Failed)
-        .count() as u64
-}
-
 impl Tally {
-    fn new(held: BTreeMap<u64, Held>, runs: u64, todo: u64) -> Self {
-        let failed = failed(&held);
-        Self {
-            kept: held.len() as u64,
-            held,
-            progress: Progress {
-                runs,
-                todo,
-                done: 0,
-                failed,
-            },
-            record_seconds: 0.0,
-            verify_seconds: 0.0,
-        }
-    }
-
     fn add(&mut self, done: &Done, line: String) {
-        let status = done.row.status;
         self.record_seconds += done.record;
         self.verify_seconds += done.verify;
         self.progress.done += 1;
-        self.progress.failed += u64::from(status == RunStatus::Failed);
-        self.held.insert(done.row.index, Held { line, status });
+        self.progress.failed += u64::from(done.row.status == RunStatus::Failed);
+        self.held.insert(done.row.index, line);
     }
 
-    fn outcome(
+    /// Writes the catalogue (or the shard's part) in index order and, for a whole sweep, `sweep.json`.
+    fn finish(
         self,
-        catalogue: PathBuf,
-        summary: Option<PathBuf>,
-        interrupted: bool,
-    ) -> SweepOutcome {
-        let (rows, failed) = (self.held.len() as u64, failed(&self.held));
-        SweepOutcome {
-            runs: self.progress.runs,
+        folder: &Folder,
+        shard: Shard,
+        stop: &AtomicBool,
+    ) -> Result<SweepOutcome, SweepError> {
+        let lines = self.held.values();
+        let (runs, rows, failed) = (
+            self.progress.runs,
+            self.held.len() as u64,
+            self.progress.failed,
+        );
+        let (catalogue, summary) = if shard.is_all() {
+            let (catalogue, summary) =
+                folder.write_whole(lines, [rows - failed, failed, runs - rows])?;
+            (catalogue, Some(summary))
+        } else {
+            (
+                folder.write_catalogue(&folder::PART.name(shard), lines)?,
+                None,
+            )
+        };
+        Ok(SweepOutcome {
+            runs,
             finished: rows - failed,
             failed,
-            pending: self.progress.runs - rows,
+            pending: runs - rows,
             kept: self.kept,
             done: self.progress.done,
-            interrupted,
+            interrupted: stop.load(Ordering::SeqCst),
             catalogue,
             summary,
             record_seconds: self.record_seconds,
             verify_seconds: self.verify_seconds,
-        }
+        })
     }
-}
-
-/// Runs `todo` on `jobs` threads; `handle` sees the results on the calling thread, in the order they end,
-/// in batches of those that ended while it handled the previous batch (so that one journal sync serves
-/// them all: the sweep is never slower than the disk syncs one row).
-fn pool(
-    sweep: &Sweep,
-    folder: &Folder,
-    todo: &[u64],
-    jobs: usize,
-    stop: &AtomicBool,
-    mut handle: impl FnMut(Vec<Done>),
-) {
-    let next = AtomicUsize::new(0);
-    let (sender, receiver) = mpsc::channel();
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, todo.len().max(1)) {
-            let sender = sender.clone();
-            let next = &next;
-            scope.spawn(move || {
-                while !stop.load(Ordering::SeqCst) {
-                    let Some(&index) = todo.get(next.fetch_add(1, Ordering::SeqCst)) else {
-                        break;
-                    };
-                    let Some(done) = run_one(sweep, folder, index, stop) else {
-                        continue;
-                    };
-                    if sender.send(done).is_err() {
-                        break;
-                    }
-                }
-            });
-        }
-        drop(sender);
-        for first in &receiver {
-            let mut batch = vec![first];
-            batch.extend(receiver.try_iter());
-            handle(batch);
-        }
-    });
 }
 
 /// The rows to keep from the journals and the runs to do. A row is kept when its file is there with
 /// the size and modification time it was journalled with, or, if only the time differs, with the same
 /// SHA-256; a failed row is kept unless it failed on I/O or `retry_failed` is set.
 fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resumed, SweepError> {
-    let columns = folder.columns();
-    let at = |name: &str| columns.iter().position(|c| c == name).unwrap_or(0);
-    let (status_at, failure_at, file_at, bytes_at, sha_at) = (
-        at("status"),
-        at("failure"),
-        at("file"),
-        at("bytes"),
-        at("sha256"),
-    );
+    let [status_at, failure_at, file_at, bytes_at, sha_at] =
+        ["status", "failure", "file", "bytes", "sha256"].map(|c| folder.column(c));
     let mut latest: BTreeMap<u64, JournalRow> = BTreeMap::new();
     for row in folder.journal_rows()? {
-        if row.index() < sweep.runs() && options.shard.takes(row.index()) {
-            latest.insert(row.index(), row);
+        if row.index < sweep.runs() && options.shard.takes(row.index) {
+            latest.insert(row.index, row);
         }
     }
-    let (mut held, mut todo, mut refreshed) = (BTreeMap::new(), Vec::new(), Vec::new());
+    let (mut held, mut failed, mut todo, mut refreshed) =
+        (BTreeMap::new(), 0, Vec::new(), Vec::new());
     for index in options.shard.runs(sweep.runs()) {
         let Some(row) = latest.remove(&index) else {
             todo.push(index);
@@ -313,41 +251,16 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         if retry || !file_ok {
             todo.push(index);
         } else {
-            held.insert(
-                index,
-                Held {
-                    line: crate::csv::line(f),
-                    status,
-                },
-            );
+            failed += u64::from(status == RunStatus::Failed);
+            held.insert(index, crate::csv::line(f));
         }
     }
     Ok(Resumed {
         held,
+        failed,
         todo,
         refreshed,
     })
-}
-
-/// The catalogue (or the shard's part) in index order, and for a whole sweep `sweep.json`, each written
-/// atomically.
-fn write_catalogue(
-    sweep: &Sweep,
-    folder: &Folder,
-    shard: Shard,
-    held: &BTreeMap<u64, Held>,
-) -> Result<(PathBuf, Option<PathBuf>), SweepError> {
-    let lines = held.values().map(|h| h.line.as_str());
-    if !shard.is_all() {
-        return Ok((
-            folder.write_catalogue(&folder::part_file_name(shard), lines)?,
-            None,
-        ));
-    }
-    let catalogue = folder.write_catalogue(folder::CATALOGUE_FILE, lines)?;
-    let (rows, failed) = (held.len() as u64, failed(held));
-    let summary = folder.write_summary(rows - failed, failed, sweep.runs() - rows)?;
-    Ok((catalogue, Some(summary)))
 }
 
 /// One run: values → scene → record into a temporary file → hash → verify → move into place → row.
@@ -358,8 +271,8 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
         Ok(v) => v.iter().map(cell).collect(),
         Err(_) => vec![String::new(); sweep.keys().count()],
     };
-    let failed = |failure, reason: String| {
-        Done::without_file(Row {
+    let failed = |failure, reason: String| Done {
+        row: Row {
             index,
             values: cells.clone(),
             status: RunStatus::Failed,
@@ -368,7 +281,10 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
             recorded: None,
             prediction: None,
             wall_time: started.elapsed().as_secs_f64(),
-        })
+        },
+        mtime_ns: 0,
+        record: 0.0,
+        verify: 0.0,
     };
     let scene = values
         .map_err(RunSceneError::from)
@@ -381,14 +297,15 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
     match record_and_check(sweep, folder, index, &scene, stop) {
         Ok(None) => None,
         Ok(Some(checked)) => {
-            let (status, failure, reason) = judge(&checked.summary, checked.report.as_ref());
+            let summary = &checked.recorded.summary;
+            let (status, failure, reason) = judge(summary, checked.report.as_ref());
             let row = Row {
                 index,
                 values: cells,
                 status,
                 failure,
                 reason,
-                recorded: Some(recorded(&checked, sweep.index_width(), index)),
+                recorded: Some(checked.recorded),
                 prediction,
                 wall_time: started.elapsed().as_secs_f64(),
             };
@@ -405,9 +322,8 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
 
 /// A recorded run, in place under its final name.
 struct Checked {
-    summary: RecordSummary,
+    recorded: Recorded,
     report: Option<FileReport>,
-    sha256: String,
     mtime_ns: u128,
     record_seconds: f64,
     verify_seconds: f64,
@@ -429,9 +345,7 @@ fn record_and_check(
         let what = format!("{what} `{name}`");
         move |e: std::io::Error| format!("{what}: {e}")
     };
-    let mut temp = folder
-        .temp_file(index, width)
-        .map_err(io("creating a temporary file for"))?;
+    let mut temp = folder::temp_file(&target).map_err(io("creating a temporary file for"))?;
     let started = Instant::now();
     let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());
     let summary = record::record(scene, &sweep.record_options(), writer, stop, |_| {})
@@ -455,9 +369,13 @@ fn record_and_check(
     let (_, mtime_ns) = folder::size_and_mtime(&target)
         .ok_or_else(|| format!("`{name}` vanished once moved into place"))?;
     Ok(Some(Checked {
-        summary,
+        recorded: Recorded {
+            file: name,
+            sha256,
+            summary,
+            verify: report.as_ref().map(|r| r.verdict),
+        },
         report,
-        sha256,
         mtime_ns,
         record_seconds,
         verify_seconds,
@@ -473,25 +391,6 @@ fn error_chain(e: &dyn std::error::Error) -> String {
         source = s.source();
     }
     text
-}
-
-fn recorded(c: &Checked, width: usize, index: u64) -> Recorded {
-    let s = &c.summary;
-    Recorded {
-        file: folder::run_file_name(index, width),
-        bytes: s.bytes,
-        sha256: c.sha256.clone(),
-        termination: s.termination,
-        t_end: s.termination_time,
-        samples: s.samples,
-        messages: s.messages,
-        steps: s.stats.steps,
-        energy_drift: s.energy_drift,
-        invariant_drift: s.invariant_drift,
-        steady_residual: s.steady_residual,
-        event_trusted: s.event_trusted,
-        verify: c.report.as_ref().map(|r| r.verdict),
-    }
 }
 
 /// Finished, or failed with the kind and reason: a numerical failure first, then a verdict other than ok.

@@ -5,16 +5,13 @@
 
 use std::fmt;
 
-/// Slurm's job-array variables.
-pub const SLURM_TASK_ID: &str = "SLURM_ARRAY_TASK_ID";
-/// The number of tasks of the array.
-pub const SLURM_TASK_COUNT: &str = "SLURM_ARRAY_TASK_COUNT";
-/// The lowest task id.
-pub const SLURM_TASK_MIN: &str = "SLURM_ARRAY_TASK_MIN";
-/// The highest task id.
-pub const SLURM_TASK_MAX: &str = "SLURM_ARRAY_TASK_MAX";
-/// The index of a Kubernetes Indexed Job's pod (its count is the Job's `completions`, given by a flag).
-pub const KUBERNETES_INDEX: &str = "JOB_COMPLETION_INDEX";
+// Slurm's job-array variables, and the index of a Kubernetes Indexed Job's pod (its count is the Job's
+// `completions`, given by a flag).
+const SLURM_TASK_ID: &str = "SLURM_ARRAY_TASK_ID";
+const SLURM_TASK_COUNT: &str = "SLURM_ARRAY_TASK_COUNT";
+const SLURM_TASK_MIN: &str = "SLURM_ARRAY_TASK_MIN";
+const SLURM_TASK_MAX: &str = "SLURM_ARRAY_TASK_MAX";
+const KUBERNETES_INDEX: &str = "JOB_COMPLETION_INDEX";
 
 /// Shard `index` of `count`: the runs with run index ≡ `index` (mod `count`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -38,10 +35,7 @@ impl Shard {
     /// Every run: shard 0 of 1.
     pub const ALL: Self = Self { index: 0, count: 1 };
 
-    /// Shard `index` of `count`.
-    ///
-    /// # Errors
-    /// Unless 0 ≤ index < count.
+    /// Shard `index` of `count`, refused unless 0 ≤ index < count.
     pub fn new(index: u64, count: u64) -> Result<Self, ShardError> {
         if count == 0 {
             return Err(ShardError(format!(

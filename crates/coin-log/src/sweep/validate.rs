@@ -10,7 +10,7 @@ use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepF
 use super::random::Distribution;
 use super::space::{linspace, logspace};
 use crate::format::Channel;
-use crate::scene::{self, presets, Problem, SceneProblems};
+use crate::scene::{self, presets, ProblemCollector, SceneProblems};
 use std::fmt::Display;
 use std::path::Path;
 use std::str::FromStr;
@@ -21,7 +21,9 @@ const CHECKED_VALUES: usize = 100;
 
 /// Validates a parsed sweep file; `folder` is where a base scene path starts from.
 pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProblems> {
-    let mut c = Checker::default();
+    let mut c = Checker {
+        problems: ProblemCollector::new(&[]),
+    };
     let places = places(&file);
     let base_table = c.base(&file.base, folder);
     let set = c.set(&file.set);
@@ -43,13 +45,13 @@ pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProble
         settings,
     };
     c.collisions(&places);
-    if c.problems.is_empty() {
+    if c.problems.list.is_empty() {
         if let Some(base) = base_table {
             c.scene_keys(&sweep, &base, &places);
         }
         c.size(&sweep);
     }
-    match SceneProblems::from_vec(c.problems) {
+    match SceneProblems::from_vec(c.problems.list) {
         Some(problems) => Err(problems),
         None => {
             sweep.set.sort_by(|a, b| a.0.cmp(&b.0));
@@ -58,9 +60,8 @@ pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProble
     }
 }
 
-#[derive(Default)]
 struct Checker {
-    problems: Vec<Problem>,
+    problems: ProblemCollector<'static>,
 }
 
 /// A TOML number as f64.
@@ -102,38 +103,26 @@ fn array_text(values: &[toml::Value]) -> String {
     toml::Value::Array(values.to_vec()).to_string()
 }
 
+/// How problems name the fixed edit of `key`: `set."run.duration"`.
+fn set_name(key: &str) -> String {
+    format!("set.\"{key}\"")
+}
+
 /// True for a dotted key with no empty part.
 fn dotted(key: &str) -> bool {
     !key.trim().is_empty() && key.split('.').all(|p| !p.trim().is_empty())
 }
 
 impl Checker {
-    fn problem(
-        &mut self,
-        key: impl Into<String>,
-        value: impl Into<String>,
-        reason: impl Into<String>,
-    ) {
-        self.problems.push(Problem {
-            key: key.into(),
-            value: value.into(),
-            reason: reason.into(),
-            flag: None,
-        });
-    }
-
     /// The base scene as a table: a built-in by name, or a scene file by path.
     fn base(&mut self, base: &str, folder: &Path) -> Option<toml::Table> {
         let quoted = format!("\"{base}\"");
-        let is_path = base.contains('/')
-            || base.contains(std::path::MAIN_SEPARATOR)
-            || base.ends_with(".toml");
-        if !is_path {
+        if !presets::is_path(base) {
             if let Some(preset) = presets::preset(base) {
                 return toml::Table::try_from(&preset).ok();
             }
             let names = presets::NAMES.join(", ");
-            self.problem("base", quoted, format!(
+            self.problems.push("base", quoted, format!(
                 "is no built-in scene ({names}) and not a path: a scene file is given by its path relative \
                  to the sweep file, such as \"./{base}.toml\""));
             return None;
@@ -142,7 +131,7 @@ impl Checker {
         let text = match crate::files::read_scene(&path) {
             Ok(text) => text,
             Err(e) => {
-                self.problem("base", quoted, format!(
+                self.problems.push("base", quoted, format!(
                     "cannot be read ({e}; looked for `{}`): give the path of a scene file relative to the \
                      sweep file", path.display()));
                 return None;
@@ -152,7 +141,7 @@ impl Checker {
             Ok(table) => Some(table),
             Err(e) => {
                 let message = scene::toml_message(&e).replace('\n', " ");
-                self.problem(
+                self.problems.push(
                     "base",
                     quoted,
                     format!("is not a TOML scene file: {message}"),
@@ -165,10 +154,9 @@ impl Checker {
     fn set(&mut self, set: &toml::Table) -> Vec<(String, toml::Value)> {
         let mut edits = Vec::new();
         for (key, value) in set {
-            let name = format!("set.\"{key}\"");
             if !dotted(key) {
-                self.problem(
-                    name,
+                self.problems.push(
+                    set_name(key),
                     value.to_string(),
                     "is not a dotted scene key like \"run.duration\"",
                 );
@@ -177,7 +165,7 @@ impl Checker {
                     || format!("\"{key}.name\" = value"),
                     |(k, v)| format!("\"{key}.{k}\" = {v}"),
                 );
-                self.problem(
+                self.problems.push(
                     format!("set.{key}"),
                     value.to_string(),
                     format!(
@@ -196,7 +184,7 @@ impl Checker {
     /// Notes `{name}.key` unless `key` is dotted like `example`.
     fn key(&mut self, name: &str, key: &str, example: &str) {
         if !dotted(key) {
-            self.problem(
+            self.problems.push(
                 format!("{name}.key"),
                 format!("\"{key}\""),
                 format!("is not a dotted scene key like \"{example}\""),
@@ -219,11 +207,11 @@ impl Checker {
         match given.as_slice() {
             [form] => Some(form),
             [] => {
-                self.problem(name, "", none);
+                self.problems.push(name, "", none);
                 None
             }
             several => {
-                self.problem(
+                self.problems.push(
                     name,
                     "",
                     format!("gives {}: give exactly one {one}", several.join(" and ")),
@@ -237,7 +225,7 @@ impl Checker {
         let name = format!("axis[{i}]");
         self.key(&name, &a.key, "initial.theta");
         if a.zip.as_deref().is_some_and(|z| z.trim().is_empty()) {
-            self.problem(
+            self.problems.push(
                 format!("{name}.zip"),
                 "\"\"",
                 "is empty: give the zip group a name",
@@ -259,7 +247,8 @@ impl Checker {
 
     fn listed(&mut self, name: &str, values: &[toml::Value]) -> Option<Vec<toml::Value>> {
         if values.is_empty() {
-            self.problem(name, "[]", "is empty: give at least one value");
+            self.problems
+                .push(name, "[]", "is empty: give at least one value");
             return None;
         }
         Some(values.to_vec())
@@ -274,7 +263,7 @@ impl Checker {
     ) -> Option<Vec<toml::Value>> {
         let text = array_text(spec);
         let [first, last, n] = spec else {
-            self.problem(
+            self.problems.push(
                 name,
                 text,
                 "must be [first, last, n]: two numbers and a count",
@@ -284,7 +273,7 @@ impl Checker {
         let ends = [first, last].map(|v| number(v).filter(|x| x.is_finite()));
         let n = whole(n).filter(|&n| n >= 1);
         let (Some(first), Some(last)) = (ends[0], ends[1]) else {
-            self.problem(
+            self.problems.push(
                 name,
                 text,
                 "must start with two finite numbers, [first, last, n]",
@@ -292,13 +281,13 @@ impl Checker {
             return None;
         };
         let Some(n) = n.filter(|&n| n <= MAX_AXIS_VALUES) else {
-            self.problem(name, text, format!(
+            self.problems.push(name, text, format!(
                 "must end with a whole number of values n, 1 ≤ n ≤ {MAX_AXIS_VALUES} (more samples of a key: draw it, [[random.draw]])"));
             return None;
         };
         let values: Vec<f64> = space(first, last, n);
         if let Some(bad) = values.iter().find(|x| !x.is_finite()) {
-            self.problem(
+            self.problems.push(
                 name,
                 text,
                 format!("gives {bad}: keep the exponents within ±300"),
@@ -327,7 +316,7 @@ impl Checker {
             let first = group[0];
             let len = axes[first].as_ref().map_or(0, |a| a.values.len());
             if len != axis.values.len() {
-                self.problem(
+                self.problems.push(
                     format!("axis[{i}].zip"),
                     format!("\"{}\"", zip.map_or("", String::as_str)),
                     format!(
@@ -345,7 +334,7 @@ impl Checker {
     fn random(&mut self, r: &RandomFile) -> Option<Random> {
         let seed = whole(&r.seed).filter(|&s| i64::try_from(s).is_ok());
         if seed.is_none() {
-            self.problem(
+            self.problems.push(
                 "random.seed",
                 r.seed.to_string(),
                 "must be a whole number from 0 to 9223372036854775807",
@@ -353,14 +342,14 @@ impl Checker {
         }
         let count = whole(&r.count).filter(|&c| (1..=MAX_RUNS).contains(&c));
         if count.is_none() {
-            self.problem(
+            self.problems.push(
                 "random.count",
                 r.count.to_string(),
                 format!("must be a whole number of runs per grid point, 1 … {MAX_RUNS}"),
             );
         }
         if r.draw.is_empty() {
-            self.problem("random.draw", "", "has no draws: add a [[random.draw]] with a key and a distribution, or remove [random]");
+            self.problems.push("random.draw", "", "has no draws: add a [[random.draw]] with a key and a distribution, or remove [random]");
         }
         let draws: Vec<Draw> = r
             .draw
@@ -416,7 +405,7 @@ impl Checker {
             Some((lo, hi)) => Some(Distribution::Uniform { lo, hi }),
             None => {
                 let need = if log { "0 < lo < hi" } else { "lo < hi" };
-                self.problem(
+                self.problems.push(
                     name,
                     array_text(spec),
                     format!("must be [lo, hi], two finite numbers with {need}"),
@@ -432,7 +421,7 @@ impl Checker {
             Some(v) => match number(v).filter(|x| !x.is_nan()) {
                 Some(x) => Some(x),
                 None => {
-                    self.problem(
+                    self.problems.push(
                         format!("{name}.{key}"),
                         v.to_string(),
                         format!("must be {need}"),
@@ -447,7 +436,7 @@ impl Checker {
         let max = get("max", n.max.as_ref(), f64::INFINITY, "a number");
         let (mean, std, min, max) = (mean?, std?, min?, max?);
         if !(std.is_finite() && std > 0.0) {
-            self.problem(
+            self.problems.push(
                 format!("{name}.std"),
                 n.std.to_string(),
                 "must be a finite number > 0",
@@ -455,7 +444,7 @@ impl Checker {
             return None;
         }
         if min >= max {
-            self.problem(
+            self.problems.push(
                 name,
                 format!("{{ min = {min}, max = {max} }}"),
                 "has min ≥ max: give min < max",
@@ -475,7 +464,8 @@ impl Checker {
         let compression = self.named("compression", o.compression.as_deref());
         for c in o.channels.iter().flatten() {
             if let Err(e) = c.trim().parse::<Channel>() {
-                self.problem("output.channels", format!("\"{c}\""), e.to_string());
+                self.problems
+                    .push("output.channels", format!("\"{c}\""), e.to_string());
             }
         }
         Settings {
@@ -499,7 +489,7 @@ impl Checker {
             return T::default();
         };
         name.parse().unwrap_or_else(|e: T::Err| {
-            self.problem(
+            self.problems.push(
                 format!("output.{key}"),
                 format!("\"{name}\""),
                 e.to_string(),
@@ -548,7 +538,7 @@ fn places(file: &SweepFile) -> Vec<Place> {
     let mut places: Vec<Place> = file
         .set
         .keys()
-        .map(|k| Place::new(k, format!("set.\"{k}\"")))
+        .map(|k| Place::new(k, set_name(k)))
         .collect();
     for (i, a) in file.axis.iter().enumerate() {
         let form = axis_forms(a)
@@ -596,7 +586,7 @@ impl Checker {
                     continue;
                 };
                 let (name, value, reason) = later.key_problem(&reason);
-                self.problem(name, value, reason);
+                self.problems.push(name, value, reason);
             }
         }
     }
@@ -613,19 +603,20 @@ impl Checker {
         let mut with_set = base.clone();
         for (key, value) in &sweep.set {
             if let Err(e) = fits(base, key, value) {
-                self.problem(
-                    format!("set.\"{key}\""),
+                self.problems.push(
+                    set_name(key),
                     value.to_string(),
                     format!("does not fit the scene: {e}"),
                 );
             }
             let _ = scene::set_value(&mut with_set, key, value.clone());
         }
-        if !self.problems.is_empty() {
+        if !self.problems.list.is_empty() {
             return;
         }
         if let Err(e) = scene::file_from_table(with_set.clone()) {
-            self.problem("set", "", format!("does not fit the scene: {e}"));
+            self.problems
+                .push("set", "", format!("does not fit the scene: {e}"));
             return;
         }
         let draws = sweep.random.iter().flat_map(|r| &r.draws);
@@ -643,7 +634,7 @@ impl Checker {
         for (place, values) in swept.zip(candidates.chain(channels)) {
             for value in values.iter().take(CHECKED_VALUES) {
                 if let Err(e) = fits(&with_set, &place.key, value) {
-                    self.problem(
+                    self.problems.push(
                         place.values_name.clone(),
                         value.to_string(),
                         format!("does not fit the scene key `{}`: {e}", place.key),
@@ -658,16 +649,15 @@ impl Checker {
     fn size(&mut self, sweep: &Sweep) {
         let values: usize = sweep.axes.iter().map(|a| a.values.len()).sum();
         if values as u64 > MAX_AXIS_VALUES {
-            self.problem("axis", "", format!(
+            self.problems.push("axis", "", format!(
                 "gives {values} values in all, more than the {MAX_AXIS_VALUES} the axes may (sweep.json lists them): \
                  draw the densest keys at random ([[random.draw]]), or split the sweep"));
         }
-        let lengths = sweep.lengths();
-        let count = sweep.random.as_ref().map_or(1, |r| r.count);
-        let runs = lengths.chain([count]).try_fold(1u64, u64::checked_mul);
+        let mut factors = sweep.lengths().chain([sweep.per_point()]);
+        let runs = factors.try_fold(1u64, u64::checked_mul);
         if runs.is_none_or(|r| r > MAX_RUNS) {
             let what = runs.map_or_else(|| "more than 2⁶⁴".to_string(), |r| r.to_string());
-            self.problem("axis", "", format!(
+            self.problems.push("axis", "", format!(
                 "gives {what} runs, more than the {MAX_RUNS} a sweep may have: sweep fewer values, or split the sweep"));
         }
     }
