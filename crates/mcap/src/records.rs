@@ -3,7 +3,7 @@
 //! the bench `crates/bench/benches/crate_vs_ours.rs`.
 //!
 //! Parsing is bounded: every length is checked against what the record holds before anything is
-//! allocated, so a record never costs more than its size (plus [`MAX_MAP_ENTRIES`] entries per map).
+//! allocated, so a record never costs more than its size (plus `MAX_MAP_ENTRIES`, 65 536, entries per map).
 //! `mcap::parse_record` reserves what a string claims: 4 GiB for a 30-byte metadata index record.
 
 use mcap::records::{

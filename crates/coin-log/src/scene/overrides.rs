@@ -34,7 +34,7 @@ pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
 
 /// Sets the dotted KEY to a typed `value` (the form of [`apply_set`] for callers that hold TOML values,
 /// such as `coin-log sweep`); missing tables on the way are created. The keys of the fact's other form
-/// ([`other_form`]) are removed: `body.inertia_z = 0.4` on a scene with `body.shape` drops the shape.
+/// (`other_form`) are removed: `body.inertia_z = 0.4` on a scene with `body.shape` drops the shape.
 ///
 /// ```
 /// let mut t = toml::Table::new();

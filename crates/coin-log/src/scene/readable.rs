@@ -5,7 +5,7 @@
 //! that reads back to the same double, so the printed scene is still the same scene.
 
 /// `text` (TOML as the `toml` crate writes it: one `key = value` per line) with every float of every value
-/// written as [`float_literal`] does; strings, keys, comments and table headers are kept as they are.
+/// written as `float_literal` does; strings, keys, comments and table headers are kept as they are.
 #[must_use]
 pub fn readable_toml(text: &str) -> String {
     let mut out = String::with_capacity(text.len());

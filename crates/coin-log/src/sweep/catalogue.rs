@@ -122,7 +122,7 @@ impl Row {
             self.status.name().to_string(),
             text(s.map(|s| s.termination.name())),
             opt(s.map(|s| s.termination_time)),
-            text(r.map(|r| r.verify.map_or("off", verdict_name))),
+            text(r.map(|r| r.verify.map_or("off", Verdict::name))),
             text(self.failure.map(|f| f.name())),
             one_line(&self.reason),
             text(r.map(|r| &r.file)),
@@ -146,17 +146,6 @@ impl Row {
     /// The row as one CSV line, without the line break.
     pub fn line(&self) -> String {
         crate::csv::line(&self.fields())
-    }
-}
-
-/// The name `verify --json` gives a verdict.
-#[must_use]
-pub fn verdict_name(v: Verdict) -> &'static str {
-    match v {
-        Verdict::Ok => "ok",
-        Verdict::Failed => "failed",
-        Verdict::CannotVerify => "cannot-verify",
-        Verdict::Unusable => "unusable",
     }
 }
 

@@ -149,7 +149,7 @@ impl Sweep {
 
     /// The swept keys' values of run `index` (< [`runs`](Self::runs)), in the order of
     /// [`keys`](Self::keys): grid point ⌊index / count⌋ (its coordinates with the last dimension varying
-    /// fastest), then the draws of run `index`; [`OutOfBounds`] when a bounded normal draw finds nothing.
+    /// fastest), then the draws of run `index`; an error when a bounded normal draw finds nothing.
     pub fn values(&self, index: u64) -> Result<Vec<toml::Value>, OutOfBounds> {
         let mut point = index / self.per_point();
         let mut values = vec![toml::Value::Boolean(false); self.axes.len()];

@@ -3,7 +3,7 @@
 //! row journalled as it finishes; then the catalogue (or this shard's part) and, for a whole sweep,
 //! `sweep.json`.
 
-use super::catalogue::{self, cell, FailureKind, Prediction, Recorded, Row, RunStatus};
+use super::catalogue::{cell, FailureKind, Prediction, Recorded, Row, RunStatus};
 use super::definition::{RunSceneError, Sweep};
 use super::error::SweepError;
 use super::folder::{self, Folder, JournalRow};
@@ -438,7 +438,7 @@ fn verify_reason(r: &FileReport) -> String {
             _ => c.id.to_string(),
         })
         .collect();
-    let mut reason = format!("verify: {}", catalogue::verdict_name(r.verdict));
+    let mut reason = format!("verify: {}", r.verdict.name());
     if !failing.is_empty() {
         reason.push_str(&format!(": {}", failing.join(", ")));
     }
