@@ -271,7 +271,7 @@ impl Decompressor {
     /// size, and checks their size and CRC.
     fn run(&mut self, chunk: &ChunkRecord<'_>, out: &mut Vec<u8>) -> Result<(), ChunkError> {
         let h = &chunk.header;
-        let stored = chunk.records.0;
+        let stored = chunk.records;
         let declared = h.uncompressed_size;
         let start = out.len();
         // At most MAX_RECORD_BYTES + 1: checked by the caller.

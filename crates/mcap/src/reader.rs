@@ -714,7 +714,7 @@ impl Book {
             d.digest.push(t);
             d.digest.push(offset);
         }
-        match visitor.message(&header, data.0) {
+        match visitor.message(&header, data) {
             ControlFlow::Continue(()) => Ok(()),
             ControlFlow::Break(()) => Err(ReadError::new(ReadErrorKind::Stopped, "")),
         }

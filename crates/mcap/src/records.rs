@@ -323,11 +323,6 @@ codec!(ChunkHeader {
     compressed_size
 });
 
-/// The data of a message or a chunk: the rest of the record, or the chunk's compressed records (which
-/// its header gives the length of; padding may follow).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Tail<'a>(pub(crate) &'a [u8]);
-
 /// Bytes of a message header: channel id, sequence, log time, publish time.
 const MESSAGE_HEADER_LEN: usize = 2 + 4 + 8 + 8;
 
@@ -339,7 +334,7 @@ const MESSAGE_HEADER_LEN: usize = 2 + 4 + 8 + 8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MessageRecord<'a> {
     pub header: MessageHeader,
-    pub(crate) data: Tail<'a>,
+    pub(crate) data: &'a [u8],
 }
 
 impl<'a> Field<'a> for MessageRecord<'a> {
@@ -348,15 +343,15 @@ impl<'a> Field<'a> for MessageRecord<'a> {
         let header = MessageHeader::parse(c, field)?;
         Ok(Self {
             header,
-            data: Tail(c.rest()),
+            data: c.rest(),
         })
     }
     #[inline]
     fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         // One allocation check for the whole record: the writer's hot path.
-        out.reserve(MESSAGE_HEADER_LEN + self.data.0.len());
+        out.reserve(MESSAGE_HEADER_LEN + self.data.len());
         self.header.encode(out, field)?;
-        out.extend_from_slice(self.data.0);
+        out.extend_from_slice(self.data);
         Ok(())
     }
 }
@@ -367,19 +362,19 @@ record!(MessageRecord<'a> = op::MESSAGE, "message");
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct ChunkRecord<'a> {
     pub(crate) header: ChunkHeader,
-    /// The records as stored.
-    pub(crate) records: Tail<'a>,
+    /// The records as stored (padding may follow them in the record).
+    pub(crate) records: &'a [u8],
 }
 
 impl<'a> Field<'a> for ChunkRecord<'a> {
     fn parse(c: &mut Cursor<'a>, field: &'static str) -> Result<Self, WireError> {
         let header = ChunkHeader::parse(c, field)?;
-        let records = Tail(c.take(header.compressed_size, "records")?);
+        let records = c.take(header.compressed_size, "records")?;
         Ok(Self { header, records })
     }
     fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         self.header.encode(out, field)?;
-        out.extend_from_slice(self.records.0);
+        out.extend_from_slice(self.records);
         Ok(())
     }
 }
@@ -395,14 +390,14 @@ pub(crate) struct AttachmentRecord<'a> {
     pub(crate) name: String,
     pub(crate) media_type: String,
     /// With a u64 length prefix in the file.
-    pub(crate) data: Tail<'a>,
+    pub(crate) data: &'a [u8],
     pub(crate) crc: u32,
 }
 
 impl AttachmentRecord<'_> {
     /// Bytes of the body that the CRC covers: every field before it.
     pub(crate) fn crc_covered_len(&self) -> usize {
-        8 + 8 + 4 + self.name.len() + 4 + self.media_type.len() + 8 + self.data.0.len()
+        8 + 8 + 4 + self.name.len() + 4 + self.media_type.len() + 8 + self.data.len()
     }
 }
 
@@ -413,7 +408,7 @@ impl<'a> Field<'a> for AttachmentRecord<'a> {
         let name = String::parse(c, "name")?;
         let media_type = String::parse(c, "media_type")?;
         let len = u64::parse(c, "data")?;
-        let data = Tail(c.take(len, "data")?);
+        let data = c.take(len, "data")?;
         let crc = u32::parse(c, "crc")?;
         Ok(Self {
             log_time,
@@ -429,8 +424,8 @@ impl<'a> Field<'a> for AttachmentRecord<'a> {
         self.create_time.encode(out, "create_time")?;
         self.name.encode(out, "name")?;
         self.media_type.encode(out, "media_type")?;
-        (self.data.0.len() as u64).encode(out, "data")?;
-        out.extend_from_slice(self.data.0);
+        (self.data.len() as u64).encode(out, "data")?;
+        out.extend_from_slice(self.data);
         self.crc.encode(out, "crc")
     }
 }
@@ -483,7 +478,7 @@ mod tests {
             create_time: 2,
             name: "note".into(),
             media_type: "text/plain".into(),
-            data: Tail(b"hello"),
+            data: b"hello",
             crc: 7,
         };
         let mut out = Vec::new();
@@ -542,6 +537,6 @@ mod tests {
             (h.channel_id, h.sequence, h.log_time, h.publish_time),
             (7, 1, 5, 6)
         );
-        assert_eq!(m.data.0, b"{}");
+        assert_eq!(m.data, b"{}");
     }
 }

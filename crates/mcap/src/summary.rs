@@ -28,8 +28,6 @@ pub struct ChannelSummary {
     pub message_encoding: String,
     /// Messages on the channel, from the statistics.
     pub messages: u64,
-    /// The schema id the channel record names (resolved into `schema_name`).
-    schema_id_of: u16,
 }
 
 /// A file's self-description, from its summary section.
@@ -68,28 +66,23 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     let Some(library) = header_library(&mut file, file_len)? else {
         return Ok(None);
     };
-    let Some(section) = summary_section(&mut file, file_len)? else {
+    let Some((start, bytes)) = summary_section(&mut file, file_len, true)? else {
         return Ok(None);
     };
-    if let Some(e) = section.bad_crc {
-        return Err(e);
-    }
     let mut records = SummaryRecords::default();
-    records.parse(&section.bytes, section.start)?;
+    records.parse(&bytes, start)?;
     if !records.statistics {
         return Ok(None);
     }
     let mut out = records.summary;
     out.file_len = file_len;
     out.library = library;
-    out.channels = std::mem::take(&mut records.channels)
-        .into_values()
-        .collect();
-    for c in &mut out.channels {
+    for (schema_id, mut c) in std::mem::take(&mut records.channels).into_values() {
         c.messages = records.counts.get(&c.id).copied().unwrap_or(0);
-        if let Some(name) = records.schemas.get(&c.schema_id_of) {
+        if let Some(name) = records.schemas.get(&schema_id) {
             c.schema_name.clone_from(name);
         }
+        out.channels.push(c);
     }
     let indexes = std::mem::take(&mut records.metadata_indexes);
     let Some(found) =
@@ -106,19 +99,13 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     Ok(Some(out))
 }
 
-/// The summary section's bytes, where they start, and the error when its CRC is not the footer's.
-struct Section {
-    start: u64,
-    bytes: Vec<u8>,
-    bad_crc: Option<ReadError>,
-}
-
-/// The summary section (from `summary_start` to the footer); `None` when the footer says there is none
-/// or it is larger than the reader accepts.
+/// Where the summary section starts and its bytes (up to the footer), its CRC checked if `check_crc`;
+/// `None` when the footer says there is none or it is larger than the reader accepts.
 fn summary_section(
     file: &mut (impl Read + Seek),
     file_len: u64,
-) -> Result<Option<Section>, ReadError> {
+    check_crc: bool,
+) -> Result<Option<(u64, Vec<u8>)>, ReadError> {
     if file_len < MAGIC_LEN + FOOTER_LEN + MAGIC_LEN {
         return Err(corrupt(format!(
             "{file_len} bytes: too short for an MCAP file with a footer"
@@ -146,18 +133,14 @@ fn summary_section(
     let crc_end = footer_at + FOOTER_LEN - 4;
     let mut bytes = bytes_at(file, file_len, summary_start, crc_end - summary_start)?;
     let computed = crc32fast::hash(&bytes);
-    let bad_crc = (footer.summary_crc != 0 && computed != footer.summary_crc).then(|| {
-        corrupt(format!(
+    if check_crc && footer.summary_crc != 0 && computed != footer.summary_crc {
+        return Err(corrupt(format!(
             "corrupt summary section: CRC {computed:#010x} does not match the stored {:#010x}",
             footer.summary_crc
-        ))
-    });
+        )));
+    }
     bytes.truncate(usize::try_from(footer_at - summary_start).unwrap_or(0));
-    Ok(Some(Section {
-        start: summary_start,
-        bytes,
-        bad_crc,
-    }))
+    Ok(Some((summary_start, bytes)))
 }
 
 /// The footer of the MCAP file of `len` bytes and where it starts, if it has a readable one.
@@ -179,8 +162,8 @@ pub(crate) fn metadata_indexes(
     source: &mut (impl Read + Seek),
     len: u64,
 ) -> Option<Vec<(u64, u64)>> {
-    let section = summary_section(source, len).ok()??;
-    let mut c = Cursor::new(&section.bytes);
+    let (_, bytes) = summary_section(source, len, false).ok()??;
+    let mut c = Cursor::new(&bytes);
     let mut found = Vec::new();
     while let Ok((opcode, body)) = c.record() {
         if opcode == op::METADATA_INDEX && found.len() < MAX_EARLY {
@@ -195,8 +178,8 @@ pub(crate) fn metadata_indexes(
 struct SummaryRecords {
     summary: Summary,
     statistics: bool,
-    /// The first record of each channel id.
-    channels: BTreeMap<u16, ChannelSummary>,
+    /// The first record of each channel id, with the schema id it names.
+    channels: BTreeMap<u16, (u16, ChannelSummary)>,
     schemas: BTreeMap<u16, String>,
     counts: BTreeMap<u16, u64>,
     metadata_indexes: Vec<(u64, u64)>,
@@ -223,14 +206,14 @@ impl SummaryRecords {
             }
             op::CHANNEL => {
                 let c = Channel::parse_body(body)?;
-                self.channels.entry(c.id).or_insert(ChannelSummary {
+                let channel = ChannelSummary {
                     id: c.id,
                     topic: c.topic,
                     schema_name: String::new(),
                     message_encoding: c.message_encoding,
                     messages: 0,
-                    schema_id_of: c.schema_id,
-                });
+                };
+                self.channels.entry(c.id).or_insert((c.schema_id, channel));
             }
             op::STATISTICS => {
                 let s = Statistics::parse_body(body)?;

@@ -7,9 +7,9 @@
 //! with 0, 1 and 2 compression threads: 1.56 to 2.03 times as long. It would also change every
 //! recording's bytes.
 
-use crate::records::{ChunkRecord, MessageRecord, Record, Tail, MAGIC};
+use crate::records::{ChunkRecord, MessageRecord, Record, MAGIC};
 use mcap::records::{
-    op, Channel, ChunkHeader, ChunkIndex, DataEnd, Footer, Header, MessageHeader, MessageIndex,
+    Channel, ChunkHeader, ChunkIndex, DataEnd, Footer, Header, MessageHeader, MessageIndex,
     MessageIndexEntry, Metadata, MetadataIndex, Statistics, SummaryOffset,
 };
 use mcap::Schema;
@@ -162,9 +162,9 @@ struct Done {
 }
 
 struct Worker {
-    jobs: Option<Sender<Job>>,
-    done: Option<Receiver<Done>>,
-    thread: Option<JoinHandle<()>>,
+    jobs: Sender<Job>,
+    done: Receiver<Done>,
+    thread: JoinHandle<()>,
 }
 
 /// The compression threads. Dropping stops and joins them (a worker finishes at most its current chunk).
@@ -180,9 +180,9 @@ impl Workers {
                 .name(format!("mcap-compress-{number}"))
                 .spawn(move || compress_chunks(compression, &job_receiver, &done_sender))?;
             workers.0.push(Worker {
-                jobs: Some(job_sender),
-                done: Some(done_receiver),
-                thread: Some(thread),
+                jobs: job_sender,
+                done: done_receiver,
+                thread,
             });
         }
         Ok(workers)
@@ -195,13 +195,10 @@ impl Workers {
     /// Stops and joins every worker; `WorkerLost` if one had panicked.
     fn stop(&mut self) -> Result<(), WriteError> {
         let mut lost = false;
-        for worker in &mut self.0 {
+        for worker in self.0.drain(..) {
             // Closing both channels ends the worker's loop after its current chunk, if any.
-            worker.jobs = None;
-            worker.done = None;
-            if let Some(thread) = worker.thread.take() {
-                lost |= thread.join().is_err();
-            }
+            drop((worker.jobs, worker.done));
+            lost |= worker.thread.join().is_err();
         }
         if lost {
             Err(WriteError::WorkerLost)
@@ -294,23 +291,37 @@ impl<W: Write> Output<W> {
         self.position += bytes.len() as u64;
         Ok(())
     }
+
+    /// Writes `records` as one summary group (nothing for none) and notes where it went.
+    fn group<'a, R: Record<'a>>(
+        &mut self,
+        records: &[R],
+        groups: &mut Vec<SummaryOffset>,
+    ) -> Result<(), WriteError> {
+        let mut b = Vec::new();
+        for record in records {
+            record.encode_record(&mut b)?;
+        }
+        if !b.is_empty() {
+            groups.push(SummaryOffset {
+                group_opcode: R::OPCODE,
+                group_start: self.position,
+                group_length: b.len() as u64,
+            });
+            self.write_all(&b)?;
+        }
+        Ok(())
+    }
 }
 
-/// A chunked, indexed MCAP writer whose chunks are compressed on worker threads.
+/// A chunked, indexed MCAP writer whose chunks are compressed on worker threads, in the layout of
+/// docs/format.md ("Files"); the file is complete only after [`finish`](Self::finish).
 ///
-/// The calling thread appends Message records to the open chunk, noting its message index entries and
-/// time bounds. A full chunk ([`WriterOptions::chunk_size`]) goes to a worker, which computes its CRC and
-/// compresses it in one call; buffers are reused. The calling thread writes finished chunks in order (so
-/// the output need not be `Send`), with at most two per worker in flight. Chunk boundaries depend only on
-/// the bytes written and each chunk is compressed alone with fixed parameters, so neither the worker
-/// count nor timing changes a byte. An I/O error surfaces from the call that met it, a compression error
-/// or a lost worker from the next call that collects a chunk; after any error every call fails.
-///
-/// Layout: magic; Header; chunks (a channel's Schema and Channel records in the chunk of its first
-/// message), each followed by its MessageIndex records, and Metadata records between chunks; DataEnd
-/// (data CRC); summary: Schemas, Channels, Statistics, ChunkIndexes, MetadataIndexes, each group listed
-/// by a SummaryOffset record; Footer (summary CRC); magic. Call [`finish`](Self::finish) to complete
-/// the file; dropping the writer without it leaves the file incomplete.
+/// The calling thread fills the open chunk; a full one ([`WriterOptions::chunk_size`]) goes to a worker
+/// (CRC and compression in one call), and the calling thread writes finished chunks in order, at most two
+/// per worker in flight. Each chunk is compressed alone with fixed parameters, so neither the worker count
+/// nor timing changes a byte. An I/O error surfaces from the call that met it, a compression error or a
+/// lost worker from the next call that collects a chunk; after any error every call fails.
 #[must_use = "an MCAP file is complete only after `finish`"]
 pub struct McapWriter<W: Write> {
     out: Output<W>,
@@ -322,9 +333,8 @@ pub struct McapWriter<W: Write> {
     /// Chunks sent to workers, oldest first.
     in_flight: VecDeque<ChunkMeta>,
     workers: Workers,
-    /// Chunks sent and chunks written since the start; chunk n goes to worker n mod workers.
+    /// Chunks sent since the start; chunk n goes to worker n mod workers.
     dispatched: usize,
-    collected: usize,
     free_records: Vec<Vec<u8>>,
     free_compressed: Vec<Vec<u8>>,
     free_meta: Vec<ChunkMeta>,
@@ -362,7 +372,6 @@ impl<W: Write> McapWriter<W> {
             in_flight: VecDeque::new(),
             workers,
             dispatched: 0,
-            collected: 0,
             free_records: Vec::new(),
             free_compressed: Vec::new(),
             free_meta: Vec::new(),
@@ -499,11 +508,7 @@ impl<W: Write> McapWriter<W> {
             log_time,
             publish_time,
         };
-        MessageRecord {
-            header,
-            data: Tail(data),
-        }
-        .encode_record(&mut self.chunk)?;
+        MessageRecord { header, data }.encode_record(&mut self.chunk)?;
         if self.chunk.len() >= self.chunk_size {
             self.guard(Self::dispatch)?;
         }
@@ -609,8 +614,6 @@ impl<W: Write> McapWriter<W> {
         let worker = &self.workers.0[self.dispatched % self.workers.len()];
         worker
             .jobs
-            .as_ref()
-            .ok_or(WriteError::WorkerLost)?
             .send(Job {
                 records,
                 compressed,
@@ -632,24 +635,23 @@ impl<W: Write> McapWriter<W> {
     /// Writes the oldest chunk in flight if it is done (waiting for it if `wait`); false if there was
     /// none or it is not done.
     fn collect(&mut self, wait: bool) -> Result<bool, WriteError> {
-        if self.in_flight.is_empty() {
+        // The oldest chunk in flight went to the worker of its number.
+        let oldest = self.dispatched - self.in_flight.len();
+        let Some(mut meta) = self.in_flight.pop_front() else {
             return Ok(false);
-        }
-        let worker = &self.workers.0[self.collected % self.workers.len()];
-        let receiver = worker.done.as_ref().ok_or(WriteError::WorkerLost)?;
+        };
+        let worker = &self.workers.0[oldest % self.workers.len()];
         let done = if wait {
-            receiver.recv().map_err(|_| WriteError::WorkerLost)?
+            worker.done.recv().map_err(|_| WriteError::WorkerLost)?
         } else {
-            match receiver.try_recv() {
+            match worker.done.try_recv() {
                 Ok(done) => done,
-                Err(TryRecvError::Empty) => return Ok(false),
+                Err(TryRecvError::Empty) => {
+                    self.in_flight.push_front(meta);
+                    return Ok(false);
+                }
                 Err(TryRecvError::Disconnected) => return Err(WriteError::WorkerLost),
             }
-        };
-        self.collected += 1;
-        let Some(mut meta) = self.in_flight.pop_front() else {
-            // Unreachable: a chunk was in flight (checked above) and answers come back in order.
-            return Err(WriteError::WorkerLost);
         };
         done.result.map_err(WriteError::Compress)?;
         let Job {
@@ -691,7 +693,7 @@ impl<W: Write> McapWriter<W> {
                 compression: compression.clone(),
                 compressed_size: stored.len() as u64,
             },
-            records: Tail(stored),
+            records: stored,
         }
         .encode_record(&mut buffer)?;
         let chunk_start_offset = self.out.position;
@@ -719,7 +721,8 @@ impl<W: Write> McapWriter<W> {
         Ok(written?)
     }
 
-    /// DataEnd, the summary section, the footer and the closing magic.
+    /// DataEnd, the summary section (each group listed by a SummaryOffset record), the footer and the
+    /// closing magic.
     fn write_summary(&mut self) -> Result<(), WriteError> {
         let data_section_crc = mem::take(&mut self.out.crc).finalize();
         let mut b = Vec::new();
@@ -729,64 +732,17 @@ impl<W: Write> McapWriter<W> {
         // The summary CRC starts at the summary's first byte, after DataEnd.
         self.out.crc = crc32fast::Hasher::new();
         let summary_start = self.out.position;
-        let groups = self.write_summary_groups()?;
-        self.write_footer(summary_start, &groups)
-    }
-
-    /// The summary's groups, in the order of the layout; returns the offset of each group written (an
-    /// empty group is left out).
-    fn write_summary_groups(&mut self) -> Result<Vec<SummaryOffset>, WriteError> {
+        let statistics = [self.statistics()?];
         let mut groups = Vec::new();
-        let mut b = Vec::new();
-        for schema in &self.schemas {
-            schema.encode_record(&mut b)?;
-        }
-        self.write_group(op::SCHEMA, &mut b, &mut groups)?;
-        for channel in &self.channels {
-            channel.encode_record(&mut b)?;
-        }
-        self.write_group(op::CHANNEL, &mut b, &mut groups)?;
-        self.statistics()?.encode_record(&mut b)?;
-        self.write_group(op::STATISTICS, &mut b, &mut groups)?;
-        for index in &self.chunk_indexes {
-            index.encode_record(&mut b)?;
-        }
-        self.write_group(op::CHUNK_INDEX, &mut b, &mut groups)?;
-        for index in &self.metadata_indexes {
-            index.encode_record(&mut b)?;
-        }
-        self.write_group(op::METADATA_INDEX, &mut b, &mut groups)?;
-        Ok(groups)
-    }
+        self.out.group(&self.schemas, &mut groups)?;
+        self.out.group(&self.channels, &mut groups)?;
+        self.out.group(&statistics, &mut groups)?;
+        self.out.group(&self.chunk_indexes, &mut groups)?;
+        self.out.group(&self.metadata_indexes, &mut groups)?;
 
-    /// Writes the records of one summary group (if any), notes where they went, and empties `records`.
-    fn write_group(
-        &mut self,
-        group_opcode: u8,
-        records: &mut Vec<u8>,
-        groups: &mut Vec<SummaryOffset>,
-    ) -> io::Result<()> {
-        if !records.is_empty() {
-            groups.push(SummaryOffset {
-                group_opcode,
-                group_start: self.out.position,
-                group_length: records.len() as u64,
-            });
-            self.out.write_all(records)?;
-        }
-        records.clear();
-        Ok(())
-    }
-
-    /// The SummaryOffset records of `groups`, the footer and the closing magic.
-    fn write_footer(
-        &mut self,
-        summary_start: u64,
-        groups: &[SummaryOffset],
-    ) -> Result<(), WriteError> {
         let summary_offset_start = self.out.position;
-        let mut b = Vec::new();
-        for group in groups {
+        b.clear();
+        for group in &groups {
             group.encode_record(&mut b)?;
         }
         Footer {
