@@ -1,16 +1,9 @@
-//! Before the stream: the file's metadata records, wherever they sit, and what its ends look like.
-//!
-//! MCAP lets metadata records sit anywhere in the data section (the Python writer with small chunks and
-//! `@mcap/core` put them after chunks of messages), and a reader must know them before it can interpret
-//! a message. They are found through the summary's MetadataIndex records, one seek each, or, without
-//! them, by a scan of the top-level records that reads each 9-byte prefix and seeks past the body
-//! (metadata never sit inside chunks). Both read each byte at most once, and what they keep counts
-//! against the budget ([`Lookahead::too_large`]). The records go to the visitor before the first
-//! message; the stream recognises them by offset. Hence a seekable source: buffering the messages until
-//! a late metadata record arrives could hold the whole file.
-//!
-//! Nothing here is trusted: a record that is not what the index says sends the search to the scan, an
-//! I/O error ends it; the stream reports both.
+//! Before the stream: the file's metadata records, wherever they sit (docs/format.md, "Files from other
+//! MCAP writers"), and what its ends look like. They are found through the summary's MetadataIndex
+//! records, one seek each, or, without them, by a scan of the top-level records that reads each 9-byte
+//! prefix and seeks past the body (metadata never sit inside chunks). Both read each byte at most once and
+//! count what they keep against the budget. Nothing here is trusted: a record that is not what the index
+//! says sends the search to the scan, an I/O error ends it; the stream reports both.
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::digest::Digest;
@@ -55,20 +48,25 @@ pub(crate) struct Lookahead {
     pub(crate) indexed: bool,
     /// Where the scan stopped early, when it ran and did.
     pub(crate) scan_end: Option<ScanEnd>,
-    /// The metadata found exceeds the budget (the search stopped there).
-    pub(crate) too_large: Option<ReadError>,
 }
 
 /// Looks for the metadata records of the MCAP file of `len` bytes in `source` (see the module doc),
 /// counting them in `kept`. Leaves the source at an unspecified position.
-pub(crate) fn find(source: &mut (impl Read + Seek), len: u64, kept: &mut Kept) -> Lookahead {
+///
+/// # Errors
+/// [`ReadError`] (too large) when the metadata found exceeds the budget.
+pub(crate) fn find(
+    source: &mut (impl Read + Seek),
+    len: u64,
+    kept: &mut Kept,
+) -> Result<Lookahead, ReadError> {
     let mut p = Lookahead::default();
     let Ok(head) = bytes_at(source, len, 0, len.min(MAGIC_LEN)) else {
-        return p;
+        return Ok(p);
     };
     p.magic_prefix = head == MAGIC[..head.len()];
     if len < MAGIC_LEN || !p.magic_prefix {
-        return p;
+        return Ok(p);
     }
     // The end magic is a second copy: a file of 8 to 15 bytes holds only the first.
     p.ends_with_magic = len >= 2 * MAGIC_LEN
@@ -77,25 +75,17 @@ pub(crate) fn find(source: &mut (impl Read + Seek), len: u64, kept: &mut Kept) -
     if let Some(indexes) = indexes.flatten().filter(|i| !i.is_empty()) {
         // Counted aside: if the index proves untrustworthy, the scan counts them again.
         let mut found = kept.clone();
-        match read_indexed(source, len, indexes, &mut found) {
-            Ok(Some(metadata)) => {
-                p.indexed = true;
-                p.metadata = metadata;
-                *kept = found;
-                return p;
-            }
-            Err(e) => {
-                p.too_large = Some(e);
-                return p;
-            }
-            // An index entry that points at no metadata record of its length (e.g. @mcap/core 2.2's
-            // unchunked writer records the offset of the messages it still buffers): the scan finds
-            // them where they are.
-            Ok(None) => {}
+        if let Some(metadata) = read_indexed(source, len, indexes, &mut found)? {
+            p.indexed = true;
+            p.metadata = metadata;
+            *kept = found;
+            return Ok(p);
         }
+        // An index entry points at no metadata record of its length (e.g. @mcap/core 2.2's unchunked
+        // writer records the offset of the messages it still buffers): the scan finds them where they are.
     }
-    scan(source, len, &mut p, kept);
-    p
+    p.scan_end = scan(source, len, &mut p.metadata, kept)?;
+    Ok(p)
 }
 
 /// Reads the record prefix at the reader's position: (opcode, body length), or `None` at a short read.
@@ -166,58 +156,53 @@ fn read_metadata(r: &mut impl Read, at: u64, body_len: u64) -> Option<FoundMetad
     })
 }
 
-/// Walks the top-level records from the header to DataEnd (or the footer), reading metadata records and
-/// skipping everything else; notes where it stopped if the file ends or a record is impossible first.
-fn scan(source: &mut (impl Read + Seek), len: u64, p: &mut Lookahead, kept: &mut Kept) {
+/// Walks the top-level records from the header to DataEnd (or the footer), reading metadata records into
+/// `found` and skipping everything else; returns where it stopped if the file ends or a record is
+/// impossible first.
+fn scan(
+    source: &mut (impl Read + Seek),
+    len: u64,
+    found: &mut Vec<FoundMetadata>,
+    kept: &mut Kept,
+) -> Result<Option<ScanEnd>, ReadError> {
     if source.seek(SeekFrom::Start(MAGIC_LEN)).is_err() {
-        return;
+        return Ok(None);
     }
     let mut r = io::BufReader::new(source);
     let mut at = MAGIC_LEN;
     loop {
         if at == len {
-            p.scan_end = Some(ScanEnd::Cut { at, claimed: None });
-            return;
+            return Ok(Some(ScanEnd::Cut { at, claimed: None }));
         }
         let Some((opcode, body_len)) = prefix(&mut r) else {
-            let end = if len - at < PREFIX_LEN {
+            return Ok(Some(if len - at < PREFIX_LEN {
                 ScanEnd::Cut { at, claimed: None }
             } else {
                 ScanEnd::Malformed { at }
-            };
-            p.scan_end = Some(end);
-            return;
+            }));
         };
         let end = (at + PREFIX_LEN).saturating_add(body_len);
         if end > len {
-            p.scan_end = Some(ScanEnd::Cut {
-                at,
-                claimed: Some(body_len),
-            });
-            return;
+            let claimed = Some(body_len);
+            return Ok(Some(ScanEnd::Cut { at, claimed }));
         }
         match opcode {
-            op::DATA_END | op::FOOTER => return,
+            op::DATA_END | op::FOOTER => return Ok(None),
             // One too large to read: the stream refuses it where it stands.
-            op::METADATA if body_len > MAX_RECORD_BYTES => return,
-            op::METADATA if p.metadata.len() < MAX_EARLY => {
+            op::METADATA if body_len > MAX_RECORD_BYTES => return Ok(None),
+            op::METADATA if found.len() < MAX_EARLY => {
                 let Some(m) = read_metadata(&mut r, at, body_len) else {
-                    p.scan_end = Some(ScanEnd::Malformed { at });
-                    return;
+                    return Ok(Some(ScanEnd::Malformed { at }));
                 };
-                if let Err(e) = kept.charge(PREFIX_LEN + body_len, m.record.metadata.len(), at) {
-                    p.too_large = Some(e);
-                    return;
-                }
-                p.metadata.push(m);
+                kept.charge(PREFIX_LEN + body_len, m.record.metadata.len(), at)?;
+                found.push(m);
             }
             _ => {
                 let Ok(skip) = i64::try_from(body_len) else {
-                    p.scan_end = Some(ScanEnd::Malformed { at });
-                    return;
+                    return Ok(Some(ScanEnd::Malformed { at }));
                 };
                 if r.seek_relative(skip).is_err() {
-                    return;
+                    return Ok(None);
                 }
             }
         }
@@ -293,7 +278,7 @@ mod tests {
     fn a_late_metadata_record_is_found_through_the_index_and_by_the_scan() {
         for indexed in [true, false] {
             let (f, at) = file(5000, indexed);
-            let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
+            let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default()).unwrap();
             assert_eq!(p.indexed, indexed);
             assert!(p.ends_with_magic && p.magic_prefix && p.scan_end.is_none());
             assert_eq!(p.metadata.len(), 1, "indexed {indexed}");
@@ -313,7 +298,8 @@ mod tests {
             &mut IoCursor::new(cut),
             cut.len() as u64,
             &mut Kept::default(),
-        );
+        )
+        .unwrap();
         assert!(!p.ends_with_magic && p.metadata.is_empty());
         assert_eq!(
             p.scan_end,
@@ -323,7 +309,7 @@ mod tests {
             })
         );
         // Cut inside a record prefix, and inside the magic.
-        let p = find(&mut IoCursor::new(&f[..12]), 12, &mut Kept::default());
+        let p = find(&mut IoCursor::new(&f[..12]), 12, &mut Kept::default()).unwrap();
         assert_eq!(
             p.scan_end,
             Some(ScanEnd::Cut {
@@ -331,7 +317,7 @@ mod tests {
                 claimed: None
             })
         );
-        let p = find(&mut IoCursor::new(&f[..5]), 5, &mut Kept::default());
+        let p = find(&mut IoCursor::new(&f[..5]), 5, &mut Kept::default()).unwrap();
         assert!(p.magic_prefix && p.scan_end.is_none());
     }
 
@@ -347,7 +333,7 @@ mod tests {
             f.extend(index(at, m_len));
         }
         f.extend(footer(summary_start));
-        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
+        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default()).unwrap();
         assert!(p.indexed);
         assert_eq!(p.metadata.len(), 1);
     }
@@ -359,7 +345,7 @@ mod tests {
         let tail = f.len() - 8 - FOOTER_LEN as usize;
         let entry = (tail - 9 - 8 - 8 - 4 - 8) + 9;
         f[entry..entry + 8].copy_from_slice(&29u64.to_le_bytes());
-        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default());
+        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default()).unwrap();
         assert!(!p.indexed);
         assert_eq!(p.metadata.len(), 1);
         assert_eq!(p.metadata[0].at, at);

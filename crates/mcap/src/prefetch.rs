@@ -1,6 +1,8 @@
 //! The reading half of the reader's pipeline: a worker thread runs the `mcap` crate's sans-io
 //! `LinearReader` (records, magic, data and summary CRCs, the end), decompresses each chunk whole and
 //! checks its size and CRC, and hands the records over in batches through a bounded channel.
+//! Consumer and worker split a read's CPU time 74/26 (verify) and 22/78 (info) (perf samples per thread,
+//! 2.1 M-message wobble file): with a second core free, the overlap takes the smaller share off the clock.
 //!
 //! A batch holds record bodies and decompressed chunks back to back, and [`Event`]s pointing into them in
 //! file order; errors travel as events in their place. At most [`POOL`] batches exist (see `budget`); one

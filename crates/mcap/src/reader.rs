@@ -310,10 +310,10 @@ pub fn read_from(
         );
         return (book.s, Some(e));
     }
-    book.ahead = early_metadata::find(&mut source, len, &mut book.kept);
-    if let Some(e) = book.ahead.too_large.take() {
-        return (book.s, Some(e));
-    }
+    book.ahead = match early_metadata::find(&mut source, len, &mut book.kept) {
+        Ok(ahead) => ahead,
+        Err(e) => return (book.s, Some(e)),
+    };
     for m in std::mem::take(&mut book.ahead.metadata) {
         book.early.insert(m.at, m.digest);
         visitor.metadata(&m.record.name, &m.record.metadata);
@@ -777,7 +777,13 @@ impl Book {
                 }
                 Ok(())
             }
-            op::CHUNK_INDEX => self.chunk_index(data, at),
+            op::CHUNK_INDEX => {
+                // Folded into the digest that must match the chunks' own.
+                let i: ChunkIndex = parse(data, at)?;
+                self.chunk_index_digest.push(index_digest(&i).0);
+                self.chunk_indexes += 1;
+                Ok(())
+            }
             op::METADATA_INDEX => {
                 let i: MetadataIndex = parse(data, at)?;
                 if self.metadata_indexes.len() < MAX_REMEMBERED {
@@ -898,15 +904,6 @@ impl Book {
                 visitor.metadata(&m.name, &m.metadata);
             }
         }
-        Ok(())
-    }
-
-    /// A chunk index record: folded into the digest that must match the chunks' own.
-    fn chunk_index(&mut self, data: &[u8], at: u64) -> Result<(), ReadError> {
-        let i: ChunkIndex = parse(data, at)?;
-        let d = index_digest(&i);
-        self.chunk_index_digest.push(d.0);
-        self.chunk_indexes += 1;
         Ok(())
     }
 

@@ -16,12 +16,8 @@ pub struct UnknownName {
 /// What [`named_enum!`] gives every enum it declares, for code generic over such enums (a command-line
 /// parser listing the possible values, say).
 pub trait Named: Copy + Send + Sync + 'static {
-    /// Every variant, in declaration order.
-    const ALL: &'static [Self];
-    /// Every variant's name, in the order of `ALL`.
+    /// Every variant's name, in declaration order.
     const NAMES: &'static [&'static str];
-    /// What a name of the enum is called in an error ("integrator").
-    const KIND: &'static str;
     /// The variant's name.
     fn name(self) -> &'static str;
 }
@@ -85,9 +81,7 @@ macro_rules! named_enum {
         }
 
         impl $crate::Named for $name {
-            const ALL: &'static [Self] = Self::ALL;
             const NAMES: &'static [&'static str] = Self::NAMES;
-            const KIND: &'static str = $kind;
             fn name(self) -> &'static str {
                 Self::name(self)
             }
