@@ -13,7 +13,7 @@ use mcap::records::{
     MessageIndexEntry, Metadata, MetadataIndex, Statistics, SummaryOffset,
 };
 use mcap::Schema;
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::BTreeMap;
 use std::io::{self, BufWriter, Write};
 use std::mem;
 use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
@@ -147,23 +147,20 @@ impl ChunkMeta {
     }
 }
 
-/// A chunk on its way to a worker and back: its records, and them compressed (empty for
+/// A chunk on its way to a worker and back, its buffers then reused: its records and what the calling
+/// thread knows of them, to which the worker adds their CRC-32 and them compressed (empty for
 /// [`Compression::None`]).
 struct Job {
     records: Vec<u8>,
+    meta: ChunkMeta,
     compressed: Vec<u8>,
-}
-
-/// A worker's answer, with the CRC-32 of `job.records`.
-struct Done {
-    job: Job,
     crc: u32,
     result: io::Result<()>,
 }
 
 struct Worker {
     jobs: Sender<Job>,
-    done: Receiver<Done>,
+    done: Receiver<Job>,
     thread: JoinHandle<()>,
 }
 
@@ -175,7 +172,7 @@ impl Workers {
         let mut workers = Self(Vec::with_capacity(count));
         for number in 0..count.max(1) {
             let (job_sender, job_receiver) = mpsc::channel::<Job>();
-            let (done_sender, done_receiver) = mpsc::channel::<Done>();
+            let (done_sender, done_receiver) = mpsc::channel::<Job>();
             let thread = std::thread::Builder::new()
                 .name(format!("mcap-compress-{number}"))
                 .spawn(move || compress_chunks(compression, &job_receiver, &done_sender))?;
@@ -215,12 +212,12 @@ impl Drop for Workers {
 }
 
 /// A worker's loop: compress each chunk it is sent, send it back, until either channel closes.
-fn compress_chunks(compression: Compression, jobs: &Receiver<Job>, done: &Sender<Done>) {
+fn compress_chunks(compression: Compression, jobs: &Receiver<Job>, done: &Sender<Job>) {
     let mut compressor = ChunkCompressor::new(compression);
     while let Ok(mut job) = jobs.recv() {
-        let crc = crc32fast::hash(&job.records);
-        let result = compressor.compress(&job.records, &mut job.compressed);
-        if done.send(Done { job, crc, result }).is_err() {
+        job.crc = crc32fast::hash(&job.records);
+        job.result = compressor.compress(&job.records, &mut job.compressed);
+        if done.send(job).is_err() {
             break;
         }
     }
@@ -330,14 +327,12 @@ pub struct McapWriter<W: Write> {
     /// The open chunk's records and what is known about them.
     chunk: Vec<u8>,
     meta: ChunkMeta,
-    /// Chunks sent to workers, oldest first.
-    in_flight: VecDeque<ChunkMeta>,
     workers: Workers,
-    /// Chunks sent since the start; chunk n goes to worker n mod workers.
+    /// Chunks sent since the start (chunk n goes to worker n mod workers), and of them not written yet.
     dispatched: usize,
-    free_records: Vec<Vec<u8>>,
-    free_compressed: Vec<Vec<u8>>,
-    free_meta: Vec<ChunkMeta>,
+    in_flight: usize,
+    /// Jobs back from the workers, for their buffers.
+    free: Vec<Job>,
     /// Reused for records written outside chunks.
     scratch: Vec<u8>,
     /// Schema id n is `schemas[n − 1]`; channel id n is `channels[n − 1]`.
@@ -369,12 +364,10 @@ impl<W: Write> McapWriter<W> {
             chunk_size,
             chunk: Vec::with_capacity(chunk_capacity(chunk_size)),
             meta: ChunkMeta::default(),
-            in_flight: VecDeque::new(),
+            in_flight: 0,
             workers,
             dispatched: 0,
-            free_records: Vec::new(),
-            free_compressed: Vec::new(),
-            free_meta: Vec::new(),
+            free: Vec::new(),
             scratch: Vec::new(),
             schemas: Vec::new(),
             channels: Vec::new(),
@@ -594,32 +587,27 @@ impl<W: Write> McapWriter<W> {
         if self.chunk.is_empty() {
             return Ok(());
         }
-        while self.in_flight.len() >= self.workers.len() * IN_FLIGHT_PER_WORKER {
+        while self.in_flight >= self.workers.len() * IN_FLIGHT_PER_WORKER {
             self.collect(true)?;
         }
-        let fresh = self
-            .free_records
-            .pop()
-            .unwrap_or_else(|| Vec::with_capacity(chunk_capacity(self.chunk_size)));
-        let records = mem::replace(&mut self.chunk, fresh);
-        let mut next = self.free_meta.pop().unwrap_or_default();
-        for channel in &self.channels[next.indexes.len()..] {
-            next.indexes.push(MessageIndex {
+        let mut job = self.free.pop().unwrap_or_else(|| Job {
+            records: Vec::with_capacity(chunk_capacity(self.chunk_size)),
+            meta: ChunkMeta::default(),
+            compressed: Vec::new(),
+            crc: 0,
+            result: Ok(()),
+        });
+        mem::swap(&mut job.records, &mut self.chunk);
+        mem::swap(&mut job.meta, &mut self.meta);
+        for channel in &self.channels[self.meta.indexes.len()..] {
+            self.meta.indexes.push(MessageIndex {
                 channel_id: channel.id,
                 records: Vec::new(),
             });
         }
-        let meta = mem::replace(&mut self.meta, next);
-        let compressed = self.free_compressed.pop().unwrap_or_default();
         let worker = &self.workers.0[self.dispatched % self.workers.len()];
-        worker
-            .jobs
-            .send(Job {
-                records,
-                compressed,
-            })
-            .map_err(|_| WriteError::WorkerLost)?;
-        self.in_flight.push_back(meta);
+        worker.jobs.send(job).map_err(|_| WriteError::WorkerLost)?;
+        self.in_flight += 1;
         self.dispatched += 1;
         while self.collect(false)? {}
         Ok(())
@@ -635,47 +623,41 @@ impl<W: Write> McapWriter<W> {
     /// Writes the oldest chunk in flight if it is done (waiting for it if `wait`); false if there was
     /// none or it is not done.
     fn collect(&mut self, wait: bool) -> Result<bool, WriteError> {
-        // The oldest chunk in flight went to the worker of its number.
-        let oldest = self.dispatched - self.in_flight.len();
-        let Some(mut meta) = self.in_flight.pop_front() else {
+        if self.in_flight == 0 {
             return Ok(false);
-        };
-        let worker = &self.workers.0[oldest % self.workers.len()];
-        let done = if wait {
+        }
+        // The oldest chunk in flight went to the worker of its number.
+        let worker = &self.workers.0[(self.dispatched - self.in_flight) % self.workers.len()];
+        let mut job = if wait {
             worker.done.recv().map_err(|_| WriteError::WorkerLost)?
         } else {
             match worker.done.try_recv() {
-                Ok(done) => done,
-                Err(TryRecvError::Empty) => {
-                    self.in_flight.push_front(meta);
-                    return Ok(false);
-                }
+                Ok(job) => job,
+                Err(TryRecvError::Empty) => return Ok(false),
                 Err(TryRecvError::Disconnected) => return Err(WriteError::WorkerLost),
             }
         };
-        done.result.map_err(WriteError::Compress)?;
-        let Job {
-            mut records,
-            mut compressed,
-        } = done.job;
-        self.write_chunk(&meta, &records, &compressed, done.crc)?;
-        records.clear();
-        compressed.clear();
-        meta.clear();
-        self.free_records.push(records);
-        self.free_compressed.push(compressed);
-        self.free_meta.push(meta);
+        self.in_flight -= 1;
+        if let Err(e) = job.result {
+            return Err(WriteError::Compress(e));
+        }
+        self.write_chunk(&job)?;
+        job.records.clear();
+        job.compressed.clear();
+        job.meta.clear();
+        self.free.push(job);
         Ok(true)
     }
 
     /// Writes a Chunk record and its MessageIndex records, and notes its ChunkIndex.
-    fn write_chunk(
-        &mut self,
-        meta: &ChunkMeta,
-        records: &[u8],
-        compressed: &[u8],
-        crc: u32,
-    ) -> Result<(), WriteError> {
+    fn write_chunk(&mut self, job: &Job) -> Result<(), WriteError> {
+        let Job {
+            records,
+            meta,
+            compressed,
+            crc,
+            ..
+        } = job;
         let stored = match self.compression {
             Compression::None => records,
             Compression::Zstd | Compression::Lz4 => compressed,
@@ -689,7 +671,7 @@ impl<W: Write> McapWriter<W> {
                 message_start_time,
                 message_end_time,
                 uncompressed_size: records.len() as u64,
-                uncompressed_crc: crc,
+                uncompressed_crc: *crc,
                 compression: compression.clone(),
                 compressed_size: stored.len() as u64,
             },
