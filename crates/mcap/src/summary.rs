@@ -77,14 +77,14 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     let mut out = records.summary;
     out.file_len = file_len;
     out.library = library;
-    for (schema_id, mut c) in std::mem::take(&mut records.channels).into_values() {
+    for (schema_id, mut c) in records.channels.into_values() {
         c.messages = records.counts.get(&c.id).copied().unwrap_or(0);
         if let Some(name) = records.schemas.get(&schema_id) {
             c.schema_name.clone_from(name);
         }
         out.channels.push(c);
     }
-    let indexes = std::mem::take(&mut records.metadata_indexes);
+    let indexes = records.metadata_indexes;
     let Some(found) =
         early_metadata::read_indexed(&mut file, file_len, indexes, &mut Kept::default())?
     else {
