@@ -25,47 +25,19 @@ pub enum InputKind {
 
 /// Why an input path is refused. The message does not name the path: the caller puts it first.
 #[derive(Debug, thiserror::Error)]
-pub enum InputError {
-    /// `-`.
-    #[error(
-        "reading standard input is not offered (`-`): save the input to a file and give its path (a file \
-         named `-` is `./-`)"
-    )]
-    Stdin,
+#[error("{0}")]
+pub struct InputError(String);
+
+impl InputError {
     /// The path cannot be looked at or read (for an MCAP file in the words of its reader).
-    #[error("{}{source}", if *kind == InputKind::Mcap { "cannot read: " } else { "" })]
-    Io {
-        /// What is read.
-        kind: InputKind,
-        /// The system's reason.
-        source: io::Error,
-    },
-    /// A folder.
-    #[error("is a directory, not {}", what(*.0))]
-    Folder(InputKind),
-    /// A pipe, device or socket.
-    #[error("{}", special(*kind, what, *stdin))]
-    Special {
-        /// What is read.
-        kind: InputKind,
-        /// What the path is ("a named pipe").
-        what: &'static str,
-        /// The path is standard input (`/dev/stdin`).
-        stdin: bool,
-    },
-    /// A scene file above [`SCENE_MAX_BYTES`].
-    #[error(
-        "holds more than {limit} bytes (at least {bytes}), more than {} may (they are a few kB of TOML): is \
-         this the file you meant?", what(*kind)
-    )]
-    TooLarge {
-        /// What is read.
-        kind: InputKind,
-        /// What it holds, as far as it was read.
-        bytes: u64,
-        /// The limit.
-        limit: u64,
-    },
+    fn io(kind: InputKind, source: &io::Error) -> Self {
+        let prefix = if kind == InputKind::Mcap {
+            "cannot read: "
+        } else {
+            ""
+        };
+        Self(format!("{prefix}{source}"))
+    }
 }
 
 fn what(kind: InputKind) -> &'static str {
@@ -102,19 +74,19 @@ const STDIN_PATHS: [&str; 3] = ["/dev/stdin", "/dev/fd/0", "/proc/self/fd/0"];
 /// [`InputError`]: `-`, a path that cannot be looked at, a folder, a pipe, a device or a socket.
 pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
     if path.as_os_str() == "-" {
-        return Err(InputError::Stdin);
+        return Err(InputError(
+            "reading standard input is not offered (`-`): save the input to a file and give its path (a \
+             file named `-` is `./-`)"
+                .into(),
+        ));
     }
-    let meta = fs::metadata(path).map_err(|source| InputError::Io { kind, source })?;
+    let meta = fs::metadata(path).map_err(|source| InputError::io(kind, &source))?;
     if meta.is_dir() {
-        return Err(InputError::Folder(kind));
+        return Err(InputError(format!("is a directory, not {}", what(kind))));
     }
     if !meta.is_file() {
         let stdin = STDIN_PATHS.iter().any(|s| path == Path::new(s));
-        return Err(InputError::Special {
-            kind,
-            what: kind_of(&meta),
-            stdin,
-        });
+        return Err(InputError(special(kind, kind_of(&meta), stdin)));
     }
     Ok(meta)
 }
@@ -138,14 +110,14 @@ pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
     let mut text = String::new();
     let read = File::open(path)
         .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_string(&mut text))
-        .map_err(|source| InputError::Io { kind, source })?;
+        .map_err(|source| InputError::io(kind, &source))?;
     if read as u64 > SCENE_MAX_BYTES {
         let bytes = fs::metadata(path).map_or(read as u64, |m| m.len().max(read as u64));
-        return Err(InputError::TooLarge {
-            kind,
-            bytes,
-            limit: SCENE_MAX_BYTES,
-        });
+        return Err(InputError(format!(
+            "holds more than {SCENE_MAX_BYTES} bytes (at least {bytes}), more than {} may (they are a few kB \
+             of TOML): is this the file you meant?",
+            what(kind)
+        )));
     }
     Ok(text)
 }

@@ -26,136 +26,14 @@ pub struct Policy {
     pub protect: Option<(PathBuf, &'static str)>,
 }
 
-/// Why an output cannot be written, or was not moved into place. `fix` says what to do instead.
+/// Why an output cannot be written, or was not moved into place, and what to do instead.
 #[derive(Debug, thiserror::Error)]
-pub enum OutputError {
-    /// The target is a folder.
-    #[error("`{path}` is a folder; {fix}")]
-    Folder {
-        /// The target.
-        path: String,
-        /// What to do instead.
-        fix: String,
-    },
-    /// The target is a symbolic link.
-    #[error(
-        "`{path}` is a symbolic link (to `{to}`), not a regular file; coin-log writes a new file and moves it \
-         into place, which would replace the link itself with a plain file: give the path it points to, or \
-         choose another path"
-    )]
-    Link {
-        /// The target.
-        path: String,
-        /// Where the link points.
-        to: String,
-    },
-    /// The target is a device, a named pipe or a socket.
-    #[error(
-        "`{path}` is {what}, not a regular file; coin-log writes a new file and moves it into place, which \
-         would replace {the}: {fix}"
-    )]
-    Special {
-        /// The target.
-        path: String,
-        /// What it is ("a named pipe").
-        what: &'static str,
-        /// The same with "the" ("the named pipe").
-        the: String,
-        /// What to do instead.
-        fix: String,
-    },
-    /// The target is the protected file.
-    #[error("`{path}` is {what}; writing there would replace it: {fix}")]
-    Protected {
-        /// The target.
-        path: String,
-        /// What the protected file is.
-        what: String,
-        /// What to do instead.
-        fix: String,
-    },
-    /// The target is `-`, which would be a file of that name, not standard output.
-    #[error(
-        "`-` would be a file named `-`: coin-log does not write to standard output, it writes a file and \
-         moves it into place; {fix} (a file named `-` is `./-`)"
-    )]
-    Stdout {
-        /// What to do instead.
-        fix: String,
-    },
-    /// The target exists and may not be replaced.
-    #[error("`{path}` already exists; {fix}")]
-    Exists {
-        /// The target.
-        path: String,
-        /// What to do instead.
-        fix: String,
-    },
-    /// The target's folder does not exist.
-    #[error("the folder `{folder}` does not exist (for `{path}`): create it first, or choose another path")]
-    NoFolder {
-        /// The target.
-        path: String,
-        /// Its folder.
-        folder: String,
-    },
-    /// The folder given for several outputs is a file (or a device, ...).
-    #[error("`{path}` is not a folder; {flag} takes a folder (created if missing) for the files")]
-    FileAsFolder {
-        /// The folder given.
-        path: String,
-        /// The flag that gave it.
-        flag: &'static str,
-    },
-    /// Something on the way to the target is not a folder.
-    #[error("`{folder}` is not a folder, so `{path}` cannot be created in it")]
-    NotAFolder {
-        /// The target.
-        path: String,
-        /// The part that is not a folder.
-        folder: String,
-    },
-    /// The system refuses the target or its folder: the name, the permissions, the file system.
-    #[error("cannot {doing} `{path}`{target}: {source}")]
-    System {
-        /// What was being done ("create", "write in", "use").
-        doing: &'static str,
-        /// The path.
-        path: String,
-        /// For a folder, the target it was for (` (for `x.mcap`)`), or empty.
-        target: String,
-        /// The system's reason.
-        source: io::Error,
-    },
-    /// An existing file in a sticky folder that belongs to another user.
-    #[error(
-        "cannot replace `{path}`: it belongs to another user (uid {uid}) in a folder with the sticky bit (like \
-         /tmp), where only its owner may replace it: choose another path"
-    )]
-    Sticky {
-        /// The target.
-        path: String,
-        /// Its owner.
-        uid: u32,
-    },
-    /// The finished file could not be moved into place; it is kept.
-    #[error("the finished file was not moved into place: {reason}; it is kept as `{kept}`")]
-    Kept {
-        /// Why it was not moved.
-        reason: String,
-        /// Where it is, or why it could not be kept.
-        kept: String,
-    },
-}
+#[error("{0}")]
+pub struct OutputError(String);
 
 impl OutputError {
-    fn system(doing: &'static str, path: &Path, source: io::Error) -> Self {
-        Self::System {
-            doing,
-            path: shown(path),
-            target: String::new(),
-            source,
-        }
+    fn system(doing: &str, path: &Path, source: &io::Error) -> Self {
+        Self(format!("cannot {doing} `{}`: {source}", shown(path)))
     }
 }
 
@@ -229,47 +107,70 @@ fn folder_of(target: &Path) -> PathBuf {
 /// Checks `target` against `policy`; returns its metadata when it is a regular file that may be replaced,
 /// `None` when it does not exist (its folder then does).
 fn check_target(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
+    let meta = look_at(target, policy)?;
+    if meta.is_some() && !policy.overwrite {
+        return Err(exists(target, policy));
+    }
+    Ok(meta)
+}
+
+fn exists(target: &Path, policy: &Policy) -> OutputError {
+    let fix = policy.fix(Refused::Exists, target);
+    OutputError(format!("`{}` already exists; {fix}", shown(target)))
+}
+
+fn not_a_folder(path: &str, folder: &str) -> OutputError {
+    OutputError(format!(
+        "`{folder}` is not a folder, so `{path}` cannot be created in it"
+    ))
+}
+
+/// [`check_target`] but for an existing file, which is returned whatever the policy says of replacing it.
+fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
     if target.as_os_str() == "-" {
         let fix = policy.fix(Refused::Special, target);
-        return Err(OutputError::Stdout { fix });
+        return Err(OutputError(format!(
+            "`-` would be a file named `-`: coin-log does not write to standard output, it writes a file and \
+             moves it into place; {fix} (a file named `-` is `./-`)"
+        )));
     }
     let path = shown(target);
     let meta = match fs::symlink_metadata(target) {
         Ok(meta) => meta,
         Err(e) if e.kind() == ErrorKind::NotFound => return check_folder(target).map(|()| None),
-        Err(source) => return Err(OutputError::system("use", target, source)),
+        Err(source) => return Err(OutputError::system("use", target, &source)),
     };
     let kind = meta.file_type();
     if kind.is_dir() {
         let fix = policy.fix(Refused::Folder, target);
-        return Err(OutputError::Folder { path, fix });
+        return Err(OutputError(format!("`{path}` is a folder; {fix}")));
     }
     if kind.is_symlink() {
         let to = fs::read_link(target).map_or_else(|_| "?".into(), |p| shown(&p));
-        return Err(OutputError::Link { path, to });
+        return Err(OutputError(format!(
+            "`{path}` is a symbolic link (to `{to}`), not a regular file; coin-log writes a new file and moves \
+             it into place, which would replace the link itself with a plain file: give the path it points \
+             to, or choose another path"
+        )));
     }
     if !kind.is_file() {
         let what = kind_of(&meta);
         let the = what.replacen("a ", "the ", 1);
         let fix = policy.fix(Refused::Special, target);
-        return Err(OutputError::Special {
-            path,
-            what,
-            the,
-            fix,
-        });
+        return Err(OutputError(format!(
+            "`{path}` is {what}, not a regular file; coin-log writes a new file and moves it into place, \
+             which would replace {the}: {fix}"
+        )));
     }
     if let Some((_, what)) = policy
         .protect
         .as_ref()
         .filter(|(file, _)| same_file(&meta, file))
     {
-        let (what, fix) = (what.to_string(), policy.fix(Refused::Protected, target));
-        return Err(OutputError::Protected { path, what, fix });
-    }
-    if !policy.overwrite {
-        let fix = policy.fix(Refused::Exists, target);
-        return Err(OutputError::Exists { path, fix });
+        let fix = policy.fix(Refused::Protected, target);
+        return Err(OutputError(format!(
+            "`{path}` is {what}; writing there would replace it: {fix}"
+        )));
     }
     Ok(Some(meta))
 }
@@ -280,15 +181,12 @@ fn check_folder(target: &Path) -> Result<(), OutputError> {
     let (path, shown_folder) = (shown(target), shown(&folder));
     match fs::metadata(&folder) {
         Ok(m) if m.is_dir() => Ok(()),
-        Ok(_) => Err(OutputError::NotAFolder {
-            path,
-            folder: shown_folder,
-        }),
-        Err(e) if e.kind() == ErrorKind::NotFound => Err(OutputError::NoFolder {
-            path,
-            folder: shown_folder,
-        }),
-        Err(source) => Err(OutputError::system("use the folder", &folder, source)),
+        Ok(_) => Err(not_a_folder(&path, &shown_folder)),
+        Err(e) if e.kind() == ErrorKind::NotFound => Err(OutputError(format!(
+            "the folder `{shown_folder}` does not exist (for `{path}`): create it first, or choose another \
+             path"
+        ))),
+        Err(source) => Err(OutputError::system("use the folder", &folder, &source)),
     }
 }
 
@@ -323,20 +221,18 @@ fn probe_target(
             Ok(file) => {
                 drop(file);
                 fs::remove_file(target)
-                    .map_err(|source| OutputError::system("remove the probe", target, source))
+                    .map_err(|source| OutputError::system("remove the probe", target, &source))
             }
-            Err(e) if e.kind() == ErrorKind::AlreadyExists => Err(OutputError::Exists {
-                path: shown(target),
-                fix: policy.fix(Refused::Exists, target),
-            }),
-            Err(source) => Err(OutputError::system("create", target, source)),
+            Err(e) if e.kind() == ErrorKind::AlreadyExists => Err(exists(target, policy)),
+            Err(source) => Err(OutputError::system("create", target, &source)),
         };
     };
     match sticky_owner(target, meta, temp) {
-        Some(uid) => Err(OutputError::Sticky {
-            path: shown(target),
-            uid,
-        }),
+        Some(uid) => Err(OutputError(format!(
+            "cannot replace `{}`: it belongs to another user (uid {uid}) in a folder with the sticky bit \
+             (like /tmp), where only its owner may replace it: choose another path",
+            shown(target)
+        ))),
         None => Ok(()),
     }
 }
@@ -406,11 +302,12 @@ impl Output {
             .prefix(".coin-log-")
             .suffix(&suffix)
             .tempfile_in(&folder)
-            .map_err(|source| OutputError::System {
-                doing: "write in",
-                path: shown(&folder),
-                target: format!(" (for `{}`)", shown(target)),
-                source,
+            .map_err(|source| {
+                OutputError(format!(
+                    "cannot write in `{}` (for `{}`): {source}",
+                    shown(&folder),
+                    shown(target)
+                ))
             })?;
         probe_target(target, existing.as_ref(), &temp, policy)?;
         Ok(Self {
@@ -453,15 +350,15 @@ impl Output {
     /// The error of a failed write into the output.
     #[must_use]
     pub fn write_error(&self, source: io::Error) -> OutputError {
-        OutputError::system("write", &self.target, source)
+        OutputError::system("write", &self.target, &source)
     }
 
     /// Syncs the finished file, makes it readable and moves it into place. If the target no longer takes
     /// it or the move fails, the file is kept under its temporary name and the error says where.
     ///
     /// # Errors
-    /// [`OutputError::System`] if the file cannot be synced (it is then removed: it is not finished);
-    /// [`OutputError::Kept`] if it was not moved into place.
+    /// [`OutputError`] if the file cannot be synced (it is then removed: it is not finished), or was not
+    /// moved into place.
     pub fn commit(self) -> Result<(), OutputError> {
         self.temp
             .as_file()
@@ -469,12 +366,13 @@ impl Output {
             .map_err(|source| self.write_error(source))?;
         make_readable(self.temp.as_file());
         // Checked again: something may have appeared there meanwhile.
-        let reason = match check(&self.target, &self.policy) {
-            Err(e @ OutputError::Exists { .. }) => {
-                format!("{e} (it appeared while the file was written, and was left alone)")
-            }
+        let reason = match look_at(&self.target, &self.policy) {
+            Ok(Some(_)) if !self.policy.overwrite => format!(
+                "{} (it appeared while the file was written, and was left alone)",
+                exists(&self.target, &self.policy)
+            ),
             Err(e) => e.to_string(),
-            Ok(()) => {
+            Ok(_) => {
                 let moved = if self.policy.overwrite {
                     self.temp.persist(&self.target).map(drop)
                 } else {
@@ -503,7 +401,9 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
         ),
         Err(e) => format!("nowhere: it could not be kept either ({})", e.error),
     };
-    OutputError::Kept { reason, kept }
+    OutputError(format!(
+        "the finished file was not moved into place: {reason}; it is kept as `{kept}`"
+    ))
 }
 
 /// Several output files in one folder, each an [`Output`]: created if missing (and removed again, with
@@ -530,17 +430,12 @@ impl OutputFolder {
             match fs::metadata(d) {
                 Ok(m) if m.is_dir() => break,
                 Ok(_) if d == dir => {
-                    return Err(OutputError::FileAsFolder {
-                        path: shown(dir),
-                        flag: "--out",
-                    })
+                    return Err(OutputError(format!(
+                    "`{}` is not a folder; --out takes a folder (created if missing) for the files",
+                    shown(dir)
+                )))
                 }
-                Ok(_) => {
-                    return Err(OutputError::NotAFolder {
-                        path: shown(dir),
-                        folder: shown(d),
-                    })
-                }
+                Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
                 Err(_) => created.push(d.to_path_buf()),
             }
             missing = d.parent();
@@ -554,7 +449,7 @@ impl OutputFolder {
         };
         while let Some(d) = created.pop() {
             fs::create_dir(&d)
-                .map_err(|source| OutputError::system("create the folder", &d, source))?;
+                .map_err(|source| OutputError::system("create the folder", &d, &source))?;
             folder.created.insert(0, d);
         }
         Ok(folder)
