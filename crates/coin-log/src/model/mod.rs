@@ -13,7 +13,7 @@ pub mod quadrature;
 mod stability;
 mod state;
 mod steady;
-pub mod turning_points;
+mod turning_points;
 
 pub use derived::{centre, contact_point, energy, orientation, reaction, Energy, Reaction};
 pub use dissipation::{

@@ -159,12 +159,10 @@ impl Orbit {
                 limit,
             });
         }
-        if is_steady(coin, state) {
-            return Ok(Self::steady(coin, chaplygin, state));
-        }
-        let mut reduced = Reduced::new(coin, chaplygin, state, limit);
         let mut orbit = Self::steady(coin, chaplygin, state);
-        reduced.fill(&mut orbit);
+        if !is_steady(coin, state) {
+            Reduced::new(coin, chaplygin, state, limit).fill(&mut orbit);
+        }
         Ok(orbit)
     }
 
