@@ -24,12 +24,12 @@ const DECREASING_RUN: usize = 2;
 /// A hard bound on the series length (μ ≤ [`MU_MAX`] needs about 1000 at most).
 const MAX_TERMS: usize = 20_000;
 /// Largest μ accepted (every real body has μ < 2). The tests cover μ = 20 and μ = 100.
-pub const MU_MAX: f64 = 100.0;
+const MU_MAX: f64 = 100.0;
 
 /// Why the integrals cannot be built for these parameters.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum InvariantsError {
-    /// μ is larger than [`MU_MAX`].
+    /// μ is larger than 100 (`max`).
     #[error(
         "μ = I_Z·Ma²/(I_X·(I_Z + Ma²)) = {mu} is above {max}, where C1, C2 cannot be evaluated accurately; \
          every real body has I_Z ≤ 2·I_X and μ < 2, so check inertia_x and inertia_z"
@@ -37,7 +37,7 @@ pub enum InvariantsError {
     MuTooLarge {
         /// The parameters' μ.
         mu: f64,
-        /// The largest accepted μ ([`MU_MAX`]).
+        /// The largest accepted μ, 100.
         max: f64,
     },
 }
@@ -78,8 +78,7 @@ struct Connection {
 /// C1, C2 for one set of body parameters: the series coefficients and connection constants, computed once.
 ///
 /// ```
-/// use coin_log::model::CoinParams;
-/// use coin_log::model::invariants::Chaplygin;
+/// use coin_log::model::{Chaplygin, CoinParams};
 /// let chaplygin = Chaplygin::new(&CoinParams::unit_disk()).unwrap();
 /// // Upright (s = 0): y_e = 1, y_o = 0, y_e′ = 0, y_o′ = 1, k = 3/2, so C1 = ω_Z and C2 = ω_Y / k.
 /// let c = chaplygin.evaluate(0.0, 0.6, 1.5);
@@ -104,7 +103,7 @@ impl Chaplygin {
     /// Precomputes the expansions of physics §6 for `params`.
     ///
     /// # Errors
-    /// [`InvariantsError::MuTooLarge`] if μ > [`MU_MAX`] (no real body; see there).
+    /// [`InvariantsError::MuTooLarge`] if μ > 100 (no real body).
     pub fn new(params: &CoinParams) -> Result<Self, InvariantsError> {
         let ma2 = params.ma2();
         let iz = params.inertia_z();

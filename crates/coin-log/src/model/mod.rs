@@ -6,7 +6,7 @@ mod dissipation;
 pub mod drift;
 mod equations;
 pub mod fit;
-pub mod invariants;
+mod invariants;
 pub mod nutation;
 mod params;
 pub mod quadrature;
