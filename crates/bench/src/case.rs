@@ -5,8 +5,7 @@ use super::BenchError;
 use coin_log::analyse::steady_path::steady_state_at;
 use coin_log::integrate::{Flow, Method, MethodConfig, RunEnd, RunOutcome, RunSettings};
 use coin_log::model::drift::{EnergyDrift, InvariantDrift};
-use coin_log::model::invariants::Chaplygin;
-use coin_log::model::{energy, Coin, Dissipation, Dynamics, State, Steady, STATE_LEN};
+use coin_log::model::{energy, Chaplygin, Coin, Dissipation, Dynamics, State, Steady, STATE_LEN};
 use coin_log::scene::defaults;
 use coin_log::simulation::{run_dynamics, CoinEvents};
 

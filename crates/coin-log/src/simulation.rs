@@ -32,9 +32,9 @@ impl OdeSystem<DISSIPATIVE_STATE_LEN> for DissipativeCoin {
     }
 }
 
-/// The coin's eight state components of a dissipative state (θ, φ, ψ, ω, x, z), without W.
+/// The coin's eight state components (θ, φ, ψ, ω, x, z) of a state, without W.
 #[inline]
-fn coin_part(y: &[f64; DISSIPATIVE_STATE_LEN]) -> [f64; STATE_LEN] {
+fn coin_part<const N: usize>(y: &[f64; N]) -> [f64; STATE_LEN] {
     let mut out = [0.0; STATE_LEN];
     out.copy_from_slice(&y[..STATE_LEN]);
     out
@@ -83,8 +83,10 @@ impl CoinEvents {
             _ => PhysicalEvent::Slip,
         }
     }
+}
 
-    fn event_count(&self) -> usize {
+impl<const N: usize> EventFunctions<N> for CoinEvents {
+    fn count(&self) -> usize {
         if self.friction.is_some() {
             3
         } else {
@@ -92,38 +94,18 @@ impl CoinEvents {
         }
     }
 
-    /// The event functions at state `s`.
     #[inline]
-    fn evaluate_at(&self, s: &State, out: &mut [f64]) {
+    fn evaluate(&self, _t: f64, y: &[f64; N], out: &mut [f64]) {
+        let s = State::from_array(&coin_part(y));
         out[0] = std::f64::consts::FRAC_PI_2 - self.flat_margin - s.theta.abs();
         // Beyond flat the reaction formulas are meaningless; the flat event comes first there anyway.
-        let r = self.dynamics.reaction(s);
+        let r = self.dynamics.reaction(&s);
         let params = self.dynamics.coin().params();
         let weight = params.mass() * params.gravity();
         out[1] = r.normal / weight;
         if let (Some(mu), Some(slot)) = (self.friction, out.get_mut(2)) {
             *slot = (mu * r.normal - r.friction) / weight;
         }
-    }
-}
-
-impl EventFunctions<STATE_LEN> for CoinEvents {
-    fn count(&self) -> usize {
-        self.event_count()
-    }
-
-    fn evaluate(&self, _t: f64, y: &[f64; STATE_LEN], out: &mut [f64]) {
-        self.evaluate_at(&State::from_array(y), out);
-    }
-}
-
-impl EventFunctions<DISSIPATIVE_STATE_LEN> for CoinEvents {
-    fn count(&self) -> usize {
-        self.event_count()
-    }
-
-    fn evaluate(&self, _t: f64, y: &[f64; DISSIPATIVE_STATE_LEN], out: &mut [f64]) {
-        self.evaluate_at(&State::from_array(&coin_part(y)), out);
     }
 }
 

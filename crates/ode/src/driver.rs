@@ -137,7 +137,6 @@ where
         stepper,
         settings,
         bounds: *bounds,
-        steps: 0,
         events,
         observe,
         n_events: events.count().min(MAX_EVENTS),
@@ -163,8 +162,6 @@ struct Run<'a, const N: usize, S, M, E, O> {
     stepper: &'a mut M,
     settings: &'a RunSettings,
     bounds: Bounds<'a>,
-    /// Accepted steps so far.
-    steps: u64,
     events: &'a E,
     observe: O,
     n_events: usize,
@@ -217,7 +214,6 @@ where
             if let Err(e) = self.stepper.step(self.sys, self.settings.t_end) {
                 return RunEnd::Failed(e);
             }
-            self.steps += 1;
             self.dense_ready = false;
             let t_new = self.stepper.state().t;
             let event = self.event_in_step(t_new);
@@ -250,10 +246,11 @@ where
         if self.bounds.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             return Some(RunEnd::Stopped { t: self.t_last });
         }
+        let state = self.stepper.state();
         match self.bounds.max_steps {
-            Some(max) if self.steps >= max => Some(RunEnd::Failed(StepError::BudgetSpent {
-                t: self.stepper.state().t,
-                steps: self.steps,
+            Some(max) if state.stats.steps >= max => Some(RunEnd::Failed(StepError::BudgetSpent {
+                t: state.t,
+                steps: state.stats.steps,
             })),
             _ => None,
         }

@@ -13,9 +13,8 @@ pub mod steady_path;
 
 pub use steady::{Stability, SteadyAnalysis};
 
-use crate::model::invariants::Chaplygin;
 use crate::model::nutation::{Motion, NutationError, Orbit};
-use crate::model::{Coin, InvariantsError, State, Steady};
+use crate::model::{Chaplygin, Coin, InvariantsError, State, Steady};
 use crate::scene::{InitialSpec, Scene};
 use serde_json::json;
 use thiserror::Error;

@@ -1,52 +1,8 @@
 //! Chaplygin–Appell integrals C1, C2 (physics §6): C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k and
 //! C2 = cos θ y_e(s) ω_Y / k − cos²θ y_e′(s) ω_Z, with y_e, y_o the even and odd solutions of Legendre's
 //! equation (1 − s²) y″ − 2s y′ − μ y = 0 in s = sin θ.
-//!
-//! # Method
-//!
-//! Everything is written with the *flux* p = (1 − s²) y′(s) = cos²θ y′ in place of y′: p is what C1, C2
-//! contain, it stays finite at s → ±1 (where y′ ~ 1/(1 − s) and y ~ ln(1 − s)), and the equation becomes
-//! dp/ds = μ y. Two convergent expansions, glued at |s| = ½ (for μ ≤ 4; see below):
-//!
-//! * **|s| ≤ ½: Taylor series about s = 0**, a_{m+2} = (m² + m + μ)/((m + 2)(m + 1)) a_m, summed in t = s² ≤ ¼.
-//!   This is ₂F₁(A, B; ½; s²) and s ₂F₁(A + ½, B + ½; 3/2; s²) of physics §6, written with μ alone, so real
-//!   A, B (μ < ¼), complex conjugate A, B (μ > ¼) and μ = ¼ are one and the same code path.
-//! * **|s| > ½: Frobenius expansion about s = 1** in x = (1 − |s|)/2 ≤ ¼, the logarithmic case of
-//!   x(1 − x) y″ + (1 − 2x) y′ − μ y = 0 (indicial roots 0, 0):
-//!   u₁ = Σ c_n xⁿ, c_{n+1} = (n² + n + μ)/(n + 1)² c_n, c₀ = 1 (the Legendre function regular at s = 1), and
-//!   u₂ = u₁ ln x + Σ d_n xⁿ, d_{n+1} = ((n² + n + μ) d_n + (2n + 1) c_n − 2(n + 1) c_{n+1})/(n + 1)², d₀ = 0.
-//!   Their fluxes are p₁ = −2(1 − x) x u₁′ and p₂ = −2(1 − x)(x u₁′ ln x + u₁ + x w′), w = Σ d_n xⁿ, finite at
-//!   x = 0; the Wronskian is u₁ p₂ − u₂ p₁ = −2.
-//!
-//! Both variables are ≤ ¼ on their side of the split, so both series converge like 4⁻ⁿ (34 terms each for
-//! the disk and the hoop) and every coefficient comes from an exact recurrence. The connection constants
-//! (y = α u₁ + β u₂ for y_e and y_o) are obtained by matching value and flux of the two expansions at the
-//! split, where both converge, instead of from Γ and ψ functions of complex argument: this is as accurate
-//! (the 2 × 2 system has the exact determinant −2) and needs no special functions. Even/odd symmetry is
-//! exact by construction: y_e(−s) = y_e(s), y_o(−s) = −y_o(s), p_e odd, p_o even (bit for bit).
-//!
-//! For μ > 4 (no real body: I_Z ≤ 2 I_X gives μ < 2) the basis about s = 1 grows like exp(√μ (π/2 − θ))
-//! towards s = 0 and matching at s = ½ would cost digits, so the split moves towards s = 1
-//! (`MU_SPLIT_FIXED`) and the all-positive series about s = 0 takes more terms (184 at μ = 20, 900 at
-//! μ = [`MU_MAX`] = 100, beyond which construction fails with [`InvariantsError::MuTooLarge`]).
-//!
-//! Near flat, s = sin θ loses the relative precision of 1 − s (at θ = 1.5705, 1 − s ≈ 4.5e-8, so the
-//! rounding of s alone would cost 2e-9). [`Chaplygin::evaluate`] therefore never forms 1 − s: it uses
-//! x = cos²θ / (2(1 + |s|)) and ln x = ln cos²θ − ln(2(1 + |s|)), exact to a few ulp, and the flux p
-//! directly, so C1, C2 keep full precision up to the flat landing.
-//!
-//! # Accuracy and cost
-//!
-//! Each basis function is accurate to a few ulp of its own size (y_e, y_o, p_e, p_o are all positive on
-//! 0 < s < 1, so relative error is meaningful): against an independent integration of Legendre's equation
-//! (`tests/it/invariants.rs`), ≤ 3e-15 for μ ≤ 2.7 and ≤ 8e-15 up to μ = 100, over |θ| ≤ 1.5705. C1, C2 then
-//! carry a few ulp of the *term scale* |cos²θ y′ ω_Z| + |cos θ y ω_Y / k|, the size of what is summed.
-//! The map (ω_Y, ω_Z) → (C1, C2) has determinant −cos θ / k, so |C1| + |C2| (the contract's drift
-//! denominator) can be smaller than the term scale, by at most a factor of order 1/cos θ (and exp(2√μ|θ|)
-//! for large μ): measured against |C1| + |C2| the error is ≤ 7e-15 for μ ≤ 2.7 and ≤ 7e-14 up to μ = 100,
-//! for |θ| ≤ 1.5 and up to 1.5705 alike (requirement: 1e-12 and 1e-9). One evaluation is a `sin_cos`, for
-//! |s| > ½ a `ln`, and four Horner sums of 34 terms run as eight independent chains: about 35–50 ns on
-//! the development machine, no allocation.
+//! Evaluated by two exact series, about s = 0 and about s = 1, matched at a split; the method and its
+//! measured accuracy are in physics §6, "Evaluating y_e and y_o".
 
 use super::params::CoinParams;
 use super::state::State;
@@ -56,11 +12,8 @@ use thiserror::Error;
 /// |s| at which the two expansions meet for μ ≤ [`MU_SPLIT_FIXED`]: both series variables, t = s² and
 /// x = (1 − |s|)/2, are ≤ ¼ there, so both series converge like 4⁻ⁿ.
 const SPLIT_SIN: f64 = 0.5;
-/// Above this μ the split moves towards s = 1. The basis u₁, u₂ about s = 1 grows like exp(√μ (π/2 − θ))
-/// towards s = 0 with both members alike, so matching at θ_split costs about exp(2√μ (π/2 − θ_split)) in
-/// conditioning; the split is placed where √μ (π/2 − θ_split) equals its value at μ = 4, θ_split = π/6
-/// (a factor ≈ 70, so a few units of 1e-15), and the series about s = 0, whose terms are all positive and
-/// lose nothing, takes more terms instead.
+/// Above this μ the split moves towards s = 1, keeping √μ (π/2 − θ_split) at its value for μ = 4,
+/// θ_split = π/6: matching there costs a factor ≈ 70 in conditioning (physics §6).
 const MU_SPLIT_FIXED: f64 = 4.0;
 /// The first dropped term, at the largest series variable, is below this fraction of the sum of the
 /// magnitudes of the terms, and the terms have been decreasing for [`DECREASING_RUN`] steps (so the
@@ -70,13 +23,13 @@ const TRUNCATION: f64 = 1e-18;
 const DECREASING_RUN: usize = 2;
 /// A hard bound on the series length (μ ≤ [`MU_MAX`] needs about 1000 at most).
 const MAX_TERMS: usize = 20_000;
-/// Largest μ accepted (no real body comes near: see the module doc). The tests cover μ = 20 and μ = 100.
-pub const MU_MAX: f64 = 100.0;
+/// Largest μ accepted (every real body has μ < 2). The tests cover μ = 20 and μ = 100.
+const MU_MAX: f64 = 100.0;
 
 /// Why the integrals cannot be built for these parameters.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum InvariantsError {
-    /// μ is larger than [`MU_MAX`].
+    /// μ is larger than 100 (`max`).
     #[error(
         "μ = I_Z·Ma²/(I_X·(I_Z + Ma²)) = {mu} is above {max}, where C1, C2 cannot be evaluated accurately; \
          every real body has I_Z ≤ 2·I_X and μ < 2, so check inertia_x and inertia_z"
@@ -84,7 +37,7 @@ pub enum InvariantsError {
     MuTooLarge {
         /// The parameters' μ.
         mu: f64,
-        /// The largest accepted μ ([`MU_MAX`]).
+        /// The largest accepted μ, 100.
         max: f64,
     },
 }
@@ -125,8 +78,7 @@ struct Connection {
 /// C1, C2 for one set of body parameters: the series coefficients and connection constants, computed once.
 ///
 /// ```
-/// use coin_log::model::CoinParams;
-/// use coin_log::model::invariants::Chaplygin;
+/// use coin_log::model::{Chaplygin, CoinParams};
 /// let chaplygin = Chaplygin::new(&CoinParams::unit_disk()).unwrap();
 /// // Upright (s = 0): y_e = 1, y_o = 0, y_e′ = 0, y_o′ = 1, k = 3/2, so C1 = ω_Z and C2 = ω_Y / k.
 /// let c = chaplygin.evaluate(0.0, 0.6, 1.5);
@@ -151,7 +103,7 @@ impl Chaplygin {
     /// Precomputes the expansions of physics §6 for `params`.
     ///
     /// # Errors
-    /// [`InvariantsError::MuTooLarge`] if μ > [`MU_MAX`] (no real body; see there).
+    /// [`InvariantsError::MuTooLarge`] if μ > 100 (no real body).
     pub fn new(params: &CoinParams) -> Result<Self, InvariantsError> {
         let ma2 = params.ma2();
         let iz = params.inertia_z();

@@ -6,14 +6,14 @@ mod dissipation;
 pub mod drift;
 mod equations;
 pub mod fit;
-pub mod invariants;
+mod invariants;
 pub mod nutation;
 mod params;
 pub mod quadrature;
 mod stability;
 mod state;
 mod steady;
-pub mod turning_points;
+mod turning_points;
 
 pub use derived::{centre, contact_point, energy, orientation, reaction, Energy, Reaction};
 pub use dissipation::{

@@ -2,13 +2,10 @@
 //! the turning points, the nutation period and the heading advance per period are one-dimensional
 //! integrals.
 //!
-//! Beyond physics §10: U(θ) − U(θ₀) within `SHORT_RANGE` of θ₀, and f near a turning point once found,
-//! are 16-point Gauss–Legendre integrals of S = dU/dθ rather than differences of two O(U) values. Turning
-//! points are found by a geometric scan outwards from θ₀ and bisection to adjacent floats. Times to an
-//! event (flat landing, lift-off) are adaptive Gauss–Legendre integrals along the path, leg by leg, in v
-//! with θ = r + (θ₁ − r) v² from a turning point r; the escape from near upright is in closed form up to
-//! a matching angle (physics §12). The extremes of N and |F|/N: a scan of 257 points refined by golden
-//! section.
+//! Beyond physics §10 ("Precision") and §12 ("Quadrature"): turning points by a geometric scan outwards
+//! from θ₀ and bisection to adjacent floats; times to an event leg by leg, by adaptive Gauss–Legendre in v
+//! with θ = r + (θ₁ − r) v² from a turning point r; the extremes of N and |F|/N by a scan of 257 points
+//! refined by golden section.
 
 use super::derived::{energy, reaction};
 use super::equations::Coin;
@@ -159,12 +156,10 @@ impl Orbit {
                 limit,
             });
         }
-        if is_steady(coin, state) {
-            return Ok(Self::steady(coin, chaplygin, state));
-        }
-        let mut reduced = Reduced::new(coin, chaplygin, state, limit);
         let mut orbit = Self::steady(coin, chaplygin, state);
-        reduced.fill(&mut orbit);
+        if !is_steady(coin, state) {
+            Reduced::new(coin, chaplygin, state, limit).fill(&mut orbit);
+        }
         Ok(orbit)
     }
 

@@ -6,7 +6,7 @@
 /// guesses; Abramowitz & Stegun 25.4.29). The nodes come in decreasing order.
 #[must_use]
 #[allow(clippy::cast_precision_loss)]
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+pub(super) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let nf = n as f64;
     (1..=n)
         .map(|i| {
@@ -56,20 +56,14 @@ const MAX_EVALUATIONS: usize = 200_000;
 /// of magnitude; where it does not shrink by at least `NOISE_RATIO`, the difference is the integrand's
 /// rounding noise, which no further halving removes, and the panel is accepted.
 #[derive(Debug, Clone)]
-pub struct Adaptive {
+pub(super) struct Adaptive {
     coarse: Vec<(f64, f64)>,
     fine: Vec<(f64, f64)>,
 }
 
-impl Default for Adaptive {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
 /// The result of [`Adaptive::integrate`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Integral {
+pub(super) struct Integral {
     /// The integral (the sum of the fine rule over the accepted panels).
     pub value: f64,
     /// The sum of |coarse − fine| over the accepted panels: an error bound in practice.
@@ -79,9 +73,8 @@ pub struct Integral {
 }
 
 impl Adaptive {
-    /// The two rules.
     #[must_use]
-    pub fn new() -> Self {
+    pub(super) fn new() -> Self {
         Self {
             coarse: gauss_legendre(COARSE),
             fine: gauss_legendre(FINE),
@@ -89,7 +82,7 @@ impl Adaptive {
     }
 
     /// ∫ₐᵇ f to the relative tolerance `rtol` of ∫ₐᵇ |f| (estimated from a first pass).
-    pub fn integrate(&self, f: &impl Fn(f64) -> f64, a: f64, b: f64, rtol: f64) -> Integral {
+    pub(super) fn integrate(&self, f: &impl Fn(f64) -> f64, a: f64, b: f64, rtol: f64) -> Integral {
         let mut out = Integral {
             value: 0.0,
             error: 0.0,

@@ -17,8 +17,7 @@ use crate::format::{
     log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
-use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, CoinParams, Dynamics, Inertia};
+use crate::model::{Chaplygin, Coin, CoinParams, Dynamics, Inertia};
 use crate::scene::{self, Scene};
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
 use std::collections::{BTreeMap, BTreeSet};

@@ -14,8 +14,7 @@ pub use crate::model::drift::Worst as Max;
 
 use super::samples::Sample;
 use crate::format::{ResultMetadata, RunMetadata};
-use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, Dynamics, Steady};
+use crate::model::{Chaplygin, Coin, Dynamics, Steady};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
