@@ -18,7 +18,7 @@ use crate::format::{
     FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
 use crate::model::invariants::Chaplygin;
-use crate::model::{Coin, CoinParams, Dynamics, Inertia};
+use crate::model::{Coin, Dynamics};
 use crate::scene::{self, Scene};
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
 use std::collections::{BTreeMap, BTreeSet};
@@ -171,22 +171,11 @@ impl Judge {
             ));
             return;
         }
-        let params = CoinParams::new(
-            run.mass,
-            run.radius,
-            run.gravity,
-            Inertia::Explicit {
-                inertia_x: run.inertia_x,
-                inertia_z: run.inertia_z,
-            },
-        );
-        let params = match params {
+        let params = match run.params() {
             Ok(p) => p,
-            Err(errors) => {
-                let list: Vec<String> = errors.iter().map(ToString::to_string).collect();
+            Err(e) => {
                 self.run_error = Some(format!(
-                    "its `coin-log` metadata has unusable body parameters: {}",
-                    list.join("; ")
+                    "its `coin-log` metadata has unusable body parameters: {e}"
                 ));
                 return;
             }
