@@ -131,8 +131,13 @@ pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
     }
 }
 
-/// What the readers need of every `coin_log.*` message type.
+/// What the recorder and the readers need of every `coin_log.*` message type.
 pub trait Message: Copy + serde::de::DeserializeOwned {
+    /// Appends this message to `buf` in `encoding`.
+    ///
+    /// # Errors
+    /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+    fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField>;
     /// The message of the field values `v` in schema order (0 past its end); without the added fields
     /// when `first` (a schema of the type's first version).
     fn from_values(v: &[f64], first: bool) -> Self;
@@ -143,13 +148,15 @@ pub trait Message: Copy + serde::de::DeserializeOwned {
     fn t(&self) -> f64;
 }
 
-/// Defines a message type. Fields listed under `added` came with a later version of the schema (docs/format.md
+/// Defines a message type (a field without a doc is the one of format.md's table, `t` the simulation
+/// time). Fields listed under `added` came with a later version of the schema (docs/format.md
 /// says which): they are `Option<f64>`, `None` in messages of files written before them, and the recorder
 /// always writes them.
 macro_rules! message {
     ($(#[$doc:meta])* $name:ident, $schema:literal, { $($(#[$fdoc:meta])* $field:ident),+ $(,)? }
      $(added { $($(#[$adoc:meta])* $added:ident),+ $(,)? })?) => {
         $(#[$doc])*
+        #[allow(missing_docs)]
         #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
         #[serde(deny_unknown_fields)]
         pub struct $name {
@@ -189,18 +196,6 @@ macro_rules! message {
                     }
                 )+)?
                 Ok(())
-            }
-
-            /// Appends this message to `buf` in `encoding`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
-            #[inline]
-            pub fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
-                match encoding {
-                    Encoding::Json => self.write_json(buf),
-                    Encoding::Protobuf => self.write_protobuf(buf),
-                }
             }
 
             /// Appends this message in Protobuf to `buf`: every field as a double numbered by its place in the
@@ -254,6 +249,14 @@ macro_rules! message {
         }
 
         impl Message for $name {
+            #[inline]
+            fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+                match encoding {
+                    Encoding::Json => self.write_json(buf),
+                    Encoding::Protobuf => self.write_protobuf(buf),
+                }
+            }
+
             #[allow(unused_variables)]
             fn from_values(v: &[f64], first: bool) -> Self {
                 let mut it = v.iter().copied();
@@ -277,20 +280,15 @@ macro_rules! message {
 message!(
     /// `/coin/omega`: ω in the lean frame [rad/time].
     AngularVelocity, "coin_log.AngularVelocity", {
-    /// Simulation time.
     t,
-    /// ω_X.
     x,
-    /// ω_Y.
     y,
-    /// ω_Z.
     z,
 });
 
 message!(
     /// `/coin/angles`: θ, φ, ψ \[rad\], φ and ψ unwrapped.
     Angles, "coin_log.Angles", {
-    /// Simulation time.
     t,
     /// θ, lean.
     theta,
@@ -306,41 +304,29 @@ message!(
 message!(
     /// `/coin/quaternion`: q of physics §1.
     QuaternionMessage, "coin_log.Quaternion", {
-    /// Simulation time.
     t,
-    /// Vector part x.
     x,
-    /// Vector part y.
     y,
-    /// Vector part z.
     z,
-    /// Scalar part.
     w,
 });
 
 message!(
     /// `/coin/position` (centre) and `/coin/contact` (contact point), world frame, y up \[length\].
     Position, "coin_log.Position", {
-    /// Simulation time.
     t,
-    /// x.
     x,
     /// y (height).
     y,
-    /// z.
     z,
 });
 
 message!(
     /// `/coin/reaction`: R (world frame), F and N \[force\].
     ReactionMessage, "coin_log.Reaction", {
-    /// Simulation time.
     t,
-    /// R_x.
     x,
-    /// R_y.
     y,
-    /// R_z.
     z,
     /// F = √(R_x² + R_z²).
     friction,
@@ -354,13 +340,9 @@ message!(
 message!(
     /// `/coin/energy` [mass·length²/time²].
     EnergyMessage, "coin_log.Energy", {
-    /// Simulation time.
     t,
-    /// Total energy.
     total,
-    /// Kinetic energy.
     kinetic,
-    /// Potential energy.
     potential,
 } added {
     /// E − E₀, E₀ the total energy at the first sample of the file.
@@ -373,18 +355,14 @@ message!(
 message!(
     /// `/coin/invariants`: C1, C2 of physics §6.
     InvariantsMessage, "coin_log.Invariants", {
-    /// Simulation time.
     t,
-    /// C1.
     c1,
-    /// C2.
     c2,
 });
 
 message!(
     /// `/coin/work`: the dissipated work and the energy balance (physics §11) [mass·length²/time²].
     WorkMessage, "coin_log.Work", {
-    /// Simulation time.
     t,
     /// W, the energy dissipated since t = 0.
     dissipated,

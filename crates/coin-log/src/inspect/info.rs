@@ -292,7 +292,10 @@ fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
 
 fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
     let (run, result) = records(&s.metadata);
-    let scene = run.as_ref().ok().and_then(|r| toml::from_str(&r.scene).ok());
+    let scene = run
+        .as_ref()
+        .ok()
+        .and_then(|r| toml::from_str(&r.scene).ok());
     FileInfo {
         file_size: s.file_len,
         library: s.library,

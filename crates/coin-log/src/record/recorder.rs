@@ -7,7 +7,7 @@
 use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
-    drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
+    drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Message,
     NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::promise::{self, Shortfall};
@@ -287,14 +287,10 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
 
     /// Formats one message into the sample's batch (an error abandons the sample).
     #[inline]
-    fn stage(
-        &mut self,
-        channel: Channel,
-        format: impl FnOnce(&mut Vec<u8>) -> Result<(), NonFiniteField>,
-    ) -> Result<(), SampleError> {
-        let mut formatted = Ok(());
+    fn stage(&mut self, channel: Channel, m: impl Message) -> Result<(), SampleError> {
+        let (encoding, mut formatted) = (self.out.encoding, Ok(()));
         self.batch
-            .push(Topic::Main(channel), |b| formatted = format(b));
+            .push(Topic::Main(channel), |b| formatted = m.write(encoding, b));
         Ok(formatted?)
     }
 
@@ -330,7 +326,6 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// follows in place of E (physics §11).
     #[inline]
     fn stage_work(&mut self, t: f64, total: f64, work: f64) -> Result<f64, SampleError> {
-        let encoding = self.out.encoding;
         let balance = total + work;
         if self.on(Channel::Work) {
             let m = WorkMessage {
@@ -338,7 +333,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 dissipated: work,
                 balance,
             };
-            self.stage(Channel::Work, |b| m.write(encoding, b))?;
+            self.stage(Channel::Work, m)?;
         }
         Ok(balance)
     }
@@ -346,7 +341,6 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
     #[inline]
     fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
-        let encoding = self.out.encoding;
         let coin = self.coin;
         if self.on(Channel::Omega) {
             let m = AngularVelocity {
@@ -355,7 +349,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 y: s.omega_y,
                 z: s.omega_z,
             };
-            self.stage(Channel::Omega, |b| m.write(encoding, b))?;
+            self.stage(Channel::Omega, m)?;
         }
         if self.on(Channel::Angles) {
             let m = Angles {
@@ -365,7 +359,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 psi: s.psi,
                 phi_dot: Some(s.omega_y / s.theta.cos()),
             };
-            self.stage(Channel::Angles, |b| m.write(encoding, b))?;
+            self.stage(Channel::Angles, m)?;
         }
         if self.on(Channel::Quaternion) {
             let q = orientation(s);
@@ -376,7 +370,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 z: q.k,
                 w: q.w,
             };
-            self.stage(Channel::Quaternion, |b| m.write(encoding, b))?;
+            self.stage(Channel::Quaternion, m)?;
         }
         let points = [
             (Channel::Position, centre as fn(&_, &_) -> _),
@@ -391,7 +385,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                     y: c.y,
                     z: c.z,
                 };
-                self.stage(channel, |b| m.write(encoding, b))?;
+                self.stage(channel, m)?;
             }
         }
         Ok(())
@@ -406,7 +400,6 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         s: &State,
     ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
         let coin = self.coin;
-        let encoding = self.out.encoding;
         if self.on(Channel::Reaction) {
             let r = self.dynamics.reaction(s);
             let p = coin.params();
@@ -419,7 +412,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 normal: r.normal,
                 friction_ratio: Some(friction_ratio(r.friction, r.normal, p.mass(), p.gravity())),
             };
-            self.stage(Channel::Reaction, |b| m.write(encoding, b))?;
+            self.stage(Channel::Reaction, m)?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
         let e = energy(&coin, s);
@@ -433,7 +426,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 change: Some(e.total - e0),
                 drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
             };
-            self.stage(Channel::Energy, |b| m.write(encoding, b))?;
+            self.stage(Channel::Energy, m)?;
         }
         let invariants = self.chaplygin.as_ref().map(|c| c.of_state(s));
         if let Some(c) = invariants {
@@ -442,7 +435,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 c1: c.c1,
                 c2: c.c2,
             };
-            self.stage(Channel::Invariants, |b| m.write(encoding, b))?;
+            self.stage(Channel::Invariants, m)?;
         }
         Ok((e.total, invariants.map(|c| (c.c1, c.c2))))
     }
