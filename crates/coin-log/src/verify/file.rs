@@ -263,10 +263,11 @@ impl Visitor for Judge {
         message_encoding: &str,
         schema: Option<&Schema<'_>>,
     ) {
+        let known = Topic::from_name(topic);
         // A topic of fixed wire form (the CDR robot description) is judged by that form, not by the file's.
-        let fixed = Topic::from_name(topic).filter(|t| *t == Topic::RerunRobot);
-        let mut judged = match (schema, fixed) {
-            (Some(s), Some(_)) => {
+        let fixed = known == Some(Topic::RerunRobot);
+        let mut judged = match schema {
+            Some(s) if fixed => {
                 let (encoding, data, _) = ROS_STRING_WIRE;
                 if (s.encoding.as_str(), &s.data[..]) != (encoding, data) {
                     self.problems.push_with(|| {
@@ -275,10 +276,10 @@ impl Visitor for Judge {
                 }
                 SchemaJudged::default()
             }
-            (Some(s), None) => self.schema(s),
-            (None, _) => SchemaJudged::default(),
+            Some(s) => self.schema(s),
+            None => SchemaJudged::default(),
         };
-        let kind = match Topic::from_name(topic) {
+        let kind = match known {
             None => {
                 self.problems
                     .push_with(|| format!("topic `{topic}` is not one of coin-log's"));
@@ -294,9 +295,10 @@ impl Visitor for Judge {
                         )
                     });
                 }
-                let expected = match fixed {
-                    Some(_) => ROS_STRING_WIRE.2,
-                    None => judged.encoding.unwrap_or_default().message_encoding(),
+                let expected = if fixed {
+                    ROS_STRING_WIRE.2
+                } else {
+                    judged.encoding.unwrap_or_default().message_encoding()
                 };
                 if message_encoding != expected {
                     self.problems.push_with(|| {
@@ -305,7 +307,7 @@ impl Visitor for Judge {
                 }
                 match t.channel().message_type() {
                     // The robot description is CDR, whatever the file's encoding: its schema is judged.
-                    _ if fixed.is_some() => Kind::Unknown,
+                    _ if fixed => Kind::Unknown,
                     Some(m) => {
                         let c = t.channel();
                         self.assembler.declare(c);
