@@ -148,18 +148,6 @@ pub trait Tap {
     fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]);
 }
 
-/// A tap lent to a recording, so that the caller reads its state afterwards.
-impl<T: Tap + ?Sized> Tap for &mut T {
-    #[inline]
-    fn channel(&mut self, info: &ChannelDeclaration) {
-        (**self).channel(info);
-    }
-    #[inline]
-    fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]) {
-        (**self).message(topic, log_time, data);
-    }
-}
-
 /// The tap of a plain recording: sees nothing (and costs nothing: it is inlined away).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoTap;
@@ -173,16 +161,16 @@ impl Tap for NoTap {
 
 /// The writer with its topics: registers a topic's MCAP channel at its first message, numbers messages per
 /// topic, and shows both to the tap.
-struct Output<W: Write + Seek, T: Tap> {
+struct Output<'t, W: Write + Seek, T: Tap> {
     writer: McapWriter<W>,
-    tap: T,
+    tap: &'t mut T,
     encoding: Encoding,
     ids: [Option<u16>; Topic::COUNT],
     sequence: [u32; Topic::COUNT],
     messages: u64,
 }
 
-impl<W: Write + Seek, T: Tap> Output<W, T> {
+impl<W: Write + Seek, T: Tap> Output<'_, W, T> {
     #[inline]
     fn write(&mut self, topic: Topic, log_time: u64, data: &[u8]) -> Result<(), SampleError> {
         let index = topic.index();
@@ -261,8 +249,8 @@ impl Drift {
 }
 
 /// Everything a sample needs, built once.
-struct Sampler<W: Write + Seek, T: Tap> {
-    out: Output<W, T>,
+struct Sampler<'t, W: Write + Seek, T: Tap> {
+    out: Output<'t, W, T>,
     coin: Coin,
     /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
     dynamics: Dynamics,
@@ -279,7 +267,7 @@ struct Sampler<W: Write + Seek, T: Tap> {
     samples: u64,
 }
 
-impl<W: Write + Seek, T: Tap> Sampler<W, T> {
+impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
     #[inline]
     fn on(&self, channel: Channel) -> bool {
         self.on[channel as usize]
@@ -481,10 +469,11 @@ pub fn record<W: Write + Seek>(
     stop: &AtomicBool,
     progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
-    record_with_tap(scene, options, writer, NoTap, stop, progress)
+    record_with_tap(scene, options, writer, &mut NoTap, stop, progress)
 }
 
-/// [`record`], showing every channel and message to `tap` as it is written.
+/// [`record`], showing every channel and message to `tap` as it is written (lent, so that the caller reads
+/// its state afterwards).
 ///
 /// # Errors
 /// As [`record`].
@@ -492,7 +481,7 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
     scene: &Scene,
     options: &RecordOptions,
     writer: W,
-    tap: T,
+    tap: &mut T,
     stop: &AtomicBool,
     progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
@@ -567,7 +556,7 @@ fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Fai
 /// stopped writing, if one did.
 fn integrate_into<W: Write + Seek, T: Tap>(
     scene: &Scene,
-    sampler: &mut Sampler<W, T>,
+    sampler: &mut Sampler<'_, W, T>,
     stop: &AtomicBool,
     mut progress: impl FnMut(f64),
 ) -> (RunOutcome, Option<SampleError>) {
@@ -626,14 +615,14 @@ fn integrate_into<W: Write + Seek, T: Tap>(
     (outcome, error)
 }
 
-impl<W: Write + Seek, T: Tap> Sampler<W, T> {
+impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
     /// Opens the file: writer, `coin-log` metadata, and what each sample will compute. A body whose C1, C2
     /// cannot be evaluated fails here, before the first byte, so no half-written file is left.
     fn start(
         scene: &Scene,
         options: &RecordOptions,
         writer: W,
-        tap: T,
+        tap: &'t mut T,
     ) -> Result<Self, RecordError> {
         let dynamics = scene.dynamics();
         let coin = *dynamics.coin();
