@@ -563,3 +563,107 @@ fn a_numerical_failure_finishes_the_file_with_the_samples_up_to_it() {
         "the sample at t = 0 is in the file"
     );
 }
+
+/// The message types alone: strict reading, exact writing, the fields in schema order.
+mod messages {
+    use coin_log::format::messages::{
+        Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Message, Position,
+        QuaternionMessage, ReactionMessage,
+    };
+
+    #[test]
+    fn messages_round_trip_bit_for_bit_through_json() {
+        let m = EnergyMessage {
+            t: 0.01,
+            total: 1.0 / 3.0,
+            kinetic: -0.0,
+            potential: 1e-300,
+            change: Some(-2.5e-17),
+            drift_eps: Some(-3.0),
+        };
+        let mut buf = Vec::new();
+        m.write_json(&mut buf).unwrap();
+        let back: EnergyMessage = serde_json::from_slice(&buf).unwrap();
+        assert_eq!(format!("{back:?}"), format!("{m:?}"));
+        assert_eq!(back.total.to_bits(), m.total.to_bits());
+        assert_eq!(back.change.map(f64::to_bits), m.change.map(f64::to_bits));
+    }
+
+    #[test]
+    fn a_message_of_the_first_version_parses_without_its_added_fields_and_writes_back_the_same() {
+        let old = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1}"#;
+        let m: EnergyMessage = serde_json::from_str(old).unwrap();
+        assert_eq!(m.change, None);
+        assert!(!m.is_complete());
+        let mut buf = Vec::new();
+        m.write_json(&mut buf).unwrap();
+        assert_eq!(
+            String::from_utf8(buf).unwrap(),
+            r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1.0}"#
+        );
+        // An added field is a number: `null` is refused, not read as absent.
+        let null = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1,"change":null}"#;
+        assert!(serde_json::from_str::<EnergyMessage>(null).is_err());
+        assert_eq!(
+            EnergyMessage::FIELDS,
+            &["t", "total", "kinetic", "potential", "change", "drift_eps"]
+        );
+        assert_eq!(
+            EnergyMessage::FIRST_FIELDS,
+            &["t", "total", "kinetic", "potential"]
+        );
+    }
+
+    /// The readers' fast path reads the fields in the order the recorder writes them.
+    #[test]
+    fn the_fields_are_in_schema_order() {
+        for (fields, expected) in [
+            (AngularVelocity::FIELDS, &["t", "x", "y", "z"][..]),
+            (Position::FIELDS, &["t", "x", "y", "z"]),
+            (Angles::FIELDS, &["t", "theta", "phi", "psi", "phi_dot"]),
+            (QuaternionMessage::FIELDS, &["t", "x", "y", "z", "w"]),
+            (InvariantsMessage::FIELDS, &["t", "c1", "c2"]),
+            (
+                ReactionMessage::FIELDS,
+                &["t", "x", "y", "z", "friction", "normal", "friction_ratio"],
+            ),
+        ] {
+            assert_eq!(fields, expected);
+        }
+    }
+
+    /// A NaN field, or an infinite added one, is refused by name and leaves the buffer alone.
+    #[test]
+    fn non_finite_numbers_are_refused_and_leave_the_buffer_alone() {
+        let omega = AngularVelocity {
+            t: 0.0,
+            x: f64::NAN,
+            y: 0.0,
+            z: 0.0,
+        };
+        let reaction = ReactionMessage {
+            t: 0.0,
+            x: 0.0,
+            y: 1.0,
+            z: 0.0,
+            friction: 0.0,
+            normal: 1.0,
+            friction_ratio: Some(f64::INFINITY),
+        };
+        let mut buf = b"x".to_vec();
+        assert_eq!(omega.write_json(&mut buf).unwrap_err().field, "x");
+        assert_eq!(
+            reaction.write_json(&mut buf).unwrap_err().field,
+            "friction_ratio"
+        );
+        assert_eq!(buf, b"x");
+    }
+
+    #[test]
+    fn unknown_and_missing_fields_are_rejected() {
+        assert!(
+            serde_json::from_str::<InvariantsMessage>(r#"{"t":0,"c1":1,"c2":2,"c3":3}"#).is_err()
+        );
+        assert!(serde_json::from_str::<InvariantsMessage>(r#"{"t":0,"c1":1}"#).is_err());
+    }
+}

@@ -131,8 +131,13 @@ pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
     }
 }
 
-/// What the readers need of every `coin_log.*` message type.
+/// What the recorder and the readers need of every `coin_log.*` message type.
 pub trait Message: Copy + serde::de::DeserializeOwned {
+    /// Appends this message to `buf` in `encoding`.
+    ///
+    /// # Errors
+    /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+    fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField>;
     /// The message of the field values `v` in schema order (0 past its end); without the added fields
     /// when `first` (a schema of the type's first version).
     fn from_values(v: &[f64], first: bool) -> Self;
@@ -143,13 +148,15 @@ pub trait Message: Copy + serde::de::DeserializeOwned {
     fn t(&self) -> f64;
 }
 
-/// Defines a message type. Fields listed under `added` came with a later version of the schema (docs/format.md
+/// Defines a message type (a field without a doc is the one of format.md's table, `t` the simulation
+/// time). Fields listed under `added` came with a later version of the schema (docs/format.md
 /// says which): they are `Option<f64>`, `None` in messages of files written before them, and the recorder
 /// always writes them.
 macro_rules! message {
     ($(#[$doc:meta])* $name:ident, $schema:literal, { $($(#[$fdoc:meta])* $field:ident),+ $(,)? }
      $(added { $($(#[$adoc:meta])* $added:ident),+ $(,)? })?) => {
         $(#[$doc])*
+        #[allow(missing_docs)]
         #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
         #[serde(deny_unknown_fields)]
         pub struct $name {
@@ -189,18 +196,6 @@ macro_rules! message {
                     }
                 )+)?
                 Ok(())
-            }
-
-            /// Appends this message to `buf` in `encoding`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
-            #[inline]
-            pub fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
-                match encoding {
-                    Encoding::Json => self.write_json(buf),
-                    Encoding::Protobuf => self.write_protobuf(buf),
-                }
             }
 
             /// Appends this message in Protobuf to `buf`: every field as a double numbered by its place in the
@@ -254,6 +249,14 @@ macro_rules! message {
         }
 
         impl Message for $name {
+            #[inline]
+            fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+                match encoding {
+                    Encoding::Json => self.write_json(buf),
+                    Encoding::Protobuf => self.write_protobuf(buf),
+                }
+            }
+
             #[allow(unused_variables)]
             fn from_values(v: &[f64], first: bool) -> Self {
                 let mut it = v.iter().copied();
@@ -277,20 +280,15 @@ macro_rules! message {
 message!(
     /// `/coin/omega`: ω in the lean frame [rad/time].
     AngularVelocity, "coin_log.AngularVelocity", {
-    /// Simulation time.
     t,
-    /// ω_X.
     x,
-    /// ω_Y.
     y,
-    /// ω_Z.
     z,
 });
 
 message!(
     /// `/coin/angles`: θ, φ, ψ \[rad\], φ and ψ unwrapped.
     Angles, "coin_log.Angles", {
-    /// Simulation time.
     t,
     /// θ, lean.
     theta,
@@ -306,41 +304,29 @@ message!(
 message!(
     /// `/coin/quaternion`: q of physics §1.
     QuaternionMessage, "coin_log.Quaternion", {
-    /// Simulation time.
     t,
-    /// Vector part x.
     x,
-    /// Vector part y.
     y,
-    /// Vector part z.
     z,
-    /// Scalar part.
     w,
 });
 
 message!(
     /// `/coin/position` (centre) and `/coin/contact` (contact point), world frame, y up \[length\].
     Position, "coin_log.Position", {
-    /// Simulation time.
     t,
-    /// x.
     x,
     /// y (height).
     y,
-    /// z.
     z,
 });
 
 message!(
     /// `/coin/reaction`: R (world frame), F and N \[force\].
     ReactionMessage, "coin_log.Reaction", {
-    /// Simulation time.
     t,
-    /// R_x.
     x,
-    /// R_y.
     y,
-    /// R_z.
     z,
     /// F = √(R_x² + R_z²).
     friction,
@@ -354,13 +340,9 @@ message!(
 message!(
     /// `/coin/energy` [mass·length²/time²].
     EnergyMessage, "coin_log.Energy", {
-    /// Simulation time.
     t,
-    /// Total energy.
     total,
-    /// Kinetic energy.
     kinetic,
-    /// Potential energy.
     potential,
 } added {
     /// E − E₀, E₀ the total energy at the first sample of the file.
@@ -373,126 +355,17 @@ message!(
 message!(
     /// `/coin/invariants`: C1, C2 of physics §6.
     InvariantsMessage, "coin_log.Invariants", {
-    /// Simulation time.
     t,
-    /// C1.
     c1,
-    /// C2.
     c2,
 });
 
 message!(
     /// `/coin/work`: the dissipated work and the energy balance (physics §11) [mass·length²/time²].
     WorkMessage, "coin_log.Work", {
-    /// Simulation time.
     t,
     /// W, the energy dissipated since t = 0.
     dissipated,
     /// E + W, constant for an exact solution.
     balance,
 });
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn messages_round_trip_bit_for_bit_through_json() {
-        let m = EnergyMessage {
-            t: 0.01,
-            total: 1.0 / 3.0,
-            kinetic: -0.0,
-            potential: 1e-300,
-            change: Some(-2.5e-17),
-            drift_eps: Some(-3.0),
-        };
-        let mut buf = Vec::new();
-        m.write_json(&mut buf).unwrap();
-        let back: EnergyMessage = serde_json::from_slice(&buf).unwrap();
-        assert_eq!(format!("{back:?}"), format!("{m:?}"));
-        assert_eq!(back.total.to_bits(), m.total.to_bits());
-        assert_eq!(back.change.map(f64::to_bits), m.change.map(f64::to_bits));
-    }
-
-    #[test]
-    fn a_message_of_the_first_version_parses_without_its_added_fields_and_writes_back_the_same() {
-        let old = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1}"#;
-        let m: EnergyMessage = serde_json::from_str(old).unwrap();
-        assert_eq!(m.change, None);
-        assert!(!m.is_complete());
-        let mut buf = Vec::new();
-        m.write_json(&mut buf).unwrap();
-        assert_eq!(
-            String::from_utf8(buf).unwrap(),
-            r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1.0}"#
-        );
-        // An added field is a number: `null` is refused, not read as absent.
-        let null = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1,"change":null}"#;
-        assert!(serde_json::from_str::<EnergyMessage>(null).is_err());
-        assert_eq!(
-            EnergyMessage::FIELDS,
-            &["t", "total", "kinetic", "potential", "change", "drift_eps"]
-        );
-        assert_eq!(
-            EnergyMessage::FIRST_FIELDS,
-            &["t", "total", "kinetic", "potential"]
-        );
-    }
-
-    /// The readers' fast path reads the fields in the order the recorder writes them.
-    #[test]
-    fn the_fields_are_in_schema_order() {
-        for (fields, expected) in [
-            (AngularVelocity::FIELDS, &["t", "x", "y", "z"][..]),
-            (Position::FIELDS, &["t", "x", "y", "z"]),
-            (Angles::FIELDS, &["t", "theta", "phi", "psi", "phi_dot"]),
-            (QuaternionMessage::FIELDS, &["t", "x", "y", "z", "w"]),
-            (InvariantsMessage::FIELDS, &["t", "c1", "c2"]),
-            (
-                ReactionMessage::FIELDS,
-                &["t", "x", "y", "z", "friction", "normal", "friction_ratio"],
-            ),
-        ] {
-            assert_eq!(fields, expected);
-        }
-    }
-
-    #[test]
-    fn a_non_finite_added_field_is_refused() {
-        let m = ReactionMessage {
-            t: 0.0,
-            x: 0.0,
-            y: 1.0,
-            z: 0.0,
-            friction: 0.0,
-            normal: 1.0,
-            friction_ratio: Some(f64::INFINITY),
-        };
-        let mut buf = Vec::new();
-        assert_eq!(m.write_json(&mut buf).unwrap_err().field, "friction_ratio");
-        assert!(buf.is_empty());
-    }
-
-    #[test]
-    fn non_finite_numbers_are_refused_and_leave_the_buffer_alone() {
-        let mut buf = b"x".to_vec();
-        let err = AngularVelocity {
-            t: 0.0,
-            x: f64::NAN,
-            y: 0.0,
-            z: 0.0,
-        }
-        .write_json(&mut buf)
-        .unwrap_err();
-        assert_eq!(err.field, "x");
-        assert_eq!(buf, b"x");
-    }
-
-    #[test]
-    fn unknown_and_missing_fields_are_rejected() {
-        assert!(
-            serde_json::from_str::<InvariantsMessage>(r#"{"t":0,"c1":1,"c2":2,"c3":3}"#).is_err()
-        );
-        assert!(serde_json::from_str::<InvariantsMessage>(r#"{"t":0,"c1":1}"#).is_err());
-    }
-}

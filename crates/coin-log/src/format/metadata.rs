@@ -5,7 +5,7 @@
 
 use super::Termination;
 use crate::integrate::Method;
-use crate::model::{Dissipation, DissipationModel, SteadyFamily};
+use crate::model::{CoinParams, Dissipation, DissipationModel, Inertia, SteadyFamily};
 use std::collections::BTreeMap;
 
 /// Name of the metadata record written before the first message.
@@ -281,6 +281,23 @@ record! {
         pub r_c: Option<f64>,
         optional:
         pub dissipation: Option<Dissipation>,
+    }
+}
+
+impl RunMetadata {
+    /// The body the record stores.
+    ///
+    /// # Errors
+    /// Each parameter that is unusable, joined by "; ".
+    pub fn params(&self) -> Result<CoinParams, String> {
+        let inertia = Inertia::Explicit {
+            inertia_x: self.inertia_x,
+            inertia_z: self.inertia_z,
+        };
+        CoinParams::new(self.mass, self.radius, self.gravity, inertia).map_err(|errors| {
+            let list: Vec<String> = errors.iter().map(ToString::to_string).collect();
+            list.join("; ")
+        })
     }
 }
 

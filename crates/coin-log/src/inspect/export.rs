@@ -99,7 +99,7 @@ fn join_failed(e: &str) -> ExportError {
     ))
 }
 
-/// What each channel id is exported as./// What each channel id is exported as.
+/// What each channel id is exported as.
 #[derive(Clone, Copy)]
 enum Target {
     /// A `coin_log.*` channel: its table (per channel) or its place in the wide row, and the index of

@@ -283,12 +283,6 @@ fn records(
     (run, result)
 }
 
-fn scene_of(run: &Result<RunMetadata, String>) -> Option<SceneFile> {
-    run.as_ref()
-        .ok()
-        .and_then(|r| toml::from_str::<SceneFile>(&r.scene).ok())
-}
-
 /// (n − 1) / span in messages per second.
 #[allow(clippy::cast_precision_loss)]
 fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
@@ -298,7 +292,10 @@ fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
 
 fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
     let (run, result) = records(&s.metadata);
-    let scene = scene_of(&run);
+    let scene = run
+        .as_ref()
+        .ok()
+        .and_then(|r| toml::from_str(&r.scene).ok());
     FileInfo {
         file_size: s.file_len,
         library: s.library,
@@ -380,8 +377,6 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
         Some(e) => Some(e.detail),
         None => None,
     };
-    let (run, result) = records(&v.metadata);
-    let scene = scene_of(&run);
     let channels = v
         .channels
         .into_iter()
@@ -391,19 +386,22 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
             c
         })
         .collect();
-    Ok(FileInfo {
-        file_size: s.file_len,
+    let summary = coin_log_mcap::Summary {
+        file_len: s.file_len,
         library: s.library,
-        source: Source::Scan,
         messages: s.messages,
         time_range: v.time_range,
+        channels: Vec::new(),
         chunks: s.chunks,
         compressions: s.compressions,
-        chunk_bytes: (s.compressed_bytes, s.uncompressed_bytes),
+        compressed_bytes: s.compressed_bytes,
+        uncompressed_bytes: s.uncompressed_bytes,
+        metadata: v.metadata,
+    };
+    Ok(FileInfo {
+        source: Source::Scan,
         channels,
-        run,
-        result,
-        scene,
         problem,
+        ..from_summary(summary)
     })
 }

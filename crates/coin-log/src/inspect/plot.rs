@@ -8,7 +8,7 @@ use crate::format::{
     Channel, ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::model::drift::{EnergyDrift, InvariantDrift};
-use crate::model::{CoinParams, Inertia};
+use crate::model::CoinParams;
 use crate::palette::{
     legend_box, legend_line, svg_page, Area, DrawError, BLUE, GREEN, GREY, ORANGE, RED,
 };
@@ -249,16 +249,9 @@ impl Collect {
     fn run_metadata(&mut self, entries: &BTreeMap<String, String>) {
         let run = RunMetadata::from_map(entries).map_err(|e| e.to_string());
         if let Ok(r) = &run {
-            let inertia = Inertia::Explicit {
-                inertia_x: r.inertia_x,
-                inertia_z: r.inertia_z,
-            };
-            match CoinParams::new(r.mass, r.radius, r.gravity, inertia) {
+            match r.params() {
                 Ok(p) => self.params = Some(p),
-                Err(e) => {
-                    let list: Vec<String> = e.iter().map(ToString::to_string).collect();
-                    self.problem = Some(format!("unusable body parameters: {}", list.join("; ")));
-                }
+                Err(e) => self.problem = Some(format!("unusable body parameters: {e}")),
             }
         }
         self.run = Some(run);

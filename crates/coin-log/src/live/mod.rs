@@ -174,11 +174,6 @@ impl LiveServer {
         self.handle.client_count()
     }
 
-    /// Tells every viewer the simulation's time \[ns\].
-    fn broadcast_time(&self, log_time: u64) {
-        self.handle.broadcast_time(log_time);
-    }
-
     /// Closes every connection and stops serving.
     pub fn stop(self) {
         self.handle.stop().wait_blocking();

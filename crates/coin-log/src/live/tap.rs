@@ -139,7 +139,7 @@ impl<'a, F: FnMut(LiveEvent)> LiveTap<'a, F> {
         let first = match self.times {
             None => {
                 self.times = Some((log_time, log_time));
-                self.server.broadcast_time(log_time);
+                self.server.handle.broadcast_time(log_time);
                 return;
             }
             Some((first, _)) => first,
@@ -151,7 +151,7 @@ impl<'a, F: FnMut(LiveEvent)> LiveTap<'a, F> {
         };
         let deadline = start.checked_add(self.pacing.wall_offset(log_time.saturating_sub(first)));
         self.sleep_until(deadline);
-        self.server.broadcast_time(log_time);
+        self.server.handle.broadcast_time(log_time);
     }
 
     fn start_clock(&mut self) -> Instant {

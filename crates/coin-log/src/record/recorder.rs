@@ -7,7 +7,7 @@
 use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
-    drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage,
+    drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Message,
     NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::promise::{self, Shortfall};
@@ -148,18 +148,6 @@ pub trait Tap {
     fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]);
 }
 
-/// A tap lent to a recording, so that the caller reads its state afterwards.
-impl<T: Tap + ?Sized> Tap for &mut T {
-    #[inline]
-    fn channel(&mut self, info: &ChannelDeclaration) {
-        (**self).channel(info);
-    }
-    #[inline]
-    fn message(&mut self, topic: Topic, log_time: u64, data: &[u8]) {
-        (**self).message(topic, log_time, data);
-    }
-}
-
 /// The tap of a plain recording: sees nothing (and costs nothing: it is inlined away).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoTap;
@@ -173,16 +161,16 @@ impl Tap for NoTap {
 
 /// The writer with its topics: registers a topic's MCAP channel at its first message, numbers messages per
 /// topic, and shows both to the tap.
-struct Output<W: Write + Seek, T: Tap> {
+struct Output<'t, W: Write + Seek, T: Tap> {
     writer: McapWriter<W>,
-    tap: T,
+    tap: &'t mut T,
     encoding: Encoding,
     ids: [Option<u16>; Topic::COUNT],
     sequence: [u32; Topic::COUNT],
     messages: u64,
 }
 
-impl<W: Write + Seek, T: Tap> Output<W, T> {
+impl<W: Write + Seek, T: Tap> Output<'_, W, T> {
     #[inline]
     fn write(&mut self, topic: Topic, log_time: u64, data: &[u8]) -> Result<(), SampleError> {
         let index = topic.index();
@@ -261,8 +249,8 @@ impl Drift {
 }
 
 /// Everything a sample needs, built once.
-struct Sampler<W: Write + Seek, T: Tap> {
-    out: Output<W, T>,
+struct Sampler<'t, W: Write + Seek, T: Tap> {
+    out: Output<'t, W, T>,
     coin: Coin,
     /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
     dynamics: Dynamics,
@@ -279,7 +267,7 @@ struct Sampler<W: Write + Seek, T: Tap> {
     samples: u64,
 }
 
-impl<W: Write + Seek, T: Tap> Sampler<W, T> {
+impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
     #[inline]
     fn on(&self, channel: Channel) -> bool {
         self.on[channel as usize]
@@ -287,14 +275,10 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
 
     /// Formats one message into the sample's batch (an error abandons the sample).
     #[inline]
-    fn stage(
-        &mut self,
-        channel: Channel,
-        format: impl FnOnce(&mut Vec<u8>) -> Result<(), NonFiniteField>,
-    ) -> Result<(), SampleError> {
-        let mut formatted = Ok(());
+    fn stage(&mut self, channel: Channel, m: impl Message) -> Result<(), SampleError> {
+        let (encoding, mut formatted) = (self.out.encoding, Ok(()));
         self.batch
-            .push(Topic::Main(channel), |b| formatted = format(b));
+            .push(Topic::Main(channel), |b| formatted = m.write(encoding, b));
         Ok(formatted?)
     }
 
@@ -330,7 +314,6 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// follows in place of E (physics §11).
     #[inline]
     fn stage_work(&mut self, t: f64, total: f64, work: f64) -> Result<f64, SampleError> {
-        let encoding = self.out.encoding;
         let balance = total + work;
         if self.on(Channel::Work) {
             let m = WorkMessage {
@@ -338,7 +321,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 dissipated: work,
                 balance,
             };
-            self.stage(Channel::Work, |b| m.write(encoding, b))?;
+            self.stage(Channel::Work, m)?;
         }
         Ok(balance)
     }
@@ -346,7 +329,6 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
     /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
     #[inline]
     fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
-        let encoding = self.out.encoding;
         let coin = self.coin;
         if self.on(Channel::Omega) {
             let m = AngularVelocity {
@@ -355,7 +337,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 y: s.omega_y,
                 z: s.omega_z,
             };
-            self.stage(Channel::Omega, |b| m.write(encoding, b))?;
+            self.stage(Channel::Omega, m)?;
         }
         if self.on(Channel::Angles) {
             let m = Angles {
@@ -365,7 +347,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 psi: s.psi,
                 phi_dot: Some(s.omega_y / s.theta.cos()),
             };
-            self.stage(Channel::Angles, |b| m.write(encoding, b))?;
+            self.stage(Channel::Angles, m)?;
         }
         if self.on(Channel::Quaternion) {
             let q = orientation(s);
@@ -376,7 +358,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 z: q.k,
                 w: q.w,
             };
-            self.stage(Channel::Quaternion, |b| m.write(encoding, b))?;
+            self.stage(Channel::Quaternion, m)?;
         }
         let points = [
             (Channel::Position, centre as fn(&_, &_) -> _),
@@ -391,7 +373,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                     y: c.y,
                     z: c.z,
                 };
-                self.stage(channel, |b| m.write(encoding, b))?;
+                self.stage(channel, m)?;
             }
         }
         Ok(())
@@ -406,7 +388,6 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
         s: &State,
     ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
         let coin = self.coin;
-        let encoding = self.out.encoding;
         if self.on(Channel::Reaction) {
             let r = self.dynamics.reaction(s);
             let p = coin.params();
@@ -419,7 +400,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 normal: r.normal,
                 friction_ratio: Some(friction_ratio(r.friction, r.normal, p.mass(), p.gravity())),
             };
-            self.stage(Channel::Reaction, |b| m.write(encoding, b))?;
+            self.stage(Channel::Reaction, m)?;
         }
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
         let e = energy(&coin, s);
@@ -433,7 +414,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 change: Some(e.total - e0),
                 drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
             };
-            self.stage(Channel::Energy, |b| m.write(encoding, b))?;
+            self.stage(Channel::Energy, m)?;
         }
         let invariants = self.chaplygin.as_ref().map(|c| c.of_state(s));
         if let Some(c) = invariants {
@@ -442,7 +423,7 @@ impl<W: Write + Seek, T: Tap> Sampler<W, T> {
                 c1: c.c1,
                 c2: c.c2,
             };
-            self.stage(Channel::Invariants, |b| m.write(encoding, b))?;
+            self.stage(Channel::Invariants, m)?;
         }
         Ok((e.total, invariants.map(|c| (c.c1, c.c2))))
     }
@@ -488,10 +469,11 @@ pub fn record<W: Write + Seek>(
     stop: &AtomicBool,
     progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
-    record_with_tap(scene, options, writer, NoTap, stop, progress)
+    record_with_tap(scene, options, writer, &mut NoTap, stop, progress)
 }
 
-/// [`record`], showing every channel and message to `tap` as it is written.
+/// [`record`], showing every channel and message to `tap` as it is written (lent, so that the caller reads
+/// its state afterwards).
 ///
 /// # Errors
 /// As [`record`].
@@ -499,7 +481,7 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
     scene: &Scene,
     options: &RecordOptions,
     writer: W,
-    tap: T,
+    tap: &mut T,
     stop: &AtomicBool,
     progress: impl FnMut(f64),
 ) -> Result<RecordSummary, RecordError> {
@@ -574,7 +556,7 @@ fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Fai
 /// stopped writing, if one did.
 fn integrate_into<W: Write + Seek, T: Tap>(
     scene: &Scene,
-    sampler: &mut Sampler<W, T>,
+    sampler: &mut Sampler<'_, W, T>,
     stop: &AtomicBool,
     mut progress: impl FnMut(f64),
 ) -> (RunOutcome, Option<SampleError>) {
@@ -633,14 +615,14 @@ fn integrate_into<W: Write + Seek, T: Tap>(
     (outcome, error)
 }
 
-impl<W: Write + Seek, T: Tap> Sampler<W, T> {
+impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
     /// Opens the file: writer, `coin-log` metadata, and what each sample will compute. A body whose C1, C2
     /// cannot be evaluated fails here, before the first byte, so no half-written file is left.
     fn start(
         scene: &Scene,
         options: &RecordOptions,
         writer: W,
-        tap: T,
+        tap: &'t mut T,
     ) -> Result<Self, RecordError> {
         let dynamics = scene.dynamics();
         let coin = *dynamics.coin();

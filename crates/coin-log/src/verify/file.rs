@@ -17,7 +17,7 @@ use crate::format::{
     log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
-use crate::model::{Chaplygin, Coin, CoinParams, Dynamics, Inertia};
+use crate::model::{Chaplygin, Coin, Dynamics};
 use crate::scene::{self, Scene};
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
 use std::collections::{BTreeMap, BTreeSet};
@@ -170,22 +170,11 @@ impl Judge {
             ));
             return;
         }
-        let params = CoinParams::new(
-            run.mass,
-            run.radius,
-            run.gravity,
-            Inertia::Explicit {
-                inertia_x: run.inertia_x,
-                inertia_z: run.inertia_z,
-            },
-        );
-        let params = match params {
+        let params = match run.params() {
             Ok(p) => p,
-            Err(errors) => {
-                let list: Vec<String> = errors.iter().map(ToString::to_string).collect();
+            Err(e) => {
                 self.run_error = Some(format!(
-                    "its `coin-log` metadata has unusable body parameters: {}",
-                    list.join("; ")
+                    "its `coin-log` metadata has unusable body parameters: {e}"
                 ));
                 return;
             }
@@ -273,10 +262,11 @@ impl Visitor for Judge {
         message_encoding: &str,
         schema: Option<&Schema<'_>>,
     ) {
+        let known = Topic::from_name(topic);
         // A topic of fixed wire form (the CDR robot description) is judged by that form, not by the file's.
-        let fixed = Topic::from_name(topic).filter(|t| *t == Topic::RerunRobot);
-        let mut judged = match (schema, fixed) {
-            (Some(s), Some(_)) => {
+        let fixed = known == Some(Topic::RerunRobot);
+        let mut judged = match schema {
+            Some(s) if fixed => {
                 let (encoding, data, _) = ROS_STRING_WIRE;
                 if (s.encoding.as_str(), &s.data[..]) != (encoding, data) {
                     self.problems.push_with(|| {
@@ -285,10 +275,10 @@ impl Visitor for Judge {
                 }
                 SchemaJudged::default()
             }
-            (Some(s), None) => self.schema(s),
-            (None, _) => SchemaJudged::default(),
+            Some(s) => self.schema(s),
+            None => SchemaJudged::default(),
         };
-        let kind = match Topic::from_name(topic) {
+        let kind = match known {
             None => {
                 self.problems
                     .push_with(|| format!("topic `{topic}` is not one of coin-log's"));
@@ -304,9 +294,10 @@ impl Visitor for Judge {
                         )
                     });
                 }
-                let expected = match fixed {
-                    Some(_) => ROS_STRING_WIRE.2,
-                    None => judged.encoding.unwrap_or_default().message_encoding(),
+                let expected = if fixed {
+                    ROS_STRING_WIRE.2
+                } else {
+                    judged.encoding.unwrap_or_default().message_encoding()
                 };
                 if message_encoding != expected {
                     self.problems.push_with(|| {
@@ -315,7 +306,7 @@ impl Visitor for Judge {
                 }
                 match t.channel().message_type() {
                     // The robot description is CDR, whatever the file's encoding: its schema is judged.
-                    _ if fixed.is_some() => Kind::Unknown,
+                    _ if fixed => Kind::Unknown,
                     Some(m) => {
                         let c = t.channel();
                         self.assembler.declare(c);

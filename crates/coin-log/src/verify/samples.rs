@@ -50,20 +50,17 @@ impl Sample {
         })
     }
 
-    /// Takes `channel`'s message from `o`.
-    fn set(&mut self, channel: Channel, o: &Sample) {
-        match channel {
-            Channel::Omega => self.omega = o.omega,
-            Channel::Angles => self.angles = o.angles,
-            Channel::Quaternion => self.quaternion = o.quaternion,
-            Channel::Position => self.position = o.position,
-            Channel::Contact => self.contact = o.contact,
-            Channel::Reaction => self.reaction = o.reaction,
-            Channel::Energy => self.energy = o.energy,
-            Channel::Invariants => self.invariants = o.invariants,
-            Channel::Work => self.work = o.work,
-            Channel::Tf | Channel::Scene | Channel::Rerun => {}
-        }
+    /// Takes the messages of `o` (one channel's) that `self` lacks.
+    fn merge(&mut self, o: &Sample) {
+        self.omega = self.omega.or(o.omega);
+        self.angles = self.angles.or(o.angles);
+        self.quaternion = self.quaternion.or(o.quaternion);
+        self.position = self.position.or(o.position);
+        self.contact = self.contact.or(o.contact);
+        self.reaction = self.reaction.or(o.reaction);
+        self.energy = self.energy.or(o.energy);
+        self.invariants = self.invariants.or(o.invariants);
+        self.work = self.work.or(o.work);
     }
 }
 
@@ -99,7 +96,7 @@ impl Assembler {
                 let s = &mut self.pending[i];
                 if s.present & bit == 0 {
                     s.present |= bit;
-                    s.set(channel, one);
+                    s.merge(one);
                 }
             }
             _ => {

@@ -162,12 +162,13 @@ impl ConsistencyCheck {
                 None => format!("{what} {}", fmt_num(*value)),
             })
             .collect();
-        let Some((value, tolerance, which)) = worst(&measures) else {
+        let Some((first, rest)) = measures.split_first() else {
             return CheckResult::skip(
                 CheckId::Consistency,
                 "no pair of channels to compare (needs /coin/angles with /coin/quaternion, /coin/position or /coin/reaction)",
             );
         };
+        let (value, tolerance, which) = worst(*first, rest);
         CheckResult::measured(
             CheckId::Consistency,
             value,

@@ -75,13 +75,8 @@ impl EnergyCheck {
         };
         let drift = energy_drift.value();
         let agreement = self.agreement.value / energy_drift.scale;
-        let mut measures = vec![(drift, tol.energy, "drift")];
-        if self.stored > 0 {
-            measures.push((agreement, RECOMPUTE_TOLERANCE, "agreement"));
-        }
-        let Some((value, tolerance, which)) = worst(&measures) else {
-            return CheckResult::skip(CheckId::Energy, "nothing measured");
-        };
+        let agreed = (self.stored > 0).then_some((agreement, RECOMPUTE_TOLERANCE, "agreement"));
+        let (value, tolerance, which) = worst((drift, tol.energy, "drift"), agreed.as_slice());
         let stored = if self.stored > 0 {
             let what = if self.last_work.is_some() {
                 "/coin/energy and the /coin/work balance differ from E and E + W recomputed"

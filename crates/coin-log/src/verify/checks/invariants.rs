@@ -62,13 +62,8 @@ impl InvariantsCheck {
         } else {
             "|C1_0| + |C2_0|"
         };
-        let mut measures = vec![(drift, tol.energy, "drift")];
-        if self.stored > 0 {
-            measures.push((agreement, RECOMPUTE_TOLERANCE, "agreement"));
-        }
-        let Some((value, tolerance, which)) = worst(&measures) else {
-            return CheckResult::skip(CheckId::Invariants, "nothing measured");
-        };
+        let agreed = (self.stored > 0).then_some((agreement, RECOMPUTE_TOLERANCE, "agreement"));
+        let (value, tolerance, which) = worst((drift, tol.energy, "drift"), agreed.as_slice());
         CheckResult::measured(
             CheckId::Invariants,
             value,

@@ -69,9 +69,10 @@ impl RunStats {
     }
 }
 
-/// The worst of several (value, tolerance, label) measures: the one with the largest value/tolerance.
+/// The worst of `first` and `rest`, (value, tolerance, label) measures: the one with the largest
+/// value/tolerance (the last of equals).
 #[must_use]
-pub fn worst<'a>(measures: &[(f64, f64, &'a str)]) -> Option<(f64, f64, &'a str)> {
+pub fn worst<'a>(first: (f64, f64, &'a str), rest: &[(f64, f64, &'a str)]) -> (f64, f64, &'a str) {
     let ratio = |m: &(f64, f64, &str)| {
         if m.0.is_nan() {
             f64::INFINITY
@@ -79,10 +80,13 @@ pub fn worst<'a>(measures: &[(f64, f64, &'a str)]) -> Option<(f64, f64, &'a str)
             m.0 / m.1
         }
     };
-    measures
-        .iter()
-        .copied()
-        .max_by(|a, b| ratio(a).total_cmp(&ratio(b)))
+    rest.iter().copied().fold(first, |w, m| {
+        if ratio(&m).total_cmp(&ratio(&w)).is_ge() {
+            m
+        } else {
+            w
+        }
+    })
 }
 
 /// Shortest readable form of a number for reasons: 3 significant digits.

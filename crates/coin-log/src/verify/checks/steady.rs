@@ -159,14 +159,14 @@ impl SteadyCheck {
         let a = p.radius();
         let omega_scale = self.max_omega.max(1.0 / p.time_unit());
         let acc_scale = self.max_omega * self.max_omega + p.topple_rate_squared();
+        let rhs = (self.acceleration.value / acc_scale, tol.residual, "rhs");
+        let meta_dev = metadata_deviation(ctx, steady, omega_scale);
         let mut measures = vec![
-            (self.acceleration.value / acc_scale, tol.residual, "rhs"),
             (self.theta.value, tol.residual, "theta"),
             (self.omega.value / omega_scale, tol.residual, "omega"),
+            (meta_dev, tol.residual, "metadata"),
         ];
         let mut notes = Vec::new();
-        let meta_dev = metadata_deviation(ctx, steady, omega_scale);
-        measures.push((meta_dev, tol.residual, "metadata"));
         let arc = self.phi_range.map_or(0.0, |(lo, hi)| hi - lo);
         for (fit, expected, name) in [
             (&self.centre, steady.r_g, "R_G"),
@@ -176,9 +176,7 @@ impl SteadyCheck {
             measures.extend(measure.map(|m| (m, tol.residual, name)));
             notes.push(format!("{name}: {note}"));
         }
-        let Some((value, tolerance, which)) = worst(&measures) else {
-            return CheckResult::skip(CheckId::Steady, "nothing measured");
-        };
+        let (value, tolerance, which) = worst(rhs, &measures);
         CheckResult::measured(
             CheckId::Steady,
             value,
