@@ -8,6 +8,7 @@
 //! The tools are installed by `scripts/test`; a missing one fails the test (never skips it).
 
 use crate::support::other_writers::{node_readers, python};
+use crate::support::process::run_tool;
 use crate::support::record::coin_log_text;
 use crate::support::writers::{record_circle, Damage};
 use crate::support::{dataset_files, repo};
@@ -16,26 +17,19 @@ use std::process::Command;
 
 /// Runs both readers on `files`; returns (success, output) of each.
 fn run_readers(files: &[PathBuf]) -> [(bool, String); 2] {
-    let node = Command::new("node")
-        .arg(node_readers().join("check.mjs"))
-        .args(files)
-        .output()
-        .unwrap_or_else(|e| {
-            panic!("cannot run `node` ({e}): install Node.js 20 and run scripts/test")
-        });
-    let py = Command::new(python())
-        .arg(repo().join("scripts/readers/check.py"))
-        .args(files)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
-    [node, py].map(|o| {
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        (o.status.success(), text)
-    })
+    let node = run_tool(
+        Command::new("node")
+            .arg(node_readers().join("check.mjs"))
+            .args(files),
+        "install Node.js 20 and run scripts/test",
+    );
+    let py = run_tool(
+        Command::new(python())
+            .arg(repo().join("scripts/readers/check.py"))
+            .args(files),
+        "run scripts/test",
+    );
+    [node, py].map(|o| (o.status.success(), o.stdout + &o.stderr))
 }
 
 #[test]
@@ -105,17 +99,14 @@ fn python_reads_the_exported_tables_bit_for_bit() {
         String::from_utf8_lossy(&out.stderr)
     );
     let check = |what: &str| {
-        let o = Command::new(python())
-            .arg(repo().join("scripts/readers/check_export.py"))
-            .arg(&path)
-            .arg(dir.path().join("t"))
-            .output()
-            .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
+        let o = run_tool(
+            Command::new(python())
+                .arg(repo().join("scripts/readers/check_export.py"))
+                .arg(&path)
+                .arg(dir.path().join("t")),
+            "run scripts/test",
         );
+        let text = format!("{}{}", o.stdout, o.stderr);
         println!("--- check_export.py ({what})\n{text}");
         (o.status.success(), text)
     };

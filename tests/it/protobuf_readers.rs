@@ -17,13 +17,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use crate::support::other_writers::{node_readers, python};
+use crate::support::process::{run_tool, Tool};
 use crate::support::record::{coin_log_text, read_messages, scene_names};
 use crate::support::repo;
 use crate::support::writers::rewrite_protobuf;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 /// Simulated time of each recording: every channel and topic is written at t = 0 and then at the scene's
 /// rate, so one time unit gives tens to a thousand messages per channel and keeps the test to seconds.
@@ -60,36 +61,25 @@ struct ReaderRun {
 
 /// Runs the Python and the Node Protobuf readers on `files` (at once), dumping into `dump`.
 fn run_readers(files: &[PathBuf], dump: &Path) -> [ReaderRun; 2] {
-    let spawn = |program: PathBuf, script: PathBuf, what: &str| {
-        Command::new(program)
-            .arg(script)
-            .arg("--dump")
-            .arg(dump)
-            .args(files)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap_or_else(|e| panic!("cannot run {what} ({e}): run scripts/test"))
+    let command = |program: PathBuf, script: PathBuf| {
+        let mut c = Command::new(program);
+        c.arg(script).arg("--dump").arg(dump).args(files);
+        c
     };
-    let py = spawn(
-        python(),
-        repo().join("scripts/readers/protobuf_check.py"),
-        "the venv's python",
-    );
-    let node = spawn(
+    let mut py = command(python(), repo().join("scripts/readers/protobuf_check.py"));
+    let mut node = command(
         PathBuf::from("node"),
         node_readers().join("protobuf_check.mjs"),
-        "`node` (install Node.js 20)",
     );
-    [py, node].map(|child| {
-        let o = child.wait_with_output().unwrap();
+    [
+        Tool::start(&mut py, "run scripts/test"),
+        Tool::start(&mut node, "install Node.js 20 and run scripts/test"),
+    ]
+    .map(|tool| {
+        let o = tool.finish();
         ReaderRun {
             ok: o.status.success(),
-            text: format!(
-                "{}{}",
-                String::from_utf8_lossy(&o.stdout),
-                String::from_utf8_lossy(&o.stderr)
-            ),
+            text: o.stdout + &o.stderr,
         }
     })
 }
@@ -559,16 +549,17 @@ fn a_truncated_message_or_a_wrong_descriptor_fails_both_readers_and_one_ulp_fail
 
 /// Runs `rerun_check.py` (`rerun mcap convert`, then the .rrd read back with the Rerun SDK) on `file`.
 fn rerun(file: &Path, rrd: &Path) -> Value {
-    let o = Command::new(python())
-        .arg(repo().join("scripts/readers/rerun_check.py"))
-        .arg(file)
-        .arg(rrd)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
-    let err = String::from_utf8_lossy(&o.stderr);
+    let o = run_tool(
+        Command::new(python())
+            .arg(repo().join("scripts/readers/rerun_check.py"))
+            .arg(file)
+            .arg(rrd),
+        "run scripts/test",
+    );
+    let err = &o.stderr;
     assert!(o.status.success(), "rerun_check.py failed:\n{err}");
     println!("--- rerun_check.py\n{err}");
-    serde_json::from_slice(&o.stdout)
+    serde_json::from_str(&o.stdout)
         .unwrap_or_else(|e| panic!("rerun_check.py printed no JSON ({e})"))
 }
 
@@ -742,27 +733,20 @@ fn rerun_converts_a_recording_into_the_coins_transforms_and_numeric_series() {
 fn the_rerun_blueprint_is_one_rerun_accepts() {
     let dir = tempfile::tempdir().unwrap();
     let rbl = dir.path().join("coin-log.rbl");
-    let o = Command::new(python())
-        .arg(repo().join("scripts/rerun_blueprint.py"))
-        .arg(&rbl)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run_tool(
+        Command::new(python())
+            .arg(repo().join("scripts/rerun_blueprint.py"))
+            .arg(&rbl),
+        "run scripts/test",
+    );
+    assert!(o.status.success(), "{}", o.stderr);
     let rerun = python().with_file_name("rerun");
     let verify = |path: &Path| {
-        let o = Command::new(&rerun)
-            .args(["rrd", "verify"])
-            .arg(path)
-            .output()
-            .unwrap_or_else(|e| panic!("cannot run {} ({e}): run scripts/test", rerun.display()));
-        (
-            o.status.success(),
-            format!(
-                "{}{}",
-                String::from_utf8_lossy(&o.stdout),
-                String::from_utf8_lossy(&o.stderr)
-            ),
-        )
+        let o = run_tool(
+            Command::new(&rerun).args(["rrd", "verify"]).arg(path),
+            "run scripts/test",
+        );
+        (o.status.success(), o.stdout + &o.stderr)
     };
     let (ok, text) = verify(&rbl);
     assert!(ok, "rerun rrd verify refused the blueprint:\n{text}");

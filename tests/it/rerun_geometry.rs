@@ -7,6 +7,7 @@
 //! want of the geometry.
 
 use crate::support::other_writers::python;
+use crate::support::process::run_tool;
 use crate::support::record::coin_log_text;
 use crate::support::repo;
 use serde_json::Value;
@@ -22,17 +23,15 @@ fn geometry(mcap: &Path, rrd: &Path, shift: bool) -> (i32, Option<Value>, String
     if shift {
         c.arg("--shift");
     }
-    let o = c
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the venv's python ({e}): run scripts/test"));
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let o = run_tool(&mut c, "run scripts/test");
+    let err = o.stderr.clone();
     println!(
         "--- rerun_geometry.py{}\n{err}",
         if shift { " --shift" } else { "" }
     );
     (
         o.status.code().unwrap_or(-1),
-        serde_json::from_slice(&o.stdout).ok(),
+        serde_json::from_str(&o.stdout).ok(),
         err,
     )
 }

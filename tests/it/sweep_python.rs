@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use crate::support::other_writers::python;
+use crate::support::process::run_tool;
 use crate::support::repo;
 use crate::sweep::{run_in, Csv};
 use std::process::Command;
@@ -43,14 +44,14 @@ fn the_python_example_picks_the_toppled_runs_and_reads_a_channel_of_one() {
         })
         .unwrap();
     let script = repo().join("examples/sweep_catalogue.py");
-    let run = Command::new(python())
-        .arg(&script)
-        .arg("lean-sweep")
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    let stderr = String::from_utf8_lossy(&run.stderr);
+    let run = run_tool(
+        Command::new(python())
+            .arg(&script)
+            .arg("lean-sweep")
+            .current_dir(dir.path()),
+        "run scripts/test",
+    );
+    let (stdout, stderr) = (&run.stdout, &run.stderr);
     println!("{stdout}{stderr}");
     assert!(run.status.success(), "examples/sweep_catalogue.py failed (is pandas in the venv? scripts/test installs scripts/requirements.txt): {stderr}");
     assert!(

@@ -6,10 +6,11 @@
 //! shared by the tests that read them.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use super::process;
 use super::record::record_scene;
 use super::repo;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::sync::OnceLock;
 
 /// The venv's Python (`scripts/test` creates it with the pinned `mcap` package).
@@ -112,7 +113,7 @@ pub fn rewrites() -> &'static Rewrites {
     REWRITES.get_or_init(make)
 }
 
-fn spawn(layout: &Layout, original: &Path, target: &Path) -> Child {
+fn command(layout: &Layout, original: &Path, target: &Path) -> Command {
     let mut command = match layout.tool {
         Tool::Python => {
             let mut c = Command::new(python());
@@ -125,19 +126,8 @@ fn spawn(layout: &Layout, original: &Path, target: &Path) -> Child {
             c
         }
     };
+    command.arg(original).arg(target).args(layout.args);
     command
-        .arg(original)
-        .arg(target)
-        .args(layout.args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| {
-            panic!(
-                "cannot run the {:?} rewriter ({e}): run scripts/test",
-                layout.tool
-            )
-        })
 }
 
 fn make() -> Rewrites {
@@ -145,25 +135,35 @@ fn make() -> Rewrites {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let original = record_scene(&dir, "circle-plus", &["--duration", "6"]);
-    let running: Vec<(&'static Layout, PathBuf, Child)> = LAYOUTS
+    let mut commands: Vec<(&'static Layout, PathBuf, Command)> = LAYOUTS
         .iter()
         .chain(DEFECTIVE)
         .map(|l| {
             let path = dir.join(format!("{}.mcap", l.name));
-            let child = spawn(l, &original, &path);
-            (l, path, child)
+            let command = command(l, &original, &path);
+            (l, path, command)
+        })
+        .collect();
+    let running: Vec<_> = commands
+        .iter_mut()
+        .map(|(l, path, command)| {
+            (
+                *l,
+                path.clone(),
+                process::Tool::start(command, "run scripts/test"),
+            )
         })
         .collect();
     let files = running
         .into_iter()
-        .map(|(l, path, child)| {
-            let out = child.wait_with_output().unwrap();
+        .map(|(l, path, tool)| {
+            let out = tool.finish();
             assert!(
                 out.status.success(),
                 "rewriting as {}: {}{}",
                 l.name,
-                String::from_utf8_lossy(&out.stdout),
-                String::from_utf8_lossy(&out.stderr)
+                out.stdout,
+                out.stderr
             );
             (l, path)
         })

@@ -60,17 +60,18 @@ fn read_lines(
 impl Process {
     /// Starts `command` with its standard output and error piped.
     pub fn start(command: &mut Command) -> Self {
-        Self::spawn(command, None)
+        Self::spawn(command, None, "")
     }
 
     /// Starts `command` like [`Process::start`]; its standard error also comes line by line on the receiver.
     #[cfg_attr(not(feature = "live"), allow(dead_code, reason = "live.rs's"))]
     pub fn start_with_stderr_lines(command: &mut Command) -> (Self, Receiver<String>) {
         let (tx, rx) = channel();
-        (Self::spawn(command, Some(tx)), rx)
+        (Self::spawn(command, Some(tx), ""), rx)
     }
 
-    fn spawn(command: &mut Command, lines: Option<Sender<String>>) -> Self {
+    /// `hint` follows the error if the program cannot start (what to install).
+    fn spawn(command: &mut Command, lines: Option<Sender<String>>, hint: &str) -> Self {
         let words: Vec<String> = std::iter::once(command.get_program())
             .chain(command.get_args())
             .map(|w| w.to_string_lossy().into_owned())
@@ -80,7 +81,7 @@ impl Process {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
-            .unwrap_or_else(|e| panic!("cannot start `{command_line}`: {e}"));
+            .unwrap_or_else(|e| panic!("cannot start `{command_line}`: {e}{hint}"));
         let (stdout, stderr) = Default::default();
         let readers = vec![
             read_lines(child.stdout.take().unwrap(), &stdout, None),
@@ -108,6 +109,19 @@ impl Process {
     /// Waits for the child to exit and for its output; kills it and fails the test, with what it printed,
     /// if it still runs after `deadline`.
     pub fn wait_within(&mut self, deadline: Duration) -> Finished {
+        self.wait_or_kill(deadline).unwrap_or_else(|| {
+            panic!(
+                "`{}` still ran after {deadline:?}: it hangs\nstdout:\n{}\nstderr:\n{}",
+                self.command,
+                self.stdout.lock().unwrap(),
+                self.stderr()
+            )
+        })
+    }
+
+    /// Waits for the child to exit and for its output; `None` if it still ran after `deadline`, and was
+    /// killed.
+    fn wait_or_kill(&mut self, deadline: Duration) -> Option<Finished> {
         let start = Instant::now();
         let status = loop {
             if let Some(status) = self.child.try_wait().unwrap() {
@@ -121,23 +135,18 @@ impl Process {
                 while self.readers.iter().any(|r| !r.is_finished()) && Instant::now() < end {
                     std::thread::sleep(Duration::from_millis(5));
                 }
-                panic!(
-                    "`{}` still ran after {deadline:?}: it hangs\nstdout:\n{}\nstderr:\n{}",
-                    self.command,
-                    self.stdout.lock().unwrap(),
-                    self.stderr()
-                );
+                return None;
             }
             std::thread::sleep(Duration::from_millis(5));
         };
         for reader in self.readers.drain(..) {
             reader.join().unwrap();
         }
-        Finished {
+        Some(Finished {
             status,
             stdout: self.stdout.lock().unwrap().clone(),
             stderr: self.stderr(),
-        }
+        })
     }
 }
 
@@ -151,6 +160,51 @@ impl Drop for Process {
 /// Runs `command` to its end within `deadline` (see [`Process::wait_within`]).
 pub fn run_within(command: &mut Command, deadline: Duration) -> Finished {
     Process::start(command).wait_within(deadline)
+}
+
+/// How long an external tool (Python, Node, Rerun) may run: its heaviest call takes under a minute on a
+/// loaded 2-core machine.
+const TOOL_DEADLINE: Duration = Duration::from_secs(300);
+
+/// An external tool started, to be finished by [`Tool::finish`].
+pub struct Tool<'a> {
+    command: &'a mut Command,
+    process: Process,
+}
+
+impl<'a> Tool<'a> {
+    /// Starts `command`; `hint` (e.g. "run scripts/test") follows the error if it cannot start.
+    pub fn start(command: &'a mut Command, hint: &str) -> Self {
+        let process = Process::spawn(command, None, &format!(": {hint}"));
+        Self { command, process }
+    }
+
+    /// Waits for the tool. One still running after [`TOOL_DEADLINE`] is killed and run once more:
+    /// Node 20 can hang in its own shutdown after its work is done (nodejs/node#64274; CI saw
+    /// `rewrite.mjs` sit in futex waits for ten minutes once). A second hang fails the test.
+    pub fn finish(self) -> Finished {
+        self.finish_within(TOOL_DEADLINE)
+    }
+
+    fn finish_within(mut self, deadline: Duration) -> Finished {
+        if let Some(done) = self.process.wait_or_kill(deadline) {
+            return done;
+        }
+        eprintln!(
+            "`{}` still ran after {deadline:?}: killed, running it once more",
+            self.process.command
+        );
+        run_within(self.command, deadline)
+    }
+}
+
+/// Runs an external tool to its end (see [`Tool::finish`]).
+#[cfg_attr(
+    not(feature = "external-readers"),
+    allow(dead_code, reason = "the external readers' tests'")
+)]
+pub fn run_tool(command: &mut Command, hint: &str) -> Finished {
+    Tool::start(command, hint).finish()
 }
 
 /// The negative control: a child still running at its deadline is killed at once, and the test fails
@@ -180,4 +234,33 @@ fn a_child_past_its_deadline_is_killed_and_fails_with_what_it_printed() {
         (done.code(), &*done.stdout, &*done.stderr),
         (3, "out\n", "err\n")
     );
+}
+
+/// A tool that hangs once is run again and its second run counts; one that hangs twice fails the test.
+#[test]
+fn a_tool_that_hangs_once_runs_again_and_one_that_hangs_twice_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let mark = dir.path().join("ran");
+    let script = format!(
+        "if [ -e {0} ]; then echo second; else touch {0}; exec sleep 30; fi",
+        mark.display()
+    );
+    let mut once = Command::new("sh");
+    once.args(["-c", &script]);
+    let done = Tool::start(&mut once, "").finish_within(Duration::from_millis(500));
+    assert!(done.status.success());
+    assert_eq!(done.stdout, "second\n");
+    let failed = std::panic::catch_unwind(|| {
+        Tool::start(Command::new("sleep").arg("30"), "").finish_within(Duration::from_millis(300))
+    });
+    let message = *failed.unwrap_err().downcast::<String>().unwrap();
+    assert!(
+        message.contains("still ran after 300ms: it hangs"),
+        "{message}"
+    );
+    let missing = std::panic::catch_unwind(|| {
+        Tool::start(&mut Command::new("/nonexistent/tool"), "install it").finish()
+    });
+    let message = *missing.unwrap_err().downcast::<String>().unwrap();
+    assert!(message.ends_with(": install it"), "{message}");
 }
