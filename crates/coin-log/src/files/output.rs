@@ -431,9 +431,10 @@ impl OutputFolder {
                 Ok(m) if m.is_dir() => break,
                 Ok(_) if d == dir => {
                     return Err(OutputError(format!(
-                    "`{}` is not a folder; --out takes a folder (created if missing) for the files",
-                    shown(dir)
-                )))
+                        "`{}` is not a folder; --out takes a folder (created if missing) for the \
+                         files",
+                        shown(dir)
+                    )))
                 }
                 Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
                 Err(_) => created.push(d.to_path_buf()),
