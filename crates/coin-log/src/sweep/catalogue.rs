@@ -35,33 +35,19 @@ coin_log_names::named_enum! {
     }
 }
 
-/// The columns after the swept keys.
-pub const TRAILING_COLUMNS: [&str; 20] = [
-    "status",
-    "termination",
-    "t_end",
-    "verify",
-    "failure",
-    "reason",
-    "file",
-    "bytes",
-    "sha256",
-    "samples",
-    "messages",
-    "steps",
-    "energy_drift",
-    "invariant_drift",
-    "steady_residual",
-    "event_trusted",
-    "predicted_motion",
-    "predicted_stability",
-    "predicted_termination",
-    "wall_time_s",
-];
-
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
 pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
-    let trailing = TRAILING_COLUMNS.into_iter();
+    let blank = Row {
+        index: 0,
+        values: Vec::new(),
+        status: RunStatus::Finished,
+        failure: None,
+        reason: String::new(),
+        recorded: None,
+        prediction: None,
+        wall_time: 0.0,
+    };
+    let trailing = blank.trailing().map(|(column, _)| column);
     let columns = std::iter::once("index").chain(keys).chain(trailing);
     columns.map(str::to_string).collect()
 }
@@ -110,36 +96,47 @@ pub fn cell(value: &toml::Value) -> String {
 }
 
 impl Row {
-    /// The row's cells, in the order of [`columns`].
-    pub fn fields(&self) -> Vec<String> {
+    /// The cells after the swept keys, each with its column's name.
+    fn trailing(&self) -> [(&'static str, String); 20] {
         let r = self.recorded.as_ref();
         let s = r.map(|r| &r.summary);
         let opt = |x: Option<f64>| x.map(number).unwrap_or_default();
         let p = self.prediction.as_ref();
+        [
+            ("status", self.status.name().to_string()),
+            ("termination", text(s.map(|s| s.termination.name()))),
+            ("t_end", opt(s.map(|s| s.termination_time))),
+            (
+                "verify",
+                text(r.map(|r| r.verify.map_or("off", Verdict::name))),
+            ),
+            ("failure", text(self.failure.map(|f| f.name()))),
+            ("reason", one_line(&self.reason)),
+            ("file", text(r.map(|r| &r.file))),
+            ("bytes", text(s.map(|s| s.bytes))),
+            ("sha256", text(r.map(|r| &r.sha256))),
+            ("samples", text(s.map(|s| s.samples))),
+            ("messages", text(s.map(|s| s.messages))),
+            ("steps", text(s.map(|s| s.stats.steps))),
+            ("energy_drift", opt(s.map(|s| s.energy_drift))),
+            ("invariant_drift", opt(s.and_then(|s| s.invariant_drift))),
+            ("steady_residual", opt(s.and_then(|s| s.steady_residual))),
+            ("event_trusted", text(s.and_then(|s| s.event_trusted))),
+            ("predicted_motion", text(p.map(|p| p.motion))),
+            ("predicted_stability", text(p.and_then(|p| p.stability))),
+            (
+                "predicted_termination",
+                text(p.map(|p| p.termination.name())),
+            ),
+            ("wall_time_s", number(self.wall_time)),
+        ]
+    }
+
+    /// The row's cells, in the order of [`columns`].
+    pub fn fields(&self) -> Vec<String> {
         let mut fields = vec![self.index.to_string()];
         fields.extend(self.values.iter().cloned());
-        fields.extend([
-            self.status.name().to_string(),
-            text(s.map(|s| s.termination.name())),
-            opt(s.map(|s| s.termination_time)),
-            text(r.map(|r| r.verify.map_or("off", Verdict::name))),
-            text(self.failure.map(|f| f.name())),
-            one_line(&self.reason),
-            text(r.map(|r| &r.file)),
-            text(s.map(|s| s.bytes)),
-            text(r.map(|r| &r.sha256)),
-            text(s.map(|s| s.samples)),
-            text(s.map(|s| s.messages)),
-            text(s.map(|s| s.stats.steps)),
-            opt(s.map(|s| s.energy_drift)),
-            opt(s.and_then(|s| s.invariant_drift)),
-            opt(s.and_then(|s| s.steady_residual)),
-            text(s.and_then(|s| s.event_trusted)),
-            text(p.map(|p| p.motion)),
-            text(p.and_then(|p| p.stability)),
-            text(p.map(|p| p.termination.name())),
-            number(self.wall_time),
-        ]);
+        fields.extend(self.trailing().map(|(_, cell)| cell));
         fields
     }
 
@@ -149,7 +146,6 @@ impl Row {
     }
 }
 
-/// A cell that is empty when there is no value.
 fn text(value: Option<impl ToString>) -> String {
     value.map(|v| v.to_string()).unwrap_or_default()
 }
