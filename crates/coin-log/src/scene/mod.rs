@@ -17,8 +17,8 @@ pub use file::{
     SteadyFile,
 };
 pub use notes::{compact, Note};
-pub(crate) use overrides::other_form;
 pub use overrides::{apply_set, set_value, FlagOverrides};
+pub(crate) use overrides::{dotted, other_form};
 pub(crate) use problems::ProblemCollector;
 pub use problems::{Problem, SceneProblems};
 pub use readable::{readable_toml, Short};

@@ -47,12 +47,12 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
         reason,
     };
     let key = key.trim();
-    let parts: Vec<&str> = key.split('.').map(str::trim).collect();
-    if parts.iter().any(|p| p.is_empty()) {
+    if !dotted(key) {
         return Err(error(format!(
             "`{key}` is not a dotted key like `run.rate` or `initial.steady.kind`"
         )));
     }
+    let parts: Vec<&str> = key.split('.').map(str::trim).collect();
     let (last, path) = parts
         .split_last()
         .ok_or_else(|| error("the key is empty".into()))?;
@@ -79,6 +79,11 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
         remove(table, other);
     }
     Ok(())
+}
+
+/// True for a dotted key with no empty part (`run.rate`, not `run..rate`).
+pub(crate) fn dotted(key: &str) -> bool {
+    key.split('.').all(|p| !p.trim().is_empty())
 }
 
 /// The keys that an edit of `key` removes: the other form of the same fact, which the scene may give one

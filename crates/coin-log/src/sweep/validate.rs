@@ -10,7 +10,7 @@ use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepF
 use super::random::Distribution;
 use super::space::{linspace, logspace};
 use crate::format::Channel;
-use crate::scene::{self, presets, ProblemCollector, SceneProblems};
+use crate::scene::{self, dotted, presets, ProblemCollector, SceneProblems};
 use std::fmt::Display;
 use std::path::Path;
 use std::str::FromStr;
@@ -106,11 +106,6 @@ fn array_text(values: &[toml::Value]) -> String {
 /// How problems name the fixed edit of `key`: `set."run.duration"`.
 fn set_name(key: &str) -> String {
     format!("set.\"{key}\"")
-}
-
-/// True for a dotted key with no empty part.
-fn dotted(key: &str) -> bool {
-    !key.trim().is_empty() && key.split('.').all(|p| !p.trim().is_empty())
 }
 
 impl Checker {
