@@ -90,8 +90,19 @@ impl<'a> ProblemCollector<'a> {
         });
     }
 
-    pub(super) fn missing(&mut self, key: &str, reason: impl Into<String>) {
-        self.push(key, String::new(), reason);
+    /// Reports a problem with `key`, which then gives no value.
+    pub(crate) fn reject<T>(
+        &mut self,
+        key: impl Into<String>,
+        value: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> Option<T> {
+        self.push(key, value, reason);
+        None
+    }
+
+    pub(super) fn missing<T>(&mut self, key: &str, reason: impl Into<String>) -> Option<T> {
+        self.reject(key, String::new(), reason)
     }
 
     /// A required number: `value` when it is finite and `ok`, else NaN, `bad` or `missing` reported.
@@ -109,10 +120,7 @@ impl<'a> ProblemCollector<'a> {
                 self.push(key, number(v), bad);
                 f64::NAN
             }
-            None => {
-                self.missing(key, missing);
-                f64::NAN
-            }
+            None => self.missing(key, missing).unwrap_or(f64::NAN),
         }
     }
 

@@ -144,28 +144,22 @@ fn check_inertia(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Ine
         (Some(shape), None, None) => match shape.as_str() {
             "thin-disk" => Some(Inertia::ThinDisk),
             "hoop" => Some(Inertia::Hoop),
-            other => {
-                problems.push(
-                    "body.shape",
-                    quoted(other),
-                    "is not a known shape: use \"thin-disk\" or \"hoop\", or give inertia_x and inertia_z instead",
-                );
-                None
-            }
-        },
-        (Some(shape), _, _) => {
-            problems.push(
+            other => problems.reject(
                 "body.shape",
-                quoted(shape),
-                "is given together with inertia_x/inertia_z: give either a shape or both inertias, not both",
-            );
-            None
-        }
+                quoted(other),
+                "is not a known shape: use \"thin-disk\" or \"hoop\", or give inertia_x and inertia_z instead",
+            ),
+        },
+        (Some(shape), _, _) => problems.reject(
+            "body.shape",
+            quoted(shape),
+            "is given together with inertia_x/inertia_z: give either a shape or both inertias, not both",
+        ),
         (None, Some(ix), Some(iz)) => {
             let good =
                 problems.positive("body.inertia_x", ix) & problems.positive("body.inertia_z", iz);
             if good && iz > 2.0 * ix {
-                problems.push(
+                problems.reject(
                     "body.inertia_z",
                     number(iz),
                     format!(
@@ -181,27 +175,18 @@ fn check_inertia(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Ine
                 })
             }
         }
-        (None, Some(_), None) => {
-            problems.missing(
-                "body.inertia_z",
-                "is missing: inertia_x needs inertia_z too",
-            );
-            None
-        }
-        (None, None, Some(_)) => {
-            problems.missing(
-                "body.inertia_x",
-                "is missing: inertia_z needs inertia_x too",
-            );
-            None
-        }
-        (None, None, None) => {
-            problems.missing(
-                "body.shape",
-                "is missing: give shape = \"thin-disk\" or \"hoop\", or both inertia_x and inertia_z",
-            );
-            None
-        }
+        (None, Some(_), None) => problems.missing(
+            "body.inertia_z",
+            "is missing: inertia_x needs inertia_z too",
+        ),
+        (None, None, Some(_)) => problems.missing(
+            "body.inertia_x",
+            "is missing: inertia_z needs inertia_x too",
+        ),
+        (None, None, None) => problems.missing(
+            "body.shape",
+            "is missing: give shape = \"thin-disk\" or \"hoop\", or both inertia_x and inertia_z",
+        ),
     }
 }
 
@@ -395,8 +380,7 @@ fn initial_base(
             if let Some(o) = omega {
                 problems.vector3("initial.omega", o);
             }
-            problems.missing("initial.theta", "is missing: give theta and omega, or a steady motion (initial.steady = { kind = ... })");
-            None
+            problems.missing("initial.theta", "is missing: give theta and omega, or a steady motion (initial.steady = { kind = ... })")
         }
         (None, Some(theta), None) => {
             problems.finite("initial.theta", theta);
@@ -551,25 +535,19 @@ fn solve_steady(
 ) -> Option<Steady> {
     match Steady::new(coin, kind) {
         Ok(s) if s.state.is_finite() => Some(s),
-        Ok(s) => {
-            problems.push(
-                "initial.steady",
-                format!("{{ kind = \"{family}\" }}"),
-                format!(
-                    "has no finite solution here (ω_Y = {})",
-                    number(s.state.omega_y)
-                ),
-            );
-            None
-        }
-        Err(e) => {
-            problems.push(
-                "initial.steady",
-                format!("{{ kind = \"{family}\" }}"),
-                format!("cannot be built: {e}"),
-            );
-            None
-        }
+        Ok(s) => problems.reject(
+            "initial.steady",
+            format!("{{ kind = \"{family}\" }}"),
+            format!(
+                "has no finite solution here (ω_Y = {})",
+                number(s.state.omega_y)
+            ),
+        ),
+        Err(e) => problems.reject(
+            "initial.steady",
+            format!("{{ kind = \"{family}\" }}"),
+            format!("cannot be built: {e}"),
+        ),
     }
 }
 
@@ -699,7 +677,7 @@ fn check_channels(
         channels.push(Channel::Rerun);
     }
     if channels.contains(&Channel::Rerun) && !channels.contains(&Channel::Scene) {
-        problems.push(
+        return problems.reject(
             "record.channels",
             quoted(Channel::Rerun.name()),
             "draws the coin in the frames of the `scene` channel, which is not recorded: add \"scene\" or leave \"rerun\" out",

@@ -117,26 +117,24 @@ impl Checker {
                 return toml::Table::try_from(&preset).ok();
             }
             let names = presets::NAMES.join(", ");
-            self.problems.push("base", quoted, format!(
+            return self.problems.reject("base", quoted, format!(
                 "is no built-in scene ({names}) and not a path: a scene file is given by its path relative \
                  to the sweep file, such as \"./{base}.toml\""));
-            return None;
         }
         let path = folder.join(base);
         let text = match crate::files::read_scene(&path) {
             Ok(text) => text,
             Err(e) => {
-                self.problems.push("base", quoted, format!(
+                return self.problems.reject("base", quoted, format!(
                     "cannot be read ({e}; looked for `{}`): give the path of a scene file relative to the \
                      sweep file", path.display()));
-                return None;
             }
         };
         match toml::from_str::<toml::Table>(&text) {
             Ok(table) => Some(table),
             Err(e) => {
                 let message = scene::toml_message(&e).replace('\n', " ");
-                self.problems.push(
+                self.problems.reject(
                     "base",
                     quoted,
                     format!("is not a TOML scene file: {message}"),
@@ -201,18 +199,12 @@ impl Checker {
             .collect();
         match given.as_slice() {
             [form] => Some(form),
-            [] => {
-                self.problems.push(name, "", none);
-                None
-            }
-            several => {
-                self.problems.push(
-                    name,
-                    "",
-                    format!("gives {}: give exactly one {one}", several.join(" and ")),
-                );
-                None
-            }
+            [] => self.problems.reject(name, "", none),
+            several => self.problems.reject(
+                name,
+                "",
+                format!("gives {}: give exactly one {one}", several.join(" and ")),
+            ),
         }
     }
 
@@ -242,9 +234,9 @@ impl Checker {
 
     fn listed(&mut self, name: &str, values: &[toml::Value]) -> Option<Vec<toml::Value>> {
         if values.is_empty() {
-            self.problems
-                .push(name, "[]", "is empty: give at least one value");
-            return None;
+            return self
+                .problems
+                .reject(name, "[]", "is empty: give at least one value");
         }
         Some(values.to_vec())
     }
@@ -258,7 +250,7 @@ impl Checker {
     ) -> Option<Vec<toml::Value>> {
         let text = array_text(spec);
         let [first, last, n] = spec else {
-            self.problems.push(
+            return self.problems.reject(
                 name,
                 text,
                 "must be [first, last, n]: two numbers and a count",
@@ -268,21 +260,19 @@ impl Checker {
         let ends = [first, last].map(|v| number(v).filter(|x| x.is_finite()));
         let n = whole(n).filter(|&n| n >= 1);
         let (Some(first), Some(last)) = (ends[0], ends[1]) else {
-            self.problems.push(
+            return self.problems.reject(
                 name,
                 text,
                 "must start with two finite numbers, [first, last, n]",
             );
-            return None;
         };
         let Some(n) = n.filter(|&n| n <= MAX_AXIS_VALUES) else {
-            self.problems.push(name, text, format!(
+            return self.problems.reject(name, text, format!(
                 "must end with a whole number of values n, 1 ≤ n ≤ {MAX_AXIS_VALUES} (more samples of a key: draw it, [[random.draw]])"));
-            return None;
         };
         let values: Vec<f64> = space(first, last, n);
         if let Some(bad) = values.iter().find(|x| !x.is_finite()) {
-            self.problems.push(
+            return self.problems.reject(
                 name,
                 text,
                 format!("gives {bad}: keep the exponents within ±300"),
@@ -400,7 +390,7 @@ impl Checker {
             Some((lo, hi)) => Some(Distribution::Uniform { lo, hi }),
             None => {
                 let need = if log { "0 < lo < hi" } else { "lo < hi" };
-                self.problems.push(
+                self.problems.reject(
                     name,
                     array_text(spec),
                     format!("must be [lo, hi], two finite numbers with {need}"),
@@ -415,14 +405,11 @@ impl Checker {
             None => Some(default),
             Some(v) => match number(v).filter(|x| !x.is_nan()) {
                 Some(x) => Some(x),
-                None => {
-                    self.problems.push(
-                        format!("{name}.{key}"),
-                        v.to_string(),
-                        format!("must be {need}"),
-                    );
-                    None
-                }
+                None => self.problems.reject(
+                    format!("{name}.{key}"),
+                    v.to_string(),
+                    format!("must be {need}"),
+                ),
             },
         };
         let mean = get("mean", Some(&n.mean), 0.0, "a finite number").filter(|m| m.is_finite());
@@ -431,15 +418,14 @@ impl Checker {
         let max = get("max", n.max.as_ref(), f64::INFINITY, "a number");
         let (mean, std, min, max) = (mean?, std?, min?, max?);
         if !(std.is_finite() && std > 0.0) {
-            self.problems.push(
+            return self.problems.reject(
                 format!("{name}.std"),
                 n.std.to_string(),
                 "must be a finite number > 0",
             );
-            return None;
         }
         if min >= max {
-            self.problems.push(
+            return self.problems.reject(
                 name,
                 format!("{{ min = {min}, max = {max} }}"),
                 "has min ≥ max: give min < max",
