@@ -191,46 +191,33 @@ fn check_derived_scales(body: &super::file::BodyFile, problems: &mut ProblemColl
 
 /// The range of a positive rtol, for an adaptive method (atol's ceiling needs the body: [`check_atol`]).
 pub(super) fn check_rtol(rtol: f64, problems: &mut ProblemCollector) {
-    if rtol < RTOL_MIN {
-        problems.push(
-            "run.rtol",
-            number(rtol),
-            format!(
-                "is below {}, ten units of double-precision rounding (10·2⁻⁵²): the error estimate would be rounding noise and the step would shrink without end; use rtol ≥ {}",
-                short(RTOL_MIN, Round::Nearest),
-                number(RTOL_MIN)
-            ),
-        );
+    let reason = if rtol < RTOL_MIN {
+        format!(
+            "is below {}, ten units of double-precision rounding (10·2⁻⁵²): the error estimate would be rounding noise and the step would shrink without end; use rtol ≥ {}",
+            short(RTOL_MIN, Round::Nearest),
+            number(RTOL_MIN)
+        )
     } else if rtol > RTOL_MAX {
-        problems.push(
-            "run.rtol",
-            number(rtol),
-            format!("is above {RTOL_MAX:e}: an adaptive method's error estimate does not hold at such tolerances, and its events (lift-off, slip) would be artefacts; use rtol ≤ {RTOL_MAX:e}"),
-        );
-    }
+        format!("is above {RTOL_MAX:e}: an adaptive method's error estimate does not hold at such tolerances, and its events (lift-off, slip) would be artefacts; use rtol ≤ {RTOL_MAX:e}")
+    } else {
+        return;
+    };
+    problems.push("run.rtol", number(rtol), reason);
 }
 
-/// The duration against the 1 ns log-time base: at least [`MIN_DURATION`], and short enough for its log
-/// time to fit in 64 bits.
 pub(super) fn check_duration(duration: f64, problems: &mut ProblemCollector) {
-    if duration < MIN_DURATION {
-        problems.push(
-            "run.duration",
-            number(duration),
-            format!("is below {MIN_DURATION:e}, the log-time resolution (log times are whole nanoseconds, round(t·1e9), so the first and last samples would share one): use duration ≥ {MIN_DURATION:e}"),
-        );
+    let reason = if duration < MIN_DURATION {
+        format!("is below {MIN_DURATION:e}, the log-time resolution (log times are whole nanoseconds, round(t·1e9), so the first and last samples would share one): use duration ≥ {MIN_DURATION:e}")
     } else if crate::format::log_time(duration).is_err() {
-        problems.push(
-            "run.duration",
-            number(duration),
-            "is too long: log times must fit in 64-bit nanoseconds (duration < 1.8e10)",
-        );
-    }
+        "is too long: log times must fit in 64-bit nanoseconds (duration < 1.8e10)".to_string()
+    } else {
+        return;
+    };
+    problems.push("run.duration", number(duration), reason);
 }
 
-/// A fixed-step run, known before it starts: its step must advance time at t = duration (the largest t
-/// of the run, where floating point is coarsest), it takes duration/step ≤ `run.max_steps` steps (an
-/// adaptive run spends its budget as it goes: the driver stops it), and step·W ≤ [`STEP_MAX_PRODUCT`].
+/// A fixed-step run, known before it starts (an adaptive one spends `run.max_steps` as it goes): its step
+/// must advance time at t = duration, the largest t of the run, where floating point is coarsest.
 fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut ProblemCollector) {
     let run = &scene.run;
     let (h, duration) = (run.method.step, run.duration);
@@ -241,47 +228,39 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
     let steps = (duration / h * (1.0 - 1e-12)).ceil();
     #[allow(clippy::cast_precision_loss)]
     let max = run.max_steps as f64;
-    if stuck {
-        problems.push(
-            "run.step",
-            &shown,
-            format!(
-                "cannot advance time: t + step rounds back to t at t = duration = {} (the spacing of doubles there is {}), so the run would never end; use step ≥ {}",
-                number(duration),
-                short(duration * f64::EPSILON, Round::Nearest),
-                short((duration / max).max(duration * f64::EPSILON), Round::Up)
-            ),
-        );
-    } else if steps > max {
-        problems.push(
-            "run.step",
-            &shown,
-            format!(
-                "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
-                power_of_ten(steps.log10()),
-                number(duration),
-                run.max_steps,
-                short(duration / max, Round::Up)
-            ),
-        );
+    let too_many = if stuck {
+        Some(format!(
+            "cannot advance time: t + step rounds back to t at t = duration = {} (the spacing of doubles there is {}), so the run would never end; use step ≥ {}",
+            number(duration),
+            short(duration * f64::EPSILON, Round::Nearest),
+            short((duration / max).max(duration * f64::EPSILON), Round::Up)
+        ))
+    } else {
+        (steps > max).then(|| format!(
+            "takes {} steps over duration {}, more than run.max_steps = {} (about 0.15 µs of work a step): use step ≥ {}, a shorter duration, or raise run.max_steps (--max-steps)",
+            power_of_ten(steps.log10()),
+            number(duration),
+            run.max_steps,
+            short(duration / max, Round::Up)
+        ))
+    };
+    if let Some(reason) = too_many {
+        problems.push("run.step", &shown, reason);
     }
     if h * w > STEP_MAX_PRODUCT {
         let used = match given {
-            Some(g) if g != h => format!(" (used: {}, rounded to divide 1/rate)", number(h)),
+            Some(g) if g != h => format!("(used: {}, rounded to divide 1/rate) ", number(h)),
             _ => String::new(),
         };
+        let ceiling = short(STEP_MAX_PRODUCT / w, Round::Down);
         problems.push(
             "run.step",
             &shown,
             format!(
-                "{used} is above 0.178/W = {}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {}",
-                short(STEP_MAX_PRODUCT / w, Round::Down),
+                "{used}is above 0.178/W = {ceiling}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {ceiling}",
                 short(w, Round::Nearest),
                 run.method.method,
-                short(STEP_MAX_PRODUCT / w, Round::Down)
-            )
-            .trim_start()
-            .to_string(),
+            ),
         );
     }
 }
@@ -290,14 +269,13 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
 pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollector) {
     let max = max_rate(duration);
     if rate > max {
+        let max = number(max.floor());
         problems.push(
             "run.rate",
             number(rate),
             format!(
-                "is above {}, the highest rate whose samples stay ≥ 1 ns apart over duration {} (log times are whole nanoseconds, round(t·1e9), and must increase from sample to sample): use rate ≤ {}",
-                number(max.floor()),
-                number(duration),
-                number(max.floor())
+                "is above {max}, the highest rate whose samples stay ≥ 1 ns apart over duration {} (log times are whole nanoseconds, round(t·1e9), and must increase from sample to sample): use rate ≤ {max}",
+                number(duration)
             ),
         );
     }
@@ -315,8 +293,8 @@ fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
         .max(1.0 / params.time_unit())
 }
 
-/// Checks that need the whole scene: the initial state inside the model (finite energy and reaction,
-/// N > 0, |F| < μN), atol's ceiling, the fixed step against the fastest motion, and the work.
+/// Checks that need the whole scene: the initial state, atol, the fixed step and the duration against
+/// the fastest motion.
 pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut ProblemCollector) {
     let before = problems.list.len();
     check_start(scene, problems);
@@ -344,32 +322,22 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     }
 }
 
-/// atol ≤ 1e-3 × the smallest natural scale of the state: 1 rad, a, 1/τ.
 fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
     let p = &scene.params;
     let atol = scene.run.method.atol;
     let smallest = 1f64.min(p.radius()).min(1.0 / p.time_unit());
     let max = ATOL_MAX_FRACTION * smallest;
     if atol > max {
+        let max = short(max, Round::Down);
         problems.push(
             "run.atol",
             number(atol),
             format!(
-                "is above {}, {ATOL_MAX_FRACTION:e} of the smallest scale of the state (1 rad for the angles, a = {} for the centre, 1/τ = {} for ω): the error estimate would not hold; use atol ≤ {}",
-                short(max, Round::Down),
+                "is above {max}, {ATOL_MAX_FRACTION:e} of the smallest scale of the state (1 rad for the angles, a = {} for the centre, 1/τ = {} for ω): the error estimate would not hold; use atol ≤ {max}",
                 number(p.radius()),
                 short(1.0 / p.time_unit(), Round::Nearest),
-                short(max, Round::Down)
             ),
         );
-    }
-}
-
-/// The key the initial state came from (for problems of the state as a whole).
-fn initial_key(scene: &Scene) -> &'static str {
-    match scene.spec {
-        super::InitialSpec::Explicit => "initial.omega",
-        super::InitialSpec::Steady(_) => "initial.steady",
     }
 }
 
@@ -380,7 +348,10 @@ fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
     let s = &scene.initial;
     let e = energy(&coin, s).total;
     let r = reaction(&coin, s);
-    let key = initial_key(scene);
+    let key = match scene.spec {
+        super::InitialSpec::Explicit => "initial.omega",
+        super::InitialSpec::Steady(_) => "initial.steady",
+    };
     let value = || describe_state(s);
     let p = &scene.params;
     let weight = p.mass() * p.gravity();
@@ -427,7 +398,6 @@ fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
     }
 }
 
-/// The initial state in a few words: θ and ω.
 fn describe_state(s: &State) -> String {
     format!(
         "(θ = {}, ω = [{}, {}, {}])",
