@@ -20,8 +20,6 @@ use std::f64::consts::FRAC_PI_2;
 /// built-in has 379).
 pub const DESCRIPTION_MAX_CHARS: usize = 1000;
 
-/// The description is one line (format.md: Scene files): no line break or other control character, and
-/// at most [`DESCRIPTION_MAX_CHARS`], so that it cannot break the layouts that print it.
 fn check_description(description: Option<&str>, problems: &mut ProblemCollector) {
     let Some(text) = description else {
         return;
@@ -29,23 +27,19 @@ fn check_description(description: Option<&str>, problems: &mut ProblemCollector)
     let chars = text.chars().count();
     let head: String = text.chars().take(40).collect();
     let value = format!("{}{}", quoted(&head), if chars > 40 { "…" } else { "" });
-    if text.chars().any(char::is_control) {
-        problems.push(
-            "description",
-            value,
-            "holds a line break or another control character: a description is one line of text (`coin-log \
-             scenes` and `info` print it as one); write it on one line",
-        );
+    let reason = if text.chars().any(char::is_control) {
+        "holds a line break or another control character: a description is one line of text (`coin-log \
+         scenes` and `info` print it as one); write it on one line"
+            .to_string()
     } else if chars > DESCRIPTION_MAX_CHARS {
-        problems.push(
-            "description",
-            value,
-            format!(
-                "is {chars} characters long, more than the {DESCRIPTION_MAX_CHARS} of a description (one line \
-                 of `coin-log scenes` and `info`); shorten it"
-            ),
-        );
-    }
+        format!(
+            "is {chars} characters long, more than the {DESCRIPTION_MAX_CHARS} of a description (one line \
+             of `coin-log scenes` and `info`); shorten it"
+        )
+    } else {
+        return;
+    };
+    problems.push("description", value, reason);
 }
 
 /// The lean range allowed by a flat margin, in words.
@@ -138,7 +132,6 @@ fn check_body(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Body> 
     Some((params, inertia, body.friction, thickness))
 }
 
-/// The inertia: a shape, or both moments (I_Z ≤ 2 I_X).
 fn check_inertia(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Inertia> {
     match (&body.shape, body.inertia_x, body.inertia_z) {
         (Some(shape), None, None) => match shape.as_str() {
@@ -166,8 +159,7 @@ fn check_inertia(body: &BodyFile, problems: &mut ProblemCollector) -> Option<Ine
                         "is more than 2·inertia_x = {}: no rigid axisymmetric body has I_Z > 2 I_X",
                         number(2.0 * ix)
                     ),
-                );
-                None
+                )
             } else {
                 good.then_some(Inertia::Explicit {
                     inertia_x: ix,
@@ -216,7 +208,6 @@ fn check_dissipation(
         "is missing: give κ of P = κ |φ̇|^m (sin α)^(−k), e.g. coefficient = 1e-6",
     );
     let (m, k) = match model.map(|model| (model, model.exponents())) {
-        // A preset fixes m and k: giving them is an error that names `power-law`.
         Some((model, Some((m, k)))) => {
             for (name, value) in [("m", d.m), ("k", d.k)] {
                 if let Some(v) = value {
@@ -241,7 +232,6 @@ fn check_dissipation(
     Dissipation::new(model?, coefficient, m, k).ok().map(Some)
 }
 
-/// `power-law`'s m ≥ 1 and k, both required.
 fn power_law_exponents(d: &DissipationFile, problems: &mut ProblemCollector) -> (f64, f64) {
     const NEEDS: &str = "is missing: model \"power-law\" needs m (≥ 1) and k";
     let m = problems.required(
@@ -265,11 +255,7 @@ fn check_initial_alone(
         let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
         check_theta(theta, Some(margin), problems);
     }
-    for (key, value) in offsets(initial) {
-        if let Some(v) = value {
-            problems.finite(key, v);
-        }
-    }
+    offsets(initial, problems);
     if let Some(omega) = &initial.omega {
         problems.vector3("initial.omega", omega);
     }
@@ -282,14 +268,7 @@ fn check_initial(
     problems: &mut ProblemCollector,
 ) -> Option<Initial> {
     let before = problems.list.len();
-    let mut shift = [0.0; 4];
-    for (slot, (key, value)) in shift.iter_mut().zip(offsets(initial)) {
-        if let Some(v) = value {
-            if problems.finite(key, v) {
-                *slot = v;
-            }
-        }
-    }
+    let [phi, psi, x, z] = offsets(initial, problems);
     let coin = Coin::new(*params);
     let base = initial_base(initial, &coin, flat_margin, problems);
     let perturbation = initial
@@ -298,10 +277,10 @@ fn check_initial(
         .map_or(Some([0.0; 4]), |p| check_perturbation(p, problems));
     let (mut state, spec) = base?;
     let perturbation = perturbation?;
-    state.phi += shift[0];
-    state.psi += shift[1];
-    state.x += shift[2];
-    state.z += shift[3];
+    state.phi += phi;
+    state.psi += psi;
+    state.x += x;
+    state.z += z;
     let kicked = perturbed(&state, &perturbation);
     if perturbation[0] != 0.0 && !leans_less_than_flat(kicked.theta, flat_margin) {
         problems.push(
@@ -317,14 +296,15 @@ fn check_initial(
     (problems.list.len() == before).then_some((state, spec, perturbation))
 }
 
-/// The offsets φ, ψ, x, z of `[initial]`, by key.
-fn offsets(initial: &InitialFile) -> [(&'static str, Option<f64>); 4] {
-    [
+/// The offsets φ, ψ, x, z of `[initial]`: each finite, or 0 (not given, or reported).
+fn offsets(initial: &InitialFile, problems: &mut ProblemCollector) -> [f64; 4] {
+    let given = [
         ("initial.phi", initial.phi),
         ("initial.psi", initial.psi),
         ("initial.x", initial.x),
         ("initial.z", initial.z),
-    ]
+    ];
+    given.map(|(key, value)| value.filter(|&v| problems.finite(key, v)).unwrap_or(0.0))
 }
 
 /// |θ| < π/2 − margin, or the margin is not known (it is reported itself).
@@ -332,7 +312,6 @@ fn leans_less_than_flat(theta: f64, flat_margin: Option<f64>) -> bool {
     flat_margin.is_none_or(|m| theta.abs() < FRAC_PI_2 - m)
 }
 
-/// An explicit θ: finite, and leaning less than flat.
 fn check_theta(theta: f64, flat_margin: Option<f64>, problems: &mut ProblemCollector) {
     if problems.finite("initial.theta", theta) && !leans_less_than_flat(theta, flat_margin) {
         let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
@@ -387,13 +366,11 @@ fn initial_base(
             problems.missing(
                 "initial.omega",
                 "is missing: theta needs omega = [ω_X, ω_Y, ω_Z] (the lean of a steady motion is `initial.steady.theta`)",
-            );
-            None
+            )
         }
     }
 }
 
-/// `base` with the perturbation (θ, ω_X, ω_Y, ω_Z) added.
 fn perturbed(base: &State, perturbation: &[f64; 4]) -> State {
     State {
         theta: base.theta + perturbation[0],
@@ -425,7 +402,6 @@ fn steady_keys(family: SteadyFamily) -> &'static [&'static str] {
     }
 }
 
-/// `initial.steady` → a steady motion: the family, the keys it takes, their values, then the solve.
 fn check_steady(
     steady: &SteadyFile,
     coin: &Coin,
@@ -444,7 +420,6 @@ fn check_steady(
     solve_steady(coin, kind, family, problems)
 }
 
-/// Reports the keys given that `family` does not take.
 fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut ProblemCollector) {
     let allowed = steady_keys(family);
     let given = [
@@ -526,7 +501,6 @@ fn steady_kind(
     }
 }
 
-/// Solves the steady motion; a motion without a finite solution is reported.
 fn solve_steady(
     coin: &Coin,
     kind: SteadyKind,
@@ -628,23 +602,15 @@ fn check_run(
     })
 }
 
-/// The settings `method` uses; the others are 0 (format.md: Metadata records): an adaptive method uses
-/// rtol and atol, a fixed-step one the step, rounded down to divide 1/rate.
+/// The settings `method` uses, the others 0 (format.md: Metadata records).
 fn used_settings(method: Method, rtol: f64, atol: f64, step: f64, rate: f64) -> MethodConfig {
-    if method.is_adaptive() {
-        MethodConfig {
-            method,
-            rtol,
-            atol,
-            step: 0.0,
-        }
-    } else {
-        MethodConfig {
-            method,
-            rtol: 0.0,
-            atol: 0.0,
-            step: fitted_step(step, 1.0 / rate),
-        }
+    let adaptive = method.is_adaptive();
+    let used = |uses: bool, value: f64| if uses { value } else { 0.0 };
+    MethodConfig {
+        method,
+        rtol: used(adaptive, rtol),
+        atol: used(adaptive, atol),
+        step: used(!adaptive, fitted_step(step, 1.0 / rate)),
     }
 }
 
@@ -682,12 +648,10 @@ fn check_channels(
             quoted(Channel::Rerun.name()),
             "draws the coin in the frames of the `scene` channel, which is not recorded: add \"scene\" or leave \"rerun\" out",
         );
-        return None;
     }
     Some(channels)
 }
 
-/// The channels `record.channels` lists (sorted), or the default ones.
 fn listed_channels(
     record: Option<&RecordFile>,
     dissipative: bool,
