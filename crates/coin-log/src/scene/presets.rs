@@ -1,9 +1,6 @@
 //! The built-in scenes: the files `datasets/scenes/<name>.toml`, embedded at build time and read by the same
 //! parser as a user's scene file. Each file is its scene with every default written out, as
 //! `coin-log scenes --show <name>` prints it (a test checks that the two agree).
-//!
-//! Unless a file says otherwise: the unit thin disk (M = a = g = 1, physics §2), the default run settings
-//! and all channels, durations of 20–30 time units at 100 samples per unit so that recordings stay small.
 
 use super::file::{RunFile, SceneFile};
 use super::{defaults, validate};

@@ -370,7 +370,6 @@ impl Folder {
     }
 }
 
-/// The last byte of `file` (open for appending at `path`), `None` when it is empty.
 fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {
     use std::io::{Read, Seek, SeekFrom};
     if file.metadata()?.len() == 0 {
@@ -383,8 +382,7 @@ fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {
     Ok(Some(last[0]))
 }
 
-/// A journal line: the run's file's modification time when the row was written (ns since 1970, 0
-/// without a file), the run's index and the catalogue row's fields.
+/// A journal line: the `MTIME_COLUMN` value, then the catalogue row's fields (the index first).
 #[derive(Debug, Clone, PartialEq)]
 pub struct JournalRow {
     pub mtime_ns: u128,
@@ -471,7 +469,6 @@ fn short(identity: &str) -> &str {
     identity.get(..12).unwrap_or(identity)
 }
 
-/// Opens `path` for appending, creating it; refused unless it is absent or a plain file.
 fn open_append(path: &Path) -> io::Result<File> {
     files::absent_or_plain(path)?;
     OpenOptions::new().create(true).append(true).open(path)
@@ -493,8 +490,7 @@ pub fn temp_file(path: &Path) -> io::Result<tempfile::NamedTempFile> {
         .tempfile_in(path.parent().unwrap_or_else(|| Path::new(".")))
 }
 
-/// A temporary file beside `path` ([`temp_file`]) holding what `write` wrote, flushed, synced and
-/// readable.
+/// A [`temp_file`] holding what `write` wrote, synced and readable.
 fn temp_beside(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,

@@ -64,7 +64,6 @@ struct Checker {
     problems: ProblemCollector<'static>,
 }
 
-/// A TOML number as f64.
 fn number(v: &toml::Value) -> Option<f64> {
     match v {
         #[allow(clippy::cast_precision_loss)] // a TOML integer used as a bound or an exponent
@@ -85,12 +84,10 @@ fn whole(v: &toml::Value) -> Option<u64> {
     }
 }
 
-/// A list the file gives, or the empty list.
 fn spec(values: Option<&Vec<toml::Value>>) -> &[toml::Value] {
     values.map_or(&[], Vec::as_slice)
 }
 
-/// An axis's forms, each with whether it is given.
 fn axis_forms(a: &AxisFile) -> [(&'static str, bool); 3] {
     [
         ("values", a.values.is_some()),
@@ -138,8 +135,7 @@ impl Checker {
                     "base",
                     quoted,
                     format!("is not a TOML scene file: {message}"),
-                );
-                None
+                )
             }
         }
     }
@@ -255,7 +251,6 @@ impl Checker {
                 text,
                 "must be [first, last, n]: two numbers and a count",
             );
-            return None;
         };
         let ends = [first, last].map(|v| number(v).filter(|x| x.is_finite()));
         let n = whole(n).filter(|&n| n >= 1);
@@ -277,7 +272,6 @@ impl Checker {
                 text,
                 format!("gives {bad}: keep the exponents within ±300"),
             );
-            return None;
         }
         Some(values.into_iter().map(toml::Value::Float).collect())
     }
@@ -394,8 +388,7 @@ impl Checker {
                     name,
                     array_text(spec),
                     format!("must be [lo, hi], two finite numbers with {need}"),
-                );
-                None
+                )
             }
         }
     }
@@ -430,7 +423,6 @@ impl Checker {
                 format!("{{ min = {min}, max = {max} }}"),
                 "has min ≥ max: give min < max",
             );
-            return None;
         }
         Some(Distribution::Normal {
             mean,
