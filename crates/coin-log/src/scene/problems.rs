@@ -116,10 +116,7 @@ impl<'a> ProblemCollector<'a> {
     ) -> f64 {
         match value {
             Some(v) if v.is_finite() && ok(v) => v,
-            Some(v) => {
-                self.push(key, number(v), bad);
-                f64::NAN
-            }
+            Some(v) => self.reject(key, number(v), bad).unwrap_or(f64::NAN),
             None => self.missing(key, missing).unwrap_or(f64::NAN),
         }
     }
@@ -164,8 +161,7 @@ impl<'a> ProblemCollector<'a> {
                 value.len()
             ),
         };
-        self.push(key, numbers(value), reason);
-        None
+        self.reject(key, numbers(value), reason)
     }
 }
 

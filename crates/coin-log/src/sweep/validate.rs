@@ -51,13 +51,8 @@ pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProble
         }
         c.size(&sweep);
     }
-    match SceneProblems::from_vec(c.problems.list) {
-        Some(problems) => Err(problems),
-        None => {
-            sweep.set.sort_by(|a, b| a.0.cmp(&b.0));
-            Ok(sweep)
-        }
-    }
+    sweep.set.sort_by(|a, b| a.0.cmp(&b.0));
+    SceneProblems::from_vec(c.problems.list).map_or(Ok(sweep), Err)
 }
 
 struct Checker {
