@@ -5,7 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use crate::support::record::{exe, listing};
-use coin_log::sweep::{linspace, Sweep};
+use coin_log::sweep::{linspace, logspace, sha256_hex, Sweep};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -884,4 +884,36 @@ fn the_sweep_subcommand_needs_its_arguments_and_documents_itself() {
     ] {
         assert!(help.contains(flag), "{flag} in --help:\n{help}");
     }
+}
+
+#[test]
+fn linspace_is_exact_at_the_ends_and_even_between() {
+    let v = linspace(0.1, 0.7, 7);
+    assert_eq!(v.first().map(|x| x.to_bits()), Some(0.1f64.to_bits()));
+    assert_eq!(v.last().map(|x| x.to_bits()), Some(0.7f64.to_bits()));
+    for (k, x) in v.iter().enumerate() {
+        let expected = 0.1 + 0.1 * k as f64;
+        assert!(
+            (x - expected).abs() < 1e-15,
+            "v[{k}] = {x}, expected {expected}"
+        );
+    }
+    assert_eq!(linspace(3.0, 5.0, 1), vec![3.0]);
+    assert_eq!(linspace(1.0, -1.0, 3), vec![1.0, 0.0, -1.0]);
+}
+
+#[test]
+fn logspace_gives_exact_decades_and_powf_between() {
+    let v = logspace(-12.0, -6.0, 4);
+    assert_eq!(v, vec![1e-12, 1e-10, 1e-8, 1e-6]);
+    let half = logspace(0.0, 1.0, 3);
+    assert_eq!(half[1].to_bits(), 10f64.powf(0.5).to_bits());
+}
+
+#[test]
+fn the_hash_of_abc_is_the_fips_example() {
+    assert_eq!(
+        sha256_hex(b"abc"),
+        "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+    );
 }

@@ -8,6 +8,8 @@ use crate::support::record::listing;
 use crate::sweep::{
     run_files, run_in, run_with_env, sweep_json, write_sweep, Csv, SMALL, SMALL_RUNS,
 };
+use coin_log::sweep::Shard;
+use std::collections::HashMap;
 use std::path::Path;
 
 fn rows(path: &Path) -> Vec<Vec<String>> {
@@ -447,4 +449,122 @@ fn links_in_the_sweep_folder_are_refused_never_written_through_or_replaced() {
     std::fs::remove_file(&pipe).unwrap();
     // Negative control: without the link and the pipe, collect writes the catalogue.
     assert_eq!(collect(dir.path(), "d").0, 0);
+}
+
+// The library's Shard alone: its arithmetic and the schedulers' variables.
+
+#[test]
+fn shards_overlap_exactly_when_they_share_a_run() {
+    let all: Vec<Shard> = (1..=6)
+        .flat_map(|n| (0..n).map(move |k| Shard::new(k, n).unwrap()))
+        .collect();
+    for &a in &all {
+        for &b in &all {
+            let shared = (0..60).any(|i| a.takes(i) && b.takes(i));
+            assert_eq!(a.overlaps(b), shared, "{a} and {b}");
+        }
+    }
+}
+
+#[test]
+fn the_shards_of_every_count_make_each_run_exactly_once() {
+    for runs in [0, 1, 7, 23] {
+        for n in 1..=5 {
+            let mut made = vec![0; runs as usize];
+            for k in 0..n {
+                let shard = Shard::new(k, n).unwrap();
+                for run in shard.runs(runs) {
+                    assert!(shard.takes(run));
+                    made[run as usize] += 1;
+                }
+                assert_eq!(shard.runs(runs).count() as u64, shard.len(runs));
+                assert_eq!(
+                    shard.len(runs),
+                    (0..runs).filter(|r| shard.takes(*r)).count() as u64
+                );
+            }
+            assert!(
+                made.iter().all(|&m| m == 1),
+                "{runs} runs in {n} shards: {made:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_shard_outside_its_count_is_refused() {
+    let e = Shard::new(4, 4).unwrap_err().to_string();
+    assert!(
+        e.contains("K must be 0 … N − 1 = 3") && e.contains("--array=0-3"),
+        "{e}"
+    );
+    let e = Shard::new(0, 0).unwrap_err().to_string();
+    assert!(e.contains("N must be at least 1"), "{e}");
+    assert!("3/2".parse::<Shard>().is_err());
+    assert!("a/2"
+        .parse::<Shard>()
+        .unwrap_err()
+        .to_string()
+        .contains("K/N"));
+    assert_eq!("1/3".parse::<Shard>(), Shard::new(1, 3));
+}
+
+fn env(vars: &[(&str, &str)]) -> impl Fn(&str) -> Option<String> {
+    let map: HashMap<String, String> = vars
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    move |k| map.get(k).cloned()
+}
+
+#[test]
+fn slurm_and_kubernetes_variables_give_the_shard() {
+    let slurm = env(&[
+        ("SLURM_ARRAY_TASK_ID", "5"),
+        ("SLURM_ARRAY_TASK_MIN", "4"),
+        ("SLURM_ARRAY_TASK_MAX", "7"),
+        ("SLURM_ARRAY_TASK_COUNT", "4"),
+    ]);
+    assert_eq!(
+        Shard::from_environment(slurm, None),
+        Ok(Some(Shard::new(1, 4).unwrap()))
+    );
+    let count_only = env(&[
+        ("SLURM_ARRAY_TASK_ID", "2"),
+        ("SLURM_ARRAY_TASK_COUNT", "3"),
+    ]);
+    assert_eq!(
+        Shard::from_environment(count_only, None),
+        Ok(Some(Shard::new(2, 3).unwrap()))
+    );
+    let k8s = env(&[("JOB_COMPLETION_INDEX", "3")]);
+    assert_eq!(
+        Shard::from_environment(&k8s, Some(8)),
+        Ok(Some(Shard::new(3, 8).unwrap()))
+    );
+    assert!(Shard::from_environment(&k8s, None)
+        .unwrap_err()
+        .to_string()
+        .contains("--shard-count"));
+    assert_eq!(Shard::from_environment(env(&[]), None), Ok(None));
+    assert!(Shard::from_environment(env(&[]), Some(2)).is_err());
+}
+
+#[test]
+fn a_slurm_array_with_a_step_is_refused_naming_the_dense_form() {
+    let stepped = env(&[
+        ("SLURM_ARRAY_TASK_ID", "2"),
+        ("SLURM_ARRAY_TASK_MIN", "0"),
+        ("SLURM_ARRAY_TASK_MAX", "6"),
+        ("SLURM_ARRAY_TASK_COUNT", "4"),
+    ]);
+    let e = Shard::from_environment(stepped, None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--array=0-3"), "{e}");
+    let bad = env(&[
+        ("SLURM_ARRAY_TASK_ID", "x"),
+        ("SLURM_ARRAY_TASK_COUNT", "4"),
+    ]);
+    assert!(Shard::from_environment(bad, None).is_err());
 }

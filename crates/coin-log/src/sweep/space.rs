@@ -49,32 +49,3 @@ fn power_of_ten(e: f64) -> f64 {
         10f64.powf(e)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn linspace_is_exact_at_the_ends_and_even_between() {
-        let v = linspace(0.1, 0.7, 7);
-        assert_eq!(v.first().map(|x| x.to_bits()), Some(0.1f64.to_bits()));
-        assert_eq!(v.last().map(|x| x.to_bits()), Some(0.7f64.to_bits()));
-        for (k, x) in v.iter().enumerate() {
-            let expected = 0.1 + 0.1 * k as f64;
-            assert!(
-                (x - expected).abs() < 1e-15,
-                "v[{k}] = {x}, expected {expected}"
-            );
-        }
-        assert_eq!(linspace(3.0, 5.0, 1), vec![3.0]);
-        assert_eq!(linspace(1.0, -1.0, 3), vec![1.0, 0.0, -1.0]);
-    }
-
-    #[test]
-    fn logspace_gives_exact_decades_and_powf_between() {
-        let v = logspace(-12.0, -6.0, 4);
-        assert_eq!(v, vec![1e-12, 1e-10, 1e-8, 1e-6]);
-        let half = logspace(0.0, 1.0, 3);
-        assert_eq!(half[1].to_bits(), 10f64.powf(0.5).to_bits());
-    }
-}
