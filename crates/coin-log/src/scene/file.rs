@@ -170,8 +170,7 @@ pub struct RecordFile {
     /// Channel names.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub channels: Option<Vec<String>>,
-    /// `true` adds the `rerun` channel to the channels (listed or default): the coin, table and track
-    /// for Rerun.
+    /// `true` adds the `rerun` channel (the coin, table and track for Rerun) to the channels.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rerun: Option<bool>,
 }
