@@ -96,7 +96,7 @@ impl Dissipation {
     /// use coin_log::model::{Dissipation, DissipationModel};
     /// let d = Dissipation::preset(DissipationModel::Moffatt, 1e-6).unwrap();
     /// assert_eq!((d.m(), d.k(), d.angle_exponent()), (2.0, 1.0, -2.0));
-    /// assert_eq!(d.predicted_exponent(), Some(1.0 / 3.0));
+    /// assert_eq!(d.predicted_exponent(), 1.0 / 3.0);
     /// ```
     ///
     /// # Errors
@@ -160,12 +160,11 @@ impl Dissipation {
         -0.5 * self.m - self.k
     }
 
-    /// n = 1/(1 − p) of the finite-time law α ∝ (t₀ − t)^n (eq (38)); `None` when p ≥ 1, where there is
-    /// no finite-time singularity (α decays exponentially for p = 1, algebraically for p > 1).
+    /// n = 1/(1 − p) of the law α ∝ |t₀ − t|^n (physics §11.2): a finite-time collapse at t₀ for p < 1
+    /// (eq (38)), an algebraic decay (n < 0) for p > 1, an exponential one (n infinite) for p = 1.
     #[must_use]
-    pub fn predicted_exponent(&self) -> Option<f64> {
-        let p = self.angle_exponent();
-        (p < 1.0).then(|| 1.0 / (1.0 - p))
+    pub fn predicted_exponent(&self) -> f64 {
+        1.0 / (1.0 - self.angle_exponent())
     }
 
     /// The dissipated power P = κ |φ̇|^m (sin α)^(−k) at lean θ and ω_Y (eq (34)), with φ̇ = ω_Y / cos θ
@@ -358,11 +357,11 @@ mod tests {
                 .unwrap()
                 .predicted_exponent()
         };
-        assert_eq!(n(DissipationModel::Moffatt), Some(1.0 / 3.0));
-        assert_eq!(n(DissipationModel::AirDrag), Some(4.0 / 9.0));
-        assert_eq!(n(DissipationModel::Viscous), Some(0.5));
-        assert_eq!(n(DissipationModel::Rolling), Some(2.0 / 3.0));
-        assert_eq!(n(DissipationModel::Pivoting), None);
+        assert_eq!(n(DissipationModel::Moffatt), 1.0 / 3.0);
+        assert_eq!(n(DissipationModel::AirDrag), 4.0 / 9.0);
+        assert_eq!(n(DissipationModel::Viscous), 0.5);
+        assert_eq!(n(DissipationModel::Rolling), 2.0 / 3.0);
+        assert_eq!(n(DissipationModel::Pivoting), -2.0);
         assert!(Dissipation::preset(DissipationModel::PowerLaw, 1.0).is_err());
     }
 
