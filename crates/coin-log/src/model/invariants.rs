@@ -69,7 +69,7 @@ pub struct LegendreBasis {
 }
 
 /// y = α u₁ + β u₂ near s = 1.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Connection {
     alpha: f64,
     beta: f64,
@@ -127,14 +127,8 @@ impl Chaplygin {
             centre: centre_coefficients(mu, split_sin * split_sin),
             edge: edge_coefficients(mu, split_x),
             split_sin,
-            even: Connection {
-                alpha: 0.0,
-                beta: 0.0,
-            },
-            odd: Connection {
-                alpha: 0.0,
-                beta: 0.0,
-            },
+            even: Connection::default(),
+            odd: Connection::default(),
         };
         // Match value and flux of the two expansions at the split.
         let (y_even, flux_even, y_odd, flux_odd) = chaplygin.centre_values(split_sin, split_cos2);
