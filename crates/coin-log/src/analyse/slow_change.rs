@@ -15,9 +15,7 @@ pub fn alpha_of(s: &State) -> f64 {
     FRAC_PI_2 - s.theta.abs()
 }
 
-/// C of the slow-change law d(sin α)/dt = −C sin^p α on the centre-fixed family (eqs (35)–(37)):
-/// E = (3/2) Mga sin α and P = κ (Mga/I_X)^(m/2) sin^p α, so C = κ (Mga/I_X)^(m/2) / ((3/2) Mga)
-/// [1/time].
+/// C of the slow-change law d(sin α)/dt = −C sin^p α, eq (37) of physics §11.2 [1/time].
 fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
     let p = coin.params();
     let mga = p.energy_scale();

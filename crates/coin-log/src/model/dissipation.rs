@@ -1,9 +1,7 @@
 //! Dissipation (physics §11): a couple −P ω/|ω|² on the coin, with power P = κ |φ̇|^m (sin α)^(−k),
 //! α = π/2 − |θ| the angle between the coin and the table, and the dissipated work W as a ninth state
-//! component (Ẇ = P), so that E + W = E₀ holds along the equations (eqs (30)–(34)).
-//!
-//! The conservative coin ([`Coin`]) is left exactly as it is: a dissipative run integrates the separate
-//! system [`DissipativeCoin`], chosen once before the integration starts.
+//! component (Ẇ = P), so that E + W = E₀ holds along the equations (eqs (30)–(34)). [`Coin`] stays as it
+//! is: a dissipative run integrates [`DissipativeCoin`] (see `simulation`).
 
 use super::derived::{reaction_with, Reaction};
 use super::equations::{kinematics, AngularAcceleration, Coin};
@@ -230,13 +228,8 @@ impl DissipativeCoin {
         &self.dissipation
     }
 
-    /// Angular accelerations of eqs (31)–(33) and the power P of eq (34):
-    ///
-    /// (I_X + Ma²) ω̇_X = [right-hand side of (14)] − (P/|ω|²) ω_X   (31)
-    /// I_X ω̇_Y         = [right-hand side of (15)] − (P/|ω|²) ω_Y   (32)
-    /// (I_Z + Ma²) ω̇_Z = [right-hand side of (16)] − (P/|ω|²) ω_Z   (33)
-    ///
-    /// At ω = 0 the couple is 0 (P = 0 there, since m ≥ 1).
+    /// Angular accelerations of eqs (31)–(33) and the power P of eq (34) (physics §11.1); at ω = 0 the
+    /// couple is 0 (P = 0 there, since m ≥ 1).
     #[must_use]
     #[inline]
     pub fn rates(&self, theta: f64, omega_x: f64, omega_y: f64, omega_z: f64) -> DissipativeRates {

@@ -54,11 +54,7 @@ impl Coin {
         &self.params
     }
 
-    /// Angular accelerations from eqs (14)–(16), given θ and ω (lean frame).
-    ///
-    /// (I_X + Ma²) ω̇_X = −(I_Z + Ma²) ω_Y ω_Z − I_X ω_Y² tan θ + Mga sin θ   (14)
-    /// I_X ω̇_Y = I_X ω_X ω_Y tan θ + I_Z ω_Z ω_X                              (15)
-    /// (I_Z + Ma²) ω̇_Z = Ma² ω_X ω_Y                                          (16)
+    /// Angular accelerations from eqs (14)–(16) of physics §2, given θ and ω (lean frame).
     ///
     /// ```
     /// use coin_log::model::{Coin, CoinParams};

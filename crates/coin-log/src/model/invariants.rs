@@ -1,8 +1,6 @@
-//! Chaplygin–Appell integrals C1, C2 (physics §6): C1 = cos²θ y_o′(s) ω_Z − cos θ y_o(s) ω_Y / k and
-//! C2 = cos θ y_e(s) ω_Y / k − cos²θ y_e′(s) ω_Z, with y_e, y_o the even and odd solutions of Legendre's
-//! equation (1 − s²) y″ − 2s y′ − μ y = 0 in s = sin θ.
-//! Evaluated by two exact series, about s = 0 and about s = 1, matched at a split; the method and its
-//! measured accuracy are in physics §6, "Evaluating y_e and y_o".
+//! Chaplygin–Appell integrals C1, C2 (physics §6) from the even and odd solutions y_e, y_o of Legendre's
+//! equation in s = sin θ, by two exact series, about s = 0 and about s = 1, matched at a split; the method
+//! and its measured accuracy are in physics §6, "Evaluating y_e and y_o".
 
 use super::params::CoinParams;
 use super::state::State;
