@@ -387,29 +387,4 @@ mod tests {
             }
         }
     }
-
-    #[test]
-    fn thin_disk_has_mu_four_thirds_and_k_three_halves() {
-        let ch = Chaplygin::new(&CoinParams::unit_disk()).unwrap();
-        assert!((ch.mu() - 4.0 / 3.0).abs() < 1e-15);
-        assert!((ch.k() - 1.5).abs() < 1e-15);
-        println!("terms (centre, edge) = {:?}", ch.terms());
-    }
-
-    #[test]
-    fn mu_beyond_the_limit_is_refused_with_its_value() {
-        let p = CoinParams::new(
-            1.0,
-            1.0,
-            1.0,
-            Inertia::Explicit {
-                inertia_x: 1e-3,
-                inertia_z: 1.0,
-            },
-        )
-        .unwrap();
-        let err = Chaplygin::new(&p).unwrap_err();
-        assert!(matches!(err, InvariantsError::MuTooLarge { .. }));
-        assert!(err.to_string().contains("500"));
-    }
 }
