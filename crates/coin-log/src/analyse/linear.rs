@@ -6,9 +6,8 @@ use crate::model::{
     steady_sigma_squared, straight_lambda_squared, Coin, Linearisation, State, Steady,
 };
 
-/// The nutation frequency σ of small perturbations of a steady motion: σ² of physics §9, eq (21) (the
-/// linearisation of eqs (14)–(17) about ω_X = 0 has eigenvalues 0, 0, ±iσ). `None` when σ² ≤ 0 (an
-/// unstable steady motion) [1/time].
+/// The nutation frequency σ of small perturbations of a steady motion (physics §9, eq (21)); `None` when
+/// σ² ≤ 0 (an unstable steady motion) [1/time].
 ///
 /// ```
 /// use coin_log::analyse::linear::nutation_frequency;

@@ -1,7 +1,5 @@
-//! The slow-change approximation of a dissipating coin (physics §11, eqs (35)–(38)): while α = π/2 − |θ|
-//! changes little in a nutation period, the motion stays near the centre-fixed family and
-//! d(sin α)/dt = −C sin^p α, so sin^(1−p) α = sin^(1−p) α₀ − (1 − p) C t, with p = −m/2 − k
-//! ([`Dissipation::angle_exponent`]).
+//! The slow-change approximation of a dissipating coin (physics §11.2, eqs (35)–(38)): while α = π/2 − |θ|
+//! changes little in a nutation period, the motion stays near the centre-fixed family.
 
 use crate::model::{
     centre_fixed_sigma_squared, Coin, Dissipation, DissipationError, DissipationModel, State,
