@@ -108,9 +108,8 @@ impl Coin {
     }
 }
 
-/// The rows of the right-hand side that no couple changes (physics §2, §11), for a coin of radius `a`:
-/// eqs (17)–(19) and the centre's velocity ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ),
-/// ż = a(ω_Z sin φ + ω_X cos θ cos φ). Returns (sin θ, tan θ) for the accelerations.
+/// The rows of the right-hand side that no couple changes, for a coin of radius `a`: eqs (17)–(19) and
+/// the centre's ẋ, ż (physics §2, §11). Returns (sin θ, tan θ) for the accelerations.
 #[inline]
 pub(super) fn kinematics<const N: usize>(a: f64, y: &[f64; N], dydt: &mut [f64; N]) -> (f64, f64) {
     let (theta, phi, wx, wy, wz) = (y[0], y[1], y[3], y[4], y[5]);
