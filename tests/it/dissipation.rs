@@ -519,3 +519,42 @@ fn the_euler_disk_coefficient_is_moffatts() {
         1e-12,
     );
 }
+
+#[test]
+fn presets_have_the_documented_exponents_and_names_round_trip() {
+    for &m in DissipationModel::ALL {
+        assert_eq!(m.name().parse::<DissipationModel>(), Ok(m));
+    }
+    assert!("stokes".parse::<DissipationModel>().is_err());
+    let n = |model| {
+        Dissipation::preset(model, 1.0)
+            .unwrap()
+            .predicted_exponent()
+    };
+    assert_eq!(n(DissipationModel::Moffatt), 1.0 / 3.0);
+    assert_eq!(n(DissipationModel::AirDrag), 4.0 / 9.0);
+    assert_eq!(n(DissipationModel::Viscous), 0.5);
+    assert_eq!(n(DissipationModel::Rolling), 2.0 / 3.0);
+    assert_eq!(n(DissipationModel::Pivoting), -2.0);
+    assert!(Dissipation::preset(DissipationModel::PowerLaw, 1.0).is_err());
+}
+
+#[test]
+fn bad_values_are_refused() {
+    let m = DissipationModel::PowerLaw;
+    assert!(Dissipation::new(m, -1.0, 2.0, 0.0).is_err());
+    assert!(Dissipation::new(m, f64::NAN, 2.0, 0.0).is_err());
+    assert!(Dissipation::new(m, 1.0, 0.5, 0.0).is_err());
+    assert!(Dissipation::new(m, 1.0, 2.0, f64::INFINITY).is_err());
+    assert!(Dissipation::new(m, 0.0, 1.0, -3.0).is_ok());
+}
+
+#[test]
+fn the_couple_vanishes_at_rest_without_nan() {
+    let d = Dissipation::preset(DissipationModel::Rolling, 2.0).unwrap();
+    let coin = DissipativeCoin::new(Coin::new(CoinParams::unit_disk()), d);
+    let r = coin.rates(0.3, 0.0, 0.0, 0.0);
+    assert_eq!(r.power, 0.0);
+    let conservative = Coin::new(CoinParams::unit_disk()).angular_acceleration(0.3, 0.0, 0.0, 0.0);
+    assert_eq!(r.acceleration, conservative);
+}

@@ -9,7 +9,9 @@
 
 use crate::support::physics::wobble;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunEnd, RunSettings};
-use coin_log::model::{energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, State};
+use coin_log::model::{
+    energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, InvariantsError, State,
+};
 use coin_log::simulation::CoinEvents;
 
 use std::f64::consts::FRAC_PI_6;
@@ -616,4 +618,23 @@ fn energy_c1_and_c2_drift_below_1e_11_over_100_time_units_with_dop853_at_rtol_1e
             );
         }
     }
+}
+
+#[test]
+fn thin_disk_has_mu_four_thirds_and_k_three_halves() {
+    let ch = Chaplygin::new(&CoinParams::unit_disk()).unwrap();
+    assert!((ch.mu() - 4.0 / 3.0).abs() < 1e-15);
+    assert!((ch.k() - 1.5).abs() < 1e-15);
+    println!("terms (centre, edge) = {:?}", ch.terms());
+}
+
+#[test]
+fn mu_beyond_the_limit_is_refused_with_its_value() {
+    let p = params(Inertia::Explicit {
+        inertia_x: 1e-3,
+        inertia_z: 1.0,
+    });
+    let err = Chaplygin::new(&p).unwrap_err();
+    assert!(matches!(err, InvariantsError::MuTooLarge { .. }));
+    assert!(err.to_string().contains("500"));
 }

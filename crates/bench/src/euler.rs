@@ -93,7 +93,7 @@ pub struct EulerRow {
     pub dissipation: Dissipation,
     /// p = −m/2 − k.
     pub p: f64,
-    /// 1/(1 − p).
+    /// n = 1/(1 − p) ([`Dissipation::predicted_exponent`]).
     pub predicted: f64,
     /// The fit; `None` when the window holds fewer than 10 points.
     pub fit: Option<PowerLaw>,
@@ -319,7 +319,7 @@ pub fn run_model(
     Ok(EulerRow {
         dissipation: law,
         p,
-        predicted: 1.0 / (1.0 - p),
+        predicted: law.predicted_exponent(),
         fit,
         alpha_window: (bottom, options.top),
         limit,

@@ -109,13 +109,9 @@ impl<const N: usize> EventFunctions<N> for CoinEvents {
     }
 }
 
-/// Runs `config` on the scene's dynamics from `initial`, with the physical events (flat landing at
-/// |θ| = π/2 − `flat_margin`, lift-off, slip when `friction` is given), calling `observe(t, y, W)` at every
-/// sample: y the eight coin components, W the dissipated work (`None` for conservative dynamics), within
-/// `bounds` (a step budget, a stop flag seen after every step).
-///
-/// The dispatch happens here, once: conservative dynamics integrate [`Coin`] itself, dissipative ones
-/// [`DissipativeCoin`] with W as a ninth component starting at 0.
+/// Runs `config` on `dynamics` from `initial` within `bounds`, until one of the [`CoinEvents`] of
+/// `flat_margin` and `friction`, calling `observe(t, y, W)` at every sample: y the eight coin components, W
+/// the dissipated work (from 0; `None` for conservative dynamics).
 #[allow(
     clippy::too_many_arguments,
     reason = "what to integrate, how, for how long, within which bounds, until which events: each its own"

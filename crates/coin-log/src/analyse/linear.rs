@@ -6,9 +6,8 @@ use crate::model::{
     steady_sigma_squared, straight_lambda_squared, Coin, Linearisation, State, Steady,
 };
 
-/// The nutation frequency σ of small perturbations of a steady motion: σ² of physics §9, eq (21) (the
-/// linearisation of eqs (14)–(17) about ω_X = 0 has eigenvalues 0, 0, ±iσ). `None` when σ² ≤ 0 (an
-/// unstable steady motion) [1/time].
+/// The nutation frequency σ of small perturbations of a steady motion (physics §9, eq (21)); `None` when
+/// σ² ≤ 0 (an unstable steady motion) [1/time].
 ///
 /// ```
 /// use coin_log::analyse::linear::nutation_frequency;
@@ -25,10 +24,9 @@ pub fn nutation_frequency(coin: &Coin, steady: &Steady) -> Option<f64> {
     (sigma2 > 0.0).then(|| sigma2.sqrt())
 }
 
-/// A steady motion `steady` kicked along the oscillating mode of its linearisation: δω_X = σ·amplitude,
-/// which excites only the pair ±iσ (the eigenvector's imaginary part is (0, σ, 0, 0), physics §9), so the
-/// motion nutates about the steady motion itself, by `amplitude` \[rad\] in θ, and its frequency differs
-/// from σ by O(amplitude²).
+/// A steady motion `steady` kicked along the oscillating mode of its linearisation (physics §9):
+/// δω_X = σ·amplitude, so the motion nutates about the steady motion itself, by `amplitude` \[rad\] in θ,
+/// and its frequency differs from σ by O(amplitude²).
 #[must_use]
 pub fn kicked(coin: &Coin, steady: &State, amplitude: f64) -> State {
     let sigma2 = steady_sigma_squared(coin, steady.theta, steady.omega_y, steady.omega_z);
@@ -38,9 +36,8 @@ pub fn kicked(coin: &Coin, steady: &State, amplitude: f64) -> State {
     }
 }
 
-/// A steady motion `steady` displaced by `amplitude` \[rad\] in θ along the growing mode of its
-/// linearisation: the eigenvector of λ = √(−σ²) is (1, λ, D, E) with D, E the entries of physics §9, so
-/// the perturbation grows like e^{λt} from t = 0 without a decaying part.
+/// A steady motion `steady` displaced by `amplitude` \[rad\] in θ along the eigenvector (1, λ, D, E) of
+/// λ = √(−σ²) (physics §9), so the perturbation grows like e^{λt} from t = 0 without a decaying part.
 #[must_use]
 pub fn displaced(coin: &Coin, steady: &State, amplitude: f64) -> State {
     let l = Linearisation::at(coin, steady.theta, steady.omega_y, steady.omega_z);

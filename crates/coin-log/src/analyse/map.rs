@@ -454,10 +454,8 @@ fn real_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
     vec![q / a, c / q]
 }
 
-/// Where the two roots of P meet (its discriminant is zero), θ₀ > 0 and ω_Z0 > 0: the leans where a band
-/// of unstable circles closes (physics §9, eq (24)). The discriminant times tan²θ₀ is the quadratic
-/// (Ma⁴ − 6 I_Z Ma² − 3 I_Z²) u² − 2 (I_Z + Ma²)(3 I_Z + Ma² + 2 Ma² I_Z/I_X) u + (I_Z + Ma²)² in
-/// u = tan²θ₀. The mirror images (−θ₀, −ω_Z0) are closures too.
+/// Where the two roots of P meet, θ₀ > 0 and ω_Z0 > 0: the leans where a band of unstable circles closes,
+/// the roots u = tan²θ₀ of eq (24) (physics §9). The mirror images (−θ₀, −ω_Z0) are closures too.
 #[must_use]
 pub fn closures(coin: &Coin) -> Vec<BoundaryPoint> {
     let p = coin.params();

@@ -1,7 +1,5 @@
-//! The slow-change approximation of a dissipating coin (physics §11, eqs (35)–(38)): while α = π/2 − |θ|
-//! changes little in a nutation period, the motion stays near the centre-fixed family and
-//! d(sin α)/dt = −C sin^p α, so sin^(1−p) α = sin^(1−p) α₀ − (1 − p) C t, with p = −m/2 − k
-//! ([`Dissipation::angle_exponent`]).
+//! The slow-change approximation of a dissipating coin (physics §11.2, eqs (35)–(38)): while α = π/2 − |θ|
+//! changes little in a nutation period, the motion stays near the centre-fixed family.
 
 use crate::model::{
     centre_fixed_sigma_squared, Coin, Dissipation, DissipationError, DissipationModel, State,
@@ -15,9 +13,7 @@ pub fn alpha_of(s: &State) -> f64 {
     FRAC_PI_2 - s.theta.abs()
 }
 
-/// C of the slow-change law d(sin α)/dt = −C sin^p α on the centre-fixed family (eqs (35)–(37)):
-/// E = (3/2) Mga sin α and P = κ (Mga/I_X)^(m/2) sin^p α, so C = κ (Mga/I_X)^(m/2) / ((3/2) Mga)
-/// [1/time].
+/// C of the slow-change law d(sin α)/dt = −C sin^p α, eq (37) of physics §11.2 [1/time].
 fn slow_change_rate(coin: &Coin, law: &Dissipation) -> f64 {
     let p = coin.params();
     let mga = p.energy_scale();

@@ -93,10 +93,7 @@ pub struct Reaction {
     pub normal: f64,
 }
 
-/// Reaction R of the table (physics §3), from the state and eqs (14)–(16):
-/// R_x = Ma(−(ω̇_Z − ω_X ω_Y) cos φ − (ω_X² − ω_Y ω_Z tan θ) sin θ sin φ + (ω̇_X + ω_Y ω_Z) cos θ sin φ),
-/// R_y = N = Ma(−(ω_X² − ω_Y ω_Z tan θ) cos θ − (ω̇_X + ω_Y ω_Z) sin θ) + Mg,
-/// R_z = Ma((ω̇_Z − ω_X ω_Y) sin φ − (ω_X² − ω_Y ω_Z tan θ) sin θ cos φ + (ω̇_X + ω_Y ω_Z) cos θ cos φ).
+/// Reaction R of the table in world components (physics §3), with ω̇ from eqs (14)–(16).
 ///
 /// ```
 /// use coin_log::model::{reaction, Coin, CoinParams, State};

@@ -1,9 +1,7 @@
 //! Dissipation (physics §11): a couple −P ω/|ω|² on the coin, with power P = κ |φ̇|^m (sin α)^(−k),
 //! α = π/2 − |θ| the angle between the coin and the table, and the dissipated work W as a ninth state
-//! component (Ẇ = P), so that E + W = E₀ holds along the equations (eqs (30)–(34)).
-//!
-//! The conservative coin ([`Coin`]) is left exactly as it is: a dissipative run integrates the separate
-//! system [`DissipativeCoin`], chosen once before the integration starts.
+//! component (Ẇ = P), so that E + W = E₀ holds along the equations (eqs (30)–(34)). [`Coin`] stays as it
+//! is: a dissipative run integrates [`DissipativeCoin`] (see `simulation`).
 
 use super::derived::{reaction_with, Reaction};
 use super::equations::{kinematics, AngularAcceleration, Coin};
@@ -96,7 +94,7 @@ impl Dissipation {
     /// use coin_log::model::{Dissipation, DissipationModel};
     /// let d = Dissipation::preset(DissipationModel::Moffatt, 1e-6).unwrap();
     /// assert_eq!((d.m(), d.k(), d.angle_exponent()), (2.0, 1.0, -2.0));
-    /// assert_eq!(d.predicted_exponent(), Some(1.0 / 3.0));
+    /// assert_eq!(d.predicted_exponent(), 1.0 / 3.0);
     /// ```
     ///
     /// # Errors
@@ -160,12 +158,11 @@ impl Dissipation {
         -0.5 * self.m - self.k
     }
 
-    /// n = 1/(1 − p) of the finite-time law α ∝ (t₀ − t)^n (eq (38)); `None` when p ≥ 1, where there is
-    /// no finite-time singularity (α decays exponentially for p = 1, algebraically for p > 1).
+    /// n = 1/(1 − p) of the law α ∝ |t₀ − t|^n (physics §11.2): a finite-time collapse at t₀ for p < 1
+    /// (eq (38)), an algebraic decay (n < 0) for p > 1, an exponential one (n infinite) for p = 1.
     #[must_use]
-    pub fn predicted_exponent(&self) -> Option<f64> {
-        let p = self.angle_exponent();
-        (p < 1.0).then(|| 1.0 / (1.0 - p))
+    pub fn predicted_exponent(&self) -> f64 {
+        1.0 / (1.0 - self.angle_exponent())
     }
 
     /// The dissipated power P = κ |φ̇|^m (sin α)^(−k) at lean θ and ω_Y (eq (34)), with φ̇ = ω_Y / cos θ
@@ -231,13 +228,8 @@ impl DissipativeCoin {
         &self.dissipation
     }
 
-    /// Angular accelerations of eqs (31)–(33) and the power P of eq (34):
-    ///
-    /// (I_X + Ma²) ω̇_X = [right-hand side of (14)] − (P/|ω|²) ω_X   (31)
-    /// I_X ω̇_Y         = [right-hand side of (15)] − (P/|ω|²) ω_Y   (32)
-    /// (I_Z + Ma²) ω̇_Z = [right-hand side of (16)] − (P/|ω|²) ω_Z   (33)
-    ///
-    /// At ω = 0 the couple is 0 (P = 0 there, since m ≥ 1).
+    /// Angular accelerations of eqs (31)–(33) and the power P of eq (34) (physics §11.1); at ω = 0 the
+    /// couple is 0 (P = 0 there, since m ≥ 1).
     #[must_use]
     #[inline]
     pub fn rates(&self, theta: f64, omega_x: f64, omega_y: f64, omega_z: f64) -> DissipativeRates {
@@ -339,51 +331,5 @@ impl Dynamics {
             Self::Conservative(c) => super::derived::reaction(c, s),
             Self::Dissipative(d) => d.reaction(s),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::CoinParams;
-
-    #[test]
-    fn presets_have_the_documented_exponents_and_names_round_trip() {
-        for &m in DissipationModel::ALL {
-            assert_eq!(m.name().parse::<DissipationModel>(), Ok(m));
-        }
-        assert!("stokes".parse::<DissipationModel>().is_err());
-        let n = |model| {
-            Dissipation::preset(model, 1.0)
-                .unwrap()
-                .predicted_exponent()
-        };
-        assert_eq!(n(DissipationModel::Moffatt), Some(1.0 / 3.0));
-        assert_eq!(n(DissipationModel::AirDrag), Some(4.0 / 9.0));
-        assert_eq!(n(DissipationModel::Viscous), Some(0.5));
-        assert_eq!(n(DissipationModel::Rolling), Some(2.0 / 3.0));
-        assert_eq!(n(DissipationModel::Pivoting), None);
-        assert!(Dissipation::preset(DissipationModel::PowerLaw, 1.0).is_err());
-    }
-
-    #[test]
-    fn bad_values_are_refused() {
-        let m = DissipationModel::PowerLaw;
-        assert!(Dissipation::new(m, -1.0, 2.0, 0.0).is_err());
-        assert!(Dissipation::new(m, f64::NAN, 2.0, 0.0).is_err());
-        assert!(Dissipation::new(m, 1.0, 0.5, 0.0).is_err());
-        assert!(Dissipation::new(m, 1.0, 2.0, f64::INFINITY).is_err());
-        assert!(Dissipation::new(m, 0.0, 1.0, -3.0).is_ok());
-    }
-
-    #[test]
-    fn the_couple_vanishes_at_rest_without_nan() {
-        let d = Dissipation::preset(DissipationModel::Rolling, 2.0).unwrap();
-        let coin = DissipativeCoin::new(Coin::new(CoinParams::unit_disk()), d);
-        let r = coin.rates(0.3, 0.0, 0.0, 0.0);
-        assert_eq!(r.power, 0.0);
-        let conservative =
-            Coin::new(CoinParams::unit_disk()).angular_acceleration(0.3, 0.0, 0.0, 0.0);
-        assert_eq!(r.acceleration, conservative);
     }
 }

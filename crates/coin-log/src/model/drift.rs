@@ -1,13 +1,6 @@
-//! Drift of the conserved quantities over a run, defined once for the recorder's summary, the benches and
-//! `verify` (format.md, verify):
-//!
-//! - energy drift = max |E − E₀| / max(|E₀|, M g a): relative to E₀, never to less than the potential energy
-//!   scale M g a, so that a run with E₀ ≈ 0 is not judged against round-off;
-//! - invariant drift = max over C1, C2 of |C − C₀| / (|C1₀| + |C2₀|) (physics §6). When C1₀ = C2₀ = 0 (a coin
-//!   released without ω_Y and ω_Z) the scale is √(g/a) instead, the natural unit of C (C1, C2 are angular
-//!   velocities times dimensionless functions of θ): they must stay zero, and that is still checked.
-//!
-//! A NaN wins every comparison: a non-finite value makes the drift NaN, which fails any tolerance.
+//! Drift of the conserved quantities over a run, defined once (format.md, "Drift definitions") for the
+//! recorder's summary, the benches and `verify`. A NaN wins every comparison: a non-finite value makes the
+//! drift NaN, which fails any tolerance.
 
 use super::params::CoinParams;
 

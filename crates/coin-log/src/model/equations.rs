@@ -54,11 +54,7 @@ impl Coin {
         &self.params
     }
 
-    /// Angular accelerations from eqs (14)–(16), given θ and ω (lean frame).
-    ///
-    /// (I_X + Ma²) ω̇_X = −(I_Z + Ma²) ω_Y ω_Z − I_X ω_Y² tan θ + Mga sin θ   (14)
-    /// I_X ω̇_Y = I_X ω_X ω_Y tan θ + I_Z ω_Z ω_X                              (15)
-    /// (I_Z + Ma²) ω̇_Z = Ma² ω_X ω_Y                                          (16)
+    /// Angular accelerations from eqs (14)–(16) of physics §2, given θ and ω (lean frame).
     ///
     /// ```
     /// use coin_log::model::{Coin, CoinParams};
@@ -112,9 +108,8 @@ impl Coin {
     }
 }
 
-/// The rows of the right-hand side that no couple changes (physics §2, §11), for a coin of radius `a`:
-/// eqs (17)–(19) and the centre's velocity ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ),
-/// ż = a(ω_Z sin φ + ω_X cos θ cos φ). Returns (sin θ, tan θ) for the accelerations.
+/// The rows of the right-hand side that no couple changes, for a coin of radius `a`: eqs (17)–(19) and
+/// the centre's ẋ, ż (physics §2, §11). Returns (sin θ, tan θ) for the accelerations.
 #[inline]
 pub(super) fn kinematics<const N: usize>(a: f64, y: &[f64; N], dydt: &mut [f64; N]) -> (f64, f64) {
     let (theta, phi, wx, wy, wz) = (y[0], y[1], y[3], y[4], y[5]);

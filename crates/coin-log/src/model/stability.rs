@@ -107,11 +107,7 @@ pub fn eigenvalues(sigma_squared: f64) -> [(f64, f64); 4] {
     }
 }
 
-/// σ² of the steady motion at lean θ₀ with rates ω_Y0, ω_Z0 (ω_X = 0; physics §9, eq (21)):
-///
-/// (I_X + Ma²) σ² = (I_X (1 + 2 sin²θ₀)/cos²θ₀ + Ma²) ω_Y0² + (3 I_Z + Ma²) tan θ₀ ω_Y0 ω_Z0
-///                  + I_Z (I_Z + Ma²) ω_Z0² / I_X − Mga cos θ₀.
-///
+/// σ² of the steady motion at lean θ₀ with rates ω_Y0, ω_Z0 (ω_X = 0; physics §9, eq (21)).
 /// σ² > 0: stable, small perturbations nutate at σ; σ² < 0: unstable, they grow like e^{√(−σ²) t}.
 /// Straight rolling, the upright spin and the centre-fixed motion are its special cases (physics §5).
 ///

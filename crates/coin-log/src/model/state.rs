@@ -3,7 +3,7 @@
 /// Number of state components.
 pub const STATE_LEN: usize = 8;
 
-/// The coin's state, in the order the integrators see it (`as_array`):
+/// The coin's state, in the order the integrators see it ([`State::to_array`]):
 /// θ, φ, ψ, ω_X, ω_Y, ω_Z, x, z.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct State {

@@ -1,7 +1,4 @@
 //! Steady motions (physics §4) and their analytic properties.
-//!
-//! In every steady motion ω_X = 0 and θ, ω_Y, ω_Z are constant; eq (14) then reduces to the steady family
-//! I_X tan θ ω_Y² + (I_Z + Ma²) ω_Z ω_Y − Mga sin θ = 0, which gives ω_Y for a chosen θ and ω_Z.
 
 use super::equations::Coin;
 use super::state::State;

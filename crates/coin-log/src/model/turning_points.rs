@@ -6,9 +6,7 @@
 //! between two samples; the crossing time is the root of the quintic Hermite interpolant of ω_X with its
 //! first two derivatives (ω̇_X from eq (14), ω̈_X = A ω_X + B ω̇_Y + C ω̇_Z with A, B, C the partial
 //! derivatives of eq (14), physics §9: exact, since eq (14) does not contain ω_X), and φ there the quintic
-//! Hermite interpolant of φ with φ̇ = ω_Y / cos θ and φ̈ = (ω̇_Y + ω_X ω_Y tan θ)/cos θ. T and ΔΦ are
-//! (last − first)/(count − 1) over the maxima of θ, and likewise over the minima; the two are averaged,
-//! weighted by their counts.
+//! Hermite interpolant of φ with φ̇ = ω_Y / cos θ and φ̈ = (ω̇_Y + ω_X ω_Y tan θ)/cos θ.
 //!
 //! **Accuracy**: the quintic Hermite interpolant errs by h⁶/46080·max|ω_X⁽⁶⁾| for samples h apart, with
 //! ω_X⁽⁶⁾ ≈ σ⁶ max|ω_X| for the nutation frequency σ, over a slope σ max|ω_X|: each turning point is off
