@@ -16,6 +16,7 @@ use crate::prefetch::{self, Batch, ChunkError, Event};
 use crate::records::{
     AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
 };
+use crate::summary::Summary;
 use mcap::records::{
     op, Channel, ChunkHeader, ChunkIndex, Footer, Header, MessageHeader, MessageIndex, Metadata,
     MetadataIndex, Statistics, SummaryOffset,
@@ -112,22 +113,11 @@ impl fmt::Display for ReadError {
 /// What the structural pass found.
 #[derive(Debug, Default)]
 pub struct Structure {
-    /// File size \[bytes\].
-    pub file_len: u64,
-    /// Messages read.
-    pub messages: u64,
-    /// Chunks read.
-    pub chunks: u64,
+    /// What was read, in the terms of [`read_summary`](crate::read_summary); its `channels` and
+    /// `metadata` stay empty (the visitor is given them).
+    pub summary: Summary,
     /// Structural problems (indexes, statistics, summary).
     pub problems: BoundedFindings,
-    /// The `library` of the header record.
-    pub library: String,
-    /// Chunks by compression name (`""` for uncompressed chunks).
-    pub compressions: BTreeMap<String, u64>,
-    /// The chunks' records, compressed \[bytes\].
-    pub compressed_bytes: u64,
-    /// The chunks' records, uncompressed \[bytes\].
-    pub uncompressed_bytes: u64,
 }
 
 /// Per channel, the digest of the (log time, offset) entries its message index must list.
@@ -172,7 +162,8 @@ fn index_digest(i: &ChunkIndex) -> Digest {
 
 #[derive(Debug, Default)]
 struct Book {
-    s: Structure,
+    s: Summary,
+    problems: BoundedFindings,
     ahead: Lookahead,
     /// Digests of the metadata records passed on early, by offset: the stream does not pass them again.
     early: BTreeMap<u64, Digest>,
@@ -308,11 +299,11 @@ pub fn read_from(
             ReadErrorKind::NotMcap,
             "empty file (0 bytes), not an MCAP file",
         );
-        return (book.s, Some(e));
+        return (book.structure(), Some(e));
     }
     book.ahead = match early_metadata::find(&mut source, len, &mut book.kept) {
         Ok(ahead) => ahead,
-        Err(e) => return (book.s, Some(e)),
+        Err(e) => return (book.structure(), Some(e)),
     };
     for m in std::mem::take(&mut book.ahead.metadata) {
         book.early.insert(m.at, m.digest);
@@ -331,7 +322,7 @@ pub fn read_from(
     if error.is_none() {
         book.finish();
     }
-    (book.s, error)
+    (book.structure(), error)
 }
 
 /// Opens the regular file at `path` and gives its length.
@@ -399,6 +390,17 @@ fn consume(
 }
 
 impl Book {
+    fn structure(self) -> Structure {
+        let time_range = self.min_time.map(|start| (start, self.max_time));
+        Structure {
+            summary: Summary {
+                time_range,
+                ..self.s
+            },
+            problems: self.problems,
+        }
+    }
+
     fn walk(&mut self, batch: &Batch, visitor: &mut impl Visitor) -> Result<(), ReadError> {
         for event in &batch.events {
             match event {
@@ -562,7 +564,7 @@ impl Book {
     }
 
     fn problem(&mut self, p: impl FnOnce() -> String) {
-        self.s.problems.push_with(p);
+        self.problems.push_with(p);
     }
 
     fn close_chunk(&mut self) {

@@ -30,7 +30,8 @@ pub struct ChannelSummary {
     pub messages: u64,
 }
 
-/// A file's self-description, from its summary section.
+/// What a file holds: from its summary section ([`read_summary`]), or as counted by the streaming pass
+/// ([`Structure::summary`](crate::Structure::summary)).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Summary {
     /// File size \[bytes\].
