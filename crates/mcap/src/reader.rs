@@ -327,6 +327,18 @@ pub fn read_from(
 
 /// Opens the regular file at `path` and gives its length.
 pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
+    let len = regular_file(path, false)?.len();
+    let file = std::fs::File::open(path).map_err(io_error)?;
+    Ok((file, len))
+}
+
+/// The metadata of `path` if it names a regular file (following links), looked at without opening it:
+/// an MCAP file is read by seeking, which a folder, pipe, socket or device cannot do. `stdin`: the path
+/// names standard input, which the refusal then says.
+///
+/// # Errors
+/// [`ReadError`] ([`ReadErrorKind::Io`]) if the path cannot be looked at or is not a regular file.
+pub fn regular_file(path: &Path, stdin: bool) -> Result<std::fs::Metadata, ReadError> {
     let meta = std::fs::metadata(path).map_err(io_error)?;
     if meta.is_dir() {
         return Err(ReadError::new(
@@ -337,12 +349,14 @@ pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
     if !meta.is_file() {
         return Err(ReadError::new(
             ReadErrorKind::Io,
-            "is not a regular file (a pipe, socket or device): an MCAP file is read by seeking to its \
-             summary and metadata, which a stream cannot do; save it to a file first",
+            format!(
+                "is {}not a regular file (a pipe, socket or device): an MCAP file is read by seeking \
+                 to its summary and metadata, which a stream cannot do; save it to a file first",
+                if stdin { "standard input, " } else { "" }
+            ),
         ));
     }
-    let file = std::fs::File::open(path).map_err(io_error)?;
-    Ok((file, meta.len()))
+    Ok(meta)
 }
 
 fn read_into(
