@@ -104,16 +104,6 @@ fn folder_of(target: &Path) -> PathBuf {
     }
 }
 
-/// Checks `target` against `policy`; returns its metadata when it is a regular file that may be replaced,
-/// `None` when it does not exist (its folder then does).
-fn check_target(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
-    let meta = look_at(target, policy)?;
-    if meta.is_some() && !policy.overwrite {
-        return Err(exists(target, policy));
-    }
-    Ok(meta)
-}
-
 fn exists(target: &Path, policy: &Policy) -> OutputError {
     let fix = policy.fix(Refused::Exists, target);
     OutputError(format!("`{}` already exists; {fix}", shown(target)))
@@ -125,7 +115,7 @@ fn not_a_folder(path: &str, folder: &str) -> OutputError {
     ))
 }
 
-/// [`check_target`] but for an existing file, which is returned whatever the policy says of replacing it.
+/// [`check`] but for an existing file, which is returned whatever the policy says of replacing it.
 fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
     if target.as_os_str() == "-" {
         let fix = policy.fix(Refused::Special, target);
@@ -266,14 +256,20 @@ pub fn make_readable(file: &File) {
     let _ = file;
 }
 
-/// Checks `target` against `policy` as [`Output::create`] will, creating nothing: for a command that works
-/// long before it writes (`bench`), so that a target it would refuse at the end is refused first.
+/// Checks `target` against `policy` as [`Output::create`] does, creating nothing (for a command that works
+/// long before it writes, `bench`, so that a target it would refuse at the end is refused first); returns
+/// its metadata when it is a regular file that may be replaced, `None` when it does not exist (its folder
+/// then does).
 ///
 /// # Errors
 /// As [`Output::create`]'s checks: the target is not a file that may be written or replaced, or its folder
 /// is missing.
-pub fn check(target: &Path, policy: &Policy) -> Result<(), OutputError> {
-    check_target(target, policy).map(drop)
+pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
+    let meta = look_at(target, policy)?;
+    if meta.is_some() && !policy.overwrite {
+        return Err(exists(target, policy));
+    }
+    Ok(meta)
 }
 
 /// One output file being written: a temporary file beside its target until [`Output::commit`].
@@ -292,7 +288,7 @@ impl Output {
     /// [`OutputError`]: the target is not a file that may be written or replaced, its folder is missing,
     /// or the system refuses the name or the folder.
     pub fn create(target: &Path, policy: &Policy) -> Result<Self, OutputError> {
-        let existing = check_target(target, policy)?;
+        let existing = check(target, policy)?;
         let folder = folder_of(target);
         let suffix = target.extension().map_or_else(
             || ".tmp".to_string(),
