@@ -198,6 +198,13 @@ pub(crate) fn corrupt(detail: String) -> ReadError {
     ReadError::new(ReadErrorKind::Corrupt, detail)
 }
 
+/// The `section` ("data" or "summary") whose CRC `computed` does not match the `stored` one.
+pub(crate) fn bad_crc(section: &str, computed: u32, stored: u32) -> ReadError {
+    corrupt(format!(
+        "corrupt {section} section: CRC {computed:#010x} does not match the stored {stored:#010x}"
+    ))
+}
+
 pub(crate) fn not_mcap() -> ReadError {
     ReadError::new(
         ReadErrorKind::NotMcap,
@@ -526,16 +533,12 @@ impl Book {
                     Some((*claimed, format!("record (opcode {opcode:#04x})"))),
                 )
                 .after(before),
-            McapError::BadDataCrc { saved, calculated } => corrupt(format!(
-                "corrupt data section: CRC {calculated:#010x} does not match the stored \
-                 {saved:#010x}"
-            ))
-            .after(read),
-            McapError::BadSummaryCrc { saved, calculated } => corrupt(format!(
-                "corrupt summary section: CRC {calculated:#010x} does not match the stored \
-                 {saved:#010x}"
-            ))
-            .after(read),
+            McapError::BadDataCrc { saved, calculated } => {
+                bad_crc("data", *calculated, *saved).after(read)
+            }
+            McapError::BadSummaryCrc { saved, calculated } => {
+                bad_crc("summary", *calculated, *saved).after(read)
+            }
             McapError::BytesAfterEndMagic => corrupt(format!(
                 "{} bytes follow the MCAP end magic",
                 len.saturating_sub(at)
