@@ -339,9 +339,8 @@ pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
     Ok((file, len))
 }
 
-/// The metadata of `path` if it names a regular file (following links), looked at without opening it:
-/// an MCAP file is read by seeking, which a folder, pipe, socket or device cannot do. `stdin`: the path
-/// names standard input, which the refusal then says.
+/// The metadata of `path` if it is a regular file (links followed), looked at without opening it: an MCAP
+/// file is read by seeking. `stdin`: the path names standard input (the refusal says so).
 ///
 /// # Errors
 /// [`ReadError`] ([`ReadErrorKind::Io`]) if the path cannot be looked at or is not a regular file.
