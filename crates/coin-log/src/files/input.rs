@@ -163,36 +163,3 @@ pub fn read_regular(path: &Path) -> io::Result<String> {
     open_regular(path)?.read_to_string(&mut text)?;
     Ok(text)
 }
-
-#[cfg(test)]
-mod tests {
-    use super::{check, read_scene, InputKind, SCENE_MAX_BYTES};
-    use std::path::Path;
-
-    #[test]
-    fn devices_folders_and_stdin_are_refused_with_the_reason() {
-        for (path, needle) in [
-            ("/dev/zero", "is a character device, not a regular file"),
-            ("/dev/urandom", "is a character device"),
-            ("/", "is a directory, not a scene file"),
-            ("-", "reading standard input is not offered"),
-        ] {
-            let e = read_scene(Path::new(path)).unwrap_err().to_string();
-            assert!(e.contains(needle), "{path}: {e}");
-        }
-        let e = check(Path::new("/dev/null"), InputKind::Mcap).unwrap_err();
-        assert!(e.to_string().starts_with("is not a regular file"), "{e}");
-    }
-
-    #[test]
-    fn a_scene_above_the_limit_is_refused_and_one_at_it_read() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("s.toml");
-        let at = usize::try_from(SCENE_MAX_BYTES).unwrap();
-        std::fs::write(&path, "#".repeat(at)).unwrap();
-        assert_eq!(read_scene(&path).unwrap().len(), at);
-        std::fs::write(&path, "#".repeat(at + 1)).unwrap();
-        let e = read_scene(&path).unwrap_err().to_string();
-        assert!(e.contains("more than 1048576 bytes"), "{e}");
-    }
-}
