@@ -11,7 +11,7 @@
 use crate::support::mkfifo;
 use crate::support::record::{coin_log, exe, listing};
 use coin_log::files::input::{check, read_scene, InputKind, SCENE_MAX_BYTES};
-use coin_log::files::{Output, OutputFolder, Policy};
+use coin_log::files::{cut, shown, Output, OutputFolder, Policy};
 use std::io::{Read, Write};
 use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
@@ -682,4 +682,16 @@ fn a_scene_above_the_limit_is_refused_and_one_at_it_read() {
     std::fs::write(&path, "#".repeat(at + 1)).unwrap();
     let e = read_scene(&path).unwrap_err().to_string();
     assert!(e.contains("more than 1048576 bytes"), "{e}");
+}
+
+#[test]
+fn a_cut_keeps_whole_characters() {
+    assert_eq!(cut("ééé", 2), "éé…");
+    assert_eq!(cut("ab", 2), "ab");
+}
+
+#[test]
+fn control_characters_in_paths_are_escaped_and_the_rest_kept() {
+    assert_eq!(shown(Path::new("a/b c é.mcap")), "a/b c é.mcap");
+    assert_eq!(shown(Path::new("x\ny\r\u{1b}[31m")), "x\\ny\\r\\u{1b}[31m");
 }
