@@ -10,6 +10,8 @@
 
 use crate::support::mkfifo;
 use crate::support::record::{coin_log, exe, listing};
+use coin_log::files::input::{check, read_scene, InputKind, SCENE_MAX_BYTES};
+use coin_log::files::{cut, shown, Output, OutputFolder, Policy};
 use std::io::{Read, Write};
 use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
@@ -595,4 +597,101 @@ fn export_of_a_file_without_coin_log_channels_exits_non_zero() {
         "{err}"
     );
     assert_eq!(listing(dir.path()), ["other.mcap"], "no folder left");
+}
+
+// The library's policies (coin_log::files) without a child process.
+
+fn policy(overwrite: bool) -> Policy {
+    Policy {
+        overwrite,
+        flag: "-o",
+        example: "x.txt".into(),
+        protect: None,
+    }
+}
+
+#[test]
+fn a_file_lands_whole_and_replaces_only_with_overwrite() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("a.txt");
+    Output::write(&target, &policy(false), b"one").unwrap();
+    assert_eq!(std::fs::read(&target).unwrap(), b"one");
+    let e = Output::write(&target, &policy(false), b"two").unwrap_err();
+    assert!(e.to_string().contains("already exists"), "{e}");
+    Output::write(&target, &policy(true), b"two").unwrap();
+    assert_eq!(std::fs::read(&target).unwrap(), b"two");
+    assert_eq!(listing(dir.path()), ["a.txt"]);
+}
+
+#[test]
+fn a_target_replaced_by_a_folder_keeps_the_finished_file_and_names_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("a.txt");
+    std::fs::write(&target, "old").unwrap();
+    let mut output = Output::create(&target, &policy(true)).unwrap();
+    output.file().write_all(b"finished").unwrap();
+    std::fs::remove_file(&target).unwrap();
+    std::fs::create_dir(&target).unwrap();
+    let e = output.commit().unwrap_err().to_string();
+    println!("{e}");
+    let kept = e.split("kept as `").nth(1).unwrap().trim_end_matches('`');
+    assert!(e.contains("is a folder"), "{e}");
+    assert_eq!(std::fs::read(kept).unwrap(), b"finished");
+}
+
+#[test]
+fn a_dropped_folder_output_leaves_nothing_not_even_its_folders() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut folder = OutputFolder::create(&dir.path().join("a/b"), false).unwrap();
+    folder.file("t.csv").unwrap().write_all(b"x").unwrap();
+    assert_eq!(
+        listing(&dir.path().join("a/b")).len(),
+        1,
+        "the temporary file"
+    );
+    drop(folder);
+    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    let mut folder = OutputFolder::create(&dir.path().join("c"), false).unwrap();
+    folder.file("t.csv").unwrap().write_all(b"x").unwrap();
+    folder.commit().unwrap();
+    assert_eq!(listing(&dir.path().join("c")), ["t.csv"]);
+}
+
+#[test]
+fn devices_folders_and_stdin_are_refused_with_the_reason() {
+    for (path, needle) in [
+        ("/dev/zero", "is a character device, not a regular file"),
+        ("/dev/urandom", "is a character device"),
+        ("/", "is a directory, not a scene file"),
+        ("-", "reading standard input is not offered"),
+    ] {
+        let e = read_scene(Path::new(path)).unwrap_err().to_string();
+        assert!(e.contains(needle), "{path}: {e}");
+    }
+    let e = check(Path::new("/dev/null"), InputKind::Mcap).unwrap_err();
+    assert!(e.to_string().starts_with("is not a regular file"), "{e}");
+}
+
+#[test]
+fn a_scene_above_the_limit_is_refused_and_one_at_it_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.toml");
+    let at = usize::try_from(SCENE_MAX_BYTES).unwrap();
+    std::fs::write(&path, "#".repeat(at)).unwrap();
+    assert_eq!(read_scene(&path).unwrap().len(), at);
+    std::fs::write(&path, "#".repeat(at + 1)).unwrap();
+    let e = read_scene(&path).unwrap_err().to_string();
+    assert!(e.contains("more than 1048576 bytes"), "{e}");
+}
+
+#[test]
+fn a_cut_keeps_whole_characters() {
+    assert_eq!(cut("ééé", 2), "éé…");
+    assert_eq!(cut("ab", 2), "ab");
+}
+
+#[test]
+fn control_characters_in_paths_are_escaped_and_the_rest_kept() {
+    assert_eq!(shown(Path::new("a/b c é.mcap")), "a/b c é.mcap");
+    assert_eq!(shown(Path::new("x\ny\r\u{1b}[31m")), "x\\ny\\r\\u{1b}[31m");
 }

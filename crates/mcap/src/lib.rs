@@ -23,7 +23,7 @@ pub use findings::BoundedFindings;
 pub use mcap::records::MessageHeader;
 pub use mcap::Schema;
 pub use reader::{
-    read, read_from, read_with_progress, ReadError, ReadErrorKind, Structure, Visitor,
+    read, read_from, read_with_progress, regular_file, ReadError, ReadErrorKind, Structure, Visitor,
 };
 pub use summary::{read_summary, ChannelSummary, Summary};
 pub use writer::{

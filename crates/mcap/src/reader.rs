@@ -16,6 +16,7 @@ use crate::prefetch::{self, Batch, ChunkError, Event};
 use crate::records::{
     AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
 };
+use crate::summary::Summary;
 use mcap::records::{
     op, Channel, ChunkHeader, ChunkIndex, Footer, Header, MessageHeader, MessageIndex, Metadata,
     MetadataIndex, Statistics, SummaryOffset,
@@ -112,22 +113,11 @@ impl fmt::Display for ReadError {
 /// What the structural pass found.
 #[derive(Debug, Default)]
 pub struct Structure {
-    /// File size \[bytes\].
-    pub file_len: u64,
-    /// Messages read.
-    pub messages: u64,
-    /// Chunks read.
-    pub chunks: u64,
+    /// What was read, in the terms of [`read_summary`](crate::read_summary); its `channels` and
+    /// `metadata` stay empty (the visitor is given them).
+    pub summary: Summary,
     /// Structural problems (indexes, statistics, summary).
     pub problems: BoundedFindings,
-    /// The `library` of the header record.
-    pub library: String,
-    /// Chunks by compression name (`""` for uncompressed chunks).
-    pub compressions: BTreeMap<String, u64>,
-    /// The chunks' records, compressed \[bytes\].
-    pub compressed_bytes: u64,
-    /// The chunks' records, uncompressed \[bytes\].
-    pub uncompressed_bytes: u64,
 }
 
 /// Per channel, the digest of the (log time, offset) entries its message index must list.
@@ -172,7 +162,8 @@ fn index_digest(i: &ChunkIndex) -> Digest {
 
 #[derive(Debug, Default)]
 struct Book {
-    s: Structure,
+    s: Summary,
+    problems: BoundedFindings,
     ahead: Lookahead,
     /// Digests of the metadata records passed on early, by offset: the stream does not pass them again.
     early: BTreeMap<u64, Digest>,
@@ -205,6 +196,13 @@ struct Book {
 
 pub(crate) fn corrupt(detail: String) -> ReadError {
     ReadError::new(ReadErrorKind::Corrupt, detail)
+}
+
+/// The `section` ("data" or "summary") whose CRC `computed` does not match the `stored` one.
+pub(crate) fn bad_crc(section: &str, computed: u32, stored: u32) -> ReadError {
+    corrupt(format!(
+        "corrupt {section} section: CRC {computed:#010x} does not match the stored {stored:#010x}"
+    ))
 }
 
 pub(crate) fn not_mcap() -> ReadError {
@@ -308,11 +306,11 @@ pub fn read_from(
             ReadErrorKind::NotMcap,
             "empty file (0 bytes), not an MCAP file",
         );
-        return (book.s, Some(e));
+        return (book.structure(), Some(e));
     }
     book.ahead = match early_metadata::find(&mut source, len, &mut book.kept) {
         Ok(ahead) => ahead,
-        Err(e) => return (book.s, Some(e)),
+        Err(e) => return (book.structure(), Some(e)),
     };
     for m in std::mem::take(&mut book.ahead.metadata) {
         book.early.insert(m.at, m.digest);
@@ -331,11 +329,22 @@ pub fn read_from(
     if error.is_none() {
         book.finish();
     }
-    (book.s, error)
+    (book.structure(), error)
 }
 
 /// Opens the regular file at `path` and gives its length.
 pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
+    let len = regular_file(path, false)?.len();
+    let file = std::fs::File::open(path).map_err(io_error)?;
+    Ok((file, len))
+}
+
+/// The metadata of `path` if it is a regular file (links followed), looked at without opening it: an MCAP
+/// file is read by seeking. `stdin`: the path names standard input (the refusal says so).
+///
+/// # Errors
+/// [`ReadError`] ([`ReadErrorKind::Io`]) if the path cannot be looked at or is not a regular file.
+pub fn regular_file(path: &Path, stdin: bool) -> Result<std::fs::Metadata, ReadError> {
     let meta = std::fs::metadata(path).map_err(io_error)?;
     if meta.is_dir() {
         return Err(ReadError::new(
@@ -346,12 +355,14 @@ pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
     if !meta.is_file() {
         return Err(ReadError::new(
             ReadErrorKind::Io,
-            "is not a regular file (a pipe, socket or device): an MCAP file is read by seeking to its \
-             summary and metadata, which a stream cannot do; save it to a file first",
+            format!(
+                "is {}not a regular file (a pipe, socket or device): an MCAP file is read by seeking \
+                 to its summary and metadata, which a stream cannot do; save it to a file first",
+                if stdin { "standard input, " } else { "" }
+            ),
         ));
     }
-    let file = std::fs::File::open(path).map_err(io_error)?;
-    Ok((file, meta.len()))
+    Ok(meta)
 }
 
 fn read_into(
@@ -399,6 +410,17 @@ fn consume(
 }
 
 impl Book {
+    fn structure(self) -> Structure {
+        let time_range = self.min_time.map(|start| (start, self.max_time));
+        Structure {
+            summary: Summary {
+                time_range,
+                ..self.s
+            },
+            problems: self.problems,
+        }
+    }
+
     fn walk(&mut self, batch: &Batch, visitor: &mut impl Visitor) -> Result<(), ReadError> {
         for event in &batch.events {
             match event {
@@ -510,16 +532,12 @@ impl Book {
                     Some((*claimed, format!("record (opcode {opcode:#04x})"))),
                 )
                 .after(before),
-            McapError::BadDataCrc { saved, calculated } => corrupt(format!(
-                "corrupt data section: CRC {calculated:#010x} does not match the stored \
-                 {saved:#010x}"
-            ))
-            .after(read),
-            McapError::BadSummaryCrc { saved, calculated } => corrupt(format!(
-                "corrupt summary section: CRC {calculated:#010x} does not match the stored \
-                 {saved:#010x}"
-            ))
-            .after(read),
+            McapError::BadDataCrc { saved, calculated } => {
+                bad_crc("data", *calculated, *saved).after(read)
+            }
+            McapError::BadSummaryCrc { saved, calculated } => {
+                bad_crc("summary", *calculated, *saved).after(read)
+            }
             McapError::BytesAfterEndMagic => corrupt(format!(
                 "{} bytes follow the MCAP end magic",
                 len.saturating_sub(at)
@@ -562,7 +580,7 @@ impl Book {
     }
 
     fn problem(&mut self, p: impl FnOnce() -> String) {
-        self.s.problems.push_with(p);
+        self.problems.push_with(p);
     }
 
     fn close_chunk(&mut self) {

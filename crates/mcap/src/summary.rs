@@ -7,7 +7,7 @@
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::early_metadata::{self, MAX_EARLY};
-use crate::reader::{self, corrupt, io_error, not_mcap, ReadError};
+use crate::reader::{self, bad_crc, corrupt, io_error, not_mcap, ReadError};
 use crate::records::{self, Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
 use mcap::records::{op, Channel, ChunkIndex, Footer, Header, MetadataIndex, Statistics};
 use mcap::Schema;
@@ -30,7 +30,8 @@ pub struct ChannelSummary {
     pub messages: u64,
 }
 
-/// A file's self-description, from its summary section.
+/// What a file holds: from its summary section ([`read_summary`]), or as counted by the streaming pass
+/// ([`Structure::summary`](crate::Structure::summary)).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Summary {
     /// File size \[bytes\].
@@ -134,10 +135,7 @@ fn summary_section(
     let mut bytes = bytes_at(file, file_len, summary_start, crc_end - summary_start)?;
     let computed = crc32fast::hash(&bytes);
     if check_crc && footer.summary_crc != 0 && computed != footer.summary_crc {
-        return Err(corrupt(format!(
-            "corrupt summary section: CRC {computed:#010x} does not match the stored {:#010x}",
-            footer.summary_crc
-        )));
+        return Err(bad_crc("summary", computed, footer.summary_crc));
     }
     bytes.truncate(usize::try_from(footer_at - summary_start).unwrap_or(0));
     Ok(Some((summary_start, bytes)))

@@ -28,40 +28,11 @@ pub enum InputKind {
 #[error("{0}")]
 pub struct InputError(String);
 
-impl InputError {
-    /// The path cannot be looked at or read (for an MCAP file in the words of its reader).
-    fn io(kind: InputKind, source: &io::Error) -> Self {
-        let prefix = if kind == InputKind::Mcap {
-            "cannot read: "
-        } else {
-            ""
-        };
-        Self(format!("{prefix}{source}"))
-    }
-}
-
 fn what(kind: InputKind) -> &'static str {
     match kind {
         InputKind::Scene => "a scene file",
         InputKind::Sweep => "a sweep file",
         InputKind::Mcap => "an MCAP file",
-    }
-}
-
-fn special(kind: InputKind, what: &str, stdin: bool) -> String {
-    match kind {
-        // The words of coin_log_mcap's reader, which refuses the same for `verify`.
-        InputKind::Mcap => format!(
-            "is {}not a regular file (a pipe, socket or device): an MCAP file is read by seeking to its \
-             summary and metadata, which a stream cannot do; save it to a file first",
-            if stdin { "standard input, " } else { "" }
-        ),
-        InputKind::Scene | InputKind::Sweep => format!(
-            "is {}{what}, not a regular file: {} is read whole, and a pipe or device may never end; save it \
-             to a file and give its path",
-            if stdin { "standard input, " } else { "" },
-            self::what(kind)
-        ),
     }
 }
 
@@ -80,13 +51,22 @@ pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
                 .into(),
         ));
     }
-    let meta = fs::metadata(path).map_err(|source| InputError::io(kind, &source))?;
+    let stdin = STDIN_PATHS.iter().any(|s| path == Path::new(s));
+    if kind == InputKind::Mcap {
+        return coin_log_mcap::regular_file(path, stdin).map_err(|e| InputError(e.detail));
+    }
+    let meta = fs::metadata(path).map_err(|source| InputError(source.to_string()))?;
     if meta.is_dir() {
         return Err(InputError(format!("is a directory, not {}", what(kind))));
     }
     if !meta.is_file() {
-        let stdin = STDIN_PATHS.iter().any(|s| path == Path::new(s));
-        return Err(InputError(special(kind, kind_of(&meta), stdin)));
+        return Err(InputError(format!(
+            "is {}{}, not a regular file: {} is read whole, and a pipe or device may never end; save it \
+             to a file and give its path",
+            if stdin { "standard input, " } else { "" },
+            kind_of(&meta),
+            what(kind)
+        )));
     }
     Ok(meta)
 }
@@ -110,7 +90,7 @@ pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
     let mut text = String::new();
     let read = File::open(path)
         .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_string(&mut text))
-        .map_err(|source| InputError::io(kind, &source))?;
+        .map_err(|source| InputError(source.to_string()))?;
     if read as u64 > SCENE_MAX_BYTES {
         let bytes = fs::metadata(path).map_or(read as u64, |m| m.len().max(read as u64));
         return Err(InputError(format!(
@@ -182,37 +162,4 @@ pub fn read_regular(path: &Path) -> io::Result<String> {
     let mut text = String::new();
     open_regular(path)?.read_to_string(&mut text)?;
     Ok(text)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{check, read_scene, InputKind, SCENE_MAX_BYTES};
-    use std::path::Path;
-
-    #[test]
-    fn devices_folders_and_stdin_are_refused_with_the_reason() {
-        for (path, needle) in [
-            ("/dev/zero", "is a character device, not a regular file"),
-            ("/dev/urandom", "is a character device"),
-            ("/", "is a directory, not a scene file"),
-            ("-", "reading standard input is not offered"),
-        ] {
-            let e = read_scene(Path::new(path)).unwrap_err().to_string();
-            assert!(e.contains(needle), "{path}: {e}");
-        }
-        let e = check(Path::new("/dev/null"), InputKind::Mcap).unwrap_err();
-        assert!(e.to_string().starts_with("is not a regular file"), "{e}");
-    }
-
-    #[test]
-    fn a_scene_above_the_limit_is_refused_and_one_at_it_read() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("s.toml");
-        let at = usize::try_from(SCENE_MAX_BYTES).unwrap();
-        std::fs::write(&path, "#".repeat(at)).unwrap();
-        assert_eq!(read_scene(&path).unwrap().len(), at);
-        std::fs::write(&path, "#".repeat(at + 1)).unwrap();
-        let e = read_scene(&path).unwrap_err().to_string();
-        assert!(e.contains("more than 1048576 bytes"), "{e}");
-    }
 }

@@ -58,21 +58,3 @@ pub fn cut(text: &str, max: usize) -> Cow<'_, str> {
         None => text.into(),
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::{cut, shown};
-    use std::path::Path;
-
-    #[test]
-    fn a_cut_keeps_whole_characters() {
-        assert_eq!(cut("ééé", 2), "éé…");
-        assert_eq!(cut("ab", 2), "ab");
-    }
-
-    #[test]
-    fn control_characters_in_paths_are_escaped_and_the_rest_kept() {
-        assert_eq!(shown(Path::new("a/b c é.mcap")), "a/b c é.mcap");
-        assert_eq!(shown(Path::new("x\ny\r\u{1b}[31m")), "x\\ny\\r\\u{1b}[31m");
-    }
-}

@@ -104,16 +104,6 @@ fn folder_of(target: &Path) -> PathBuf {
     }
 }
 
-/// Checks `target` against `policy`; returns its metadata when it is a regular file that may be replaced,
-/// `None` when it does not exist (its folder then does).
-fn check_target(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
-    let meta = look_at(target, policy)?;
-    if meta.is_some() && !policy.overwrite {
-        return Err(exists(target, policy));
-    }
-    Ok(meta)
-}
-
 fn exists(target: &Path, policy: &Policy) -> OutputError {
     let fix = policy.fix(Refused::Exists, target);
     OutputError(format!("`{}` already exists; {fix}", shown(target)))
@@ -125,7 +115,7 @@ fn not_a_folder(path: &str, folder: &str) -> OutputError {
     ))
 }
 
-/// [`check_target`] but for an existing file, which is returned whatever the policy says of replacing it.
+/// [`check`] but for an existing file, which is returned whatever the policy says of replacing it.
 fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
     if target.as_os_str() == "-" {
         let fix = policy.fix(Refused::Special, target);
@@ -266,14 +256,20 @@ pub fn make_readable(file: &File) {
     let _ = file;
 }
 
-/// Checks `target` against `policy` as [`Output::create`] will, creating nothing: for a command that works
-/// long before it writes (`bench`), so that a target it would refuse at the end is refused first.
+/// Checks `target` against `policy` as [`Output::create`] does, creating nothing (for a command that works
+/// long before it writes, `bench`, so that a target it would refuse at the end is refused first); returns
+/// its metadata when it is a regular file that may be replaced, `None` when it does not exist (its folder
+/// then does).
 ///
 /// # Errors
 /// As [`Output::create`]'s checks: the target is not a file that may be written or replaced, or its folder
 /// is missing.
-pub fn check(target: &Path, policy: &Policy) -> Result<(), OutputError> {
-    check_target(target, policy).map(drop)
+pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
+    let meta = look_at(target, policy)?;
+    if meta.is_some() && !policy.overwrite {
+        return Err(exists(target, policy));
+    }
+    Ok(meta)
 }
 
 /// One output file being written: a temporary file beside its target until [`Output::commit`].
@@ -292,7 +288,7 @@ impl Output {
     /// [`OutputError`]: the target is not a file that may be written or replaced, its folder is missing,
     /// or the system refuses the name or the folder.
     pub fn create(target: &Path, policy: &Policy) -> Result<Self, OutputError> {
-        let existing = check_target(target, policy)?;
+        let existing = check(target, policy)?;
         let folder = folder_of(target);
         let suffix = target.extension().map_or_else(
             || ".tmp".to_string(),
@@ -504,76 +500,5 @@ impl Drop for OutputFolder {
         for d in &self.created {
             let _ = fs::remove_dir(d);
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{Output, OutputFolder, Policy};
-    use std::io::Write;
-
-    fn policy(overwrite: bool) -> Policy {
-        Policy {
-            overwrite,
-            flag: "-o",
-            example: "x.txt".into(),
-            protect: None,
-        }
-    }
-
-    fn listing(dir: &std::path::Path) -> Vec<String> {
-        let mut names: Vec<String> = std::fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        names.sort();
-        names
-    }
-
-    #[test]
-    fn a_file_lands_whole_and_replaces_only_with_overwrite() {
-        let dir = tempfile::tempdir().unwrap();
-        let target = dir.path().join("a.txt");
-        Output::write(&target, &policy(false), b"one").unwrap();
-        assert_eq!(std::fs::read(&target).unwrap(), b"one");
-        let e = Output::write(&target, &policy(false), b"two").unwrap_err();
-        assert!(e.to_string().contains("already exists"), "{e}");
-        Output::write(&target, &policy(true), b"two").unwrap();
-        assert_eq!(std::fs::read(&target).unwrap(), b"two");
-        assert_eq!(listing(dir.path()), ["a.txt"]);
-    }
-
-    #[test]
-    fn a_target_replaced_by_a_folder_keeps_the_finished_file_and_names_it() {
-        let dir = tempfile::tempdir().unwrap();
-        let target = dir.path().join("a.txt");
-        std::fs::write(&target, "old").unwrap();
-        let mut output = Output::create(&target, &policy(true)).unwrap();
-        output.file().write_all(b"finished").unwrap();
-        std::fs::remove_file(&target).unwrap();
-        std::fs::create_dir(&target).unwrap();
-        let e = output.commit().unwrap_err().to_string();
-        println!("{e}");
-        let kept = e.split("kept as `").nth(1).unwrap().trim_end_matches('`');
-        assert!(e.contains("is a folder"), "{e}");
-        assert_eq!(std::fs::read(kept).unwrap(), b"finished");
-    }
-
-    #[test]
-    fn a_dropped_folder_output_leaves_nothing_not_even_its_folders() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut folder = OutputFolder::create(&dir.path().join("a/b"), false).unwrap();
-        folder.file("t.csv").unwrap().write_all(b"x").unwrap();
-        assert_eq!(
-            listing(&dir.path().join("a/b")).len(),
-            1,
-            "the temporary file"
-        );
-        drop(folder);
-        assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
-        let mut folder = OutputFolder::create(&dir.path().join("c"), false).unwrap();
-        folder.file("t.csv").unwrap().write_all(b"x").unwrap();
-        folder.commit().unwrap();
-        assert_eq!(listing(&dir.path().join("c")), ["t.csv"]);
     }
 }

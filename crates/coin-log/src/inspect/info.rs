@@ -387,16 +387,9 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
         })
         .collect();
     let summary = coin_log_mcap::Summary {
-        file_len: s.file_len,
-        library: s.library,
-        messages: s.messages,
         time_range: v.time_range,
-        channels: Vec::new(),
-        chunks: s.chunks,
-        compressions: s.compressions,
-        compressed_bytes: s.compressed_bytes,
-        uncompressed_bytes: s.uncompressed_bytes,
         metadata: v.metadata,
+        ..s.summary
     };
     Ok(FileInfo {
         source: Source::Scan,

@@ -554,7 +554,7 @@ fn verdict(
                  judge",
                 e.detail
             ),
-            (None, None) => judge.not_coin_log(&structure.library),
+            (None, None) => judge.not_coin_log(&structure.summary.library),
         };
         return unusable(&shown, why);
     };
@@ -566,7 +566,7 @@ fn verdict(
     let tol = tolerances(&ctx, &judge.checks.stats, options);
     let read = format!(
         "{} messages in {} chunks, {} samples",
-        structure.messages, structure.chunks, judge.checks.stats.samples
+        structure.summary.messages, structure.summary.chunks, judge.checks.stats.samples
     );
     let c = &judge.checks;
     let results = vec![

@@ -50,12 +50,22 @@ fn color(c: Rgba) -> Option<Color> {
     })
 }
 
+/// The pose at `position` rotated by `q`.
+pub(super) fn pose(position: [f64; 3], q: &UnitQuaternion<f64>) -> Pose {
+    Pose {
+        position: vector3(position[0], position[1], position[2]),
+        orientation: quaternion(q),
+    }
+}
+
 /// The pose of a frame's own origin, unrotated.
 pub(super) fn identity() -> Pose {
-    Pose {
-        position: vector3(0.0, 0.0, 0.0),
-        orientation: quaternion(&UnitQuaternion::identity()),
-    }
+    pose([0.0; 3], &UnitQuaternion::identity())
+}
+
+/// A point (x, y, 0) of a line.
+fn point(x: f64, y: f64) -> Point3 {
+    Point3 { x, y, z: 0.0 }
 }
 
 pub(super) fn transform(
@@ -139,19 +149,13 @@ pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, th
     let mut e = entity(log_time, FOLLOW_FRAME, "coin");
     for (position, size, rgba) in coin_marks(r, thickness) {
         e.cubes.push(CubePrimitive {
-            pose: Some(Pose {
-                position: vector3(position.x, position.y, position.z),
-                orientation: quaternion(r),
-            }),
+            pose: Some(pose(position.into(), r)),
             size: vector3(size[0], size[1], size[2]),
             color: color(rgba),
         });
     }
     e.cylinders.push(CylinderPrimitive {
-        pose: Some(Pose {
-            position: vector3(0.0, 0.0, 0.0),
-            orientation: quaternion(r),
-        }),
+        pose: Some(pose([0.0; 3], r)),
         size: vector3(2.0, 2.0, thickness),
         bottom_scale: 1.0,
         top_scale: 1.0,
@@ -165,33 +169,20 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     let mut e = entity(log_time, WORLD_FRAME, "table");
     let side = 2.0 * TABLE_HALF_SIDE;
     e.cubes.push(CubePrimitive {
-        pose: Some(Pose {
-            position: vector3(centre[0], centre[1], TABLE_TOP - 0.5 * TABLE_THICKNESS),
-            orientation: quaternion(&UnitQuaternion::identity()),
-        }),
+        pose: Some(pose(
+            [centre[0], centre[1], TABLE_TOP - 0.5 * TABLE_THICKNESS],
+            &UnitQuaternion::identity(),
+        )),
         size: vector3(side, side, TABLE_THICKNESS),
         color: color(TABLE_RGBA),
     });
     for major in [false, true] {
-        let mut points = Vec::new();
-        for (a, b) in grid_segments(centre, major) {
-            points.push(Point3 {
-                x: a[0],
-                y: a[1],
-                z: 0.0,
-            });
-            points.push(Point3 {
-                x: b[0],
-                y: b[1],
-                z: 0.0,
-            });
-        }
+        let points = grid_segments(centre, major)
+            .flat_map(|(a, b)| [point(a[0], a[1]), point(b[0], b[1])])
+            .collect();
         e.lines.push(LinePrimitive {
             r#type: line_primitive::Type::LineList as i32,
-            pose: Some(Pose {
-                position: vector3(0.0, 0.0, GRID_HEIGHT),
-                orientation: quaternion(&UnitQuaternion::identity()),
-            }),
+            pose: Some(pose([0.0, 0.0, GRID_HEIGHT], &UnitQuaternion::identity())),
             thickness: GRID_WIDTHS[usize::from(major)],
             scale_invariant: true,
             points,
@@ -205,14 +196,7 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
 
 /// `/scene/track/<L>`: the level's points as one line strip.
 pub(super) fn track(buf: &mut Vec<u8>, log_time: u64, points: &[TrackPoint]) {
-    let line = points
-        .iter()
-        .map(|p| Point3 {
-            x: p.x,
-            y: p.y,
-            z: 0.0,
-        })
-        .collect();
+    let line = points.iter().map(|p| point(p.x, p.y)).collect();
     let mut e = entity(log_time, WORLD_FRAME, "track");
     e.lines.push(LinePrimitive {
         r#type: line_primitive::Type::LineStrip as i32,

@@ -2,7 +2,7 @@
 //! the table (a voxel grid) and the track (point clouds) again, in the types Rerun's MCAP importer turns
 //! into geometry, since it draws no `foxglove.SceneUpdate`. Display units and frames as in [`super`].
 
-use super::proto::{identity, timestamp, transform};
+use super::proto::{identity, pose, timestamp, transform};
 use super::{
     coin_marks, Rgba, COIN_RGBA, FOLLOW_FRAME, TABLE_HALF_SIDE, TABLE_RGBA, TABLE_THICKNESS,
     TABLE_TOP, TRACK_RGBA, WORLD_FRAME,
@@ -10,7 +10,7 @@ use super::{
 use super::{FoxgloveBatch, Topic};
 use crate::format::Channel;
 use foxglove::messages::packed_element_field::NumericType;
-use foxglove::messages::{PackedElementField, PointCloud, Pose, Vector3, VoxelGrid};
+use foxglove::messages::{PackedElementField, PointCloud, Vector3, VoxelGrid};
 use nalgebra::UnitQuaternion;
 use prost::Message;
 
@@ -151,14 +151,14 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     VoxelGrid {
         timestamp: Some(timestamp(log_time)),
         frame_id: WORLD_FRAME.to_string(),
-        pose: Some(Pose {
-            position: Some(Vector3 {
-                x: centre[0] - TABLE_HALF_SIDE,
-                y: centre[1] - TABLE_HALF_SIDE,
-                z: TABLE_TOP - TABLE_THICKNESS,
-            }),
-            ..identity()
-        }),
+        pose: Some(pose(
+            [
+                centre[0] - TABLE_HALF_SIDE,
+                centre[1] - TABLE_HALF_SIDE,
+                TABLE_TOP - TABLE_THICKNESS,
+            ],
+            &UnitQuaternion::identity(),
+        )),
         row_count: n,
         column_count: n,
         cell_size: Some(Vector3 {
