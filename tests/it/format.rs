@@ -2,6 +2,8 @@
 //! terminations round-trip, the one time conversion is exact and monotone, and the tolerances and what
 //! `record` promises follow from a run's settings.
 
+#![allow(clippy::unwrap_used)]
+
 use coin_log::format::promise::{check_list, shortfalls, Cause, FixedSteps};
 use coin_log::format::tolerances::{RunAccuracy, Tolerances};
 use coin_log::format::{log_time, schema_data, Channel, Encoding, Termination, Topic};
