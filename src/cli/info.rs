@@ -185,9 +185,9 @@ fn text(shown: &str, i: &FileInfo) -> String {
 
 /// Size, compression, writer, description, time span and message count.
 fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
-    let (packed, unpacked) = i.chunk_bytes;
+    let (packed, unpacked) = (i.summary.compressed_bytes, i.summary.uncompressed_bytes);
     // A file cut inside its only chunk has seen that chunk's compression but counts no (complete) chunk.
-    let chunks = match (i.chunks, i.compressions.is_empty()) {
+    let chunks = match (i.summary.chunks, i.summary.compressions.is_empty()) {
         (0, true) => "no chunks".to_string(),
         (0, false) => format!("no complete chunk ({})", i.compression()),
         (n, _) => format!("{} {}", counted(n, "chunk"), i.compression()),
@@ -196,8 +196,8 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
         "file",
         format!(
             "{} ({} B), {chunks}, {} of records in {}",
-            size(i.file_size),
-            i.file_size,
+            size(i.summary.file_len),
+            i.summary.file_len,
             size(unpacked),
             size(packed)
         ),
@@ -212,21 +212,21 @@ fn file_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
         |_| String::new(),
         |r| format!(", format {}", r.format_version),
     );
-    let library = if i.library.is_empty() {
+    let library = if i.summary.library.is_empty() {
         "(no library named: no header, or an empty one)".into()
     } else {
-        shown_name(&i.library)
+        shown_name(&i.summary.library)
     };
     rows.push(("written by", format!("{library}{version}")));
     if let Some(d) = i.scene.as_ref().and_then(|s| s.description.as_ref()) {
         rows.push(("scene", shown_name(d)));
     }
-    let span = i.time_range.map_or_else(
+    let span = i.summary.time_range.map_or_else(
         || "no messages".into(),
         |(a, b)| format!("t = {} … {}", seconds_text(a), seconds_text(b)),
     );
     rows.push(("time", span));
-    rows.push(("messages", i.messages.to_string()));
+    rows.push(("messages", i.summary.messages.to_string()));
     rows
 }
 
@@ -297,12 +297,12 @@ fn coin_log_rows(i: &FileInfo) -> Vec<(&'static str, String)> {
 }
 
 fn channels(out: &mut String, i: &FileInfo) {
-    if i.channels.is_empty() {
+    let channels = i.channels();
+    if channels.is_empty() {
         return; // the `encoding` row says "no channels"
     }
     // Each name escaped and cut once; the columns as wide as the widest, up to COLUMN_MAX.
-    let cells: Vec<[String; 2]> = i
-        .channels
+    let cells: Vec<[String; 2]> = channels
         .iter()
         .map(|c| [shown_name(&c.topic), shown_name(&c.schema)])
         .collect();
@@ -319,7 +319,7 @@ fn channels(out: &mut String, i: &FileInfo) {
         "messages",
         "rate"
     );
-    for (c, [topic, schema]) in i.channels.iter().zip(&cells) {
+    for (c, [topic, schema]) in channels.iter().zip(&cells) {
         let rate = c.rate.map_or_else(|| "-".into(), |r| format!("{r:.2}"));
         let _ = writeln!(
             out,

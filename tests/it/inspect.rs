@@ -10,6 +10,7 @@ use crate::support::repo;
 use coin_log::format::{Channel, RUN_METADATA_NAME};
 use coin_log::inspect::export::{TF_COLUMNS, WIDE_TABLE};
 use coin_log::inspect::plot::PANELS;
+use coin_log::inspect::seconds_text;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -664,4 +665,17 @@ fn info_does_not_trust_a_summary_whose_crc_fails() {
     assert!(f["problem"].as_str().unwrap().contains("summary"), "{f}");
     let file = read_back(&std::fs::read(&path).unwrap());
     assert_eq!(f["messages"], file.messages.len());
+}
+
+#[test]
+fn log_times_print_as_exact_decimals() {
+    for (ns, text) in [
+        (0, "0"),
+        (1_500_000_000, "1.5"),
+        (10_000_000, "0.01"),
+        (1, "0.000000001"),
+        (30_000_000_001, "30.000000001"),
+    ] {
+        assert_eq!(seconds_text(ns), text);
+    }
 }

@@ -47,6 +47,7 @@ mod escape_time;
 mod events;
 #[cfg(feature = "external-readers")]
 mod external_readers;
+mod format;
 mod formulas;
 mod foxglove;
 mod inspect;

@@ -605,11 +605,11 @@ mod messages {
         let null = r#"{"t":0.5,"total":1.75,"kinetic":0.75,"potential":1,"change":null}"#;
         assert!(serde_json::from_str::<EnergyMessage>(null).is_err());
         assert_eq!(
-            EnergyMessage::FIELDS,
+            EnergyMessage::TYPE.fields,
             &["t", "total", "kinetic", "potential", "change", "drift_eps"]
         );
         assert_eq!(
-            EnergyMessage::FIRST_FIELDS,
+            EnergyMessage::TYPE.first_fields,
             &["t", "total", "kinetic", "potential"]
         );
     }
@@ -618,13 +618,16 @@ mod messages {
     #[test]
     fn the_fields_are_in_schema_order() {
         for (fields, expected) in [
-            (AngularVelocity::FIELDS, &["t", "x", "y", "z"][..]),
-            (Position::FIELDS, &["t", "x", "y", "z"]),
-            (Angles::FIELDS, &["t", "theta", "phi", "psi", "phi_dot"]),
-            (QuaternionMessage::FIELDS, &["t", "x", "y", "z", "w"]),
-            (InvariantsMessage::FIELDS, &["t", "c1", "c2"]),
+            (AngularVelocity::TYPE.fields, &["t", "x", "y", "z"][..]),
+            (Position::TYPE.fields, &["t", "x", "y", "z"]),
             (
-                ReactionMessage::FIELDS,
+                Angles::TYPE.fields,
+                &["t", "theta", "phi", "psi", "phi_dot"],
+            ),
+            (QuaternionMessage::TYPE.fields, &["t", "x", "y", "z", "w"]),
+            (InvariantsMessage::TYPE.fields, &["t", "c1", "c2"]),
+            (
+                ReactionMessage::TYPE.fields,
                 &["t", "x", "y", "z", "friction", "normal", "friction_ratio"],
             ),
         ] {

@@ -7,7 +7,10 @@ use crate::support::writers::{
     nudge, record, recorded, rewrite, rewrite_run_metadata, rewrite_with_schemas, steady_circle,
     wobble, Edit, Spec,
 };
-use coin_log::verify::{verify_file, CheckId, CheckResult, FileReport, Options, Status, Verdict};
+use coin_log::scene::{self, presets, FlagOverrides, Scene};
+use coin_log::verify::{
+    coverage, verify_file, CheckId, CheckResult, FileReport, Options, Status, Verdict,
+};
 
 fn show(r: &FileReport) -> String {
     r.checks
@@ -823,4 +826,69 @@ fn record_warns_when_verify_cannot_judge_the_recording_and_verify_agrees() {
         "--overwrite",
     ]);
     assert_eq!((code, err.as_str()), (0, ""));
+}
+
+#[test]
+fn the_json_names_are_the_names() {
+    for v in Verdict::ALL {
+        assert_eq!(serde_json::to_value(v).unwrap(), v.name());
+    }
+    for c in CheckId::ALL {
+        assert_eq!(serde_json::to_value(c).unwrap(), c.name());
+    }
+    for s in Status::ALL {
+        assert_eq!(serde_json::to_value(s).unwrap(), s.name());
+    }
+}
+
+fn preset_scene(name: &str, sets: &[&str]) -> Scene {
+    let sets: Vec<String> = sets.iter().map(ToString::to_string).collect();
+    let file = scene::file_with_sets(&presets::preset(name).unwrap(), &sets).unwrap();
+    scene::resolve(&file, &FlagOverrides::default()).unwrap()
+}
+
+#[test]
+fn every_built_in_scene_as_given_can_be_verified() {
+    for name in presets::NAMES {
+        let s = preset_scene(name, &[]);
+        assert_eq!(coverage(&s), Vec::<String>::new(), "{name}");
+    }
+}
+
+#[test]
+fn missing_channels_are_named_with_the_fix() {
+    let s = preset_scene("wobble", &["record.channels=[\"energy\"]"]);
+    assert_eq!(
+        coverage(&s),
+        [
+            "`energy` will not run: it recomputes E from ω and θ, and omega and angles are not \
+             recorded; add channels omega, angles",
+            "neither `constraint` nor `steady` will run, so the motion will not be verified: \
+             `steady` does not apply (the scene does not start on an unperturbed steady motion), and \
+             `constraint` needs the centre's positions with ω and θ, and omega and angles and \
+             position are not recorded; add channels omega, angles, position"
+        ]
+    );
+    // A steady scene is judged by `steady` without positions.
+    let s = preset_scene("circle-plus", &["record.channels=[\"omega\", \"angles\"]"]);
+    assert_eq!(coverage(&s), Vec::<String>::new());
+}
+
+#[test]
+fn a_rate_that_does_not_resolve_the_motion_is_named_with_the_rate_that_does() {
+    let s = preset_scene("high-spin", &["run.rate=100"]);
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(
+        c[0].contains("at 100 samples per time unit, h·Ω = 0.5 (Ω = max(|ω|, |φ̇|) = 50 at t = 0)"),
+        "{}",
+        c[0]
+    );
+    let fix = c[0].rsplit("raise --rate to at least ").next().unwrap();
+    let fix: f64 = fix.parse().unwrap();
+    // The suggested rate is enough, and a rate 1% lower would not be.
+    let s = preset_scene("high-spin", &[&format!("run.rate={fix}")]);
+    assert_eq!(coverage(&s), Vec::<String>::new());
+    let s = preset_scene("high-spin", &[&format!("run.rate={}", fix * 0.99)]);
+    assert_eq!(coverage(&s).len(), 1);
 }

@@ -268,38 +268,3 @@ pub fn schema_data(schema_name: &str, encoding: Encoding) -> Option<&'static [u8
         Encoding::Protobuf => super::protobuf::descriptor_set(schema_name),
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn topics_have_distinct_names_and_dense_indexes() {
-        let all: Vec<Topic> = Topic::all().collect();
-        assert_eq!(all.len(), Topic::COUNT);
-        for (i, t) in all.iter().enumerate() {
-            assert_eq!(t.index(), i, "{t}");
-            assert_eq!(Topic::from_name(t.name()), Some(*t));
-            for &e in t.channel().encodings() {
-                assert!(t.wire(e).is_some(), "{t} {e}");
-                if *t != Topic::RerunRobot {
-                    assert!(schema_data(t.schema_name(), e).is_some(), "{t} {e}");
-                }
-            }
-        }
-        let names: std::collections::BTreeSet<&str> = all.iter().map(|t| t.name()).collect();
-        assert_eq!(names.len(), all.len());
-        assert_eq!(Channel::from_topic("/scene/track/15"), Some(Channel::Scene));
-        assert_eq!(Channel::from_topic("/tf_static"), Some(Channel::Tf));
-        assert_eq!(Channel::from_topic("/scene/track/16"), None);
-        assert_eq!(Channel::from_topic("/rerun/track"), Some(Channel::Rerun));
-        assert_eq!(
-            Topic::RerunTrack.wire(Encoding::Json),
-            None,
-            "Rerun reads Protobuf"
-        );
-        assert!(!Channel::DEFAULT.contains(&Channel::Rerun));
-        assert!(!Channel::DEFAULT.contains(&Channel::Work));
-        assert_eq!(Channel::DEFAULT.len(), 10);
-    }
-}

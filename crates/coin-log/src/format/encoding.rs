@@ -42,21 +42,3 @@ impl Encoding {
             .find(|e| e.schema_encoding() == name)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_round_trip_and_unknown_names_are_refused() {
-        for &e in Encoding::ALL {
-            assert_eq!(e.name().parse::<Encoding>(), Ok(e));
-            assert_eq!(Encoding::from_schema_encoding(e.schema_encoding()), Some(e));
-        }
-        assert_eq!(
-            "cbor".parse::<Encoding>().unwrap_err().to_string(),
-            "unknown encoding `cbor`; valid: json, protobuf"
-        );
-        assert_eq!(Encoding::from_schema_encoding("ros2msg"), None);
-    }
-}

@@ -186,7 +186,7 @@ mod tests {
         };
         let mut outs = Vec::new();
         for &e in Encoding::ALL {
-            let schema = schema_data(Position::SCHEMA, e).unwrap();
+            let schema = schema_data(Position::TYPE.schema, e).unwrap();
             let (r, version) =
                 FieldReader::new(e.schema_encoding(), &Position::TYPE, schema).unwrap();
             assert_eq!(version, Version::Ours);

@@ -169,17 +169,11 @@ macro_rules! message {
         }
 
         impl $name {
-            /// Schema name of this message type.
-            pub const SCHEMA: &'static str = $schema;
-            /// Field names in schema order (the current schema).
-            pub const FIELDS: &'static [&'static str] = &[$(stringify!($field)),+ $($(, stringify!($added))+)?];
-            /// Field names of the schema's first version (before any `added` field).
-            pub const FIRST_FIELDS: &'static [&'static str] = &[$(stringify!($field)),+];
             /// What the format says of the type.
             pub const TYPE: MessageType = MessageType {
                 schema: $schema,
-                fields: Self::FIELDS,
-                first_fields: Self::FIRST_FIELDS,
+                fields: &[$(stringify!($field)),+ $($(, stringify!($added))+)?],
+                first_fields: &[$(stringify!($field)),+],
                 json_schema: include_bytes!(concat!("../../../../schemas/", $schema, ".json")),
             };
 

@@ -362,9 +362,9 @@ mod tests {
 
     fn energy() -> MessageDecoder {
         MessageDecoder::new(
-            descriptor_set(EnergyMessage::SCHEMA).unwrap(),
-            EnergyMessage::SCHEMA,
-            EnergyMessage::FIELDS,
+            descriptor_set(EnergyMessage::TYPE.schema).unwrap(),
+            EnergyMessage::TYPE.schema,
+            EnergyMessage::TYPE.fields,
         )
         .unwrap()
     }
@@ -424,22 +424,22 @@ mod tests {
 
     #[test]
     fn a_descriptor_without_the_type_or_a_field_is_refused_by_name() {
-        let d = descriptor_set(EnergyMessage::SCHEMA).unwrap();
+        let energy = EnergyMessage::TYPE;
+        let d = descriptor_set(energy.schema).unwrap();
         assert_eq!(
-            MessageDecoder::new(d, "coin_log.Angles", Angles::FIELDS),
+            MessageDecoder::new(d, "coin_log.Angles", Angles::TYPE.fields),
             Err(SchemaError::NoMessage("coin_log.Angles".into()))
         );
         assert_eq!(
-            MessageDecoder::new(d, EnergyMessage::SCHEMA, &["t", "energy"]),
+            MessageDecoder::new(d, energy.schema, &["t", "energy"]),
             Err(SchemaError::Missing("energy".into()))
         );
         assert!(matches!(
-            MessageDecoder::new(b"\xff\xff", EnergyMessage::SCHEMA, &["t"]),
+            MessageDecoder::new(b"\xff\xff", energy.schema, &["t"]),
             Err(SchemaError::NotDescriptor(_))
         ));
         // The first version's fields alone: the later ones are skipped.
-        let first =
-            MessageDecoder::new(d, EnergyMessage::SCHEMA, EnergyMessage::FIRST_FIELDS).unwrap();
+        let first = MessageDecoder::new(d, energy.schema, energy.first_fields).unwrap();
         let mut buf = Vec::new();
         put_double(&mut buf, 6, 3.0);
         put_double(&mut buf, 2, 1.0);

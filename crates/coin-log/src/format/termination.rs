@@ -61,30 +61,3 @@ impl From<PhysicalEvent> for Termination {
         }
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_round_trip_and_unknown_names_are_refused() {
-        for &t in Termination::ALL {
-            assert_eq!(t.name().parse::<Termination>(), Ok(t));
-            assert_eq!(t.to_string(), t.name());
-        }
-        assert!("finished".parse::<Termination>().is_err());
-        assert_eq!(Termination::ALL.iter().filter(|t| t.is_event()).count(), 3);
-    }
-
-    #[test]
-    fn events_map_to_their_termination() {
-        for (index, expected) in [
-            (0, Termination::FlatLanding),
-            (1, Termination::LiftOff),
-            (2, Termination::Slip),
-        ] {
-            let end = integrate::RunEnd::Event { index, t: 1.0 };
-            assert_eq!(Termination::of_run(&end), expected);
-        }
-    }
-}

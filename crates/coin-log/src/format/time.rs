@@ -31,36 +31,3 @@ pub fn log_time(t: f64) -> Result<u64, TimeError> {
         Err(TimeError { t })
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::log_time;
-    use proptest::prelude::*;
-
-    proptest! {
-        #![proptest_config(ProptestConfig { cases: 256, rng_seed: proptest::test_runner::RngSeed::Fixed(11), ..ProptestConfig::default() })]
-
-        /// Whole nanoseconds below 2^50 ns (1.1e6 time units, far beyond any run) convert exactly: there
-        /// the two roundings of t = ns/1e9 and t·1e9 stay below half a nanosecond.
-        #[test]
-        fn whole_nanoseconds_convert_exactly(ns in 0u64..(1u64 << 50)) {
-            #[allow(clippy::cast_precision_loss)]
-            let t = ns as f64 / 1e9;
-            prop_assert_eq!(log_time(t).unwrap(), ns);
-        }
-
-        /// The conversion never decreases: t1 ≤ t2 gives log_time(t1) ≤ log_time(t2).
-        #[test]
-        fn the_conversion_is_monotone(a in 0.0f64..1.8e10, b in 0.0f64..1.8e10) {
-            let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
-            prop_assert!(log_time(lo).unwrap() <= log_time(hi).unwrap());
-        }
-    }
-
-    #[test]
-    fn non_finite_negative_and_huge_times_are_refused() {
-        for t in [f64::NAN, f64::INFINITY, -1e-12, -1.0, 1.8e10, 1e300] {
-            assert!(log_time(t).is_err(), "{t}");
-        }
-    }
-}

@@ -341,28 +341,17 @@ impl<W: Write> Exporter<'_, W> {
     }
 
     fn tf(&mut self, h: &MessageHeader, data: &[u8], table: usize, protobuf: bool) {
-        let m = if protobuf {
-            decode_transform(data)
-        } else {
-            serde_json::from_slice(data).map_err(|e| e.to_string())
-        };
-        let m: FrameTransform = match m {
-            Ok(m) => m,
+        let (ns, parent, child, values) = match transform_row(data, protobuf) {
+            Ok(row) => row,
             Err(e) => {
                 let reason = format!("is not a foxglove.FrameTransform: {e}");
                 return self.fail(message(Channel::Tf.topic(), h.log_time, reason));
             }
         };
-        let ns = m
-            .timestamp
-            .sec
-            .saturating_mul(1_000_000_000)
-            .saturating_add(u64::from(m.timestamp.nsec));
         self.line.clear();
         self.line.text(&seconds_text(ns));
-        self.line.text(&m.parent_frame_id).text(&m.child_frame_id);
-        let (tr, ro) = (&m.translation, &m.rotation);
-        for v in [tr.x, tr.y, tr.z, ro.x, ro.y, ro.z, ro.w] {
+        self.line.text(&parent).text(&child);
+        for v in values {
             self.line.number(v);
         }
         self.write_line(table);
@@ -546,33 +535,28 @@ impl<W: Write> Visitor for Exporter<'_, W> {
     }
 }
 
-/// A Protobuf `foxglove.FrameTransform` as the fields the table holds (absent sub-messages read as zeros,
-/// as proto3 defines them).
-fn decode_transform(data: &[u8]) -> Result<FrameTransform, String> {
-    use prost::Message;
-    let m = foxglove::messages::FrameTransform::decode(data).map_err(|e| e.to_string())?;
-    let time = m.timestamp.unwrap_or_default();
-    let tr = m.translation.unwrap_or_default();
-    let ro = m.rotation.unwrap_or_default();
-    Ok(FrameTransform {
-        timestamp: Time {
-            sec: u64::from(time.sec()),
-            nsec: time.nsec(),
-        },
-        parent_frame_id: m.parent_frame_id,
-        child_frame_id: m.child_frame_id,
-        translation: Vector3 {
-            x: tr.x,
-            y: tr.y,
-            z: tr.z,
-        },
-        rotation: Quaternion {
-            x: ro.x,
-            y: ro.y,
-            z: ro.z,
-            w: ro.w,
-        },
-    })
+/// A `foxglove.FrameTransform` as its table's row: the timestamp \[ns\], the parent and child frames, the
+/// translation and rotation (absent Protobuf sub-messages read as zeros, as proto3 defines them).
+fn transform_row(data: &[u8], protobuf: bool) -> Result<(u64, String, String, [f64; 7]), String> {
+    let ns = |sec: u64, nsec: u32| {
+        sec.saturating_mul(1_000_000_000)
+            .saturating_add(u64::from(nsec))
+    };
+    if protobuf {
+        use prost::Message;
+        let m = foxglove::messages::FrameTransform::decode(data).map_err(|e| e.to_string())?;
+        let time = m.timestamp.unwrap_or_default();
+        let tr = m.translation.unwrap_or_default();
+        let ro = m.rotation.unwrap_or_default();
+        let values = [tr.x, tr.y, tr.z, ro.x, ro.y, ro.z, ro.w];
+        let ns = ns(u64::from(time.sec()), time.nsec());
+        return Ok((ns, m.parent_frame_id, m.child_frame_id, values));
+    }
+    let m: FrameTransform = serde_json::from_slice(data).map_err(|e| e.to_string())?;
+    let (tr, ro) = (m.translation, m.rotation);
+    let values = [tr.x, tr.y, tr.z, ro.x, ro.y, ro.z, ro.w];
+    let ns = ns(m.timestamp.sec, m.timestamp.nsec);
+    Ok((ns, m.parent_frame_id, m.child_frame_id, values))
 }
 
 /// The fields of `foxglove.FrameTransform` that the table holds (others are ignored).

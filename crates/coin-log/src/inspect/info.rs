@@ -5,7 +5,9 @@
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
-use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Schema, Visitor};
+use coin_log_mcap::{
+    self, ChannelSummary, MessageHeader, ReadError, ReadErrorKind, Schema, Visitor,
+};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -41,24 +43,11 @@ coin_log_names::named_enum! {
 /// What a file holds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FileInfo {
-    /// File size \[bytes\].
-    pub file_size: u64,
-    /// The header's `library` (`coin-log/<version>` for this tool's files).
-    pub library: String,
+    /// Sizes, counts, channels and metadata records, as the summary section states them or the streaming
+    /// pass found them.
+    pub summary: coin_log_mcap::Summary,
     /// Where this was read from.
     pub source: Source,
-    /// Messages.
-    pub messages: u64,
-    /// Earliest and latest log time \[ns\]; `None` without messages.
-    pub time_range: Option<(u64, u64)>,
-    /// Chunks.
-    pub chunks: u64,
-    /// Chunks by compression (`""` = uncompressed).
-    pub compressions: BTreeMap<String, u64>,
-    /// The chunks' records compressed and uncompressed \[bytes\].
-    pub chunk_bytes: (u64, u64),
-    /// Channels, by id.
-    pub channels: Vec<ChannelReport>,
     /// The `coin-log` record, or why it is missing or unusable.
     pub run: Result<RunMetadata, String>,
     /// The `coin-log.result` record, or why it is missing or unusable.
@@ -75,12 +64,13 @@ impl FileInfo {
     #[must_use]
     pub fn compression(&self) -> String {
         let name = |c: &str| if c.is_empty() { "none" } else { c }.to_string();
-        match self.compressions.len() {
+        let compressions = &self.summary.compressions;
+        match compressions.len() {
             0 => "no chunks".into(),
-            1 => self.compressions.keys().map(|c| name(c)).collect(),
+            1 => compressions.keys().map(|c| name(c)).collect(),
             _ => format!(
                 "mixed ({})",
-                self.compressions
+                compressions
                     .iter()
                     .map(|(c, n)| format!("{} × {n}", name(c)))
                     .collect::<Vec<_>>()
@@ -94,6 +84,7 @@ impl FileInfo {
     #[must_use]
     pub fn encoding(&self) -> String {
         let set: std::collections::BTreeSet<&str> = self
+            .summary
             .channels
             .iter()
             .map(|c| c.message_encoding.as_str())
@@ -106,28 +97,45 @@ impl FileInfo {
         }
     }
 
+    /// The channels, by id, with their message rates.
+    #[must_use]
+    pub fn channels(&self) -> Vec<ChannelReport> {
+        let s = &self.summary;
+        s.channels
+            .iter()
+            .map(|c| ChannelReport {
+                topic: c.topic.clone(),
+                schema: c.schema_name.clone(),
+                message_encoding: c.message_encoding.clone(),
+                messages: c.messages,
+                rate: rate(c.messages, s.time_range),
+            })
+            .collect()
+    }
+
     /// The contract's JSON object of this file (format.md: info --json), `path` as given.
     #[must_use]
     pub fn json<'a>(&'a self, path: &'a str) -> impl Serialize + 'a {
         let run = self.run.as_ref().ok();
+        let s = &self.summary;
         FileJson {
             path,
-            file_size: self.file_size,
-            library: &self.library,
+            file_size: s.file_len,
+            library: &s.library,
             read_from: self.source.name(),
             coin_log: run.is_some(),
             format_version: run.map(|r| r.format_version.as_str()),
             tool_version: run.map(|r| r.tool_version.as_str()),
             description: self.scene.as_ref().and_then(|s| s.description.as_deref()),
-            messages: self.messages,
-            start_time: self.time_range.map(|r| seconds(r.0)),
-            end_time: self.time_range.map(|r| seconds(r.1)),
-            chunks: self.chunks,
+            messages: s.messages,
+            start_time: s.time_range.map(|r| seconds(r.0)),
+            end_time: s.time_range.map(|r| seconds(r.1)),
+            chunks: s.chunks,
             compression: self.compression(),
             encoding: self.encoding(),
-            compressed_bytes: self.chunk_bytes.0,
-            uncompressed_bytes: self.chunk_bytes.1,
-            channels: &self.channels,
+            compressed_bytes: s.compressed_bytes,
+            uncompressed_bytes: s.uncompressed_bytes,
+            channels: self.channels(),
             body: run.map(|r| BodyJson {
                 mass: r.mass,
                 radius: r.radius,
@@ -188,7 +196,7 @@ struct FileJson<'a> {
     encoding: String,
     compressed_bytes: u64,
     uncompressed_bytes: u64,
-    channels: &'a [ChannelReport],
+    channels: Vec<ChannelReport>,
     body: Option<BodyJson>,
     run: Option<RunJson>,
     result: Option<ResultJson>,
@@ -290,32 +298,15 @@ fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
     (messages >= 2 && end > start).then(|| (messages - 1) as f64 / ((end - start) as f64 / 1e9))
 }
 
-fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
-    let (run, result) = records(&s.metadata);
+fn from_summary(summary: coin_log_mcap::Summary) -> FileInfo {
+    let (run, result) = records(&summary.metadata);
     let scene = run
         .as_ref()
         .ok()
         .and_then(|r| toml::from_str(&r.scene).ok());
     FileInfo {
-        file_size: s.file_len,
-        library: s.library,
+        summary,
         source: Source::Summary,
-        messages: s.messages,
-        time_range: s.time_range,
-        chunks: s.chunks,
-        compressions: s.compressions,
-        chunk_bytes: (s.compressed_bytes, s.uncompressed_bytes),
-        channels: s
-            .channels
-            .iter()
-            .map(|c| ChannelReport {
-                topic: c.topic.clone(),
-                schema: c.schema_name.clone(),
-                message_encoding: c.message_encoding.clone(),
-                messages: c.messages,
-                rate: rate(c.messages, s.time_range),
-            })
-            .collect(),
         run,
         result,
         scene,
@@ -326,7 +317,7 @@ fn from_summary(s: coin_log_mcap::Summary) -> FileInfo {
 /// What the streaming pass gathers.
 #[derive(Default)]
 struct Scan {
-    channels: BTreeMap<u16, ChannelReport>,
+    channels: BTreeMap<u16, ChannelSummary>,
     metadata: Vec<(String, BTreeMap<String, String>)>,
     counts: BTreeMap<u16, u64>,
     time_range: Option<(u64, u64)>,
@@ -342,12 +333,12 @@ impl Visitor for Scan {
     ) {
         self.channels.insert(
             id,
-            ChannelReport {
+            ChannelSummary {
+                id,
                 topic: topic.to_string(),
-                schema: schema.map(|s| s.name.clone()).unwrap_or_default(),
+                schema_name: schema.map(|s| s.name.clone()).unwrap_or_default(),
                 message_encoding: message_encoding.to_string(),
                 messages: 0,
-                rate: None,
             },
         );
     }
@@ -377,23 +368,21 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
         Some(e) => Some(e.detail),
         None => None,
     };
-    let channels = v
-        .channels
-        .into_iter()
-        .map(|(id, mut c)| {
-            c.messages = v.counts.get(&id).copied().unwrap_or(0);
-            c.rate = rate(c.messages, v.time_range);
-            c
-        })
-        .collect();
     let summary = coin_log_mcap::Summary {
         time_range: v.time_range,
+        channels: v
+            .channels
+            .into_iter()
+            .map(|(id, mut c)| {
+                c.messages = v.counts.get(&id).copied().unwrap_or(0);
+                c
+            })
+            .collect(),
         metadata: v.metadata,
         ..s.summary
     };
     Ok(FileInfo {
         source: Source::Scan,
-        channels,
         problem,
         ..from_summary(summary)
     })

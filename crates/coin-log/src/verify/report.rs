@@ -167,22 +167,3 @@ impl Report {
         self.files.iter().map(|f| f.exit_code).max().unwrap_or(0)
     }
 }
-
-#[cfg(test)]
-#[allow(clippy::unwrap_used)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_json_names_are_the_names() {
-        for v in Verdict::ALL {
-            assert_eq!(serde_json::to_value(v).unwrap(), v.name());
-        }
-        for c in CheckId::ALL {
-            assert_eq!(serde_json::to_value(c).unwrap(), c.name());
-        }
-        for s in Status::ALL {
-            assert_eq!(serde_json::to_value(s).unwrap(), s.name());
-        }
-    }
-}
