@@ -161,3 +161,49 @@ fn an_error_in_the_middle_ends_the_read_and_its_worker() {
     let e = e.unwrap();
     assert_eq!(e.kind, ReadErrorKind::Corrupt, "{e}");
 }
+
+/// The streaming pass counts what the summary section states: the same channels (first definitions,
+/// by id, with their message counts), messages, time range, chunks and sizes; only the metadata, which
+/// the visitor is given, stays out of it.
+#[test]
+fn the_streaming_pass_counts_what_the_summary_section_states() {
+    let mut options = WriterOptions::new(Compression::Zstd, "test");
+    options.chunk_size = 1 << 12;
+    let mut w = McapWriter::new(Cursor::new(Vec::new()), &options).unwrap();
+    let a = w.add_schema("a", "jsonschema", b"{}").unwrap();
+    let b = w.add_schema("b", "jsonschema", b"{}").unwrap();
+    let none = BTreeMap::new();
+    let ca = w.add_channel(a, "/a", "json", &none).unwrap();
+    let cb = w.add_channel(b, "/b", "json", &none).unwrap();
+    for i in 0..500_u32 {
+        // Out of order on purpose: the range is the minimum and the maximum, not the first and last.
+        let t = 10_000 + u64::from(i * 7919 % 1000);
+        w.write_message(ca, i, t, t, b"{}").unwrap();
+        if i % 3 == 0 {
+            w.write_message(cb, i, t + 5, t + 5, b"{}").unwrap();
+        }
+    }
+    let bytes = w.finish().unwrap().0.into_inner();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let stated = coin_log_mcap::read_summary(&path).unwrap().unwrap();
+    let (_, streamed, e) = read_with_deadline(bytes, u64::MAX);
+    assert_eq!(e, None);
+    assert_eq!(streamed.summary.messages, 500 + 167);
+    assert_eq!(streamed.summary.time_range, Some((10_000, 10_999 + 5)));
+    let counts: Vec<_> = streamed
+        .summary
+        .channels
+        .iter()
+        .map(|c| (c.topic.as_str(), c.messages))
+        .collect();
+    assert_eq!(counts, [("/a", 500), ("/b", 167)]);
+    assert!(
+        streamed.summary.chunks > 1,
+        "{} chunks",
+        streamed.summary.chunks
+    );
+    assert_eq!(streamed.summary.metadata, []);
+    assert_eq!(streamed.summary, stated);
+}

@@ -16,7 +16,7 @@ use crate::prefetch::{self, Batch, ChunkError, Event};
 use crate::records::{
     AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
 };
-use crate::summary::Summary;
+use crate::summary::{ChannelSummary, Summary};
 use mcap::records::{
     op, Channel, ChunkHeader, ChunkIndex, Footer, Header, MessageHeader, MessageIndex, Metadata,
     MetadataIndex, Statistics, SummaryOffset,
@@ -113,8 +113,8 @@ impl fmt::Display for ReadError {
 /// What the structural pass found.
 #[derive(Debug, Default)]
 pub struct Structure {
-    /// What was read, in the terms of [`read_summary`](crate::read_summary); its `channels` and
-    /// `metadata` stay empty (the visitor is given them).
+    /// What was read, in the terms of [`read_summary`](crate::read_summary): the channels as first
+    /// defined, with the messages counted on each; its `metadata` stays empty (the visitor is given them).
     pub summary: Summary,
     /// Structural problems (indexes, statistics, summary).
     pub problems: BoundedFindings,
@@ -180,7 +180,8 @@ struct Book {
     channel_counts: BTreeMap<u16, u64>,
     /// The digest of each schema's record, and the schema for the channels that name it.
     schemas: BTreeMap<u16, (Digest, Schema<'static>)>,
-    channels: BTreeMap<u16, Digest>,
+    /// The digest of each channel's first record, and the channel as the summary lists it.
+    channels: BTreeMap<u16, (Digest, ChannelSummary)>,
     /// (offset, length, name digest) of metadata records and of metadata index entries.
     metadata: Vec<(u64, u64, Digest)>,
     metadata_count: u64,
@@ -412,9 +413,19 @@ fn consume(
 impl Book {
     fn structure(self) -> Structure {
         let time_range = self.min_time.map(|start| (start, self.max_time));
+        let counts = &self.channel_counts;
+        let channels = self
+            .channels
+            .into_values()
+            .map(|(_, c)| ChannelSummary {
+                messages: counts.get(&c.id).copied().unwrap_or(0),
+                ..c
+            })
+            .collect();
         Structure {
             summary: Summary {
                 time_range,
+                channels,
                 ..self.s
             },
             problems: self.problems,
@@ -865,7 +876,7 @@ impl Book {
         let c: Channel = parse(data, at)?;
         let d = Digest::of(data);
         match self.channels.get(&c.id) {
-            Some(earlier) if *earlier != d => {
+            Some((earlier, _)) if *earlier != d => {
                 let (id, topic) = (c.id, c.topic);
                 self.problem(|| {
                     format!(
@@ -875,12 +886,19 @@ impl Book {
             }
             Some(_) => {}
             None => {
-                self.channels.insert(c.id, d);
                 let schema = self
                     .schemas
                     .get(&c.schema_id)
                     .map(|(_, s)| s)
                     .filter(|_| c.schema_id != 0);
+                let summary = ChannelSummary {
+                    id: c.id,
+                    topic: c.topic.clone(),
+                    schema_name: schema.map(|s| s.name.clone()).unwrap_or_default(),
+                    message_encoding: c.message_encoding.clone(),
+                    messages: 0,
+                };
+                self.channels.insert(c.id, (d, summary));
                 // The visitor may keep a copy of the schema with each channel.
                 let size =
                     PREFIX_LEN + data.len() as u64 + schema.map_or(0, |s| s.data.len() as u64);

@@ -5,9 +5,7 @@
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
-use coin_log_mcap::{
-    self, ChannelSummary, MessageHeader, ReadError, ReadErrorKind, Schema, Visitor,
-};
+use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -314,44 +312,17 @@ fn from_summary(summary: coin_log_mcap::Summary) -> FileInfo {
     }
 }
 
-/// What the streaming pass gathers.
+/// What the streaming pass gathers beyond the reader's own summary: the metadata records.
 #[derive(Default)]
 struct Scan {
-    channels: BTreeMap<u16, ChannelSummary>,
     metadata: Vec<(String, BTreeMap<String, String>)>,
-    counts: BTreeMap<u16, u64>,
-    time_range: Option<(u64, u64)>,
 }
 
 impl Visitor for Scan {
-    fn channel(
-        &mut self,
-        id: u16,
-        topic: &str,
-        message_encoding: &str,
-        schema: Option<&Schema<'_>>,
-    ) {
-        self.channels.insert(
-            id,
-            ChannelSummary {
-                id,
-                topic: topic.to_string(),
-                schema_name: schema.map(|s| s.name.clone()).unwrap_or_default(),
-                message_encoding: message_encoding.to_string(),
-                messages: 0,
-            },
-        );
-    }
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
         self.metadata.push((name.to_string(), entries.clone()));
     }
-    fn message(&mut self, header: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
-        *self.counts.entry(header.channel_id).or_insert(0) += 1;
-        let t = header.log_time;
-        self.time_range = Some(
-            self.time_range
-                .map_or((t, t), |(a, b)| (a.min(t), b.max(t))),
-        );
+    fn message(&mut self, _: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
         ControlFlow::Continue(())
     }
 }
@@ -369,15 +340,6 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
         None => None,
     };
     let summary = coin_log_mcap::Summary {
-        time_range: v.time_range,
-        channels: v
-            .channels
-            .into_iter()
-            .map(|(id, mut c)| {
-                c.messages = v.counts.get(&id).copied().unwrap_or(0);
-                c
-            })
-            .collect(),
         metadata: v.metadata,
         ..s.summary
     };
