@@ -207,3 +207,43 @@ fn the_streaming_pass_counts_what_the_summary_section_states() {
     assert_eq!(streamed.summary.metadata, []);
     assert_eq!(streamed.summary, stated);
 }
+
+/// When the channels outgrow what the reader keeps, the read ends there, and the streamed summary lists
+/// exactly the channels the visitor was given (the refused one is not among them).
+#[test]
+fn the_streamed_channels_are_those_the_visitor_was_given_when_the_budget_ends_the_read() {
+    #[derive(Default)]
+    struct Channels(Vec<u16>);
+    impl Visitor for Channels {
+        fn channel(&mut self, id: u16, _: &str, _: &str, _: Option<&coin_log_mcap::Schema<'_>>) {
+            self.0.push(id);
+        }
+        fn message(&mut self, _: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
+            ControlFlow::Continue(())
+        }
+    }
+    let options = WriterOptions::new(Compression::None, "test");
+    let mut w = McapWriter::new(Cursor::new(Vec::new()), &options).unwrap();
+    let schema = w.add_schema("s", "jsonschema", b"{}").unwrap();
+    let long = "x".repeat(1000);
+    // 20 000 channels of about 1 kB: more than the 16 MiB the reader keeps of schemas and channels.
+    for i in 0..20_000_u32 {
+        let c = w
+            .add_channel(schema, &format!("/{i}{long}"), "json", &BTreeMap::new())
+            .unwrap();
+        w.write_message(c, 0, u64::from(i), u64::from(i), b"{}")
+            .unwrap();
+    }
+    let bytes = w.finish().unwrap().0.into_inner();
+    let len = bytes.len() as u64;
+    let mut v = Channels::default();
+    let (s, e) = read_from(Cursor::new(bytes), len, &mut v);
+    assert_eq!(e.unwrap().kind, ReadErrorKind::TooLarge);
+    assert!(
+        !v.0.is_empty() && v.0.len() < 20_000,
+        "{} channels",
+        v.0.len()
+    );
+    let streamed: Vec<u16> = s.summary.channels.iter().map(|c| c.id).collect();
+    assert_eq!(streamed, v.0);
+}

@@ -891,19 +891,20 @@ impl Book {
                     .get(&c.schema_id)
                     .map(|(_, s)| s)
                     .filter(|_| c.schema_id != 0);
-                let summary = ChannelSummary {
-                    id: c.id,
-                    topic: c.topic.clone(),
-                    schema_name: schema.map(|s| s.name.clone()).unwrap_or_default(),
-                    message_encoding: c.message_encoding.clone(),
-                    messages: 0,
-                };
-                self.channels.insert(c.id, (d, summary));
                 // The visitor may keep a copy of the schema with each channel.
                 let size =
                     PREFIX_LEN + data.len() as u64 + schema.map_or(0, |s| s.data.len() as u64);
                 self.kept.charge(size, c.metadata.len(), at)?;
                 visitor.channel(c.id, &c.topic, &c.message_encoding, schema);
+                // Summarised only once passed on: a channel refused by the budget is not listed.
+                let summary = ChannelSummary {
+                    id: c.id,
+                    schema_name: schema.map(|s| s.name.clone()).unwrap_or_default(),
+                    topic: c.topic,
+                    message_encoding: c.message_encoding,
+                    messages: 0,
+                };
+                self.channels.insert(c.id, (d, summary));
             }
         }
         Ok(())
