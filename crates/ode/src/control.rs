@@ -99,7 +99,7 @@ impl StepSize {
         f0: &mut [f64; N],
         order: u32,
     ) -> Result<(), StepError> {
-        *state = StepperState::start(t0, y0, super::Stats::default());
+        *state = StepperState::start(t0, y0);
         self.h_last = 0.0;
         self.old_error = MIN_OLD_ERROR;
         self.rejected = false;

@@ -268,7 +268,7 @@ impl<const N: usize> Dop853<N> {
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
             size: StepSize::new(CONTROLLER, rtol, atol),
-            state: StepperState::start(0.0, &[0.0; N], super::Stats::default()),
+            state: StepperState::start(0.0, &[0.0; N]),
             y_prev: [0.0; N],
             k: [[0.0; N]; 16],
             dense: [[0.0; N]; 8],

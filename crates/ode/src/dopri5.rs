@@ -85,7 +85,7 @@ impl<const N: usize> Dopri5<N> {
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
             size: StepSize::new(CONTROLLER, rtol, atol),
-            state: StepperState::start(0.0, &[0.0; N], super::Stats::default()),
+            state: StepperState::start(0.0, &[0.0; N]),
             f: [0.0; N],
             dense: [[0.0; N]; 5],
         }
@@ -100,9 +100,8 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         y0: &[f64; N],
         t_end: f64,
     ) -> Result<(), StepError> {
-        for (i, row) in self.dense.iter_mut().enumerate() {
-            *row = if i == 0 { *y0 } else { [0.0; N] };
-        }
+        self.dense = [[0.0; N]; 5];
+        self.dense[0] = *y0;
         let order = Method::Dopri5.order();
         self.size
             .start(&mut self.state, sys, (t0, y0), t_end, &mut self.f, order)
