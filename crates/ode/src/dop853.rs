@@ -250,11 +250,10 @@ const CONTROLLER: Controller = Controller {
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
     steps: AdaptiveSteps<N>,
-    y_prev: [f64; N],
     /// Stages of the last accepted step: 0..=11 the method's, 12 = f(t, y) (FSAL), 13..=15 dense.
     k: [[f64; N]; 16],
-    /// Coefficients of the continuous extension (`rcont` of `dop853.f`); rows 4..8 valid only when
-    /// `dense_ready`.
+    /// Coefficients of the continuous extension (`rcont` of `dop853.f`), row 0 the state at the start of
+    /// the last step; rows 4..8 valid only when `dense_ready`.
     dense: [[f64; N]; 8],
     dense_ready: bool,
 }
@@ -265,7 +264,6 @@ impl<const N: usize> Dop853<N> {
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
             steps: AdaptiveSteps::new(CONTROLLER, rtol, atol),
-            y_prev: [0.0; N],
             k: [[0.0; N]; 16],
             dense: [[0.0; N]; 8],
             dense_ready: false,
@@ -281,7 +279,6 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         y0: &[f64; N],
         t_end: f64,
     ) -> Result<(), StepError> {
-        self.y_prev = *y0;
         self.k = [[0.0; N]; 16];
         self.dense = [[0.0; N]; 8];
         self.dense[0] = *y0;
@@ -352,7 +349,6 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
             }
 
             self.steps.accept(h, err, (t_new, &y_new));
-            self.y_prev = y;
             self.k[..13].copy_from_slice(&k);
             // The cubic Hermite part of the dense output is free; the rest waits for a request.
             cubic_dense_output(h, &y, &k[0], &y_new, &k[12], &mut self.dense);
@@ -369,7 +365,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         let mut y_stage = [0.0; N];
         for s in 13..16 {
             let (done, rest) = self.k.split_at_mut(s);
-            combine(&self.y_prev, h, A[s], done, &mut y_stage);
+            combine(&self.dense[0], h, A[s], done, &mut y_stage);
             sys.rhs(self.steps.state.t_prev + C[s] * h, &y_stage, &mut rest[0]);
         }
         self.steps.state.stats.rhs_evaluations += 3;
