@@ -1,7 +1,7 @@
 //! Pieces shared by the adaptive embedded pairs ([`Dopri5`](super::Dopri5), [`Dop853`](super::Dop853)):
 //! the mixed error norm, the initial step guess, the step-size controller of Hairer's codes
 //! (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4 and the Fortran `dopri5.f` / `dop853.f`),
-//! the step bookkeeping around the stages ([`StepSize`]), the tableau row sum and the continuous
+//! the step bookkeeping around the stages ([`AdaptiveSteps`]), the tableau row sum and the continuous
 //! extension.
 
 use super::{all_finite, OdeSystem, StepError, StepperState};
@@ -29,12 +29,6 @@ const LAST_STEP_STRETCH: f64 = 1.01;
 /// Smallest remembered error, so the Lund factor cannot explode after a zero-error step (`facold`).
 const MIN_OLD_ERROR: f64 = 1e-4;
 
-/// Per-component error weight sk = atol + rtol·max(|y₀ᵢ|, |y₁ᵢ|) (HNW I, eq. (4.10)).
-#[inline]
-pub(crate) fn weight(rtol: f64, atol: f64, y0: f64, y1: f64) -> f64 {
-    atol + rtol * y0.abs().max(y1.abs())
-}
-
 /// Step-size controller parameters of Hairer's codes: new step h·min(1/fac_min, max(1/fac_max,
 /// err^expo / err_old^β / safety)) with expo = 1/(q+1) − 0.75·β·(stabilisation) as in `dopri5.f`/`dop853.f`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,14 +43,15 @@ pub(crate) struct Controller {
     pub beta: f64,
 }
 
-/// The step size of an adaptive pair between steps, and what both pairs do around their stages: the
-/// start, the trial step towards `t_limit`, the underflow test, and the new step after a rejection or
-/// an acceptance.
+/// The last accepted step of an adaptive pair and its step size, and what both pairs do around their
+/// stages: the start, the trial step towards `t_limit`, the underflow test, the error weights, the new
+/// step after a rejection or an acceptance, and the continuous extension.
 #[derive(Debug, Clone)]
-pub(crate) struct StepSize {
+pub(crate) struct AdaptiveSteps<const N: usize> {
+    pub state: StepperState<N>,
     controller: Controller,
-    pub rtol: f64,
-    pub atol: f64,
+    rtol: f64,
+    atol: f64,
     /// Cap on the step in this run: the whole span.
     h_max: f64,
     /// Next step to try.
@@ -69,10 +64,11 @@ pub(crate) struct StepSize {
     rejected: bool,
 }
 
-impl StepSize {
+impl<const N: usize> AdaptiveSteps<N> {
     /// Not started yet.
     pub fn new(controller: Controller, rtol: f64, atol: f64) -> Self {
         Self {
+            state: StepperState::start(0.0, &[0.0; N]),
             controller,
             rtol,
             atol,
@@ -90,28 +86,27 @@ impl StepSize {
     ///
     /// # Errors
     /// [`StepError::NonFinite`] if y0 or f(t0, y0) is not finite.
-    pub fn start<const N: usize, S: OdeSystem<N>>(
+    pub fn start<S: OdeSystem<N>>(
         &mut self,
-        state: &mut StepperState<N>,
         sys: &S,
         (t0, y0): (f64, &[f64; N]),
         t_end: f64,
         f0: &mut [f64; N],
         order: u32,
     ) -> Result<(), StepError> {
-        *state = StepperState::start(t0, y0, super::Stats::default());
+        self.state = StepperState::start(t0, y0);
         self.h_last = 0.0;
         self.old_error = MIN_OLD_ERROR;
         self.rejected = false;
         // `min` ignores a NaN span.
         self.h_max = f64::INFINITY.min((t_end - t0).abs());
         sys.rhs(t0, y0, f0);
-        state.stats.rhs_evaluations += 1;
+        self.state.stats.rhs_evaluations += 1;
         if !(all_finite(y0) && all_finite(f0)) {
             return Err(StepError::NonFinite { t: t0 });
         }
         self.h = self.initial_step(sys, t0, y0, f0, order);
-        state.stats.rhs_evaluations += 1;
+        self.state.stats.rhs_evaluations += 1;
         Ok(())
     }
 
@@ -119,7 +114,7 @@ impl StepSize {
     /// h₀ = 0.01·‖y₀‖/‖f₀‖, one explicit Euler step to estimate ‖y''‖, then h = min(100·h₀,
     /// (0.01/max(‖f₀‖, ‖y''‖))^(1/order), h_max). Costs one right-hand side evaluation. Returns a
     /// positive finite step.
-    fn initial_step<const N: usize, S: OdeSystem<N>>(
+    fn initial_step<S: OdeSystem<N>>(
         &self,
         sys: &S,
         t0: f64,
@@ -127,11 +122,10 @@ impl StepSize {
         f0: &[f64; N],
         order: u32,
     ) -> f64 {
-        let (rtol, atol, h_max) = (self.rtol, self.atol, self.h_max);
         let mut dnf = 0.0;
         let mut dny = 0.0;
         for i in 0..N {
-            let sk = weight(rtol, atol, y0[i], y0[i]);
+            let sk = self.weight(y0[i], y0[i]);
             dnf += (f0[i] / sk).powi(2);
             dny += (y0[i] / sk).powi(2);
         }
@@ -140,7 +134,7 @@ impl StepSize {
         } else {
             (dny / dnf).sqrt() * HINIT_TARGET
         };
-        h = h.min(h_max);
+        h = h.min(self.h_max);
         let mut y1 = [0.0; N];
         for i in 0..N {
             y1[i] = y0[i] + h * f0[i];
@@ -149,7 +143,7 @@ impl StepSize {
         sys.rhs(t0 + h, &y1, &mut f1);
         let mut der2 = 0.0;
         for i in 0..N {
-            let sk = weight(rtol, atol, y0[i], y0[i]);
+            let sk = self.weight(y0[i], y0[i]);
             der2 += ((f1[i] - f0[i]) / sk).powi(2);
         }
         let der2 = der2.sqrt() / h;
@@ -159,17 +153,23 @@ impl StepSize {
         } else {
             (HINIT_TARGET / der12).powf(1.0 / f64::from(order))
         };
-        let h = (100.0 * h).min(h1).min(h_max);
+        let h = (100.0 * h).min(h1).min(self.h_max);
         if h.is_finite() && h > 0.0 {
             h
         } else {
             // f(t0 + h, y1) was not finite: start small and let the controller (and its non-finite
             // rejections) find a workable step.
-            HINIT_FALLBACK_STEP.min(h_max)
+            HINIT_FALLBACK_STEP.min(self.h_max)
         }
     }
 
-    /// The next trial step from `t` as (h, t_new), or `None` when `t` has reached `t_limit`. A step
+    /// Per-component error weight sk = atol + rtol·max(|y₀ᵢ|, |y₁ᵢ|) (HNW I, eq. (4.10)).
+    #[inline]
+    pub fn weight(&self, y0: f64, y1: f64) -> f64 {
+        self.atol + self.rtol * y0.abs().max(y1.abs())
+    }
+
+    /// The next trial step from `state.t` as (h, t_new), or `None` when it has reached `t_limit`. A step
     /// within 1 % of `t_limit` is stretched to end exactly there.
     ///
     /// # Errors
@@ -177,12 +177,8 @@ impl StepSize {
     /// [`StepError::NonFinite`] if non-finite trials shrank it (`non_finite`),
     /// [`StepError::StepSizeUnderflow`] otherwise.
     #[inline]
-    pub fn trial(
-        &self,
-        t: f64,
-        t_limit: f64,
-        non_finite: bool,
-    ) -> Result<Option<(f64, f64)>, StepError> {
+    pub fn trial(&self, t_limit: f64, non_finite: bool) -> Result<Option<(f64, f64)>, StepError> {
+        let t = self.state.t;
         let remaining = t_limit - t;
         if remaining <= 0.0 {
             return Ok(None);
@@ -204,16 +200,16 @@ impl StepSize {
 
     /// The trial step `h` produced non-finite values: shrink it and count the rejection.
     #[inline]
-    pub fn reject_non_finite<const N: usize>(&mut self, h: f64, state: &mut StepperState<N>) {
-        state.stats.rejected_steps += 1;
+    pub fn reject_non_finite(&mut self, h: f64) {
+        self.state.stats.rejected_steps += 1;
         self.rejected = true;
         self.h = h * NON_FINITE_SHRINK;
     }
 
     /// The trial step `h` had scaled error `err` > 1: shrink it and count the rejection.
     #[inline]
-    pub fn reject<const N: usize>(&mut self, h: f64, err: f64, state: &mut StepperState<N>) {
-        state.stats.rejected_steps += 1;
+    pub fn reject(&mut self, h: f64, err: f64) {
+        self.state.stats.rejected_steps += 1;
         let c = &self.controller;
         let fac11 = err.powf(c.exponent);
         self.rejected = true;
@@ -223,13 +219,7 @@ impl StepSize {
     /// The step `h` to (t_new, y_new) was accepted with scaled error `err` ≤ 1: pick the next step and
     /// move `state` there.
     #[inline]
-    pub fn accept<const N: usize>(
-        &mut self,
-        h: f64,
-        err: f64,
-        state: &mut StepperState<N>,
-        (t_new, y_new): (f64, &[f64; N]),
-    ) {
+    pub fn accept(&mut self, h: f64, err: f64, (t_new, y_new): (f64, &[f64; N])) {
         let c = &self.controller;
         let fac11 = err.powf(c.exponent);
         let fac = fac11 / self.old_error.powf(c.beta);
@@ -242,7 +232,29 @@ impl StepSize {
         self.rejected = false;
         self.h = h_new;
         self.h_last = h;
-        state.advance(t_new, y_new);
+        self.state.advance(t_new, y_new);
+    }
+
+    /// The continuous extension at `t` in the last step from its coefficients `r` (`contd5`, `contd8`):
+    /// r₀ + s(r₁ + s₁(r₂ + s(r₃ + s₁·high))), s the fraction of the step, s₁ = 1 − s, `high(i, s, s1)` the
+    /// higher part of component i.
+    #[inline]
+    pub fn interpolate(
+        &self,
+        r: &[[f64; N]],
+        t: f64,
+        out: &mut [f64; N],
+        high: impl Fn(usize, f64, f64) -> f64,
+    ) {
+        let s = if self.h_last == 0.0 {
+            0.0
+        } else {
+            (t - self.state.t_prev) / self.h_last
+        };
+        let s1 = 1.0 - s;
+        for i in 0..N {
+            out[i] = r[0][i] + s * (r[1][i] + s1 * (r[2][i] + s * (r[3][i] + s1 * high(i, s, s1))));
+        }
     }
 }
 
@@ -283,28 +295,5 @@ pub(crate) fn cubic_dense_output<const N: usize>(
         dense[1][i] = ydiff;
         dense[2][i] = bspl;
         dense[3][i] = ydiff - h * f1[i] - bspl;
-    }
-}
-
-/// The continuous extension at `t` in the last step of `state` (length `h_last`) from its coefficients
-/// `r` (`contd5`, `contd8`): r₀ + s(r₁ + s₁(r₂ + s(r₃ + s₁·high))), s the fraction of the step, s₁ = 1 − s,
-/// `high(i, s, s1)` the higher part of component i.
-#[inline]
-pub(crate) fn continuous_extension<const N: usize>(
-    state: &StepperState<N>,
-    h_last: f64,
-    r: &[[f64; N]],
-    t: f64,
-    out: &mut [f64; N],
-    high: impl Fn(usize, f64, f64) -> f64,
-) {
-    let s = if h_last == 0.0 {
-        0.0
-    } else {
-        (t - state.t_prev) / h_last
-    };
-    let s1 = 1.0 - s;
-    for i in 0..N {
-        out[i] = r[0][i] + s * (r[1][i] + s1 * (r[2][i] + s * (r[3][i] + s1 * high(i, s, s1))));
     }
 }

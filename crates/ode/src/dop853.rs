@@ -12,9 +12,7 @@
 // the source digit by digit; the compiler rounds them to the nearest f64.
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
-use super::control::{
-    combine, continuous_extension, cubic_dense_output, weight, Controller, StepSize,
-};
+use super::control::{combine, cubic_dense_output, AdaptiveSteps, Controller};
 use super::{all_finite, Method, OdeSystem, StepError, Stepper, StepperState};
 
 /// Nodes c₁..c₁₆ (`c2..c16` of `dop853.f`; c₁₃ = 1 is the FSAL stage f(t + h, y₁)).
@@ -251,13 +249,11 @@ const CONTROLLER: Controller = Controller {
 /// The Dormand–Prince 8(5,3) method with error control and 7th-order dense output.
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
-    size: StepSize,
-    state: StepperState<N>,
-    y_prev: [f64; N],
+    steps: AdaptiveSteps<N>,
     /// Stages of the last accepted step: 0..=11 the method's, 12 = f(t, y) (FSAL), 13..=15 dense.
     k: [[f64; N]; 16],
-    /// Coefficients of the continuous extension (`rcont` of `dop853.f`); rows 4..8 valid only when
-    /// `dense_ready`.
+    /// Coefficients of the continuous extension (`rcont` of `dop853.f`), row 0 the state at the start of
+    /// the last step; rows 4..8 valid only when `dense_ready`.
     dense: [[f64; N]; 8],
     dense_ready: bool,
 }
@@ -267,9 +263,7 @@ impl<const N: usize> Dop853<N> {
     #[must_use]
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
-            size: StepSize::new(CONTROLLER, rtol, atol),
-            state: StepperState::start(0.0, &[0.0; N], super::Stats::default()),
-            y_prev: [0.0; N],
+            steps: AdaptiveSteps::new(CONTROLLER, rtol, atol),
             k: [[0.0; N]; 16],
             dense: [[0.0; N]; 8],
             dense_ready: false,
@@ -285,20 +279,14 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         y0: &[f64; N],
         t_end: f64,
     ) -> Result<(), StepError> {
-        self.y_prev = *y0;
         self.k = [[0.0; N]; 16];
         self.dense = [[0.0; N]; 8];
         self.dense[0] = *y0;
         self.dense_ready = true;
         let order = Method::Dop853.order();
-        let started = self.size.start(
-            &mut self.state,
-            sys,
-            (t0, y0),
-            t_end,
-            &mut self.k[12],
-            order,
-        );
+        let started = self
+            .steps
+            .start(sys, (t0, y0), t_end, &mut self.k[12], order);
         self.k[0] = self.k[12];
         started
     }
@@ -307,9 +295,9 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         let mut k = [[0.0; N]; 13];
         let mut y_new = [0.0; N];
         let mut non_finite = false;
-        let y = self.state.y;
+        let y = self.steps.state.y;
         loop {
-            let Some((h, t_new)) = self.size.trial(self.state.t, t_limit, non_finite)? else {
+            let Some((h, t_new)) = self.steps.trial(t_limit, non_finite)? else {
                 return Ok(());
             };
 
@@ -320,18 +308,18 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
                 let t_stage = if s == 11 {
                     t_new
                 } else {
-                    self.state.t + C[s] * h
+                    self.steps.state.t + C[s] * h
                 };
                 sys.rhs(t_stage, &y_stage, &mut k[s]);
             }
             combine(&y, h, A[12], &k, &mut y_new);
-            self.state.stats.rhs_evaluations += 11;
+            self.steps.state.stats.rhs_evaluations += 11;
 
             // Combined 5th/3rd-order error estimate (dop853.f, label 'error estimation').
             let mut err5 = 0.0;
             let mut err3 = 0.0;
             for i in 0..N {
-                let sk = weight(self.size.rtol, self.size.atol, y[i], y_new[i]);
+                let sk = self.steps.weight(y[i], y_new[i]);
                 let b_sum: f64 = A[12].iter().map(|&(j, b)| b * k[j][i]).sum();
                 let e3 = b_sum - BHH.iter().map(|&(j, b)| b * k[j][i]).sum::<f64>();
                 let e5: f64 = ER.iter().map(|&(j, e)| e * k[j][i]).sum();
@@ -347,21 +335,20 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
 
             let finite = err.is_finite() && all_finite(&y_new);
             if finite && err > 1.0 {
-                self.size.reject(h, err, &mut self.state);
+                self.steps.reject(h, err);
                 continue;
             }
             if finite {
                 sys.rhs(t_new, &y_new, &mut k[12]);
-                self.state.stats.rhs_evaluations += 1;
+                self.steps.state.stats.rhs_evaluations += 1;
             }
             if !finite || !all_finite(&k[12]) {
                 non_finite = true;
-                self.size.reject_non_finite(h, &mut self.state);
+                self.steps.reject_non_finite(h);
                 continue;
             }
 
-            self.size.accept(h, err, &mut self.state, (t_new, &y_new));
-            self.y_prev = y;
+            self.steps.accept(h, err, (t_new, &y_new));
             self.k[..13].copy_from_slice(&k);
             // The cubic Hermite part of the dense output is free; the rest waits for a request.
             cubic_dense_output(h, &y, &k[0], &y_new, &k[12], &mut self.dense);
@@ -374,14 +361,14 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         if self.dense_ready {
             return;
         }
-        let h = self.size.h_last;
+        let h = self.steps.h_last;
         let mut y_stage = [0.0; N];
         for s in 13..16 {
             let (done, rest) = self.k.split_at_mut(s);
-            combine(&self.y_prev, h, A[s], done, &mut y_stage);
-            sys.rhs(self.state.t_prev + C[s] * h, &y_stage, &mut rest[0]);
+            combine(&self.dense[0], h, A[s], done, &mut y_stage);
+            sys.rhs(self.steps.state.t_prev + C[s] * h, &y_stage, &mut rest[0]);
         }
-        self.state.stats.rhs_evaluations += 3;
+        self.steps.state.stats.rhs_evaluations += 3;
         // A non-finite extra stage leaves the (finite) cubic Hermite part alone rather than pass NaN on.
         let finite = self.k[13..16].iter().all(all_finite);
         for (row, coefficients) in DENSE.iter().enumerate() {
@@ -394,13 +381,13 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
     }
 
     fn state(&self) -> &StepperState<N> {
-        &self.state
+        &self.steps.state
     }
     /// 7th-order dense output (`contd8` of `dop853.f`) once [`Stepper::prepare_interpolation`] ran for
     /// this step; the cubic Hermite interpolant (its first four terms) before that.
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
         let r = &self.dense;
-        continuous_extension(&self.state, self.size.h_last, r, t, out, |i, s, s1| {
+        self.steps.interpolate(r, t, out, |i, s, s1| {
             if self.dense_ready {
                 r[4][i] + s * (r[5][i] + s1 * (r[6][i] + s * r[7][i]))
             } else {

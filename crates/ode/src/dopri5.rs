@@ -3,9 +3,7 @@
 //! extension of Hairer's `dopri5.f` (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4–II.6,
 //! Table 5.2 and the dense output of §II.6, eq. (6.12)).
 
-use super::control::{
-    combine, continuous_extension, cubic_dense_output, weight, Controller, StepSize,
-};
+use super::control::{combine, cubic_dense_output, AdaptiveSteps, Controller};
 use super::{all_finite, Method, OdeSystem, StepError, Stepper, StepperState};
 
 /// Nodes cᵢ (HNW I, Table 5.2).
@@ -71,8 +69,7 @@ const CONTROLLER: Controller = Controller {
 /// The Dormand–Prince 5(4) pair with error control and 4th-order dense output.
 #[derive(Debug, Clone)]
 pub struct Dopri5<const N: usize> {
-    size: StepSize,
-    state: StepperState<N>,
+    steps: AdaptiveSteps<N>,
     /// f(t, y), the FSAL stage.
     f: [f64; N],
     /// Coefficients r₁..r₅ of the continuous extension over the last step (`rcont` of `dopri5.f`).
@@ -84,8 +81,7 @@ impl<const N: usize> Dopri5<N> {
     #[must_use]
     pub fn new(rtol: f64, atol: f64) -> Self {
         Self {
-            size: StepSize::new(CONTROLLER, rtol, atol),
-            state: StepperState::start(0.0, &[0.0; N], super::Stats::default()),
+            steps: AdaptiveSteps::new(CONTROLLER, rtol, atol),
             f: [0.0; N],
             dense: [[0.0; N]; 5],
         }
@@ -100,21 +96,19 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         y0: &[f64; N],
         t_end: f64,
     ) -> Result<(), StepError> {
-        for (i, row) in self.dense.iter_mut().enumerate() {
-            *row = if i == 0 { *y0 } else { [0.0; N] };
-        }
-        let order = Method::Dopri5.order();
-        self.size
-            .start(&mut self.state, sys, (t0, y0), t_end, &mut self.f, order)
+        self.dense = [[0.0; N]; 5];
+        self.dense[0] = *y0;
+        self.steps
+            .start(sys, (t0, y0), t_end, &mut self.f, Method::Dopri5.order())
     }
 
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError> {
         let mut k = [[0.0; N]; 7];
         let mut y_stage = [0.0; N];
         let mut non_finite = false;
-        let y = self.state.y;
+        let y = self.steps.state.y;
         loop {
-            let Some((h, t_new)) = self.size.trial(self.state.t, t_limit, non_finite)? else {
+            let Some((h, t_new)) = self.steps.trial(t_limit, non_finite)? else {
                 return Ok(());
             };
 
@@ -124,16 +118,16 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
                 let t_stage = if s == 6 {
                     t_new
                 } else {
-                    self.state.t + C[s] * h
+                    self.steps.state.t + C[s] * h
                 };
                 sys.rhs(t_stage, &y_stage, &mut k[s]);
             }
             // y_stage now holds the 5th-order solution at t_new, k[6] = f(t_new, y_new) (FSAL).
-            self.state.stats.rhs_evaluations += 6;
+            self.steps.state.stats.rhs_evaluations += 6;
 
             let mut err = 0.0;
             for i in 0..N {
-                let sk = weight(self.size.rtol, self.size.atol, y[i], y_stage[i]);
+                let sk = self.steps.weight(y[i], y_stage[i]);
                 let e: f64 = E.iter().map(|&(j, e)| e * k[j][i]).sum();
                 err += (h * e / sk).powi(2);
             }
@@ -142,11 +136,11 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
 
             if !err.is_finite() || !all_finite(&y_stage) || !all_finite(&k[6]) {
                 non_finite = true;
-                self.size.reject_non_finite(h, &mut self.state);
+                self.steps.reject_non_finite(h);
                 continue;
             }
             if err > 1.0 {
-                self.size.reject(h, err, &mut self.state);
+                self.steps.reject(h, err);
                 continue;
             }
 
@@ -155,17 +149,17 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
             for (i, r4) in self.dense[4].iter_mut().enumerate() {
                 *r4 = h * D.iter().map(|&(j, d)| d * k[j][i]).sum::<f64>();
             }
-            self.size.accept(h, err, &mut self.state, (t_new, &y_stage));
+            self.steps.accept(h, err, (t_new, &y_stage));
             self.f = k[6];
             return Ok(());
         }
     }
 
     fn state(&self) -> &StepperState<N> {
-        &self.state
+        &self.steps.state
     }
     fn interpolate(&self, t: f64, out: &mut [f64; N]) {
         let r = &self.dense;
-        continuous_extension(&self.state, self.size.h_last, r, t, out, |i, _, _| r[4][i]);
+        self.steps.interpolate(r, t, out, |i, _, _| r[4][i]);
     }
 }

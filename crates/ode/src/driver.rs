@@ -272,14 +272,7 @@ where
         for i in 0..n {
             if self.g_old[i] > 0.0 && self.g_new[i] <= 0.0 {
                 self.prepare_dense();
-                let t_root = locate(
-                    &*self.stepper,
-                    self.events,
-                    i,
-                    n,
-                    (t_old, t_new),
-                    &mut self.buffer,
-                );
+                let t_root = locate(&*self.stepper, self.events, i, n, (t_old, t_new));
                 if event.is_none_or(|(_, t)| t_root < t) {
                     event = Some((i, t_root));
                 }
@@ -328,12 +321,7 @@ where
                 self.events.evaluate(t, &self.buffer, &mut g[..n]);
             }
             let dips = (0..n).filter(|&i| near[i] && g[i] <= 0.0);
-            let roots = dips.map(|i| {
-                (
-                    i,
-                    locate(&*self.stepper, self.events, i, n, (lo, t), &mut [0.0; N]),
-                )
-            });
+            let roots = dips.map(|i| (i, locate(&*self.stepper, self.events, i, n, (lo, t))));
             if let Some(first) = roots.min_by(|a, b| a.1.total_cmp(&b.1)) {
                 return Some(first);
             }
@@ -400,16 +388,16 @@ fn locate<const N: usize, M: Stepper<N>, E: EventFunctions<N>>(
     i: usize,
     n_events: usize,
     (lo, hi): (f64, f64),
-    buffer: &mut [f64; N],
 ) -> f64 {
+    let mut y = [0.0; N];
     let mut g = [0.0; MAX_EVENTS];
-    let mut eval = |t: f64, buffer: &mut [f64; N]| {
-        stepper.interpolate(t, buffer);
-        events.evaluate(t, buffer, &mut g[..n_events]);
+    let mut eval = |t: f64| {
+        stepper.interpolate(t, &mut y);
+        events.evaluate(t, &y, &mut g[..n_events]);
         g[i]
     };
     let (mut lo, mut hi) = (lo, hi);
-    let (mut g_lo, mut g_hi) = (eval(lo, buffer), eval(hi, buffer));
+    let (mut g_lo, mut g_hi) = (eval(lo), eval(hi));
     if g_lo <= 0.0 {
         return lo;
     }
@@ -423,7 +411,7 @@ fn locate<const N: usize, M: Stepper<N>, E: EventFunctions<N>>(
         if !(t > lo && t < hi && t.is_finite()) {
             t = 0.5 * (lo + hi);
         }
-        let g_t = eval(t, buffer);
+        let g_t = eval(t);
         if g_t <= 0.0 {
             hi = t;
             g_hi = g_t;

@@ -2,7 +2,7 @@
 //! t0 + n·h and the two ends of the last accepted step with their derivatives, from which the cubic
 //! Hermite dense output interpolates.
 
-use super::{all_finite, OdeSystem, Stats, StepError, StepperState};
+use super::{all_finite, OdeSystem, StepError, StepperState};
 
 /// Clock and last step of a fixed-step method. Only the stages differ between methods: they read the
 /// start of the step (`state.t`, `state.y`, `f`), and hand the new state to [`FixedSteps::accept`].
@@ -29,7 +29,7 @@ impl<const N: usize> FixedSteps<N> {
             h,
             t0: 0.0,
             n: 0,
-            state: StepperState::start(0.0, &[0.0; N], Stats::default()),
+            state: StepperState::start(0.0, &[0.0; N]),
             f: [0.0; N],
             y_prev: [0.0; N],
             f_prev: [0.0; N],
@@ -46,15 +46,12 @@ impl<const N: usize> FixedSteps<N> {
         t0: f64,
         y0: &[f64; N],
     ) -> Result<(), StepError> {
-        let stats = Stats {
-            rhs_evaluations: 1,
-            ..Stats::default()
-        };
         self.t0 = t0;
         self.n = 0;
-        self.state = StepperState::start(t0, y0, stats);
+        self.state = StepperState::start(t0, y0);
         self.y_prev = *y0;
         sys.rhs(t0, y0, &mut self.f);
+        self.state.stats.rhs_evaluations += 1;
         self.f_prev = self.f;
         if all_finite(y0) && all_finite(&self.f) {
             Ok(())

@@ -127,23 +127,20 @@ impl<const N: usize> Gauss4<N> {
     /// w(s) (w(0) = 0, w(cᵢ) = Zᵢ, s in units of the previous step) extrapolated,
     /// Zᵢ ≈ w(1 + r·cᵢ) − w(1) with r = h / h_previous; explicit Euler without a previous step.
     fn initial_guess(&self, h: f64) -> [[f64; N]; 2] {
-        let mut z = [[0.0; N]; 2];
         let ratio = h / self.h_z_last;
-        if self.h_z_last > 0.0 && ratio <= MAX_EXTRAPOLATION_RATIO {
-            let w = |s: f64, i: usize| {
-                self.z_last[0][i] * s * (s - C[1]) / (C[0] * (C[0] - C[1]))
-                    + self.z_last[1][i] * s * (s - C[0]) / (C[1] * (C[1] - C[0]))
-            };
-            for (a, za) in z.iter_mut().enumerate() {
-                for (i, zi) in za.iter_mut().enumerate() {
-                    *zi = w(1.0 + ratio * C[a], i) - w(1.0, i);
-                }
-            }
-        } else {
-            for (a, za) in z.iter_mut().enumerate() {
-                for (i, zi) in za.iter_mut().enumerate() {
-                    *zi = C[a] * h * self.steps.f[i];
-                }
+        let extrapolate = self.h_z_last > 0.0 && ratio <= MAX_EXTRAPOLATION_RATIO;
+        let w = |s: f64, i: usize| {
+            self.z_last[0][i] * s * (s - C[1]) / (C[0] * (C[0] - C[1]))
+                + self.z_last[1][i] * s * (s - C[0]) / (C[1] * (C[1] - C[0]))
+        };
+        let mut z = [[0.0; N]; 2];
+        for a in 0..2 {
+            for i in 0..N {
+                z[a][i] = if extrapolate {
+                    w(1.0 + ratio * C[a], i) - w(1.0, i)
+                } else {
+                    C[a] * h * self.steps.f[i]
+                };
             }
         }
         z

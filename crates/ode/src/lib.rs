@@ -113,13 +113,13 @@ pub struct StepperState<const N: usize> {
 }
 
 impl<const N: usize> StepperState<N> {
-    /// At (t0, y0) with `stats`.
-    fn start(t0: f64, y0: &[f64; N], stats: Stats) -> Self {
+    /// At (t0, y0), no work done yet.
+    fn start(t0: f64, y0: &[f64; N]) -> Self {
         Self {
             t: t0,
             t_prev: t0,
             y: *y0,
-            stats,
+            stats: Stats::default(),
         }
     }
 

@@ -35,22 +35,19 @@ impl<const N: usize> Stepper<N> for Rk4<N> {
         let end = self.steps.next_end(t_limit);
         let (t, y, k1) = (self.steps.state.t, &self.steps.state.y, &self.steps.f);
         let h = end.0 - t;
+        let stage = |dt: f64, k_previous: &[f64; N], k: &mut [f64; N]| {
+            let mut y_stage = [0.0; N];
+            for i in 0..N {
+                y_stage[i] = y[i] + dt * k_previous[i];
+            }
+            sys.rhs(t + dt, &y_stage, k);
+        };
         let mut k2 = [0.0; N];
         let mut k3 = [0.0; N];
         let mut k4 = [0.0; N];
-        let mut tmp = [0.0; N];
-        for i in 0..N {
-            tmp[i] = y[i] + 0.5 * h * k1[i];
-        }
-        sys.rhs(t + 0.5 * h, &tmp, &mut k2);
-        for i in 0..N {
-            tmp[i] = y[i] + 0.5 * h * k2[i];
-        }
-        sys.rhs(t + 0.5 * h, &tmp, &mut k3);
-        for i in 0..N {
-            tmp[i] = y[i] + h * k3[i];
-        }
-        sys.rhs(t + h, &tmp, &mut k4);
+        stage(0.5 * h, k1, &mut k2);
+        stage(0.5 * h, &k2, &mut k3);
+        stage(h, &k3, &mut k4);
         let mut y_new = [0.0; N];
         for i in 0..N {
             y_new[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
