@@ -92,7 +92,7 @@ impl Rerun3d {
             self.started = true;
         }
         out.push(Topic::Main(Channel::Rerun), |buf| {
-            transform(log_time, FOLLOW_FRAME, BODY_FRAME, [0.0; 3], r).encode_raw(buf);
+            transform(buf, log_time, FOLLOW_FRAME, BODY_FRAME, None, Some(r));
         });
     }
 
