@@ -251,8 +251,7 @@ impl Drift {
 /// Everything a sample needs, built once.
 struct Sampler<'t, W: Write + Seek, T: Tap> {
     out: Output<'t, W, T>,
-    coin: Coin,
-    /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
+    /// The coin and its equations with the scene's dissipation, for the reaction (physics §11).
     dynamics: Dynamics,
     on: [bool; Channel::ALL.len()],
     /// The messages of the current sample, written once all are formatted.
@@ -329,7 +328,7 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
     /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
     #[inline]
     fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
-        let coin = self.coin;
+        let coin = *self.dynamics.coin();
         self.stage(Channel::Omega, || AngularVelocity {
             t,
             x: s.omega_x,
@@ -379,7 +378,8 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
         t: f64,
         s: &State,
     ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
-        let (coin, dynamics) = (self.coin, self.dynamics);
+        let dynamics = self.dynamics;
+        let coin = dynamics.coin();
         self.stage(Channel::Reaction, || {
             let r = dynamics.reaction(s);
             let p = coin.params();
@@ -394,7 +394,7 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
             }
         })?;
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
-        let e = energy(&coin, s);
+        let e = energy(coin, s);
         let e0 = *self.energy0.get_or_insert(e.total);
         self.stage(Channel::Energy, || EnergyMessage {
             t,
@@ -424,7 +424,7 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
         d.last_theta = s.theta;
         // With dissipation C1, C2 are not conserved (physics §11): their change is no drift.
         if let (Some((c1, c2)), None) = (invariants, self.dynamics.dissipation()) {
-            let params = self.coin.params();
+            let params = self.dynamics.coin().params();
             d.invariants
                 .get_or_insert_with(|| InvariantDrift::new(params, c1, c2))
                 .observe(t, c1, c2);
@@ -648,7 +648,6 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
                 sequence: [0; Topic::COUNT],
                 messages: 0,
             },
-            coin,
             dynamics,
             on,
             batch: FoxgloveBatch::default(),
