@@ -103,45 +103,39 @@ fn flat_protobuf_bytes(fields: &[&str]) -> u64 {
     clippy::cast_precision_loss
 )]
 pub fn estimate(scene: &Scene, compression: Compression, encoding: Encoding) -> Estimate {
-    let protobuf = encoding == Encoding::Protobuf;
     let n = samples(scene.run.duration, scene.run.rate);
     let updates = n.min((scene.run.duration * SCENE_RATE).ceil() as u64 + 2);
     let mut per_channel = Vec::new();
     let (mut payload, mut schemas) = (0u64, 0u64);
     let mut seen_schemas = Vec::new();
+    // Bytes of a /tf message, of a /scene update and of one of its track points, of a flat message.
+    let (tf, update, point, flat): (_, _, _, fn(&[&str]) -> u64) = match encoding {
+        Encoding::Json => (TF_BYTES, SCENE_BYTES, TRACK_POINT_BYTES, flat_bytes),
+        Encoding::Protobuf => (
+            TF_PROTOBUF_BYTES,
+            SCENE_PROTOBUF_BYTES,
+            TRACK_POINT_PROTOBUF_BYTES,
+            flat_protobuf_bytes,
+        ),
+    };
     for &c in &scene.channels {
         let (count, bytes) = match c {
             // /tf: world → table once, then table → coin per sample; /tf_static: world → table once.
-            Channel::Tf => (
-                n + 2,
-                if protobuf {
-                    TF_PROTOBUF_BYTES
-                } else {
-                    TF_BYTES
-                },
-            ),
+            Channel::Tf => (n + 2, tf),
             // Per display update: the follow frame and the coin, and on average about two track levels
             // (level k changes every 2^k updates: a binary counter); the table once, then when it moves.
             // The bytes per message are averaged over these.
-            Channel::Scene => {
-                let (update, point) = if protobuf {
-                    (SCENE_PROTOBUF_BYTES, TRACK_POINT_PROTOBUF_BYTES)
-                } else {
-                    (SCENE_BYTES, TRACK_POINT_BYTES)
-                };
-                (
-                    SCENE_MESSAGES_PER_UPDATE * updates + 1,
-                    (update + point * n.div_ceil(updates.max(1))) / SCENE_MESSAGES_PER_UPDATE,
-                )
-            }
+            Channel::Scene => (
+                SCENE_MESSAGES_PER_UPDATE * updates + 1,
+                (update + point * n.div_ceil(updates.max(1))) / SCENE_MESSAGES_PER_UPDATE,
+            ),
             // Per display update: /rerun/coin_body and a point cloud of the track; the URDF once and the
             // table (a 60 × 60 voxel grid, 14.5 kB, compressing to little) once, then when it moves.
             Channel::Rerun => (
                 2 * updates + 2,
                 RERUN_UPDATE_BYTES + TRACK_POINT_RERUN_BYTES * n.div_ceil(updates.max(1)) / 2,
             ),
-            _ if protobuf => (n, c.fields().map_or(100, flat_protobuf_bytes)),
-            _ => (n, c.fields().map_or(100, flat_bytes)),
+            _ => (n, c.fields().map_or(100, flat)),
         };
         per_channel.push((c, count));
         payload += count * (bytes + RECORD_OVERHEAD);

@@ -251,8 +251,7 @@ impl Drift {
 /// Everything a sample needs, built once.
 struct Sampler<'t, W: Write + Seek, T: Tap> {
     out: Output<'t, W, T>,
-    coin: Coin,
-    /// The coin's equations with the scene's dissipation, for the reaction (physics §11).
+    /// The coin and its equations with the scene's dissipation, for the reaction (physics §11).
     dynamics: Dynamics,
     on: [bool; Channel::ALL.len()],
     /// The messages of the current sample, written once all are formatted.
@@ -268,17 +267,20 @@ struct Sampler<'t, W: Write + Seek, T: Tap> {
 }
 
 impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
+    /// Formats the message `m()` into the sample's batch when `channel` is recorded (an error abandons the
+    /// sample).
     #[inline]
-    fn on(&self, channel: Channel) -> bool {
-        self.on[channel as usize]
-    }
-
-    /// Formats one message into the sample's batch (an error abandons the sample).
-    #[inline]
-    fn stage(&mut self, channel: Channel, m: impl Message) -> Result<(), SampleError> {
+    fn stage<M: Message>(
+        &mut self,
+        channel: Channel,
+        m: impl FnOnce() -> M,
+    ) -> Result<(), SampleError> {
+        if !self.on[channel as usize] {
+            return Ok(());
+        }
         let (encoding, mut formatted) = (self.out.encoding, Ok(()));
         self.batch
-            .push(Topic::Main(channel), |b| formatted = m.write(encoding, b));
+            .push(Topic::Main(channel), |b| formatted = m().write(encoding, b));
         Ok(formatted?)
     }
 
@@ -315,66 +317,55 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
     #[inline]
     fn stage_work(&mut self, t: f64, total: f64, work: f64) -> Result<f64, SampleError> {
         let balance = total + work;
-        if self.on(Channel::Work) {
-            let m = WorkMessage {
-                t,
-                dissipated: work,
-                balance,
-            };
-            self.stage(Channel::Work, m)?;
-        }
+        self.stage(Channel::Work, || WorkMessage {
+            t,
+            dissipated: work,
+            balance,
+        })?;
         Ok(balance)
     }
 
     /// Stages the messages of the state alone: ω, angles, quaternion, centre, contact point.
     #[inline]
     fn stage_kinematics(&mut self, t: f64, s: &State) -> Result<(), SampleError> {
-        let coin = self.coin;
-        if self.on(Channel::Omega) {
-            let m = AngularVelocity {
-                t,
-                x: s.omega_x,
-                y: s.omega_y,
-                z: s.omega_z,
-            };
-            self.stage(Channel::Omega, m)?;
-        }
-        if self.on(Channel::Angles) {
-            let m = Angles {
-                t,
-                theta: s.theta,
-                phi: s.phi,
-                psi: s.psi,
-                phi_dot: Some(s.omega_y / s.theta.cos()),
-            };
-            self.stage(Channel::Angles, m)?;
-        }
-        if self.on(Channel::Quaternion) {
+        let coin = *self.dynamics.coin();
+        self.stage(Channel::Omega, || AngularVelocity {
+            t,
+            x: s.omega_x,
+            y: s.omega_y,
+            z: s.omega_z,
+        })?;
+        self.stage(Channel::Angles, || Angles {
+            t,
+            theta: s.theta,
+            phi: s.phi,
+            psi: s.psi,
+            phi_dot: Some(s.omega_y / s.theta.cos()),
+        })?;
+        self.stage(Channel::Quaternion, || {
             let q = orientation(s);
-            let m = QuaternionMessage {
+            QuaternionMessage {
                 t,
                 x: q.i,
                 y: q.j,
                 z: q.k,
                 w: q.w,
-            };
-            self.stage(Channel::Quaternion, m)?;
-        }
+            }
+        })?;
         let points = [
             (Channel::Position, centre as fn(&_, &_) -> _),
             (Channel::Contact, contact_point),
         ];
         for (channel, point) in points {
-            if self.on(channel) {
+            self.stage(channel, || {
                 let c = point(&coin, s);
-                let m = Position {
+                Position {
                     t,
                     x: c.x,
                     y: c.y,
                     z: c.z,
-                };
-                self.stage(channel, m)?;
-            }
+                }
+            })?;
         }
         Ok(())
     }
@@ -387,11 +378,12 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
         t: f64,
         s: &State,
     ) -> Result<(f64, Option<(f64, f64)>), SampleError> {
-        let coin = self.coin;
-        if self.on(Channel::Reaction) {
-            let r = self.dynamics.reaction(s);
+        let dynamics = self.dynamics;
+        let coin = dynamics.coin();
+        self.stage(Channel::Reaction, || {
+            let r = dynamics.reaction(s);
             let p = coin.params();
-            let m = ReactionMessage {
+            ReactionMessage {
                 t,
                 x: r.force.x,
                 y: r.force.y,
@@ -399,31 +391,26 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
                 friction: r.friction,
                 normal: r.normal,
                 friction_ratio: Some(friction_ratio(r.friction, r.normal, p.mass(), p.gravity())),
-            };
-            self.stage(Channel::Reaction, m)?;
-        }
+            }
+        })?;
         // Energy is always computed: the summary's drift needs it, and it is a handful of flops.
-        let e = energy(&coin, s);
+        let e = energy(coin, s);
         let e0 = *self.energy0.get_or_insert(e.total);
-        if self.on(Channel::Energy) {
-            let m = EnergyMessage {
-                t,
-                total: e.total,
-                kinetic: e.kinetic,
-                potential: e.potential,
-                change: Some(e.total - e0),
-                drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
-            };
-            self.stage(Channel::Energy, m)?;
-        }
+        self.stage(Channel::Energy, || EnergyMessage {
+            t,
+            total: e.total,
+            kinetic: e.kinetic,
+            potential: e.potential,
+            change: Some(e.total - e0),
+            drift_eps: Some(drift_eps(e.total, e0, coin.params().energy_scale())),
+        })?;
         let invariants = self.chaplygin.as_ref().map(|c| c.of_state(s));
         if let Some(c) = invariants {
-            let m = InvariantsMessage {
+            self.stage(Channel::Invariants, || InvariantsMessage {
                 t,
                 c1: c.c1,
                 c2: c.c2,
-            };
-            self.stage(Channel::Invariants, m)?;
+            })?;
         }
         Ok((e.total, invariants.map(|c| (c.c1, c.c2))))
     }
@@ -437,7 +424,7 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
         d.last_theta = s.theta;
         // With dissipation C1, C2 are not conserved (physics §11): their change is no drift.
         if let (Some((c1, c2)), None) = (invariants, self.dynamics.dissipation()) {
-            let params = self.coin.params();
+            let params = self.dynamics.coin().params();
             d.invariants
                 .get_or_insert_with(|| InvariantDrift::new(params, c1, c2))
                 .observe(t, c1, c2);
@@ -626,10 +613,7 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
     ) -> Result<Self, RecordError> {
         let dynamics = scene.dynamics();
         let coin = *dynamics.coin();
-        let mut on = [false; Channel::ALL.len()];
-        for c in &scene.channels {
-            on[*c as usize] = true;
-        }
+        let on = std::array::from_fn(|c| scene.records(Channel::ALL[c]));
         if options.encoding == Encoding::Protobuf && scene.run.duration > PROTOBUF_MAX_SECONDS {
             return Err(RecordError::TooLongForProtobuf {
                 duration: scene.run.duration,
@@ -643,7 +627,7 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
         {
             return Err(RecordError::Encoding { channel });
         }
-        let chaplygin = if on[Channel::Invariants as usize] {
+        let chaplygin = if scene.records(Channel::Invariants) {
             Some(Chaplygin::new(&scene.params)?)
         } else {
             None
@@ -664,7 +648,6 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
                 sequence: [0; Topic::COUNT],
                 messages: 0,
             },
-            coin,
             dynamics,
             on,
             batch: FoxgloveBatch::default(),

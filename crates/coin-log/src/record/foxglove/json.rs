@@ -4,9 +4,8 @@
 
 use super::track::TrackPoint;
 use super::{
-    coin_marks, grid_segments, Rgba, COIN_FRAME, COIN_RGBA, FOLLOW_FRAME, GRID_HEIGHT, GRID_RGBA,
-    GRID_WIDTHS, TABLE_FRAME, TABLE_HALF_SIDE, TABLE_RGBA, TABLE_ROTATION, TABLE_THICKNESS,
-    TABLE_TOP, TRACK_RGBA, TRACK_WIDTH, WORLD_FRAME,
+    coin_marks, grid_segments, Rgba, COIN_RGBA, FOLLOW_FRAME, GRID_HEIGHT, GRID_RGBA, GRID_WIDTHS,
+    TABLE_HALF_SIDE, TABLE_RGBA, TABLE_THICKNESS, TABLE_TOP, TRACK_RGBA, TRACK_WIDTH, WORLD_FRAME,
 };
 use crate::format::messages::push_number;
 use nalgebra::{UnitQuaternion, Vector3};
@@ -113,17 +112,6 @@ impl<'a> Writer<'a> {
         self.raw(b",\"z\":0}");
     }
 
-    /// A `FrameTransform` up to its `"translation":`.
-    fn transform_head(&mut self, log_time: u64, parent: &str, child: &str) {
-        self.raw(b"{\"timestamp\":");
-        self.time(log_time);
-        self.raw(b",\"parent_frame_id\":\"");
-        self.raw(parent.as_bytes());
-        self.raw(b"\",\"child_frame_id\":\"");
-        self.raw(child.as_bytes());
-        self.raw(b"\",\"translation\":");
-    }
-
     /// A `SceneUpdate` of one entity up to its `"arrows":[],`; the caller writes cubes, spheres, cylinders
     /// and lines (each followed by a comma), then [`Self::entity_tail`].
     fn entity_head(&mut self, log_time: u64, frame: &str, id: &[u8]) {
@@ -142,36 +130,34 @@ impl<'a> Writer<'a> {
     }
 }
 
-/// `/tf` and `/tf_static` world → table (static, [`TABLE_ROTATION`]).
-pub(super) fn table_transform(buf: &mut Vec<u8>, log_time: u64) {
-    let mut w = Writer::new(buf);
-    w.transform_head(log_time, WORLD_FRAME, TABLE_FRAME);
-    w.raw(b"{\"x\":0,\"y\":0,\"z\":0},\"rotation\":");
-    w.quaternion(&TABLE_ROTATION);
-    w.raw(b"}");
-}
-
-/// `/tf` table → coin: the centre `translation` and the orientation `q`.
-pub(super) fn coin_transform(
+/// A `FrameTransform` `parent` → `child`: the zero translation (`None`) and the identity rotation (`None`)
+/// are written as literals.
+pub(super) fn transform(
     buf: &mut Vec<u8>,
     log_time: u64,
-    translation: [f64; 3],
-    q: &UnitQuaternion<f64>,
+    parent: &str,
+    child: &str,
+    translation: Option<[f64; 3]>,
+    rotation: Option<&UnitQuaternion<f64>>,
 ) {
     let mut w = Writer::new(buf);
-    w.transform_head(log_time, TABLE_FRAME, COIN_FRAME);
-    w.vector3(translation[0], translation[1], translation[2]);
+    w.raw(b"{\"timestamp\":");
+    w.time(log_time);
+    w.raw(b",\"parent_frame_id\":\"");
+    w.raw(parent.as_bytes());
+    w.raw(b"\",\"child_frame_id\":\"");
+    w.raw(child.as_bytes());
+    w.raw(b"\",\"translation\":");
+    match translation {
+        Some([x, y, z]) => w.vector3(x, y, z),
+        None => w.raw(b"{\"x\":0,\"y\":0,\"z\":0}"),
+    }
     w.raw(b",\"rotation\":");
-    w.quaternion(q);
+    match rotation {
+        Some(q) => w.quaternion(q),
+        None => w.raw(b"{\"x\":0,\"y\":0,\"z\":0,\"w\":1}"),
+    }
     w.raw(b"}");
-}
-
-/// `/scene/follow` world → coin_level: translation `centre` (display units), no rotation.
-pub(super) fn follow_transform(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 3]) {
-    let mut w = Writer::new(buf);
-    w.transform_head(log_time, WORLD_FRAME, FOLLOW_FRAME);
-    w.vector3(centre[0], centre[1], centre[2]);
-    w.raw(b",\"rotation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}");
 }
 
 /// `/scene`: the coin in `coin_level`, posed with its orientation `r` in `world`: a cylinder with its axis

@@ -226,16 +226,25 @@ impl Foxglove3d {
             finite(FRAME_TRANSFORM, "translation", &translation)?;
             finite(FRAME_TRANSFORM, "rotation", q.coords.as_slice())?;
             let tf = Topic::Main(Channel::Tf);
+            let rotation = Some(&TABLE_ROTATION);
+            let table = |buf: &mut _| {
+                encode!(
+                    encoding,
+                    transform(buf, log_time, WORLD_FRAME, TABLE_FRAME, None, rotation)
+                );
+            };
             if first {
-                out.push(tf, |buf| encode!(encoding, table_transform(buf, log_time)));
+                out.push(tf, table);
             }
             out.push(tf, |buf| {
-                encode!(encoding, coin_transform(buf, log_time, translation, &q));
+                let (parent, child) = (TABLE_FRAME, COIN_FRAME);
+                encode!(
+                    encoding,
+                    transform(buf, log_time, parent, child, Some(translation), Some(&q))
+                );
             });
             if first {
-                out.push(Topic::TfStatic, |buf| {
-                    encode!(encoding, table_transform(buf, log_time));
-                });
+                out.push(Topic::TfStatic, table);
             }
         }
         if self.scene {
@@ -270,7 +279,11 @@ impl Foxglove3d {
         finite(SCENE_UPDATE, "pose.orientation", rotation.coords.as_slice())?;
         finite(SCENE_UPDATE, "cylinders.size.z", &[thickness])?;
         out.push(Topic::SceneFollow, |buf| {
-            encode!(encoding, follow_transform(buf, log_time, centre));
+            let (parent, child) = (WORLD_FRAME, FOLLOW_FRAME);
+            encode!(
+                encoding,
+                transform(buf, log_time, parent, child, Some(centre), None)
+            );
         });
         out.push(Topic::Main(Channel::Scene), |buf| {
             encode!(encoding, coin(buf, log_time, &rotation, thickness));

@@ -5,8 +5,7 @@
 use super::track::TrackPoint;
 use super::{
     coin_marks, grid_segments, Rgba, COIN_RGBA, FOLLOW_FRAME, GRID_HEIGHT, GRID_RGBA, GRID_WIDTHS,
-    TABLE_HALF_SIDE, TABLE_RGBA, TABLE_ROTATION, TABLE_THICKNESS, TABLE_TOP, TRACK_RGBA,
-    TRACK_WIDTH, WORLD_FRAME,
+    TABLE_HALF_SIDE, TABLE_RGBA, TABLE_THICKNESS, TABLE_TOP, TRACK_RGBA, TRACK_WIDTH, WORLD_FRAME,
 };
 use foxglove::messages::{
     line_primitive, scene_entity_deletion, Color, CubePrimitive, CylinderPrimitive, Duration,
@@ -68,60 +67,24 @@ fn point(x: f64, y: f64) -> Point3 {
     Point3 { x, y, z: 0.0 }
 }
 
+/// A `FrameTransform` `parent` → `child`: no translation (`None`) is the zero one, no rotation the identity
+/// (signature as in [`super::json`]).
 pub(super) fn transform(
+    buf: &mut Vec<u8>,
     log_time: u64,
     parent: &str,
     child: &str,
-    translation: [f64; 3],
-    rotation: &UnitQuaternion<f64>,
-) -> FrameTransform {
+    translation: Option<[f64; 3]>,
+    rotation: Option<&UnitQuaternion<f64>>,
+) {
+    let [x, y, z] = translation.unwrap_or([0.0; 3]);
     FrameTransform {
         timestamp: Some(timestamp(log_time)),
         parent_frame_id: parent.to_string(),
         child_frame_id: child.to_string(),
-        translation: vector3(translation[0], translation[1], translation[2]),
-        rotation: quaternion(rotation),
+        translation: vector3(x, y, z),
+        rotation: quaternion(rotation.unwrap_or(&UnitQuaternion::identity())),
     }
-}
-
-/// `/tf` and `/tf_static` world → table.
-pub(super) fn table_transform(buf: &mut Vec<u8>, log_time: u64) {
-    transform(
-        log_time,
-        WORLD_FRAME,
-        super::TABLE_FRAME,
-        [0.0; 3],
-        &TABLE_ROTATION,
-    )
-    .encode_raw(buf);
-}
-
-/// `/tf` table → coin: the centre `translation` and the orientation `q`.
-pub(super) fn coin_transform(
-    buf: &mut Vec<u8>,
-    log_time: u64,
-    translation: [f64; 3],
-    q: &UnitQuaternion<f64>,
-) {
-    transform(
-        log_time,
-        super::TABLE_FRAME,
-        super::COIN_FRAME,
-        translation,
-        q,
-    )
-    .encode_raw(buf);
-}
-
-/// `/scene/follow` world → coin_level.
-pub(super) fn follow_transform(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 3]) {
-    transform(
-        log_time,
-        WORLD_FRAME,
-        FOLLOW_FRAME,
-        centre,
-        &UnitQuaternion::identity(),
-    )
     .encode_raw(buf);
 }
 

@@ -39,7 +39,7 @@ const fn rgba8(c: Rgba) -> [u8; 4] {
 }
 
 /// State of the `rerun` channel across drawing updates.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Rerun3d {
     thickness: f64,
     /// Whether the URDF has been written.
@@ -55,10 +55,7 @@ impl Rerun3d {
     pub fn new(thickness: f64) -> Self {
         Self {
             thickness,
-            started: false,
-            pending: Vec::new(),
-            kept: None,
-            latest: None,
+            ..Self::default()
         }
     }
 
@@ -92,7 +89,7 @@ impl Rerun3d {
             self.started = true;
         }
         out.push(Topic::Main(Channel::Rerun), |buf| {
-            transform(log_time, FOLLOW_FRAME, BODY_FRAME, [0.0; 3], r).encode_raw(buf);
+            transform(buf, log_time, FOLLOW_FRAME, BODY_FRAME, None, Some(r));
         });
     }
 

@@ -186,12 +186,16 @@ impl Track {
 /// The error bound of replacing points a..=b by the segment [P_a, P_b], and the inner point farthest from
 /// that segment (to split at), if there is an inner point off the segment.
 fn segment_bound(points: &[TrackPoint], a: usize, b: usize) -> (f64, Option<usize>) {
-    let (pa, pb) = (points[a], points[b]);
+    let (pa, pb) = ([points[a].x, points[a].y], [points[b].x, points[b].y]);
     let mut bound: f64 = 0.0;
     let mut farthest: Option<(usize, f64)> = None;
     let mut previous: f64 = 0.0;
     for (k, p) in points.iter().enumerate().take(b + 1).skip(a + 1) {
-        let d = if k == b { 0.0 } else { distance(p, &pa, &pb) };
+        let d = if k == b {
+            0.0
+        } else {
+            segment_distance([p.x, p.y], pa, pb)
+        };
         bound = bound.max(p.err + previous.max(d));
         if d > 0.0 && farthest.is_none_or(|(_, f)| d > f) {
             farthest = Some((k, d));
@@ -199,11 +203,6 @@ fn segment_bound(points: &[TrackPoint], a: usize, b: usize) -> (f64, Option<usiz
         previous = d;
     }
     (bound, farthest.map(|(k, _)| k))
-}
-
-/// Distance from p to the segment [a, b].
-fn distance(p: &TrackPoint, a: &TrackPoint, b: &TrackPoint) -> f64 {
-    segment_distance([p.x, p.y], [a.x, a.y], [b.x, b.y])
 }
 
 /// Distance from the point `p` to the segment [`a`, `b`] of the plane.
@@ -225,16 +224,11 @@ mod tests {
 
     /// Distance from p to the polyline `line`.
     fn to_polyline(p: (f64, f64), line: &[TrackPoint]) -> f64 {
-        let q = TrackPoint {
-            x: p.0,
-            y: p.1,
-            err: 0.0,
-        };
         match line {
             [only] => (only.x - p.0).hypot(only.y - p.1),
             _ => line
                 .windows(2)
-                .map(|w| distance(&q, &w[0], &w[1]))
+                .map(|w| segment_distance([p.0, p.1], [w[0].x, w[0].y], [w[1].x, w[1].y]))
                 .fold(f64::INFINITY, f64::min),
         }
     }
