@@ -488,16 +488,6 @@ impl Judge {
     }
 }
 
-fn unusable(path: &str, problem: String) -> FileReport {
-    FileReport {
-        path: path.to_string(),
-        exit_code: Verdict::Unusable.exit_code(),
-        verdict: Verdict::Unusable,
-        problem: Some(problem),
-        checks: Vec::new(),
-    }
-}
-
 /// Judges one file. Never fails: an unreadable file is a report with exit code 2 and the reason in
 /// [`FileReport::problem`].
 #[must_use]
@@ -535,7 +525,7 @@ fn verdict(
 ) -> FileReport {
     if let Some(e) = &error {
         if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) {
-            return unusable(&shown, e.to_string());
+            return FileReport::unusable(shown, e.to_string());
         }
     }
     // A truncated or corrupt file is judged on what could be read, and is unusable (exit 2).
@@ -556,7 +546,7 @@ fn verdict(
             ),
             (None, None) => judge.not_coin_log(&structure.summary.library),
         };
-        return unusable(&shown, why);
+        return FileReport::unusable(shown, why);
     };
     ctx.result = judge.result.take();
     let problem = read_problem.map(ToString::to_string);
@@ -587,13 +577,7 @@ fn verdict(
         (None, false, Some(why)) => (Verdict::CannotVerify, Some(why)),
         (None, false, None) => (Verdict::Ok, None),
     };
-    FileReport {
-        path: shown,
-        exit_code: verdict.exit_code(),
-        verdict,
-        problem,
-        checks: results,
-    }
+    FileReport::new(shown, verdict, problem, results)
 }
 
 impl Judge {
