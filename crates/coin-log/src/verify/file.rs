@@ -58,23 +58,12 @@ impl Checks {
     fn observe(&mut self, s: &Sample, ctx: &Context) {
         self.stats.observe(s);
         self.energy.observe(s, ctx);
-        self.invariants
-            .observe(s, ctx.coin.params(), invariants_of(ctx));
+        self.invariants.observe(s, ctx);
         self.steady.observe(s, ctx);
         self.constraint.observe(s, ctx.coin.params().radius());
         self.consistency.observe(s, ctx);
         self.validity.observe(s, ctx);
         self.nutation.observe(s, ctx);
-    }
-}
-
-/// C1, C2 at (θ, ω_Y, ω_Z), when they can be evaluated for these parameters.
-fn invariants_of(ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> + '_ {
-    move |theta, omega_y, omega_z| {
-        ctx.chaplygin.as_ref().ok().map(|c| {
-            let i = c.evaluate(theta, omega_y, omega_z);
-            (i.c1, i.c2)
-        })
     }
 }
 
@@ -192,14 +181,7 @@ impl Judge {
                 format!("{e}: record stores a scene that reads back to the run it made")
             }),
         }
-        let steady = match &run.dissipation {
-            Some(d) => Err(format!(
-                "the run has dissipation ({}, κ = {}): a dissipative couple moves the coin off every steady motion (physics §11)",
-                d.model(),
-                super::checks::fmt_num(d.coefficient())
-            )),
-            None => steady::plan(&coin, &run, &scene),
-        };
+        let steady = steady::plan(&coin, &run, &scene);
         let chaplygin = Chaplygin::new(&params)
             .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
         self.ctx = Some(Context {
@@ -562,7 +544,7 @@ fn verdict(
     let results = vec![
         integrity::finish(&problems, &read, &judge.notes),
         c.energy.finish(&tol, &ctx),
-        c.invariants.finish(&tol, invariants_skip(&ctx).as_deref()),
+        c.invariants.finish(&tol, &ctx),
         c.steady.finish(&ctx, &tol),
         c.constraint.finish(ctx.coin.params().radius(), &tol),
         c.consistency.finish(),
@@ -622,19 +604,6 @@ impl Judge {
         }
         problems
     }
-}
-
-/// Why the invariants check does not run: C1, C2 cannot be evaluated for the body, or the run has
-/// dissipation, which changes them (physics §11).
-fn invariants_skip(ctx: &Context) -> Option<String> {
-    if let Some(d) = ctx.dynamics.dissipation() {
-        return Some(format!(
-            "the run has dissipation ({}, κ = {}): C1, C2 are not conserved by the dissipative couple (physics §11); the energy check judges E + W = E0 instead",
-            d.model(),
-            super::checks::fmt_num(d.coefficient())
-        ));
-    }
-    ctx.chaplygin.as_ref().err().cloned()
 }
 
 /// The tolerances of this file: derived from its recorded settings and span, or the flags'.
