@@ -592,10 +592,8 @@ impl TimeAxis<'_> {
             return empty(area, title, "the channel this needs was not recorded");
         }
         let points: Vec<Vec<(f64, f64)>> = series.iter().map(|s| s.1.points()).collect();
-        let positive = points.iter().flatten().map(|p| p.1).filter(|v| *v > 0.0);
-        let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
+        let positive = points.iter().flatten().filter(|p| p.1 > 0.0);
+        let (lo, hi) = min_max(positive, |p| p.1);
         let (floor, top) = if hi > 0.0 {
             (lo / 10.0, hi * 10.0)
         } else {
