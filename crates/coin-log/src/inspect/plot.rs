@@ -646,27 +646,23 @@ impl TimeAxis<'_> {
                 .label(*label)
                 .legend(legend_line(*colour, 2));
         }
-        if let Some((label, v)) = line {
+        let mut dashed = |ends: [(f64, f64); 2], dash, colour: RGBColor, label: String| {
             chart
-                .draw_series(DashedLineSeries::new(
-                    [(0.0, v), (self.t_max, v)],
-                    6,
-                    4,
-                    GREEN.stroke_width(2),
-                ))?
-                .label(format!("{label} = {v}"))
-                .legend(legend_line(GREEN, 2));
+                .draw_series(DashedLineSeries::new(ends, dash, 4, colour.stroke_width(2)))?
+                .label(label)
+                .legend(legend_line(colour, 2));
+            Ok::<_, DrawError>(())
+        };
+        if let Some((label, v)) = line {
+            dashed(
+                [(0.0, v), (self.t_max, v)],
+                6,
+                GREEN,
+                format!("{label} = {v}"),
+            )?;
         }
         if let Some((name, t)) = self.end {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    [(t, y0), (t, y1)],
-                    5,
-                    4,
-                    RED.stroke_width(2),
-                ))?
-                .label(format!("{name} at t = {t}"))
-                .legend(legend_line(RED, 2));
+            dashed([(t, y0), (t, y1)], 5, RED, format!("{name} at t = {t}"))?;
         }
         legend_box(chart, SeriesLabelPosition::UpperRight)
     }
