@@ -17,6 +17,7 @@ use crate::format::{
     log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
+use crate::integrate::MethodConfig;
 use crate::model::{Chaplygin, Coin, Dynamics};
 use crate::scene::{self, Scene};
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
@@ -609,20 +610,14 @@ impl Judge {
 /// The tolerances of this file: derived from its recorded settings and span, or the flags'.
 fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances {
     let run = &ctx.run;
-    Tolerances::derive(
-        &RunAccuracy {
-            integrator: run.integrator,
-            rtol: run.rtol,
-            atol: run.atol,
-            step: run.step,
-            radius: run.radius,
-            time_unit: ctx.coin.params().time_unit(),
-            span: stats.span(),
-            max_omega: stats.max_omega,
-        },
-        options.energy_tol,
-        options.residual_tol,
-    )
+    let method = MethodConfig {
+        method: run.integrator,
+        rtol: run.rtol,
+        atol: run.atol,
+        step: run.step,
+    };
+    let accuracy = RunAccuracy::new(&method, ctx.coin.params(), stats.span(), stats.max_omega);
+    Tolerances::derive(&accuracy, options.energy_tol, options.residual_tol)
 }
 
 /// format.md: a file in which `integrity`, `energy` or both `constraint` and `steady` could not run cannot
