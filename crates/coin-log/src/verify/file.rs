@@ -560,7 +560,13 @@ fn verdict(
         (None, false, Some(why)) => (Verdict::CannotVerify, Some(why)),
         (None, false, None) => (Verdict::Ok, None),
     };
-    FileReport::new(shown, verdict, problem, results)
+    FileReport {
+        path: shown,
+        exit_code: verdict.exit_code(),
+        verdict,
+        problem,
+        checks: results,
+    }
 }
 
 impl Judge {

@@ -146,27 +146,16 @@ pub struct FileReport {
 }
 
 impl FileReport {
-    /// The report on `path` with this verdict (the exit code follows from it).
-    #[must_use]
-    pub fn new(
-        path: String,
-        verdict: Verdict,
-        problem: Option<String>,
-        checks: Vec<CheckResult>,
-    ) -> Self {
-        Self {
-            path,
-            exit_code: verdict.exit_code(),
-            verdict,
-            problem,
-            checks,
-        }
-    }
-
-    /// A file that could not be read at all, and why.
+    /// A file that could not be read at all, and why (exit 2).
     #[must_use]
     pub fn unusable(path: String, problem: String) -> Self {
-        Self::new(path, Verdict::Unusable, Some(problem), Vec::new())
+        Self {
+            path,
+            exit_code: Verdict::Unusable.exit_code(),
+            verdict: Verdict::Unusable,
+            problem: Some(problem),
+            checks: Vec::new(),
+        }
     }
 
     /// The result of check `id`, if it is in the report.
