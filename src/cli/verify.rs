@@ -112,15 +112,7 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<Outcome> {
 fn verify_with_progress(path: &Path, options: &Options) -> FileReport {
     let len = match check(path, InputKind::Mcap) {
         Ok(meta) => meta.len(),
-        Err(e) => {
-            return FileReport {
-                path: path.display().to_string(),
-                exit_code: Verdict::Unusable.exit_code(),
-                verdict: Verdict::Unusable,
-                problem: Some(e.to_string()),
-                checks: Vec::new(),
-            }
-        }
+        Err(e) => return FileReport::unusable(path.display().to_string(), e.to_string()),
     };
     let progress = FileProgress::new(&shown(path), len);
     let report = verify::verify_file_with_progress(path, options, &|b| progress.update(b));

@@ -592,10 +592,8 @@ impl TimeAxis<'_> {
             return empty(area, title, "the channel this needs was not recorded");
         }
         let points: Vec<Vec<(f64, f64)>> = series.iter().map(|s| s.1.points()).collect();
-        let positive = points.iter().flatten().map(|p| p.1).filter(|v| *v > 0.0);
-        let (lo, hi) = positive.fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
+        let positive = points.iter().flatten().filter(|p| p.1 > 0.0);
+        let (lo, hi) = min_max(positive, |p| p.1);
         let (floor, top) = if hi > 0.0 {
             (lo / 10.0, hi * 10.0)
         } else {
@@ -648,27 +646,23 @@ impl TimeAxis<'_> {
                 .label(*label)
                 .legend(legend_line(*colour, 2));
         }
-        if let Some((label, v)) = line {
+        let mut dashed = |ends: [(f64, f64); 2], dash, colour: RGBColor, label: String| {
             chart
-                .draw_series(DashedLineSeries::new(
-                    [(0.0, v), (self.t_max, v)],
-                    6,
-                    4,
-                    GREEN.stroke_width(2),
-                ))?
-                .label(format!("{label} = {v}"))
-                .legend(legend_line(GREEN, 2));
+                .draw_series(DashedLineSeries::new(ends, dash, 4, colour.stroke_width(2)))?
+                .label(label)
+                .legend(legend_line(colour, 2));
+            Ok::<_, DrawError>(())
+        };
+        if let Some((label, v)) = line {
+            dashed(
+                [(0.0, v), (self.t_max, v)],
+                6,
+                GREEN,
+                format!("{label} = {v}"),
+            )?;
         }
         if let Some((name, t)) = self.end {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    [(t, y0), (t, y1)],
-                    5,
-                    4,
-                    RED.stroke_width(2),
-                ))?
-                .label(format!("{name} at t = {t}"))
-                .legend(legend_line(RED, 2));
+            dashed([(t, y0), (t, y1)], 5, RED, format!("{name} at t = {t}"))?;
         }
         legend_box(chart, SeriesLabelPosition::UpperRight)
     }

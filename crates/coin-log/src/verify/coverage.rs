@@ -91,24 +91,15 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
          max(|ω|, |φ̇|) = {} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
          tenth of the residual tolerance {tol:.1e}; raise --rate to at least {}",
         run.rate,
-        round3(h * rate),
-        round3(rate),
+        digits3(h * rate, f64::round),
+        digits3(rate, f64::round),
         constraint::truncation(h, rate),
-        round3_up(constraint::min_rate(rate, tol))
+        digits3(constraint::min_rate(rate, tol), f64::ceil)
     ))
 }
 
-/// `x` to 3 significant digits.
-fn round3(x: f64) -> f64 {
-    scaled(x, f64::round)
-}
-
-/// `x` rounded up to 3 significant digits (a rate that is enough).
-fn round3_up(x: f64) -> f64 {
-    scaled(x, f64::ceil)
-}
-
-fn scaled(x: f64, round: fn(f64) -> f64) -> f64 {
+/// `x` rounded by `round` to 3 significant digits (`f64::ceil` for a rate that is enough).
+fn digits3(x: f64, round: fn(f64) -> f64) -> f64 {
     if !x.is_finite() || x == 0.0 {
         return x;
     }

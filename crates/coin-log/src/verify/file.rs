@@ -17,6 +17,7 @@ use crate::format::{
     log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
     FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
+use crate::integrate::MethodConfig;
 use crate::model::{Chaplygin, Coin, Dynamics};
 use crate::scene::{self, Scene};
 use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
@@ -58,23 +59,12 @@ impl Checks {
     fn observe(&mut self, s: &Sample, ctx: &Context) {
         self.stats.observe(s);
         self.energy.observe(s, ctx);
-        self.invariants
-            .observe(s, ctx.coin.params(), invariants_of(ctx));
+        self.invariants.observe(s, ctx);
         self.steady.observe(s, ctx);
         self.constraint.observe(s, ctx.coin.params().radius());
         self.consistency.observe(s, ctx);
         self.validity.observe(s, ctx);
         self.nutation.observe(s, ctx);
-    }
-}
-
-/// C1, C2 at (θ, ω_Y, ω_Z), when they can be evaluated for these parameters.
-fn invariants_of(ctx: &Context) -> impl Fn(f64, f64, f64) -> Option<(f64, f64)> + '_ {
-    move |theta, omega_y, omega_z| {
-        ctx.chaplygin.as_ref().ok().map(|c| {
-            let i = c.evaluate(theta, omega_y, omega_z);
-            (i.c1, i.c2)
-        })
     }
 }
 
@@ -192,14 +182,7 @@ impl Judge {
                 format!("{e}: record stores a scene that reads back to the run it made")
             }),
         }
-        let steady = match &run.dissipation {
-            Some(d) => Err(format!(
-                "the run has dissipation ({}, κ = {}): a dissipative couple moves the coin off every steady motion (physics §11)",
-                d.model(),
-                super::checks::fmt_num(d.coefficient())
-            )),
-            None => steady::plan(&coin, &run, &scene),
-        };
+        let steady = steady::plan(&coin, &run, &scene);
         let chaplygin = Chaplygin::new(&params)
             .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
         self.ctx = Some(Context {
@@ -488,16 +471,6 @@ impl Judge {
     }
 }
 
-fn unusable(path: &str, problem: String) -> FileReport {
-    FileReport {
-        path: path.to_string(),
-        exit_code: Verdict::Unusable.exit_code(),
-        verdict: Verdict::Unusable,
-        problem: Some(problem),
-        checks: Vec::new(),
-    }
-}
-
 /// Judges one file. Never fails: an unreadable file is a report with exit code 2 and the reason in
 /// [`FileReport::problem`].
 #[must_use]
@@ -535,7 +508,7 @@ fn verdict(
 ) -> FileReport {
     if let Some(e) = &error {
         if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) {
-            return unusable(&shown, e.to_string());
+            return FileReport::unusable(shown, e.to_string());
         }
     }
     // A truncated or corrupt file is judged on what could be read, and is unusable (exit 2).
@@ -556,7 +529,7 @@ fn verdict(
             ),
             (None, None) => judge.not_coin_log(&structure.summary.library),
         };
-        return unusable(&shown, why);
+        return FileReport::unusable(shown, why);
     };
     ctx.result = judge.result.take();
     let problem = read_problem.map(ToString::to_string);
@@ -572,7 +545,7 @@ fn verdict(
     let results = vec![
         integrity::finish(&problems, &read, &judge.notes),
         c.energy.finish(&tol, &ctx),
-        c.invariants.finish(&tol, invariants_skip(&ctx).as_deref()),
+        c.invariants.finish(&tol, &ctx),
         c.steady.finish(&ctx, &tol),
         c.constraint.finish(ctx.coin.params().radius(), &tol),
         c.consistency.finish(),
@@ -640,36 +613,17 @@ impl Judge {
     }
 }
 
-/// Why the invariants check does not run: C1, C2 cannot be evaluated for the body, or the run has
-/// dissipation, which changes them (physics §11).
-fn invariants_skip(ctx: &Context) -> Option<String> {
-    if let Some(d) = ctx.dynamics.dissipation() {
-        return Some(format!(
-            "the run has dissipation ({}, κ = {}): C1, C2 are not conserved by the dissipative couple (physics §11); the energy check judges E + W = E0 instead",
-            d.model(),
-            super::checks::fmt_num(d.coefficient())
-        ));
-    }
-    ctx.chaplygin.as_ref().err().cloned()
-}
-
 /// The tolerances of this file: derived from its recorded settings and span, or the flags'.
 fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances {
     let run = &ctx.run;
-    Tolerances::derive(
-        &RunAccuracy {
-            integrator: run.integrator,
-            rtol: run.rtol,
-            atol: run.atol,
-            step: run.step,
-            radius: run.radius,
-            time_unit: ctx.coin.params().time_unit(),
-            span: stats.span(),
-            max_omega: stats.max_omega,
-        },
-        options.energy_tol,
-        options.residual_tol,
-    )
+    let method = MethodConfig {
+        method: run.integrator,
+        rtol: run.rtol,
+        atol: run.atol,
+        step: run.step,
+    };
+    let accuracy = RunAccuracy::new(&method, ctx.coin.params(), stats.span(), stats.max_omega);
+    Tolerances::derive(&accuracy, options.energy_tol, options.residual_tol)
 }
 
 /// format.md: a file in which `integrity`, `energy` or both `constraint` and `steady` could not run cannot

@@ -146,6 +146,18 @@ pub struct FileReport {
 }
 
 impl FileReport {
+    /// A file that could not be read at all, and why (exit 2).
+    #[must_use]
+    pub fn unusable(path: String, problem: String) -> Self {
+        Self {
+            path,
+            exit_code: Verdict::Unusable.exit_code(),
+            verdict: Verdict::Unusable,
+            problem: Some(problem),
+            checks: Vec::new(),
+        }
+    }
+
     /// The result of check `id`, if it is in the report.
     #[must_use]
     pub fn check(&self, id: CheckId) -> Option<&CheckResult> {

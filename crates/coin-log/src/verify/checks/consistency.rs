@@ -1,11 +1,5 @@
-//! `consistency`: the stored channels agree with each other. The quaternion equals q(e_y, φ)·q(e_x, θ)·
-//! q(e_z, ψ) of the stored angles up to sign (physics §1) and has unit norm; the contact point is the centre
-//! plus c (x_c = x − a sin θ sin φ, z_c = z − a sin θ cos φ, y_c = 0, physics §3); the centre's height is
-//! a cos θ; the stored reaction equals R recomputed from the stored state (physics §3), with F = √(R_x² + R_z²)
-//! and N = R_y. The fields added since the format's first version, when stored: φ̇ against ω_Y / cos θ (eq 18),
-//! the friction ratio against F / max(N, 1e-12 Mg), the energy change against E − E₀ (E₀ the first stored
-//! total), the drift in units of ε against (E − E₀)/(ε max(|E₀|, Mga)). Each is a recomputation from
-//! stored numbers, held to the recomputation tolerance.
+//! `consistency`: the stored channels agree with each other (format.md: verify, Checks, lists each pair and
+//! its scale). Each is a recomputation from stored numbers, held to the recomputation tolerance.
 
 use super::{fmt_num, worst, Context, Max};
 use crate::format::messages::{drift_eps, friction_ratio};

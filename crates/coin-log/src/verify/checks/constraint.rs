@@ -1,7 +1,6 @@
 //! `constraint`: the coin rolls without slipping. The centre's velocity is taken from the stored positions
 //! by an 8th-order central finite difference over 9 equally spaced samples and compared with the rolling
-//! constraint's v = a(−ω_Z e_X + ω_X e_Z) from the stored ω and angles (physics §2):
-//! ẋ = a(−ω_Z cos φ + ω_X cos θ sin φ), ż = a(ω_Z sin φ + ω_X cos θ cos φ), ẏ = −a ω_X sin θ.
+//! constraint's v = a(−ω_Z e_X + ω_X e_Z) from the stored ω and angles (physics §2, the ẋ, ẏ, ż there).
 //! The residual is max|v_fd − v| / (a max|ω|).
 //!
 //! The difference's leading error, −h⁸x⁽⁹⁾/630, is cancelled by the eighth difference of the constraint's

@@ -1,10 +1,8 @@
-//! `energy`: E = ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²) + Mga cos θ (physics §3) recomputed from
-//! the stored ω and θ; drift = max|E − E₀| / max(|E₀|, Mga) (format.md); agreement of `/coin/energy` with
-//! the recomputed total, kinetic and potential parts, in the same units.
+//! `energy`: E (physics §3) recomputed from the stored ω and θ, its drift (format.md: Drift definitions), and
+//! the agreement of `/coin/energy`'s total, kinetic and potential parts with it, in the same units.
 //!
 //! With dissipation (physics §11) the conserved quantity is the balance E + W, W the dissipated work stored
-//! in `/coin/work`: the drift is max|E + W − E₀| / max(|E₀|, Mga) (W₀ = 0), and the stored balance must
-//! equal E recomputed plus the stored W. Without `/coin/work` a dissipative file's energy cannot be judged.
+//! in `/coin/work` (format.md: verify). Without `/coin/work` a dissipative file's energy cannot be judged.
 
 use super::{fmt_num, worst, Context, Max};
 use crate::format::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};

@@ -1,6 +1,4 @@
-//! `integrity`: the file's structure (magic, summary, chunk and message indexes, CRCs, statistics against
-//! the real counts), its schemas (the tool's bytes, or another version the messages must conform to), every
-//! message parsed strictly into its type, and log times monotonic per channel and equal to round(t·10⁹).
+//! `integrity`: the file's structure, schemas, message shapes and log times (format.md: verify, Checks).
 //! The value is the number of problems found; the tolerance is 0.
 
 use crate::verify::report::{CheckId, CheckResult};

@@ -1,14 +1,13 @@
 //! `invariants`: the Chaplygin–Appell integrals C1, C2 (physics §6) recomputed from the stored θ, ω_Y, ω_Z;
 //! drift = max|C − C₀| / (|C1₀| + |C2₀|) (format.md), and agreement with `/coin/invariants` when stored.
 
-use super::{fmt_num, worst, Max};
+use super::{fmt_num, worst, Context, Max};
 use crate::format::tolerances::{Tolerances, RECOMPUTE_TOLERANCE};
 use crate::model::drift::InvariantDrift;
-use crate::model::CoinParams;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
-/// Running state of the invariants check, given a way to evaluate (C1, C2) from (θ, ω_Y, ω_Z).
+/// Running state of the invariants check.
 #[derive(Debug, Default, Clone)]
 pub struct InvariantsCheck {
     drift: Option<InvariantDrift>,
@@ -18,22 +17,15 @@ pub struct InvariantsCheck {
 }
 
 impl InvariantsCheck {
-    /// Accounts for one sample; `evaluate` gives (C1, C2) or `None` where it cannot (e.g. |θ| too close to
-    /// π/2 for the series).
-    pub fn observe(
-        &mut self,
-        s: &Sample,
-        params: &CoinParams,
-        evaluate: impl Fn(f64, f64, f64) -> Option<(f64, f64)>,
-    ) {
-        let (Some(w), Some(a)) = (s.omega, s.angles) else {
+    /// Accounts for one sample, when C1, C2 can be evaluated for the run's parameters.
+    pub fn observe(&mut self, s: &Sample, ctx: &Context) {
+        let (Some(w), Some(a), Ok(chaplygin)) = (s.omega, s.angles, &ctx.chaplygin) else {
             return;
         };
-        let Some((c1, c2)) = evaluate(a.theta, w.y, w.z) else {
-            return;
-        };
+        let c = chaplygin.evaluate(a.theta, w.y, w.z);
+        let (c1, c2) = (c.c1, c.c2);
         self.drift
-            .get_or_insert_with(|| InvariantDrift::new(params, c1, c2))
+            .get_or_insert_with(|| InvariantDrift::new(ctx.coin.params(), c1, c2))
             .observe(s.t, c1, c2);
         self.samples += 1;
         if let Some(m) = s.invariants {
@@ -43,11 +35,19 @@ impl InvariantsCheck {
         }
     }
 
-    /// The result; `missing` is why the check cannot run at all (e.g. no C1, C2 in this build).
+    /// The result. It does not run when C1, C2 cannot be evaluated for the body, or the run has
+    /// dissipation, which changes them (physics §11).
     #[must_use]
-    pub fn finish(&self, tol: &Tolerances, missing: Option<&str>) -> CheckResult {
-        if let Some(reason) = missing {
-            return CheckResult::skip(CheckId::Invariants, reason);
+    pub fn finish(&self, tol: &Tolerances, ctx: &Context) -> CheckResult {
+        if let Some(d) = ctx.dynamics.dissipation() {
+            return CheckResult::skip(CheckId::Invariants, format!(
+                "the run has dissipation ({}, κ = {}): C1, C2 are not conserved by the dissipative couple (physics §11); the energy check judges E + W = E0 instead",
+                d.model(),
+                fmt_num(d.coefficient())
+            ));
+        }
+        if let Err(e) = &ctx.chaplygin {
+            return CheckResult::skip(CheckId::Invariants, e.clone());
         }
         let Some(invariant_drift) = self.drift else {
             return CheckResult::skip(

@@ -42,48 +42,44 @@ impl NutationCheck {
     /// The result: T and ΔΦ against the quadrature, or why they cannot be compared.
     #[must_use]
     pub fn finish(&self, ctx: &Context, tol: &Tolerances) -> CheckResult {
-        let skip = |reason: String| CheckResult::skip(CheckId::Nutation, reason);
+        self.judge(ctx, tol)
+            .unwrap_or_else(|reason| CheckResult::skip(CheckId::Nutation, reason))
+    }
+
+    fn judge(&self, ctx: &Context, tol: &Tolerances) -> Result<CheckResult, String> {
         if let Some(d) = ctx.dynamics.dissipation() {
-            return skip(format!(
+            return Err(format!(
                 "the run has dissipation ({}): E, C1 and C2 change, so θ does not nutate periodically and the quadrature (physics §10) does not apply",
                 d.model()
             ));
         }
         if let Some(kind) = ctx.run.steady_kind {
-            return skip(format!(
+            return Err(format!(
                 "a steady motion ({kind}) does not nutate; the steady check judges it"
             ));
         }
-        let Some(initial) = self.initial else {
-            return skip(
-                "no sample has both /coin/omega and /coin/angles, so θ's turning points cannot be found"
-                    .into(),
-            );
-        };
-        let chaplygin = match &ctx.chaplygin {
-            Ok(c) => c,
-            Err(e) => return skip(e.clone()),
-        };
-        let orbit = match Orbit::new(&ctx.coin, chaplygin, &initial, flat_margin(ctx)) {
-            Ok(o) => o,
-            Err(e) => return skip(format!("the first stored state has no orbit: {e}")),
-        };
+        let initial = self.initial.ok_or(
+            "no sample has both /coin/omega and /coin/angles, so θ's turning points cannot be found",
+        )?;
+        let chaplygin = ctx.chaplygin.as_ref().map_err(Clone::clone)?;
+        let orbit = Orbit::new(&ctx.coin, chaplygin, &initial, flat_margin(ctx))
+            .map_err(|e| format!("the first stored state has no orbit: {e}"))?;
         let (period, precession) = match orbit.motion {
             Motion::Periodic {
                 period, precession, ..
             } => (period, precession),
             Motion::Steady => {
-                return skip("the first stored state is steady: θ does not nutate".into())
+                return Err("the first stored state is steady: θ does not nutate".into())
             }
             Motion::FlatLanding { time, .. } => {
-                return skip(format!(
+                return Err(format!(
                     "the quadrature says the coin lands flat at t = {}: there is no period",
                     fmt_num(time)
                 ))
             }
         };
         if orbit.theta_max - orbit.theta_min < MIN_AMPLITUDE {
-            return skip(format!(
+            return Err(format!(
                 "θ nutates by {} rad only: below {MIN_AMPLITUDE:e} its turning points are the integrator's noise",
                 fmt_num(orbit.theta_max - orbit.theta_min)
             ));
@@ -96,20 +92,19 @@ impl NutationCheck {
         orbit: &Orbit,
         (period, precession): (f64, f64),
         tol: &Tolerances,
-    ) -> CheckResult {
-        let skip = |reason: String| CheckResult::skip(CheckId::Nutation, reason);
+    ) -> Result<CheckResult, String> {
         let meter = &self.turning_points;
-        let Some(measured) = meter.measure() else {
-            return skip(format!(
+        let measured = meter.measure().ok_or_else(|| {
+            format!(
                 "fewer than two nutation periods recorded ({} maxima and {} minima of θ; T = {} by quadrature)",
                 meter.maxima(),
                 meter.minima(),
                 fmt_num(period)
-            ));
-        };
+            )
+        })?;
         let h = meter.largest_interval();
         if h * MIN_SAMPLES_PER_PERIOD > period {
-            return skip(format!(
+            return Err(format!(
                 "undersampled: samples {} apart, fewer than {MIN_SAMPLES_PER_PERIOD} per nutation period T = {}; record with a higher --rate",
                 fmt_num(h),
                 fmt_num(period)
@@ -118,7 +113,7 @@ impl NutationCheck {
         let (t_measured, phi_measured) = (measured.period, measured.precession);
         let interpolation = meter.interpolation_error(&measured, period);
         if interpolation > INTERPOLATION_SHARE * tol.nutation {
-            return skip(format!(
+            return Err(format!(
                 "undersampled: interpolating the turning points between samples {} apart may be off by {} of T, more than {} of the tolerance {}; record with a higher --rate",
                 fmt_num(h),
                 fmt_num(interpolation),
@@ -133,7 +128,7 @@ impl NutationCheck {
             (t_error, tolerance, "period"),
             &[(phi_error, tolerance, "heading advance")],
         );
-        CheckResult::measured(
+        Ok(CheckResult::measured(
             CheckId::Nutation,
             value,
             tolerance,
@@ -152,7 +147,7 @@ impl NutationCheck {
                 fmt_num(orbit.error),
                 fmt_num(interpolation)
             ),
-        )
+        ))
     }
 }
 

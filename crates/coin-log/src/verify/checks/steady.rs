@@ -22,6 +22,13 @@ pub fn plan(
     run: &RunMetadata,
     scene: &Result<Scene, String>,
 ) -> Result<Steady, String> {
+    if let Some(d) = &run.dissipation {
+        return Err(format!(
+            "the run has dissipation ({}, κ = {}): a dissipative couple moves the coin off every steady motion (physics §11)",
+            d.model(),
+            fmt_num(d.coefficient())
+        ));
+    }
     let Some(family) = run.steady_kind else {
         return Err("not a steady scene (steady_kind = none)".into());
     };
