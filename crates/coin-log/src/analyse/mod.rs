@@ -179,17 +179,18 @@ fn steady_json(s: &SteadyAnalysis) -> serde_json::Value {
         .iter()
         .map(|&(re, im)| [clean(re), clean(im)])
         .collect();
+    let steady = &s.steady;
     json!({
-        "kind": s.kind.name(),
-        "omega_y": s.omega_y,
-        "phi_dot": s.phi_dot,
-        "psi_dot": s.psi_dot,
-        "r_g": s.r_g,
-        "r_c": s.r_c,
+        "kind": steady.kind.name(),
+        "omega_y": steady.state.omega_y,
+        "phi_dot": steady.phi_dot,
+        "psi_dot": steady.psi_dot,
+        "r_g": steady.r_g,
+        "r_c": steady.r_c,
         "sigma_squared": s.sigma_squared,
         "eigenvalues": eigenvalues,
         "verdict": s.verdict.name(),
-        "branch": s.branch.map(crate::model::Branch::name),
+        "branch": steady.kind.branch().map(crate::model::Branch::name),
         "normal": s.normal,
         "friction": s.friction,
         "nutation_period": s.nutation_period(),
