@@ -254,7 +254,6 @@ struct Reduced<'a> {
     chaplygin: &'a Chaplygin,
     c1: f64,
     c2: f64,
-    k: f64,
     /// I_X + Ma².
     lever: f64,
     theta0: f64,
@@ -280,7 +279,6 @@ impl<'a> Reduced<'a> {
             chaplygin,
             c1: c.c1,
             c2: c.c2,
-            k: chaplygin.k(),
             lever: p.inertia_x() + p.ma2(),
             theta0: state.theta,
             omega_x0: state.omega_x,
@@ -299,7 +297,8 @@ impl<'a> Reduced<'a> {
     fn rates(&self, theta: f64) -> (f64, f64) {
         let b = self.chaplygin.basis(theta);
         let omega_z = self.c1 * b.y_even + self.c2 * b.y_odd;
-        let omega_y = self.k * (self.c1 * b.flux_even + self.c2 * b.flux_odd) / theta.cos();
+        let omega_y =
+            self.chaplygin.k() * (self.c1 * b.flux_even + self.c2 * b.flux_odd) / theta.cos();
         (omega_y, omega_z)
     }
 
