@@ -181,7 +181,7 @@ fn steady_json(s: &SteadyAnalysis) -> serde_json::Value {
         .collect();
     let steady = &s.steady;
     json!({
-        "kind": steady.kind.name(),
+        "kind": steady.kind.family().name(),
         "omega_y": steady.state.omega_y,
         "phi_dot": steady.phi_dot,
         "psi_dot": steady.psi_dot,

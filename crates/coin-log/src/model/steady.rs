@@ -87,12 +87,6 @@ impl SteadyKind {
         }
     }
 
-    /// The family's name (`steady_kind` metadata).
-    #[must_use]
-    pub fn name(&self) -> &'static str {
-        self.family().name()
-    }
-
     /// The root of the steady family for circles and the sign of ω_Y for the centre-fixed motion.
     #[must_use]
     pub fn branch(&self) -> Option<Branch> {
@@ -204,7 +198,7 @@ impl Steady {
     /// [`SteadyError`] when θ is outside the range where the motion exists, or a rate is not finite.
     pub fn new(coin: &Coin, kind: SteadyKind) -> Result<Self, SteadyError> {
         let p = coin.params();
-        let name = kind.name();
+        let name = kind.family().name();
         let (theta, omega_y, omega_z) = match kind {
             SteadyKind::Straight { omega_z } => {
                 check_finite(name, "omega_z", omega_z)?;
