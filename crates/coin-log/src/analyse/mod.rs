@@ -101,12 +101,6 @@ impl Analysis {
         })
     }
 
-    /// Whether N stays positive over the motion.
-    #[must_use]
-    pub fn normal_stays_positive(&self) -> bool {
-        self.orbit.min_normal.value > 0.0
-    }
-
     /// With μ given: whether the motion needs more friction than μ (|F| > μN somewhere, or N reaching 0,
     /// where |F|/N is unbounded).
     #[must_use]
@@ -151,7 +145,7 @@ impl Analysis {
             "flat_landing_time": flat_landing_time,
             "lift_off_time": o.lift_off.map(|e| e.time),
             "lift_off_theta": o.lift_off.map(|e| e.theta),
-            "normal_stays_positive": self.normal_stays_positive(),
+            "normal_stays_positive": o.min_normal.value > 0.0,
             "friction": self.friction,
             "slips": self.slips(),
             "quadrature_error": o.error,
