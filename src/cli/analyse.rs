@@ -176,13 +176,13 @@ fn summary(label: &str, scene: &Scene, a: &Analysis) -> Vec<(&'static str, Strin
 }
 
 fn family(s: &SteadyAnalysis) -> String {
-    let name = match s.kind {
+    let name = match s.steady.kind.family() {
         SteadyFamily::Straight => "steady: straight rolling",
         SteadyFamily::CentreFixed => "steady: centre at rest",
         SteadyFamily::Circle => "steady circle",
         SteadyFamily::SpinUpright => "steady: spinning upright in place",
     };
-    match s.branch {
+    match s.steady.kind.branch() {
         Some(b) => format!("{name} ({b} branch)"),
         None => name.to_string(),
     }
@@ -205,6 +205,7 @@ fn verdict(s: &SteadyAnalysis) -> String {
 }
 
 fn steady_rows(s: &SteadyAnalysis) -> Vec<(&'static str, String)> {
+    let m = &s.steady;
     let radius = |r: Option<f64>| r.map_or_else(|| "∞".to_string(), n);
     let root = s.eigenvalues[2];
     let pair = if root.1 != 0.0 {
@@ -218,14 +219,14 @@ fn steady_rows(s: &SteadyAnalysis) -> Vec<(&'static str, String)> {
             "rates",
             format!(
                 "ω_Y = {}, φ̇ = {}, ψ̇ = {}",
-                n(s.omega_y),
-                n(s.phi_dot),
-                n(s.psi_dot)
+                n(m.state.omega_y),
+                n(m.phi_dot),
+                n(m.psi_dot)
             ),
         ),
         (
             "radii",
-            format!("R_G = {}, R_C = {}", radius(s.r_g), radius(s.r_c)),
+            format!("R_G = {}, R_C = {}", radius(m.r_g), radius(m.r_c)),
         ),
         (
             "forces",

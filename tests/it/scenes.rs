@@ -70,7 +70,7 @@ fn every_scene_file_is_a_built_in_that_parses_validates_and_lists_every_default(
             "{name:<18} {} θ0 = {:.6} ω0 = ({:.6}, {:.6}, {:.6}), {} samples",
             match scene.spec {
                 InitialSpec::Explicit => "explicit".to_string(),
-                InitialSpec::Steady(s) => format!("steady {}", s.kind.name()),
+                InitialSpec::Steady(s) => format!("steady {}", s.kind.family().name()),
             },
             scene.initial.theta,
             scene.initial.omega_x,

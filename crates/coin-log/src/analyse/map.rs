@@ -542,8 +542,9 @@ fn scene_points(coin: &Coin, extra: Option<(&str, &Scene)>) -> Vec<ScenePoint> {
             let analysis = SteadyAnalysis::of_state(&scene.coin(), &s, Some(&steady));
             // Straight rolling continues the + root for ω_Z0 > 0 and the − root for ω_Z0 < 0; the upright
             // spin is the centre-fixed motion's limit, on the branch of the sign of ω_Y0.
-            let branch = analysis
-                .branch
+            let branch = steady
+                .kind
+                .branch()
                 .unwrap_or(if s.omega_y < 0.0 || s.omega_z < 0.0 {
                     Branch::Minus
                 } else {

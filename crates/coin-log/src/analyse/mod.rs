@@ -101,12 +101,6 @@ impl Analysis {
         })
     }
 
-    /// Whether N stays positive over the motion.
-    #[must_use]
-    pub fn normal_stays_positive(&self) -> bool {
-        self.orbit.min_normal.value > 0.0
-    }
-
     /// With μ given: whether the motion needs more friction than μ (|F| > μN somewhere, or N reaching 0,
     /// where |F|/N is unbounded).
     #[must_use]
@@ -151,7 +145,7 @@ impl Analysis {
             "flat_landing_time": flat_landing_time,
             "lift_off_time": o.lift_off.map(|e| e.time),
             "lift_off_theta": o.lift_off.map(|e| e.theta),
-            "normal_stays_positive": self.normal_stays_positive(),
+            "normal_stays_positive": o.min_normal.value > 0.0,
             "friction": self.friction,
             "slips": self.slips(),
             "quadrature_error": o.error,
@@ -179,17 +173,18 @@ fn steady_json(s: &SteadyAnalysis) -> serde_json::Value {
         .iter()
         .map(|&(re, im)| [clean(re), clean(im)])
         .collect();
+    let steady = &s.steady;
     json!({
-        "kind": s.kind.name(),
-        "omega_y": s.omega_y,
-        "phi_dot": s.phi_dot,
-        "psi_dot": s.psi_dot,
-        "r_g": s.r_g,
-        "r_c": s.r_c,
+        "kind": steady.kind.family().name(),
+        "omega_y": steady.state.omega_y,
+        "phi_dot": steady.phi_dot,
+        "psi_dot": steady.psi_dot,
+        "r_g": steady.r_g,
+        "r_c": steady.r_c,
         "sigma_squared": s.sigma_squared,
         "eigenvalues": eigenvalues,
         "verdict": s.verdict.name(),
-        "branch": s.branch.map(crate::model::Branch::name),
+        "branch": steady.kind.branch().map(crate::model::Branch::name),
         "normal": s.normal,
         "friction": s.friction,
         "nutation_period": s.nutation_period(),

@@ -4,7 +4,7 @@
 //! Cells of one θ₀ column with the same colour are drawn as one rectangle, so the file stays small
 //! (a 200 × 200 map of the thin disk on both branches is about 2,000 rectangles, not 80,000).
 
-use super::map::{boundary, on_branch, BoundaryPoint, MapError, MapPoint, StabilityMap};
+use super::map::{boundary, on_branch, BoundaryPoint, Grid, MapError, MapPoint, StabilityMap};
 use super::steady::Stability;
 use crate::model::Branch;
 use crate::palette::{svg_page, Area, DrawError, MARGINAL, STABLE, UNSTABLE};
@@ -181,13 +181,12 @@ fn boundary_lines(
     (y0, y1): (f64, f64),
 ) -> Vec<Vec<(f64, f64)>> {
     let coin = &map.coin;
-    let mut leans: Vec<f64> = (1..CURVE_SAMPLES)
-        .map(|j| {
-            #[allow(clippy::cast_precision_loss)]
-            let x = j as f64 / CURVE_SAMPLES as f64;
-            x0 + (x1 - x0) * x
-        })
-        .collect();
+    let curve = Grid {
+        from: x0,
+        to: x1,
+        count: CURVE_SAMPLES + 1,
+    };
+    let mut leans: Vec<f64> = (1..CURVE_SAMPLES).map(|j| curve.value(j)).collect();
     let mut folds: Vec<BoundaryPoint> = Vec::new();
     for c in &map.closures {
         for (theta, omega, omega_y) in [

@@ -2,8 +2,8 @@
 //! stability (physics §4, §9).
 
 use crate::model::{
-    eigenvalues, rates_and_radii, reaction, steady_sigma_squared, Branch, Coin, Linearisation,
-    State, Steady, SteadyFamily, SteadyKind,
+    eigenvalues, reaction, steady_sigma_squared, Branch, Coin, Linearisation, State, Steady,
+    SteadyKind,
 };
 
 /// |σ²| within this many ulp of the size of its terms is zero to rounding: the verdict is marginal.
@@ -40,20 +40,8 @@ impl Stability {
 /// A steady motion, analysed (physics §4, §9).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SteadyAnalysis {
-    /// The family, as in the metadata's `steady_kind`.
-    pub kind: SteadyFamily,
-    /// The root of the steady family for circles and the sign of ω_Y for the centre-fixed motion.
-    pub branch: Option<Branch>,
-    /// ω_Y [rad/time].
-    pub omega_y: f64,
-    /// φ̇ = ω_Y / cos θ [rad/time].
-    pub phi_dot: f64,
-    /// ψ̇ = ω_Z + ω_Y tan θ [rad/time].
-    pub psi_dot: f64,
-    /// R_G \[length\]; `None` for straight rolling (infinite).
-    pub r_g: Option<f64>,
-    /// R_C \[length\]; `None` for straight rolling.
-    pub r_c: Option<f64>,
+    /// The motion: its kind (family and branch), state, rates and radii.
+    pub steady: Steady,
     /// N \[force\] (= Mg on every steady motion).
     pub normal: f64,
     /// |F| \[force\], the centripetal force of the centre's circle.
@@ -74,19 +62,12 @@ impl SteadyAnalysis {
     #[must_use]
     pub fn of_state(coin: &Coin, state: &State, given: Option<&Steady>) -> Self {
         let (theta, wy, wz) = (state.theta, state.omega_y, state.omega_z);
-        let (kind, branch) = given.map_or_else(|| classify(coin, state), |s| named(s.kind));
-        let (phi_dot, psi_dot, r_g, r_c) = rates_and_radii(coin, kind, state);
+        let kind = given.map_or_else(|| classify(coin, state), |s| s.kind);
         let r = reaction(coin, state);
         let sigma_squared = steady_sigma_squared(coin, theta, wy, wz);
         let sigma_scale = Linearisation::at(coin, theta, wy, wz).scale();
         Self {
-            kind,
-            branch,
-            omega_y: wy,
-            phi_dot,
-            psi_dot,
-            r_g,
-            r_c,
+            steady: Steady::at(coin, kind, *state),
             normal: r.normal,
             friction: r.friction,
             sigma_squared,
@@ -110,40 +91,29 @@ impl SteadyAnalysis {
     }
 }
 
-/// The family and branch of a steady motion given by name.
-fn named(kind: SteadyKind) -> (SteadyFamily, Option<Branch>) {
-    let branch = match kind {
-        SteadyKind::CentreFixed { branch, .. } | SteadyKind::Circle { branch, .. } => Some(branch),
-        SteadyKind::Straight { .. } | SteadyKind::SpinUpright { .. } => None,
-    };
-    (kind.family(), branch)
-}
-
-/// The family and branch of a steady state given by its values: upright with ω_Y = 0 rolls straight,
+/// The steady motion a steady state is, given by its values: upright with ω_Y = 0 rolls straight,
 /// upright otherwise spins in place; leaning without ω_Z rolls round its resting centre (branch by the
 /// sign of ω_Y); otherwise a circle, on the root of the steady family nearest to ω_Y.
-fn classify(coin: &Coin, state: &State) -> (SteadyFamily, Option<Branch>) {
-    let (theta, wy, wz) = (state.theta, state.omega_y, state.omega_z);
-    let sign = |w: f64| {
-        if w >= 0.0 {
+fn classify(coin: &Coin, state: &State) -> SteadyKind {
+    let (theta, omega_y, omega_z) = (state.theta, state.omega_y, state.omega_z);
+    if theta == 0.0 {
+        return if omega_y.abs() <= omega_z.abs() {
+            SteadyKind::Straight { omega_z }
+        } else {
+            SteadyKind::SpinUpright { omega_y }
+        };
+    }
+    if omega_z == 0.0 {
+        let branch = if omega_y >= 0.0 {
             Branch::Plus
         } else {
             Branch::Minus
-        }
-    };
-    if theta == 0.0 {
-        let kind = if wy.abs() <= wz.abs() {
-            SteadyFamily::Straight
-        } else {
-            SteadyFamily::SpinUpright
         };
-        return (kind, None);
+        return SteadyKind::CentreFixed { theta, branch };
     }
-    if wz == 0.0 {
-        return (SteadyFamily::CentreFixed, Some(sign(wy)));
+    SteadyKind::Circle {
+        theta,
+        omega_z,
+        branch: Branch::nearest(coin, theta, omega_z, omega_y),
     }
-    (
-        SteadyFamily::Circle,
-        Some(Branch::nearest(coin, theta, wz, wy)),
-    )
 }

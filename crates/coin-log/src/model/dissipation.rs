@@ -37,14 +37,8 @@ coin_log_names::named_enum! {
 }
 
 impl DissipationModel {
-    /// The models with fixed exponents (every one but `power-law`).
-    pub const PRESETS: [DissipationModel; 5] = [
-        Self::Moffatt,
-        Self::AirDrag,
-        Self::Viscous,
-        Self::Rolling,
-        Self::Pivoting,
-    ];
+    /// The models with fixed exponents: every one but `power-law`, the last.
+    pub const PRESETS: &'static [DissipationModel] = Self::ALL.split_at(Self::ALL.len() - 1).0;
 
     /// The fixed exponents (m, k) of a preset; `None` for `power-law`.
     #[must_use]

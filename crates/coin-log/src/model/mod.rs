@@ -28,6 +28,5 @@ pub use stability::{
     steady_sigma_squared, straight_lambda_squared, Linearisation,
 };
 pub use state::{State, StateRate, STATE_LEN};
-pub(crate) use steady::rates_and_radii;
 pub use steady::{steady_omega_y, Branch, Steady, SteadyError, SteadyFamily, SteadyKind};
 pub use turning_points::{MeasuredNutation, TurningPoints};

@@ -254,7 +254,6 @@ struct Reduced<'a> {
     chaplygin: &'a Chaplygin,
     c1: f64,
     c2: f64,
-    k: f64,
     /// I_X + Ma².
     lever: f64,
     theta0: f64,
@@ -280,7 +279,6 @@ impl<'a> Reduced<'a> {
             chaplygin,
             c1: c.c1,
             c2: c.c2,
-            k: chaplygin.k(),
             lever: p.inertia_x() + p.ma2(),
             theta0: state.theta,
             omega_x0: state.omega_x,
@@ -291,7 +289,7 @@ impl<'a> Reduced<'a> {
             rule: gauss_legendre(SHORT_RULE),
             adaptive: Adaptive::new(),
         };
-        reduced.u0 = reduced.potential(state.theta);
+        reduced.u0 = reduced.potential(reduced.rates(state.theta), state.theta.cos());
         reduced
     }
 
@@ -299,17 +297,17 @@ impl<'a> Reduced<'a> {
     fn rates(&self, theta: f64) -> (f64, f64) {
         let b = self.chaplygin.basis(theta);
         let omega_z = self.c1 * b.y_even + self.c2 * b.y_odd;
-        let omega_y = self.k * (self.c1 * b.flux_even + self.c2 * b.flux_odd) / theta.cos();
+        let omega_y =
+            self.chaplygin.k() * (self.c1 * b.flux_even + self.c2 * b.flux_odd) / theta.cos();
         (omega_y, omega_z)
     }
 
-    /// U(θ) = ½ I_X ω_Y² + ½ (I_Z + Ma²) ω_Z² + Mga cos θ, eq (25).
-    fn potential(&self, theta: f64) -> f64 {
+    /// U = ½ I_X ω_Y² + ½ (I_Z + Ma²) ω_Z² + Mga cos θ, eq (25), from (ω_Y, ω_Z) and cos θ.
+    fn potential(&self, (wy, wz): (f64, f64), cos_t: f64) -> f64 {
         let p = self.coin.params();
-        let (wy, wz) = self.rates(theta);
         0.5 * p.inertia_x() * wy * wy
             + 0.5 * (p.inertia_z() + p.ma2()) * wz * wz
-            + p.energy_scale() * theta.cos()
+            + p.energy_scale() * cos_t
     }
 
     /// S(θ) = dU/dθ, eq (26).
@@ -347,7 +345,7 @@ impl<'a> Reduced<'a> {
         let change = if offset.abs() <= self.short {
             offset * self.mean_slope(self.theta0, theta)
         } else {
-            self.potential(theta) - self.u0
+            self.potential(self.rates(theta), theta.cos()) - self.u0
         };
         self.omega_x0 * self.omega_x0 - 2.0 * change / self.lever
     }
@@ -372,11 +370,6 @@ impl<'a> Reduced<'a> {
             omega_z,
             ..State::default()
         }
-    }
-
-    /// 1/|θ̇| at θ.
-    fn inverse_rate(&self, theta: f64) -> f64 {
-        1.0 / self.theta_dot_squared(theta).max(0.0).sqrt()
     }
 
     /// |f′| = |2S/(I_X + Ma²)| at θ: how fast θ̇² opens from a turning point there.
@@ -590,12 +583,10 @@ impl Reduced<'_> {
     /// the terms of U where U(θ) − U(θ₀) is a difference, of the terms of S times the distance where it
     /// is an integral (module doc); the period inherits about half of it.
     fn rounding(&self, lo: f64, hi: f64, f_max: f64) -> f64 {
-        let p = self.coin.params();
         let mid = 0.5 * (lo + hi);
         let (wy, wz) = self.rates(mid);
-        let u_terms = 0.5 * p.inertia_x() * wy * wy
-            + 0.5 * (p.inertia_z() + p.ma2()) * wz * wz
-            + p.energy_scale();
+        // The terms of U, Mga cos θ at its largest.
+        let u_terms = self.potential((wy, wz), 1.0);
         let reach = (hi - self.theta0).abs().max((lo - self.theta0).abs());
         let (_, s_terms) = steady_residual(self.coin, mid, wy, wz);
         let du = if reach <= self.short {
@@ -617,13 +608,15 @@ impl Reduced<'_> {
             }
             (true, false) => self.leaving_turning_point(leg.from, leg.to),
             (false, true) => self.leaving_turning_point(leg.to, leg.from),
-            (false, false) => {
-                let f = |theta: f64| self.inverse_rate(theta);
-                let (a, b) = (leg.from.min(leg.to), leg.from.max(leg.to));
-                let r = self.adaptive.integrate(&f, a, b, TRAVEL_RTOL);
-                (r.value, r.error)
-            }
+            (false, false) => self.between(leg.from, leg.to),
         }
+    }
+
+    /// ∫dθ/|θ̇| between `a` and `b` (either order, θ̇ ≠ 0 on the way) and its error bound.
+    fn between(&self, a: f64, b: f64) -> (f64, f64) {
+        let f = |theta: f64| 1.0 / self.theta_dot_squared(theta).max(0.0).sqrt();
+        let r = self.adaptive.integrate(&f, a.min(b), a.max(b), TRAVEL_RTOL);
+        (r.value, r.error)
     }
 
     /// ∫dθ/|θ̇| from the turning point `turn` to `other` (where θ̇ ≠ 0): the escape from near upright
@@ -663,12 +656,8 @@ impl Reduced<'_> {
             2.0 / q.sqrt() * asinh
         };
         let time_from = |x: f64| {
-            let at = turn + direction * x;
-            let f = |theta: f64| self.inverse_rate(theta);
-            let r = self
-                .adaptive
-                .integrate(&f, at.min(other), at.max(other), TRAVEL_RTOL);
-            (linear(x) + r.value, r.error)
+            let (t, e) = self.between(turn + direction * x, other);
+            (linear(x) + t, e)
         };
         let (t, e) = time_from(MATCHING);
         let (t_half, e_half) = time_from(0.5 * MATCHING);

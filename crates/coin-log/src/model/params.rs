@@ -75,16 +75,13 @@ impl CoinParams {
             Inertia::Explicit {
                 inertia_x,
                 inertia_z,
-            } => {
-                positive("inertia_x", inertia_x, &mut errors);
-                positive("inertia_z", inertia_z, &mut errors);
-                (inertia_x, inertia_z)
-            }
+            } => (inertia_x, inertia_z),
         };
-        // A shape's inertias (M a²/4, ...) can still overflow to inf or underflow to 0 when M and a are
-        // valid; check them then (not when M or a is already reported, to name each problem once).
+        // Explicit inertias are checked as given; a shape's (M a²/4, ...) can overflow to inf or
+        // underflow to 0 when M and a are valid: checked then (not when M or a is already reported, to
+        // name each problem once).
         let scale_ok = [mass, radius].iter().all(|v| v.is_finite() && *v > 0.0);
-        if scale_ok && !matches!(inertia, Inertia::Explicit { .. }) {
+        if scale_ok || matches!(inertia, Inertia::Explicit { .. }) {
             positive("inertia_x", inertia_x, &mut errors);
             positive("inertia_z", inertia_z, &mut errors);
         }

@@ -87,10 +87,13 @@ impl SteadyKind {
         }
     }
 
-    /// The family's name (`steady_kind` metadata).
+    /// The root of the steady family for circles and the sign of ω_Y for the centre-fixed motion.
     #[must_use]
-    pub fn name(&self) -> &'static str {
-        self.family().name()
+    pub fn branch(&self) -> Option<Branch> {
+        match *self {
+            Self::CentreFixed { branch, .. } | Self::Circle { branch, .. } => Some(branch),
+            Self::Straight { .. } | Self::SpinUpright { .. } => None,
+        }
     }
 }
 
@@ -195,8 +198,7 @@ impl Steady {
     /// [`SteadyError`] when θ is outside the range where the motion exists, or a rate is not finite.
     pub fn new(coin: &Coin, kind: SteadyKind) -> Result<Self, SteadyError> {
         let p = coin.params();
-        let a = p.radius();
-        let name = kind.name();
+        let name = kind.family().name();
         let (theta, omega_y, omega_z) = match kind {
             SteadyKind::Straight { omega_z } => {
                 check_finite(name, "omega_z", omega_z)?;
@@ -208,7 +210,7 @@ impl Steady {
             }
             SteadyKind::CentreFixed { theta, branch } => {
                 check_lean(name, theta)?;
-                let magnitude = (p.mass() * p.gravity() * a * theta.cos() / p.inertia_x()).sqrt();
+                let magnitude = (p.energy_scale() * theta.cos() / p.inertia_x()).sqrt();
                 (
                     theta,
                     if branch == Branch::Plus {
@@ -235,36 +237,31 @@ impl Steady {
             omega_z,
             ..State::default()
         };
-        let (phi_dot, psi_dot, r_g, r_c) = rates_and_radii(coin, kind.family(), &state);
-        Ok(Self {
+        Ok(Self::at(coin, kind, state))
+    }
+
+    /// The steady motion `kind` at `state` (ω_X = 0 on the steady family), with its rates and its radii
+    /// R_G = a|ω_Z cos θ / ω_Y|, R_C = a|ω_Z cos θ / ω_Y + sin θ| (physics §4.3; 0 for the upright spin).
+    #[must_use]
+    pub(crate) fn at(coin: &Coin, kind: SteadyKind, state: State) -> Self {
+        let (wy, wz) = (state.omega_y, state.omega_z);
+        let a = coin.params().radius();
+        let (st, ct) = state.theta.sin_cos();
+        let (r_g, r_c) = match kind.family() {
+            SteadyFamily::Straight => (None, None),
+            SteadyFamily::SpinUpright => (Some(0.0), Some(0.0)),
+            SteadyFamily::CentreFixed | SteadyFamily::Circle => {
+                let signed = wz * ct / wy;
+                (Some(a * signed.abs()), Some(a * (signed + st).abs()))
+            }
+        };
+        Self {
             kind,
             state,
-            phi_dot,
-            psi_dot,
+            phi_dot: wy / ct,
+            psi_dot: wz + wy * st / ct,
             r_g,
             r_c,
-        })
-    }
-}
-
-/// φ̇ = ω_Y / cos θ and ψ̇ = ω_Z + ω_Y tan θ (eqs (18)–(19)), and the radii R_G = a|ω_Z cos θ / ω_Y| and
-/// R_C = a|ω_Z cos θ / ω_Y + sin θ| of the circles of the centre and the contact point (physics §4.3;
-/// `None` for straight rolling, 0 for the upright spin) of the steady motion `state` of `family`.
-pub(crate) fn rates_and_radii(
-    coin: &Coin,
-    family: SteadyFamily,
-    state: &State,
-) -> (f64, f64, Option<f64>, Option<f64>) {
-    let (wy, wz) = (state.omega_y, state.omega_z);
-    let a = coin.params().radius();
-    let (st, ct) = state.theta.sin_cos();
-    let (r_g, r_c) = match family {
-        SteadyFamily::Straight => (None, None),
-        SteadyFamily::SpinUpright => (Some(0.0), Some(0.0)),
-        SteadyFamily::CentreFixed | SteadyFamily::Circle => {
-            let signed = wz * ct / wy;
-            (Some(a * signed.abs()), Some(a * (signed + st).abs()))
         }
-    };
-    (wy / ct, wz + wy * st / ct, r_g, r_c)
+    }
 }

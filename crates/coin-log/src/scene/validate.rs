@@ -798,7 +798,7 @@ fn steady_file(kind: &SteadyKind) -> SteadyFile {
         } => (Some(theta), None, Some(omega_z), Some(branch)),
     };
     SteadyFile {
-        kind: kind.name().to_string(),
+        kind: kind.family().name().to_string(),
         theta,
         omega_y,
         omega_z,

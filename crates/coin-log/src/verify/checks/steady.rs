@@ -190,7 +190,7 @@ impl SteadyCheck {
             tolerance,
             format!(
                 "{} steady motion over {} samples; worst measure {which}: |ω̇|/(|ω|² + Mga/(I_X + Ma²)) = {} (t = {}), |θ - θs| = {} rad (t = {}), |ω - ωs|/|ω| = {} (t = {}), metadata φ̇, ψ̇, R_G, R_C off by {}; {}",
-                steady.kind.name(),
+                steady.kind.family().name(),
                 self.samples,
                 fmt_num(self.acceleration.value / acc_scale),
                 fmt_num(self.acceleration.t),
