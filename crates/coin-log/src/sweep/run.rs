@@ -76,13 +76,19 @@ pub struct SweepOutcome {
     pub verify_seconds: f64,
 }
 
-/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume), with the
-/// seconds spent recording and verifying it.
+/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume).
 struct Done {
     row: Row,
+    spent: Spent,
+}
+
+/// A run's file: its modification time once in place, and the seconds spent recording and verifying it
+/// (all 0 without a file).
+#[derive(Default)]
+struct Spent {
     mtime_ns: u128,
-    record: f64,
-    verify: f64,
+    record_seconds: f64,
+    verify_seconds: f64,
 }
 
 /// What resume found: the lines to keep and how many of them are failed rows, the runs to do, and kept
@@ -132,7 +138,10 @@ pub fn run(
     let mut error = None;
     let work = |&index: &u64| run_one(sweep, &folder, index, stop);
     super::on_threads(&todo, options.jobs, stop, work, |batch| {
-        let lines: Vec<(u128, String)> = batch.iter().map(|d| (d.mtime_ns, d.row.line())).collect();
+        let lines: Vec<(u128, String)> = batch
+            .iter()
+            .map(|d| (d.spent.mtime_ns, d.row.line()))
+            .collect();
         if let Err(e) = journal.append(&lines) {
             stop.store(true, Ordering::SeqCst);
             error.get_or_insert(e);
@@ -160,8 +169,8 @@ struct Tally {
 
 impl Tally {
     fn add(&mut self, done: &Done, line: String) {
-        self.record_seconds += done.record;
-        self.verify_seconds += done.verify;
+        self.record_seconds += done.spent.record_seconds;
+        self.verify_seconds += done.spent.verify_seconds;
         self.progress.done += 1;
         self.progress.failed += u64::from(done.row.status == RunStatus::Failed);
         self.held.insert(done.row.index, line);
@@ -271,75 +280,39 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
         Ok(v) => v.iter().map(cell).collect(),
         Err(_) => vec![String::new(); sweep.keys().count()],
     };
-    let failed = |failure, reason: String| Done {
-        row: Row {
-            index,
-            values: cells.clone(),
-            status: RunStatus::Failed,
-            failure: Some(failure),
-            reason,
-            recorded: None,
-            prediction: None,
-            wall_time: started.elapsed().as_secs_f64(),
-        },
-        mtime_ns: 0,
-        record: 0.0,
-        verify: 0.0,
+    let mut done = Done {
+        row: Row::failed(index, cells, FailureKind::Scene),
+        spent: Spent::default(),
     };
+    let row = &mut done.row;
     let scene = values
         .map_err(RunSceneError::from)
         .and_then(|v| sweep.scene(&v));
-    let scene = match scene {
-        Ok(scene) => scene,
-        Err(e) => return Some(failed(FailureKind::Scene, e.to_string())),
-    };
-    let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
-    match record_and_check(sweep, folder, index, &scene, stop) {
-        Ok(None) => None,
-        Ok(Some(checked)) => {
-            let summary = &checked.recorded.summary;
-            let (status, failure, reason) = judge(summary, checked.report.as_ref());
-            let row = Row {
-                index,
-                values: cells,
-                status,
-                failure,
-                reason,
-                recorded: Some(checked.recorded),
-                prediction,
-                wall_time: started.elapsed().as_secs_f64(),
-            };
-            Some(Done {
-                row,
-                mtime_ns: checked.mtime_ns,
-                record: checked.record_seconds,
-                verify: checked.verify_seconds,
-            })
+    match scene {
+        Err(e) => row.reason = e.to_string(),
+        Ok(scene) => {
+            let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
+            match record_and_check(sweep, folder, &scene, stop, row) {
+                Ok(None) => return None,
+                Ok(Some(spent)) => (row.prediction, done.spent) = (prediction, spent),
+                Err(e) => (row.failure, row.reason) = (Some(FailureKind::Io), e),
+            }
         }
-        Err(e) => Some(failed(FailureKind::Io, e)),
     }
+    done.row.wall_time = started.elapsed().as_secs_f64();
+    Some(done)
 }
 
-/// A recorded run, in place under its final name.
-struct Checked {
-    recorded: Recorded,
-    report: Option<FileReport>,
-    mtime_ns: u128,
-    record_seconds: f64,
-    verify_seconds: f64,
-}
-
-/// Records the run into a temporary file, syncs, hashes and verifies it, and moves it to its name;
-/// `None` when a stop request interrupted it (the temporary file is deleted).
+/// Records `row`'s run into a temporary file, syncs, hashes and verifies it, moves it to its name and
+/// judges it into `row`; `None` when a stop request interrupted it (the temporary file is deleted).
 fn record_and_check(
     sweep: &Sweep,
     folder: &Folder,
-    index: u64,
     scene: &Scene,
     stop: &AtomicBool,
-) -> Result<Option<Checked>, String> {
-    let width = sweep.index_width();
-    let name = folder::run_file_name(index, width);
+    row: &mut Row,
+) -> Result<Option<Spent>, String> {
+    let name = folder::run_file_name(row.index, sweep.index_width());
     let target = folder.file(&name);
     let io = |what: &str| {
         let what = format!("{what} `{name}`");
@@ -368,14 +341,14 @@ fn record_and_check(
         .map_err(|e| io("moving the recording to")(e.error))?;
     let (_, mtime_ns) = folder::size_and_mtime(&target)
         .ok_or_else(|| format!("`{name}` vanished once moved into place"))?;
-    Ok(Some(Checked {
-        recorded: Recorded {
-            file: name,
-            sha256,
-            summary,
-            verify: report.as_ref().map(|r| r.verdict),
-        },
-        report,
+    (row.status, row.failure, row.reason) = judge(&summary, report.as_ref());
+    row.recorded = Some(Recorded {
+        file: name,
+        sha256,
+        summary,
+        verify: report.as_ref().map(|r| r.verdict),
+    });
+    Ok(Some(Spent {
         mtime_ns,
         record_seconds,
         verify_seconds,
