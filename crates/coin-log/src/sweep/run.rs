@@ -184,14 +184,11 @@ impl Tally {
         stop: &AtomicBool,
     ) -> Result<SweepOutcome, SweepError> {
         let lines = self.held.values();
-        let (runs, rows, failed) = (
-            self.progress.runs,
-            self.held.len() as u64,
-            self.progress.failed,
-        );
+        let (runs, rows) = (self.progress.runs, self.held.len() as u64);
+        let failed = self.progress.failed;
+        let counts @ [finished, _, pending] = [rows - failed, failed, runs - rows];
         let (catalogue, summary) = if shard.is_all() {
-            let (catalogue, summary) =
-                folder.write_whole(lines, [rows - failed, failed, runs - rows])?;
+            let (catalogue, summary) = folder.write_whole(lines, counts)?;
             (catalogue, Some(summary))
         } else {
             (
@@ -201,9 +198,9 @@ impl Tally {
         };
         Ok(SweepOutcome {
             runs,
-            finished: rows - failed,
+            finished,
             failed,
-            pending: runs - rows,
+            pending,
             kept: self.kept,
             done: self.progress.done,
             interrupted: stop.load(Ordering::SeqCst),
