@@ -10,7 +10,7 @@ use super::folder::{self, Folder, JournalRow};
 use super::hash::sha256_file;
 use super::shard::Shard;
 use crate::analyse::{motion_name, Analysis};
-use crate::format::Termination;
+use crate::format::{promise, Termination};
 use crate::model::nutation::Motion;
 use crate::record::{self, RecordSummary};
 use crate::scene::Scene;
@@ -379,16 +379,11 @@ fn judge(
     match report {
         Some(r) if r.verdict != Verdict::Ok => {
             let mut reason = verify_reason(r);
-            let expected: Vec<&str> = s
-                .shortfalls
-                .iter()
-                .flat_map(|f| f.checks.iter().copied())
-                .collect();
+            let expected = promise::check_list(&s.shortfalls, ", ");
             if !expected.is_empty() {
                 // What record warns of before the run: a dataset's reader sees it beside the failure.
                 reason.push_str(&format!(
-                    "; record expected it: its settings allow more error than verify accepts in {} (tighten rtol/atol, or step)",
-                    expected.join(", ")
+                    "; record expected it: its settings allow more error than verify accepts in {expected} (tighten rtol/atol, or step)"
                 ));
             }
             (RunStatus::Failed, Some(FailureKind::Verify), reason)
