@@ -93,6 +93,7 @@ struct Spent {
 
 /// What resume found: the lines to keep and how many of them are failed rows, the runs to do, and kept
 /// rows whose file was touched but not changed (to journal again with the new modification time).
+#[derive(Default)]
 struct Resumed {
     held: BTreeMap<u64, String>,
     failed: u64,
@@ -113,23 +114,18 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
     let _lock = folder.lock(options.shard)?;
-    let Resumed {
-        held,
-        failed,
-        todo,
-        refreshed,
-    } = resume(sweep, &folder, options)?;
+    let resumed = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
-    journal.append(&refreshed)?;
+    journal.append(&resumed.refreshed)?;
     let mut tally = Tally {
-        kept: held.len() as u64,
-        held,
+        kept: resumed.held.len() as u64,
+        held: resumed.held,
         progress: Progress {
             runs: options.shard.len(sweep.runs()),
-            todo: todo.len() as u64,
+            todo: resumed.todo.len() as u64,
             done: 0,
-            failed,
+            failed: resumed.failed,
         },
         record_seconds: 0.0,
         verify_seconds: 0.0,
@@ -137,7 +133,7 @@ pub fn run(
     progress(&tally.progress);
     let mut error = None;
     let work = |&index: &u64| run_one(sweep, &folder, index, stop);
-    super::on_threads(&todo, options.jobs, stop, work, |batch| {
+    super::on_threads(&resumed.todo, options.jobs, stop, work, |batch| {
         let lines: Vec<(u128, String)> = batch
             .iter()
             .map(|d| (d.spent.mtime_ns, d.row.line()))
@@ -224,16 +220,15 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             latest.insert(row.index, row);
         }
     }
-    let (mut held, mut failed, mut todo, mut refreshed) =
-        (BTreeMap::new(), 0, Vec::new(), Vec::new());
+    let mut resumed = Resumed::default();
     for index in options.shard.runs(sweep.runs()) {
         let Some(row) = latest.remove(&index) else {
-            todo.push(index);
+            resumed.todo.push(index);
             continue;
         };
         let f = &row.fields;
         let Ok(status) = f[status_at].parse::<RunStatus>() else {
-            todo.push(index);
+            resumed.todo.push(index);
             continue;
         };
         let retry = status == RunStatus::Failed
@@ -247,7 +242,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
                 Some((size, mtime)) if size.to_string() == f[bytes_at] => {
                     let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
                     if same {
-                        refreshed.push((mtime, crate::csv::line(f)));
+                        resumed.refreshed.push((mtime, crate::csv::line(f)));
                     }
                     same
                 }
@@ -255,18 +250,13 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             }
         };
         if retry || !file_ok {
-            todo.push(index);
+            resumed.todo.push(index);
         } else {
-            failed += u64::from(status == RunStatus::Failed);
-            held.insert(index, crate::csv::line(f));
+            resumed.failed += u64::from(status == RunStatus::Failed);
+            resumed.held.insert(index, crate::csv::line(f));
         }
     }
-    Ok(Resumed {
-        held,
-        failed,
-        todo,
-        refreshed,
-    })
+    Ok(resumed)
 }
 
 /// One run: values → scene → record into a temporary file → hash → verify → move into place → row.
