@@ -145,12 +145,12 @@ pub fn shortfalls(run: &RunAccuracy, fixed: Option<FixedSteps>) -> Vec<Shortfall
     .collect()
 }
 
-/// The check ids of `shortfalls`, comma-separated (the `expected_to_fail` metadata value).
+/// The check ids of `shortfalls`, joined by `separator` (`,` in the `expected_to_fail` metadata value).
 #[must_use]
-pub fn check_list(shortfalls: &[Shortfall]) -> String {
+pub fn check_list(shortfalls: &[Shortfall], separator: &str) -> String {
     shortfalls
         .iter()
         .flat_map(|s| s.checks.iter().copied())
         .collect::<Vec<_>>()
-        .join(",")
+        .join(separator)
 }

@@ -685,7 +685,7 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
                 termination_time,
                 termination_alpha: drift.termination_alpha(),
                 expected_to_fail: (!shortfalls.is_empty())
-                    .then(|| promise::check_list(&shortfalls)),
+                    .then(|| promise::check_list(&shortfalls, ",")),
             }
             .to_map(),
         )?;

@@ -37,16 +37,7 @@ coin_log_names::named_enum! {
 
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
 pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
-    let blank = Row {
-        index: 0,
-        values: Vec::new(),
-        status: RunStatus::Finished,
-        failure: None,
-        reason: String::new(),
-        recorded: None,
-        prediction: None,
-        wall_time: 0.0,
-    };
+    let blank = Row::failed(0, Vec::new(), FailureKind::Scene);
     let trailing = blank.trailing().map(|(column, _)| column);
     let columns = std::iter::once("index").chain(keys).chain(trailing);
     columns.map(str::to_string).collect()
@@ -96,6 +87,21 @@ pub fn cell(value: &toml::Value) -> String {
 }
 
 impl Row {
+    /// A run that failed with `failure` before it had a file; the reason and the wall time are filled in
+    /// when it ends.
+    pub fn failed(index: u64, values: Vec<String>, failure: FailureKind) -> Self {
+        Self {
+            index,
+            values,
+            status: RunStatus::Failed,
+            failure: Some(failure),
+            reason: String::new(),
+            recorded: None,
+            prediction: None,
+            wall_time: 0.0,
+        }
+    }
+
     /// The cells after the swept keys, each with its column's name.
     fn trailing(&self) -> [(&'static str, String); 20] {
         let r = self.recorded.as_ref();

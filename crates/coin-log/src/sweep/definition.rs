@@ -184,8 +184,7 @@ impl Sweep {
             scene::set_value(&mut table, key, value.clone())?;
         }
         if let Some(channels) = &self.settings.channels {
-            let list = channels.iter().map(|c| toml::Value::from(c.as_str()));
-            scene::set_value(&mut table, CHANNELS_KEY, toml::Value::Array(list.collect()))?;
+            scene::set_value(&mut table, CHANNELS_KEY, channels.clone().into())?;
         }
         let file = scene::file_from_table(table)?;
         let scene = Scene::from_file(&file)?;

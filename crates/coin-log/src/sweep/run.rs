@@ -10,7 +10,7 @@ use super::folder::{self, Folder, JournalRow};
 use super::hash::sha256_file;
 use super::shard::Shard;
 use crate::analyse::{motion_name, Analysis};
-use crate::format::Termination;
+use crate::format::{promise, Termination};
 use crate::model::nutation::Motion;
 use crate::record::{self, RecordSummary};
 use crate::scene::Scene;
@@ -76,17 +76,24 @@ pub struct SweepOutcome {
     pub verify_seconds: f64,
 }
 
-/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume), with the
-/// seconds spent recording and verifying it.
+/// A run done, as a worker hands it over (none for a run a stop ended: it is redone on resume).
 struct Done {
     row: Row,
+    spent: Spent,
+}
+
+/// A run's file: its modification time once in place, and the seconds spent recording and verifying it
+/// (all 0 without a file).
+#[derive(Default)]
+struct Spent {
     mtime_ns: u128,
-    record: f64,
-    verify: f64,
+    record_seconds: f64,
+    verify_seconds: f64,
 }
 
 /// What resume found: the lines to keep and how many of them are failed rows, the runs to do, and kept
 /// rows whose file was touched but not changed (to journal again with the new modification time).
+#[derive(Default)]
 struct Resumed {
     held: BTreeMap<u64, String>,
     failed: u64,
@@ -107,23 +114,18 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
     let _lock = folder.lock(options.shard)?;
-    let Resumed {
-        held,
-        failed,
-        todo,
-        refreshed,
-    } = resume(sweep, &folder, options)?;
+    let resumed = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
-    journal.append(&refreshed)?;
+    journal.append(&resumed.refreshed)?;
     let mut tally = Tally {
-        kept: held.len() as u64,
-        held,
+        kept: resumed.held.len() as u64,
+        held: resumed.held,
         progress: Progress {
             runs: options.shard.len(sweep.runs()),
-            todo: todo.len() as u64,
+            todo: resumed.todo.len() as u64,
             done: 0,
-            failed,
+            failed: resumed.failed,
         },
         record_seconds: 0.0,
         verify_seconds: 0.0,
@@ -131,8 +133,11 @@ pub fn run(
     progress(&tally.progress);
     let mut error = None;
     let work = |&index: &u64| run_one(sweep, &folder, index, stop);
-    super::on_threads(&todo, options.jobs, stop, work, |batch| {
-        let lines: Vec<(u128, String)> = batch.iter().map(|d| (d.mtime_ns, d.row.line())).collect();
+    super::on_threads(&resumed.todo, options.jobs, stop, work, |batch| {
+        let lines: Vec<(u128, String)> = batch
+            .iter()
+            .map(|d| (d.spent.mtime_ns, d.row.line()))
+            .collect();
         if let Err(e) = journal.append(&lines) {
             stop.store(true, Ordering::SeqCst);
             error.get_or_insert(e);
@@ -160,8 +165,8 @@ struct Tally {
 
 impl Tally {
     fn add(&mut self, done: &Done, line: String) {
-        self.record_seconds += done.record;
-        self.verify_seconds += done.verify;
+        self.record_seconds += done.spent.record_seconds;
+        self.verify_seconds += done.spent.verify_seconds;
         self.progress.done += 1;
         self.progress.failed += u64::from(done.row.status == RunStatus::Failed);
         self.held.insert(done.row.index, line);
@@ -175,14 +180,11 @@ impl Tally {
         stop: &AtomicBool,
     ) -> Result<SweepOutcome, SweepError> {
         let lines = self.held.values();
-        let (runs, rows, failed) = (
-            self.progress.runs,
-            self.held.len() as u64,
-            self.progress.failed,
-        );
+        let (runs, rows) = (self.progress.runs, self.held.len() as u64);
+        let failed = self.progress.failed;
+        let counts @ [finished, _, pending] = [rows - failed, failed, runs - rows];
         let (catalogue, summary) = if shard.is_all() {
-            let (catalogue, summary) =
-                folder.write_whole(lines, [rows - failed, failed, runs - rows])?;
+            let (catalogue, summary) = folder.write_whole(lines, counts)?;
             (catalogue, Some(summary))
         } else {
             (
@@ -192,9 +194,9 @@ impl Tally {
         };
         Ok(SweepOutcome {
             runs,
-            finished: rows - failed,
+            finished,
             failed,
-            pending: runs - rows,
+            pending,
             kept: self.kept,
             done: self.progress.done,
             interrupted: stop.load(Ordering::SeqCst),
@@ -218,16 +220,15 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             latest.insert(row.index, row);
         }
     }
-    let (mut held, mut failed, mut todo, mut refreshed) =
-        (BTreeMap::new(), 0, Vec::new(), Vec::new());
+    let mut resumed = Resumed::default();
     for index in options.shard.runs(sweep.runs()) {
         let Some(row) = latest.remove(&index) else {
-            todo.push(index);
+            resumed.todo.push(index);
             continue;
         };
         let f = &row.fields;
         let Ok(status) = f[status_at].parse::<RunStatus>() else {
-            todo.push(index);
+            resumed.todo.push(index);
             continue;
         };
         let retry = status == RunStatus::Failed
@@ -241,7 +242,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
                 Some((size, mtime)) if size.to_string() == f[bytes_at] => {
                     let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
                     if same {
-                        refreshed.push((mtime, crate::csv::line(f)));
+                        resumed.refreshed.push((mtime, crate::csv::line(f)));
                     }
                     same
                 }
@@ -249,18 +250,13 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             }
         };
         if retry || !file_ok {
-            todo.push(index);
+            resumed.todo.push(index);
         } else {
-            failed += u64::from(status == RunStatus::Failed);
-            held.insert(index, crate::csv::line(f));
+            resumed.failed += u64::from(status == RunStatus::Failed);
+            resumed.held.insert(index, crate::csv::line(f));
         }
     }
-    Ok(Resumed {
-        held,
-        failed,
-        todo,
-        refreshed,
-    })
+    Ok(resumed)
 }
 
 /// One run: values → scene → record into a temporary file → hash → verify → move into place → row.
@@ -271,75 +267,39 @@ fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Opt
         Ok(v) => v.iter().map(cell).collect(),
         Err(_) => vec![String::new(); sweep.keys().count()],
     };
-    let failed = |failure, reason: String| Done {
-        row: Row {
-            index,
-            values: cells.clone(),
-            status: RunStatus::Failed,
-            failure: Some(failure),
-            reason,
-            recorded: None,
-            prediction: None,
-            wall_time: started.elapsed().as_secs_f64(),
-        },
-        mtime_ns: 0,
-        record: 0.0,
-        verify: 0.0,
+    let mut done = Done {
+        row: Row::failed(index, cells, FailureKind::Scene),
+        spent: Spent::default(),
     };
+    let row = &mut done.row;
     let scene = values
         .map_err(RunSceneError::from)
         .and_then(|v| sweep.scene(&v));
-    let scene = match scene {
-        Ok(scene) => scene,
-        Err(e) => return Some(failed(FailureKind::Scene, e.to_string())),
-    };
-    let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
-    match record_and_check(sweep, folder, index, &scene, stop) {
-        Ok(None) => None,
-        Ok(Some(checked)) => {
-            let summary = &checked.recorded.summary;
-            let (status, failure, reason) = judge(summary, checked.report.as_ref());
-            let row = Row {
-                index,
-                values: cells,
-                status,
-                failure,
-                reason,
-                recorded: Some(checked.recorded),
-                prediction,
-                wall_time: started.elapsed().as_secs_f64(),
-            };
-            Some(Done {
-                row,
-                mtime_ns: checked.mtime_ns,
-                record: checked.record_seconds,
-                verify: checked.verify_seconds,
-            })
+    match scene {
+        Err(e) => row.reason = e.to_string(),
+        Ok(scene) => {
+            let prediction = sweep.settings.predict.then(|| predict(&scene)).flatten();
+            match record_and_check(sweep, folder, &scene, stop, row) {
+                Ok(None) => return None,
+                Ok(Some(spent)) => (row.prediction, done.spent) = (prediction, spent),
+                Err(e) => (row.failure, row.reason) = (Some(FailureKind::Io), e),
+            }
         }
-        Err(e) => Some(failed(FailureKind::Io, e)),
     }
+    done.row.wall_time = started.elapsed().as_secs_f64();
+    Some(done)
 }
 
-/// A recorded run, in place under its final name.
-struct Checked {
-    recorded: Recorded,
-    report: Option<FileReport>,
-    mtime_ns: u128,
-    record_seconds: f64,
-    verify_seconds: f64,
-}
-
-/// Records the run into a temporary file, syncs, hashes and verifies it, and moves it to its name;
-/// `None` when a stop request interrupted it (the temporary file is deleted).
+/// Records `row`'s run into a temporary file, syncs, hashes and verifies it, moves it to its name and
+/// judges it into `row`; `None` when a stop request interrupted it (the temporary file is deleted).
 fn record_and_check(
     sweep: &Sweep,
     folder: &Folder,
-    index: u64,
     scene: &Scene,
     stop: &AtomicBool,
-) -> Result<Option<Checked>, String> {
-    let width = sweep.index_width();
-    let name = folder::run_file_name(index, width);
+    row: &mut Row,
+) -> Result<Option<Spent>, String> {
+    let name = folder::run_file_name(row.index, sweep.index_width());
     let target = folder.file(&name);
     let io = |what: &str| {
         let what = format!("{what} `{name}`");
@@ -368,14 +328,14 @@ fn record_and_check(
         .map_err(|e| io("moving the recording to")(e.error))?;
     let (_, mtime_ns) = folder::size_and_mtime(&target)
         .ok_or_else(|| format!("`{name}` vanished once moved into place"))?;
-    Ok(Some(Checked {
-        recorded: Recorded {
-            file: name,
-            sha256,
-            summary,
-            verify: report.as_ref().map(|r| r.verdict),
-        },
-        report,
+    (row.status, row.failure, row.reason) = judge(&summary, report.as_ref());
+    row.recorded = Some(Recorded {
+        file: name,
+        sha256,
+        summary,
+        verify: report.as_ref().map(|r| r.verdict),
+    });
+    Ok(Some(Spent {
         mtime_ns,
         record_seconds,
         verify_seconds,
@@ -409,16 +369,11 @@ fn judge(
     match report {
         Some(r) if r.verdict != Verdict::Ok => {
             let mut reason = verify_reason(r);
-            let expected: Vec<&str> = s
-                .shortfalls
-                .iter()
-                .flat_map(|f| f.checks.iter().copied())
-                .collect();
+            let expected = promise::check_list(&s.shortfalls, ", ");
             if !expected.is_empty() {
                 // What record warns of before the run: a dataset's reader sees it beside the failure.
                 reason.push_str(&format!(
-                    "; record expected it: its settings allow more error than verify accepts in {} (tighten rtol/atol, or step)",
-                    expected.join(", ")
+                    "; record expected it: its settings allow more error than verify accepts in {expected} (tighten rtol/atol, or step)"
                 ));
             }
             (RunStatus::Failed, Some(FailureKind::Verify), reason)

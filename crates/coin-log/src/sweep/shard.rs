@@ -44,8 +44,7 @@ impl Shard {
         }
         if index >= count {
             return Err(ShardError(format!(
-                "shard {index}/{count}: K must be 0 … N − 1 = {} (number a Slurm array from 0: --array=0-{})",
-                count - 1,
+                "shard {index}/{count}: K must be 0 … N − 1 = {} (number a Slurm array from 0: --array=0-{0})",
                 count - 1
             )));
         }

@@ -593,11 +593,8 @@ impl Checker {
             .iter()
             .map(|a| a.values.clone())
             .chain(draws.map(representatives));
-        let channels = sweep.settings.channels.iter().map(|l| {
-            vec![toml::Value::Array(
-                l.iter().map(|c| toml::Value::from(c.as_str())).collect(),
-            )]
-        });
+        let channels = sweep.settings.channels.as_ref();
+        let channels = channels.map(|l| vec![toml::Value::from(l.clone())]);
         let swept = places.iter().filter(|p| !p.name.starts_with("set."));
         for (place, values) in swept.zip(candidates.chain(channels)) {
             for value in values.iter().take(CHECKED_VALUES) {
