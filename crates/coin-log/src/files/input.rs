@@ -71,14 +71,6 @@ pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
     Ok(meta)
 }
 
-/// Reads the scene file at `path` as text: [`read_toml`] of a [`InputKind::Scene`].
-///
-/// # Errors
-/// As [`read_toml`].
-pub fn read_scene(path: &Path) -> Result<String, InputError> {
-    read_toml(path, InputKind::Scene)
-}
-
 /// Reads the scene or sweep file at `path` as text: a regular file of at most [`SCENE_MAX_BYTES`] (the
 /// bound holds while reading too, for files that grow or whose size the system does not report, like
 /// `/proc` files).
