@@ -744,16 +744,16 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
             }),
         },
         run: Some(run_file(&scene.run)),
-        record: Some(RecordFile {
-            channels: Some(
-                scene
-                    .channels
-                    .iter()
-                    .map(|c| c.name().to_string())
-                    .collect(),
-            ),
-            rerun: None,
-        }),
+        record: Some(record_file(&scene.channels)),
+    }
+}
+
+/// `[record]` listing `channels` by name.
+pub(super) fn record_file(channels: &[Channel]) -> RecordFile {
+    let names = channels.iter().map(|c| c.name().to_string()).collect();
+    RecordFile {
+        channels: Some(names),
+        rerun: None,
     }
 }
 
