@@ -105,14 +105,7 @@ pub fn absent_or_regular(path: &Path) -> io::Result<()> {
         Ok(meta) if meta.is_file() => Ok(()),
         Ok(meta) => Err(io::Error::new(
             io::ErrorKind::InvalidInput,
-            format!(
-                "is {}, not a regular file: move it away",
-                if meta.is_dir() {
-                    "a folder"
-                } else {
-                    kind_of(&meta)
-                }
-            ),
+            format!("is {}, not a regular file: move it away", kind_of(&meta)),
         )),
         Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
         Err(e) => Err(e),
