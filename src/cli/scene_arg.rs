@@ -6,7 +6,7 @@
 //! the `--set KEY=VALUE` edits applied (format.md: Scene edits).
 
 use anyhow::anyhow;
-use coin_log::files::{escaped, read_scene, shown};
+use coin_log::files::{escaped, read_toml, shown, InputKind};
 use coin_log::scene::{self, presets, SceneFile};
 use std::path::{Path, PathBuf};
 
@@ -53,7 +53,8 @@ pub fn classify(arg: &str) -> anyhow::Result<SceneArg<'_>> {
 /// # Errors
 /// The path is not such a file, or cannot be read.
 pub fn read_scene_file(path: &Path) -> anyhow::Result<String> {
-    read_scene(path).map_err(|e| anyhow!("cannot read scene file `{}`: {e}", shown(path)))
+    read_toml(path, InputKind::Scene)
+        .map_err(|e| anyhow!("cannot read scene file `{}`: {e}", shown(path)))
 }
 
 /// Where a scene came from: its name in messages, its default output stem, and its file if it is one.

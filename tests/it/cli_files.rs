@@ -10,7 +10,7 @@
 
 use crate::support::mkfifo;
 use crate::support::record::{coin_log, exe, listing};
-use coin_log::files::input::{check, read_scene, InputKind, SCENE_MAX_BYTES};
+use coin_log::files::input::{check, read_toml, InputKind, SCENE_MAX_BYTES};
 use coin_log::files::{cut, shown, Output, OutputFolder, Policy};
 use std::io::{Read, Write};
 use std::os::unix::fs::FileTypeExt;
@@ -665,7 +665,9 @@ fn devices_folders_and_stdin_are_refused_with_the_reason() {
         ("/", "is a directory, not a scene file"),
         ("-", "reading standard input is not offered"),
     ] {
-        let e = read_scene(Path::new(path)).unwrap_err().to_string();
+        let e = read_toml(Path::new(path), InputKind::Scene)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(needle), "{path}: {e}");
     }
     let e = check(Path::new("/dev/null"), InputKind::Mcap).unwrap_err();
@@ -678,9 +680,9 @@ fn a_scene_above_the_limit_is_refused_and_one_at_it_read() {
     let path = dir.path().join("s.toml");
     let at = usize::try_from(SCENE_MAX_BYTES).unwrap();
     std::fs::write(&path, "#".repeat(at)).unwrap();
-    assert_eq!(read_scene(&path).unwrap().len(), at);
+    assert_eq!(read_toml(&path, InputKind::Scene).unwrap().len(), at);
     std::fs::write(&path, "#".repeat(at + 1)).unwrap();
-    let e = read_scene(&path).unwrap_err().to_string();
+    let e = read_toml(&path, InputKind::Scene).unwrap_err().to_string();
     assert!(e.contains("more than 1048576 bytes"), "{e}");
 }
 

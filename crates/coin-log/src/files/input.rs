@@ -71,14 +71,6 @@ pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
     Ok(meta)
 }
 
-/// Reads the scene file at `path` as text: [`read_toml`] of a [`InputKind::Scene`].
-///
-/// # Errors
-/// As [`read_toml`].
-pub fn read_scene(path: &Path) -> Result<String, InputError> {
-    read_toml(path, InputKind::Scene)
-}
-
 /// Reads the scene or sweep file at `path` as text: a regular file of at most [`SCENE_MAX_BYTES`] (the
 /// bound holds while reading too, for files that grow or whose size the system does not report, like
 /// `/proc` files).
@@ -113,14 +105,7 @@ pub fn absent_or_regular(path: &Path) -> io::Result<()> {
         Ok(meta) if meta.is_file() => Ok(()),
         Ok(meta) => Err(io::Error::new(
             io::ErrorKind::InvalidInput,
-            format!(
-                "is {}, not a regular file: move it away",
-                if meta.is_dir() {
-                    "a folder"
-                } else {
-                    kind_of(&meta)
-                }
-            ),
+            format!("is {}, not a regular file: move it away", kind_of(&meta)),
         )),
         Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
         Err(e) => Err(e),

@@ -5,8 +5,8 @@ pub mod input;
 pub mod output;
 
 pub use input::{
-    absent_or_plain, absent_or_regular, open_regular, read_regular, read_scene, read_toml,
-    InputError, InputKind,
+    absent_or_plain, absent_or_regular, open_regular, read_regular, read_toml, InputError,
+    InputKind,
 };
 pub use output::{make_readable, Output, OutputError, OutputFolder, Policy};
 

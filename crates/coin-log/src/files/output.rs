@@ -73,8 +73,11 @@ impl Policy {
     }
 }
 
-/// What a file that is neither regular, a folder nor a link is, in words.
+/// What a file that is neither regular nor a link is, in words.
 pub(super) fn kind_of(meta: &Metadata) -> &'static str {
+    if meta.is_dir() {
+        return "a folder";
+    }
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -92,7 +95,6 @@ pub(super) fn kind_of(meta: &Metadata) -> &'static str {
             return "a socket";
         }
     }
-    let _ = meta;
     "a special file"
 }
 

@@ -100,20 +100,13 @@ pub(crate) fn other_form(key: &str) -> &'static [&'static str] {
     }
 }
 
-/// Removes the dotted `key` where its tables exist.
+/// Removes `key`, `table.name` as [`other_form`] gives them, where the table exists.
 fn remove(table: &mut toml::Table, key: &str) {
-    let Some((path, last)) = key.rsplit_once('.') else {
-        table.remove(key);
-        return;
-    };
-    let mut current = table;
-    for part in path.split('.') {
-        match current.get_mut(part) {
-            Some(toml::Value::Table(t)) => current = t,
-            _ => return,
+    if let Some((name, last)) = key.split_once('.') {
+        if let Some(toml::Value::Table(t)) = table.get_mut(name) {
+            t.remove(last);
         }
     }
-    current.remove(last);
 }
 
 /// VALUE as TOML, else as a bare string.

@@ -73,9 +73,6 @@ fn without_defaults(mut file: SceneFile) -> SceneFile {
     drop_if(&mut run.step, &defaults::STEP);
     drop_if(&mut run.flat_margin, &defaults::FLAT_MARGIN);
     let channels = validate::default_channels(file.body.dissipation.is_some());
-    let names: Vec<String> = channels.iter().map(|c| c.name().to_string()).collect();
-    if file.record.as_ref().and_then(|r| r.channels.as_ref()) == Some(&names) {
-        file.record = None;
-    }
+    drop_if(&mut file.record, &validate::record_file(&channels));
     file
 }

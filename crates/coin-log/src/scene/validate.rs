@@ -42,8 +42,9 @@ fn check_description(description: Option<&str>, problems: &mut ProblemCollector)
     problems.push("description", value, reason);
 }
 
-/// The lean range allowed by a flat margin, in words.
-fn lean_range(margin: f64) -> String {
+/// The lean range allowed by a flat margin (the default when it is not known), in words.
+fn lean_range(margin: Option<f64>) -> String {
+    let margin = margin.unwrap_or(defaults::FLAT_MARGIN);
     format!("is outside (−π/2 + {margin}, π/2 − {margin}) (run.flat_margin = {margin}): a rolling coin must lean less than flat")
 }
 
@@ -252,8 +253,7 @@ fn check_initial_alone(
     problems: &mut ProblemCollector,
 ) {
     if let Some(theta) = initial.theta {
-        let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
-        check_theta(theta, Some(margin), problems);
+        check_theta(theta, flat_margin.or(Some(defaults::FLAT_MARGIN)), problems);
     }
     offsets(initial, problems);
     if let Some(omega) = &initial.omega {
@@ -289,7 +289,7 @@ fn check_initial(
             format!(
                 "takes theta to {}, which {}",
                 number(kicked.theta),
-                lean_range(flat_margin.unwrap_or(defaults::FLAT_MARGIN))
+                lean_range(flat_margin)
             ),
         );
     }
@@ -314,8 +314,7 @@ fn leans_less_than_flat(theta: f64, flat_margin: Option<f64>) -> bool {
 
 fn check_theta(theta: f64, flat_margin: Option<f64>, problems: &mut ProblemCollector) {
     if problems.finite("initial.theta", theta) && !leans_less_than_flat(theta, flat_margin) {
-        let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
-        problems.push("initial.theta", number(theta), lean_range(margin));
+        problems.push("initial.theta", number(theta), lean_range(flat_margin));
     }
 }
 
@@ -745,16 +744,16 @@ pub(super) fn file_from_scene(scene: &Scene) -> SceneFile {
             }),
         },
         run: Some(run_file(&scene.run)),
-        record: Some(RecordFile {
-            channels: Some(
-                scene
-                    .channels
-                    .iter()
-                    .map(|c| c.name().to_string())
-                    .collect(),
-            ),
-            rerun: None,
-        }),
+        record: Some(record_file(&scene.channels)),
+    }
+}
+
+/// `[record]` listing `channels` by name.
+pub(super) fn record_file(channels: &[Channel]) -> RecordFile {
+    let names = channels.iter().map(|c| c.name().to_string()).collect();
+    RecordFile {
+        channels: Some(names),
+        rerun: None,
     }
 }
 

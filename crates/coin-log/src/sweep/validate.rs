@@ -114,7 +114,7 @@ impl Checker {
                  to the sweep file, such as \"./{base}.toml\""));
         }
         let path = folder.join(base);
-        let text = match crate::files::read_scene(&path) {
+        let text = match crate::files::read_toml(&path, crate::files::InputKind::Scene) {
             Ok(text) => text,
             Err(e) => {
                 return self.problems.reject("base", quoted, format!(
