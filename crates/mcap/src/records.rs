@@ -121,7 +121,8 @@ macro_rules! integer_fields {
 }
 integer_fields!(u8, u16, u32, u64);
 
-fn len32(len: usize, what: &'static str) -> Result<u32, WriteError> {
+/// `len` as an MCAP length or count field (u32); `what`: what it measures, for the error.
+pub(crate) fn len32(len: usize, what: &'static str) -> Result<u32, WriteError> {
     u32::try_from(len).map_err(|_| WriteError::TooLong { what, len })
 }
 
