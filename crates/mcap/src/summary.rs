@@ -56,6 +56,15 @@ pub struct Summary {
     pub metadata: Vec<(String, BTreeMap<String, String>)>,
 }
 
+/// `bounds` (earliest, latest) widened to include the time `t`.
+#[inline]
+pub(crate) fn widen(bounds: Option<(u64, u64)>, t: u64) -> (u64, u64) {
+    match bounds {
+        None => (t, t),
+        Some((start, end)) => (start.min(t), end.max(t)),
+    }
+}
+
 /// Reads the summary of the MCAP file at `path`. `Ok(None)` when the file has no summary section, its
 /// summary has no statistics record, or it is larger than the largest record the reader accepts.
 ///

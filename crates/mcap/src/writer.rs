@@ -8,6 +8,7 @@
 //! recording's bytes.
 
 use crate::records::{len32, ChunkRecord, MessageRecord, Record, MAGIC};
+use crate::summary::widen;
 use mcap::records::{
     Channel, ChunkHeader, ChunkIndex, DataEnd, Footer, Header, MessageHeader, MessageIndex,
     MessageIndexEntry, Metadata, MetadataIndex, Statistics, SummaryOffset,
@@ -768,11 +769,4 @@ impl<W: Write> McapWriter<W> {
 /// A chunk buffer's initial capacity: the chunk size plus room for the message that crosses it.
 fn chunk_capacity(chunk_size: usize) -> usize {
     chunk_size.saturating_add(chunk_size / 8).min(1 << 30)
-}
-
-fn widen(bounds: Option<(u64, u64)>, t: u64) -> (u64, u64) {
-    match bounds {
-        None => (t, t),
-        Some((start, end)) => (start.min(t), end.max(t)),
-    }
 }
