@@ -233,7 +233,7 @@ fn truncated(len: u64, at: u64) -> String {
     }
 }
 
-fn wire_error(what: &str, at: u64, e: &WireError) -> ReadError {
+pub(crate) fn wire_error(what: &str, at: u64, e: &WireError) -> ReadError {
     corrupt(format!("malformed {what} record at byte {at}: {e}"))
 }
 
