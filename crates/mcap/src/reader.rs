@@ -431,7 +431,7 @@ impl Book {
                 Event::Record { opcode, body } => {
                     let data = &batch.bytes[body.clone()];
                     let at = self.enter(*opcode, data.len() as u64);
-                    self.top_level(*opcode, data, at, visitor)?;
+                    self.record(*opcode, data, at, None, visitor)?;
                 }
                 Event::Chunk {
                     len,
@@ -613,29 +613,6 @@ impl Book {
         self.s.chunks += 1;
     }
 
-    fn top_level(
-        &mut self,
-        opcode: u8,
-        data: &[u8],
-        at: u64,
-        visitor: &mut impl Visitor,
-    ) -> Result<(), ReadError> {
-        match opcode {
-            op::HEADER => {
-                let header: Header = parse(data, at)?;
-                self.s.library = header.library;
-            }
-            op::MESSAGE_INDEX => self.message_index(data, at)?,
-            op::FOOTER => self.footer(data, at)?,
-            op::DATA_END => {
-                self.data_end_seen = true;
-                self.in_summary = true;
-            }
-            _ => self.record(opcode, data, at, visitor)?,
-        }
-        Ok(())
-    }
-
     fn chunk_record(&mut self, header: &ChunkHeader, at: u64, len: u64) {
         *self
             .s
@@ -683,10 +660,11 @@ impl Book {
             if let Some(c) = self.chunk.as_mut() {
                 c.offset += PREFIX_LEN + data.len() as u64;
             }
+            // Messages straight to `message`: the hot path, kept short.
             if opcode == op::MESSAGE {
                 self.message(data, at, Some(offset), visitor)?;
             } else {
-                self.record(opcode, data, at, visitor)?;
+                self.record(opcode, data, at, Some(offset), visitor)?;
             }
         }
         Ok(())
@@ -765,16 +743,35 @@ impl Book {
         Ok(())
     }
 
-    /// A record outside the chunk bookkeeping: definitions, metadata and the summary's records.
+    /// The record at `at`, top-level or (`chunk_offset`: where in its records) inside the current chunk,
+    /// where the records that only stand at the top level are ignored.
     fn record(
         &mut self,
         opcode: u8,
         data: &[u8],
         at: u64,
+        chunk_offset: Option<u64>,
         visitor: &mut impl Visitor,
     ) -> Result<(), ReadError> {
         match opcode {
-            op::MESSAGE => self.message(data, at, None, visitor),
+            op::MESSAGE => self.message(data, at, chunk_offset, visitor),
+            op::HEADER | op::MESSAGE_INDEX | op::FOOTER | op::DATA_END
+                if chunk_offset.is_some() =>
+            {
+                Ok(())
+            }
+            op::HEADER => {
+                let header: Header = parse(data, at)?;
+                self.s.library = header.library;
+                Ok(())
+            }
+            op::MESSAGE_INDEX => self.message_index(data, at),
+            op::FOOTER => self.footer(data, at),
+            op::DATA_END => {
+                self.data_end_seen = true;
+                self.in_summary = true;
+                Ok(())
+            }
             op::SCHEMA => self.schema(data, at),
             op::CHANNEL => self.channel(data, at, visitor),
             op::METADATA => self.metadata(data, at, visitor),
