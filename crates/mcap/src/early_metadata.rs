@@ -9,7 +9,7 @@ use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::digest::Digest;
 use crate::reader::ReadError;
 use crate::records::{self, Record, MAGIC, MAGIC_LEN, PREFIX_LEN};
-use crate::summary::{bytes_at, metadata_indexes};
+use crate::summary::{bytes_at, metadata_indexes, record_at};
 use mcap::records::{op, Metadata};
 use std::io::{self, Read, Seek, SeekFrom};
 
@@ -95,17 +95,6 @@ fn prefix(r: &mut impl Read) -> Option<(u8, u64)> {
     records::prefix(&b)
 }
 
-/// Reads a body of `len` bytes at the reader's position; `None` if it is larger than the reader
-/// accepts or cannot be read.
-fn body(r: &mut impl Read, len: u64) -> Option<Vec<u8>> {
-    if len > MAX_RECORD_BYTES {
-        return None;
-    }
-    let mut body = vec![0u8; usize::try_from(len).ok()?];
-    r.read_exact(&mut body).ok()?;
-    Some(body)
-}
-
 /// Reads the metadata records the index points at: in file order, each once, never two that overlap
 /// (so that no byte is read twice), each checked to be a metadata record of the indexed length, and
 /// counted in `kept`. `None` when an entry points at no such record (a repeated entry counts as valid).
@@ -124,18 +113,11 @@ pub(crate) fn read_indexed(
     let mut free_from = MAGIC_LEN;
     for (at, length) in indexes {
         let end = at.saturating_add(length);
-        if at < free_from || end > len || length < PREFIX_LEN {
+        if at < free_from || length > PREFIX_LEN + MAX_RECORD_BYTES {
             return Ok(None);
         }
-        let record = source
-            .seek(SeekFrom::Start(at))
-            .ok()
-            .and_then(|_| prefix(source))
-            .filter(|(opcode, body_len)| {
-                *opcode == op::METADATA && *body_len == length - PREFIX_LEN
-            })
-            .and_then(|(_, body_len)| read_metadata(source, at, body_len));
-        let Some(m) = record else {
+        let record = record_at(source, len, at, length, op::METADATA);
+        let Some(m) = record.and_then(|body| parsed(at, &body)) else {
             return Ok(None);
         };
         kept.charge(length, m.record.metadata.len(), at)?;
@@ -145,15 +127,11 @@ pub(crate) fn read_indexed(
     Ok(Some(out))
 }
 
-/// Reads and parses the body of the metadata record at `at` from the reader's position.
-fn read_metadata(r: &mut impl Read, at: u64, body_len: u64) -> Option<FoundMetadata> {
-    let body = body(r, body_len)?;
-    let record = Metadata::parse_body(&body).ok()?;
-    Some(FoundMetadata {
-        at,
-        digest: Digest::of(&body),
-        record,
-    })
+/// The metadata record at `at` whose body is `body`, if it parses.
+fn parsed(at: u64, body: &[u8]) -> Option<FoundMetadata> {
+    let record = Metadata::parse_body(body).ok()?;
+    let digest = Digest::of(body);
+    Some(FoundMetadata { at, digest, record })
 }
 
 /// Walks the top-level records from the header to DataEnd (or the footer), reading metadata records into
@@ -191,7 +169,9 @@ fn scan(
             // One too large to read: the stream refuses it where it stands.
             op::METADATA if body_len > MAX_RECORD_BYTES => return Ok(None),
             op::METADATA if found.len() < MAX_EARLY => {
-                let Some(m) = read_metadata(&mut r, at, body_len) else {
+                let mut body = vec![0; usize::try_from(body_len).unwrap_or(0)];
+                let read = r.read_exact(&mut body);
+                let Some(m) = read.ok().and_then(|()| parsed(at, &body)) else {
                     return Ok(Some(ScanEnd::Malformed { at }));
                 };
                 kept.charge(PREFIX_LEN + body_len, m.record.metadata.len(), at)?;

@@ -228,38 +228,29 @@ pub(crate) fn produce(
 /// consumer has gone.
 fn chunk(data: &[u8], batches: &mut Batches, decompressor: &mut Decompressor) -> Option<Event> {
     let len = data.len() as u64;
+    let bad = |header, error| Some(Event::BadChunk { len, header, error });
     let chunk = match ChunkRecord::parse_body(data) {
         Ok(chunk) => chunk,
-        Err(e) => {
-            let error = ChunkError::Malformed(e);
-            return Some(Event::BadChunk {
-                len,
-                header: None,
-                error,
-            });
-        }
+        Err(e) => return bad(None, ChunkError::Malformed(e)),
     };
     let declared = chunk.header.uncompressed_size;
     if declared > MAX_RECORD_BYTES {
-        let error = ChunkError::TooLarge(declared);
-        let header = Some(chunk.header);
-        return Some(Event::BadChunk { len, header, error });
+        return bad(Some(chunk.header), ChunkError::TooLarge(declared));
     }
     batches.room_for(declared)?;
     let bytes = &mut batches.current.bytes;
     let start = bytes.len();
-    Some(match decompressor.run(&chunk, bytes) {
-        Ok(()) => Event::Chunk {
+    match decompressor.run(&chunk, bytes) {
+        Ok(()) => Some(Event::Chunk {
             len,
             header: chunk.header,
             records: start..bytes.len(),
-        },
+        }),
         Err(error) => {
             bytes.truncate(start);
-            let header = Some(chunk.header);
-            Event::BadChunk { len, header, error }
+            bad(Some(chunk.header), error)
         }
-    })
+    }
 }
 
 /// The chunk decompressors, kept from chunk to chunk.

@@ -16,7 +16,7 @@ use crate::prefetch::{self, Batch, ChunkError, Event};
 use crate::records::{
     AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
 };
-use crate::summary::{ChannelSummary, Summary};
+use crate::summary::{widen, ChannelSummary, Summary};
 use mcap::records::{
     op, Channel, ChunkHeader, ChunkIndex, Footer, Header, MessageHeader, MessageIndex, Metadata,
     MetadataIndex, Statistics, SummaryOffset,
@@ -133,8 +133,8 @@ struct IndexDigest {
 struct ChunkBook {
     index: ChunkIndex,
     offset: u64,
-    min_time: Option<u64>,
-    max_time: u64,
+    /// (earliest, latest) log time of its messages.
+    bounds: Option<(u64, u64)>,
     per_channel: BTreeMap<u16, IndexDigest>,
 }
 
@@ -187,8 +187,6 @@ struct Book {
     metadata_count: u64,
     metadata_indexes: Vec<(u64, u64, Digest)>,
     attachment_count: u64,
-    min_time: Option<u64>,
-    max_time: u64,
     /// (opcode, start, length) of the summary's groups and of its summary offset records.
     groups: Vec<(u8, u64, u64)>,
     summary_offsets: Vec<(u8, u64, u64)>,
@@ -235,7 +233,7 @@ fn truncated(len: u64, at: u64) -> String {
     }
 }
 
-fn wire_error(what: &str, at: u64, e: &WireError) -> ReadError {
+pub(crate) fn wire_error(what: &str, at: u64, e: &WireError) -> ReadError {
     corrupt(format!("malformed {what} record at byte {at}: {e}"))
 }
 
@@ -412,7 +410,6 @@ fn consume(
 
 impl Book {
     fn structure(self) -> Structure {
-        let time_range = self.min_time.map(|start| (start, self.max_time));
         let counts = &self.channel_counts;
         let channels = self
             .channels
@@ -423,11 +420,7 @@ impl Book {
             })
             .collect();
         Structure {
-            summary: Summary {
-                time_range,
-                channels,
-                ..self.s
-            },
+            summary: Summary { channels, ..self.s },
             problems: self.problems,
         }
     }
@@ -438,7 +431,7 @@ impl Book {
                 Event::Record { opcode, body } => {
                     let data = &batch.bytes[body.clone()];
                     let at = self.enter(*opcode, data.len() as u64);
-                    self.top_level(*opcode, data, at, visitor)?;
+                    self.record(*opcode, data, at, None, visitor)?;
                 }
                 Event::Chunk {
                     len,
@@ -600,10 +593,7 @@ impl Book {
         };
         let (i, start) = (&chunk.index, chunk.index.chunk_start_offset);
         let (s, e) = (i.message_start_time, i.message_end_time);
-        if chunk.min_time.is_some_and(|t| t != s)
-            || (chunk.min_time.is_some() && chunk.max_time != e)
-        {
-            let (a, b) = (chunk.min_time.unwrap_or(0), chunk.max_time);
+        if let Some((a, b)) = chunk.bounds.filter(|&b| b != (s, e)) {
             self.problem(|| {
                 format!("chunk at byte {start}: header says messages span {s}..{e} ns, they span {a}..{b} ns")
             });
@@ -621,29 +611,6 @@ impl Book {
         }
         self.chunk_digest.push(index_digest(&chunk.index).0);
         self.s.chunks += 1;
-    }
-
-    fn top_level(
-        &mut self,
-        opcode: u8,
-        data: &[u8],
-        at: u64,
-        visitor: &mut impl Visitor,
-    ) -> Result<(), ReadError> {
-        match opcode {
-            op::HEADER => {
-                let header: Header = parse(data, at)?;
-                self.s.library = header.library;
-            }
-            op::MESSAGE_INDEX => self.message_index(data, at)?,
-            op::FOOTER => self.footer(data, at)?,
-            op::DATA_END => {
-                self.data_end_seen = true;
-                self.in_summary = true;
-            }
-            _ => self.record(opcode, data, at, visitor)?,
-        }
-        Ok(())
     }
 
     fn chunk_record(&mut self, header: &ChunkHeader, at: u64, len: u64) {
@@ -667,8 +634,7 @@ impl Book {
                 uncompressed_size: header.uncompressed_size,
             },
             offset: 0,
-            min_time: None,
-            max_time: 0,
+            bounds: None,
             per_channel: BTreeMap::new(),
         });
     }
@@ -694,10 +660,11 @@ impl Book {
             if let Some(c) = self.chunk.as_mut() {
                 c.offset += PREFIX_LEN + data.len() as u64;
             }
+            // Messages straight to `message`: the hot path, kept short.
             if opcode == op::MESSAGE {
                 self.message(data, at, Some(offset), visitor)?;
             } else {
-                self.record(opcode, data, at, visitor)?;
+                self.record(opcode, data, at, Some(offset), visitor)?;
             }
         }
         Ok(())
@@ -733,11 +700,9 @@ impl Book {
         self.s.messages += 1;
         *self.channel_counts.entry(header.channel_id).or_insert(0) += 1;
         let t = header.log_time;
-        self.min_time = Some(self.min_time.map_or(t, |m| m.min(t)));
-        self.max_time = self.max_time.max(t);
+        self.s.time_range = Some(widen(self.s.time_range, t));
         if let (Some(offset), Some(chunk)) = (chunk_offset, self.chunk.as_mut()) {
-            chunk.min_time = Some(chunk.min_time.map_or(t, |m| m.min(t)));
-            chunk.max_time = chunk.max_time.max(t);
+            chunk.bounds = Some(widen(chunk.bounds, t));
             let d = chunk.per_channel.entry(header.channel_id).or_default();
             d.count += 1;
             d.digest.push(t);
@@ -778,16 +743,35 @@ impl Book {
         Ok(())
     }
 
-    /// A record outside the chunk bookkeeping: definitions, metadata and the summary's records.
+    /// The record at `at`, top-level or (`chunk_offset`: where in its records) inside the current chunk,
+    /// where the records that only stand at the top level are ignored.
     fn record(
         &mut self,
         opcode: u8,
         data: &[u8],
         at: u64,
+        chunk_offset: Option<u64>,
         visitor: &mut impl Visitor,
     ) -> Result<(), ReadError> {
         match opcode {
-            op::MESSAGE => self.message(data, at, None, visitor),
+            op::MESSAGE => self.message(data, at, chunk_offset, visitor),
+            op::HEADER | op::MESSAGE_INDEX | op::FOOTER | op::DATA_END
+                if chunk_offset.is_some() =>
+            {
+                Ok(())
+            }
+            op::HEADER => {
+                let header: Header = parse(data, at)?;
+                self.s.library = header.library;
+                Ok(())
+            }
+            op::MESSAGE_INDEX => self.message_index(data, at),
+            op::FOOTER => self.footer(data, at),
+            op::DATA_END => {
+                self.data_end_seen = true;
+                self.in_summary = true;
+                Ok(())
+            }
             op::SCHEMA => self.schema(data, at),
             op::CHANNEL => self.channel(data, at, visitor),
             op::METADATA => self.metadata(data, at, visitor),
@@ -945,6 +929,7 @@ impl Book {
     }
 
     fn check_statistics(&mut self, claimed: &Statistics) {
+        let (start, end) = self.s.time_range.unwrap_or((0, 0));
         let real: [(&str, u64, u64); 8] = [
             ("message_count", claimed.message_count, self.s.messages),
             (
@@ -968,12 +953,8 @@ impl Book {
                 self.metadata_count,
             ),
             ("chunk_count", u64::from(claimed.chunk_count), self.s.chunks),
-            (
-                "message_start_time",
-                claimed.message_start_time,
-                self.min_time.unwrap_or(0),
-            ),
-            ("message_end_time", claimed.message_end_time, self.max_time),
+            ("message_start_time", claimed.message_start_time, start),
+            ("message_end_time", claimed.message_end_time, end),
         ];
         for (name, claimed, counted) in real {
             if claimed != counted {

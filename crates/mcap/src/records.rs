@@ -121,7 +121,8 @@ macro_rules! integer_fields {
 }
 integer_fields!(u8, u16, u32, u64);
 
-fn len32(len: usize, what: &'static str) -> Result<u32, WriteError> {
+/// `len` as an MCAP length or count field (u32); `what`: what it measures, for the error.
+pub(crate) fn len32(len: usize, what: &'static str) -> Result<u32, WriteError> {
     u32::try_from(len).map_err(|_| WriteError::TooLong { what, len })
 }
 
@@ -145,6 +146,22 @@ impl<'a> Field<'a> for String {
     }
     fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
         Cow::Borrowed(self.as_bytes()).encode(out, field)
+    }
+}
+
+/// Bytes with a u64 length prefix (an attachment's data), borrowed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LongBytes<'a>(pub(crate) &'a [u8]);
+
+impl<'a> Field<'a> for LongBytes<'a> {
+    fn parse(c: &mut Cursor<'a>, field: &'static str) -> Result<Self, WireError> {
+        let len = u64::parse(c, field)?;
+        Ok(Self(c.take(len, field)?))
+    }
+    fn encode(&self, out: &mut Vec<u8>, field: &'static str) -> Result<(), WriteError> {
+        (self.0.len() as u64).encode(out, field)?;
+        out.extend_from_slice(self.0);
+        Ok(())
     }
 }
 
@@ -389,48 +406,20 @@ pub(crate) struct AttachmentRecord<'a> {
     pub(crate) create_time: u64,
     pub(crate) name: String,
     pub(crate) media_type: String,
-    /// With a u64 length prefix in the file.
-    pub(crate) data: &'a [u8],
+    pub(crate) data: LongBytes<'a>,
     pub(crate) crc: u32,
 }
 
 impl AttachmentRecord<'_> {
     /// Bytes of the body that the CRC covers: every field before it.
     pub(crate) fn crc_covered_len(&self) -> usize {
-        8 + 8 + 4 + self.name.len() + 4 + self.media_type.len() + 8 + self.data.len()
+        8 + 8 + 4 + self.name.len() + 4 + self.media_type.len() + 8 + self.data.0.len()
     }
 }
 
-impl<'a> Field<'a> for AttachmentRecord<'a> {
-    fn parse(c: &mut Cursor<'a>, _: &'static str) -> Result<Self, WireError> {
-        let log_time = u64::parse(c, "log_time")?;
-        let create_time = u64::parse(c, "create_time")?;
-        let name = String::parse(c, "name")?;
-        let media_type = String::parse(c, "media_type")?;
-        let len = u64::parse(c, "data")?;
-        let data = c.take(len, "data")?;
-        let crc = u32::parse(c, "crc")?;
-        Ok(Self {
-            log_time,
-            create_time,
-            name,
-            media_type,
-            data,
-            crc,
-        })
-    }
-    fn encode(&self, out: &mut Vec<u8>, _: &'static str) -> Result<(), WriteError> {
-        self.log_time.encode(out, "log_time")?;
-        self.create_time.encode(out, "create_time")?;
-        self.name.encode(out, "name")?;
-        self.media_type.encode(out, "media_type")?;
-        (self.data.len() as u64).encode(out, "data")?;
-        out.extend_from_slice(self.data);
-        self.crc.encode(out, "crc")
-    }
-}
-
-record!(AttachmentRecord<'a> = op::ATTACHMENT, "attachment");
+codec!(AttachmentRecord<'a> = op::ATTACHMENT, "attachment" {
+    log_time, create_time, name, media_type, data, crc
+});
 
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
@@ -478,7 +467,7 @@ mod tests {
             create_time: 2,
             name: "note".into(),
             media_type: "text/plain".into(),
-            data: b"hello",
+            data: LongBytes(b"hello"),
             crc: 7,
         };
         let mut out = Vec::new();

@@ -7,7 +7,7 @@
 
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::early_metadata::{self, MAX_EARLY};
-use crate::reader::{self, bad_crc, corrupt, io_error, not_mcap, ReadError};
+use crate::reader::{self, bad_crc, corrupt, io_error, not_mcap, wire_error, ReadError};
 use crate::records::{self, Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
 use mcap::records::{op, Channel, ChunkIndex, Footer, Header, MetadataIndex, Statistics};
 use mcap::Schema;
@@ -54,6 +54,15 @@ pub struct Summary {
     pub uncompressed_bytes: u64,
     /// Metadata records, in file order: name and entries.
     pub metadata: Vec<(String, BTreeMap<String, String>)>,
+}
+
+/// `bounds` (earliest, latest) widened to include the time `t`.
+#[inline]
+pub(crate) fn widen(bounds: Option<(u64, u64)>, t: u64) -> (u64, u64) {
+    match bounds {
+        None => (t, t),
+        Some((start, end)) => (start.min(t), end.max(t)),
+    }
 }
 
 /// Reads the summary of the MCAP file at `path`. `Ok(None)` when the file has no summary section, its
@@ -144,13 +153,24 @@ fn summary_section(
 /// The footer of the MCAP file of `len` bytes and where it starts, if it has a readable one.
 fn footer(source: &mut (impl Read + Seek), len: u64) -> Option<(Footer, u64)> {
     let at = len.checked_sub(MAGIC_LEN + FOOTER_LEN)?;
-    let bytes = bytes_at(source, len, at, FOOTER_LEN).ok()?;
-    match Cursor::new(&bytes).record().ok()? {
-        (op::FOOTER, body) if body.len() as u64 == FOOTER_LEN - PREFIX_LEN => {
-            Some((Footer::parse_body(body).ok()?, at))
-        }
-        _ => None,
+    let body = record_at(source, len, at, FOOTER_LEN, op::FOOTER)?;
+    Some((Footer::parse_body(&body).ok()?, at))
+}
+
+/// The body of the record at `at` if it is an `opcode` record of `length` bytes, prefix included.
+pub(crate) fn record_at(
+    source: &mut (impl Read + Seek),
+    file_len: u64,
+    at: u64,
+    length: u64,
+    opcode: u8,
+) -> Option<Vec<u8>> {
+    let mut record = bytes_at(source, file_len, at, length).ok()?;
+    if records::prefix(&record)? != (opcode, length - PREFIX_LEN) {
+        return None;
     }
+    record.drain(..PREFIX_LEN as usize);
+    Some(record)
 }
 
 /// The (offset, length) of the summary's first [`MAX_EARLY`] MetadataIndex records, its CRC unchecked
@@ -189,7 +209,7 @@ impl SummaryRecords {
         let mut c = Cursor::new(bytes);
         while !c.rest().is_empty() {
             let at = start + (bytes.len() - c.rest().len()) as u64;
-            let err = |e: WireError| corrupt(format!("malformed summary record at byte {at}: {e}"));
+            let err = |e: WireError| wire_error("summary", at, &e);
             let (opcode, body) = c.record().map_err(err)?;
             self.record(opcode, body).map_err(err)?;
         }
