@@ -515,6 +515,34 @@ channels = ["omega", "velocity"]
 }
 
 #[test]
+fn an_infinite_normal_mean_is_a_problem_not_a_silently_dropped_random_table() {
+    // It was turned into "no value" without a problem: the [random] table vanished and the sweep ran
+    // its one grid point (`--dry-run`: "1 run", exit 0).
+    let err = refused(
+        r#"
+base = "wobble"
+[random]
+seed = 1
+count = 2
+[[random.draw]]
+key = "initial.theta"
+normal = { mean = inf, std = 0.1 }
+[[random.draw]]
+key = "initial.psi"
+normal = { mean = -inf, std = inf }
+"#,
+    );
+    for e in [
+        "`random.draw[0].normal.mean` = inf must be a finite number",
+        "`random.draw[1].normal.mean` = -inf must be a finite number",
+        "`random.draw[1].normal.std` = inf must be a finite number > 0",
+    ] {
+        assert!(err.contains(e), "missing `{e}` in:\n{err}");
+    }
+    assert!(err.contains("3 problems:"), "{err}");
+}
+
+#[test]
 fn axes_of_more_values_than_memory_and_sweep_json_take_are_refused_before_any_is_made() {
     // A linspace of 10⁹ values (as many as a sweep's runs) once asked for 32 GB and aborted.
     let err = refused(

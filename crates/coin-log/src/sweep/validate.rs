@@ -400,11 +400,17 @@ impl Checker {
                 ),
             },
         };
-        let mean = get("mean", Some(&n.mean), 0.0, "a finite number").filter(|m| m.is_finite());
+        let mean = get("mean", Some(&n.mean), 0.0, "a finite number");
         let std = get("std", Some(&n.std), 1.0, "a finite number > 0");
         let min = get("min", n.min.as_ref(), f64::NEG_INFINITY, "a number");
         let max = get("max", n.max.as_ref(), f64::INFINITY, "a number");
         let (mean, std, min, max) = (mean?, std?, min?, max?);
+        // An infinite mean was once dropped without a word, and with it the whole [random] table.
+        let mean = mean.is_finite().then_some(mean).or_else(|| {
+            let mean_key = format!("{name}.mean");
+            self.problems
+                .reject(mean_key, n.mean.to_string(), "must be a finite number")
+        });
         if !(std.is_finite() && std > 0.0) {
             return self.problems.reject(
                 format!("{name}.std"),
@@ -420,7 +426,7 @@ impl Checker {
             );
         }
         Some(Distribution::Normal {
-            mean,
+            mean: mean?,
             std,
             min,
             max,
