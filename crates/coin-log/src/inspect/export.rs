@@ -407,7 +407,7 @@ impl<W: Write> Exporter<'_, W> {
             return;
         };
         if self.wide.channels.is_none() {
-            let channels: Vec<(Channel, &'static [&'static str])> = self
+            let mut channels: Vec<(Channel, &'static [&'static str])> = self
                 .targets
                 .values()
                 .filter_map(|t| match t {
@@ -417,7 +417,6 @@ impl<W: Write> Exporter<'_, W> {
                     _ => None,
                 })
                 .collect();
-            let mut channels = channels;
             channels.sort_by_key(|(c, _)| *c);
             let mut columns = vec!["t".to_string()];
             for (c, fields) in &channels {
