@@ -333,9 +333,10 @@ fn export_writes_every_value_bit_for_bit() {
     let file = read_back(&std::fs::read(&path).unwrap());
     let tables = dir.path().join("tables");
     let mut compared = 0;
-    for c in Channel::DEFAULT.iter().filter(|c| c.fields().is_some()) {
+    for c in Channel::DEFAULT {
+        let Some(t) = c.message_type() else { continue };
         let table = tables.join(format!("{}.csv", c.name()));
-        compared += compare_flat(&file, c.topic(), &table, c.fields().unwrap());
+        compared += compare_flat(&file, c.topic(), &table, t.fields);
     }
     println!("{compared} values equal bit for bit");
     assert!(compared > 8 * 501 * 3);
@@ -428,7 +429,7 @@ fn the_bit_comparison_catches_one_ulp() {
     lines[5] = cells.join(",");
     std::fs::write(&table, lines.join("\n") + "\n").unwrap();
     let file = read_back(&std::fs::read(&path).unwrap());
-    let fields = Channel::Omega.fields().unwrap();
+    let fields = Channel::Omega.message_type().unwrap().fields;
     let caught = std::panic::catch_unwind(|| compare_flat(&file, "/coin/omega", &table, fields));
     assert!(caught.is_err(), "a one-ulp change must fail the comparison");
 }
@@ -503,8 +504,8 @@ fn the_wide_table_joins_the_channels_on_t() {
         // without dissipation), from the format's field lists.
         let fields: usize = Channel::DEFAULT
             .iter()
-            .filter_map(|c| c.fields())
-            .map(|f| f.len() - 1)
+            .filter_map(|c| c.message_type())
+            .map(|t| t.fields.len() - 1)
             .sum();
         assert_eq!(header.len(), 1 + fields);
         println!("{source}: {compared} values equal bit for bit");

@@ -94,6 +94,17 @@ impl ReadError {
         }
     }
 
+    /// A read's outcome as every command takes it: `Err` when the file cannot be read at all (`Io`,
+    /// `NotMcap`); else the failure that broke it off part way (`Truncated`, `Corrupt`, `TooLarge`), what
+    /// came before it being usable, or `None` when it was read to its end or the visitor stopped.
+    pub fn broken_off(error: Option<Self>) -> Result<Option<Self>, Self> {
+        match error {
+            Some(e) if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) => Err(e),
+            Some(e) if e.kind == ReadErrorKind::Stopped => Ok(None),
+            broken => Ok(broken),
+        }
+    }
+
     fn after(mut self, read_before: String) -> Self {
         self.read_before = read_before;
         self

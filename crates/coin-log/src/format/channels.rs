@@ -94,13 +94,6 @@ impl Channel {
         }
     }
 
-    /// The fields of the channel's messages in schema order (the JSON keys, `t` first) for the
-    /// `coin_log.*` channels; `None` for Foxglove's `/tf` and `/scene`, whose messages are nested.
-    #[must_use]
-    pub fn fields(self) -> Option<&'static [&'static str]> {
-        self.message_type().map(|t| t.fields)
-    }
-
     /// Every channel's name, comma-separated, for messages.
     #[must_use]
     pub fn names() -> String {

@@ -74,11 +74,10 @@ impl FieldReader {
             return Ok((Self::json(t, version == Version::First), version));
         }
         let reader = |first: bool| {
-            let fields = if first { t.first_fields } else { t.fields };
-            MessageDecoder::new(data, t.schema, fields).map(|d| Self {
-                fields,
-                first,
+            let json = Self::json(t, first);
+            MessageDecoder::new(data, t.schema, json.fields).map(|d| Self {
                 protobuf: Some(d),
+                ..json
             })
         };
         match reader(false) {

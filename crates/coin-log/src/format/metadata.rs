@@ -96,14 +96,11 @@ const NO_STEADY: &str = "none";
 
 impl Value for Option<SteadyFamily> {
     fn write(&self) -> String {
-        self.map_or_else(|| NO_STEADY.to_string(), |k| k.to_string())
+        self.map_or_else(|| NO_STEADY.to_string(), |k| k.write())
     }
     fn read(text: &str) -> Result<Self, String> {
         (text != NO_STEADY)
-            .then(|| {
-                text.parse()
-                    .map_err(|e: coin_log_names::UnknownName| e.to_string())
-            })
+            .then(|| SteadyFamily::read(text))
             .transpose()
     }
 }
@@ -121,7 +118,7 @@ macro_rules! named_values {
         }
     )+};
 }
-named_values!(Method, Termination, DissipationModel);
+named_values!(Method, Termination, DissipationModel, SteadyFamily);
 
 /// The value of `key` in `record`'s `map`.
 fn read<T: Value>(

@@ -18,40 +18,32 @@ pub const PACKAGE: &str = "coin_log";
 /// one of the `foxglove.*` types it writes (FrameTransform, SceneUpdate, and PointCloud, VoxelGrid for Rerun).
 #[must_use]
 pub fn descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
-    static COIN: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
+    static COIN: OnceLock<[Vec<u8>; MESSAGE_TYPES.len()]> = OnceLock::new();
     if let Some(i) = MESSAGE_TYPES.iter().position(|t| t.schema == schema_name) {
         let all = COIN.get_or_init(|| {
-            MESSAGE_TYPES
-                .iter()
-                .map(|t| coin_descriptor_set(t.schema, t.fields).encode_to_vec())
-                .collect()
+            MESSAGE_TYPES.map(|t| coin_descriptor_set(t.schema, t.fields).encode_to_vec())
         });
-        return all.get(i).map(Vec::as_slice);
+        return Some(&all[i]);
     }
     foxglove_descriptor_set(schema_name)
 }
 
 fn foxglove_descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
     use foxglove::messages::{FrameTransform, PointCloud, SceneUpdate, VoxelGrid};
-    use foxglove::Encode;
+    use foxglove::{Encode, Schema};
+    type GetSchema = fn() -> Option<Schema>;
+    const SCHEMAS: [(&str, GetSchema); 4] = [
+        (FRAME_TRANSFORM, FrameTransform::get_schema),
+        (SCENE_UPDATE, SceneUpdate::get_schema),
+        (POINT_CLOUD, PointCloud::get_schema),
+        (VOXEL_GRID, VoxelGrid::get_schema),
+    ];
     static FOXGLOVE: OnceLock<[Vec<u8>; 4]> = OnceLock::new();
-    let [tf, scene, cloud, grid] = FOXGLOVE.get_or_init(|| {
-        let bytes =
-            |s: Option<foxglove::Schema>| s.map(|s| s.data.into_owned()).unwrap_or_default();
-        [
-            bytes(FrameTransform::get_schema()),
-            bytes(SceneUpdate::get_schema()),
-            bytes(PointCloud::get_schema()),
-            bytes(VoxelGrid::get_schema()),
-        ]
+    let i = SCHEMAS.iter().position(|(name, _)| *name == schema_name)?;
+    let all = FOXGLOVE.get_or_init(|| {
+        SCHEMAS.map(|(_, get)| get().map(|s| s.data.into_owned()).unwrap_or_default())
     });
-    match schema_name {
-        FRAME_TRANSFORM => Some(tf),
-        SCENE_UPDATE => Some(scene),
-        POINT_CLOUD => Some(cloud),
-        VOXEL_GRID => Some(grid),
-        _ => None,
-    }
+    Some(&all[i])
 }
 
 /// The file name of a `coin_log.*` type's `.proto` (in `schemas/` and in its descriptor).

@@ -8,7 +8,7 @@ use crate::files::shown_name;
 use crate::format::fields::FieldReader;
 use crate::format::Channel;
 use crate::format::Encoding;
-use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadError, Schema, Visitor};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::{self, BufWriter, Write};
@@ -180,15 +180,11 @@ pub fn export<W: Write>(
     if let Some(err) = e.error.take() {
         return Err(err);
     }
-    if let Some(err) = read_error {
-        let detail = match err.kind {
-            ReadErrorKind::Truncated | ReadErrorKind::Corrupt | ReadErrorKind::TooLarge => format!(
-                "{}; nothing exported (`coin-log verify` says more about the file)",
-                err.detail
-            ),
-            _ => err.detail,
-        };
-        return Err(ExportError(detail));
+    if let Some(err) = ReadError::broken_off(read_error).map_err(|e| ExportError(e.detail))? {
+        return Err(ExportError(format!(
+            "{}; nothing exported (`coin-log verify` says more about the file)",
+            err.detail
+        )));
     }
     e.finish()
 }
@@ -411,7 +407,7 @@ impl<W: Write> Exporter<'_, W> {
             return;
         };
         if self.wide.channels.is_none() {
-            let channels: Vec<(Channel, &'static [&'static str])> = self
+            let mut channels: Vec<(Channel, &'static [&'static str])> = self
                 .targets
                 .values()
                 .filter_map(|t| match t {
@@ -421,7 +417,6 @@ impl<W: Write> Exporter<'_, W> {
                     _ => None,
                 })
                 .collect();
-            let mut channels = channels;
             channels.sort_by_key(|(c, _)| *c);
             let mut columns = vec!["t".to_string()];
             for (c, fields) in &channels {

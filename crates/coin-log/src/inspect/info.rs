@@ -5,7 +5,7 @@
 
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
-use coin_log_mcap::{self, MessageHeader, ReadError, ReadErrorKind, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadError, Visitor};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -250,27 +250,25 @@ pub struct InfoError(pub String);
 /// # Errors
 /// [`InfoError`] if the file cannot be opened, is not MCAP, or breaks off before anything is known.
 pub fn info(path: &Path) -> Result<FileInfo, InfoError> {
-    match coin_log_mcap::read_summary(path) {
-        Ok(Some(summary)) => Ok(from_summary(summary)),
-        Err(e) if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) => {
-            Err(InfoError(e.detail))
-        }
+    let damaged = match coin_log_mcap::read_summary(path) {
+        Ok(Some(summary)) => return Ok(from_summary(summary)),
         // No summary: the streaming pass says what the file holds (and where it breaks).
-        Ok(None) => scan(path),
+        Ok(None) => None,
         // A damaged one: the same pass, and the problem names the summary first.
-        Err(e) => {
-            let mut info = scan(path)?;
-            let damaged = format!(
-                "the summary section is damaged ({}), so the whole file was read instead",
-                e.detail
-            );
-            info.problem = Some(match info.problem.take() {
-                Some(p) => format!("{damaged}; {p}"),
-                None => damaged,
-            });
-            Ok(info)
-        }
+        Err(e) => ReadError::broken_off(Some(e)).map_err(|e| InfoError(e.detail))?,
+    };
+    let mut info = scan(path)?;
+    if let Some(e) = damaged {
+        let damaged = format!(
+            "the summary section is damaged ({}), so the whole file was read instead",
+            e.detail
+        );
+        info.problem = Some(match info.problem.take() {
+            Some(p) => format!("{damaged}; {p}"),
+            None => damaged,
+        });
     }
+    Ok(info)
 }
 
 /// The `coin-log` and `coin-log.result` records among `metadata` (the first of each name).
@@ -330,15 +328,9 @@ impl Visitor for Scan {
 fn scan(path: &Path) -> Result<FileInfo, InfoError> {
     let mut v = Scan::default();
     let (s, error) = coin_log_mcap::read(path, &mut v);
-    let problem = match error {
-        Some(ReadError {
-            kind: ReadErrorKind::Io | ReadErrorKind::NotMcap,
-            detail,
-            ..
-        }) => return Err(InfoError(detail)),
-        Some(e) => Some(e.detail),
-        None => None,
-    };
+    let problem = ReadError::broken_off(error)
+        .map_err(|e| InfoError(e.detail))?
+        .map(|e| e.detail);
     let summary = coin_log_mcap::Summary {
         metadata: v.metadata,
         ..s.summary

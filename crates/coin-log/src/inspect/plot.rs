@@ -13,7 +13,7 @@ use crate::palette::{
     legend_box, legend_line, svg_page, Area, DrawError, BLUE, GREEN, GREY, ORANGE, RED,
 };
 use crate::scene::SceneFile;
-use coin_log_mcap::{self, MessageHeader, ReadErrorKind, Schema, Visitor};
+use coin_log_mcap::{self, MessageHeader, ReadError, Schema, Visitor};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
@@ -343,16 +343,9 @@ pub struct Plot {
 pub fn plot(path: &Path, name: &str) -> Result<Plot, PlotError> {
     let mut c = Collect::default();
     let (_, error) = coin_log_mcap::read(path, &mut c);
-    let mut broken = None;
-    if let Some(e) = error {
-        match e.kind {
-            ReadErrorKind::Io | ReadErrorKind::NotMcap => return Err(PlotError(e.detail)),
-            ReadErrorKind::Stopped => {}
-            ReadErrorKind::Truncated | ReadErrorKind::Corrupt | ReadErrorKind::TooLarge => {
-                broken = Some(e.detail);
-            }
-        }
-    }
+    let broken = ReadError::broken_off(error)
+        .map_err(|e| PlotError(e.detail))?
+        .map(|e| e.detail);
     if let Some(p) = c.problem.take() {
         return Err(PlotError(p));
     }

@@ -135,7 +135,7 @@ pub fn estimate(scene: &Scene, compression: Compression, encoding: Encoding) -> 
                 2 * updates + 2,
                 RERUN_UPDATE_BYTES + TRACK_POINT_RERUN_BYTES * n.div_ceil(updates.max(1)) / 2,
             ),
-            _ => (n, c.fields().map_or(100, flat)),
+            _ => (n, c.message_type().map_or(100, |t| flat(t.fields))),
         };
         per_channel.push((c, count));
         payload += count * (bytes + RECORD_OVERHEAD);

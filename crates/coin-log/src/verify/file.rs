@@ -20,7 +20,7 @@ use crate::format::{
 use crate::integrate::MethodConfig;
 use crate::model::{Chaplygin, Coin, Dynamics};
 use crate::scene::{self, Scene};
-use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadErrorKind, Schema, Visitor};
+use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadError, Schema, Visitor};
 use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -503,21 +503,15 @@ fn verdict(
     shown: String,
     mut judge: Judge,
     structure: coin_log_mcap::Structure,
-    error: Option<coin_log_mcap::ReadError>,
+    error: Option<ReadError>,
     options: &Options,
 ) -> FileReport {
-    if let Some(e) = &error {
-        if matches!(e.kind, ReadErrorKind::Io | ReadErrorKind::NotMcap) {
-            return FileReport::unusable(shown, e.to_string());
-        }
-    }
+    let read_whole = error.is_none();
     // A truncated or corrupt file is judged on what could be read, and is unusable (exit 2).
-    let read_problem = error.as_ref().filter(|e| {
-        matches!(
-            e.kind,
-            ReadErrorKind::Truncated | ReadErrorKind::Corrupt | ReadErrorKind::TooLarge
-        )
-    });
+    let read_problem = match ReadError::broken_off(error) {
+        Ok(broken) => broken,
+        Err(e) => return FileReport::unusable(shown, e.to_string()),
+    };
     let Some(mut ctx) = judge.ctx.take() else {
         let why = match (judge.run_error.take(), read_problem) {
             (Some(run), Some(e)) => format!("{run}; {e}"),
@@ -532,10 +526,10 @@ fn verdict(
         return FileReport::unusable(shown, why);
     };
     ctx.result = judge.result.take();
-    let problem = read_problem.map(ToString::to_string);
+    let problem = read_problem.as_ref().map(ToString::to_string);
     let checks = &mut judge.checks;
     judge.assembler.finish(&mut |s| checks.observe(s, &ctx));
-    let problems = judge.all_problems(&structure, &ctx, error.is_none(), problem.as_ref());
+    let problems = judge.all_problems(&structure, &ctx, read_whole, problem.as_ref());
     let tol = tolerances(&ctx, &judge.checks.stats, options);
     let read = format!(
         "{} messages in {} chunks, {} samples",
