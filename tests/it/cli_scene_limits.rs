@@ -75,6 +75,16 @@ fn a_rate_the_nanosecond_time_base_cannot_hold_apart_is_refused() {
     );
 }
 
+#[test]
+fn a_highest_rate_below_one_is_given_as_it_is_not_floored_to_zero() {
+    // max_rate(1e20) = 1/(1e-9 + 6·2⁻⁵³·1e20) = 1.5012e-5 per time unit; the message said "use rate ≤ 0".
+    let err = refused(
+        &["wobble", "--set", "run.duration=1e20"],
+        &["is too long", "use rate ≤ 1.501e-5"],
+    );
+    assert!(!err.contains("rate ≤ 0"), "{err}");
+}
+
 /// At the highest rate, and with a duration 0.3 ns past a grid point, every sample has its own log time
 /// and the last one is at the duration.
 #[test]

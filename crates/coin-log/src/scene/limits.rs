@@ -269,7 +269,12 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
 pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollector) {
     let max = max_rate(duration);
     if rate > max {
-        let max = number(max.floor());
+        // Whole rates are shown whole; below 1 (durations past ~1e15) flooring printed "use rate ≤ 0".
+        let max = if max >= 1.0 {
+            number(max.floor())
+        } else {
+            short(max, Round::Down)
+        };
         problems.push(
             "run.rate",
             number(rate),
