@@ -172,14 +172,15 @@ fn jobs(flag: Option<u16>) -> usize {
     )
 }
 
-/// Says once, before the runs, which required checks `verify` will not be able to run (on the first run
-/// whose scene is valid): with verification on, every such run would fail.
+/// Says once, before the runs, which required checks `verify` will not be able to run on the first run
+/// whose scene is valid: with verification on, that run and every run like it would fail. (It names the
+/// run: a swept rate or duration can leave the others judgeable.)
 fn warn_about_coverage(sweep: &Sweep) {
     let first = (0..sweep.runs().min(sweep::SAMPLED_RUNS))
-        .find_map(|i| sweep.values(i).ok().and_then(|v| sweep.scene(&v).ok()));
-    if let (true, Some(scene)) = (sweep.settings.verify, first) {
+        .find_map(|i| Some((i, sweep.scene(&sweep.values(i).ok()?).ok()?)));
+    if let (true, Some((i, scene))) = (sweep.settings.verify, first) {
         for warning in coin_log::verify::coverage(&scene) {
-            errln!("warning: verify will not be able to judge these recordings (each run would fail): {warning}");
+            errln!("warning: verify will not be able to judge run {i}'s recording (it and every run like it would fail): {warning}");
         }
     }
 }

@@ -748,7 +748,7 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
     let (code, out, err) = run_in(dir.path(), &["sweep", "on.toml", "-o", "on"]);
     assert_eq!(code, 1, "{out}{err}");
     assert!(
-        err.contains("warning: verify will not be able to judge these recordings"),
+        err.contains("warning: verify will not be able to judge run 0's recording (it and every run like it would fail): "),
         "{err}"
     );
     let row = &Csv::read(&dir.path().join("on/catalogue.csv")).records()[0];
