@@ -389,35 +389,27 @@ impl Checker {
     }
 
     fn normal(&mut self, name: &str, n: &NormalFile) -> Option<Distribution> {
-        let mut get = |key: &str, v: Option<&toml::Value>, default: f64, need: &str| match v {
-            None => Some(default),
-            Some(v) => match number(v).filter(|x| !x.is_nan()) {
-                Some(x) => Some(x),
-                None => self.problems.reject(
-                    format!("{name}.{key}"),
-                    v.to_string(),
-                    format!("must be {need}"),
-                ),
-            },
+        // Each value is held to what its message says it must be (an infinite mean once passed, and was
+        // then dropped without a word, and the whole [random] table with it).
+        let mut value = |key: &str, v: &toml::Value, need: &str, ok: fn(f64) -> bool| {
+            number(v).filter(|&x| ok(x)).or_else(|| {
+                let key = format!("{name}.{key}");
+                self.problems
+                    .reject(key, v.to_string(), format!("must be {need}"))
+            })
         };
-        let mean = get("mean", Some(&n.mean), 0.0, "a finite number");
-        let std = get("std", Some(&n.std), 1.0, "a finite number > 0");
-        let min = get("min", n.min.as_ref(), f64::NEG_INFINITY, "a number");
-        let max = get("max", n.max.as_ref(), f64::INFINITY, "a number");
-        let (mean, std, min, max) = (mean?, std?, min?, max?);
-        // An infinite mean was once dropped without a word, and with it the whole [random] table.
-        let mean = mean.is_finite().then_some(mean).or_else(|| {
-            let mean_key = format!("{name}.mean");
-            self.problems
-                .reject(mean_key, n.mean.to_string(), "must be a finite number")
+        let mean = value("mean", &n.mean, "a finite number", f64::is_finite);
+        let std = value("std", &n.std, "a finite number > 0", |x| {
+            x.is_finite() && x > 0.0
         });
-        if !(std.is_finite() && std > 0.0) {
-            return self.problems.reject(
-                format!("{name}.std"),
-                n.std.to_string(),
-                "must be a finite number > 0",
-            );
-        }
+        let mut bound = |key, v: Option<&toml::Value>, default| {
+            v.map_or(Some(default), |v| {
+                value(key, v, "a number", |x| !x.is_nan())
+            })
+        };
+        let min = bound("min", n.min.as_ref(), f64::NEG_INFINITY);
+        let max = bound("max", n.max.as_ref(), f64::INFINITY);
+        let (mean, std, min, max) = (mean?, std?, min?, max?);
         if min >= max {
             return self.problems.reject(
                 name,
@@ -426,7 +418,7 @@ impl Checker {
             );
         }
         Some(Distribution::Normal {
-            mean: mean?,
+            mean,
             std,
             min,
             max,
