@@ -530,16 +530,22 @@ normal = { mean = inf, std = 0.1 }
 [[random.draw]]
 key = "initial.psi"
 normal = { mean = -inf, std = inf }
+[[random.draw]]
+key = "initial.phi"
+normal = { mean = 0.0, std = 0.0, min = "x" }
 "#,
     );
     for e in [
         "`random.draw[0].normal.mean` = inf must be a finite number",
         "`random.draw[1].normal.mean` = -inf must be a finite number",
         "`random.draw[1].normal.std` = inf must be a finite number > 0",
+        // Each value is judged on its own: a bad bound does not hide a bad std.
+        "`random.draw[2].normal.std` = 0.0 must be a finite number > 0",
+        "`random.draw[2].normal.min` = \"x\" must be a number",
     ] {
         assert!(err.contains(e), "missing `{e}` in:\n{err}");
     }
-    assert!(err.contains("3 problems:"), "{err}");
+    assert!(err.contains("5 problems:"), "{err}");
 }
 
 #[test]
