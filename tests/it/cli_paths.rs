@@ -396,3 +396,51 @@ fn plot_export_and_the_map_never_replace_a_pipe_or_a_link() {
         .unwrap()
         .contains("<svg"));
 }
+
+/// A file-size limit (`ulimit -f`) reached mid-write is an error like a full disk: exit 1 naming it, and
+/// no temporary file or created folder left. The signal of that limit, SIGXFSZ, used to kill the process
+/// (exit 153, no message) with its `.coin-log-*.tmp` file left behind.
+#[test]
+fn a_file_size_limit_reached_mid_write_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let under_limit = |kib: u32, args: &[&str]| {
+        Command::new("sh")
+            .arg("-c")
+            .arg(format!("ulimit -f {kib} && exec \"$0\" \"$@\""))
+            .arg(exe())
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap()
+    };
+    for (kib, args) in [
+        (
+            64,
+            &["record", "wobble", "--duration", "30", "-o", "big.mcap"][..],
+        ),
+        (1, &["man", "--out", "pages"][..]),
+        (
+            1,
+            &["analyse", "map", "--theta", "0.1:1:50", "--out", "map"][..],
+        ),
+    ] {
+        let out = under_limit(kib, args);
+        let err = stderr(&out);
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{args:?}: {:?} {err}",
+            out.status
+        );
+        assert!(err.contains("File too large"), "{args:?}: {err}");
+        assert_eq!(listing(d), Vec::<String>::new(), "{args:?}: nothing left");
+    }
+    // Negative control: under a limit it stays below, the recording is written.
+    let out = under_limit(
+        100_000,
+        &["record", "wobble", "--duration", "1", "-o", "small.mcap"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert_eq!(listing(d), ["small.mcap"]);
+}
