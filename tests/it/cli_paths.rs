@@ -444,3 +444,25 @@ fn a_file_size_limit_reached_mid_write_fails_cleanly() {
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     assert_eq!(listing(d), ["small.mcap"]);
 }
+
+/// A finished output has the mode a new file gets from the umask, as any tool's output does: it was
+/// 0644 whatever the umask, so `umask 077` still gave world-readable recordings.
+#[test]
+fn a_finished_file_has_the_mode_the_umask_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (umask, mode) in [("077", 0o600), ("002", 0o664), ("022", 0o644)] {
+        let name = format!("u{umask}.mcap");
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!("umask {umask} && exec \"$0\" \"$@\""))
+            .arg(exe())
+            .args(["record", "wobble", "--duration", "0.1", "-o", &name])
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        let found = std::fs::metadata(d.join(&name)).unwrap().mode() & 0o777;
+        assert_eq!(found, mode, "umask {umask}: mode {found:o}");
+    }
+}

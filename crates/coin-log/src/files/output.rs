@@ -247,15 +247,30 @@ fn sticky_owner(target: &Path, meta: &Metadata, temp: &NamedTempFile) -> Option<
     }
 }
 
-/// A finished output file is an ordinary file (the temporary file is created owner-only).
+/// A finished output file is an ordinary file (the temporary file is created owner-only): mode 0666 less
+/// the process's umask, as `open` gives a new file (it was 0644 whatever the umask, so `umask 077` still
+/// gave world-readable recordings).
 pub fn make_readable(file: &File) {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(fs::Permissions::from_mode(0o644));
+        let _ = file.set_permissions(fs::Permissions::from_mode(0o666 & !umask()));
     }
     #[cfg(not(unix))]
     let _ = file;
+}
+
+/// The process's umask, from `/proc/self/status` (reading it with umask(2) would change it); 022, the
+/// usual one, where the system does not say.
+#[cfg(unix)]
+fn umask() -> u32 {
+    fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|status| {
+            let line = status.lines().find_map(|l| l.strip_prefix("Umask:"))?;
+            u32::from_str_radix(line.trim(), 8).ok()
+        })
+        .unwrap_or(0o022)
 }
 
 /// Checks `target` against `policy` as [`Output::create`] does, creating nothing (for a command that works
