@@ -466,3 +466,23 @@ fn a_finished_file_has_the_mode_the_umask_gives() {
         assert_eq!(found, mode, "umask {umask}: mode {found:o}");
     }
 }
+
+/// A legal target name with a long extension is written: its temporary file's name repeated the
+/// extension and, 20 bytes longer than the target's, was refused as "File name too long".
+#[test]
+fn a_long_extension_does_not_make_the_temporary_name_too_long() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = format!("x.{}", "e".repeat(245));
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--duration", "0.1", "-o", &name],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert_eq!(listing(dir.path()), [name]);
+    // Negative control: a name beyond the system's limit is still refused, with its reason.
+    refused(
+        dir.path(),
+        &format!("x.{}", "e".repeat(254)),
+        &["File name too long"],
+    );
+}

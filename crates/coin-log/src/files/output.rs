@@ -289,6 +289,9 @@ pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputE
     Ok(meta)
 }
 
+/// The longest extension of a target repeated in its temporary file's name (`.coin-log-*.mcap.tmp`).
+const MAX_SHOWN_EXTENSION: usize = 8;
+
 /// One output file being written: a temporary file beside its target until [`Output::commit`].
 #[derive(Debug)]
 pub struct Output {
@@ -307,10 +310,16 @@ impl Output {
     pub fn create(target: &Path, policy: &Policy) -> Result<Self, OutputError> {
         let existing = check(target, policy)?;
         let folder = folder_of(target);
-        let suffix = target.extension().map_or_else(
-            || ".tmp".to_string(),
-            |e| format!(".{}.tmp", e.to_string_lossy()),
-        );
+        // The target's extension shows what the file will be; a long one is left out, so that the
+        // temporary name (20 bytes more than it) fits wherever the target's does (`-o x.<245 bytes>` was
+        // refused as "File name too long").
+        let suffix = target
+            .extension()
+            .filter(|e| e.len() <= MAX_SHOWN_EXTENSION)
+            .map_or_else(
+                || ".tmp".to_string(),
+                |e| format!(".{}.tmp", e.to_string_lossy()),
+            );
         let temp = tempfile::Builder::new()
             .prefix(".coin-log-")
             .suffix(&suffix)
