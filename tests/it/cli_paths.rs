@@ -486,3 +486,41 @@ fn a_long_extension_does_not_make_the_temporary_name_too_long() {
         &["File name too long"],
     );
 }
+
+/// A symbolic link in the way is refused with a fix that works: `/dev/stdout` leads to a pipe or a
+/// terminal (it said "give the path it points to", that is `pipe:[…]`), and a page of `man --out`
+/// cannot be given alone (the fix is another folder).
+#[test]
+fn a_refused_link_is_given_a_fix_that_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = Command::new(exe())
+        .args(["record", "wobble", "-o", "/dev/stdout"])
+        .args(LONG)
+        .current_dir(d)
+        .stdout(Stdio::piped())
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(
+        err.contains("it leads to a named pipe")
+            && err.contains("choose a file path, e.g. -o wobble.mcap")
+            && !err.contains("give the path it points to"),
+        "{err}"
+    );
+    std::fs::create_dir(d.join("pages")).unwrap();
+    std::os::unix::fs::symlink("elsewhere", d.join("pages/coin-log.1")).unwrap();
+    let out = coin_log(d, &["man", "--out", "pages"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(
+        err.contains("move it away, or choose another folder with --out"),
+        "{err}"
+    );
+    assert_eq!(listing(&d.join("pages")), ["coin-log.1"], "only the link");
+    // Negative control: a link to a regular file is still told to give the file.
+    std::fs::write(d.join("real.mcap"), "x").unwrap();
+    std::os::unix::fs::symlink("real.mcap", d.join("link.mcap")).unwrap();
+    refused(d, "link.mcap", &["give the path it points to"]);
+}

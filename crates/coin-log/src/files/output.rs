@@ -141,8 +141,8 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
         let to = fs::read_link(target).map_or_else(|_| "?".into(), |p| shown(&p));
         return Err(OutputError(format!(
             "`{path}` is a symbolic link (to `{to}`), not a regular file; coin-log writes a new file and moves \
-             it into place, which would replace the link itself with a plain file: give the path it points \
-             to, or choose another path"
+             it into place, which would replace the link itself with a plain file: {}",
+            link_fix(target, policy)
         )));
     }
     if !kind.is_file() {
@@ -165,6 +165,27 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
         )));
     }
     Ok(Some(meta))
+}
+
+/// What to do instead of writing over the symbolic link `target`. Its destination is the fix only when
+/// it is (or would be) a regular file: `/dev/stdout` leads to a pipe or a terminal (`pipe:[…]`), and a
+/// page of `man --out` cannot be given alone.
+fn link_fix(target: &Path, policy: &Policy) -> String {
+    if policy.example.is_empty() {
+        return policy.fix(Refused::Special, target);
+    }
+    match fs::metadata(target) {
+        Err(e) if e.kind() == ErrorKind::NotFound => {
+            "give the path it points to, or choose another path".into()
+        }
+        Ok(meta) if meta.is_file() => "give the path it points to, or choose another path".into(),
+        Ok(meta) => format!(
+            "it leads to {}, which coin-log does not write into (nor to standard output); {}",
+            kind_of(&meta),
+            policy.fix(Refused::Special, target)
+        ),
+        Err(_) => policy.fix(Refused::Special, target),
+    }
 }
 
 /// The target's folder must exist (a clearer message than the temporary file's ENOENT).
