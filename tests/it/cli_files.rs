@@ -697,3 +697,26 @@ fn control_characters_in_paths_are_escaped_and_the_rest_kept() {
     assert_eq!(shown(Path::new("a/b c é.mcap")), "a/b c é.mcap");
     assert_eq!(shown(Path::new("x\ny\r\u{1b}[31m")), "x\\ny\\r\\u{1b}[31m");
 }
+
+/// A scene that is not UTF-8 is refused saying where and what to do (it said only "stream did not
+/// contain valid UTF-8"), and a large binary file for its size, whatever its first bytes (its UTF-8
+/// error came first).
+#[test]
+fn a_scene_that_is_not_utf8_is_refused_saying_where_and_a_large_one_for_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, b"description = \"ok\"\n# caf\xe9\n").unwrap();
+    let e = read_toml(&path, InputKind::Scene).unwrap_err().to_string();
+    assert!(
+        e.contains("byte 0xe9 at line 2, column 6") && e.contains("save it as UTF-8"),
+        "{e}"
+    );
+    let mut binary = vec![0xff_u8; 2 << 20];
+    binary[0] = b'#';
+    std::fs::write(&path, &binary).unwrap();
+    let e = read_toml(&path, InputKind::Scene).unwrap_err().to_string();
+    assert!(e.contains("more than 1048576 bytes"), "{e}");
+    // Negative control: UTF-8 text (a BOM and a non-ASCII description included) reads.
+    std::fs::write(&path, "\u{feff}description = \"café\"\n").unwrap();
+    assert!(read_toml(&path, InputKind::Scene).unwrap().contains("café"));
+}
