@@ -485,3 +485,41 @@ fn the_readable_text_is_the_same_scene() {
         assert!(readable.lines().all(short), "{readable}");
     }
 }
+
+/// A table given as an array is refused: serde's derived structs took an array as their fields in order,
+/// so `--set initial.perturbation=[1]` kicked θ by 1 rad and `body = [1.0, 1.0, 1.0, "thin-disk"]` was a
+/// body.
+#[test]
+fn a_table_given_as_an_array_is_refused() {
+    let text = VALID.replace(
+        "[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"",
+        "body = [1.0, 1.0, 1.0, \"thin-disk\"]",
+    );
+    assert_ne!(text, VALID);
+    let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+    assert!(
+        e.contains("expected a table") && e.contains("line 3"),
+        "{e}"
+    );
+    for (set, key) in [
+        ("initial.perturbation=[1]", "initial.perturbation"),
+        ("initial.steady=[\"straight\", 1.0]", "initial.steady"),
+        ("body.dissipation=[\"moffatt\", 1e-7]", "body.dissipation"),
+        ("run=[1.0]", "run"),
+        ("record=[[\"omega\"]]", "record"),
+        ("initial=[0.3]", "initial"),
+    ] {
+        let e = scene::parse_with_sets(VALID, &[set.into()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("expected a table") && e.contains(&format!("in `{key}`")),
+            "{set}: {e}"
+        );
+    }
+    // Negative control: the same as tables are read.
+    let file =
+        scene::parse_with_sets(VALID, &["initial.perturbation={ theta = 1e-3 }".into()]).unwrap();
+    let kick = file.initial.perturbation.unwrap();
+    assert_eq!((kick.theta, kick.omega), (Some(1e-3), None));
+}
