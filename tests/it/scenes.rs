@@ -523,3 +523,24 @@ fn a_table_given_as_an_array_is_refused() {
     let kick = file.initial.perturbation.unwrap();
     assert_eq!((kick.theta, kick.omega), (Some(1e-3), None));
 }
+
+/// A key of more dotted parts than the TOML reader follows is named as such (the reader's message was
+/// the bare words "recursion limit", with no line, key or fix).
+#[test]
+fn a_key_nested_beyond_the_readers_limit_is_named() {
+    for text in [
+        format!("[{}]\nx = 1\n", vec!["a"; 200].join(".")),
+        format!("{} = 1\n", vec!["a"; 200].join(".")),
+    ] {
+        let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("too many dotted parts") && e.contains("initial.steady.kind"),
+            "{e}"
+        );
+    }
+    // Negative control: a deep key within the limit is an unknown key, named.
+    let e = scene::parse_with_sets(&format!("{} = 1\n", vec!["a"; 5].join(".")), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `a`"), "{e}");
+}

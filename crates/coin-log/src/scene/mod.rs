@@ -242,6 +242,12 @@ pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneEr
 /// (serde's message quotes the offending line, however long).
 pub(crate) fn toml_message(e: &toml::de::Error) -> String {
     let text = e.to_string();
+    if text.trim() == "recursion limit" {
+        // The reader's whole message for a key of too many dotted parts: no line, no key.
+        return "a key or table header has too many dotted parts (the TOML reader stops at 80): a scene's \
+                keys have at most three, like `initial.steady.kind`"
+            .into();
+    }
     let lines = text
         .trim()
         .lines()
