@@ -524,3 +524,33 @@ fn a_refused_link_is_given_a_fix_that_works() {
     std::os::unix::fs::symlink("real.mcap", d.join("link.mcap")).unwrap();
     refused(d, "link.mcap", &["give the path it points to"]);
 }
+
+/// A link in the way that leads to a folder is told to name a file in it, and an output folder that is
+/// a link to nothing is named as such (it said "cannot create the folder `x`: File exists").
+#[test]
+fn a_link_to_a_folder_or_to_nothing_is_named_with_its_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("real")).unwrap();
+    std::os::unix::fs::symlink("real", d.join("to-folder")).unwrap();
+    refused(
+        d,
+        "to-folder",
+        &["it leads to a folder; give a file name, e.g. -o to-folder/wobble.mcap"],
+    );
+    std::os::unix::fs::symlink("nowhere", d.join("dangling")).unwrap();
+    for out in ["dangling", "dangling/sub"] {
+        let output = coin_log(d, &["man", "--out", out]);
+        let err = stderr(&output);
+        assert_eq!(code(&output), 1, "{err}");
+        assert!(
+            err.contains("`dangling` is a symbolic link to `nowhere`, which does not exist"),
+            "{out}: {err}"
+        );
+    }
+    assert!(!d.join("nowhere").exists());
+    // Negative control: a link to a folder is a folder to write into.
+    let output = coin_log(d, &["man", "--out", "to-folder"]);
+    assert_eq!(code(&output), 0, "{}", stderr(&output));
+    assert!(d.join("real/coin-log.1").exists());
+}

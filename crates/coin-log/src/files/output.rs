@@ -179,6 +179,10 @@ fn link_fix(target: &Path, policy: &Policy) -> String {
             "give the path it points to, or choose another path".into()
         }
         Ok(meta) if meta.is_file() => "give the path it points to, or choose another path".into(),
+        Ok(meta) if meta.is_dir() => format!(
+            "it leads to a folder; {}",
+            policy.fix(Refused::Folder, target)
+        ),
         Ok(meta) => format!(
             "it leads to {}, which coin-log does not write into (nor to standard output); {}",
             kind_of(&meta),
@@ -480,6 +484,15 @@ impl OutputFolder {
                     )))
                 }
                 Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
+                // A link to nothing: creating the folder would fail with a bare "File exists".
+                Err(_) if fs::symlink_metadata(d).is_ok_and(|m| m.file_type().is_symlink()) => {
+                    let to = fs::read_link(d).map_or_else(|_| "?".into(), |p| shown(&p));
+                    return Err(OutputError(format!(
+                        "`{}` is a symbolic link to `{to}`, which does not exist: create the folder it \
+                         points to, or choose another folder with --out",
+                        shown(d)
+                    )));
+                }
                 Err(_) => created.push(d.to_path_buf()),
             }
             missing = d.parent();
