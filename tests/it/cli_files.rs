@@ -720,3 +720,31 @@ fn a_scene_that_is_not_utf8_is_refused_saying_where_and_a_large_one_for_its_size
     std::fs::write(&path, "\u{feff}description = \"café\"\n").unwrap();
     assert!(read_toml(&path, InputKind::Scene).unwrap().contains("café"));
 }
+
+/// `OutputFolder::check` refuses what `create` and `file` would, creating nothing: `analyse map` checks
+/// with it before its work, so that a signal during the work leaves nothing (creating the outputs first
+/// left two empty `.coin-log-*.tmp` files and the folder on SIGTERM).
+#[test]
+fn an_output_folder_is_checked_without_creating_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    OutputFolder::check(&d.join("new/sub"), true, &["a.csv", "b.svg"]).unwrap();
+    assert_eq!(listing(d), Vec::<String>::new(), "nothing created");
+    std::fs::create_dir(d.join("out")).unwrap();
+    std::os::unix::fs::symlink("/etc/passwd", d.join("out/b.svg")).unwrap();
+    let e = OutputFolder::check(&d.join("out"), true, &["a.csv", "b.svg"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("b.svg` is a symbolic link"), "{e}");
+    std::fs::write(d.join("out/a.csv"), "old").unwrap();
+    let e = OutputFolder::check(&d.join("out"), false, &["a.csv"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("already exists"), "{e}");
+    std::fs::write(d.join("plain"), "x").unwrap();
+    let e = OutputFolder::check(&d.join("plain/sub"), true, &["a.csv"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("plain` is not a folder, so"), "{e}");
+    assert_eq!(listing(&d.join("out")), ["a.csv", "b.svg"], "nothing added");
+}

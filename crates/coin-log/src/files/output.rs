@@ -471,32 +471,7 @@ impl OutputFolder {
     /// # Errors
     /// [`OutputError`] if `dir` (or a parent) is not a folder or cannot be created.
     pub fn create(dir: &Path, overwrite: bool) -> Result<Self, OutputError> {
-        let mut created = Vec::new();
-        let mut missing = Some(dir);
-        while let Some(d) = missing.filter(|d| !d.as_os_str().is_empty()) {
-            match fs::metadata(d) {
-                Ok(m) if m.is_dir() => break,
-                Ok(_) if d == dir => {
-                    return Err(OutputError(format!(
-                        "`{}` is not a folder; --out takes a folder (created if missing) for the \
-                         files",
-                        shown(dir)
-                    )))
-                }
-                Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
-                // A link to nothing: creating the folder would fail with a bare "File exists".
-                Err(_) if fs::symlink_metadata(d).is_ok_and(|m| m.file_type().is_symlink()) => {
-                    let to = fs::read_link(d).map_or_else(|_| "?".into(), |p| shown(&p));
-                    return Err(OutputError(format!(
-                        "`{}` is a symbolic link to `{to}`, which does not exist: create the folder it \
-                         points to, or choose another folder with --out",
-                        shown(d)
-                    )));
-                }
-                Err(_) => created.push(d.to_path_buf()),
-            }
-            missing = d.parent();
-        }
+        let mut created = missing_folders(dir)?;
         // Created from the top down; on failure, what was created is removed (by `Drop`).
         let mut folder = Self {
             dir: dir.to_path_buf(),
@@ -512,6 +487,21 @@ impl OutputFolder {
         Ok(folder)
     }
 
+    /// Checks, creating nothing, what [`OutputFolder::create`] and [`OutputFolder::file`] would: for a
+    /// command that works long before it writes (`analyse map`), so that a refused --out is refused
+    /// before the work, and the work leaves nothing behind if it fails or is stopped by a signal.
+    ///
+    /// # Errors
+    /// As [`OutputFolder::create`], and as [`Output::create`]'s checks for each of `names`.
+    pub fn check(dir: &Path, overwrite: bool, names: &[&str]) -> Result<(), OutputError> {
+        if missing_folders(dir)?.is_empty() {
+            for name in names {
+                check(&dir.join(name), &folder_policy(overwrite))?;
+            }
+        }
+        Ok(())
+    }
+
     /// The folder.
     #[must_use]
     pub fn path(&self) -> &Path {
@@ -523,12 +513,7 @@ impl OutputFolder {
     /// # Errors
     /// As [`Output::create`].
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
-        let policy = Policy {
-            overwrite: self.overwrite,
-            flag: "--out",
-            ..Policy::default()
-        };
-        let mut output = Output::create(&self.dir.join(name), &policy)?;
+        let mut output = Output::create(&self.dir.join(name), &folder_policy(self.overwrite))?;
         let file = output
             .file()
             .try_clone()
@@ -552,6 +537,49 @@ impl OutputFolder {
         self.created.clear();
         Ok(())
     }
+}
+
+/// The policy of a file in an output folder.
+fn folder_policy(overwrite: bool) -> Policy {
+    Policy {
+        overwrite,
+        flag: "--out",
+        ..Policy::default()
+    }
+}
+
+/// The folders missing on the way to `dir`, deepest first (none if it exists).
+///
+/// # Errors
+/// [`OutputError`] if `dir` or a parent is not a folder, or is a link to nothing.
+fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    let mut created = Vec::new();
+    let mut missing = Some(dir);
+    while let Some(d) = missing.filter(|d| !d.as_os_str().is_empty()) {
+        match fs::metadata(d) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) if d == dir => {
+                return Err(OutputError(format!(
+                    "`{}` is not a folder; --out takes a folder (created if missing) for the \
+                         files",
+                    shown(dir)
+                )))
+            }
+            Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
+            // A link to nothing: creating the folder would fail with a bare "File exists".
+            Err(_) if fs::symlink_metadata(d).is_ok_and(|m| m.file_type().is_symlink()) => {
+                let to = fs::read_link(d).map_or_else(|_| "?".into(), |p| shown(&p));
+                return Err(OutputError(format!(
+                        "`{}` is a symbolic link to `{to}`, which does not exist: create the folder it \
+                         points to, or choose another folder with --out",
+                        shown(d)
+                    )));
+            }
+            Err(_) => created.push(d.to_path_buf()),
+        }
+        missing = d.parent();
+    }
+    Ok(created)
 }
 
 impl Drop for OutputFolder {
