@@ -554,3 +554,38 @@ fn a_link_to_a_folder_or_to_nothing_is_named_with_its_fix() {
     assert_eq!(code(&output), 0, "{}", stderr(&output));
     assert!(d.join("real/coin-log.1").exists());
 }
+
+/// A scene file named like its default output (`s.mcap`, recorded to `s.mcap`) is protected, and the fix
+/// suggests another name: it suggested `-o s.mcap`, the refused path itself.
+#[test]
+fn a_scene_named_like_its_output_is_told_another_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = coin_log(d, &["scenes", "--show", "wobble"]);
+    std::fs::write(d.join("s.mcap"), &scene.stdout).unwrap();
+    let out = coin_log(d, &["record", "./s.mcap", "--duration", "0.1"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(
+        err.contains("is the scene file being recorded") && err.contains("e.g. -o s-recorded.mcap"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(d.join("s.mcap")).unwrap(), scene.stdout);
+    // Negative control: the suggestion works.
+    let out = coin_log(
+        d,
+        &[
+            "record",
+            "./s.mcap",
+            "--duration",
+            "0.1",
+            "-o",
+            "s-recorded.mcap",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    // And a scene whose stem differs from the target keeps the usual example.
+    std::fs::write(d.join("w.toml"), &scene.stdout).unwrap();
+    let out = coin_log(d, &["record", "./w.toml", "-o", "w.toml", "--overwrite"]);
+    assert!(stderr(&out).contains("e.g. -o w.mcap"), "{}", stderr(&out));
+}

@@ -65,7 +65,21 @@ impl Policy {
                 shown(&target.join(&*self.example))
             ),
             Refused::Special => format!("choose a file path, e.g. {flag} {}", self.example),
-            Refused::Protected => format!("choose another output, e.g. {flag} {}", self.example),
+            Refused::Protected => {
+                // The example is the scene's stem + .mcap, the protected file itself for a scene file
+                // named `s.mcap`: then another name.
+                let example = Path::new(&*self.example);
+                let example = if target.file_name() == Some(example.as_os_str()) {
+                    let stem = example.file_stem().unwrap_or_default().to_string_lossy();
+                    match example.extension() {
+                        Some(ext) => format!("{stem}-recorded.{}", ext.to_string_lossy()),
+                        None => format!("{stem}-recorded"),
+                    }
+                } else {
+                    self.example.to_string()
+                };
+                format!("choose another output, e.g. {flag} {example}")
+            }
             Refused::Exists => {
                 format!("pass --overwrite to replace it, or choose another file with {flag}")
             }
