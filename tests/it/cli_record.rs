@@ -437,3 +437,52 @@ fn ctrl_c_finishes_the_file_marked_interrupted() {
 // A numerical failure (the file finished up to it, exit 1) can no longer be reached from the command line:
 // the scene that produced one (ω_Z = 1e150 with rk4) is refused before writing (cli_scene_limits.rs), and
 // the recorder's side of it is tested on such a state in record_roundtrip.rs.
+
+/// `--dry-run` names an output the recording would refuse, so that a dry run that passes is not followed
+/// by a refusal at once: it said nothing of `-o /dev/null`, a missing folder or an existing file.
+#[test]
+fn a_dry_run_warns_of_an_output_the_recording_would_refuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("exists.mcap"), "x").unwrap();
+    for (target, needle) in [
+        ("/dev/null", "`/dev/null` is a character device"),
+        ("nope/x.mcap", "the folder `nope` does not exist"),
+        (
+            "exists.mcap",
+            "`exists.mcap` already exists; pass --overwrite",
+        ),
+    ] {
+        let out = coin_log(d, &["record", "wobble", "--dry-run", "-o", target]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), 0, "{err}");
+        assert!(
+            err.contains(&format!(
+                "warning: the recording itself would be refused: {needle}"
+            )),
+            "{target}: {err}"
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("[body]"));
+    }
+    assert_eq!(listing(d), ["exists.mcap"], "nothing written");
+    // Negative control: a target the recording may write gives no warning.
+    for args in [
+        &["record", "wobble", "--dry-run", "-o", "new.mcap"][..],
+        &[
+            "record",
+            "wobble",
+            "--dry-run",
+            "-o",
+            "exists.mcap",
+            "--overwrite",
+        ][..],
+    ] {
+        let out = coin_log(d, args);
+        assert_eq!(code(&out), 0);
+        assert!(
+            !stderr(&out).contains("warning"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
