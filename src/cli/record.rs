@@ -86,7 +86,7 @@ pub struct SceneFlags {
     /// Most integrator steps, ≥ 1: a fixed-step run needing more is refused before it starts, an adaptive
     /// one stops when they are spent (termination `step-budget-spent`, exit 1) (overrides `run.max_steps`;
     /// default 100000000, under a minute of work).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = whole_steps)]
     pub max_steps: Option<u64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
     /// invariants, tf, scene, and work with dissipation, rerun with --encoding protobuf (overrides
@@ -124,6 +124,15 @@ impl SceneFlags {
             rerun: self.rerun,
         }
     }
+}
+
+/// `--max-steps N`: a whole number in digits (the parser's "invalid digit found in string" said neither
+/// what was wrong with `1e8` nor what to write).
+fn whole_steps(text: &str) -> Result<u64, String> {
+    text.parse().map_err(|_| {
+        "not a whole number of steps in digits: write e.g. 100000000 (not 1e8, 1_000 or 1.5)"
+            .to_string()
+    })
 }
 
 /// Runs `coin-log record`: load → resolve → prepare the output → record → persist → summary and exit code.

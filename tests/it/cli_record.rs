@@ -486,3 +486,31 @@ fn a_dry_run_warns_of_an_output_the_recording_would_refuse() {
         );
     }
 }
+
+/// `--max-steps` in another form than digits is a usage error that says how to write it (clap's "invalid
+/// digit found in string" for `1e8` said neither).
+#[test]
+fn a_max_steps_not_in_digits_says_how_to_write_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for value in ["1e8", "-1", "1.5", "many"] {
+        let out = coin_log(dir.path(), &["record", "wobble", "--max-steps", value]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), 2, "{value}: {err}");
+        assert!(
+            err.contains("not a whole number of steps in digits: write e.g. 100000000"),
+            "{value}: {err}"
+        );
+    }
+    // Negative control: digits are read (and 0 is the scene's error, naming the flag).
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--max-steps", "0", "--dry-run"],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(stderr(&out).contains("(set by `--max-steps`)"));
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--max-steps", "100000000", "--dry-run"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+}
