@@ -589,3 +589,27 @@ fn a_scene_named_like_its_output_is_told_another_name() {
     let out = coin_log(d, &["record", "./w.toml", "-o", "w.toml", "--overwrite"]);
     assert!(stderr(&out).contains("e.g. -o w.mcap"), "{}", stderr(&out));
 }
+
+/// `-o new/` (a folder that is not there) is named as such: the system's reason was "cannot create
+/// `new/`: Is a directory (os error 21)", about a name that does not exist.
+#[test]
+fn an_output_ending_with_a_slash_that_names_no_folder_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        dir.path(),
+        "new/",
+        &["`new/` ends with `/`, so it names a folder, and there is none: drop the `/`, or create the folder and give a file name, e.g. -o new/wobble.mcap"],
+    );
+    // Negative control: an existing folder with a slash is the folder case, and without it the name works.
+    std::fs::create_dir(dir.path().join("there")).unwrap();
+    refused(
+        dir.path(),
+        "there/",
+        &["`there/` is a folder; give a file name"],
+    );
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--duration", "0.1", "-o", "new"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+}

@@ -143,6 +143,14 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
     let path = shown(target);
     let meta = match fs::symlink_metadata(target) {
         Ok(meta) => meta,
+        // `-o new/` names a folder that is not there (the system's word for it: "Is a directory").
+        Err(e) if e.kind() == ErrorKind::NotFound && path.ends_with('/') => {
+            let fix = policy.fix(Refused::Folder, target);
+            return Err(OutputError(format!(
+                "`{path}` ends with `/`, so it names a folder, and there is none: drop the `/`, or create \
+                 the folder and {fix}"
+            )));
+        }
         Err(e) if e.kind() == ErrorKind::NotFound => return check_folder(target).map(|()| None),
         Err(source) => return Err(OutputError::system("use", target, &source)),
     };
