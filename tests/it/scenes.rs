@@ -544,3 +544,24 @@ fn a_key_nested_beyond_the_readers_limit_is_named() {
         .to_string();
     assert!(e.contains("unknown field `a`"), "{e}");
 }
+
+/// A `--set` key of tens of thousands of dotted parts is refused, shown cut: it built tables nested as
+/// deep, whose recursive reading and dropping overflowed the stack (the process aborted, exit 134).
+#[test]
+fn a_set_key_of_very_many_parts_is_refused_without_overflowing_the_stack() {
+    let key = vec!["a"; 60_000].join(".");
+    let e = scene::parse_with_sets(VALID, &[format!("{key}=1")])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the key has 60000 dotted parts") && e.len() < 1000,
+        "{}",
+        &e[..e.len().min(500)]
+    );
+    // Negative control: a key of a few parts is applied, or refused as an unknown key.
+    let e = scene::parse_with_sets(VALID, &["a.b.c.d.e=1".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `a`"), "{e}");
+    scene::parse_with_sets(VALID, &["initial.perturbation.theta=1e-3".into()]).unwrap();
+}
