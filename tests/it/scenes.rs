@@ -539,7 +539,7 @@ fn a_key_nested_beyond_the_readers_limit_is_named() {
         );
     }
     // Negative control: a deep key within the limit is an unknown key, named.
-    let e = scene::parse_with_sets(&format!("{} = 1\n", vec!["a"; 5].join(".")), &[])
+    let e = scene::parse_with_sets(&format!("{} = 1\n", ["a"; 5].join(".")), &[])
         .unwrap_err()
         .to_string();
     assert!(e.contains("unknown field `a`"), "{e}");
