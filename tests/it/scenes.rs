@@ -565,3 +565,39 @@ fn a_set_key_of_very_many_parts_is_refused_without_overflowing_the_stack() {
     assert!(e.contains("unknown field `a`"), "{e}");
     scene::parse_with_sets(VALID, &["initial.perturbation.theta=1e-3".into()]).unwrap();
 }
+
+/// A value or key of any length given with `--set` is shown cut, as paths and TOML lines are: a 100 kB
+/// `run.integrator` or unknown key was quoted whole in the message.
+#[test]
+fn a_long_value_or_key_is_shown_cut_in_the_message() {
+    let long = "x".repeat(100_000);
+    for set in [
+        format!("run.integrator={long}"),
+        format!("body.shape={long}"),
+        format!("record.channels=[\"{long}\"]"),
+        format!("body.{long}=1"),
+    ] {
+        let file = scene::parse_with_sets(VALID, std::slice::from_ref(&set));
+        let e = match file {
+            Ok(file) => scene::resolve(&file, &FlagOverrides::default())
+                .unwrap_err()
+                .to_string(),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.len() < 1000 && e.contains("xxx…"),
+            "{}: {}",
+            &set[..20],
+            &e[..e.len().min(300)]
+        );
+    }
+    // Negative control: short values are shown whole.
+    let file = scene::parse_with_sets(VALID, &["run.integrator=rk5".into()]).unwrap();
+    let e = scene::resolve(&file, &FlagOverrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`run.integrator` = \"rk5\" is not a known integrator"),
+        "{e}"
+    );
+}
