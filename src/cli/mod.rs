@@ -114,6 +114,7 @@ impl From<Outcome> for ExitCode {
 
 /// Parses the command line, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
+    block_file_size_signal();
     let matches = negative_numbers(<Cli as clap::CommandFactory>::command()).try_get_matches();
     let cli = match matches.and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m)) {
         Ok(cli) => cli,
@@ -125,6 +126,21 @@ pub fn main() -> ExitCode {
         Outcome::Failure
     });
     output::settle(outcome).into()
+}
+
+/// Blocks SIGXFSZ in this thread, before any other starts (they inherit the mask): a write beyond the
+/// file-size limit (`ulimit -f`) then fails with EFBIG ("File too large"), which every command reports
+/// and cleans up after as for a full disk, instead of the signal killing the process and leaving its
+/// temporary file behind.
+fn block_file_size_signal() {
+    #[cfg(unix)]
+    {
+        use nix::sys::signal::{SigSet, Signal};
+        let mut set = SigSet::empty();
+        set.add(Signal::SIGXFSZ);
+        // Without it (it cannot fail for a valid signal) the default stays: killed at the limit.
+        let _ = set.thread_block();
+    }
 }
 
 /// Every option of every command takes a negative number as its value: without it clap read

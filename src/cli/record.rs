@@ -8,6 +8,7 @@ use super::text::help;
 use super::text::{number, size};
 use super::{output, Outcome};
 use anyhow::{anyhow, Context};
+use coin_log::files::output::check;
 use coin_log::files::{shown, Output, Policy};
 use coin_log::format::Encoding;
 use coin_log::format::Termination;
@@ -85,7 +86,7 @@ pub struct SceneFlags {
     /// Most integrator steps, ≥ 1: a fixed-step run needing more is refused before it starts, an adaptive
     /// one stops when they are spent (termination `step-budget-spent`, exit 1) (overrides `run.max_steps`;
     /// default 100000000, under a minute of work).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = whole_steps)]
     pub max_steps: Option<u64>,
     /// Comma-separated channels: omega, angles, quaternion, position, contact, reaction, energy,
     /// invariants, tf, scene, and work with dissipation, rerun with --encoding protobuf (overrides
@@ -125,6 +126,15 @@ impl SceneFlags {
     }
 }
 
+/// `--max-steps N`: a whole number in digits (the parser's "invalid digit found in string" said neither
+/// what was wrong with `1e8` nor what to write).
+fn whole_steps(text: &str) -> Result<u64, String> {
+    text.parse().map_err(|_| {
+        "not a whole number of steps in digits: write e.g. 100000000 (not 1e8, 1_000 or 1.5)"
+            .to_string()
+    })
+}
+
 /// Runs `coin-log record`: load → resolve → prepare the output → record → persist → summary and exit code.
 pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     // First, so that a signal at any later stage finishes or abandons cleanly (never kills the process
@@ -133,6 +143,13 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     let source = load_source(&args.scene, &args.flags.set)?;
     let scene = resolve(&args, &source)?;
     if args.dry_run {
+        // The output is checked as the recording would check it (creating nothing), so that a dry run
+        // that passes is not followed by a recording refused at once; a warning, since the resolved scene
+        // it prints does not depend on it (`--dry-run > scene.toml` beside an earlier recording).
+        let target = output_path(&args, &source);
+        if let Err(e) = check(&target, &output_policy(args.overwrite, &source)) {
+            errln!("warning: the recording itself would be refused: {e}");
+        }
         return dry_run(&args, &scene, &source.label);
     }
     // Before simulating: say which required checks `verify` will not be able to run on this recording.
@@ -321,6 +338,19 @@ fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)))
 }
 
+/// What the recording's target may be: a regular file (replaced with `--overwrite`), never the scene.
+fn output_policy(overwrite: bool, source: &SceneSource) -> Policy {
+    Policy {
+        overwrite,
+        flag: "-o",
+        example: format!("{}.mcap", source.stem).into(),
+        protect: source
+            .path
+            .clone()
+            .map(|p| (p, "the scene file being recorded")),
+    }
+}
+
 /// Checks the target and creates the temporary file beside it, all before simulating (files::output):
 /// the target must be absent or (with `--overwrite`) a regular file other than the scene.
 pub(super) fn prepare_output(
@@ -329,15 +359,7 @@ pub(super) fn prepare_output(
     source: &SceneSource,
     signals: &Signals,
 ) -> anyhow::Result<Output> {
-    let policy = Policy {
-        overwrite,
-        flag: "-o",
-        example: format!("{}.mcap", source.stem).into(),
-        protect: source
-            .path
-            .clone()
-            .map(|p| (p, "the scene file being recorded")),
-    };
+    let policy = output_policy(overwrite, source);
     // Locked while the temporary file is created, so that a second signal finds it to delete.
     let mut slot = signals.slot();
     let output = Output::create(target, &policy)?;

@@ -663,3 +663,40 @@ fn verify_fails_a_recording_whose_clock_runs_1e_6_fast() {
     }
     assert_eq!(r.exit_code, 1);
 }
+
+/// `analyse map` checks its --out folder and files before any work, as every command does (it computed
+/// the whole grid first: 1.2 s and 0.8 GB at the largest, then refused `--out /dev/null`); a grid that
+/// fails after the check leaves no file, nor the folder it created.
+#[test]
+fn analyse_map_checks_its_outputs_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("taken")).unwrap();
+    std::os::unix::fs::symlink("/etc/passwd", d.join("taken/stability-map.svg")).unwrap();
+    // A grid the work refuses (σ² overflows): the outputs must be refused before it is reached.
+    let failing = ["analyse", "map", "--omega-z", "1e300:1e301:3", "--out"];
+    for (out, needle) in [
+        ("/dev/null", "`/dev/null` is not a folder"),
+        ("taken", "stability-map.svg` is a symbolic link"),
+    ] {
+        let mut args = failing.to_vec();
+        args.push(out);
+        let output = coin_log(d, &args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(needle), "{out}: {stderr}");
+    }
+    // Negative control: a folder it may write lets the work run, and its error leaves nothing behind.
+    let mut args = failing.to_vec();
+    args.push("fresh/map");
+    let output = coin_log(d, &args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("σ² = inf: too fast"), "{stderr}");
+    assert!(!d.join("fresh").exists(), "the created folder is removed");
+    let mut left: Vec<_> = std::fs::read_dir(d.join("taken"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["stability-map.svg"], "only the link");
+}

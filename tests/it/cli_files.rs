@@ -697,3 +697,54 @@ fn control_characters_in_paths_are_escaped_and_the_rest_kept() {
     assert_eq!(shown(Path::new("a/b c é.mcap")), "a/b c é.mcap");
     assert_eq!(shown(Path::new("x\ny\r\u{1b}[31m")), "x\\ny\\r\\u{1b}[31m");
 }
+
+/// A scene that is not UTF-8 is refused saying where and what to do (it said only "stream did not
+/// contain valid UTF-8"), and a large binary file for its size, whatever its first bytes (its UTF-8
+/// error came first).
+#[test]
+fn a_scene_that_is_not_utf8_is_refused_saying_where_and_a_large_one_for_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, b"description = \"ok\"\n# caf\xe9\n").unwrap();
+    let e = read_toml(&path, InputKind::Scene).unwrap_err().to_string();
+    assert!(
+        e.contains("byte 0xe9 at line 2, column 6") && e.contains("save it as UTF-8"),
+        "{e}"
+    );
+    let mut binary = vec![0xff_u8; 2 << 20];
+    binary[0] = b'#';
+    std::fs::write(&path, &binary).unwrap();
+    let e = read_toml(&path, InputKind::Scene).unwrap_err().to_string();
+    assert!(e.contains("more than 1048576 bytes"), "{e}");
+    // Negative control: UTF-8 text (a BOM and a non-ASCII description included) reads.
+    std::fs::write(&path, "\u{feff}description = \"café\"\n").unwrap();
+    assert!(read_toml(&path, InputKind::Scene).unwrap().contains("café"));
+}
+
+/// `OutputFolder::check` refuses what `create` and `file` would, creating nothing: `analyse map` checks
+/// with it before its work, so that a signal during the work leaves nothing (creating the outputs first
+/// left two empty `.coin-log-*.tmp` files and the folder on SIGTERM).
+#[test]
+fn an_output_folder_is_checked_without_creating_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    OutputFolder::check(&d.join("new/sub"), true, &["a.csv", "b.svg"]).unwrap();
+    assert_eq!(listing(d), Vec::<String>::new(), "nothing created");
+    std::fs::create_dir(d.join("out")).unwrap();
+    std::os::unix::fs::symlink("/etc/passwd", d.join("out/b.svg")).unwrap();
+    let e = OutputFolder::check(&d.join("out"), true, &["a.csv", "b.svg"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("b.svg` is a symbolic link"), "{e}");
+    std::fs::write(d.join("out/a.csv"), "old").unwrap();
+    let e = OutputFolder::check(&d.join("out"), false, &["a.csv"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("already exists"), "{e}");
+    std::fs::write(d.join("plain"), "x").unwrap();
+    let e = OutputFolder::check(&d.join("plain/sub"), true, &["a.csv"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("plain` is not a folder, so"), "{e}");
+    assert_eq!(listing(&d.join("out")), ["a.csv", "b.svg"], "nothing added");
+}

@@ -396,3 +396,220 @@ fn plot_export_and_the_map_never_replace_a_pipe_or_a_link() {
         .unwrap()
         .contains("<svg"));
 }
+
+/// A file-size limit (`ulimit -f`) reached mid-write is an error like a full disk: exit 1 naming it, and
+/// no temporary file or created folder left. The signal of that limit, SIGXFSZ, used to kill the process
+/// (exit 153, no message) with its `.coin-log-*.tmp` file left behind.
+#[test]
+fn a_file_size_limit_reached_mid_write_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let under_limit = |kib: u32, args: &[&str]| {
+        Command::new("sh")
+            .arg("-c")
+            .arg(format!("ulimit -f {kib} && exec \"$0\" \"$@\""))
+            .arg(exe())
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap()
+    };
+    for (kib, args) in [
+        (
+            64,
+            &["record", "wobble", "--duration", "30", "-o", "big.mcap"][..],
+        ),
+        (1, &["man", "--out", "pages"][..]),
+        (
+            1,
+            &["analyse", "map", "--theta", "0.1:1:50", "--out", "map"][..],
+        ),
+    ] {
+        let out = under_limit(kib, args);
+        let err = stderr(&out);
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{args:?}: {:?} {err}",
+            out.status
+        );
+        assert!(err.contains("File too large"), "{args:?}: {err}");
+        assert_eq!(listing(d), Vec::<String>::new(), "{args:?}: nothing left");
+    }
+    // Negative control: under a limit it stays below, the recording is written.
+    let out = under_limit(
+        100_000,
+        &["record", "wobble", "--duration", "1", "-o", "small.mcap"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert_eq!(listing(d), ["small.mcap"]);
+}
+
+/// A finished output has the mode a new file gets from the umask, as any tool's output does: it was
+/// 0644 whatever the umask, so `umask 077` still gave world-readable recordings.
+#[test]
+fn a_finished_file_has_the_mode_the_umask_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (umask, mode) in [("077", 0o600), ("002", 0o664), ("022", 0o644)] {
+        let name = format!("u{umask}.mcap");
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!("umask {umask} && exec \"$0\" \"$@\""))
+            .arg(exe())
+            .args(["record", "wobble", "--duration", "0.1", "-o", &name])
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        let found = std::fs::metadata(d.join(&name)).unwrap().mode() & 0o777;
+        assert_eq!(found, mode, "umask {umask}: mode {found:o}");
+    }
+}
+
+/// A legal target name with a long extension is written: its temporary file's name repeated the
+/// extension and, 20 bytes longer than the target's, was refused as "File name too long".
+#[test]
+fn a_long_extension_does_not_make_the_temporary_name_too_long() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = format!("x.{}", "e".repeat(245));
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--duration", "0.1", "-o", &name],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert_eq!(listing(dir.path()), [name]);
+    // Negative control: a name beyond the system's limit is still refused, with its reason.
+    refused(
+        dir.path(),
+        &format!("x.{}", "e".repeat(254)),
+        &["File name too long"],
+    );
+}
+
+/// A symbolic link in the way is refused with a fix that works: `/dev/stdout` leads to a pipe or a
+/// terminal (it said "give the path it points to", that is `pipe:[…]`), and a page of `man --out`
+/// cannot be given alone (the fix is another folder).
+#[test]
+fn a_refused_link_is_given_a_fix_that_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = Command::new(exe())
+        .args(["record", "wobble", "-o", "/dev/stdout"])
+        .args(LONG)
+        .current_dir(d)
+        .stdout(Stdio::piped())
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(
+        err.contains("it leads to a named pipe")
+            && err.contains("choose a file path, e.g. -o wobble.mcap")
+            && !err.contains("give the path it points to"),
+        "{err}"
+    );
+    std::fs::create_dir(d.join("pages")).unwrap();
+    std::os::unix::fs::symlink("elsewhere", d.join("pages/coin-log.1")).unwrap();
+    let out = coin_log(d, &["man", "--out", "pages"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(
+        err.contains("move it away, or choose another folder with --out"),
+        "{err}"
+    );
+    assert_eq!(listing(&d.join("pages")), ["coin-log.1"], "only the link");
+    // Negative control: a link to a regular file is still told to give the file.
+    std::fs::write(d.join("real.mcap"), "x").unwrap();
+    std::os::unix::fs::symlink("real.mcap", d.join("link.mcap")).unwrap();
+    refused(d, "link.mcap", &["give the path it points to"]);
+}
+
+/// A link in the way that leads to a folder is told to name a file in it, and an output folder that is
+/// a link to nothing is named as such (it said "cannot create the folder `x`: File exists").
+#[test]
+fn a_link_to_a_folder_or_to_nothing_is_named_with_its_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("real")).unwrap();
+    std::os::unix::fs::symlink("real", d.join("to-folder")).unwrap();
+    refused(
+        d,
+        "to-folder",
+        &["it leads to a folder; give a file name, e.g. -o to-folder/wobble.mcap"],
+    );
+    std::os::unix::fs::symlink("nowhere", d.join("dangling")).unwrap();
+    for out in ["dangling", "dangling/sub"] {
+        let output = coin_log(d, &["man", "--out", out]);
+        let err = stderr(&output);
+        assert_eq!(code(&output), 1, "{err}");
+        assert!(
+            err.contains("`dangling` is a symbolic link to `nowhere`, which does not exist"),
+            "{out}: {err}"
+        );
+    }
+    assert!(!d.join("nowhere").exists());
+    // Negative control: a link to a folder is a folder to write into.
+    let output = coin_log(d, &["man", "--out", "to-folder"]);
+    assert_eq!(code(&output), 0, "{}", stderr(&output));
+    assert!(d.join("real/coin-log.1").exists());
+}
+
+/// A scene file named like its default output (`s.mcap`, recorded to `s.mcap`) is protected, and the fix
+/// suggests another name: it suggested `-o s.mcap`, the refused path itself.
+#[test]
+fn a_scene_named_like_its_output_is_told_another_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = coin_log(d, &["scenes", "--show", "wobble"]);
+    std::fs::write(d.join("s.mcap"), &scene.stdout).unwrap();
+    let out = coin_log(d, &["record", "./s.mcap", "--duration", "0.1"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), 1, "{err}");
+    assert!(
+        err.contains("is the scene file being recorded") && err.contains("e.g. -o s-recorded.mcap"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(d.join("s.mcap")).unwrap(), scene.stdout);
+    // Negative control: the suggestion works.
+    let out = coin_log(
+        d,
+        &[
+            "record",
+            "./s.mcap",
+            "--duration",
+            "0.1",
+            "-o",
+            "s-recorded.mcap",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    // And a scene whose stem differs from the target keeps the usual example.
+    std::fs::write(d.join("w.toml"), &scene.stdout).unwrap();
+    let out = coin_log(d, &["record", "./w.toml", "-o", "w.toml", "--overwrite"]);
+    assert!(stderr(&out).contains("e.g. -o w.mcap"), "{}", stderr(&out));
+}
+
+/// `-o new/` (a folder that is not there) is named as such: the system's reason was "cannot create
+/// `new/`: Is a directory (os error 21)", about a name that does not exist.
+#[test]
+fn an_output_ending_with_a_slash_that_names_no_folder_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        dir.path(),
+        "new/",
+        &["`new/` ends with `/`, so it names a folder, and there is none: drop the `/`, or create the folder and give a file name, e.g. -o new/wobble.mcap"],
+    );
+    // Negative control: an existing folder with a slash is the folder case, and without it the name works.
+    std::fs::create_dir(dir.path().join("there")).unwrap();
+    refused(
+        dir.path(),
+        "there/",
+        &["`there/` is a folder; give a file name"],
+    );
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--duration", "0.1", "-o", "new"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+}

@@ -437,3 +437,80 @@ fn ctrl_c_finishes_the_file_marked_interrupted() {
 // A numerical failure (the file finished up to it, exit 1) can no longer be reached from the command line:
 // the scene that produced one (ω_Z = 1e150 with rk4) is refused before writing (cli_scene_limits.rs), and
 // the recorder's side of it is tested on such a state in record_roundtrip.rs.
+
+/// `--dry-run` names an output the recording would refuse, so that a dry run that passes is not followed
+/// by a refusal at once: it said nothing of `-o /dev/null`, a missing folder or an existing file.
+#[test]
+fn a_dry_run_warns_of_an_output_the_recording_would_refuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("exists.mcap"), "x").unwrap();
+    for (target, needle) in [
+        ("/dev/null", "`/dev/null` is a character device"),
+        ("nope/x.mcap", "the folder `nope` does not exist"),
+        (
+            "exists.mcap",
+            "`exists.mcap` already exists; pass --overwrite",
+        ),
+    ] {
+        let out = coin_log(d, &["record", "wobble", "--dry-run", "-o", target]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), 0, "{err}");
+        assert!(
+            err.contains(&format!(
+                "warning: the recording itself would be refused: {needle}"
+            )),
+            "{target}: {err}"
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("[body]"));
+    }
+    assert_eq!(listing(d), ["exists.mcap"], "nothing written");
+    // Negative control: a target the recording may write gives no warning.
+    for args in [
+        &["record", "wobble", "--dry-run", "-o", "new.mcap"][..],
+        &[
+            "record",
+            "wobble",
+            "--dry-run",
+            "-o",
+            "exists.mcap",
+            "--overwrite",
+        ][..],
+    ] {
+        let out = coin_log(d, args);
+        assert_eq!(code(&out), 0);
+        assert!(
+            !stderr(&out).contains("warning"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
+
+/// `--max-steps` in another form than digits is a usage error that says how to write it (clap's "invalid
+/// digit found in string" for `1e8` said neither).
+#[test]
+fn a_max_steps_not_in_digits_says_how_to_write_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for value in ["1e8", "-1", "1.5", "many"] {
+        let out = coin_log(dir.path(), &["record", "wobble", "--max-steps", value]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), 2, "{value}: {err}");
+        assert!(
+            err.contains("not a whole number of steps in digits: write e.g. 100000000"),
+            "{value}: {err}"
+        );
+    }
+    // Negative control: digits are read (and 0 is the scene's error, naming the flag).
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--max-steps", "0", "--dry-run"],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(stderr(&out).contains("(set by `--max-steps`)"));
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--max-steps", "100000000", "--dry-run"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+}

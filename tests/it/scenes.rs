@@ -485,3 +485,119 @@ fn the_readable_text_is_the_same_scene() {
         assert!(readable.lines().all(short), "{readable}");
     }
 }
+
+/// A table given as an array is refused: serde's derived structs took an array as their fields in order,
+/// so `--set initial.perturbation=[1]` kicked θ by 1 rad and `body = [1.0, 1.0, 1.0, "thin-disk"]` was a
+/// body.
+#[test]
+fn a_table_given_as_an_array_is_refused() {
+    let text = VALID.replace(
+        "[body]\nmass = 1.0\nradius = 1.0\ngravity = 1.0\nshape = \"thin-disk\"",
+        "body = [1.0, 1.0, 1.0, \"thin-disk\"]",
+    );
+    assert_ne!(text, VALID);
+    let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+    assert!(
+        e.contains("expected a table") && e.contains("line 3"),
+        "{e}"
+    );
+    for (set, key) in [
+        ("initial.perturbation=[1]", "initial.perturbation"),
+        ("initial.steady=[\"straight\", 1.0]", "initial.steady"),
+        ("body.dissipation=[\"moffatt\", 1e-7]", "body.dissipation"),
+        ("run=[1.0]", "run"),
+        ("record=[[\"omega\"]]", "record"),
+        ("initial=[0.3]", "initial"),
+    ] {
+        let e = scene::parse_with_sets(VALID, &[set.into()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("expected a table") && e.contains(&format!("in `{key}`")),
+            "{set}: {e}"
+        );
+    }
+    // Negative control: the same as tables are read.
+    let file =
+        scene::parse_with_sets(VALID, &["initial.perturbation={ theta = 1e-3 }".into()]).unwrap();
+    let kick = file.initial.perturbation.unwrap();
+    assert_eq!((kick.theta, kick.omega), (Some(1e-3), None));
+}
+
+/// A key of more dotted parts than the TOML reader follows is named as such (the reader's message was
+/// the bare words "recursion limit", with no line, key or fix).
+#[test]
+fn a_key_nested_beyond_the_readers_limit_is_named() {
+    for text in [
+        format!("[{}]\nx = 1\n", vec!["a"; 200].join(".")),
+        format!("{} = 1\n", vec!["a"; 200].join(".")),
+    ] {
+        let e = scene::parse_with_sets(&text, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("too many dotted parts") && e.contains("initial.steady.kind"),
+            "{e}"
+        );
+    }
+    // Negative control: a deep key within the limit is an unknown key, named.
+    let e = scene::parse_with_sets(&format!("{} = 1\n", ["a"; 5].join(".")), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `a`"), "{e}");
+}
+
+/// A `--set` key of tens of thousands of dotted parts is refused, shown cut: it built tables nested as
+/// deep, whose recursive reading and dropping overflowed the stack (the process aborted, exit 134).
+#[test]
+fn a_set_key_of_very_many_parts_is_refused_without_overflowing_the_stack() {
+    let key = vec!["a"; 60_000].join(".");
+    let e = scene::parse_with_sets(VALID, &[format!("{key}=1")])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the key has 60000 dotted parts") && e.len() < 1000,
+        "{}",
+        &e[..e.len().min(500)]
+    );
+    // Negative control: a key of a few parts is applied, or refused as an unknown key.
+    let e = scene::parse_with_sets(VALID, &["a.b.c.d.e=1".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `a`"), "{e}");
+    scene::parse_with_sets(VALID, &["initial.perturbation.theta=1e-3".into()]).unwrap();
+}
+
+/// A value or key of any length given with `--set` is shown cut, as paths and TOML lines are: a 100 kB
+/// `run.integrator` or unknown key was quoted whole in the message.
+#[test]
+fn a_long_value_or_key_is_shown_cut_in_the_message() {
+    let long = "x".repeat(100_000);
+    for set in [
+        format!("run.integrator={long}"),
+        format!("body.shape={long}"),
+        format!("record.channels=[\"{long}\"]"),
+        format!("body.{long}=1"),
+    ] {
+        let file = scene::parse_with_sets(VALID, std::slice::from_ref(&set));
+        let e = match file {
+            Ok(file) => scene::resolve(&file, &FlagOverrides::default())
+                .unwrap_err()
+                .to_string(),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.len() < 1000 && e.contains("xxx…"),
+            "{}: {}",
+            &set[..20],
+            &e[..e.len().min(300)]
+        );
+    }
+    // Negative control: short values are shown whole.
+    let file = scene::parse_with_sets(VALID, &["run.integrator=rk5".into()]).unwrap();
+    let e = scene::resolve(&file, &FlagOverrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`run.integrator` = \"rk5\" is not a known integrator"),
+        "{e}"
+    );
+}

@@ -79,10 +79,11 @@ pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
 /// As [`check`]; a file above the limit, one that cannot be read, or that is not UTF-8.
 pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
     check(path, kind)?;
-    let mut text = String::new();
+    let mut bytes = Vec::new();
     let read = File::open(path)
-        .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_string(&mut text))
+        .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_end(&mut bytes))
         .map_err(|source| InputError(source.to_string()))?;
+    // The size first: a large file is refused for its size, wherever its first non-UTF-8 byte is.
     if read as u64 > SCENE_MAX_BYTES {
         let bytes = fs::metadata(path).map_or(read as u64, |m| m.len().max(read as u64));
         return Err(InputError(format!(
@@ -91,7 +92,22 @@ pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
             what(kind)
         )));
     }
-    Ok(text)
+    String::from_utf8(bytes).map_err(|e| not_utf8(e.as_bytes(), e.utf8_error().valid_up_to(), kind))
+}
+
+/// Where the text stops being UTF-8 (the system's "stream did not contain valid UTF-8" said neither where
+/// nor what to do).
+fn not_utf8(bytes: &[u8], valid: usize, kind: InputKind) -> InputError {
+    let before = String::from_utf8_lossy(&bytes[..valid]);
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    InputError(format!(
+        "is not UTF-8 text: byte 0x{:02x} at line {line}, column {column} is not UTF-8; {} is TOML, which \
+         is UTF-8: save it as UTF-8 (e.g. `iconv -f latin1 -t utf-8`), or check that this is the file you \
+         meant",
+        bytes[valid],
+        what(kind)
+    ))
 }
 
 /// Ok if `path` is absent or a regular file (following links): for the files a command keeps in a folder

@@ -65,7 +65,21 @@ impl Policy {
                 shown(&target.join(&*self.example))
             ),
             Refused::Special => format!("choose a file path, e.g. {flag} {}", self.example),
-            Refused::Protected => format!("choose another output, e.g. {flag} {}", self.example),
+            Refused::Protected => {
+                // The example is the scene's stem + .mcap, the protected file itself for a scene file
+                // named `s.mcap`: then another name.
+                let example = Path::new(&*self.example);
+                let example = if target.file_name() == Some(example.as_os_str()) {
+                    let stem = example.file_stem().unwrap_or_default().to_string_lossy();
+                    match example.extension() {
+                        Some(ext) => format!("{stem}-recorded.{}", ext.to_string_lossy()),
+                        None => format!("{stem}-recorded"),
+                    }
+                } else {
+                    self.example.to_string()
+                };
+                format!("choose another output, e.g. {flag} {example}")
+            }
             Refused::Exists => {
                 format!("pass --overwrite to replace it, or choose another file with {flag}")
             }
@@ -129,6 +143,14 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
     let path = shown(target);
     let meta = match fs::symlink_metadata(target) {
         Ok(meta) => meta,
+        // `-o new/` names a folder that is not there (the system's word for it: "Is a directory").
+        Err(e) if e.kind() == ErrorKind::NotFound && path.ends_with('/') => {
+            let fix = policy.fix(Refused::Folder, target);
+            return Err(OutputError(format!(
+                "`{path}` ends with `/`, so it names a folder, and there is none: drop the `/`, or create \
+                 the folder and {fix}"
+            )));
+        }
         Err(e) if e.kind() == ErrorKind::NotFound => return check_folder(target).map(|()| None),
         Err(source) => return Err(OutputError::system("use", target, &source)),
     };
@@ -141,8 +163,8 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
         let to = fs::read_link(target).map_or_else(|_| "?".into(), |p| shown(&p));
         return Err(OutputError(format!(
             "`{path}` is a symbolic link (to `{to}`), not a regular file; coin-log writes a new file and moves \
-             it into place, which would replace the link itself with a plain file: give the path it points \
-             to, or choose another path"
+             it into place, which would replace the link itself with a plain file: {}",
+            link_fix(target, policy)
         )));
     }
     if !kind.is_file() {
@@ -165,6 +187,31 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
         )));
     }
     Ok(Some(meta))
+}
+
+/// What to do instead of writing over the symbolic link `target`. Its destination is the fix only when
+/// it is (or would be) a regular file: `/dev/stdout` leads to a pipe or a terminal (`pipe:[…]`), and a
+/// page of `man --out` cannot be given alone.
+fn link_fix(target: &Path, policy: &Policy) -> String {
+    if policy.example.is_empty() {
+        return policy.fix(Refused::Special, target);
+    }
+    match fs::metadata(target) {
+        Err(e) if e.kind() == ErrorKind::NotFound => {
+            "give the path it points to, or choose another path".into()
+        }
+        Ok(meta) if meta.is_file() => "give the path it points to, or choose another path".into(),
+        Ok(meta) if meta.is_dir() => format!(
+            "it leads to a folder; {}",
+            policy.fix(Refused::Folder, target)
+        ),
+        Ok(meta) => format!(
+            "it leads to {}, which coin-log does not write into (nor to standard output); {}",
+            kind_of(&meta),
+            policy.fix(Refused::Special, target)
+        ),
+        Err(_) => policy.fix(Refused::Special, target),
+    }
 }
 
 /// The target's folder must exist (a clearer message than the temporary file's ENOENT).
@@ -247,15 +294,30 @@ fn sticky_owner(target: &Path, meta: &Metadata, temp: &NamedTempFile) -> Option<
     }
 }
 
-/// A finished output file is an ordinary file (the temporary file is created owner-only).
+/// A finished output file is an ordinary file (the temporary file is created owner-only): mode 0666 less
+/// the process's umask, as `open` gives a new file (it was 0644 whatever the umask, so `umask 077` still
+/// gave world-readable recordings).
 pub fn make_readable(file: &File) {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        let _ = file.set_permissions(fs::Permissions::from_mode(0o644));
+        let _ = file.set_permissions(fs::Permissions::from_mode(0o666 & !umask()));
     }
     #[cfg(not(unix))]
     let _ = file;
+}
+
+/// The process's umask, from `/proc/self/status` (reading it with umask(2) would change it); 022, the
+/// usual one, where the system does not say.
+#[cfg(unix)]
+fn umask() -> u32 {
+    fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|status| {
+            let line = status.lines().find_map(|l| l.strip_prefix("Umask:"))?;
+            u32::from_str_radix(line.trim(), 8).ok()
+        })
+        .unwrap_or(0o022)
 }
 
 /// Checks `target` against `policy` as [`Output::create`] does, creating nothing (for a command that works
@@ -273,6 +335,9 @@ pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputE
     }
     Ok(meta)
 }
+
+/// The longest extension of a target repeated in its temporary file's name (`.coin-log-*.mcap.tmp`).
+const MAX_SHOWN_EXTENSION: usize = 8;
 
 /// One output file being written: a temporary file beside its target until [`Output::commit`].
 #[derive(Debug)]
@@ -292,10 +357,16 @@ impl Output {
     pub fn create(target: &Path, policy: &Policy) -> Result<Self, OutputError> {
         let existing = check(target, policy)?;
         let folder = folder_of(target);
-        let suffix = target.extension().map_or_else(
-            || ".tmp".to_string(),
-            |e| format!(".{}.tmp", e.to_string_lossy()),
-        );
+        // The target's extension shows what the file will be; a long one is left out, so that the
+        // temporary name (20 bytes more than it) fits wherever the target's does (`-o x.<245 bytes>` was
+        // refused as "File name too long").
+        let suffix = target
+            .extension()
+            .filter(|e| e.len() <= MAX_SHOWN_EXTENSION)
+            .map_or_else(
+                || ".tmp".to_string(),
+                |e| format!(".{}.tmp", e.to_string_lossy()),
+            );
         let temp = tempfile::Builder::new()
             .prefix(".coin-log-")
             .suffix(&suffix)
@@ -422,23 +493,7 @@ impl OutputFolder {
     /// # Errors
     /// [`OutputError`] if `dir` (or a parent) is not a folder or cannot be created.
     pub fn create(dir: &Path, overwrite: bool) -> Result<Self, OutputError> {
-        let mut created = Vec::new();
-        let mut missing = Some(dir);
-        while let Some(d) = missing.filter(|d| !d.as_os_str().is_empty()) {
-            match fs::metadata(d) {
-                Ok(m) if m.is_dir() => break,
-                Ok(_) if d == dir => {
-                    return Err(OutputError(format!(
-                        "`{}` is not a folder; --out takes a folder (created if missing) for the \
-                         files",
-                        shown(dir)
-                    )))
-                }
-                Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
-                Err(_) => created.push(d.to_path_buf()),
-            }
-            missing = d.parent();
-        }
+        let mut created = missing_folders(dir)?;
         // Created from the top down; on failure, what was created is removed (by `Drop`).
         let mut folder = Self {
             dir: dir.to_path_buf(),
@@ -454,6 +509,21 @@ impl OutputFolder {
         Ok(folder)
     }
 
+    /// Checks, creating nothing, what [`OutputFolder::create`] and [`OutputFolder::file`] would: for a
+    /// command that works long before it writes (`analyse map`), so that a refused --out is refused
+    /// before the work, and the work leaves nothing behind if it fails or is stopped by a signal.
+    ///
+    /// # Errors
+    /// As [`OutputFolder::create`], and as [`Output::create`]'s checks for each of `names`.
+    pub fn check(dir: &Path, overwrite: bool, names: &[&str]) -> Result<(), OutputError> {
+        if missing_folders(dir)?.is_empty() {
+            for name in names {
+                check(&dir.join(name), &folder_policy(overwrite))?;
+            }
+        }
+        Ok(())
+    }
+
     /// The folder.
     #[must_use]
     pub fn path(&self) -> &Path {
@@ -465,12 +535,7 @@ impl OutputFolder {
     /// # Errors
     /// As [`Output::create`].
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
-        let policy = Policy {
-            overwrite: self.overwrite,
-            flag: "--out",
-            ..Policy::default()
-        };
-        let mut output = Output::create(&self.dir.join(name), &policy)?;
+        let mut output = Output::create(&self.dir.join(name), &folder_policy(self.overwrite))?;
         let file = output
             .file()
             .try_clone()
@@ -494,6 +559,49 @@ impl OutputFolder {
         self.created.clear();
         Ok(())
     }
+}
+
+/// The policy of a file in an output folder.
+fn folder_policy(overwrite: bool) -> Policy {
+    Policy {
+        overwrite,
+        flag: "--out",
+        ..Policy::default()
+    }
+}
+
+/// The folders missing on the way to `dir`, deepest first (none if it exists).
+///
+/// # Errors
+/// [`OutputError`] if `dir` or a parent is not a folder, or is a link to nothing.
+fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    let mut created = Vec::new();
+    let mut missing = Some(dir);
+    while let Some(d) = missing.filter(|d| !d.as_os_str().is_empty()) {
+        match fs::metadata(d) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) if d == dir => {
+                return Err(OutputError(format!(
+                    "`{}` is not a folder; --out takes a folder (created if missing) for the \
+                         files",
+                    shown(dir)
+                )))
+            }
+            Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
+            // A link to nothing: creating the folder would fail with a bare "File exists".
+            Err(_) if fs::symlink_metadata(d).is_ok_and(|m| m.file_type().is_symlink()) => {
+                let to = fs::read_link(d).map_or_else(|_| "?".into(), |p| shown(&p));
+                return Err(OutputError(format!(
+                        "`{}` is a symbolic link to `{to}`, which does not exist: create the folder it \
+                         points to, or choose another folder with --out",
+                        shown(d)
+                    )));
+            }
+            Err(_) => created.push(d.to_path_buf()),
+        }
+        missing = d.parent();
+    }
+    Ok(created)
 }
 
 impl Drop for OutputFolder {

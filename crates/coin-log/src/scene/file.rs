@@ -2,7 +2,10 @@
 //! optional key is an `Option`, names (shape, integrator, channels, steady kind) stay strings so that
 //! validation can report every bad one at once with its key, value and allowed values.
 
+use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::marker::PhantomData;
 
 /// A scene file: `description`, `[body]`, `[initial]`, `[run]`, `[record]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -12,14 +15,24 @@ pub struct SceneFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub description: Option<String>,
     /// The coin.
+    #[serde(deserialize_with = "table")]
     pub body: BodyFile,
     /// The initial state.
+    #[serde(deserialize_with = "table")]
     pub initial: InitialFile,
     /// Duration, sampling and integrator.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_table"
+    )]
     pub run: Option<RunFile>,
     /// What to record.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_table"
+    )]
     pub record: Option<RecordFile>,
 }
 
@@ -49,7 +62,11 @@ pub struct BodyFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness: Option<f64>,
     /// A dissipative couple (physics §11).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_table"
+    )]
     pub dissipation: Option<DissipationFile>,
 }
 
@@ -94,10 +111,18 @@ pub struct InitialFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub z: Option<f64>,
     /// A steady motion (physics §4) whose ω the solver fills in.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_table"
+    )]
     pub steady: Option<SteadyFile>,
     /// A kick added to the initial state of either form.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_table"
+    )]
     pub perturbation: Option<PerturbationFile>,
 }
 
@@ -173,4 +198,27 @@ pub struct RecordFile {
     /// `true` adds the `rerun` channel (the coin, table and track for Rerun) to the channels.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rerun: Option<bool>,
+}
+
+/// A table, and only a table: serde's derived structs also take an array, read as their fields in order,
+/// so `perturbation = [1]` was a kick of θ by 1 rad and `body = [1.0, 1.0, 1.0, "thin-disk"]` a body.
+fn table<'de, D: Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<T, D::Error> {
+    struct Table<T>(PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> Visitor<'de> for Table<T> {
+        type Value = T;
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str("a table")
+        }
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+            T::deserialize(de::value::MapAccessDeserializer::new(map))
+        }
+    }
+    deserializer.deserialize_map(Table(PhantomData))
+}
+
+/// [`table`] for an optional key (its absence is `None` by `#[serde(default)]`).
+fn optional_table<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+    deserializer: D,
+) -> Result<Option<T>, D::Error> {
+    table(deserializer).map(Some)
 }

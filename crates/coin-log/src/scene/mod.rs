@@ -242,6 +242,12 @@ pub fn parse_with_sets(text: &str, sets: &[String]) -> Result<SceneFile, SceneEr
 /// (serde's message quotes the offending line, however long).
 pub(crate) fn toml_message(e: &toml::de::Error) -> String {
     let text = e.to_string();
+    if text.trim() == "recursion limit" {
+        // The reader's whole message for a key of too many dotted parts: no line, no key.
+        return "a key or table header has too many dotted parts (the TOML reader stops at 80): a scene's \
+                keys have at most three, like `initial.steady.kind`"
+            .into();
+    }
     let lines = text
         .trim()
         .lines()
@@ -270,7 +276,13 @@ fn with_sets(mut table: toml::Table, sets: &[String]) -> Result<SceneFile, Scene
 pub fn file_from_table(table: toml::Table) -> Result<SceneFile, SceneError> {
     toml::Value::Table(table)
         .try_into::<SceneFile>()
-        .map_err(|e| SceneError::Parse(e.to_string().trim().replace('\n', " ")))
+        .map_err(|e| {
+            let message = e.to_string().trim().replace('\n', " ");
+            // Cut as a TOML error's lines are: an unknown `--set` key is quoted whole.
+            SceneError::Parse(
+                crate::files::cut(&message, 2 * crate::files::SHOWN_CHARS).into_owned(),
+            )
+        })
 }
 
 /// Resolves a raw file with command-line flags on top into a validated scene; problems caused by a flag

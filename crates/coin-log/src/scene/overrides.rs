@@ -25,7 +25,7 @@ pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
     };
     set_value(table, key, parse_value(raw.trim())).map_err(|e| match e {
         SceneError::Set { reason, .. } => SceneError::Set {
-            arg: arg.to_string(),
+            arg: crate::files::cut(arg, crate::files::SHOWN_CHARS).into_owned(),
             reason,
         },
         other => other,
@@ -43,7 +43,7 @@ pub fn apply_set(table: &mut toml::Table, arg: &str) -> Result<(), SceneError> {
 /// ```
 pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), SceneError> {
     let error = |reason: String| SceneError::Set {
-        arg: key.to_string(),
+        arg: crate::files::cut(key, crate::files::SHOWN_CHARS).into_owned(),
         reason,
     };
     let key = key.trim();
@@ -53,6 +53,14 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
         )));
     }
     let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+    // Tables nested as deep as the key would be dropped (and read) recursively: 60000 parts overflowed
+    // the stack. No scene key has more than three.
+    if parts.len() > MAX_KEY_PARTS {
+        return Err(error(format!(
+            "the key has {} dotted parts: a scene's keys have at most three, like `initial.steady.kind`",
+            parts.len()
+        )));
+    }
     let (last, path) = parts
         .split_last()
         .ok_or_else(|| error("the key is empty".into()))?;
@@ -80,6 +88,10 @@ pub fn set_value(table: &mut toml::Table, key: &str, value: toml::Value) -> Resu
     }
     Ok(())
 }
+
+/// The most dotted parts a `--set` key may have: more than any scene key (three), far fewer than would
+/// nest tables deep enough to overflow the stack.
+const MAX_KEY_PARTS: usize = 16;
 
 /// True for a dotted key with no empty part (`run.rate`, not `run..rate`).
 pub(crate) fn dotted(key: &str) -> bool {

@@ -22,7 +22,9 @@ impl fmt::Display for Problem {
         if self.value.is_empty() {
             write!(f, "`{}` {}", self.key, self.reason)?;
         } else {
-            write!(f, "`{}` = {} {}", self.key, self.value, self.reason)?;
+            // A value may be anything given (a 100 kB `--set run.integrator=…`): shown cut, as paths are.
+            let value = crate::files::cut(&self.value, crate::files::SHOWN_CHARS);
+            write!(f, "`{}` = {value} {}", self.key, self.reason)?;
         }
         if let Some(flag) = &self.flag {
             write!(f, " (set by `{flag}`)")?;
