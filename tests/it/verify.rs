@@ -922,3 +922,36 @@ fn a_small_nutation_about_a_steady_circle_is_judged_within_what_the_recording_ca
         }
     }
 }
+
+/// A coin upright at rest (θ = 0, ω = 0) is an equilibrium: ω stays 0, the constraint check finds
+/// nothing moving, and verify cannot verify. Before, `record` gave no warning for it (the coverage
+/// prediction looked only at channels and sampling); the steady form of the same state is judged by
+/// `steady` and gets none, and a coin given any tilt or spin gets none either.
+#[test]
+fn a_coin_upright_at_rest_is_warned_of_and_verify_cannot_verify_it() {
+    let at_rest = ["initial.theta=0.0", "initial.omega=[0.0, 0.0, 0.0]"];
+    let s = preset_scene("wobble", &at_rest);
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(
+        c[0].contains("the coin starts upright at rest (θ = 0, ω = 0)"),
+        "{}",
+        c[0]
+    );
+    let s = preset_scene("straight", &["initial.steady.omega_z=0.0"]);
+    assert_eq!(coverage(&s), Vec::<String>::new());
+    let s = preset_scene(
+        "wobble",
+        &["initial.theta=0.0", "initial.omega=[0.0, 0.0, 1.0]"],
+    );
+    assert_eq!(coverage(&s), Vec::<String>::new());
+    // What verify says of the recording.
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(
+        dir.path(),
+        "wobble",
+        &["--set", at_rest[0], "--set", at_rest[1], "--duration", "1"],
+    );
+    let r = verify_file(&path, &Options::default());
+    assert_eq!(r.verdict, Verdict::CannotVerify, "{}", show(&r));
+}

@@ -79,6 +79,16 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
     }
     let s = &scene.initial;
     let omega = Vector3::new(s.omega_x, s.omega_y, s.omega_z).norm();
+    if omega == 0.0 && s.theta == 0.0 {
+        // Upright at rest: eqs (14)–(16) give ω̇ = 0 (sin θ = 0, every other term has a factor ω, and the
+        // dissipative couple is 0 at ω = 0), so ω stays 0 and the check finds nothing moving.
+        return Some(
+            "will find nothing to compare: the coin starts upright at rest (θ = 0, ω = 0), an equilibrium \
+             it never leaves, so its centre does not move; give it a motion (a tilt or a spin), or start \
+             it as the steady motion `steady = { kind = \"straight\", omega_z = 0 }`, which `steady` judges"
+                .to_string(),
+        );
+    }
     let rate = omega.max((s.omega_y / s.theta.cos()).abs());
     let accuracy = RunAccuracy::new(&run.method, &scene.params, run.duration, omega);
     let tol = Tolerances::derive(&accuracy, None, None).residual;
