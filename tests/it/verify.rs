@@ -955,3 +955,30 @@ fn a_coin_upright_at_rest_is_warned_of_and_verify_cannot_verify_it() {
     let r = verify_file(&path, &Options::default());
     assert_eq!(r.verdict, Verdict::CannotVerify, "{}", show(&r));
 }
+
+/// A couple strong enough to change the rates within a sample from the first instant: `euler-disk` with
+/// `power-law` m = 1, k = 5, κ = 1e-3 lands flat after 0.077 s, and the constraint check, which adds each
+/// window's relative rate of change to its rate, resolves none of its windows at 400 Hz: verify cannot
+/// verify. Before, the prediction took only Ω₀ = max(|ω₀|, |φ̇₀|) and `record` gave no warning; it now adds
+/// |d ln Ω/dt| at t = 0 from the scene's equations, as the check does.
+#[test]
+fn a_couple_that_brakes_within_a_sample_from_the_start_is_warned_of() {
+    let law = "body.dissipation={model=\"power-law\",coefficient=1e-3,m=1,k=5}";
+    let s = preset_scene("euler-disk", &[law]);
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(
+        c[0].contains("will find no window the sampling resolves"),
+        "{}",
+        c[0]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "euler-disk", &["--set", law]);
+    let r = verify_file(&path, &Options::default());
+    assert_eq!(r.verdict, Verdict::CannotVerify, "{}", show(&r));
+    // The scene as given is unchanged.
+    assert_eq!(
+        coverage(&preset_scene("euler-disk", &[])),
+        Vec::<String>::new()
+    );
+}

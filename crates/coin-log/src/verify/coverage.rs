@@ -5,7 +5,8 @@
 //!
 //! The prediction uses what the checks themselves use: the channels they need, and for `constraint` the
 //! rule that leaves out windows the sampling does not resolve ([`constraint::resolves`]), applied to the
-//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|), with the default residual tolerance the file's settings will give.
+//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|) plus its relative rate of change |d ln Ω/dt| there (the check adds
+//! each window's), with the default residual tolerance the file's settings will give.
 //! The rates at t = 0 stand for the run's: a motion that speeds up later loses only its later windows,
 //! while one that cannot be resolved at the start is in practice not resolved anywhere (the steady and
 //! high-spin scenes keep their rates).
@@ -13,6 +14,7 @@
 use super::checks::constraint;
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
+use crate::model::{Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
@@ -89,7 +91,8 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
                 .to_string(),
         );
     }
-    let rate = omega.max((s.omega_y / s.theta.cos()).abs());
+    let phi_dot = (s.omega_y / s.theta.cos()).abs();
+    let rate = omega.max(phi_dot) + initial_steepness(scene, omega, phi_dot);
     let accuracy = RunAccuracy::new(&run.method, &scene.params, run.duration, omega);
     let tol = Tolerances::derive(&accuracy, None, None).residual;
     let h = run.sample_interval();
@@ -106,6 +109,35 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
         constraint::truncation(h, rate),
         digits3(constraint::min_rate(rate, tol), f64::ceil)
     ))
+}
+
+/// |d ln Ω/dt| at t = 0 for Ω = max(|ω|, |φ̇|), the relative change the check adds to the rate of each
+/// window ([`constraint`]'s steepest term), from ω̇ of the scene's equations: a dissipative couple brakes
+/// from the first instant, and one strong enough changes the rates within a sample.
+fn initial_steepness(scene: &Scene, omega: f64, phi_dot: f64) -> f64 {
+    let s = &scene.initial;
+    let mut y = [0.0; DISSIPATIVE_STATE_LEN];
+    y[..STATE_LEN].copy_from_slice(&s.to_array());
+    let mut dydt = [0.0; DISSIPATIVE_STATE_LEN];
+    match scene.dynamics() {
+        Dynamics::Conservative(coin) => {
+            let mut rate = [0.0; STATE_LEN];
+            coin.derivative(&s.to_array(), &mut rate);
+            dydt[..STATE_LEN].copy_from_slice(&rate);
+        }
+        Dynamics::Dissipative(coin) => coin.derivative(&y, &mut dydt),
+    }
+    let (dx, dy, dz) = (dydt[3], dydt[4], dydt[5]);
+    let steepness = if phi_dot > omega {
+        dy / s.omega_y + s.theta.tan() * s.omega_x
+    } else {
+        (s.omega_x * dx + s.omega_y * dy + s.omega_z * dz) / (omega * omega)
+    };
+    if steepness.is_finite() {
+        steepness.abs()
+    } else {
+        0.0
+    }
 }
 
 /// `x` rounded by `round` to 3 significant digits (`f64::ceil` for a rate that is enough).
