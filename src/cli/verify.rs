@@ -25,7 +25,8 @@ of order p with step h (rk4, gauss4: p = 4) eps = (h W)^p (only the settings the
   energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
   constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
   nutation period and advance:    min(1e-6, max(1e-11, 100 eps)), plus the quadrature's and the
-                                  interpolation's error estimates
+                                  interpolation's error estimates and the turning points' timing
+                                  2 delta/(A sigma span), delta = 0.1 eps (1 + T/tau) W, A = max|omega_X|
 Stored values recomputed from other stored values (energy, invariants, quaternion, contact, height,
 reaction) must agree to 1e-12 relative; N >= 0 and |F| <= mu N are held to 1e-12 Mg.
 

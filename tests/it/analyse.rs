@@ -700,3 +700,31 @@ fn analyse_map_checks_its_outputs_before_any_work() {
     left.sort();
     assert_eq!(left, ["stability-map.svg"], "only the link");
 }
+
+/// Straight rolling at ω_c = 1/√3 (thin disk) has σ² = 0 in exact arithmetic; in floating point `analyse`
+/// prints σ² = 1.8e-16 and calls it `marginal` (zero to rounding, 64 ulp of the size of its terms). The
+/// contract said `marginal` only for σ² = 0 and "σ² > 0 is stable", contradicting the object it printed;
+/// it now states the rounding rule.
+#[test]
+fn a_marginal_verdict_with_a_nonzero_sigma_squared_is_the_rounding_rule_the_contract_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let omega_c = format!("initial.steady.omega_z={:?}", 1.0 / 3f64.sqrt());
+    let out = coin_log(
+        dir.path(),
+        &["analyse", "straight", "--json", "--set", &omega_c],
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let steady = &v["steady"];
+    assert_eq!(steady["verdict"], "marginal", "{steady}");
+    let s2 = steady["sigma_squared"].as_f64().unwrap();
+    assert!(s2 != 0.0 && s2.abs() < 1e-14, "{s2:e}");
+    let format = std::fs::read_to_string(crate::support::repo().join("docs/format.md")).unwrap();
+    let section = &format[format.find("## analyse --json").unwrap()..];
+    let section = &section[..section.find("\n## ").unwrap_or(section.len())];
+    assert!(
+        section.contains("zero to rounding")
+            && section.contains("is marginal whatever its printed"),
+        "docs/format.md, analyse --json, must state when a nonzero σ² is marginal"
+    );
+}

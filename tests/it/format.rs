@@ -4,7 +4,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use coin_log::format::promise::{check_list, shortfalls, Cause, FixedSteps};
+use coin_log::format::promise::{check_list, shortfalls, Cause, FixedSteps, Positions};
 use coin_log::format::tolerances::{RunAccuracy, Tolerances};
 use coin_log::format::{log_time, schema_data, Channel, Encoding, Termination, Topic};
 use coin_log::integrate;
@@ -102,6 +102,12 @@ fn non_finite_negative_and_huge_times_are_refused() {
     }
 }
 
+/// A centre that starts at the origin, sampled at rate 100.
+const AT_ORIGIN: Positions = Positions {
+    offset: 0.0,
+    sample_interval: 0.01,
+};
+
 fn promise_run(integrator: &str, rtol: f64, step: f64, span: f64) -> RunAccuracy {
     RunAccuracy {
         integrator: integrator.parse().unwrap(),
@@ -119,27 +125,44 @@ fn promise_run(integrator: &str, rtol: f64, step: f64, span: f64) -> RunAccuracy
 /// do not, each for its reason.
 #[test]
 fn loose_settings_and_very_many_steps_are_predicted_to_fail() {
-    assert!(shortfalls(&promise_run("dop853", 1e-10, 0.0, 30.0), None).is_empty());
+    assert!(shortfalls(&promise_run("dop853", 1e-10, 0.0, 30.0), None, AT_ORIGIN).is_empty());
     let fixed = |steps: f64, sample_interval: f64| {
         Some(FixedSteps {
             steps,
             sample_interval,
         })
     };
-    assert!(shortfalls(&promise_run("rk4", 0.0, 1e-3, 30.0), fixed(3e4, 0.01)).is_empty());
-    let loose = shortfalls(&promise_run("dop853", 1e-3, 0.0, 30.0), None);
+    assert!(shortfalls(
+        &promise_run("rk4", 0.0, 1e-3, 30.0),
+        fixed(3e4, 0.01),
+        AT_ORIGIN
+    )
+    .is_empty());
+    let loose = shortfalls(&promise_run("dop853", 1e-3, 0.0, 30.0), None, AT_ORIGIN);
     println!("{}", loose[0]);
     assert_eq!(
         check_list(&loose, ","),
         "energy,invariants,constraint,steady,nutation"
     );
-    let long = shortfalls(&promise_run("rk4", 0.0, 0.1, 30.0), fixed(300.0, 1.0));
+    let long = shortfalls(
+        &promise_run("rk4", 0.0, 0.1, 30.0),
+        fixed(300.0, 1.0),
+        AT_ORIGIN,
+    );
     assert!(matches!(long[0].cause, Cause::Accuracy { .. }), "{long:?}");
-    let many = shortfalls(&promise_run("rk4", 0.0, 1e-12, 1e-3), fixed(1e9, 1e-3));
+    let many = shortfalls(
+        &promise_run("rk4", 0.0, 1e-12, 1e-3),
+        fixed(1e9, 1e-3),
+        AT_ORIGIN,
+    );
     println!("{}", many[0]);
     assert!(matches!(many[0].cause, Cause::Rounding { .. }), "{many:?}");
     assert_eq!(check_list(&many, ","), "energy,invariants");
-    let dense = shortfalls(&promise_run("rk4", 0.0, 1e-9, 1e-3), fixed(1e6, 1e-9));
+    let dense = shortfalls(
+        &promise_run("rk4", 0.0, 1e-9, 1e-3),
+        fixed(1e6, 1e-9),
+        AT_ORIGIN,
+    );
     assert_eq!(check_list(&dense, ","), "constraint,steady");
 }
 

@@ -276,3 +276,47 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
         );
     }
 }
+
+/// A centre that starts far from the origin: its stored coordinates carry rounding of 2⁻⁵³ |x₀|, which
+/// the constraint check's 8th-order difference over samples 0.01 apart amplifies past the tolerance.
+/// Before, `--set initial.x=1e10` recorded without a word (expected_to_fail empty) and verify failed
+/// `constraint` at 1.05e-4 against 1e-6 (dop853), 7e-4 against 2.4e-7 (rk4); near the origin nothing
+/// changes.
+#[test]
+fn record_warns_when_the_centre_starts_too_far_from_the_origin_for_the_constraint() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |words: &[&str]| words.iter().map(|w| (*w).to_string()).collect::<Vec<_>>();
+    let mut rows = Vec::new();
+    for integrator in ["dop853", "rk4"] {
+        for x in ["1e3", "1e10"] {
+            let flags = s(&[
+                "--integrator",
+                integrator,
+                "--set",
+                &format!("initial.x={x}"),
+            ]);
+            rows.push(corner(d, format!("{integrator}: x0 = {x}"), &flags));
+        }
+    }
+    for r in &rows {
+        println!("{:<24} {:<40} {}", r.case, r.word(), r.verdict());
+        assert_ne!(
+            r.agreement(),
+            "BROKEN PROMISE",
+            "{}: {}",
+            r.case,
+            r.verdict()
+        );
+        assert!(
+            r.failed.is_subset(&r.expected),
+            "{}: verify failed {:?}, record expected {:?}",
+            r.case,
+            r.failed,
+            r.expected
+        );
+        let far = r.case.ends_with("1e10");
+        assert_eq!(r.expected.contains("constraint"), far, "{}", r.case);
+        assert_eq!(r.verify_code == 0, !far, "{}: {}", r.case, r.verdict());
+    }
+}

@@ -486,7 +486,11 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
         sampler.drift.max_omega,
     );
     let tolerance = Tolerances::derive(&accuracy, None, None).energy;
-    let shortfalls = promise::shortfalls(&accuracy, fixed_steps(scene, termination_time));
+    let shortfalls = promise::shortfalls(
+        &accuracy,
+        fixed_steps(scene, termination_time),
+        positions(scene),
+    );
     let doubt = departure_doubt(&scene.coin(), &scene.initial).filter(|_| termination.is_event());
     sampler.finish(
         outcome.stats,
@@ -506,7 +510,15 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
     let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
     let span = scene.run.duration;
     let accuracy = RunAccuracy::new(&scene.run.method, &scene.params, span, omega);
-    promise::shortfalls(&accuracy, fixed_steps(scene, span))
+    promise::shortfalls(&accuracy, fixed_steps(scene, span), positions(scene))
+}
+
+/// Where the centre starts and how far apart its stored coordinates are sampled.
+fn positions(scene: &Scene) -> promise::Positions {
+    promise::Positions {
+        offset: scene.initial.x.abs().max(scene.initial.z.abs()) / scene.params.radius(),
+        sample_interval: scene.run.sample_interval(),
+    }
 }
 
 /// The steps a fixed-step method takes over `span`; `None` for adaptive methods.

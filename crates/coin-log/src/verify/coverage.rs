@@ -5,7 +5,8 @@
 //!
 //! The prediction uses what the checks themselves use: the channels they need, and for `constraint` the
 //! rule that leaves out windows the sampling does not resolve ([`constraint::resolves`]), applied to the
-//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|), with the default residual tolerance the file's settings will give.
+//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|) plus its relative rate of change |d ln Ω/dt| there (the check adds
+//! each window's), with the default residual tolerance the file's settings will give.
 //! The rates at t = 0 stand for the run's: a motion that speeds up later loses only its later windows,
 //! while one that cannot be resolved at the start is in practice not resolved anywhere (the steady and
 //! high-spin scenes keep their rates).
@@ -13,6 +14,7 @@
 use super::checks::constraint;
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
+use crate::model::{Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
@@ -79,7 +81,18 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
     }
     let s = &scene.initial;
     let omega = Vector3::new(s.omega_x, s.omega_y, s.omega_z).norm();
-    let rate = omega.max((s.omega_y / s.theta.cos()).abs());
+    if omega == 0.0 && s.theta == 0.0 {
+        // Upright at rest: eqs (14)–(16) give ω̇ = 0 (sin θ = 0, every other term has a factor ω, and the
+        // dissipative couple is 0 at ω = 0), so ω stays 0 and the check finds nothing moving.
+        return Some(
+            "will find nothing to compare: the coin starts upright at rest (θ = 0, ω = 0), an equilibrium \
+             it never leaves, so its centre does not move; give it a motion (a tilt or a spin), or start \
+             it as the steady motion `steady = { kind = \"straight\", omega_z = 0 }`, which `steady` judges"
+                .to_string(),
+        );
+    }
+    let phi_dot = (s.omega_y / s.theta.cos()).abs();
+    let rate = omega.max(phi_dot) + initial_steepness(scene, omega, phi_dot);
     let accuracy = RunAccuracy::new(&run.method, &scene.params, run.duration, omega);
     let tol = Tolerances::derive(&accuracy, None, None).residual;
     let h = run.sample_interval();
@@ -96,6 +109,35 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
         constraint::truncation(h, rate),
         digits3(constraint::min_rate(rate, tol), f64::ceil)
     ))
+}
+
+/// |d ln Ω/dt| at t = 0 for Ω = max(|ω|, |φ̇|), the relative change the check adds to the rate of each
+/// window ([`constraint`]'s steepest term), from ω̇ of the scene's equations: a dissipative couple brakes
+/// from the first instant, and one strong enough changes the rates within a sample.
+fn initial_steepness(scene: &Scene, omega: f64, phi_dot: f64) -> f64 {
+    let s = &scene.initial;
+    let mut y = [0.0; DISSIPATIVE_STATE_LEN];
+    y[..STATE_LEN].copy_from_slice(&s.to_array());
+    let mut dydt = [0.0; DISSIPATIVE_STATE_LEN];
+    match scene.dynamics() {
+        Dynamics::Conservative(coin) => {
+            let mut rate = [0.0; STATE_LEN];
+            coin.derivative(&s.to_array(), &mut rate);
+            dydt[..STATE_LEN].copy_from_slice(&rate);
+        }
+        Dynamics::Dissipative(coin) => coin.derivative(&y, &mut dydt),
+    }
+    let (dx, dy, dz) = (dydt[3], dydt[4], dydt[5]);
+    let steepness = if phi_dot > omega {
+        dy / s.omega_y + s.theta.tan() * s.omega_x
+    } else {
+        (s.omega_x * dx + s.omega_y * dy + s.omega_z * dz) / (omega * omega)
+    };
+    if steepness.is_finite() {
+        steepness.abs()
+    } else {
+        0.0
+    }
 }
 
 /// `x` rounded by `round` to 3 significant digits (`f64::ceil` for a rate that is enough).

@@ -544,7 +544,7 @@ fn verdict(
         c.constraint.finish(ctx.coin.params().radius(), &tol),
         c.consistency.finish(),
         c.validity.finish(&ctx),
-        c.nutation.finish(&ctx, &tol),
+        c.nutation.finish(&ctx, &tol, &c.stats),
     ];
     let failed = results.iter().any(|r| r.status == Status::Fail);
     let missing = missing_required(&results);

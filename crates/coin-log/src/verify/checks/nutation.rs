@@ -7,9 +7,13 @@
 //! interpolant of ω_X and φ between samples); T and ΔΦ are the mean spacing of like turning points.
 //!
 //! **Tolerance**: the integrator's share (format.md: verify, Tolerances) plus the quadrature's own error
-//! estimate plus the meter's bound on its interpolation error ([`TurningPoints::interpolation_error`]).
+//! estimate plus the meter's bound on its interpolation error ([`TurningPoints::interpolation_error`])
+//! plus the timing bound ([`timing_error`]): the integrator keeps ω to ε of the state's scale W, not of
+//! the nutation's own amplitude, so a small nutation's turning points are timed no better than that error
+//! over ω_X's slope there.
 
-use super::{fmt_num, worst, Context};
+use super::{fmt_num, worst, Context, RunStats};
+use crate::format::promise::GROWTH_SHARE;
 use crate::format::tolerances::Tolerances;
 use crate::model::nutation::{Motion, Orbit};
 use crate::model::{State, TurningPoints};
@@ -23,11 +27,16 @@ const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
 const INTERPOLATION_SHARE: f64 = 0.1;
 /// Smallest θ range worth measuring \[rad\]: below it the crossings of ω_X are the integrator's noise.
 const MIN_AMPLITUDE: f64 = 1e-8;
+/// Largest timing bound ([`timing_error`]) the check accepts: the ceiling of every default tolerance
+/// (format.md: Tolerances). Above it the nutation is too small for the recorded accuracy to time.
+const MAX_TIMING: f64 = 1e-6;
 
 #[derive(Debug, Default, Clone)]
 pub struct NutationCheck {
     initial: Option<State>,
     turning_points: TurningPoints,
+    /// max|ω_X| over the samples: the nutation's amplitude in ω_X.
+    max_omega_x: f64,
 }
 
 impl NutationCheck {
@@ -36,17 +45,23 @@ impl NutationCheck {
             return;
         };
         self.initial.get_or_insert(state);
+        self.max_omega_x = self.max_omega_x.max(state.omega_x.abs());
         self.turning_points.observe(&ctx.coin, s.t, &state);
     }
 
     /// The result: T and ΔΦ against the quadrature, or why they cannot be compared.
     #[must_use]
-    pub fn finish(&self, ctx: &Context, tol: &Tolerances) -> CheckResult {
-        self.judge(ctx, tol)
+    pub fn finish(&self, ctx: &Context, tol: &Tolerances, stats: &RunStats) -> CheckResult {
+        self.judge(ctx, tol, stats)
             .unwrap_or_else(|reason| CheckResult::skip(CheckId::Nutation, reason))
     }
 
-    fn judge(&self, ctx: &Context, tol: &Tolerances) -> Result<CheckResult, String> {
+    fn judge(
+        &self,
+        ctx: &Context,
+        tol: &Tolerances,
+        stats: &RunStats,
+    ) -> Result<CheckResult, String> {
         if let Some(d) = ctx.dynamics.dissipation() {
             return Err(format!(
                 "the run has dissipation ({}): E, C1 and C2 change, so θ does not nutate periodically and the quadrature (physics §10) does not apply",
@@ -84,7 +99,11 @@ impl NutationCheck {
                 fmt_num(orbit.theta_max - orbit.theta_min)
             ));
         }
-        self.compare(&orbit, (period, precession), tol)
+        let time_unit = ctx.coin.params().time_unit();
+        let growth = 1.0 + (stats.last_t - stats.first_t.unwrap_or(0.0)).max(0.0) / time_unit;
+        let scale = stats.max_omega.max(1.0 / time_unit);
+        let omega_error = GROWTH_SHARE * tol.epsilon * growth * scale;
+        self.compare(&orbit, (period, precession), tol, omega_error)
     }
 
     fn compare(
@@ -92,6 +111,7 @@ impl NutationCheck {
         orbit: &Orbit,
         (period, precession): (f64, f64),
         tol: &Tolerances,
+        omega_error: f64,
     ) -> Result<CheckResult, String> {
         let meter = &self.turning_points;
         let measured = meter.measure().ok_or_else(|| {
@@ -121,7 +141,16 @@ impl NutationCheck {
                 fmt_num(tol.nutation)
             ));
         }
-        let tolerance = tol.nutation + orbit.error + interpolation;
+        let timing = timing_error(omega_error, self.max_omega_x, period, measured.span);
+        if timing > MAX_TIMING {
+            return Err(format!(
+                "the nutation is too small for the recorded accuracy: ω_X swings by {} only, and an error of {} in ω (0.1 ε (1 + T/τ) W, what the integrator's errors reach) times its turning points to {} of T, above {MAX_TIMING:e}; record with a tighter --rtol/--atol (--step) or a larger nutation",
+                fmt_num(self.max_omega_x),
+                fmt_num(omega_error),
+                fmt_num(timing)
+            ));
+        }
+        let tolerance = tol.nutation + orbit.error + interpolation + timing;
         let t_error = (t_measured - period).abs() / period;
         let phi_error = (phi_measured - precession).abs() / precession.abs().max(1.0);
         let (value, _, which) = worst(
@@ -133,7 +162,7 @@ impl NutationCheck {
             value,
             tolerance,
             format!(
-                "{which} is the worst measure: T = {} measured over {} periods ({} maxima, {} minima of θ) vs {} by quadrature, relative {}; ΔΦ = {} vs {} rad, off by {} (relative to max(|ΔΦ|, 1 rad)); tolerance {} + quadrature {} + interpolation {}",
+                "{which} is the worst measure: T = {} measured over {} periods ({} maxima, {} minima of θ) vs {} by quadrature, relative {}; ΔΦ = {} vs {} rad, off by {} (relative to max(|ΔΦ|, 1 rad)); tolerance {} + quadrature {} + interpolation {} + timing {}",
                 t_measured,
                 fmt_num(measured.periods),
                 meter.maxima(),
@@ -145,10 +174,24 @@ impl NutationCheck {
                 fmt_num(phi_error),
                 fmt_num(tol.nutation),
                 fmt_num(orbit.error),
-                fmt_num(interpolation)
+                fmt_num(interpolation),
+                fmt_num(timing)
             ),
         ))
     }
+}
+
+/// Relative error of T and ΔΦ from the timing of the turning points: the recorded ω_X may be off by
+/// `omega_error` = 0.1 ε (1 + T_run/τ) W (the error an integrator held to ε reaches over the run, the
+/// share [`GROWTH_SHARE`] `record` predicts for the drifts, format.md: What record promises), which
+/// moves a zero of ω_X by omega_error / |ω̇_X|, |ω̇_X| = A σ at a zero of a nutation of amplitude
+/// A = max|ω_X| and frequency σ = 2π/T; the first and last turning points of a span each move so, 2 of
+/// them over `span`.
+/// Measured on `circle-plus` kicked by δω_X = 1e-5 … 1.5e-8 (dop853 and dopri5, defaults): the error is
+/// 1/65 … 1/3 of this bound, and 2.6e-8 … 1.2e-4 against the 1e-8 of the nutation tolerance alone.
+fn timing_error(omega_error: f64, max_omega_x: f64, period: f64, span: f64) -> f64 {
+    let sigma = std::f64::consts::TAU / period;
+    2.0 * omega_error / (max_omega_x * sigma * span)
 }
 
 /// The flat margin of the stored scene (the default when the scene cannot be read).
