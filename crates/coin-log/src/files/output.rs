@@ -410,6 +410,8 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
 pub struct OutputFolder {
     dir: PathBuf,
     overwrite: bool,
+    /// A file no output may replace, and what it is ([`Policy::protect`]).
+    protect: Option<(PathBuf, &'static str)>,
     outputs: Vec<Output>,
     /// The folders this created, deepest first.
     created: Vec<PathBuf>,
@@ -443,6 +445,7 @@ impl OutputFolder {
         let mut folder = Self {
             dir: dir.to_path_buf(),
             overwrite,
+            protect: None,
             outputs: Vec::new(),
             created: Vec::new(),
         };
@@ -460,6 +463,14 @@ impl OutputFolder {
         &self.dir
     }
 
+    /// No file of the folder may replace `file` (the input being read, however reached), `what` saying
+    /// what it is: [`Policy::protect`].
+    #[must_use]
+    pub fn protecting(mut self, file: &Path, what: &'static str) -> Self {
+        self.protect = Some((file.to_path_buf(), what));
+        self
+    }
+
     /// Starts the file `name` in the folder; returns a handle to write it through.
     ///
     /// # Errors
@@ -468,6 +479,7 @@ impl OutputFolder {
         let policy = Policy {
             overwrite: self.overwrite,
             flag: "--out",
+            protect: self.protect.clone(),
             ..Policy::default()
         };
         let mut output = Output::create(&self.dir.join(name), &policy)?;
