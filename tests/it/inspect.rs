@@ -680,3 +680,41 @@ fn log_times_print_as_exact_decimals() {
         assert_eq!(seconds_text(ns), text);
     }
 }
+
+/// `info --scene` on a file that cannot be read to its end (cut in its chunk, or with a header record
+/// claiming more bytes than the file has) still prints the stored scene, but exits 1 with the problem on
+/// stderr, as `info` does, and its comment does not claim that a command line writes the same bytes again.
+#[test]
+fn the_stored_scene_of_a_damaged_file_is_printed_with_exit_1_and_no_reproduction_claim() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "straight", &["--duration", "0.5"]);
+    let bytes = std::fs::read(&path).unwrap();
+    let cut = dir.path().join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    let mut lying = bytes.clone();
+    lying[9..17].copy_from_slice(&u64::MAX.to_le_bytes());
+    let header = dir.path().join("header.mcap");
+    std::fs::write(&header, &lying).unwrap();
+    for (file, problem) in [
+        (&cut, "truncated"),
+        (&header, "claims 18446744073709551615 bytes"),
+    ] {
+        let (code, text, err) = coin_log_text(&["info", file.to_str().unwrap(), "--scene"]);
+        println!(
+            "exit {code}: {err}{}",
+            text.lines().take(3).collect::<Vec<_>>().join("\n")
+        );
+        assert_eq!(code, 1, "{text}{err}");
+        assert!(err.starts_with("error: ") && err.contains(problem), "{err}");
+        assert!(
+            text.contains("could not be read to its end")
+                && !text.contains("writes the same bytes"),
+            "{text}"
+        );
+        assert!(text.contains("[body]"), "the scene is printed: {text}");
+    }
+    // The whole file: exit 0 and the command line.
+    let (code, text, err) = coin_log_text(&["info", path.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(text.contains("writes the same bytes again"), "{text}");
+}
