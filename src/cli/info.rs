@@ -184,7 +184,7 @@ fn text(shown: &str, i: &FileInfo) -> String {
         "read from",
         match i.source {
             info::Source::Summary => "the summary section".into(),
-            info::Source::Scan => "the whole file (it has no summary section)".into(),
+            info::Source::Scan => "the whole file (it has no complete summary section)".into(),
         },
     ));
     if let Some(p) = &i.problem {

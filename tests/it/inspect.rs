@@ -27,17 +27,27 @@ fn json(out: &std::process::Output) -> serde_json::Value {
 /// Copies `src` into `dst` with the `mcap` crate's writer and no summary section (no statistics, no
 /// indexes), as a recording from another writer or an unfinished one might be.
 fn without_summary(src: &Path, dst: &Path) {
+    copy_with(
+        src,
+        dst,
+        mcap::WriteOptions::new()
+            .emit_summary_records(false)
+            .emit_summary_offsets(false)
+            .emit_statistics(false)
+            .emit_chunk_indexes(false)
+            .emit_metadata_indexes(false),
+    );
+}
+
+/// Copies the `coin-log` record and the messages of `src` into `dst` with the `mcap` crate's writer, lz4
+/// chunks and the summary `options` make.
+fn copy_with(src: &Path, dst: &Path, options: mcap::WriteOptions) {
     let bytes = std::fs::read(src).unwrap();
     let file = read_back(&bytes);
     let out = std::io::BufWriter::new(std::fs::File::create(dst).unwrap());
-    let mut w = mcap::WriteOptions::new()
+    let mut w = options
         .compression(Some(mcap::Compression::Lz4))
         .library("another-writer")
-        .emit_summary_records(false)
-        .emit_summary_offsets(false)
-        .emit_statistics(false)
-        .emit_chunk_indexes(false)
-        .emit_metadata_indexes(false)
         .create(out)
         .unwrap();
     let run = &file.metadata[RUN_METADATA_NAME].1;
@@ -161,6 +171,69 @@ fn info_reports_what_the_file_holds_with_or_without_a_summary() {
         "summary section",
     ] {
         assert!(text.contains(expected), "`{expected}` in:\n{text}");
+    }
+}
+
+/// MCAP makes each group of the summary optional: a summary with statistics but without the metadata
+/// indexes, the chunk indexes or the schema and channel records does not say what the file holds, so
+/// `info` reads the file instead and describes it as it describes the copy with the whole summary (it
+/// said `coin_log` false, 0 chunks or no channels).
+#[test]
+fn info_reads_the_file_when_its_summary_leaves_a_group_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "topple", &["--duration", "1"]);
+    let options = || mcap::WriteOptions::new().chunk_size(Some(64 << 10));
+    copy_with(&path, &dir.path().join("whole.mcap"), options());
+    let copies = [
+        ("no-metadata-index", options().emit_metadata_indexes(false)),
+        ("no-chunk-index", options().emit_chunk_indexes(false)),
+        ("no-channels", options().emit_summary_records(false)),
+    ];
+    for (name, o) in copies {
+        copy_with(&path, &dir.path().join(format!("{name}.mcap")), o);
+    }
+    let out = coin_log(
+        dir.path(),
+        &[
+            "info",
+            "--json",
+            "whole.mcap",
+            "no-metadata-index.mcap",
+            "no-chunk-index.mcap",
+            "no-channels.mcap",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = json(&out);
+    let files = v["files"].as_array().unwrap();
+    let whole = &files[0];
+    assert_eq!(whole["read_from"], "summary");
+    assert_eq!(whole["coin_log"], true);
+    assert!(whole["chunks"].as_u64().unwrap() > 1, "{whole}");
+    assert_eq!(whole["channels"].as_array().unwrap().len(), 13, "{whole}");
+    let comparable = |f: &serde_json::Value| {
+        let mut f = f.clone();
+        for key in ["path", "file_size", "read_from"] {
+            f.as_object_mut().unwrap().remove(key);
+        }
+        f
+    };
+    for f in &files[1..] {
+        println!(
+            "{}: read from {}, coin_log {}, {} chunks, {} channels",
+            f["path"],
+            f["read_from"],
+            f["coin_log"],
+            f["chunks"],
+            f["channels"].as_array().unwrap().len()
+        );
+        assert_eq!(f["read_from"], "scan", "{}", f["path"]);
+        assert_eq!(comparable(f), comparable(whole), "{}", f["path"]);
     }
 }
 
