@@ -42,6 +42,12 @@ fn without_summary(src: &Path, dst: &Path) {
 /// Copies the `coin-log` record and the messages of `src` into `dst` with the `mcap` crate's writer, lz4
 /// chunks and the summary `options` make.
 fn copy_with(src: &Path, dst: &Path, options: mcap::WriteOptions) {
+    copy_twice(src, dst, options, "");
+}
+
+/// [`copy_with`], with the messages of `topic` written twice, on two channels of that topic (legal
+/// MCAP: two publishers of one topic).
+fn copy_twice(src: &Path, dst: &Path, options: mcap::WriteOptions, topic: &str) {
     let bytes = std::fs::read(src).unwrap();
     let file = read_back(&bytes);
     let out = std::io::BufWriter::new(std::fs::File::create(dst).unwrap());
@@ -59,29 +65,36 @@ fn copy_with(src: &Path, dst: &Path, options: mcap::WriteOptions) {
     let mut ids = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
-        let id = *ids.entry(m.channel.topic.clone()).or_insert_with(|| {
-            let schema = m.channel.schema.as_ref().unwrap();
-            let sid = w
-                .add_schema(&schema.name, &schema.encoding, &schema.data)
-                .unwrap();
-            w.add_channel(
-                sid,
-                &m.channel.topic,
-                &m.channel.message_encoding,
-                &BTreeMap::new(),
+        let copies = if m.channel.topic == topic { 2 } else { 1 };
+        for copy in 0..copies {
+            let id = *ids
+                .entry((m.channel.topic.clone(), copy))
+                .or_insert_with(|| {
+                    let schema = m.channel.schema.as_ref().unwrap();
+                    let sid = w
+                        .add_schema(&schema.name, &schema.encoding, &schema.data)
+                        .unwrap();
+                    // Another publisher: the writer merges an identical channel into the first.
+                    let publisher = (copy > 0).then(|| ("publisher".to_string(), copy.to_string()));
+                    w.add_channel(
+                        sid,
+                        &m.channel.topic,
+                        &m.channel.message_encoding,
+                        &publisher.into_iter().collect(),
+                    )
+                    .unwrap()
+                });
+            w.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: m.sequence,
+                    log_time: m.log_time,
+                    publish_time: m.publish_time,
+                },
+                &m.data,
             )
-            .unwrap()
-        });
-        w.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: id,
-                sequence: m.sequence,
-                log_time: m.log_time,
-                publish_time: m.publish_time,
-            },
-            &m.data,
-        )
-        .unwrap();
+            .unwrap();
+        }
     }
     w.finish().unwrap();
 }
@@ -587,6 +600,50 @@ fn the_wide_table_joins_the_channels_on_t() {
         std::fs::read(dir.path().join("wide/samples.csv")).unwrap(),
         std::fs::read(dir.path().join("wide-bare/samples.csv")).unwrap()
     );
+}
+
+/// Two channels of one topic (legal MCAP) would make one table twice: export refuses the file naming
+/// the topic and the table, before anything lands (it moved the first `omega.csv` into place, failed on
+/// the second, and left a temporary file in the folder).
+#[test]
+fn two_channels_of_one_topic_are_refused_and_nothing_lands() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "topple", &["--duration", "1"]);
+    for topic in ["/coin/omega", "/tf_static"] {
+        let copy = dir.path().join("twice.mcap");
+        copy_twice(&path, &copy, mcap::WriteOptions::new(), topic);
+        for existing in [false, true] {
+            let out_dir = dir.path().join("tables");
+            if existing {
+                std::fs::create_dir(&out_dir).unwrap();
+            }
+            let (code, _, err) = coin_log_text(&[
+                "export",
+                copy.to_str().unwrap(),
+                "--out",
+                out_dir.to_str().unwrap(),
+            ]);
+            println!("{topic}: exit {code}: {err}");
+            assert_eq!(code, 1, "{err}");
+            let table = format!(
+                "`{}.csv`",
+                topic.trim_start_matches('/').replace("coin/", "")
+            );
+            assert!(
+                err.contains(&format!("two channels of the topic {topic}")) && err.contains(&table),
+                "{err}"
+            );
+            if existing {
+                assert!(
+                    std::fs::read_dir(&out_dir).unwrap().next().is_none(),
+                    "left empty"
+                );
+                std::fs::remove_dir(&out_dir).unwrap();
+            } else {
+                assert!(!out_dir.exists(), "not created");
+            }
+        }
+    }
 }
 
 /// Parquet is not built in: a clear error naming why and how to convert; nothing is written.
