@@ -592,3 +592,70 @@ fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
     let (code, _, err) = verify(&good);
     assert_eq!(code, 0, "{err}");
 }
+
+/// A `coin-log.result` record whose termination_time is not a finite time ≥ 0 (NaN, inf, -5) fails
+/// integrity: verify judged such a file ok, and plot labelled its termination "at t = NaN".
+#[test]
+fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrity() {
+    use std::collections::BTreeMap;
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let bytes = std::fs::read(&good).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let metadata: Vec<mcap::records::Metadata> = summary
+        .metadata_indexes
+        .iter()
+        .map(|i| mcap::read::metadata(&bytes, i).unwrap())
+        .collect();
+    for time in ["NaN", "inf", "-5", "1.5"] {
+        let path = dir.path().join("result.mcap");
+        let mut w = mcap::WriteOptions::new()
+            .create(std::io::BufWriter::new(
+                std::fs::File::create(&path).unwrap(),
+            ))
+            .unwrap();
+        for m in metadata.iter().filter(|m| m.name == "coin-log") {
+            w.write_metadata(m).unwrap();
+        }
+        let mut ids: BTreeMap<String, u16> = BTreeMap::new();
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            let id = *ids.entry(m.channel.topic.clone()).or_insert_with(|| {
+                let s = m.channel.schema.as_ref().unwrap();
+                let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+                w.add_channel(
+                    sid,
+                    &m.channel.topic,
+                    &m.channel.message_encoding,
+                    &BTreeMap::new(),
+                )
+                .unwrap()
+            });
+            let header = mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+            };
+            w.write_to_known_channel(&header, &m.data).unwrap();
+        }
+        for m in metadata.iter().filter(|m| m.name != "coin-log") {
+            let mut m = m.clone();
+            m.metadata.insert("termination_time".into(), time.into());
+            w.write_metadata(&m).unwrap();
+        }
+        w.finish().unwrap();
+        let (code, out, err) = verify(&path);
+        println!("termination_time = {time}: exit {code}");
+        let complaint = "metadata says termination_time =";
+        if time == "1.5" {
+            // Negative control: a finite time is not this check's to judge.
+            assert!(!out.contains(complaint), "{out}{err}");
+        } else {
+            assert_eq!(code, 1, "{out}{err}");
+            assert!(
+                out.contains(complaint) && out.contains("not a finite time ≥ 0"),
+                "{out}"
+            );
+        }
+    }
+}

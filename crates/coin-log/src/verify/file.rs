@@ -608,6 +608,19 @@ impl Judge {
                 "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
             });
         }
+        if let Some(t) = ctx
+            .result
+            .as_ref()
+            .map(|r| r.termination_time)
+            .filter(|t| !t.is_finite() || *t < 0.0)
+        {
+            self.problems.push_with(|| {
+                format!(
+                    "the `coin-log.result` metadata says termination_time = {t}, not a finite time \
+                     ≥ 0"
+                )
+            });
+        }
         if ctx.result.is_none() && read_whole {
             self.problems.push_with(|| {
                 "no `coin-log.result` metadata record (the run did not finish writing)".into()
