@@ -78,7 +78,8 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<Outcome> {
         PathBuf::from(format!("{stem}-csv"))
     });
     // Dropped on an error: every table and the folders it created go with it.
-    let mut folder = OutputFolder::create(&dir, args.overwrite)?;
+    let mut folder = OutputFolder::create(&dir, args.overwrite)?
+        .protecting(&args.file, "the recording being exported");
     let progress = FileProgress::new(&shown_file, len);
     let layout = if args.wide {
         Layout::Wide

@@ -115,17 +115,32 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
         reproduction(&shown, &i, run),
         coin_log::scene::readable_toml(&run.scene)
     );
+    // The scene is still worth having, but a file that could not be read to its end is an error, as
+    // for `info` without --scene.
+    if let Some(problem) = &i.problem {
+        errln!("error: {shown}: {problem}");
+        return Ok(Outcome::Failure);
+    }
     Ok(Outcome::Success)
 }
 
 /// The comment lines before `--scene`'s TOML: the `coin-log record` command line that writes the file's
 /// bytes again from that text (every setting the scene does not hold: encoding and compression), or why
-/// no command can.
+/// no command can (mixed encodings or compressions, or a file that could not be read to its end).
 fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
     let mut text = format!(
         "# The scene stored in `{shown}` (written by coin-log {}).\n",
         run.tool_version
     );
+    if i.problem.is_some() {
+        // Its encoding and compression are those of the part read, and its bytes are not all known.
+        let _ = writeln!(
+            text,
+            "# It could not be read to its end (the error says why), so no command line is known to \
+             write\n# the same bytes again."
+        );
+        return text;
+    }
     let (encoding, compression) = (i.encoding(), i.compression());
     let named = |word: &str, names: &[&str]| names.contains(&word);
     if !named(&encoding, Encoding::NAMES) || !named(&compression, Compression::NAMES) {
@@ -169,7 +184,7 @@ fn text(shown: &str, i: &FileInfo) -> String {
         "read from",
         match i.source {
             info::Source::Summary => "the summary section".into(),
-            info::Source::Scan => "the whole file (it has no summary section)".into(),
+            info::Source::Scan => "the whole file (it has no complete summary section)".into(),
         },
     ));
     if let Some(p) = &i.problem {

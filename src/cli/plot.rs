@@ -42,7 +42,7 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
         overwrite: args.overwrite,
         flag: "--out",
         example: "plot.svg".into(),
-        protect: None,
+        protect: Some((args.file.clone(), "the recording being plotted")),
     };
     // Before reading: a bad target costs nothing.
     let mut output = Output::create(&target, &policy)?;

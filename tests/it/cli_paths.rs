@@ -613,3 +613,71 @@ fn an_output_ending_with_a_slash_that_names_no_folder_is_named() {
     );
     assert_eq!(code(&out), 0, "{}", stderr(&out));
 }
+
+/// `plot` and `export` never replace the recording they read, even with `--overwrite` and however it is
+/// named (the same path, another spelling of it, a table name in the export folder): it would be gone
+/// once the output is moved into place. Negative control: another existing file is replaced.
+#[test]
+fn plot_and_export_never_replace_the_recording_they_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = coin_log(d, &["record", "topple", "-o", "run.mcap"]);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    std::fs::create_dir(d.join("tables")).unwrap();
+    std::fs::copy(d.join("run.mcap"), d.join("tables/omega.csv")).unwrap();
+    let recording = std::fs::read(d.join("run.mcap")).unwrap();
+    let runs: [(&[&str], &str, &str); 3] = [
+        (
+            &["plot", "run.mcap", "--out", "run.mcap", "--overwrite"],
+            "`run.mcap` is the recording being plotted; writing there would replace it",
+            "run.mcap",
+        ),
+        (
+            &[
+                "plot",
+                "run.mcap",
+                "--out",
+                "./tables/../run.mcap",
+                "--overwrite",
+            ],
+            "is the recording being plotted",
+            "run.mcap",
+        ),
+        (
+            &[
+                "export",
+                "tables/omega.csv",
+                "--out",
+                "tables",
+                "--overwrite",
+            ],
+            "omega.csv` is the recording being exported; writing there would replace it",
+            "tables/omega.csv",
+        ),
+    ];
+    let before = (listing(d), listing(&d.join("tables")));
+    for (args, needle, input) in runs {
+        let out = coin_log(d, args);
+        println!("{args:?}: exit {}: {}", code(&out), stderr(&out));
+        assert_eq!(code(&out), 1, "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        assert_eq!(std::fs::read(d.join(input)).unwrap(), recording, "{args:?}");
+        assert_eq!(
+            (listing(d), listing(&d.join("tables"))),
+            before,
+            "{args:?}: the folders are as they were"
+        );
+    }
+    // Negative control: another file of the same names is replaced with --overwrite.
+    std::fs::write(d.join("other.svg"), "old").unwrap();
+    let out = coin_log(
+        d,
+        &["plot", "run.mcap", "--out", "other.svg", "--overwrite"],
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let out = coin_log(d, &["export", "run.mcap", "--out", "tables", "--overwrite"]);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(std::fs::read_to_string(d.join("tables/omega.csv"))
+        .unwrap()
+        .starts_with("t,"));
+}

@@ -27,17 +27,33 @@ fn json(out: &std::process::Output) -> serde_json::Value {
 /// Copies `src` into `dst` with the `mcap` crate's writer and no summary section (no statistics, no
 /// indexes), as a recording from another writer or an unfinished one might be.
 fn without_summary(src: &Path, dst: &Path) {
+    copy_with(
+        src,
+        dst,
+        mcap::WriteOptions::new()
+            .emit_summary_records(false)
+            .emit_summary_offsets(false)
+            .emit_statistics(false)
+            .emit_chunk_indexes(false)
+            .emit_metadata_indexes(false),
+    );
+}
+
+/// Copies the `coin-log` record and the messages of `src` into `dst` with the `mcap` crate's writer, lz4
+/// chunks and the summary `options` make.
+fn copy_with(src: &Path, dst: &Path, options: mcap::WriteOptions) {
+    copy_twice(src, dst, options, "");
+}
+
+/// [`copy_with`], with the messages of `topic` written twice, on two channels of that topic (legal
+/// MCAP: two publishers of one topic).
+fn copy_twice(src: &Path, dst: &Path, options: mcap::WriteOptions, topic: &str) {
     let bytes = std::fs::read(src).unwrap();
     let file = read_back(&bytes);
     let out = std::io::BufWriter::new(std::fs::File::create(dst).unwrap());
-    let mut w = mcap::WriteOptions::new()
+    let mut w = options
         .compression(Some(mcap::Compression::Lz4))
         .library("another-writer")
-        .emit_summary_records(false)
-        .emit_summary_offsets(false)
-        .emit_statistics(false)
-        .emit_chunk_indexes(false)
-        .emit_metadata_indexes(false)
         .create(out)
         .unwrap();
     let run = &file.metadata[RUN_METADATA_NAME].1;
@@ -49,29 +65,36 @@ fn without_summary(src: &Path, dst: &Path) {
     let mut ids = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
-        let id = *ids.entry(m.channel.topic.clone()).or_insert_with(|| {
-            let schema = m.channel.schema.as_ref().unwrap();
-            let sid = w
-                .add_schema(&schema.name, &schema.encoding, &schema.data)
-                .unwrap();
-            w.add_channel(
-                sid,
-                &m.channel.topic,
-                &m.channel.message_encoding,
-                &BTreeMap::new(),
+        let copies = if m.channel.topic == topic { 2 } else { 1 };
+        for copy in 0..copies {
+            let id = *ids
+                .entry((m.channel.topic.clone(), copy))
+                .or_insert_with(|| {
+                    let schema = m.channel.schema.as_ref().unwrap();
+                    let sid = w
+                        .add_schema(&schema.name, &schema.encoding, &schema.data)
+                        .unwrap();
+                    // Another publisher: the writer merges an identical channel into the first.
+                    let publisher = (copy > 0).then(|| ("publisher".to_string(), copy.to_string()));
+                    w.add_channel(
+                        sid,
+                        &m.channel.topic,
+                        &m.channel.message_encoding,
+                        &publisher.into_iter().collect(),
+                    )
+                    .unwrap()
+                });
+            w.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: m.sequence,
+                    log_time: m.log_time,
+                    publish_time: m.publish_time,
+                },
+                &m.data,
             )
-            .unwrap()
-        });
-        w.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: id,
-                sequence: m.sequence,
-                log_time: m.log_time,
-                publish_time: m.publish_time,
-            },
-            &m.data,
-        )
-        .unwrap();
+            .unwrap();
+        }
     }
     w.finish().unwrap();
 }
@@ -161,6 +184,69 @@ fn info_reports_what_the_file_holds_with_or_without_a_summary() {
         "summary section",
     ] {
         assert!(text.contains(expected), "`{expected}` in:\n{text}");
+    }
+}
+
+/// MCAP makes each group of the summary optional: a summary with statistics but without the metadata
+/// indexes, the chunk indexes or the schema and channel records does not say what the file holds, so
+/// `info` reads the file instead and describes it as it describes the copy with the whole summary (it
+/// said `coin_log` false, 0 chunks or no channels).
+#[test]
+fn info_reads_the_file_when_its_summary_leaves_a_group_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "topple", &["--duration", "1"]);
+    let options = || mcap::WriteOptions::new().chunk_size(Some(64 << 10));
+    copy_with(&path, &dir.path().join("whole.mcap"), options());
+    let copies = [
+        ("no-metadata-index", options().emit_metadata_indexes(false)),
+        ("no-chunk-index", options().emit_chunk_indexes(false)),
+        ("no-channels", options().emit_summary_records(false)),
+    ];
+    for (name, o) in copies {
+        copy_with(&path, &dir.path().join(format!("{name}.mcap")), o);
+    }
+    let out = coin_log(
+        dir.path(),
+        &[
+            "info",
+            "--json",
+            "whole.mcap",
+            "no-metadata-index.mcap",
+            "no-chunk-index.mcap",
+            "no-channels.mcap",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = json(&out);
+    let files = v["files"].as_array().unwrap();
+    let whole = &files[0];
+    assert_eq!(whole["read_from"], "summary");
+    assert_eq!(whole["coin_log"], true);
+    assert!(whole["chunks"].as_u64().unwrap() > 1, "{whole}");
+    assert_eq!(whole["channels"].as_array().unwrap().len(), 13, "{whole}");
+    let comparable = |f: &serde_json::Value| {
+        let mut f = f.clone();
+        for key in ["path", "file_size", "read_from"] {
+            f.as_object_mut().unwrap().remove(key);
+        }
+        f
+    };
+    for f in &files[1..] {
+        println!(
+            "{}: read from {}, coin_log {}, {} chunks, {} channels",
+            f["path"],
+            f["read_from"],
+            f["coin_log"],
+            f["chunks"],
+            f["channels"].as_array().unwrap().len()
+        );
+        assert_eq!(f["read_from"], "scan", "{}", f["path"]);
+        assert_eq!(comparable(f), comparable(whole), "{}", f["path"]);
     }
 }
 
@@ -516,6 +602,50 @@ fn the_wide_table_joins_the_channels_on_t() {
     );
 }
 
+/// Two channels of one topic (legal MCAP) would make one table twice: export refuses the file naming
+/// the topic and the table, before anything lands (it moved the first `omega.csv` into place, failed on
+/// the second, and left a temporary file in the folder).
+#[test]
+fn two_channels_of_one_topic_are_refused_and_nothing_lands() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "topple", &["--duration", "1"]);
+    for topic in ["/coin/omega", "/tf_static"] {
+        let copy = dir.path().join("twice.mcap");
+        copy_twice(&path, &copy, mcap::WriteOptions::new(), topic);
+        for existing in [false, true] {
+            let out_dir = dir.path().join("tables");
+            if existing {
+                std::fs::create_dir(&out_dir).unwrap();
+            }
+            let (code, _, err) = coin_log_text(&[
+                "export",
+                copy.to_str().unwrap(),
+                "--out",
+                out_dir.to_str().unwrap(),
+            ]);
+            println!("{topic}: exit {code}: {err}");
+            assert_eq!(code, 1, "{err}");
+            let table = format!(
+                "`{}.csv`",
+                topic.trim_start_matches('/').replace("coin/", "")
+            );
+            assert!(
+                err.contains(&format!("two channels of the topic {topic}")) && err.contains(&table),
+                "{err}"
+            );
+            if existing {
+                assert!(
+                    std::fs::read_dir(&out_dir).unwrap().next().is_none(),
+                    "left empty"
+                );
+                std::fs::remove_dir(&out_dir).unwrap();
+            } else {
+                assert!(!out_dir.exists(), "not created");
+            }
+        }
+    }
+}
+
 /// Parquet is not built in: a clear error naming why and how to convert; nothing is written.
 #[test]
 fn parquet_is_refused_with_the_way_to_convert() {
@@ -679,4 +809,42 @@ fn log_times_print_as_exact_decimals() {
     ] {
         assert_eq!(seconds_text(ns), text);
     }
+}
+
+/// `info --scene` on a file that cannot be read to its end (cut in its chunk, or with a header record
+/// claiming more bytes than the file has) still prints the stored scene, but exits 1 with the problem on
+/// stderr, as `info` does, and its comment does not claim that a command line writes the same bytes again.
+#[test]
+fn the_stored_scene_of_a_damaged_file_is_printed_with_exit_1_and_no_reproduction_claim() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "straight", &["--duration", "0.5"]);
+    let bytes = std::fs::read(&path).unwrap();
+    let cut = dir.path().join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    let mut lying = bytes.clone();
+    lying[9..17].copy_from_slice(&u64::MAX.to_le_bytes());
+    let header = dir.path().join("header.mcap");
+    std::fs::write(&header, &lying).unwrap();
+    for (file, problem) in [
+        (&cut, "truncated"),
+        (&header, "claims 18446744073709551615 bytes"),
+    ] {
+        let (code, text, err) = coin_log_text(&["info", file.to_str().unwrap(), "--scene"]);
+        println!(
+            "exit {code}: {err}{}",
+            text.lines().take(3).collect::<Vec<_>>().join("\n")
+        );
+        assert_eq!(code, 1, "{text}{err}");
+        assert!(err.starts_with("error: ") && err.contains(problem), "{err}");
+        assert!(
+            text.contains("could not be read to its end")
+                && !text.contains("writes the same bytes"),
+            "{text}"
+        );
+        assert!(text.contains("[body]"), "the scene is printed: {text}");
+    }
+    // The whole file: exit 0 and the command line.
+    let (code, text, err) = coin_log_text(&["info", path.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(text.contains("writes the same bytes again"), "{text}");
 }

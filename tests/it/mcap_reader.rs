@@ -247,3 +247,50 @@ fn the_streamed_channels_are_those_the_visitor_was_given_when_the_budget_ends_th
     let streamed: Vec<u16> = s.summary.channels.iter().map(|c| c.id).collect();
     assert_eq!(streamed, v.0);
 }
+
+/// A file cut while it is read (here by the visitor, when the metadata record found before the stream is
+/// passed on) breaks off where its old length no longer holds; the error says the file changed size
+/// rather than blaming a record length ("... which ends with the MCAP magic, so a record length is
+/// wrong") or calling a whole file truncated.
+#[test]
+fn a_file_cut_while_it_is_read_is_named_as_changed() {
+    struct Cutter {
+        path: std::path::PathBuf,
+        to: u64,
+    }
+    impl Visitor for Cutter {
+        fn metadata(&mut self, _: &str, _: &BTreeMap<String, String>) {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&self.path)
+                .unwrap();
+            f.set_len(self.to).unwrap();
+        }
+        fn message(&mut self, _: &MessageHeader, _: &[u8]) -> ControlFlow<()> {
+            ControlFlow::Continue(())
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cut.mcap");
+    let bytes = file(8000, 0);
+    let (len, to) = (bytes.len() as u64, bytes.len() as u64 / 3);
+    std::fs::write(&path, &bytes).unwrap();
+    let mut cutter = Cutter {
+        path: path.clone(),
+        to,
+    };
+    let (_, e) = coin_log_mcap::read(&path, &mut cutter);
+    let e = e.expect("the cut file breaks off");
+    println!("{e:?}");
+    assert!(
+        e.detail.starts_with(&format!(
+            "the file changed size while it was read ({len} bytes when opened, {to} now)"
+        )),
+        "{}",
+        e.detail
+    );
+    // A file that stays as it was keeps its own error (negative control: a cut copy).
+    std::fs::write(&path, &bytes[..to as usize]).unwrap();
+    let (_, e) = coin_log_mcap::read(&path, &mut Recorder::default());
+    assert!(e.unwrap().detail.starts_with("truncated"));
+}

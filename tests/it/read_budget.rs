@@ -267,3 +267,44 @@ fn chunks_at_the_limit_read_like_small_ones_within_the_budget() {
     assert_eq!(json(&large), json(&small));
     assert!(runs.iter().all(|m| m.code == 0), "{runs:?}");
 }
+
+/// A schema under the record limit, used by one channel, counts twice (itself, and with the channel that
+/// may keep it): 9 MiB of schema is refused at 18 MiB kept, and the message says why it is more than the
+/// file holds (it said the schemas "take more than 16 MiB" where the file has 9). Negative control: the
+/// same schema with no channel reads on.
+#[test]
+fn a_schema_used_by_a_channel_counts_twice_and_the_refusal_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let schema_bytes = 9 << 20;
+    for with_channel in [true, false] {
+        let mut schema = 1u16.to_le_bytes().to_vec();
+        schema.extend(crafted::string("big"));
+        schema.extend(crafted::string("jsonschema"));
+        schema.extend((schema_bytes as u32).to_le_bytes());
+        schema.extend(vec![b' '; schema_bytes]);
+        let mut f = crafted::start();
+        let at = f.len();
+        f.extend(crafted::record(op::SCHEMA, &schema));
+        let channel_at = f.len();
+        if with_channel {
+            let mut channel = 1u16.to_le_bytes().to_vec();
+            channel.extend(1u16.to_le_bytes());
+            channel.extend(crafted::string("/big"));
+            channel.extend(crafted::string("json"));
+            channel.extend(0u32.to_le_bytes());
+            f.extend(crafted::record(op::CHANNEL, &channel));
+        }
+        f.extend(crafted::end());
+        let path = dir.path().join("schema.mcap");
+        std::fs::write(&path, f).unwrap();
+        let (code, _, err) =
+            crate::support::record::coin_log_text(&["verify", path.to_str().unwrap()]);
+        println!("schema at byte {at}, channel {with_channel}: exit {code}: {err}");
+        assert_eq!(code, 2, "{err}");
+        let refusal = format!(
+            "the schemas, channels and metadata read up to byte {channel_at} take more than the {LIMIT} \
+             this reader keeps of them (a schema counts once more with each channel that uses it)"
+        );
+        assert_eq!(err.contains(&refusal), with_channel, "{err}");
+    }
+}

@@ -505,3 +505,157 @@ fn a_pipe_is_refused_with_the_reason() {
         )
     );
 }
+
+/// A second channel on `/coin/energy` (legal MCAP: two publishers of one topic) whose messages disagree
+/// with the first: integrity fails naming the topic and both channel ids. Verify judged it ok, reading
+/// one message per sample and never looking at the other channel's.
+#[test]
+fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
+    use std::collections::BTreeMap;
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let path = dir.path().join("two-energies.mcap");
+    let bytes = std::fs::read(&good).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let metadata: Vec<mcap::records::Metadata> = summary
+        .metadata_indexes
+        .iter()
+        .map(|i| mcap::read::metadata(&bytes, i).unwrap())
+        .collect();
+    let mut w = mcap::WriteOptions::new()
+        .create(std::io::BufWriter::new(
+            std::fs::File::create(&path).unwrap(),
+        ))
+        .unwrap();
+    for m in metadata.iter().filter(|m| m.name == "coin-log") {
+        w.write_metadata(m).unwrap();
+    }
+    let mut ids: BTreeMap<(String, bool), u16> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        let copies: &[bool] = if m.channel.topic == "/coin/energy" {
+            &[false, true]
+        } else {
+            &[false]
+        };
+        for &second in copies {
+            let id = *ids
+                .entry((m.channel.topic.clone(), second))
+                .or_insert_with(|| {
+                    let s = m.channel.schema.as_ref().unwrap();
+                    let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+                    // Another publisher: the writer merges an identical channel into the first.
+                    let publisher = second.then(|| ("publisher".to_string(), "2".to_string()));
+                    w.add_channel(
+                        sid,
+                        &m.channel.topic,
+                        &m.channel.message_encoding,
+                        &publisher.into_iter().collect(),
+                    )
+                    .unwrap()
+                });
+            let mut data = m.data.to_vec();
+            if second {
+                crate::support::writers::nudge(&mut data, "total", 1.0);
+            }
+            w.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: m.sequence,
+                    log_time: m.log_time,
+                    publish_time: m.publish_time,
+                },
+                &data,
+            )
+            .unwrap();
+        }
+    }
+    for m in metadata.iter().filter(|m| m.name != "coin-log") {
+        w.write_metadata(m).unwrap();
+    }
+    w.finish().unwrap();
+    let (code, out, err) = coin_log_text(&["verify", "--json", path.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let integrity = &v["files"][0]["checks"][0];
+    println!("exit {code}: {integrity}");
+    assert_eq!(code, 1, "{out}{err}");
+    assert_eq!(integrity["status"], "fail");
+    let reason = integrity["reason"].as_str().unwrap();
+    let first = ids[&("/coin/energy".to_string(), false)];
+    let second = ids[&("/coin/energy".to_string(), true)];
+    assert!(
+        reason.contains(&format!(
+            "topic `/coin/energy` is on two channels ({first} and {second})"
+        )),
+        "{reason}"
+    );
+    // The same file with one channel per topic passes: the defect is the second channel.
+    let (code, _, err) = verify(&good);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// A `coin-log.result` record whose termination_time is not a finite time ≥ 0 (NaN, inf, -5) fails
+/// integrity: verify judged such a file ok, and plot labelled its termination "at t = NaN".
+#[test]
+fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrity() {
+    use std::collections::BTreeMap;
+    let (dir, good) = recorded(&wobble(), "good.mcap");
+    let bytes = std::fs::read(&good).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let metadata: Vec<mcap::records::Metadata> = summary
+        .metadata_indexes
+        .iter()
+        .map(|i| mcap::read::metadata(&bytes, i).unwrap())
+        .collect();
+    for time in ["NaN", "inf", "-5", "1.5"] {
+        let path = dir.path().join("result.mcap");
+        let mut w = mcap::WriteOptions::new()
+            .create(std::io::BufWriter::new(
+                std::fs::File::create(&path).unwrap(),
+            ))
+            .unwrap();
+        for m in metadata.iter().filter(|m| m.name == "coin-log") {
+            w.write_metadata(m).unwrap();
+        }
+        let mut ids: BTreeMap<String, u16> = BTreeMap::new();
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            let id = *ids.entry(m.channel.topic.clone()).or_insert_with(|| {
+                let s = m.channel.schema.as_ref().unwrap();
+                let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+                w.add_channel(
+                    sid,
+                    &m.channel.topic,
+                    &m.channel.message_encoding,
+                    &BTreeMap::new(),
+                )
+                .unwrap()
+            });
+            let header = mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+            };
+            w.write_to_known_channel(&header, &m.data).unwrap();
+        }
+        for m in metadata.iter().filter(|m| m.name != "coin-log") {
+            let mut m = m.clone();
+            m.metadata.insert("termination_time".into(), time.into());
+            w.write_metadata(&m).unwrap();
+        }
+        w.finish().unwrap();
+        let (code, out, err) = verify(&path);
+        println!("termination_time = {time}: exit {code}");
+        let complaint = "metadata says termination_time =";
+        if time == "1.5" {
+            // Negative control: a finite time is not this check's to judge.
+            assert!(!out.contains(complaint), "{out}{err}");
+        } else {
+            assert_eq!(code, 1, "{out}{err}");
+            assert!(
+                out.contains(complaint) && out.contains("not a finite time ≥ 0"),
+                "{out}"
+            );
+        }
+    }
+}

@@ -52,7 +52,8 @@ impl Kept {
                 ReadErrorKind::TooLarge,
                 format!(
                     "the schemas, channels and metadata read up to byte {at} take more than the {} \
-                     this reader keeps of them",
+                     this reader keeps of them (a schema counts once more with each channel that uses \
+                     it)",
                     limit()
                 ),
             ));

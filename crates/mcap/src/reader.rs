@@ -266,17 +266,41 @@ pub fn read_with_progress(
     progress: &(dyn Fn(u64) + Sync),
 ) -> (Structure, Option<ReadError>) {
     match open(path) {
-        Ok((file, len)) => read_from(
-            Counting {
-                inner: file,
-                read: 0,
-                progress,
-            },
-            len,
-            visitor,
-        ),
+        Ok((file, len)) => {
+            let (s, e) = read_from(
+                Counting {
+                    inner: file,
+                    read: 0,
+                    progress,
+                },
+                len,
+                visitor,
+            );
+            (s, e.map(|e| changed_size(path, len, e)))
+        }
         Err(e) => (Structure::default(), Some(e)),
     }
+}
+
+/// `e`, or, when the file at `path` is no longer `len` bytes long, that it changed while it was read: a
+/// file cut or grown under the reader breaks off where its old length no longer holds, which reads as a
+/// wrong record length or a truncation of a file that was whole.
+fn changed_size(path: &Path, len: u64, mut e: ReadError) -> ReadError {
+    if !matches!(e.kind, ReadErrorKind::Truncated | ReadErrorKind::Corrupt) {
+        return e;
+    }
+    if let Some(now) = std::fs::metadata(path)
+        .ok()
+        .map(|m| m.len())
+        .filter(|&n| n != len)
+    {
+        e.detail = format!(
+            "the file changed size while it was read ({len} bytes when opened, {now} now): read it \
+             again once nothing writes it (the read stopped with: {})",
+            e.detail
+        );
+    }
+    e
 }
 
 /// A reader that reports its position.

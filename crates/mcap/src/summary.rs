@@ -66,7 +66,10 @@ pub(crate) fn widen(bounds: Option<(u64, u64)>, t: u64) -> (u64, u64) {
 }
 
 /// Reads the summary of the MCAP file at `path`. `Ok(None)` when the file has no summary section, its
-/// summary has no statistics record, or it is larger than the largest record the reader accepts.
+/// summary has no statistics record or lists fewer channels, schemas, chunk indexes or metadata indexes
+/// than its statistics count (MCAP makes each group optional: the Python writer can leave out the
+/// channels and schemas, or the chunk or metadata indexes), or it is larger than the largest record the
+/// reader accepts.
 ///
 /// # Errors
 /// [`ReadError`] if the file cannot be read, is not MCAP, or its footer, summary (CRC included) or a
@@ -81,7 +84,7 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     };
     let mut records = SummaryRecords::default();
     records.parse(&bytes, start)?;
-    if !records.statistics {
+    if !records.statistics || !records.complete() {
         return Ok(None);
     }
     let mut out = records.summary;
@@ -201,9 +204,26 @@ struct SummaryRecords {
     schemas: BTreeMap<u16, String>,
     counts: BTreeMap<u16, u64>,
     metadata_indexes: Vec<(u64, u64)>,
+    /// The statistics' schema, channel, chunk and metadata counts.
+    stated: [u64; 4],
 }
 
 impl SummaryRecords {
+    /// The summary lists as many schemas, channels, chunk indexes and metadata indexes as its statistics
+    /// count (or more: a repeated record is not the summary's to judge here).
+    fn complete(&self) -> bool {
+        let listed = [
+            self.schemas.len() as u64,
+            self.channels.len() as u64,
+            self.summary.chunks,
+            self.metadata_indexes.len() as u64,
+        ];
+        listed
+            .iter()
+            .zip(self.stated)
+            .all(|(&n, stated)| n >= stated)
+    }
+
     /// Walks the records of the summary section `bytes` (which starts at byte `start` of the file).
     fn parse(&mut self, bytes: &[u8], start: u64) -> Result<(), ReadError> {
         let mut c = Cursor::new(bytes);
@@ -237,6 +257,12 @@ impl SummaryRecords {
                 let s = Statistics::parse_body(body)?;
                 self.counts = s.channel_message_counts;
                 self.statistics = true;
+                self.stated = [
+                    u64::from(s.schema_count),
+                    u64::from(s.channel_count),
+                    u64::from(s.chunk_count),
+                    u64::from(s.metadata_count),
+                ];
                 self.summary.messages = s.message_count;
                 self.summary.time_range =
                     (s.message_count > 0).then_some((s.message_start_time, s.message_end_time));

@@ -481,6 +481,8 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
 pub struct OutputFolder {
     dir: PathBuf,
     overwrite: bool,
+    /// A file no output may replace, and what it is ([`Policy::protect`]).
+    protect: Option<(PathBuf, &'static str)>,
     outputs: Vec<Output>,
     /// The folders this created, deepest first.
     created: Vec<PathBuf>,
@@ -498,6 +500,7 @@ impl OutputFolder {
         let mut folder = Self {
             dir: dir.to_path_buf(),
             overwrite,
+            protect: None,
             outputs: Vec::new(),
             created: Vec::new(),
         };
@@ -530,12 +533,24 @@ impl OutputFolder {
         &self.dir
     }
 
+    /// No file of the folder may replace `file` (the input being read, however reached), `what` saying
+    /// what it is: [`Policy::protect`].
+    #[must_use]
+    pub fn protecting(mut self, file: &Path, what: &'static str) -> Self {
+        self.protect = Some((file.to_path_buf(), what));
+        self
+    }
+
     /// Starts the file `name` in the folder; returns a handle to write it through.
     ///
     /// # Errors
     /// As [`Output::create`].
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
-        let mut output = Output::create(&self.dir.join(name), &folder_policy(self.overwrite))?;
+        let policy = Policy {
+            protect: self.protect.clone(),
+            ..folder_policy(self.overwrite)
+        };
+        let mut output = Output::create(&self.dir.join(name), &policy)?;
         let file = output
             .file()
             .try_clone()

@@ -52,6 +52,9 @@ pub enum FieldsError {
     /// A field the schema does not have.
     #[error("has a field `{0}` its schema does not declare")]
     Unknown(String),
+    /// A field given twice (JSON leaves its value undefined; `verify` refuses it too).
+    #[error("has the field `{0}` twice")]
+    Repeated(String),
     /// A field whose value is not a finite number.
     #[error("has `{field}` = {value}, not a finite number")]
     NotNumber {
@@ -69,8 +72,15 @@ pub fn read_fields(data: &[u8], fields: &[&str], out: &mut [f64]) -> Result<(), 
     if parse_numbers_into(data, fields, out) {
         return Ok(());
     }
-    let object: BTreeMap<String, serde_json::Value> =
+    let Entries(entries) =
         serde_json::from_slice(data).map_err(|e| FieldsError::NotObject(e.to_string()))?;
+    let mut object = BTreeMap::new();
+    for (key, value) in entries {
+        if object.contains_key(&key) {
+            return Err(FieldsError::Repeated(key));
+        }
+        object.insert(key, value);
+    }
     if let Some(extra) = object.keys().find(|k| !fields.contains(&k.as_str())) {
         return Err(FieldsError::Unknown(extra.clone()));
     }
@@ -87,6 +97,32 @@ pub fn read_fields(data: &[u8], fields: &[&str], out: &mut [f64]) -> Result<(), 
             })?;
     }
     Ok(())
+}
+
+/// A JSON object's entries in text order, a repeated key kept (a map would keep only its last value).
+struct Entries(Vec<(String, serde_json::Value)>);
+
+impl<'de> serde::Deserialize<'de> for Entries {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Object;
+        impl<'de> serde::de::Visitor<'de> for Object {
+            type Value = Entries;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a map")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut m: A,
+            ) -> Result<Entries, A::Error> {
+                let mut entries = Vec::new();
+                while let Some(entry) = m.next_entry()? {
+                    entries.push(entry);
+                }
+                Ok(Entries(entries))
+            }
+        }
+        d.deserialize_map(Object)
+    }
 }
 
 /// Exact powers of ten as f64 (10²² is the largest).
@@ -253,6 +289,14 @@ mod tests {
             (
                 r#"{"t":1,"x":2,"y":3,"w":4}"#,
                 FieldsError::Unknown("w".into()),
+            ),
+            (
+                r#"{"t":1,"x":5,"x":2,"y":3}"#,
+                FieldsError::Repeated("x".into()),
+            ),
+            (
+                r#"{"t":1,"x":2,"y":3,"\u0074":1}"#,
+                FieldsError::Repeated("t".into()),
             ),
             (
                 r#"{"t":1,"x":"2","y":3}"#,

@@ -192,6 +192,21 @@ pub fn export<W: Write>(
 impl<W: Write> Exporter<'_, W> {
     /// Opens table `name` with `columns` and writes its header.
     fn open_table(&mut self, name: &str, topic: &str, columns: Vec<String>) -> Option<usize> {
+        // Two channels of one topic (legal MCAP: two publishers), or topics that differ only where
+        // the name does not show it, would write one file twice.
+        if let Some(other) = self.tables.iter().find(|o| o.table.name == name) {
+            let first = shown_name(&other.table.topics.join(", "));
+            let which = if other.table.topics == [topic] {
+                format!("two channels of the topic {first}")
+            } else {
+                format!("the topics {first} and {}", shown_name(topic))
+            };
+            self.fail(ExportError(format!(
+                "{which} would both be exported as `{name}`, and a table holds one channel; export a \
+                 copy of the file without one of them"
+            )));
+            return None;
+        }
         let opened = (self.open)(name).and_then(|w| {
             let mut out = BufWriter::with_capacity(BUFFER, w);
             out.write_all(csv::record(&columns).as_bytes())

@@ -105,6 +105,8 @@ struct SchemaJudged {
 #[derive(Default)]
 struct Judge {
     channels: Vec<Option<ChannelState>>,
+    /// The channel id of each of coin-log's topics, at its first channel.
+    topics: BTreeMap<Topic, u16>,
     ctx: Option<Context>,
     /// The `coin-log.result` record, kept until the end (it may come before or after `coin-log`).
     result: Option<ResultMetadata>,
@@ -246,6 +248,19 @@ impl Visitor for Judge {
         schema: Option<&Schema<'_>>,
     ) {
         let known = Topic::from_name(topic);
+        // MCAP allows several channels on one topic; the contract has one, and a second would be read
+        // beside the first unseen (a sample keeps one message per channel of the table).
+        if let Some(t) = known {
+            let first = *self.topics.entry(t).or_insert(id);
+            if first != id {
+                self.problems.push_with(|| {
+                    format!(
+                        "topic `{topic}` is on two channels ({first} and {id}); the contract has one \
+                         channel per topic"
+                    )
+                });
+            }
+        }
         // A topic of fixed wire form (the CDR robot description) is judged by that form, not by the file's.
         let fixed = known == Some(Topic::RerunRobot);
         let mut judged = match schema {
@@ -591,6 +606,19 @@ impl Judge {
         if ctx.run.dissipation.is_none() && self.assembler.declared(Channel::Work) {
             self.problems.push_with(|| {
                 "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
+            });
+        }
+        if let Some(t) = ctx
+            .result
+            .as_ref()
+            .map(|r| r.termination_time)
+            .filter(|t| !t.is_finite() || *t < 0.0)
+        {
+            self.problems.push_with(|| {
+                format!(
+                    "the `coin-log.result` metadata says termination_time = {t}, not a finite time \
+                     ≥ 0"
+                )
             });
         }
         if ctx.result.is_none() && read_whole {
