@@ -276,6 +276,39 @@ fn collect_names_a_missing_part_a_run_in_two_parts_and_changed_files_and_then_wr
 }
 
 #[test]
+fn collect_refuses_a_part_whose_row_names_another_runs_file() {
+    // Two rows of a part with their indexes swapped: each file still matches its row's size and
+    // SHA-256, so only the file's name shows that run 0's row holds run 3's values (collect once wrote
+    // that catalogue).
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for k in 0..3 {
+        let shard = format!("{k}/3");
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
+            0
+        );
+    }
+    let part = dir.path().join("d/catalogue.part-0-of-3.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let (a, b) = (
+        lines[1].split_once(',').unwrap(),
+        lines[2].split_once(',').unwrap(),
+    );
+    let swapped = [format!("{},{}", b.0, a.1), format!("{},{}", a.0, b.1)];
+    lines.splice(1..3, swapped);
+    std::fs::write(&part, lines.join("\n") + "\n").unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`catalogue.part-0-of-3.csv` line 3: run 0's row names the file `run-03.mcap`, not `run-00.mcap`"),
+        "{err}"
+    );
+    assert!(!dir.path().join("d/catalogue.csv").exists());
+}
+
+#[test]
 fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);

@@ -185,6 +185,12 @@ impl Folder {
         self.plan["runs"].as_u64().unwrap_or(0)
     }
 
+    /// The name of run `index`'s file in this sweep (`run-007.mcap`), as the plan's `index_width` pads it.
+    pub fn run_file_name(&self, index: u64) -> String {
+        let width = self.plan["index_width"].as_u64().unwrap_or(1);
+        run_file_name(index, usize::try_from(width).unwrap_or(1))
+    }
+
     /// The catalogue's columns in the plan.
     pub fn columns(&self) -> Vec<String> {
         let columns = self.plan["columns"].as_array().into_iter().flatten();
