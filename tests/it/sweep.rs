@@ -549,6 +549,32 @@ normal = { mean = 0.0, std = 0.0, min = "x" }
 }
 
 #[test]
+fn a_uniform_draw_wider_than_the_largest_double_is_a_problem_not_a_sweep_of_inf() {
+    // Both bounds finite and lo < hi, but hi − lo overflows: lo + (hi − lo)·u was inf for every run
+    // (each a failed row, `--dry-run` showing inf in every row).
+    let err = refused(
+        r#"
+base = "wobble"
+[random]
+seed = 1
+count = 3
+[[random.draw]]
+key = "body.mass"
+uniform = [-1e308, 1.7e308]
+[[random.draw]]
+key = "body.radius"
+uniform = [-8e307, 8e307]
+"#,
+    );
+    assert!(
+        err.contains("`random.draw[0].uniform` = [-1000")
+            && err.contains("is wider than the largest double (hi − lo overflows, so every draw would be inf): narrow it, or draw log_uniform"),
+        "{err}"
+    );
+    assert!(!err.contains("draw[1]"), "a width that fits is fine: {err}");
+}
+
+#[test]
 fn axes_of_more_values_than_memory_and_sweep_json_take_are_refused_before_any_is_made() {
     // A linspace of 10⁹ values (as many as a sweep's runs) once asked for 32 GB and aborted.
     let err = refused(

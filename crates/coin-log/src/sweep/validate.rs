@@ -376,6 +376,12 @@ impl Checker {
         };
         match pair.filter(|&p| ok(p)) {
             Some((lo, hi)) if log => Some(Distribution::LogUniform { lo, hi }),
+            // lo + (hi − lo)·u is inf for every u when the width overflows.
+            Some((lo, hi)) if (hi - lo).is_infinite() => self.problems.reject(
+                name,
+                array_text(spec),
+                "is wider than the largest double (hi − lo overflows, so every draw would be inf): narrow it, or draw log_uniform",
+            ),
             Some((lo, hi)) => Some(Distribution::Uniform { lo, hi }),
             None => {
                 let need = if log { "0 < lo < hi" } else { "lo < hi" };
