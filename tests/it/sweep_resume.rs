@@ -243,3 +243,65 @@ fn a_sweep_interrupted_at_random_points_resumes_to_the_uninterrupted_result() {
     let summary = |d: &Path| std::fs::read_to_string(d.join("sweep.json")).unwrap();
     assert_eq!(summary(&cut), summary(&reference));
 }
+
+#[test]
+fn a_signal_before_the_runs_start_quits_at_once_writing_nothing() {
+    // Every run's bounded normal draw fails after 10⁶ attempts, so the dry run's thousand sampled runs,
+    // and the coverage warning's search for a valid run before a real sweep, take a minute; a signal
+    // was ignored until they ended (the dry run then said "the catalogue of what finished is written").
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(
+        dir.path(),
+        "s.toml",
+        r#"
+base = "wobble"
+[random]
+seed = 3
+count = 1000
+[[random.draw]]
+key = "body.mass"
+normal = { mean = 1.0, std = 1e-300, min = 5.0, max = 6.0 }
+"#,
+    );
+    for args in [&["--dry-run"][..], &["-o", "out"]] {
+        let mut command = Command::new(exe());
+        for v in SCHEDULER_VARIABLES {
+            command.env_remove(v);
+        }
+        let mut child = command
+            .args(["sweep", "s.toml"])
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(500));
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        let started = std::time::Instant::now();
+        let code = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status.code();
+            }
+            if started.elapsed() > Duration::from_secs(10) {
+                let _ = child.kill();
+                panic!("{args:?}: still running 10 s after SIGINT");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        assert_eq!(code, Some(130), "{args:?}: {err}");
+        assert!(
+            err.contains("stopped before any run: nothing written"),
+            "{err}"
+        );
+        assert!(!err.contains("catalogue"), "{err}");
+        assert!(
+            !dir.path().join("out").exists(),
+            "{args:?} wrote the folder"
+        );
+    }
+}
