@@ -575,6 +575,73 @@ uniform = [-8e307, 8e307]
 }
 
 #[test]
+fn a_sweep_of_the_most_runs_starts_at_once_in_little_memory() {
+    // 10⁹ runs is allowed; resume listed every one to do in a Vec<u64> (8 GB) before the first started,
+    // deaf to signals. Under a 2 GB address-space limit that aborted ("memory allocation … failed").
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(
+        dir.path(),
+        "s.toml",
+        r#"
+base = "wobble"
+set = { "run.duration" = 0.1, "run.rate" = 20.0 }
+[random]
+seed = 1
+count = 1000000000
+[[random.draw]]
+key = "body.mass"
+uniform = [1, 2]
+[output]
+verify = false
+"#,
+    );
+    let script = format!(
+        "ulimit -v 2000000; exec '{}' sweep s.toml -o out --jobs 1 --json",
+        exe().display()
+    );
+    let mut command = std::process::Command::new("sh");
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    let mut child = command
+        .args(["-c", &script])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = dir.path().join("out");
+    let started = std::time::Instant::now();
+    let made = |out: &Path| {
+        std::fs::read_dir(out).is_ok_and(|mut d| {
+            d.any(|e| e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with("run-")))
+        })
+    };
+    while !made(&out) {
+        if started.elapsed() > std::time::Duration::from_secs(20) {
+            let _ = child.kill();
+            panic!("no run made within 20 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let output = child.wait_with_output().unwrap();
+    let (out_text, err) = (
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr),
+    );
+    assert_eq!(output.status.code(), Some(130), "{out_text}{err}");
+    let json: serde_json::Value = serde_json::from_str(&out_text).unwrap();
+    assert_eq!(json["runs"].as_u64(), Some(1_000_000_000));
+    assert!(json["finished"].as_u64().unwrap() >= 1, "{json}");
+    if let Some(rss) = json["peak_rss_bytes"].as_u64() {
+        assert!(rss < 200 << 20, "peak RSS {rss} B: {json}");
+    }
+}
+
+#[test]
 fn axes_of_more_values_than_memory_and_sweep_json_take_are_refused_before_any_is_made() {
     // A linspace of 10⁹ values (as many as a sweep's runs) once asked for 32 GB and aborted.
     let err = refused(

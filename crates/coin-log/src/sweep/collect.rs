@@ -213,7 +213,9 @@ fn check_files(
     };
     let mut problems = Vec::new();
     let never = AtomicBool::new(false);
-    super::on_threads(&with_files, jobs, &never, check, |b| problems.extend(b));
+    let check_at = |i: u64| with_files.get(usize::try_from(i).ok()?).and_then(check);
+    let len = with_files.len() as u64;
+    super::on_threads(len, jobs, &never, check_at, |b| problems.extend(b));
     problems.sort();
     problems.into_iter().map(|(_, p)| p).collect()
 }
