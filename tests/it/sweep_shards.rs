@@ -487,6 +487,41 @@ fn links_in_the_sweep_folder_are_refused_never_written_through_or_replaced() {
 // The library's Shard alone: its arithmetic and the schedulers' variables.
 
 #[test]
+fn a_state_folder_that_is_a_link_or_a_file_and_a_dangling_output_link_are_refused() {
+    // `.coin-log-sweep` as a link was followed (the plan, journal and lock written into the folder it
+    // points to); as a file, and -o as a dangling link, gave "File exists (os error 17)", exit 1.
+    use std::os::unix::fs::symlink;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_sweep(d, "s.toml", SMALL);
+    std::fs::create_dir_all(d.join("linked")).unwrap();
+    std::fs::create_dir_all(d.join("elsewhere")).unwrap();
+    symlink("../elsewhere", d.join("linked/.coin-log-sweep")).unwrap();
+    std::fs::create_dir_all(d.join("filed")).unwrap();
+    std::fs::write(d.join("filed/.coin-log-sweep"), "mine").unwrap();
+    symlink("nowhere", d.join("dangling")).unwrap();
+    for (out, says) in [
+        ("linked", "`linked`: holds `.coin-log-sweep` as a symbolic link, not the folder a sweep keeps its state in"),
+        ("filed", "`filed`: holds `.coin-log-sweep` as a file, not the folder a sweep keeps its state in"),
+        ("dangling", "`dangling`: is a symbolic link to `nowhere`, which does not exist: create that folder, or give -o another"),
+    ] {
+        let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", out]);
+        assert_eq!(code, 2, "{out}: {err}");
+        assert!(err.contains(says), "{err}");
+    }
+    assert!(
+        listing(&d.join("elsewhere")).is_empty(),
+        "written through the link"
+    );
+    assert_eq!(listing(&d.join("linked")), [".coin-log-sweep"]);
+    assert_eq!(
+        std::fs::read_to_string(d.join("filed/.coin-log-sweep")).unwrap(),
+        "mine"
+    );
+    assert!(!d.join("nowhere").exists());
+}
+
+#[test]
 fn shards_overlap_exactly_when_they_share_a_run() {
     let all: Vec<Shard> = (1..=6)
         .flat_map(|n| (0..n).map(move |k| Shard::new(k, n).unwrap()))

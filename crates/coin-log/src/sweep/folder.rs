@@ -129,9 +129,24 @@ impl Folder {
                 "is not a folder: give -o a folder for the sweep's files".into(),
             ));
         }
+        if let (false, Ok(target)) = (path.exists(), fs::read_link(path)) {
+            return Err(folder_error(format!(
+                "is a symbolic link to `{}`, which does not exist: create that folder, or give -o another",
+                target.display()
+            )));
+        }
         fs::create_dir_all(path).map_err(SweepError::io("creating the sweep folder", path))?;
         let state = path.join(STATE_DIR);
-        if !state.is_dir() {
+        // Not `is_dir`, which follows a link: the state would be written wherever it points.
+        let state_kind = fs::symlink_metadata(&state).map(|m| m.file_type());
+        if state_kind.as_ref().is_ok_and(|t| !t.is_dir()) {
+            return Err(folder_error(format!(
+                "holds `{STATE_DIR}` as a {}, not the folder a sweep keeps its state in: it is no sweep's \
+                 folder; give -o a new or empty folder",
+                if state_kind.is_ok_and(|t| t.is_symlink()) { "symbolic link" } else { "file" }
+            )));
+        }
+        if state_kind.is_err() {
             let entries =
                 fs::read_dir(path).map_err(SweepError::io("reading the sweep folder", path))?;
             if let Some(other) = entries.flatten().find(|e| e.file_name() != STATE_DIR) {
