@@ -642,6 +642,57 @@ verify = false
 }
 
 #[test]
+fn a_system_that_refuses_threads_fails_runs_not_the_sweep() {
+    // Under a limit on processes (a cluster's pids limit, `ulimit -u`), spawning the sweep's workers and
+    // a verification's reading thread panicked ("failed to spawn thread"), killing the sweep with
+    // nothing catalogued. The limit binds root only through another user: setpriv, where there is one.
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMALL.replace("count = 2", "count = 10");
+    write_sweep(dir.path(), "s.toml", &text);
+    let mode = std::os::unix::fs::PermissionsExt::from_mode(0o777);
+    std::fs::set_permissions(dir.path(), mode).unwrap();
+    // prlimit and setpriv are util-linux's; as root the limit binds only another user.
+    let root = std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .unwrap()
+        .stdout
+        == b"0\n";
+    let mut args = vec!["--nproc=40:40".to_string(), "--".to_string()];
+    if root {
+        args.extend(
+            [
+                "setpriv",
+                "--reuid=65534",
+                "--regid=65534",
+                "--clear-groups",
+            ]
+            .map(String::from),
+        );
+    }
+    args.push(exe().display().to_string());
+    args.extend(["sweep", "s.toml", "-o", "out", "--jobs", "200"].map(String::from));
+    let mut command = std::process::Command::new("prlimit");
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    let output = command
+        .args(&args)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        matches!(output.status.code(), Some(0 | 1)),
+        "{:?}: {err}",
+        output.status
+    );
+    let catalogue = Csv::read(&dir.path().join("out/catalogue.csv"));
+    assert_eq!(catalogue.rows.len(), SMALL_RUNS * 5, "{err}");
+}
+
+#[test]
 fn axes_of_more_values_than_memory_and_sweep_json_take_are_refused_before_any_is_made() {
     // A linspace of 10⁹ values (as many as a sweep's runs) once asked for 32 GB and aborted.
     let err = refused(

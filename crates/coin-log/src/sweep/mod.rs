@@ -46,26 +46,46 @@ fn on_threads<R: Send>(
     let next = AtomicU64::new(0);
     let (sender, receiver) = mpsc::channel();
     let threads = usize::try_from(len.max(1)).map_or(jobs, |len| jobs.clamp(1, len));
+    let worker = |sender: mpsc::Sender<R>| {
+        while !stop.load(Ordering::SeqCst) {
+            let position = next.fetch_add(1, Ordering::SeqCst);
+            if position >= len {
+                break;
+            }
+            let Some(result) = work(position) else {
+                continue;
+            };
+            if sender.send(result).is_err() {
+                break;
+            }
+        }
+    };
     std::thread::scope(|scope| {
+        let mut spawned = 0;
         for _ in 0..threads.max(1) {
             let sender = sender.clone();
-            let (next, work) = (&next, &work);
-            scope.spawn(move || {
-                while !stop.load(Ordering::SeqCst) {
-                    let position = next.fetch_add(1, Ordering::SeqCst);
-                    if position >= len {
-                        break;
-                    }
-                    let Some(result) = work(position) else {
-                        continue;
-                    };
-                    if sender.send(result).is_err() {
-                        break;
-                    }
-                }
-            });
+            let worker = &worker;
+            // The system may refuse a thread (its limit on processes or threads): go on with those
+            // it gave (scope.spawn would panic).
+            let thread = std::thread::Builder::new().spawn_scoped(scope, move || worker(sender));
+            if thread.is_err() {
+                break;
+            }
+            spawned += 1;
         }
         drop(sender);
+        if spawned == 0 {
+            // Not one thread: the work is done here, each result handled as it comes.
+            while !stop.load(Ordering::SeqCst) {
+                let position = next.fetch_add(1, Ordering::SeqCst);
+                if position >= len {
+                    break;
+                }
+                if let Some(result) = work(position) {
+                    handle(vec![result]);
+                }
+            }
+        }
         for first in &receiver {
             let mut batch = vec![first];
             batch.extend(receiver.try_iter());
