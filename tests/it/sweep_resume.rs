@@ -95,6 +95,45 @@ fn resume_redoes_only_missing_cut_or_changed_files_and_keeps_what_it_can_prove_u
 }
 
 #[test]
+fn a_journal_row_that_names_another_runs_file_is_redone_not_kept() {
+    // Two journal rows with their indexes swapped: each file matched its row's size and time, so resume
+    // kept them, and the catalogue gave run 0 another run's values and file.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
+        0
+    );
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
+        0
+    );
+    let out = dir.path().join("out");
+    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let at = |i: usize| {
+        lines
+            .iter()
+            .position(|l| l.split(',').nth(1) == Some(&i.to_string()))
+            .unwrap()
+    };
+    let (a, b) = (at(0), at(4));
+    let fields = |l: &str| l.splitn(3, ',').map(str::to_string).collect::<Vec<_>>();
+    let (fa, fb) = (fields(&lines[a]), fields(&lines[b]));
+    lines[a] = format!("{},{},{}", fa[0], fb[1], fa[2]);
+    lines[b] = format!("{},{},{}", fb[0], fa[1], fb[2]);
+    std::fs::write(&journal, lines.join("\n") + "\n").unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(2), Some(10)),
+        "runs 0 and 4 redone: {json}"
+    );
+    assert_eq!(rows(&out), rows(&dir.path().join("ref")));
+}
+
+#[test]
 fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let text = "base = \"wobble\"\nset = { \"run.duration\" = 0.5 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6, 0.5]\n";

@@ -238,22 +238,27 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         };
         let retry = status == RunStatus::Failed
             && (options.retry_failed || f[failure_at] == FailureKind::Io.name());
-        let file_ok = f[file_at].is_empty() || {
-            let path = folder.file(&f[file_at]);
-            match folder::size_and_mtime(&path) {
-                Some((size, mtime)) if size.to_string() == f[bytes_at] && mtime == row.mtime_ns => {
-                    true
-                }
-                Some((size, mtime)) if size.to_string() == f[bytes_at] => {
-                    let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
-                    if same {
-                        resumed.refreshed.push((mtime, crate::csv::line(f)));
+        // A row names its own run's file or none (one naming another's, an edited index, is redone).
+        let own = folder::run_file_name(index, sweep.index_width());
+        let file_ok = f[file_at].is_empty()
+            || f[file_at] == own && {
+                let path = folder.file(&f[file_at]);
+                match folder::size_and_mtime(&path) {
+                    Some((size, mtime))
+                        if size.to_string() == f[bytes_at] && mtime == row.mtime_ns =>
+                    {
+                        true
                     }
-                    same
+                    Some((size, mtime)) if size.to_string() == f[bytes_at] => {
+                        let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
+                        if same {
+                            resumed.refreshed.push((mtime, crate::csv::line(f)));
+                        }
+                        same
+                    }
+                    _ => false,
                 }
-                _ => false,
-            }
-        };
+            };
         if !retry && file_ok {
             resumed.failed += u64::from(status == RunStatus::Failed);
             resumed.held.insert(index, crate::csv::line(f));
