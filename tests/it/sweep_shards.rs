@@ -616,6 +616,13 @@ fn slurm_and_kubernetes_variables_give_the_shard() {
         .contains("--shard-count"));
     assert_eq!(Shard::from_environment(env(&[]), None), Ok(None));
     assert!(Shard::from_environment(env(&[]), Some(2)).is_err());
+    // An index beyond the count names the Kubernetes fix (it named a Slurm array's `--array=0-2`).
+    let beyond = Shard::from_environment(env(&[("JOB_COMPLETION_INDEX", "5")]), Some(3));
+    assert_eq!(
+        beyond.unwrap_err().to_string(),
+        "JOB_COMPLETION_INDEX=5 is not below --shard-count 3: give --shard-count the Job's completions \
+         (its pods are indexed 0 … completions − 1)"
+    );
 }
 
 #[test]
