@@ -134,6 +134,43 @@ fn a_journal_row_that_names_another_runs_file_is_redone_not_kept() {
 }
 
 #[test]
+fn bytes_that_are_no_utf8_in_the_journal_spoil_their_line_not_the_resume() {
+    // A byte of damage that is no UTF-8 made every resume fail ("stream did not contain valid UTF-8",
+    // exit 1, no fix); the doc leaves out a line that does not parse, and redoes its run.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
+        0
+    );
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
+        0
+    );
+    let out = dir.path().join("out");
+    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let mut bytes = std::fs::read(&journal).unwrap();
+    // Inside the third line (a row), and a line of garbage after the last.
+    let third = bytes
+        .iter()
+        .enumerate()
+        .filter(|&(_, &b)| b == b'\n')
+        .nth(1)
+        .unwrap()
+        .0;
+    bytes[third + 40] = 0xff;
+    bytes.extend_from_slice(b"\x00\xfe\xff,,\n");
+    std::fs::write(&journal, &bytes).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(1), Some(11)),
+        "the damaged row's run redone: {json}"
+    );
+    assert_eq!(rows(&out), rows(&dir.path().join("ref")));
+}
+
+#[test]
 fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let text = "base = \"wobble\"\nset = { \"run.duration\" = 0.5 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6, 0.5]\n";

@@ -300,7 +300,7 @@ impl Folder {
 
     /// Every journal line of every shard, in the order written (journals by name): the rows, each with
     /// its file's recorded modification time. A last line without its line break (torn by a crash) and
-    /// any line that does not parse are left out.
+    /// any line that does not parse (or is no UTF-8) are left out.
     pub fn journal_rows(&self) -> Result<Vec<JournalRow>, SweepError> {
         let width = 1 + self.columns().len();
         let journals = JOURNAL.list(&self.state()).map_err(SweepError::io(
@@ -310,12 +310,21 @@ impl Folder {
         let mut rows = Vec::new();
         for (_, name) in journals {
             let path = self.state().join(name);
-            let text =
-                files::read_regular(&path).map_err(SweepError::io("reading the journal", &path))?;
+            let mut bytes = Vec::new();
+            io::Read::read_to_end(
+                &mut files::open_regular(&path)
+                    .map_err(SweepError::io("reading the journal", &path))?,
+                &mut bytes,
+            )
+            .map_err(SweepError::io("reading the journal", &path))?;
+            // Bytes that are no UTF-8 (a crash's or a disk's damage) spoil their line only: it is left
+            // out (its run redone), as a torn line is.
+            let text = String::from_utf8_lossy(&bytes);
             let complete = text.rfind('\n').map_or("", |end| &text[..end]);
             rows.extend(
                 complete
                     .lines()
+                    .filter(|line| !line.contains(char::REPLACEMENT_CHARACTER))
                     .filter_map(|line| JournalRow::parse(line, width)),
             );
         }
