@@ -549,6 +549,19 @@ normal = { mean = 0.0, std = 0.0, min = "x" }
 }
 
 #[test]
+fn an_output_channel_list_that_every_run_would_refuse_is_a_problem() {
+    // `output.channels` is fixed for all runs: an empty list or a channel listed twice passed, and every
+    // run was then a failed row with the scene's complaint.
+    for (list, says) in [
+        ("[]", "`output.channels` = [] is empty: list at least one channel, or leave the key out for the scenes' lists"),
+        (r#"["omega", "energy", "omega"]"#, "`output.channels` = \"omega\" is listed twice: list each channel once"),
+    ] {
+        let err = refused(&format!("base = \"wobble\"\n[output]\nchannels = {list}\n"));
+        assert!(err.contains(says), "{err}");
+    }
+}
+
+#[test]
 fn a_uniform_draw_wider_than_the_largest_double_is_a_problem_not_a_sweep_of_inf() {
     // Both bounds finite and lo < hi, but hi − lo overflows: lo + (hi − lo)·u was inf for every run
     // (each a failed row, `--dry-run` showing inf in every row).
