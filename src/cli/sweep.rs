@@ -108,7 +108,8 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
         anyhow::bail!("give a SWEEP.toml to run, or `collect DIR`");
     };
     // First, so that a signal at any later stage stops the sweep cleanly rather than killing it.
-    let stop = install_signals()?;
+    let running = Arc::new(AtomicBool::new(false));
+    let stop = install_signals(Arc::clone(&running))?;
     let sweep = match Sweep::load(path) {
         Ok(sweep) => sweep,
         Err(e) => return Ok(bad_sweep(&e)),
@@ -133,6 +134,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     };
     let started = Instant::now();
     let bar = Bar::new();
+    running.store(true, Ordering::SeqCst);
     let result = sweep::run(&sweep, &dir, &options, &stop, &mut |p| bar.update(p));
     bar.finish();
     let outcome = match result {
@@ -187,11 +189,21 @@ fn warn_about_coverage(sweep: &Sweep) {
 
 /// SIGINT, SIGTERM and SIGHUP: the first stops the sweep (runs in progress are discarded and redone on
 /// resume, the catalogue of what finished is written); a second quits at once (temporary files are
-/// cleaned up on resume).
-fn install_signals() -> anyhow::Result<Arc<AtomicBool>> {
+/// cleaned up on resume). Before `running` is set (checking the sweep file, the coverage warning, a dry
+/// run: each may resolve up to a thousand runs' scenes, a minute for bounded normal draws that seldom
+/// land) nothing has been written, so the first quits at once.
+fn install_signals(running: Arc<AtomicBool>) -> anyhow::Result<Arc<AtomicBool>> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     ctrlc::set_handler(move || {
+        if !running.load(Ordering::SeqCst) {
+            errln!("stopped before any run: nothing written");
+            #[allow(
+                clippy::disallowed_methods,
+                reason = "no run has started and nothing is written yet: quitting leaves nothing behind"
+            )]
+            std::process::exit(130);
+        }
         if !flag.swap(true, Ordering::SeqCst) {
             errln!(
                 "stopping: no new runs; the runs in progress are discarded (redone on resume) and the \

@@ -549,6 +549,163 @@ normal = { mean = 0.0, std = 0.0, min = "x" }
 }
 
 #[test]
+fn an_output_channel_list_that_every_run_would_refuse_is_a_problem() {
+    // `output.channels` is fixed for all runs: an empty list or a channel listed twice passed, and every
+    // run was then a failed row with the scene's complaint.
+    for (list, says) in [
+        ("[]", "`output.channels` = [] is empty: list at least one channel, or leave the key out for the scenes' lists"),
+        (r#"["omega", "energy", "omega"]"#, "`output.channels` = \"omega\" is listed twice: list each channel once"),
+    ] {
+        let err = refused(&format!("base = \"wobble\"\n[output]\nchannels = {list}\n"));
+        assert!(err.contains(says), "{err}");
+    }
+}
+
+#[test]
+fn a_uniform_draw_wider_than_the_largest_double_is_a_problem_not_a_sweep_of_inf() {
+    // Both bounds finite and lo < hi, but hi − lo overflows: lo + (hi − lo)·u was inf for every run
+    // (each a failed row, `--dry-run` showing inf in every row).
+    let err = refused(
+        r#"
+base = "wobble"
+[random]
+seed = 1
+count = 3
+[[random.draw]]
+key = "body.mass"
+uniform = [-1e308, 1.7e308]
+[[random.draw]]
+key = "body.radius"
+uniform = [-8e307, 8e307]
+"#,
+    );
+    assert!(
+        err.contains("`random.draw[0].uniform` = [-1000")
+            && err.contains("is wider than the largest double (hi − lo overflows, so every draw would be inf): narrow it, or draw log_uniform"),
+        "{err}"
+    );
+    assert!(!err.contains("draw[1]"), "a width that fits is fine: {err}");
+}
+
+#[test]
+fn a_sweep_of_the_most_runs_starts_at_once_in_little_memory() {
+    // 10⁹ runs is allowed; resume listed every one to do in a Vec<u64> (8 GB) before the first started,
+    // deaf to signals. Under a 2 GB address-space limit that aborted ("memory allocation … failed").
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(
+        dir.path(),
+        "s.toml",
+        r#"
+base = "wobble"
+set = { "run.duration" = 0.1, "run.rate" = 20.0 }
+[random]
+seed = 1
+count = 1000000000
+[[random.draw]]
+key = "body.mass"
+uniform = [1, 2]
+[output]
+verify = false
+"#,
+    );
+    let script = format!(
+        "ulimit -v 2000000; exec '{}' sweep s.toml -o out --jobs 1 --json",
+        exe().display()
+    );
+    let mut command = std::process::Command::new("sh");
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    let mut child = command
+        .args(["-c", &script])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = dir.path().join("out");
+    let started = std::time::Instant::now();
+    let made = |out: &Path| {
+        std::fs::read_dir(out).is_ok_and(|mut d| {
+            d.any(|e| e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with("run-")))
+        })
+    };
+    while !made(&out) {
+        if started.elapsed() > std::time::Duration::from_secs(20) {
+            let _ = child.kill();
+            panic!("no run made within 20 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let output = child.wait_with_output().unwrap();
+    let (out_text, err) = (
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr),
+    );
+    assert_eq!(output.status.code(), Some(130), "{out_text}{err}");
+    let json: serde_json::Value = serde_json::from_str(&out_text).unwrap();
+    assert_eq!(json["runs"].as_u64(), Some(1_000_000_000));
+    assert!(json["finished"].as_u64().unwrap() >= 1, "{json}");
+    if let Some(rss) = json["peak_rss_bytes"].as_u64() {
+        assert!(rss < 200 << 20, "peak RSS {rss} B: {json}");
+    }
+}
+
+#[test]
+fn a_system_that_refuses_threads_fails_runs_not_the_sweep() {
+    // Under a limit on processes (a cluster's pids limit, `ulimit -u`), spawning the sweep's workers and
+    // a verification's reading thread panicked ("failed to spawn thread"), killing the sweep with
+    // nothing catalogued. The limit binds root only through another user: setpriv, where there is one.
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMALL.replace("count = 2", "count = 10");
+    write_sweep(dir.path(), "s.toml", &text);
+    let mode = std::os::unix::fs::PermissionsExt::from_mode(0o777);
+    std::fs::set_permissions(dir.path(), mode).unwrap();
+    // prlimit and setpriv are util-linux's; as root the limit binds only another user.
+    let root = std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .unwrap()
+        .stdout
+        == b"0\n";
+    let mut args = vec!["--nproc=40:40".to_string(), "--".to_string()];
+    if root {
+        args.extend(
+            [
+                "setpriv",
+                "--reuid=65534",
+                "--regid=65534",
+                "--clear-groups",
+            ]
+            .map(String::from),
+        );
+    }
+    args.push(exe().display().to_string());
+    args.extend(["sweep", "s.toml", "-o", "out", "--jobs", "200"].map(String::from));
+    let mut command = std::process::Command::new("prlimit");
+    for v in SCHEDULER_VARIABLES {
+        command.env_remove(v);
+    }
+    let output = command
+        .args(&args)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        matches!(output.status.code(), Some(0 | 1)),
+        "{:?}: {err}",
+        output.status
+    );
+    let catalogue = Csv::read(&dir.path().join("out/catalogue.csv"));
+    assert_eq!(catalogue.rows.len(), SMALL_RUNS * 5, "{err}");
+}
+
+#[test]
 fn axes_of_more_values_than_memory_and_sweep_json_take_are_refused_before_any_is_made() {
     // A linspace of 10⁹ values (as many as a sweep's runs) once asked for 32 GB and aborted.
     let err = refused(

@@ -276,6 +276,39 @@ fn collect_names_a_missing_part_a_run_in_two_parts_and_changed_files_and_then_wr
 }
 
 #[test]
+fn collect_refuses_a_part_whose_row_names_another_runs_file() {
+    // Two rows of a part with their indexes swapped: each file still matches its row's size and
+    // SHA-256, so only the file's name shows that run 0's row holds run 3's values (collect once wrote
+    // that catalogue).
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for k in 0..3 {
+        let shard = format!("{k}/3");
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
+            0
+        );
+    }
+    let part = dir.path().join("d/catalogue.part-0-of-3.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let (a, b) = (
+        lines[1].split_once(',').unwrap(),
+        lines[2].split_once(',').unwrap(),
+    );
+    let swapped = [format!("{},{}", b.0, a.1), format!("{},{}", a.0, b.1)];
+    lines.splice(1..3, swapped);
+    std::fs::write(&part, lines.join("\n") + "\n").unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`catalogue.part-0-of-3.csv` line 3: run 0's row names the file `run-03.mcap`, not `run-00.mcap`"),
+        "{err}"
+    );
+    assert!(!dir.path().join("d/catalogue.csv").exists());
+}
+
+#[test]
 fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);
@@ -454,6 +487,41 @@ fn links_in_the_sweep_folder_are_refused_never_written_through_or_replaced() {
 // The library's Shard alone: its arithmetic and the schedulers' variables.
 
 #[test]
+fn a_state_folder_that_is_a_link_or_a_file_and_a_dangling_output_link_are_refused() {
+    // `.coin-log-sweep` as a link was followed (the plan, journal and lock written into the folder it
+    // points to); as a file, and -o as a dangling link, gave "File exists (os error 17)", exit 1.
+    use std::os::unix::fs::symlink;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_sweep(d, "s.toml", SMALL);
+    std::fs::create_dir_all(d.join("linked")).unwrap();
+    std::fs::create_dir_all(d.join("elsewhere")).unwrap();
+    symlink("../elsewhere", d.join("linked/.coin-log-sweep")).unwrap();
+    std::fs::create_dir_all(d.join("filed")).unwrap();
+    std::fs::write(d.join("filed/.coin-log-sweep"), "mine").unwrap();
+    symlink("nowhere", d.join("dangling")).unwrap();
+    for (out, says) in [
+        ("linked", "`linked`: holds `.coin-log-sweep` as a symbolic link, not the folder a sweep keeps its state in"),
+        ("filed", "`filed`: holds `.coin-log-sweep` as a file, not the folder a sweep keeps its state in"),
+        ("dangling", "`dangling`: is a symbolic link to `nowhere`, which does not exist: create that folder, or give -o another"),
+    ] {
+        let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", out]);
+        assert_eq!(code, 2, "{out}: {err}");
+        assert!(err.contains(says), "{err}");
+    }
+    assert!(
+        listing(&d.join("elsewhere")).is_empty(),
+        "written through the link"
+    );
+    assert_eq!(listing(&d.join("linked")), [".coin-log-sweep"]);
+    assert_eq!(
+        std::fs::read_to_string(d.join("filed/.coin-log-sweep")).unwrap(),
+        "mine"
+    );
+    assert!(!d.join("nowhere").exists());
+}
+
+#[test]
 fn shards_overlap_exactly_when_they_share_a_run() {
     let all: Vec<Shard> = (1..=6)
         .flat_map(|n| (0..n).map(move |k| Shard::new(k, n).unwrap()))
@@ -548,6 +616,13 @@ fn slurm_and_kubernetes_variables_give_the_shard() {
         .contains("--shard-count"));
     assert_eq!(Shard::from_environment(env(&[]), None), Ok(None));
     assert!(Shard::from_environment(env(&[]), Some(2)).is_err());
+    // An index beyond the count names the Kubernetes fix (it named a Slurm array's `--array=0-2`).
+    let beyond = Shard::from_environment(env(&[("JOB_COMPLETION_INDEX", "5")]), Some(3));
+    assert_eq!(
+        beyond.unwrap_err().to_string(),
+        "JOB_COMPLETION_INDEX=5 is not below --shard-count 3: give --shard-count the Job's completions \
+         (its pods are indexed 0 … completions − 1)"
+    );
 }
 
 #[test]

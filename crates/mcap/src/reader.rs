@@ -411,9 +411,16 @@ fn read_into(
     // Room for every batch, so that handing one back never blocks.
     let (to_producer, recycled) = mpsc::sync_channel(prefetch::POOL);
     std::thread::scope(|scope| {
-        let worker = scope.spawn(move || {
+        // The system may refuse a thread (its limits on threads or memory): an error, not a panic.
+        let spawned = std::thread::Builder::new().spawn_scoped(scope, move || {
             prefetch::produce(file, file_len, to_consumer, recycled);
         });
+        let worker = spawned.map_err(|e| {
+            ReadError::new(
+                ReadErrorKind::Io,
+                format!("cannot start the reading thread: {e}"),
+            )
+        })?;
         // `consume` owns the receiver, so that when it returns early or unwinds, a worker blocked on the
         // full queue wakes with an error and ends, and this scope can join it.
         let result = consume(batches, to_producer, visitor, book);

@@ -82,8 +82,35 @@ pub fn cell(value: &toml::Value) -> String {
     match value {
         toml::Value::Float(x) => number(*x),
         toml::Value::String(s) => s.clone(),
+        other => toml_text(other),
+    }
+}
+
+/// A value as TOML, with its numbers in their shortest form: toml writes a float in full positional
+/// notation (1e300 with 301 digits, 1e-7 as 0.0000001), which the contract's number format is not.
+fn toml_text(value: &toml::Value) -> String {
+    let list = |items: Vec<String>| items.join(", ");
+    match value {
+        toml::Value::Float(x) if x.is_finite() => number(*x),
+        toml::Value::Array(items) => format!("[{}]", list(items.iter().map(toml_text).collect())),
+        toml::Value::Table(table) if !table.is_empty() => {
+            let entries = table
+                .iter()
+                .map(|(k, v)| format!("{} = {}", key_text(k), toml_text(v)));
+            format!("{{ {} }}", list(entries.collect()))
+        }
         other => other.to_string(),
     }
+}
+
+/// A table key as toml writes it (bare, or quoted as it quotes it): `{ K = 0 }`, unwrapped.
+fn key_text(key: &str) -> String {
+    let one = toml::Value::Table(toml::Table::from_iter([(key.to_string(), 0.into())]));
+    let text = one.to_string();
+    let inner = text
+        .strip_prefix("{ ")
+        .and_then(|t| t.strip_suffix(" = 0 }"));
+    inner.map_or_else(|| key.to_string(), str::to_string)
 }
 
 impl Row {
@@ -177,6 +204,29 @@ mod tests {
         assert_eq!(cell(&toml::Value::Integer(250)), "250");
         assert_eq!(cell(&toml::Value::from("hoop")), "hoop");
         assert_eq!(cell(&toml::Value::from(vec![0.0, 1.5])), "[0.0, 1.5]");
+        assert_eq!(
+            cell(&toml::Value::from(vec![1e300, 1e-7, 2.5])),
+            "[1e300, 1e-7, 2.5]"
+        );
+        let steady: toml::Value = toml::from_str::<toml::Table>(
+            r#"v = { kind = "circle", theta = 1e-9, "a b" = [1, { c = 1e22 }], e = {}, f = [], n = nan }"#,
+        )
+        .unwrap()["v"]
+            .clone();
+        assert_eq!(
+            cell(&steady),
+            r#"{ "a b" = [1, { c = 1e22 }], e = {}, f = [], kind = "circle", n = nan, theta = 1e-9 }"#
+        );
+        // Otherwise as toml writes it.
+        for text in [
+            r#"{ kind = "circle", theta = 0.3, branch = "+" }"#,
+            r#"[[0.0, 0.2], { "x.y" = 1, z = [true, "s"] }]"#,
+            "[]",
+            "{}",
+        ] {
+            let v = toml::from_str::<toml::Table>(&format!("v = {text}")).unwrap()["v"].clone();
+            assert_eq!(cell(&v), v.to_string());
+        }
         assert_eq!(
             one_line("2 problems:\n  `a` x\n  `b` y"),
             "2 problems:; `a` x; `b` y"

@@ -98,6 +98,7 @@ fn read_part(
     let path = folder.file(name);
     let text = crate::files::read_regular(&path)
         .map_err(SweepError::io("reading the catalogue part", &path))?;
+    let file_at = folder.column("file");
     let mut lines = text.lines();
     let header = lines.next().and_then(csv::split);
     if header.as_deref() != Some(columns) {
@@ -117,6 +118,17 @@ fn read_part(
             ));
             continue;
         };
+        // A row names its own run's file or none: one that names another's (an edited index) would
+        // pass the file checks below with another run's values.
+        let file = &fields[file_at];
+        if !file.is_empty() && *file != folder.run_file_name(index) {
+            problems.push(format!(
+                "`{name}` line {}: run {index}'s row names the file `{file}`, not `{}`: the part was changed; run its shard again",
+                n + 2,
+                folder.run_file_name(index)
+            ));
+            continue;
+        }
         if let Some(other) = rows.get(&index) {
             problems.push(format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
@@ -201,7 +213,9 @@ fn check_files(
     };
     let mut problems = Vec::new();
     let never = AtomicBool::new(false);
-    super::on_threads(&with_files, jobs, &never, check, |b| problems.extend(b));
+    let check_at = |i: u64| with_files.get(usize::try_from(i).ok()?).and_then(check);
+    let len = with_files.len() as u64;
+    super::on_threads(len, jobs, &never, check_at, |b| problems.extend(b));
     problems.sort();
     problems.into_iter().map(|(_, p)| p).collect()
 }

@@ -129,9 +129,24 @@ impl Folder {
                 "is not a folder: give -o a folder for the sweep's files".into(),
             ));
         }
+        if let (false, Ok(target)) = (path.exists(), fs::read_link(path)) {
+            return Err(folder_error(format!(
+                "is a symbolic link to `{}`, which does not exist: create that folder, or give -o another",
+                target.display()
+            )));
+        }
         fs::create_dir_all(path).map_err(SweepError::io("creating the sweep folder", path))?;
         let state = path.join(STATE_DIR);
-        if !state.is_dir() {
+        // Not `is_dir`, which follows a link: the state would be written wherever it points.
+        let state_kind = fs::symlink_metadata(&state).map(|m| m.file_type());
+        if state_kind.as_ref().is_ok_and(|t| !t.is_dir()) {
+            return Err(folder_error(format!(
+                "holds `{STATE_DIR}` as a {}, not the folder a sweep keeps its state in: it is no sweep's \
+                 folder; give -o a new or empty folder",
+                if state_kind.is_ok_and(|t| t.is_symlink()) { "symbolic link" } else { "file" }
+            )));
+        }
+        if state_kind.is_err() {
             let entries =
                 fs::read_dir(path).map_err(SweepError::io("reading the sweep folder", path))?;
             if let Some(other) = entries.flatten().find(|e| e.file_name() != STATE_DIR) {
@@ -183,6 +198,12 @@ impl Folder {
 
     pub fn runs(&self) -> u64 {
         self.plan["runs"].as_u64().unwrap_or(0)
+    }
+
+    /// The name of run `index`'s file in this sweep (`run-007.mcap`), as the plan's `index_width` pads it.
+    pub fn run_file_name(&self, index: u64) -> String {
+        let width = self.plan["index_width"].as_u64().unwrap_or(1);
+        run_file_name(index, usize::try_from(width).unwrap_or(1))
     }
 
     /// The catalogue's columns in the plan.
@@ -279,7 +300,7 @@ impl Folder {
 
     /// Every journal line of every shard, in the order written (journals by name): the rows, each with
     /// its file's recorded modification time. A last line without its line break (torn by a crash) and
-    /// any line that does not parse are left out.
+    /// any line that does not parse (or is no UTF-8) are left out.
     pub fn journal_rows(&self) -> Result<Vec<JournalRow>, SweepError> {
         let width = 1 + self.columns().len();
         let journals = JOURNAL.list(&self.state()).map_err(SweepError::io(
@@ -289,12 +310,21 @@ impl Folder {
         let mut rows = Vec::new();
         for (_, name) in journals {
             let path = self.state().join(name);
-            let text =
-                files::read_regular(&path).map_err(SweepError::io("reading the journal", &path))?;
+            let mut bytes = Vec::new();
+            io::Read::read_to_end(
+                &mut files::open_regular(&path)
+                    .map_err(SweepError::io("reading the journal", &path))?,
+                &mut bytes,
+            )
+            .map_err(SweepError::io("reading the journal", &path))?;
+            // Bytes that are no UTF-8 (a crash's or a disk's damage) spoil their line only: it is left
+            // out (its run redone), as a torn line is.
+            let text = String::from_utf8_lossy(&bytes);
             let complete = text.rfind('\n').map_or("", |end| &text[..end]);
             rows.extend(
                 complete
                     .lines()
+                    .filter(|line| !line.contains(char::REPLACEMENT_CHARACTER))
                     .filter_map(|line| JournalRow::parse(line, width)),
             );
         }

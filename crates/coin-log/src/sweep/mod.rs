@@ -28,40 +28,64 @@ pub use run::{run, Progress, RunOptions, SweepOutcome};
 pub use shard::{Shard, ShardError};
 pub use space::{linspace, logspace};
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 
-/// Calls `work` on each of `items` on up to `jobs` threads until `stop` is set; `handle` gets the results
-/// on the calling thread as they come, in batches of those that came while it handled the previous one
-/// (so that one journal sync serves them all: the sweep is never slower than the disk syncs one row).
-fn on_threads<T: Sync, R: Send>(
-    items: &[T],
+/// Calls `work` on each position 0 … `len` − 1 on up to `jobs` threads until `stop` is set (`None`: no
+/// result for it); `handle` gets the results on the calling thread as they come, in batches of those that
+/// came while it handled the previous one (so that one journal sync serves them all: the sweep is never
+/// slower than the disk syncs one row). Positions, not a list of items: a sweep of 10⁹ runs must not
+/// hold a list of them.
+fn on_threads<R: Send>(
+    len: u64,
     jobs: usize,
     stop: &AtomicBool,
-    work: impl Fn(&T) -> Option<R> + Sync,
+    work: impl Fn(u64) -> Option<R> + Sync,
     mut handle: impl FnMut(Vec<R>),
 ) {
-    let next = AtomicUsize::new(0);
+    let next = AtomicU64::new(0);
     let (sender, receiver) = mpsc::channel();
+    let threads = usize::try_from(len.max(1)).map_or(jobs, |len| jobs.clamp(1, len));
+    let worker = |sender: mpsc::Sender<R>| {
+        while !stop.load(Ordering::SeqCst) {
+            let position = next.fetch_add(1, Ordering::SeqCst);
+            if position >= len {
+                break;
+            }
+            let Some(result) = work(position) else {
+                continue;
+            };
+            if sender.send(result).is_err() {
+                break;
+            }
+        }
+    };
     std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, items.len().max(1)) {
+        let mut spawned = 0;
+        for _ in 0..threads.max(1) {
             let sender = sender.clone();
-            let (next, work) = (&next, &work);
-            scope.spawn(move || {
-                while !stop.load(Ordering::SeqCst) {
-                    let Some(item) = items.get(next.fetch_add(1, Ordering::SeqCst)) else {
-                        break;
-                    };
-                    let Some(result) = work(item) else {
-                        continue;
-                    };
-                    if sender.send(result).is_err() {
-                        break;
-                    }
-                }
-            });
+            let worker = &worker;
+            // The system may refuse a thread (its limit on processes or threads): go on with those
+            // it gave (scope.spawn would panic).
+            let thread = std::thread::Builder::new().spawn_scoped(scope, move || worker(sender));
+            if thread.is_err() {
+                break;
+            }
+            spawned += 1;
         }
         drop(sender);
+        if spawned == 0 {
+            // Not one thread: the work is done here, each result handled as it comes.
+            while !stop.load(Ordering::SeqCst) {
+                let position = next.fetch_add(1, Ordering::SeqCst);
+                if position >= len {
+                    break;
+                }
+                if let Some(result) = work(position) {
+                    handle(vec![result]);
+                }
+            }
+        }
         for first in &receiver {
             let mut batch = vec![first];
             batch.extend(receiver.try_iter());

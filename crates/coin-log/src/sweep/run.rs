@@ -91,13 +91,13 @@ struct Spent {
     verify_seconds: f64,
 }
 
-/// What resume found: the lines to keep and how many of them are failed rows, the runs to do, and kept
-/// rows whose file was touched but not changed (to journal again with the new modification time).
+/// What resume found: the lines to keep and how many of them are failed rows, and kept rows whose file
+/// was touched but not changed (to journal again with the new modification time). The runs to do are
+/// the shard's others.
 #[derive(Default)]
 struct Resumed {
     held: BTreeMap<u64, String>,
     failed: u64,
-    todo: Vec<u64>,
     refreshed: Vec<(u128, String)>,
 }
 
@@ -118,12 +118,16 @@ pub fn run(
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
     journal.append(&resumed.refreshed)?;
+    let shard = options.shard;
+    let runs = shard.len(sweep.runs());
+    // The kept runs, to skip: as many as rows journalled, never a list of every run.
+    let kept: Vec<u64> = resumed.held.keys().copied().collect();
     let mut tally = Tally {
         kept: resumed.held.len() as u64,
         held: resumed.held,
         progress: Progress {
-            runs: options.shard.len(sweep.runs()),
-            todo: resumed.todo.len() as u64,
+            runs,
+            todo: runs - kept.len() as u64,
             done: 0,
             failed: resumed.failed,
         },
@@ -132,8 +136,12 @@ pub fn run(
     };
     progress(&tally.progress);
     let mut error = None;
-    let work = |&index: &u64| run_one(sweep, &folder, index, stop);
-    super::on_threads(&resumed.todo, options.jobs, stop, work, |batch| {
+    let work = |position: u64| {
+        let index = shard.index() + position * shard.count();
+        let todo = kept.binary_search(&index).is_err();
+        todo.then(|| run_one(sweep, &folder, index, stop)).flatten()
+    };
+    super::on_threads(runs, options.jobs, stop, work, |batch| {
         let lines: Vec<(u128, String)> = batch
             .iter()
             .map(|d| (d.spent.mtime_ns, d.row.line()))
@@ -221,37 +229,37 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         }
     }
     let mut resumed = Resumed::default();
-    for index in options.shard.runs(sweep.runs()) {
-        let Some(row) = latest.remove(&index) else {
-            resumed.todo.push(index);
-            continue;
-        };
+    // Only the journalled runs: every other run of the shard is to do (a shard of 10⁹ runs is not
+    // walked run by run before the first starts).
+    for (index, row) in latest {
         let f = &row.fields;
         let Ok(status) = f[status_at].parse::<RunStatus>() else {
-            resumed.todo.push(index);
             continue;
         };
         let retry = status == RunStatus::Failed
             && (options.retry_failed || f[failure_at] == FailureKind::Io.name());
-        let file_ok = f[file_at].is_empty() || {
-            let path = folder.file(&f[file_at]);
-            match folder::size_and_mtime(&path) {
-                Some((size, mtime)) if size.to_string() == f[bytes_at] && mtime == row.mtime_ns => {
-                    true
-                }
-                Some((size, mtime)) if size.to_string() == f[bytes_at] => {
-                    let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
-                    if same {
-                        resumed.refreshed.push((mtime, crate::csv::line(f)));
+        // A row names its own run's file or none (one naming another's, an edited index, is redone).
+        let own = folder::run_file_name(index, sweep.index_width());
+        let file_ok = f[file_at].is_empty()
+            || f[file_at] == own && {
+                let path = folder.file(&f[file_at]);
+                match folder::size_and_mtime(&path) {
+                    Some((size, mtime))
+                        if size.to_string() == f[bytes_at] && mtime == row.mtime_ns =>
+                    {
+                        true
                     }
-                    same
+                    Some((size, mtime)) if size.to_string() == f[bytes_at] => {
+                        let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
+                        if same {
+                            resumed.refreshed.push((mtime, crate::csv::line(f)));
+                        }
+                        same
+                    }
+                    _ => false,
                 }
-                _ => false,
-            }
-        };
-        if retry || !file_ok {
-            resumed.todo.push(index);
-        } else {
+            };
+        if !retry && file_ok {
             resumed.failed += u64::from(status == RunStatus::Failed);
             resumed.held.insert(index, crate::csv::line(f));
         }

@@ -128,6 +128,10 @@ impl Shard {
             .map(Some);
         }
         match (number(KUBERNETES_INDEX)?, kubernetes_count) {
+            (Some(index), Some(count)) if index >= count => Err(ShardError(format!(
+                "{KUBERNETES_INDEX}={index} is not below --shard-count {count}: give --shard-count the \
+                 Job's completions (its pods are indexed 0 … completions − 1)"
+            ))),
             (Some(index), Some(count)) => Self::new(index, count).map(Some),
             (Some(index), None) => Err(ShardError(format!(
                 "{KUBERNETES_INDEX}={index} is set (a Kubernetes Indexed Job) but not the number of shards: \

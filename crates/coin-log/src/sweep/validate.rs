@@ -376,6 +376,12 @@ impl Checker {
         };
         match pair.filter(|&p| ok(p)) {
             Some((lo, hi)) if log => Some(Distribution::LogUniform { lo, hi }),
+            // lo + (hi − lo)·u is inf for every u when the width overflows.
+            Some((lo, hi)) if (hi - lo).is_infinite() => self.problems.reject(
+                name,
+                array_text(spec),
+                "is wider than the largest double (hi − lo overflows, so every draw would be inf): narrow it, or draw log_uniform",
+            ),
             Some((lo, hi)) => Some(Distribution::Uniform { lo, hi }),
             None => {
                 let need = if log { "0 < lo < hi" } else { "lo < hi" };
@@ -428,11 +434,27 @@ impl Checker {
     fn settings(&mut self, o: &OutputFile) -> Settings {
         let encoding = self.named("encoding", o.encoding.as_deref());
         let compression = self.named("compression", o.compression.as_deref());
-        for c in o.channels.iter().flatten() {
+        for (i, c) in o.channels.iter().flatten().enumerate() {
             if let Err(e) = c.trim().parse::<Channel>() {
                 self.problems
                     .push("output.channels", format!("\"{c}\""), e.to_string());
             }
+            // Fixed for every run, so a list the scene refuses would fail them all: said here.
+            let listed = o.channels.iter().flatten().take(i);
+            if listed.map(|l| l.trim()).any(|l| l == c.trim()) {
+                self.problems.push(
+                    "output.channels",
+                    format!("\"{c}\""),
+                    "is listed twice: list each channel once",
+                );
+            }
+        }
+        if o.channels.as_ref().is_some_and(Vec::is_empty) {
+            self.problems.push(
+                "output.channels",
+                "[]",
+                "is empty: list at least one channel, or leave the key out for the scenes' lists",
+            );
         }
         Settings {
             channels: o
