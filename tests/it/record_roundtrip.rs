@@ -562,6 +562,15 @@ fn a_numerical_failure_finishes_the_file_with_the_samples_up_to_it() {
         1,
         "the sample at t = 0 is in the file"
     );
+    // Its termination_time is the failing step's, which verify accepts (within a sample of the last).
+    let report = coin_log::verify::verify_bytes("failed.mcap", &bytes, &Default::default());
+    let integrity = report.check(coin_log::verify::CheckId::Integrity).unwrap();
+    assert_eq!(
+        integrity.status,
+        coin_log::verify::Status::Pass,
+        "{}",
+        integrity.reason
+    );
 }
 
 /// The message types alone: strict reading, exact writing, the fields in schema order.

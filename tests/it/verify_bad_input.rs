@@ -593,8 +593,9 @@ fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
     assert_eq!(code, 0, "{err}");
 }
 
-/// A `coin-log.result` record whose termination_time is not a finite time ≥ 0 (NaN, inf, -5) fails
-/// integrity: verify judged such a file ok, and plot labelled its termination "at t = NaN".
+/// A `coin-log.result` record whose termination_time is not a finite time ≥ 0 (NaN, inf, -5), or not the
+/// last sample's time or a failure's before the next (1e308, 1.5 in a run of 10) fails integrity: verify
+/// judged such a file ok, and plot labelled its termination "at t = NaN".
 #[test]
 fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrity() {
     use std::collections::BTreeMap;
@@ -606,7 +607,12 @@ fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrit
         .iter()
         .map(|i| mcap::read::metadata(&bytes, i).unwrap())
         .collect();
-    for time in ["NaN", "inf", "-5", "1.5"] {
+    let own = metadata
+        .iter()
+        .find_map(|m| m.metadata.get("termination_time"))
+        .unwrap()
+        .clone();
+    for time in ["NaN", "inf", "-5", "1e308", "1.5", "10.01", &own] {
         let path = dir.path().join("result.mcap");
         let mut w = mcap::WriteOptions::new()
             .create(std::io::BufWriter::new(
@@ -647,14 +653,23 @@ fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrit
         let (code, out, err) = verify(&path);
         println!("termination_time = {time}: exit {code}");
         let complaint = "metadata says termination_time =";
-        if time == "1.5" {
-            // Negative control: a finite time is not this check's to judge.
+        if time == own {
+            // Negative control: the file's own time (its last sample's, 10) passes.
+            assert!(!out.contains(complaint), "{out}{err}");
+        } else if time == "10.01" {
+            // Just within a failure's reach (the next grid point): not this check's to judge.
             assert!(!out.contains(complaint), "{out}{err}");
         } else {
             assert_eq!(code, 1, "{out}{err}");
+            let value: f64 = time.parse().unwrap();
+            let why = if value.is_finite() && value >= 0.0 {
+                "but the last sample is at t = 10"
+            } else {
+                "not a finite time ≥ 0"
+            };
             assert!(
-                out.contains(complaint) && out.contains("not a finite time ≥ 0"),
-                "{out}"
+                out.contains(complaint) && out.contains(why),
+                "{time}: {out}"
             );
         }
     }

@@ -621,6 +621,28 @@ impl Judge {
                 )
             });
         }
+        // A run ends at its last sample or, failing, before the next grid point (format.md:
+        // `coin-log.result`); only a file read whole shows its last sample.
+        let stats = &self.checks.stats;
+        let interval = 1.0 / ctx.run.rate;
+        if let Some(t) =
+            ctx.result.as_ref().map(|r| r.termination_time).filter(|t| {
+                t.is_finite() && read_whole && stats.samples > 0 && interval.is_finite()
+            })
+        {
+            // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
+            let slack = 1e-12 * stats.last_t.abs().max(interval);
+            if !(stats.last_t - slack..=stats.last_t + interval + slack).contains(&t) {
+                self.problems.push_with(|| {
+                    format!(
+                        "the `coin-log.result` metadata says termination_time = {t}, but the last \
+                         sample is at t = {}: a run ends at its last sample or, failing, before the \
+                         next, 1/rate = {interval} later",
+                        stats.last_t
+                    )
+                });
+            }
+        }
         if ctx.result.is_none() && read_whole {
             self.problems.push_with(|| {
                 "no `coin-log.result` metadata record (the run did not finish writing)".into()
