@@ -24,7 +24,7 @@
 use crate::linearisation;
 use crate::support::physics::check_relative;
 use crate::support::record::{coin_log, record_scene};
-use crate::support::writers::rewrite;
+use crate::support::writers::rewrite_with_metadata;
 use coin_log::analyse::linear::{displaced, kicked, nutation_frequency, straight_tilt_linear};
 use coin_log::analyse::map::{boundary, closures, edge_leans};
 use coin_log::analyse::Analysis;
@@ -619,13 +619,22 @@ fn stretch(value: &mut serde_json::Value, factor: f64) {
 
 #[test]
 fn verify_fails_a_recording_whose_clock_runs_1e_6_fast() {
-    // Negative control: every time (log times, `t`, timestamps) × (1 + 1e-6). The values stay on the
-    // right orbit, so energy and the invariants cannot see it; the measured period is 1e-6 too long.
+    // Negative control: every time (log times, `t`, timestamps, the result's termination_time) × (1 +
+    // 1e-6). The values stay on the right orbit, so energy and the invariants cannot see it, nor
+    // integrity; the measured period is 1e-6 too long.
     let dir = tempfile::tempdir().unwrap();
     let good = record_scene(dir.path(), "wobble", &[]);
     let bad = dir.path().join("stretched.mcap");
     let factor = 1.0 + 1e-6;
-    rewrite(&good, &bad, |e| {
+    let stretch_end = |name: &str, entries: &mut std::collections::BTreeMap<String, String>| {
+        if let Some(t) = entries
+            .get_mut("termination_time")
+            .filter(|_| name != "coin-log")
+        {
+            *t = (t.parse::<f64>().unwrap() * factor).to_string();
+        }
+    };
+    rewrite_with_metadata(&good, &bad, &stretch_end, |e| {
         let mut v: serde_json::Value = serde_json::from_slice(e.data).unwrap();
         stretch(&mut v, factor);
         #[allow(

@@ -538,7 +538,17 @@ pub fn rewrite_with_schemas(
     schema_of: &dyn Fn(&str) -> Vec<u8>,
     edit: impl FnMut(Edit<'_>),
 ) {
-    copy(src, dst, schema_of, &|_| {}, edit);
+    copy(src, dst, schema_of, &|_, _| {}, edit);
+}
+
+/// [`rewrite`], with every metadata record's entries changed by `edit_metadata(name, entries)` too.
+pub fn rewrite_with_metadata(
+    src: &Path,
+    dst: &Path,
+    edit_metadata: &dyn Fn(&str, &mut BTreeMap<String, String>),
+    edit: impl FnMut(Edit<'_>),
+) {
+    copy(src, dst, &tool_schema, edit_metadata, edit);
 }
 
 /// Copies the coin-log MCAP `src` to `dst` with its `coin-log` record's entries changed by `edit_run`.
@@ -547,14 +557,19 @@ pub fn rewrite_run_metadata(
     dst: &Path,
     edit_run: &dyn Fn(&mut BTreeMap<String, String>),
 ) {
-    copy(src, dst, &tool_schema, edit_run, |_| {});
+    let edit_metadata = |name: &str, entries: &mut BTreeMap<String, String>| {
+        if name == RUN_METADATA_NAME {
+            edit_run(entries);
+        }
+    };
+    copy(src, dst, &tool_schema, &edit_metadata, |_| {});
 }
 
 fn copy(
     src: &Path,
     dst: &Path,
     schema_of: &dyn Fn(&str) -> Vec<u8>,
-    edit_run: &dyn Fn(&mut BTreeMap<String, String>),
+    edit_metadata: &dyn Fn(&str, &mut BTreeMap<String, String>),
     mut edit: impl FnMut(Edit<'_>),
 ) {
     let bytes = std::fs::read(src).unwrap();
@@ -564,8 +579,8 @@ fn copy(
         .iter()
         .map(|i| mcap::read::metadata(&bytes, i).unwrap())
         .collect();
-    for m in metadata.iter_mut().filter(|m| m.name == RUN_METADATA_NAME) {
-        edit_run(&mut m.metadata);
+    for m in &mut metadata {
+        edit_metadata(&m.name, &mut m.metadata);
     }
     let file = BufWriter::new(std::fs::File::create(dst).unwrap());
     let mut w = mcap::WriteOptions::new()
