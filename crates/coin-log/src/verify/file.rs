@@ -608,45 +608,35 @@ impl Judge {
                 "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
             });
         }
-        if let Some(t) = ctx
-            .result
-            .as_ref()
-            .map(|r| r.termination_time)
-            .filter(|t| !t.is_finite() || *t < 0.0)
-        {
-            self.problems.push_with(|| {
+        let stats = &self.checks.stats;
+        let interval = 1.0 / ctx.run.rate;
+        match ctx.result.as_ref().map(|r| r.termination_time) {
+            Some(t) if !t.is_finite() || t < 0.0 => self.problems.push_with(|| {
                 format!(
                     "the `coin-log.result` metadata says termination_time = {t}, not a finite time \
                      ≥ 0"
                 )
-            });
-        }
-        // A run ends at its last sample or, failing, before the next grid point (format.md:
-        // `coin-log.result`); only a file read whole shows its last sample.
-        let stats = &self.checks.stats;
-        let interval = 1.0 / ctx.run.rate;
-        if let Some(t) =
-            ctx.result.as_ref().map(|r| r.termination_time).filter(|t| {
-                t.is_finite() && read_whole && stats.samples > 0 && interval.is_finite()
-            })
-        {
-            // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
-            let slack = 1e-12 * stats.last_t.abs().max(interval);
-            if !(stats.last_t - slack..=stats.last_t + interval + slack).contains(&t) {
-                self.problems.push_with(|| {
-                    format!(
-                        "the `coin-log.result` metadata says termination_time = {t}, but the last \
-                         sample is at t = {}: a run ends at its last sample or, failing, before the \
-                         next, 1/rate = {interval} later",
-                        stats.last_t
-                    )
-                });
+            }),
+            // A run ends at its last sample or, failing, before the next grid point (format.md:
+            // `coin-log.result`); only a file read whole shows its last sample.
+            Some(t) if read_whole && stats.samples > 0 && interval.is_finite() => {
+                // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
+                let slack = 1e-12 * stats.last_t.abs().max(interval);
+                if !(stats.last_t - slack..=stats.last_t + interval + slack).contains(&t) {
+                    self.problems.push_with(|| {
+                        format!(
+                            "the `coin-log.result` metadata says termination_time = {t}, but the \
+                             last sample is at t = {}: a run ends at its last sample or, failing, \
+                             before the next, 1/rate = {interval} later",
+                            stats.last_t
+                        )
+                    });
+                }
             }
-        }
-        if ctx.result.is_none() && read_whole {
-            self.problems.push_with(|| {
+            None if read_whole => self.problems.push_with(|| {
                 "no `coin-log.result` metadata record (the run did not finish writing)".into()
-            });
+            }),
+            _ => {}
         }
         let mut problems = structure.problems.clone();
         problems.extend(&self.problems);
