@@ -7,7 +7,7 @@
 use crate::support::record::{
     coin_log_text, coin_log_within, record_scene, top_level_records as records, HANG_DEADLINE,
 };
-use crate::support::writers::{recorded, rewrite, wobble, Spec};
+use crate::support::writers::{recorded, rewrite, rewrite_with_metadata, wobble, Spec};
 use coin_log::verify::{verify_bytes, Options};
 use std::path::Path;
 
@@ -598,58 +598,23 @@ fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
 /// judged such a file ok, and plot labelled its termination "at t = NaN".
 #[test]
 fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrity() {
-    use std::collections::BTreeMap;
     let (dir, good) = recorded(&wobble(), "good.mcap");
     let bytes = std::fs::read(&good).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
-    let metadata: Vec<mcap::records::Metadata> = summary
+    let own = summary
         .metadata_indexes
         .iter()
         .map(|i| mcap::read::metadata(&bytes, i).unwrap())
-        .collect();
-    let own = metadata
-        .iter()
-        .find_map(|m| m.metadata.get("termination_time"))
-        .unwrap()
-        .clone();
+        .find_map(|m| m.metadata.get("termination_time").cloned())
+        .unwrap();
     for time in ["NaN", "inf", "-5", "1e308", "1.5", "10.01", &own] {
         let path = dir.path().join("result.mcap");
-        let mut w = mcap::WriteOptions::new()
-            .create(std::io::BufWriter::new(
-                std::fs::File::create(&path).unwrap(),
-            ))
-            .unwrap();
-        for m in metadata.iter().filter(|m| m.name == "coin-log") {
-            w.write_metadata(m).unwrap();
-        }
-        let mut ids: BTreeMap<String, u16> = BTreeMap::new();
-        for m in mcap::MessageStream::new(&bytes).unwrap() {
-            let m = m.unwrap();
-            let id = *ids.entry(m.channel.topic.clone()).or_insert_with(|| {
-                let s = m.channel.schema.as_ref().unwrap();
-                let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
-                w.add_channel(
-                    sid,
-                    &m.channel.topic,
-                    &m.channel.message_encoding,
-                    &BTreeMap::new(),
-                )
-                .unwrap()
-            });
-            let header = mcap::records::MessageHeader {
-                channel_id: id,
-                sequence: m.sequence,
-                log_time: m.log_time,
-                publish_time: m.publish_time,
-            };
-            w.write_to_known_channel(&header, &m.data).unwrap();
-        }
-        for m in metadata.iter().filter(|m| m.name != "coin-log") {
-            let mut m = m.clone();
-            m.metadata.insert("termination_time".into(), time.into());
-            w.write_metadata(&m).unwrap();
-        }
-        w.finish().unwrap();
+        let edit_result = |name: &str, entries: &mut std::collections::BTreeMap<String, String>| {
+            if name != "coin-log" {
+                entries.insert("termination_time".into(), time.into());
+            }
+        };
+        rewrite_with_metadata(&good, &path, &edit_result, |_| {});
         let (code, out, err) = verify(&path);
         println!("termination_time = {time}: exit {code}");
         let complaint = "metadata says termination_time =";
