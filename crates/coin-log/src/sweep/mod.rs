@@ -46,15 +46,22 @@ fn on_threads<R: Send>(
     let next = AtomicU64::new(0);
     let (sender, receiver) = mpsc::channel();
     let threads = usize::try_from(len.max(1)).map_or(jobs, |len| jobs.clamp(1, len));
-    let worker = |sender: mpsc::Sender<R>| {
+    // The next position's result, skipping those without one; `None` once `stop` is set or every
+    // position is taken.
+    let next_result = || {
         while !stop.load(Ordering::SeqCst) {
             let position = next.fetch_add(1, Ordering::SeqCst);
             if position >= len {
-                break;
+                return None;
             }
-            let Some(result) = work(position) else {
-                continue;
-            };
+            if let Some(result) = work(position) {
+                return Some(result);
+            }
+        }
+        None
+    };
+    let worker = |sender: mpsc::Sender<R>| {
+        while let Some(result) = next_result() {
             if sender.send(result).is_err() {
                 break;
             }
@@ -76,14 +83,8 @@ fn on_threads<R: Send>(
         drop(sender);
         if spawned == 0 {
             // Not one thread: the work is done here, each result handled as it comes.
-            while !stop.load(Ordering::SeqCst) {
-                let position = next.fetch_add(1, Ordering::SeqCst);
-                if position >= len {
-                    break;
-                }
-                if let Some(result) = work(position) {
-                    handle(vec![result]);
-                }
+            while let Some(result) = next_result() {
+                handle(vec![result]);
             }
         }
         for first in &receiver {
