@@ -120,12 +120,11 @@ fn read_part(
         };
         // A row names its own run's file or none: one that names another's (an edited index) would
         // pass the file checks below with another run's values.
-        let file = &fields[file_at];
-        if !file.is_empty() && *file != folder.run_file_name(index) {
+        let (file, own) = (&fields[file_at], folder.run_file_name(index));
+        if !file.is_empty() && *file != own {
             problems.push(format!(
-                "`{name}` line {}: run {index}'s row names the file `{file}`, not `{}`: the part was changed; run its shard again",
-                n + 2,
-                folder.run_file_name(index)
+                "`{name}` line {}: run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again",
+                n + 2
             ));
             continue;
         }
