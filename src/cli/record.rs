@@ -174,6 +174,19 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     let (summary, wall) = record_into(&args, &scene, &mut output, &signals)?;
     persist(output, &signals)?;
     print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
+    // A run that ended early has fewer samples and a tighter tolerance than its duration promised.
+    if summary.termination_time < scene.run.duration {
+        let promised = coin_log::verify::coverage(&scene);
+        for warning in coin_log::verify::coverage_over(&scene, summary.termination_time) {
+            if !promised.contains(&warning) {
+                errln!(
+                    "warning: verify will not be able to judge this recording, which ended at t = {} \
+                     before its duration: {warning}",
+                    number(summary.termination_time)
+                );
+            }
+        }
+    }
     Ok(outcome(&summary, &target))
 }
 

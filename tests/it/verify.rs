@@ -828,6 +828,56 @@ fn record_warns_when_verify_cannot_judge_the_recording_and_verify_agrees() {
     assert_eq!((code, err.as_str()), (0, ""));
 }
 
+/// A run that an event ends early has fewer samples and a tighter residual tolerance than its duration
+/// promised: `record` asks again once it knows. Before, Euler's disk under a viscous couple of κ = 1e-4
+/// fell flat after 0.084 of its 2000 time units with no warning at all, and verify said CANNOT VERIFY.
+#[test]
+fn record_warns_after_a_run_an_event_ended_too_early_for_verify_to_judge() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("viscous.mcap");
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        "euler-disk",
+        "--set",
+        "body.dissipation.model=\"viscous\"",
+        "--set",
+        "body.dissipation.coefficient=1e-4",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        err,
+        "warning: verify will not be able to judge this recording, which ended at t = 0.08404771017188632 \
+         before its duration: neither `constraint` nor `steady` will run, so the motion will not be \
+         verified: `steady` does not apply (the scene does not start on an unperturbed steady motion), \
+         and `constraint` will find no window the sampling resolves: at 400 samples per time unit, \
+         h·Ω = 0.221 (Ω = max(|ω|, |φ̇|) = 88.6 at t = 0), and the finite difference's error \
+         4(hΩ)^8/630 = 3.7e-8 exceeds a tenth of the residual tolerance 2.4e-7; raise --rate to at \
+         least 471\n"
+    );
+    let (code, out, _) = coin_log_text(&["verify", path.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("CANNOT VERIFY (exit 1)"), "{out}");
+    // At the rate it names, verify judges the run (and record says nothing).
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        "euler-disk",
+        "--set",
+        "body.dissipation.model=\"viscous\"",
+        "--set",
+        "body.dissipation.coefficient=1e-4",
+        "--rate",
+        "471",
+        "-o",
+        path.to_str().unwrap(),
+        "--overwrite",
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let (code, out, _) = coin_log_text(&["verify", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+}
+
 #[test]
 fn the_json_names_are_the_names() {
     for v in Verdict::ALL {

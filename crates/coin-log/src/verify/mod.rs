@@ -9,7 +9,7 @@ mod file;
 mod report;
 mod samples;
 
-pub use coverage::coverage;
+pub use coverage::{coverage, coverage_over};
 pub use file::{verify_bytes, verify_file, verify_file_with_progress};
 pub use report::{CheckId, CheckResult, FileReport, Report, Status, Verdict};
 
