@@ -5,7 +5,8 @@
 //! promised to verify verifies, every check that fails was named in advance, and a file verify cannot
 //! judge was warned about. Before, `--rtol 1e-3 --atol 1e-3`, dopri5 at 1e-3, `rk4 --step 0.11 --rate 1`
 //! and 1e8 steps of rk4 recorded without a word and failed verify, and so did dop853 at rtol 1e-7 (its
-//! dense output's velocity errs by 1.67e-6 against the ceiling 1e-6). The table is printed.
+//! dense output's velocity errs by 1.67e-6 against the ceiling 1e-6); 1000 time units at rtol 1e-6 failed
+//! `nutation`, which was not named. The table is printed.
 // Helpers outside #[test] functions panic on failure too: a failed step is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -164,6 +165,19 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
             ),
             ("rtol 1e-6", i(&["--rtol", "1e-6", "--atol", "1e-9"])),
             ("rtol 1e-7", i(&["--rtol", "1e-7"])),
+            (
+                "1000 time units at rtol 1e-6",
+                i(&[
+                    "--rtol",
+                    "1e-6",
+                    "--atol",
+                    "1e-9",
+                    "--duration",
+                    "1000",
+                    "--rate",
+                    "10",
+                ]),
+            ),
             ("defaults", i(&[])),
             ("lowest rate 0.1", i(&["--rate", "0.1"])),
             (
