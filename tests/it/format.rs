@@ -104,10 +104,12 @@ fn non_finite_negative_and_huge_times_are_refused() {
     }
 }
 
-/// A centre that starts at the origin, sampled at rate 100.
+/// A centre that starts at the origin, heading 0 and not turning, sampled at rate 100.
 const AT_ORIGIN: Positions = Positions {
     offset: 0.0,
     sample_interval: 0.01,
+    heading: 0.0,
+    heading_rate: 0.0,
 };
 
 fn promise_run(integrator: &str, rtol: f64, step: f64, span: f64) -> RunAccuracy {

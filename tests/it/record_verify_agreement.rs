@@ -337,3 +337,51 @@ fn record_warns_when_the_centre_starts_too_far_from_the_origin_for_the_constrain
         assert_eq!(r.verify_code == 0, !far, "{}: {}", r.case, r.verdict());
     }
 }
+
+/// A heading that starts (or grows) large: φ is rounded to 2⁻⁵³ |φ| at every step, which turns the
+/// velocity the constraint check compares and shifts the heading advance the nutation check times.
+/// Before, `--set initial.phi=1e12` recorded without a word and verify failed `constraint` (7e-4) and
+/// `nutation` (0.08); rk4 failed `nutation` from φ₀ = 1e7. A heading within a turn changes nothing.
+#[test]
+fn record_warns_when_the_heading_is_too_large_for_its_rounding() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |words: &[&str]| words.iter().map(|w| (*w).to_string()).collect::<Vec<_>>();
+    let mut rows = Vec::new();
+    for integrator in ["dop853", "rk4"] {
+        for phi in ["3", "1e7", "1e12"] {
+            let flags = s(&[
+                "--integrator",
+                integrator,
+                "--set",
+                &format!("initial.phi={phi}"),
+            ]);
+            rows.push(corner(d, format!("{integrator}: phi0 = {phi}"), &flags));
+        }
+    }
+    for r in &rows {
+        println!("{:<24} {:<44} {}", r.case, r.word(), r.verdict());
+        assert_ne!(
+            r.agreement(),
+            "BROKEN PROMISE",
+            "{}: {}",
+            r.case,
+            r.verdict()
+        );
+        assert!(
+            r.failed.is_subset(&r.expected),
+            "{}: verify failed {:?}, record expected {:?}",
+            r.case,
+            r.failed,
+            r.expected
+        );
+    }
+    let row = |case: &str| rows.iter().find(|r| r.case == case).unwrap();
+    for case in ["dop853: phi0 = 3", "rk4: phi0 = 3"] {
+        assert!(row(case).promised() && row(case).verify_code == 0, "{case}");
+    }
+    for case in ["dop853: phi0 = 1e12", "rk4: phi0 = 1e12", "rk4: phi0 = 1e7"] {
+        assert!(row(case).expected.contains("nutation"), "{case}");
+        assert_ne!(row(case).verify_code, 0, "{case}");
+    }
+}

@@ -8,6 +8,8 @@
 //!   rounding differenced   ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ / (Δt Ω)  (fixed-step methods, constraint)
 //!   offset differenced     ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ · (1 + k) X / (a Δt Ω)  (every method, constraint;
 //!                            X = max(|x₀|, |z₀|), k the fixed steps per sample, 0 for adaptive methods)
+//!   heading rounding       ≈ [`HEADING_SHARE`] · 2⁻⁵³ · Φ   (every method, constraint and nutation;
+//!                            Φ = |φ₀| + T |φ̇₀|)
 //!   dense output differenced ≈ [`dense_output_share`] · min(ε^(1/p), T Ω)^(p−1)  (adaptive methods of order
 //!                            p, constraint)
 //!
@@ -55,6 +57,14 @@ pub fn dense_output_share(method: Method) -> f64 {
     }
 }
 
+/// Share of 2⁻⁵³ Φ reached by the constraint residual and the nutation error of a run whose heading
+/// reaches Φ rad: φ is rounded to 2⁻⁵³ Φ at every step, which turns the velocity and shifts the heading
+/// advance. Measured on `wobble` with φ₀ = 1e6 … 1e9: the constraint 36 (dop853), 2 (dopri5), 1.4 (rk4,
+/// gauss4); the nutation 13 (rk4, gauss4, failing from φ₀ = 1e7), 1.2–8.4 (dop853, failing from 3e8),
+/// 2.2 (dopri5), and more beyond 1e9 (dop853: 318 at 1e10, far past every tolerance). Before, `wobble
+/// --set initial.phi=1e12` recorded without a word and failed both checks. The largest, rounded up.
+pub const HEADING_SHARE: f64 = 50.0;
+
 /// Gain of the constraint's 8th-order central difference on independent rounding of its samples:
 /// 2 Σ|wₖ| = 2 (4/5 + 1/5 + 4/105 + 1/280) = 2.08. Measured on `wobble` at the highest rate (samples 1 ns
 /// apart, over 1e-3 time units): rk4 and gauss4 fail `constraint`, whose floor 1e-10 this puts below
@@ -82,6 +92,12 @@ pub enum Cause {
         epsilon: f64,
         /// The ε at which this error is half the tolerance (the other half left to the other errors).
         enough: f64,
+    },
+    /// The heading φ grows so large that its rounding changes the velocity's direction and the heading
+    /// advance by more than the tolerance.
+    Heading {
+        /// The largest |φ| expected, |φ₀| + T |φ̇₀| \[rad\].
+        heading: f64,
     },
     /// The centre starts so far from the origin that the rounding of its stored coordinates, differenced
     /// over samples close together, exceeds the constraint's tolerance.
@@ -133,6 +149,13 @@ impl fmt::Display for Shortfall {
                  verify judges by; tighten --rtol/--atol to ε ≤ {enough:.1e}",
                 self.predicted, self.tolerance
             ),
+            Cause::Heading { heading } => write!(
+                f,
+                "the heading φ reaches about {heading:.1e} rad (|φ₀| + T |φ̇₀|), whose rounding moves the \
+                 velocity's direction and the heading advance by about {:.1e}, above the tolerance {:.1e} \
+                 verify judges by; start from initial.phi within a turn of 0, or record a shorter run",
+                self.predicted, self.tolerance
+            ),
             Cause::Offset { positions } => write!(
                 f,
                 "the centre starts {:.1e} radii from the origin, and the rounding of its stored coordinates, \
@@ -153,16 +176,21 @@ pub struct FixedSteps {
     pub sample_interval: f64,
 }
 
-/// The centre's stored coordinates, as far as their rounding goes: each is rounded to 2⁻⁵³ of its size
-/// (at every fixed step between samples), and the constraint check differentiates them over samples
-/// `sample_interval` apart. Measured on `wobble` with x₀ = 1e8 … 1e10: dop853 reaches 0.5–0.7 of the
-/// prediction, rk4 (10 steps a sample) 0.3–0.4.
+/// The stored coordinates whose size costs digits, as far as their rounding goes. The centre's are each
+/// rounded to 2⁻⁵³ of their size (at every fixed step between samples), and the constraint check
+/// differentiates them over samples `sample_interval` apart. Measured on `wobble` with x₀ = 1e8 … 1e10:
+/// dop853 reaches 0.5–0.7 of the prediction, rk4 (10 steps a sample) 0.3–0.4. The heading's rounding
+/// turns the velocity and the heading advance ([`HEADING_SHARE`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Positions {
     /// The largest initial centre coordinate, max(|x₀|, |z₀|), in radii a.
     pub offset: f64,
     /// Distance between samples Δt.
     pub sample_interval: f64,
+    /// |φ₀| \[rad\].
+    pub heading: f64,
+    /// |φ̇₀| \[rad/time\], which carries the heading to |φ₀| + T |φ̇₀| over the span T.
+    pub heading_rate: f64,
 }
 
 /// The checks of a recording integrated as `run` that verify's default tolerances are expected to fail;
@@ -196,57 +224,75 @@ pub fn shortfalls(
     } else {
         0.0
     };
-    let accumulated = GROWTH_SHARE * growth;
-    let cause = |share: f64, rounding: f64, offset: f64, dense: f64| match fixed {
-        None if dense > share.max(offset) => Cause::DenseOutput {
+    let heading = positions.heading + run.span.max(0.0) * positions.heading_rate;
+    let heading_error = HEADING_SHARE * UNIT_ROUNDOFF * heading;
+    let accuracy = Cause::Accuracy { epsilon };
+    let rounded = fixed.map_or(accuracy, |fixed| Cause::Rounding { fixed });
+    let interpolated = if dense_share > 0.0 {
+        Cause::DenseOutput {
             epsilon,
             enough: two_digits_down(
                 (0.5 * tolerances.residual / dense_share).powf(order / (order - 1.0)),
             ),
-        },
-        _ if offset > share.max(rounding) => Cause::Offset { positions },
-        Some(fixed) if share < rounding => Cause::Rounding { fixed },
-        _ => Cause::Accuracy { epsilon },
+        }
+    } else {
+        accuracy
     };
+    let offset_cause = Cause::Offset { positions };
+    let heading_cause = Cause::Heading { heading };
     [
-        (
-            &["energy", "invariants"][..],
-            accumulated,
-            rounding,
-            0.0,
-            0.0,
+        judge(
+            &["energy", "invariants"],
+            &[(GROWTH_SHARE * growth, accuracy), (rounding, rounded)],
             tolerances.energy,
         ),
-        (
-            &["constraint", "steady"][..],
-            accumulated,
-            rounding + differenced,
-            offset,
-            dense,
+        judge(
+            &["constraint", "steady"],
+            &[
+                (GROWTH_SHARE * growth, accuracy),
+                (rounding + differenced, rounded),
+                (offset, offset_cause),
+                (dense, interpolated),
+                (heading_error, heading_cause),
+            ],
             tolerances.residual,
         ),
-        (
-            &["nutation"][..],
-            NUTATION_SHARE * epsilon + NUTATION_GROWTH * growth,
-            0.0,
-            0.0,
-            0.0,
+        judge(
+            &["nutation"],
+            &[
+                (
+                    NUTATION_SHARE * epsilon + NUTATION_GROWTH * growth,
+                    accuracy,
+                ),
+                (heading_error, heading_cause),
+            ],
             tolerances.nutation,
         ),
     ]
     .into_iter()
-    .filter(|&(_, share, rounding, offset, dense, tolerance)| {
-        share + rounding + offset + dense > tolerance
-    })
-    .map(
-        |(checks, share, rounding, offset, dense, tolerance)| Shortfall {
-            checks,
-            predicted: share + rounding + offset + dense,
-            tolerance,
-            cause: cause(share, rounding, offset, dense),
-        },
-    )
+    .flatten()
     .collect()
+}
+
+/// The shortfall of `checks` whose predicted error is the sum of `parts`, each with its cause, if it
+/// exceeds `tolerance`; the largest part names the cause.
+fn judge(
+    checks: &'static [&'static str],
+    parts: &[(f64, Cause)],
+    tolerance: f64,
+) -> Option<Shortfall> {
+    let predicted = parts.iter().fold(0.0, |sum, (part, _)| sum + part);
+    let (_, cause) =
+        parts
+            .iter()
+            .copied()
+            .reduce(|largest, part| if part.0 > largest.0 { part } else { largest })?;
+    (predicted > tolerance).then_some(Shortfall {
+        checks,
+        predicted,
+        tolerance,
+        cause,
+    })
 }
 
 /// `x` > 0 rounded down to two significant digits, so that the ε a message suggests, as printed, is
