@@ -681,3 +681,45 @@ fn plot_and_export_never_replace_the_recording_they_read() {
         .unwrap()
         .starts_with("t,"));
 }
+
+/// `bench sweep` deletes its folder `DIR/sweep-bench` before and after its work: a folder of that name
+/// holding anything the bench does not write (a sweep of the user's), or a link of that name, is refused
+/// before any work and kept, not deleted.
+#[test]
+fn bench_sweep_never_deletes_a_sweep_bench_folder_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let mine = dir.path().join("o/sweep-bench/my-dataset");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("catalogue.csv"), "important").unwrap();
+    std::fs::create_dir(dir.path().join("p")).unwrap();
+    std::os::unix::fs::symlink(&mine, dir.path().join("p/sweep-bench")).unwrap();
+    for (out, says) in [
+        ("o", "it holds `my-dataset`, which the bench did not write"),
+        ("p", "it is not a folder"),
+    ] {
+        let started = Instant::now();
+        let output = coin_log(
+            dir.path(),
+            &["bench", "sweep", "--repeats", "1", "--out", out],
+        );
+        assert_eq!(code(&output), 1, "{out}: {}", stderr(&output));
+        assert!(stderr(&output).contains(says), "{out}: {}", stderr(&output));
+        assert!(
+            stderr(&output).contains("choose another folder with --out"),
+            "{}",
+            stderr(&output)
+        );
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "refused before any sweep"
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(mine.join("catalogue.csv")).unwrap(),
+        "important"
+    );
+    assert!(std::fs::symlink_metadata(dir.path().join("p/sweep-bench"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+}
