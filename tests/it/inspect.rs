@@ -752,6 +752,32 @@ fn plot_draws_every_panel_and_marks_the_termination() {
     assert_eq!(out.status.code(), Some(1));
 }
 
+/// A run of a microsecond: every time panel's ticks tell the times apart (plotters' own labels, 5 decimals
+/// without an exponent, printed `0.0` on every tick: 56 of them on the page).
+#[test]
+fn a_microsecond_run_is_plotted_with_time_ticks_that_differ() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "1e-6", "--rate", "1e7"],
+    );
+    let out = coin_log(dir.path(), &["plot", "wobble.mcap"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let texts = svg_texts(&std::fs::read_to_string(dir.path().join("wobble.svg")).unwrap());
+    let count = |label: &str| texts.iter().filter(|t| *t == label).count();
+    // θ, energy drift, invariant drift, N and |F|/N: five time axes.
+    for tick in ["0", "2.0e-7", "5.0e-7", "1.0e-6"] {
+        assert_eq!(count(tick), 5, "tick `{tick}`: {texts:?}");
+    }
+    assert!(count("0.0") <= 1, "{texts:?}");
+}
+
 /// The paths the test used, for the README's example: every committed dataset is described by `info`.
 #[test]
 fn info_describes_every_committed_dataset_from_its_summary() {
