@@ -778,6 +778,40 @@ fn a_microsecond_run_is_plotted_with_time_ticks_that_differ() {
     assert!(count("0.0") <= 1, "{texts:?}");
 }
 
+/// The default outputs of a file whose name is not UTF-8 are named with its stem's own bytes (`\xff.svg`,
+/// `\xff-csv`), not a lossy copy (`\u{fffd}.svg`, which two such names would share).
+#[test]
+fn default_outputs_keep_the_bytes_of_a_name_that_is_not_utf8() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let recorded = record_scene(dir.path(), "wobble", &["--duration", "0.1"]);
+    let file = OsStr::from_bytes(b"\xff.mcap");
+    std::fs::rename(&recorded, dir.path().join(file)).unwrap();
+    for command in ["plot", "export"] {
+        let out = coin_log(dir.path(), &[OsStr::new(command), file]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let mut names: Vec<Vec<u8>> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().as_bytes().to_vec())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            b"\xff-csv".to_vec(),
+            b"\xff.mcap".to_vec(),
+            b"\xff.svg".to_vec()
+        ]
+    );
+}
+
 /// The paths the test used, for the README's example: every committed dataset is described by `info`.
 #[test]
 fn info_describes_every_committed_dataset_from_its_summary() {
