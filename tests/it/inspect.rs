@@ -812,6 +812,31 @@ fn default_outputs_keep_the_bytes_of_a_name_that_is_not_utf8() {
     );
 }
 
+/// `export --wide` of a file with only frame transforms: the error names, for each topic, the table that
+/// exporting per channel writes (it said `tf.csv` for /tf_static and /scene/follow too).
+#[test]
+fn the_wide_error_names_each_frame_topics_own_table() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "0.1", "--channels", "tf,scene"],
+    );
+    let out = coin_log(dir.path(), &["export", "wobble.mcap", "--wide"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for (topic, table) in [
+        ("/tf", "tf.csv"),
+        ("/tf_static", "tf_static.csv"),
+        ("/scene/follow", "scene_follow.csv"),
+    ] {
+        let says = format!(
+            "{topic}: frame transforms are not one per sample; export per channel for {table}"
+        );
+        assert!(stderr.contains(&says), "{says}: {stderr}");
+    }
+}
+
 /// The paths the test used, for the README's example: every committed dataset is described by `info`.
 #[test]
 fn info_describes_every_committed_dataset_from_its_summary() {
