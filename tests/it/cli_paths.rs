@@ -723,3 +723,44 @@ fn bench_sweep_never_deletes_a_sweep_bench_folder_it_did_not_write() {
         .file_type()
         .is_symlink());
 }
+
+/// `--out -` of the commands that write into a folder is refused like `-o -` (it created a folder named
+/// `-`): nothing goes to standard output, and `./-` names such a folder.
+#[test]
+fn a_folder_output_dash_is_refused_like_a_file_output_dash() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = crate::support::repo().join("datasets/wobble.mcap");
+    let file = file.to_str().unwrap();
+    for args in [
+        vec!["export", file, "--out", "-"],
+        vec!["man", "--out", "-"],
+        vec![
+            "analyse",
+            "map",
+            "--theta",
+            "0.1:1:3",
+            "--omega-z",
+            "0:1:3",
+            "--out",
+            "-",
+        ],
+        vec!["bench", "euler", "--out", "-"],
+    ] {
+        let output = coin_log(dir.path(), &args);
+        assert_eq!(code(&output), 1, "{args:?}: {}", stderr(&output));
+        assert!(
+            stderr(&output).contains("`-` would be a folder named `-`")
+                && stderr(&output).contains("`./-`"),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no folder `-`"
+    );
+    let output = coin_log(dir.path(), &["man", "--out", "./-"]);
+    assert_eq!(code(&output), 0, "{}", stderr(&output));
+    assert!(dir.path().join("-/coin-log.1").is_file());
+}
