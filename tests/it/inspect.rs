@@ -837,6 +837,33 @@ fn the_wide_error_names_each_frame_topics_own_table() {
     }
 }
 
+/// `info` of a recording at 0.001 samples per time unit: the rate column shows the rate (`1.00e-3`), not
+/// `0.00` as if the channel had none (ordinary rates keep two decimals: the README's example pins them).
+#[test]
+fn info_shows_a_rate_below_two_decimals() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "wobble",
+        &[
+            "--duration",
+            "3000",
+            "--rate",
+            "0.001",
+            "--channels",
+            "omega",
+        ],
+    );
+    let out = coin_log(dir.path(), &["info", "wobble.mcap"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    let row = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("/coin/omega"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(row.trim_end().ends_with(" 4    1.00e-3"), "{row}");
+}
+
 /// The paths the test used, for the README's example: every committed dataset is described by `info`.
 #[test]
 fn info_describes_every_committed_dataset_from_its_summary() {
