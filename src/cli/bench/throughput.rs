@@ -10,8 +10,8 @@ use coin_log::files::output::check;
 use coin_log::files::shown;
 use coin_log::format::Encoding;
 use coin_log_bench::throughput::{
-    self, channel_list, compression_bound, recording_path, DurationRuns, ExportRun, RecordRun,
-    ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
+    self, channel_list, compression_bound, recording_path, workload_scene, DurationRuns, ExportRun,
+    RecordRun, ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
 };
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -82,6 +82,16 @@ fn durations(args: &ThroughputArgs) -> anyhow::Result<Vec<f64>> {
     };
     if let Some(bad) = durations.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
         bail!("--durations: `{bad}` is not a positive duration");
+    }
+    // A duration the workload cannot record is refused now, not by the first child `record` after the
+    // others have run (with its flags in the message, and the duration in the recording's name).
+    for &d in &durations {
+        if let Err(ThroughputError::Workload { reason, .. }) = workload_scene(d) {
+            bail!(
+                "--durations: {d:?} time units cannot be recorded by the workload ({SCENE} at {RATE} samples \
+                 per time unit): {reason}"
+            );
+        }
     }
     Ok(durations)
 }
