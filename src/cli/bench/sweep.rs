@@ -373,3 +373,48 @@ fn memory_and_resume(
     }
     Ok(rows)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{is_benchs_own, refuse_foreign};
+
+    /// A folder kept by `--keep` (or left by an interrupted bench) is the bench's own and is replaced; a
+    /// sweep of the user's under that name is not.
+    #[test]
+    fn the_benchs_own_folder_is_told_from_a_users() {
+        for name in [
+            "speed.toml",
+            "speed-1",
+            "speed-2",
+            "memory-1000.toml",
+            "memory-1000",
+            "memory-10000.toml",
+            "memory-10000",
+            ".coin-log-Ab12Cd.toml.tmp",
+        ] {
+            assert!(is_benchs_own(name), "{name}");
+        }
+        for name in [
+            "my-dataset",
+            "catalogue.csv",
+            "speed-3",
+            "memory-5",
+            "speedy",
+            "memory.toml",
+        ] {
+            assert!(!is_benchs_own(name), "{name}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let work = dir.path().join("sweep-bench");
+        refuse_foreign(&work).unwrap();
+        std::fs::create_dir_all(work.join("speed-1")).unwrap();
+        std::fs::write(work.join("memory-1000.toml"), "").unwrap();
+        refuse_foreign(&work).unwrap();
+        std::fs::create_dir(work.join("mine")).unwrap();
+        let e = refuse_foreign(&work).unwrap_err().to_string();
+        assert!(
+            e.contains("it holds `mine`, which the bench did not write"),
+            "{e}"
+        );
+    }
+}
