@@ -104,6 +104,10 @@ fn load_scene(arg: &str, sets: &[String]) -> anyhow::Result<Scene> {
     Scene::from_file(&source.file).map_err(|e| anyhow!("scene `{arg}`: {e}"))
 }
 
+/// An estimated relative error of the quadrature above which its numbers get a warning (they are
+/// ~1e-13 on ordinary scenes).
+const UNRELIABLE: f64 = 1e-2;
+
 fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> {
     let scene = load_scene(arg, sets)?;
     let analysis = Analysis::of_scene(&scene).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
@@ -113,6 +117,14 @@ fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> 
              state; the couple changes E, C1 and C2 (docs/physics.md §11), so the prediction holds for \
              times short against the dissipation's",
             d.model()
+        );
+    }
+    if analysis.orbit.error > UNRELIABLE {
+        errln!(
+            "warning: scene `{arg}`: the quadrature's estimated relative error is {:.1e}: the period and \
+             the advances per period (or the landing time) are not reliable to better than that (e.g. a \
+             kick too small for double precision to resolve near a marginal state)",
+            analysis.orbit.error
         );
     }
     if json {

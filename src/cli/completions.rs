@@ -40,9 +40,30 @@ pub fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
     // Into a buffer first: clap_complete panics when its writer fails (a closed pipe), and every print
     // goes through `output` so that a closed or full stdout ends cleanly.
     let mut script = Vec::new();
-    clap_complete::generate(args.shell, &mut cmd, "coin-log", &mut script);
-    out!("{}", String::from_utf8_lossy(&script));
+    clap_complete::generate(args.shell, &mut cmd, BIN, &mut script);
+    let mut script = String::from_utf8_lossy(&script).into_owned();
+    if args.shell == clap_complete::Shell::Bash {
+        script = bash_states_fixed(&script);
+    }
+    out!("{script}");
     Ok(Outcome::Success)
+}
+
+/// The binary's name, as completions and man pages know it.
+const BIN: &str = "coin-log";
+
+/// clap_complete's bash script of a binary with a hyphen in its name (clap issue #6421): the loop over the
+/// words sets the state `coin__log__subcmd__record`, but the `case` arms that complete a subcommand are
+/// labelled `coin__subcmd__log__subcmd__record` (the hyphen of the name escaped as a subcommand
+/// separator), so no arm matched and no subcommand's flags or values ever completed. The arms get the
+/// loop's spelling.
+fn bash_states_fixed(script: &str) -> String {
+    let state = BIN.replace('-', "__");
+    let broken = BIN.replace('-', "__subcmd__");
+    script.replace(
+        &format!("\n        {broken}"),
+        &format!("\n        {state}"),
+    )
 }
 
 /// Runs `coin-log man`.

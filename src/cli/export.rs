@@ -71,11 +71,13 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<Outcome> {
         .map_err(|e| anyhow!("{shown_file}: {e}"))?
         .len();
     let dir = args.out.clone().unwrap_or_else(|| {
-        let stem = args
+        // The stem's own bytes, not a lossy copy: a name that is not UTF-8 keeps them.
+        let mut name = args
             .file
             .file_stem()
-            .map_or_else(|| "export".into(), |s| s.to_string_lossy().into_owned());
-        PathBuf::from(format!("{stem}-csv"))
+            .map_or_else(|| "export".into(), ToOwned::to_owned);
+        name.push("-csv");
+        PathBuf::from(name)
     });
     // Dropped on an error: every table and the folders it created go with it.
     let mut folder = OutputFolder::create(&dir, args.overwrite)?

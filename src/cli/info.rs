@@ -335,7 +335,7 @@ fn channels(out: &mut String, i: &FileInfo) {
         "rate"
     );
     for (c, [topic, schema]) in channels.iter().zip(&cells) {
-        let rate = c.rate.map_or_else(|| "-".into(), |r| format!("{r:.2}"));
+        let rate = c.rate.map_or_else(|| "-".into(), rate_text);
         let _ = writeln!(
             out,
             "  {}  {}  {:>9}  {rate:>9}",
@@ -343,5 +343,16 @@ fn channels(out: &mut String, i: &FileInfo) {
             padded(schema, schema_w),
             c.messages
         );
+    }
+}
+
+/// A channel's rate with two decimals, or, below what two decimals show (a recording at 0.001 samples
+/// per time unit printed `0.00`, as if it had no rate), with three significant digits: `1.00e-3`.
+fn rate_text(rate: f64) -> String {
+    let text = format!("{rate:.2}");
+    if rate > 0.0 && text == "0.00" {
+        format!("{rate:.2e}")
+    } else {
+        text
     }
 }

@@ -32,11 +32,13 @@ pub struct PlotArgs {
 pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
     let shown_file = shown(&args.file);
     let target = args.out.clone().unwrap_or_else(|| {
-        let stem = args
+        // The stem's own bytes, not a lossy copy: a name that is not UTF-8 keeps them.
+        let mut name = args
             .file
             .file_stem()
-            .map_or_else(|| "plot".into(), |s| s.to_string_lossy().into_owned());
-        PathBuf::from(format!("{stem}.svg"))
+            .map_or_else(|| "plot".into(), ToOwned::to_owned);
+        name.push(".svg");
+        PathBuf::from(name)
     });
     let policy = Policy {
         overwrite: args.overwrite,

@@ -737,3 +737,42 @@ fn a_marginal_verdict_with_a_nonzero_sigma_squared_is_the_rounding_rule_the_cont
         "docs/format.md, analyse --json, must state when a nonzero σ² is marginal"
     );
 }
+
+/// A kick too small for double precision at a marginal state (spin-upright at Ω² = 0.8, θ kicked by
+/// 1e-25): the quadrature's own estimate of its relative error is 56, and the command warns that its
+/// period and advances are not reliable (it printed them to 17 digits without a word); an ordinary
+/// scene gets no warning.
+#[test]
+fn an_unreliable_quadrature_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "analyse",
+            "spin-upright",
+            "--json",
+            "--set",
+            "initial.steady.omega_y=0.8944271909999159",
+            "--set",
+            "initial.perturbation={theta=1e-25}",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let error = v["quadrature_error"].as_f64().unwrap();
+    assert!(error > 1.0, "{error}");
+    assert!(
+        stderr.contains(
+            "warning: scene `spin-upright`: the quadrature's estimated relative error is"
+        ) && stderr.contains("not reliable"),
+        "{stderr}"
+    );
+    let out = coin_log(dir.path(), &["analyse", "wobble"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

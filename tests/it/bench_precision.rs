@@ -182,3 +182,44 @@ fn the_timed_dop853_setting_is_the_loosest_that_reaches_1e_10_on_wobble() {
     println!("looser atols {looser:?}: {missed:?}");
     assert!(matches!(missed, Err(BenchError::Inaccurate { best, .. }) if best > DOP853_TARGET));
 }
+
+/// Two scenes of one name (two files of one stem, or one scene given twice) would share their rows' name in
+/// precision.csv and one diagram, the second replacing the first: refused before any work, nothing written.
+#[test]
+fn two_scenes_of_one_name_are_refused_before_any_work() {
+    use crate::support::record::coin_log;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = std::fs::read_to_string(crate::support::repo().join("datasets/scenes/wobble.toml"))
+        .unwrap();
+    for sub in ["a", "b"] {
+        std::fs::create_dir(dir.path().join(sub)).unwrap();
+        std::fs::write(dir.path().join(sub).join("x.toml"), &scene).unwrap();
+    }
+    for (args, says) in [
+        (
+            ["./a/x.toml", "./b/x.toml"],
+            "scenes `./a/x.toml` and `./b/x.toml` are both named `x`",
+        ),
+        (["wobble", "wobble"], "scene `wobble` is given twice"),
+    ] {
+        let out = coin_log(
+            dir.path(),
+            &[
+                "bench",
+                "precision",
+                args[0],
+                args[1],
+                "--repeats",
+                "1",
+                "--out",
+                "o",
+            ],
+        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(stderr.contains("precision-"), "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?}: nothing measured");
+        assert!(!dir.path().join("o").exists(), "{args:?}: nothing written");
+    }
+}

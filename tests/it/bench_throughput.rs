@@ -248,3 +248,136 @@ fn record_and_verify_json_carry_the_peak_rss() {
         }
     }
 }
+
+/// The bench deletes its recordings and its export folders when done. A link or a named pipe of a
+/// recording's name is refused before any work and kept (it was deleted after the child `record` refused
+/// it), and a folder of the user's named like the old export folder (`throughput-D.csv.d`) is neither
+/// written into nor deleted: the exports go to a folder of the bench's own, removed afterwards.
+#[test]
+fn what_the_bench_did_not_write_is_never_deleted() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(dir.path().join("precious.txt"), "mine").unwrap();
+    std::os::unix::fs::symlink(
+        dir.path().join("precious.txt"),
+        out.join("throughput-0.01.mcap"),
+    )
+    .unwrap();
+    crate::support::mkfifo(&out.join("throughput-0.02.mcap"));
+    for d in ["0.01", "0.02"] {
+        let run = coin_log(
+            &out,
+            &[
+                "bench",
+                "throughput",
+                "--durations",
+                d,
+                "--repeats",
+                "1",
+                "--out",
+                ".",
+            ],
+        );
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{d}: {stderr}");
+        assert!(stderr.contains(&format!("throughput-{d}.mcap")), "{stderr}");
+        assert!(
+            !stderr.contains("exited with"),
+            "refused before any run: {stderr}"
+        );
+    }
+    let link = std::fs::symlink_metadata(out.join("throughput-0.01.mcap")).unwrap();
+    assert!(link.file_type().is_symlink(), "the link is kept");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("precious.txt")).unwrap(),
+        "mine"
+    );
+    assert!(
+        std::fs::symlink_metadata(out.join("throughput-0.02.mcap")).is_ok(),
+        "the pipe is kept"
+    );
+
+    let mine = out.join("throughput-0.03.csv.d");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    let run = coin_log(
+        &out,
+        &[
+            "bench",
+            "throughput",
+            "--durations",
+            "0.03",
+            "--repeats",
+            "1",
+            "--out",
+            ".",
+        ],
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(mine.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert_eq!(
+        std::fs::read_dir(&mine).unwrap().count(),
+        1,
+        "nothing exported into it"
+    );
+    let mut left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        [
+            "throughput-0.01.mcap",
+            "throughput-0.02.mcap",
+            "throughput-0.03.csv.d",
+            "throughput.csv"
+        ],
+        "the recording and the export folder are gone, the user's entries kept"
+    );
+}
+
+/// A duration the workload cannot record (beyond the 64-bit nanosecond log times) is refused before any
+/// run, naming --durations; it was refused by the child `record` of that duration after the others had
+/// been measured, in a message quoting the child's command line.
+#[test]
+fn a_duration_the_workload_cannot_record_is_refused_before_any_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = coin_log(
+        dir.path(),
+        &[
+            "bench",
+            "throughput",
+            "--durations",
+            "0.01,2e10",
+            "--repeats",
+            "1",
+            "--out",
+            "o",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.starts_with("error: --durations: 20000000000.0 time units cannot be recorded"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("`run.duration` = 20000000000 is too long"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("exited with"), "{stderr}");
+    assert!(run.stdout.is_empty());
+    assert!(
+        !dir.path().join("o").exists(),
+        "nothing measured, nothing written"
+    );
+}

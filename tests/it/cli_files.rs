@@ -721,6 +721,35 @@ fn a_scene_that_is_not_utf8_is_refused_saying_where_and_a_large_one_for_its_size
     assert!(read_toml(&path, InputKind::Scene).unwrap().contains("café"));
 }
 
+/// A recording given where a scene is read (`record rec.mcap`, `analyse rec.mcap`) is named as one, with
+/// the command that gets its scene: it said "not UTF-8 … save it as UTF-8 (iconv -f latin1)", or for a
+/// recording over 1 MiB that it was too large.
+#[test]
+fn a_recording_given_as_a_scene_is_named_as_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = crate::support::repo().join("datasets/wobble.mcap");
+    let small = dir.path().join("small.mcap");
+    let bytes = std::fs::read(&recording).unwrap();
+    std::fs::write(&small, &bytes[..4096]).unwrap();
+    for path in [recording.as_path(), small.as_path()] {
+        let e = read_toml(path, InputKind::Scene).unwrap_err().to_string();
+        assert!(
+            e.starts_with("is an MCAP recording, not a scene file: `coin-log info --scene FILE"),
+            "{e}"
+        );
+        let e = read_toml(path, InputKind::Sweep).unwrap_err().to_string();
+        assert_eq!(e, "is an MCAP recording, not a sweep file");
+    }
+    let out = coin_log(dir.path(), &["record", "small.mcap"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("`small.mcap`: is an MCAP recording, not a scene file"),
+        "{stderr}"
+    );
+    assert_eq!(listing(dir.path()), ["small.mcap"], "nothing written");
+}
+
 /// `OutputFolder::check` refuses what `create` and `file` would, creating nothing: `analyse map` checks
 /// with it before its work, so that a signal during the work leaves nothing (creating the outputs first
 /// left two empty `.coin-log-*.tmp` files and the folder on SIGTERM).

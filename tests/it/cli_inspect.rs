@@ -261,6 +261,54 @@ fn scenes_show_prints_every_default() {
     }
 }
 
+/// The bash script completes past the command: a subcommand's flags and their values (clap_complete's
+/// script for a hyphenated binary name labelled its `case` arms so that none matched: clap issue #6421),
+/// run in bash as bash-completion runs it.
+#[test]
+fn bash_completion_completes_the_flags_and_values_of_subcommands() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, script, err) = coin_log_text(&["completions", "bash"]);
+    assert_eq!(code, 0, "{err}");
+    let file = dir.path().join("coin-log.bash");
+    std::fs::write(&file, script).unwrap();
+    for (words, prev, expected) in [
+        ("coin-log rec", "coin-log", "record"),
+        (
+            "coin-log bench ''",
+            "bench",
+            "precision stability throughput euler sweep",
+        ),
+        ("coin-log record --enc", "record", "--encoding"),
+        (
+            "coin-log record --encoding ''",
+            "--encoding",
+            "json protobuf",
+        ),
+        ("coin-log sweep collect --j", "collect", "--jobs --json"),
+    ] {
+        let cur = words.rsplit(' ').next().unwrap();
+        let line = format!(
+            "source \"$1\"; COMP_WORDS=({words}); COMP_CWORD=$((${{#COMP_WORDS[@]}} - 1)); \
+             _coin__log coin-log {cur} {prev}; echo \"${{COMPREPLY[*]}}\""
+        );
+        let out = Command::new("bash")
+            .args(["-c", &line, "bash"])
+            .arg(&file)
+            .output()
+            .unwrap();
+        let got = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{words}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            got.contains(expected),
+            "`{words}<TAB>`: expected `{expected}`, got `{got}`"
+        );
+    }
+}
+
 #[test]
 fn completions_and_man_pages_name_every_command() {
     let (code, help, _) = coin_log_text(&["--help"]);

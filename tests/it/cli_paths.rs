@@ -681,3 +681,86 @@ fn plot_and_export_never_replace_the_recording_they_read() {
         .unwrap()
         .starts_with("t,"));
 }
+
+/// `bench sweep` deletes its folder `DIR/sweep-bench` before and after its work: a folder of that name
+/// holding anything the bench does not write (a sweep of the user's), or a link of that name, is refused
+/// before any work and kept, not deleted.
+#[test]
+fn bench_sweep_never_deletes_a_sweep_bench_folder_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let mine = dir.path().join("o/sweep-bench/my-dataset");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("catalogue.csv"), "important").unwrap();
+    std::fs::create_dir(dir.path().join("p")).unwrap();
+    std::os::unix::fs::symlink(&mine, dir.path().join("p/sweep-bench")).unwrap();
+    for (out, says) in [
+        ("o", "it holds `my-dataset`, which the bench did not write"),
+        ("p", "it is not a folder"),
+    ] {
+        let started = Instant::now();
+        let output = coin_log(
+            dir.path(),
+            &["bench", "sweep", "--repeats", "1", "--out", out],
+        );
+        assert_eq!(code(&output), 1, "{out}: {}", stderr(&output));
+        assert!(stderr(&output).contains(says), "{out}: {}", stderr(&output));
+        assert!(
+            stderr(&output).contains("choose another folder with --out"),
+            "{}",
+            stderr(&output)
+        );
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "refused before any sweep"
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(mine.join("catalogue.csv")).unwrap(),
+        "important"
+    );
+    assert!(std::fs::symlink_metadata(dir.path().join("p/sweep-bench"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+}
+
+/// `--out -` of the commands that write into a folder is refused like `-o -` (it created a folder named
+/// `-`): nothing goes to standard output, and `./-` names such a folder.
+#[test]
+fn a_folder_output_dash_is_refused_like_a_file_output_dash() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = crate::support::repo().join("datasets/wobble.mcap");
+    let file = file.to_str().unwrap();
+    for args in [
+        vec!["export", file, "--out", "-"],
+        vec!["man", "--out", "-"],
+        vec![
+            "analyse",
+            "map",
+            "--theta",
+            "0.1:1:3",
+            "--omega-z",
+            "0:1:3",
+            "--out",
+            "-",
+        ],
+        vec!["bench", "euler", "--out", "-"],
+    ] {
+        let output = coin_log(dir.path(), &args);
+        assert_eq!(code(&output), 1, "{args:?}: {}", stderr(&output));
+        assert!(
+            stderr(&output).contains("`-` would be a folder named `-`")
+                && stderr(&output).contains("`./-`"),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no folder `-`"
+    );
+    let output = coin_log(dir.path(), &["man", "--out", "./-"]);
+    assert_eq!(code(&output), 0, "{}", stderr(&output));
+    assert!(dir.path().join("-/coin-log.1").is_file());
+}

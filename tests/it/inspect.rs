@@ -752,6 +752,118 @@ fn plot_draws_every_panel_and_marks_the_termination() {
     assert_eq!(out.status.code(), Some(1));
 }
 
+/// A run of a microsecond: every time panel's ticks tell the times apart (plotters' own labels, 5 decimals
+/// without an exponent, printed `0.0` on every tick: 56 of them on the page).
+#[test]
+fn a_microsecond_run_is_plotted_with_time_ticks_that_differ() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "1e-6", "--rate", "1e7"],
+    );
+    let out = coin_log(dir.path(), &["plot", "wobble.mcap"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let texts = svg_texts(&std::fs::read_to_string(dir.path().join("wobble.svg")).unwrap());
+    let count = |label: &str| texts.iter().filter(|t| *t == label).count();
+    // θ, energy drift, invariant drift, N and |F|/N: five time axes.
+    for tick in ["0", "2.0e-7", "5.0e-7", "1.0e-6"] {
+        assert_eq!(count(tick), 5, "tick `{tick}`: {texts:?}");
+    }
+    assert!(count("0.0") <= 1, "{texts:?}");
+}
+
+/// The default outputs of a file whose name is not UTF-8 are named with its stem's own bytes (`\xff.svg`,
+/// `\xff-csv`), not a lossy copy (`\u{fffd}.svg`, which two such names would share).
+#[test]
+fn default_outputs_keep_the_bytes_of_a_name_that_is_not_utf8() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let recorded = record_scene(dir.path(), "wobble", &["--duration", "0.1"]);
+    let file = OsStr::from_bytes(b"\xff.mcap");
+    std::fs::rename(&recorded, dir.path().join(file)).unwrap();
+    for command in ["plot", "export"] {
+        let out = coin_log(dir.path(), &[OsStr::new(command), file]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let mut names: Vec<Vec<u8>> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().as_bytes().to_vec())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            b"\xff-csv".to_vec(),
+            b"\xff.mcap".to_vec(),
+            b"\xff.svg".to_vec()
+        ]
+    );
+}
+
+/// `export --wide` of a file with only frame transforms: the error names, for each topic, the table that
+/// exporting per channel writes (it said `tf.csv` for /tf_static and /scene/follow too).
+#[test]
+fn the_wide_error_names_each_frame_topics_own_table() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "0.1", "--channels", "tf,scene"],
+    );
+    let out = coin_log(dir.path(), &["export", "wobble.mcap", "--wide"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for (topic, table) in [
+        ("/tf", "tf.csv"),
+        ("/tf_static", "tf_static.csv"),
+        ("/scene/follow", "scene_follow.csv"),
+    ] {
+        let says = format!(
+            "{topic}: frame transforms are not one per sample; export per channel for {table}"
+        );
+        assert!(stderr.contains(&says), "{says}: {stderr}");
+    }
+}
+
+/// `info` of a recording at 0.001 samples per time unit: the rate column shows the rate (`1.00e-3`), not
+/// `0.00` as if the channel had none (ordinary rates keep two decimals: the README's example pins them).
+#[test]
+fn info_shows_a_rate_below_two_decimals() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "wobble",
+        &[
+            "--duration",
+            "3000",
+            "--rate",
+            "0.001",
+            "--channels",
+            "omega",
+        ],
+    );
+    let out = coin_log(dir.path(), &["info", "wobble.mcap"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    let row = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("/coin/omega"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(row.trim_end().ends_with(" 4    1.00e-3"), "{row}");
+}
+
 /// The paths the test used, for the README's example: every committed dataset is described by `info`.
 #[test]
 fn info_describes_every_committed_dataset_from_its_summary() {

@@ -5,8 +5,9 @@ mod sweep;
 mod throughput;
 
 use super::Outcome;
+use anyhow::bail;
 use coin_log::files::output::check;
-use coin_log::files::{shown, Output, OutputFolder, Policy};
+use coin_log::files::{escaped, shown, Output, OutputFolder, Policy};
 use coin_log::integrate::Method;
 use coin_log_bench::euler::{euler_bench, EulerOptions, SLIP_FRICTION, WINDOW_TOP};
 use coin_log_bench::plot::{euler_svg, work_precision_svg};
@@ -155,6 +156,23 @@ fn precision(args: &PrecisionArgs) -> anyhow::Result<Outcome> {
         .iter()
         .map(|n| load_case(n))
         .collect::<anyhow::Result<Vec<_>>>()?;
+    // A scene is named in the CSV and the diagram's file by its name (a file's stem): two of one name
+    // would share their rows' name and one diagram, the second replacing the first.
+    for (i, case) in cases.iter().enumerate() {
+        if let Some(j) = cases[..i].iter().position(|c| c.name == case.name) {
+            let name = escaped(&case.name);
+            let given = if names[j] == names[i] {
+                format!("scene `{}` is given twice", escaped(&names[i]))
+            } else {
+                let (a, b) = (escaped(&names[j]), escaped(&names[i]));
+                format!("scenes `{a}` and `{b}` are both named `{name}`")
+            };
+            bail!(
+                "{given}: their rows in precision.csv and their diagram precision-{name}.svg could not be \
+                 told apart; give each scene once, from files of different names"
+            );
+        }
+    }
     let mut files: Vec<String> = cases
         .iter()
         .map(|c| format!("precision-{}.svg", c.name))

@@ -149,6 +149,7 @@ pub fn run(args: &SweepBenchArgs) -> anyhow::Result<Outcome> {
     create_dir(&args.out, &["sweep.csv".into()])?;
     let exe = std::env::current_exe().context("locating the coin-log binary")?;
     let work = args.out.join("sweep-bench");
+    refuse_foreign(&work)?;
     let _ = fs::remove_dir_all(&work);
     create_dir(&work, &[])?;
     let result = measure(&exe, &work, args.repeats as usize);
@@ -162,6 +163,47 @@ pub fn run(args: &SweepBenchArgs) -> anyhow::Result<Outcome> {
     write(&csv_path, &throughput::csv(&report))?;
     outln!("CSV: {}", coin_log::files::shown(&csv_path));
     Ok(Outcome::Success)
+}
+
+/// The entries the bench writes in its folder (speed workload, memory and resume workloads, and the
+/// temporary files of its sweep files).
+fn is_benchs_own(name: &str) -> bool {
+    let stem = name.strip_suffix(".toml").unwrap_or(name);
+    name.starts_with(".coin-log-")
+        || stem == "speed"
+        || [1, 2].iter().any(|jobs| name == format!("speed-{jobs}"))
+        || MEMORY_RUNS
+            .iter()
+            .any(|runs| stem == format!("memory-{runs}"))
+}
+
+/// The bench deletes its folder before and after its work: anything else of that name (a sweep of the
+/// user's, a link, a file) is refused before any work, never deleted.
+fn refuse_foreign(work: &Path) -> anyhow::Result<()> {
+    let shown = coin_log::files::shown(work);
+    let foreign = match fs::symlink_metadata(work) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(anyhow!("cannot look at `{shown}`: {e}")),
+        Ok(meta) if !meta.is_dir() => Some("it is not a folder".to_string()),
+        Ok(_) => fs::read_dir(work)
+            .with_context(|| format!("cannot read the folder `{shown}`"))?
+            .filter_map(Result::ok)
+            .map(|entry| entry.file_name().to_string_lossy().into_owned())
+            .find(|name| !is_benchs_own(name))
+            .map(|name| {
+                format!(
+                    "it holds `{}`, which the bench did not write",
+                    coin_log::files::shown_name(&name)
+                )
+            }),
+    };
+    match foreign {
+        None => Ok(()),
+        Some(why) => bail!(
+            "`{shown}` is the folder bench sweep works in and deletes, but {why}: move it away, or choose \
+             another folder with --out"
+        ),
+    }
 }
 
 fn measure(exe: &Path, work: &Path, repeats: usize) -> anyhow::Result<Vec<ThroughputRow>> {
@@ -330,4 +372,49 @@ fn memory_and_resume(
         }
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{is_benchs_own, refuse_foreign};
+
+    /// A folder kept by `--keep` (or left by an interrupted bench) is the bench's own and is replaced; a
+    /// sweep of the user's under that name is not.
+    #[test]
+    fn the_benchs_own_folder_is_told_from_a_users() {
+        for name in [
+            "speed.toml",
+            "speed-1",
+            "speed-2",
+            "memory-1000.toml",
+            "memory-1000",
+            "memory-10000.toml",
+            "memory-10000",
+            ".coin-log-Ab12Cd.toml.tmp",
+        ] {
+            assert!(is_benchs_own(name), "{name}");
+        }
+        for name in [
+            "my-dataset",
+            "catalogue.csv",
+            "speed-3",
+            "memory-5",
+            "speedy",
+            "memory.toml",
+        ] {
+            assert!(!is_benchs_own(name), "{name}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let work = dir.path().join("sweep-bench");
+        refuse_foreign(&work).unwrap();
+        std::fs::create_dir_all(work.join("speed-1")).unwrap();
+        std::fs::write(work.join("memory-1000.toml"), "").unwrap();
+        refuse_foreign(&work).unwrap();
+        std::fs::create_dir(work.join("mine")).unwrap();
+        let e = refuse_foreign(&work).unwrap_err().to_string();
+        assert!(
+            e.contains("it holds `mine`, which the bench did not write"),
+            "{e}"
+        );
+    }
 }

@@ -3,13 +3,15 @@
 //! peak RSS is its own), reads their `--json` summaries, and has the library measure the compression
 //! bound, turn the runs into rows and format them.
 
-use super::{create_dir, write};
+use super::{create_dir, write, POLICY};
 use crate::cli::Outcome;
 use anyhow::{anyhow, bail, Context};
+use coin_log::files::output::check;
+use coin_log::files::shown;
 use coin_log::format::Encoding;
 use coin_log_bench::throughput::{
-    self, channel_list, compression_bound, recording_path, DurationRuns, ExportRun, RecordRun,
-    ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
+    self, channel_list, compression_bound, recording_path, workload_scene, DurationRuns, ExportRun,
+    RecordRun, ThroughputError, ThroughputReport, ThroughputRow, VerifyRun, RATE, SCENE,
 };
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -44,6 +46,11 @@ pub struct ThroughputArgs {
 pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
     let durations = durations(args)?;
     create_dir(&args.out, &["throughput.csv".into()])?;
+    // The recordings are the bench's own files, replaced and deleted afterwards: a link, pipe or device of
+    // their names is refused now, before any work, and so never reaches the clean-up below.
+    for d in &durations {
+        check(&recording_path(&args.out, *d), &POLICY)?;
+    }
     let exe = std::env::current_exe().context("locating the coin-log binary")?;
     let result = measure(
         &exe,
@@ -62,7 +69,7 @@ pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
     out!("{}", throughput::table(&report));
     let csv_path = args.out.join("throughput.csv");
     write(&csv_path, &throughput::csv(&report))?;
-    outln!("CSV: {}", coin_log::files::shown(&csv_path));
+    outln!("CSV: {}", shown(&csv_path));
     Ok(Outcome::Success)
 }
 
@@ -75,6 +82,16 @@ fn durations(args: &ThroughputArgs) -> anyhow::Result<Vec<f64>> {
     };
     if let Some(bad) = durations.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
         bail!("--durations: `{bad}` is not a positive duration");
+    }
+    // A duration the workload cannot record is refused now, not by the first child `record` after the
+    // others have run (with its flags in the message, and the duration in the recording's name).
+    for &d in &durations {
+        if let Err(ThroughputError::Workload { reason, .. }) = workload_scene(d) {
+            bail!(
+                "--durations: {d:?} time units cannot be recorded by the workload ({SCENE} at {RATE} samples \
+                 per time unit): {reason}"
+            );
+        }
     }
     Ok(durations)
 }
@@ -186,19 +203,23 @@ fn record_run(
     })
 }
 
-/// Exports `path` as CSV tables into a folder beside it (removed afterwards) in a child process.
+/// Exports `path` as CSV tables in a child process, into a new folder of a unique name beside it that is
+/// removed afterwards (a folder of the user's is never written into nor removed).
 fn export_run(exe: &Path, path: &Path) -> anyhow::Result<ExportRun> {
-    let out = path.with_extension("csv.d");
+    let beside = path.parent().unwrap_or(Path::new("."));
+    let scratch = tempfile::Builder::new()
+        .prefix(".coin-log-export-")
+        .tempdir_in(beside)
+        .with_context(|| format!("cannot create a folder in `{}`", shown(beside)))?;
     let args = vec![
         "export".to_string(),
         path.display().to_string(),
         "--out".to_string(),
-        out.display().to_string(),
-        "--overwrite".to_string(),
+        scratch.path().display().to_string(),
         "--json".to_string(),
     ];
     let result = child_json(exe, &args);
-    let _ = fs::remove_dir_all(&out);
+    drop(scratch);
     let (json, seconds) = result?;
     Ok(ExportRun {
         seconds,

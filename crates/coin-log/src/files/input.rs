@@ -12,6 +12,9 @@ use std::path::Path;
 /// bounding what a wrong path can make the tool read.
 pub const SCENE_MAX_BYTES: u64 = 1 << 20;
 
+/// The first bytes of every MCAP file.
+const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
 /// What an input is read as, for the rules and the words of a refusal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InputKind {
@@ -83,6 +86,18 @@ pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
     let read = File::open(path)
         .and_then(|f| f.take(SCENE_MAX_BYTES + 1).read_to_end(&mut bytes))
         .map_err(|source| InputError(source.to_string()))?;
+    // A recording given where its scene was meant: said so, not "not UTF-8 … iconv" or "too large".
+    if bytes.starts_with(MCAP_MAGIC) {
+        return Err(InputError(format!(
+            "is an MCAP recording, not {}{}",
+            what(kind),
+            if kind == InputKind::Scene {
+                ": `coin-log info --scene FILE > scene.toml` writes the scene it was recorded from"
+            } else {
+                ""
+            }
+        )));
+    }
     // The size first: a large file is refused for its size, wherever its first non-UTF-8 byte is.
     if read as u64 > SCENE_MAX_BYTES {
         let bytes = fs::metadata(path).map_or(read as u64, |m| m.len().max(read as u64));

@@ -590,6 +590,14 @@ fn folder_policy(overwrite: bool) -> Policy {
 /// # Errors
 /// [`OutputError`] if `dir` or a parent is not a folder, or is a link to nothing.
 fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    if dir.as_os_str() == "-" {
+        // As for a file output `-`: one who writes `--out -` expects standard output, not a folder `-`.
+        return Err(OutputError(
+            "`-` would be a folder named `-`: coin-log does not write to standard output, it writes its \
+             files into a folder; choose one with --out, e.g. --out results (a folder named `-` is `./-`)"
+                .to_string(),
+        ));
+    }
     let mut created = Vec::new();
     let mut missing = Some(dir);
     while let Some(d) = missing.filter(|d| !d.as_os_str().is_empty()) {

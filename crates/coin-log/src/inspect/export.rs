@@ -262,10 +262,10 @@ impl<W: Write> Exporter<'_, W> {
         // Every frame-transform topic (/tf, /tf_static, /scene/follow) is flattened into a table named
         // after the topic, so that two topics of one channel never share a file.
         if schema == Channel::Tf.schema_name() && matches!(channel, Channel::Tf | Channel::Scene) {
+            let name = format!("{}.csv", topic.trim_start_matches('/').replace('/', "_"));
             return match self.layout {
                 Layout::PerChannel => {
                     let columns = TF_COLUMNS.iter().map(ToString::to_string).collect();
-                    let name = format!("{}.csv", topic.trim_start_matches('/').replace('/', "_"));
                     let protobuf =
                         Encoding::from_schema_encoding(encoding) == Some(Encoding::Protobuf);
                     match self.open_table(&name, topic, columns) {
@@ -275,7 +275,9 @@ impl<W: Write> Exporter<'_, W> {
                 }
                 Layout::Wide => self.skip(
                     topic,
-                    "frame transforms are not one per sample; export per channel for tf.csv",
+                    &format!(
+                        "frame transforms are not one per sample; export per channel for {name}"
+                    ),
                 ),
             };
         }

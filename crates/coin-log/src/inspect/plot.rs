@@ -472,6 +472,34 @@ fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
     }
 }
 
+/// Tick labels of an axis over `lo..hi`: plotters' own (at most 5 decimals, no exponent) when the span is
+/// wide enough for those to tell the ticks apart, as on every ordinary recording; otherwise, for a short
+/// span near 0 (the time axis of a run of a microsecond, where plotters' would print `0.0` on every tick),
+/// each tick in exponent form with the few significant digits its step needs. A value constant to
+/// rounding (θ of a steady motion) keeps plotters' labels, which show the value.
+fn tick_label(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+    let span = (hi - lo).abs();
+    // Ticks are about a tenth of the span apart: the digits between the largest value's leading digit and
+    // the step's.
+    let decade = |x: f64| x.log10().floor();
+    let digits = decade(lo.abs().max(hi.abs())) - decade(span / 10.0);
+    let digits = (span < WIDE_SPAN && digits <= SHORT_DIGITS).then(|| {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let digits = digits.max(0.0) as usize;
+        digits
+    });
+    move |v: &f64| match digits {
+        None => <RangedCoordf64 as plotters::coord::ranged1d::ValueFormatter<f64>>::format(v),
+        Some(_) if *v == 0.0 => "0".to_string(),
+        Some(d) => format!("{v:.d$e}"),
+    }
+}
+
+/// The narrowest span whose ticks plotters' labels (5 decimals) tell apart: ticks a tenth of it apart.
+const WIDE_SPAN: f64 = 1e-3;
+/// The most digits after the leading one of an exponent-form tick label (it fits the label area).
+const SHORT_DIGITS: f64 = 6.0;
+
 fn min_max<'a>(
     points: impl Iterator<Item = &'a (f64, f64)>,
     pick: fn(&(f64, f64)) -> f64,
@@ -513,6 +541,8 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), DrawError> {
         .configure_mesh()
         .x_desc("x")
         .y_desc("z (down the page: the view from above)")
+        .x_label_formatter(&tick_label(xc - hx, xc + hx))
+        .y_label_formatter(&tick_label(zc - hz, zc + hz))
         .draw()?;
     for (label, points, colour) in [
         ("contact track", &contact, BLUE),
@@ -569,7 +599,13 @@ impl TimeAxis<'_> {
             .x_label_area_size(40)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..self.t_max, y0..y1)?;
-        chart.configure_mesh().x_desc("t").y_desc(y_desc).draw()?;
+        chart
+            .configure_mesh()
+            .x_desc("t")
+            .y_desc(y_desc)
+            .x_label_formatter(&tick_label(0.0, self.t_max))
+            .y_label_formatter(&tick_label(y0, y1))
+            .draw()?;
         self.finish(&mut chart, series, &points, |v| v, line, (y0, y1))
     }
 
@@ -601,6 +637,7 @@ impl TimeAxis<'_> {
         chart
             .configure_mesh()
             .x_desc("t")
+            .x_label_formatter(&tick_label(0.0, self.t_max))
             .y_desc(if hi > 0.0 {
                 "relative drift (0 on the bottom edge)"
             } else {
