@@ -6,7 +6,7 @@ use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::format::tolerances::UNIT_ROUNDOFF;
-use crate::model::{energy, reaction, CoinParams, Inertia, State};
+use crate::model::{energy, CoinParams, Dissipation, DissipationModel, Inertia, State};
 
 /// Smallest scale (mass, length, inertia, energy, ...) a scene may have: the model multiplies and divides
 /// pairs of scales (I_Z·Ma² in C1, C2; |R|² ~ (Mg)²) times factors up to 1e8 (tan θ, ωτ), which stay
@@ -257,7 +257,8 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
             "run.step",
             &shown,
             format!(
-                "{used}is above 0.178/W = {ceiling}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {ceiling}",
+                "{used}is above 0.178/W = {ceiling}, where W = {} = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {ceiling}",
+                rates_named(scene),
                 short(w, Round::Nearest),
                 run.method.method,
             ),
@@ -298,6 +299,134 @@ fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
         .max(1.0 / params.time_unit())
 }
 
+/// The rates W is the largest of, as the refusals name them: λ, the couple's, only with dissipation.
+fn rates_named(scene: &Scene) -> &'static str {
+    if scene.dissipation.is_some() {
+        "max(|ω|, |φ̇|, |ψ̇|, 1/τ, λ)"
+    } else {
+        "max(|ω|, |φ̇|, |ψ̇|, 1/τ)"
+    }
+}
+
+/// λ = P/(|ω|²·min(I_X, I_Z + Ma²)) at t = 0: the rate at which the dissipative couple −P ω/|ω|² changes
+/// ω (eqs (31)–(33): |ω̇|/|ω| of the couple alone, the largest of its three inertias' rates), and so the
+/// rate an explicit integrator's step must resolve (physics §11); 0 without dissipation. |ω|² as the
+/// equations form it, so that a state whose |ω|² underflows to 0 (couple 0 there) has λ = 0.
+fn couple_rate(scene: &Scene) -> f64 {
+    let Some(d) = &scene.dissipation else {
+        return 0.0;
+    };
+    let s = &scene.initial;
+    let p = &scene.params;
+    let w2 = s.omega_x * s.omega_x + s.omega_y * s.omega_y + s.omega_z * s.omega_z;
+    if w2 > 0.0 {
+        d.power(s.theta, s.omega_y) / w2 / p.inertia_x().min(p.inertia_z() + p.ma2())
+    } else {
+        0.0
+    }
+}
+
+/// With dissipation, the couple at t = 0 must be finite and, for an adaptive method, within what its error
+/// estimate can square: P = κ |φ̇|^m (sin α)^(−k) finite (k = 1e300 made (sin α)^(−k) infinite) and P,
+/// λ|ω| ≤ 1e150·atol (κ = 1e300 gave P = 3e304). Each ended the run "non-finite at t = 0" with one sample
+/// written. `true` when a problem was reported.
+fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector) -> bool {
+    let s = &scene.initial;
+    let power = d.power(s.theta, s.omega_y);
+    let (kappa, m, k) = (d.coefficient(), d.m(), d.k());
+    if !power.is_finite() {
+        let sin_alpha = s.theta.cos();
+        let phi_dot = (s.omega_y / sin_alpha).abs();
+        let angle_factor = sin_alpha.powf(-k);
+        let rate_factor = phi_dot.powf(m);
+        let laws = format!(
+            "gives a non-finite dissipated power P = κ |φ̇|^m (sin α)^(−k) at t = 0 (κ = {}, |φ̇| = {}, sin α = {}, m = {}, k = {})",
+            number(kappa),
+            short(phi_dot, Round::Nearest),
+            short(sin_alpha, Round::Nearest),
+            number(m),
+            number(k)
+        );
+        let ln_max = f64::MAX.ln();
+        if !angle_factor.is_finite() {
+            // ln P = ln(κ |φ̇|^m) + k ln(1/sin α) < ln(MAX); the factor alone must stay finite too.
+            let ln_rest = (kappa.ln() + m * phi_dot.ln()).max(0.0);
+            let k_max = (ln_max - ln_rest) / -sin_alpha.ln();
+            problems.push(
+                "body.dissipation.k",
+                number(k),
+                format!(
+                    "{laws}: (sin α)^(−k) overflows double precision; use k < {}",
+                    short(k_max, Round::Down)
+                ),
+            );
+        } else if !rate_factor.is_finite() {
+            if d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
+                // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
+                let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
+                problems.push(
+                    "body.dissipation.m",
+                    number(m),
+                    format!(
+                        "{laws}: |φ̇|^m overflows double precision; use m < {}",
+                        short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
+                    ),
+                );
+            } else {
+                problems.push(
+                    initial_key(scene),
+                    describe_state(s),
+                    format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
+                );
+            }
+        } else {
+            let kappa_max = f64::MAX / rate_factor / angle_factor;
+            problems.push(
+                "body.dissipation.coefficient",
+                number(kappa),
+                format!(
+                    "{laws}: P overflows double precision; use coefficient < {}",
+                    short(kappa_max, Round::Down)
+                ),
+            );
+        }
+        return true;
+    }
+    // An adaptive method squares each component of its error estimate over its weight (≥ atol): Ẇ = P
+    // and the couple's ω̇ (λ|ω|) beyond 1e150·atol overflow it whatever the step, and every trial step is
+    // rejected as non-finite (κ = 1e200 on `euler-disk`: P = 5e203). The same 1e150 as the scales'.
+    let method = &scene.run.method;
+    if method.method.is_adaptive() {
+        let rate = power.max(couple_rate(scene) * s.omega_x.hypot(s.omega_y).hypot(s.omega_z));
+        let max = SCALE_MAX * method.atol;
+        if !(rate <= max) {
+            problems.push(
+                "body.dissipation.coefficient",
+                number(kappa),
+                format!(
+                    "gives the couple a rate of change max(P, λ|ω|) = {} at t = 0 (P = {}, λ = P/(|ω|²·min(I_X, I_Z + Ma²)) = {}), more than {SCALE_MAX:e}·atol = {}: {}'s error estimate squares it over atol and would overflow at every step, ending the run at t = 0; use coefficient ≤ {}",
+                    short(rate, Round::Nearest),
+                    short(power, Round::Nearest),
+                    short(couple_rate(scene), Round::Nearest),
+                    short(max, Round::Nearest),
+                    method.method,
+                    // Both terms are linear in κ.
+                    short(kappa * (max / rate), Round::Down)
+                ),
+            );
+            return true;
+        }
+    }
+    false
+}
+
+fn initial_key(scene: &Scene) -> &'static str {
+    match scene.spec {
+        super::InitialSpec::Explicit => "initial.omega",
+        super::InitialSpec::Steady(_) => "initial.steady",
+    }
+}
+
 /// Checks that need the whole scene: the initial state, atol, the fixed step and the duration against
 /// the fastest motion.
 pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut ProblemCollector) {
@@ -311,6 +440,10 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     if run.method.method.is_adaptive() {
         check_atol(scene, problems);
     } else {
+        // A fixed step must resolve the couple's rate too (rk4 at h·λ = 130 on `euler-disk` with κ = 100
+        // "landed flat" at t = 9e-14 with no drift shown). An adaptive step follows it as the couple
+        // decays: λ at t = 0 does not bound its work.
+        let w = w.max(couple_rate(scene));
         check_fixed_step(scene, file.run.as_ref().and_then(|r| r.step), w, problems);
     }
     if run.duration * w > MAX_RADIANS {
@@ -349,14 +482,17 @@ fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
 /// The initial state must be inside the model: finite energy and reaction, the table pushing (N > 0)
 /// and, with μ, friction within the cone (|F| < μN). Otherwise the run would end at t = 0 with one sample.
 fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
+    if let Some(d) = &scene.dissipation {
+        if check_couple(scene, d, problems) {
+            return;
+        }
+    }
     let coin = scene.coin();
     let s = &scene.initial;
     let e = energy(&coin, s).total;
-    let r = reaction(&coin, s);
-    let key = match scene.spec {
-        super::InitialSpec::Explicit => "initial.omega",
-        super::InitialSpec::Steady(_) => "initial.steady",
-    };
+    // The reaction of the equations the run integrates (with the couple's ω̇ when there is one).
+    let r = scene.dynamics().reaction(s);
+    let key = initial_key(scene);
     let value = || describe_state(s);
     let p = &scene.params;
     let weight = p.mass() * p.gravity();
