@@ -293,6 +293,46 @@ fn a_light_coin_braked_within_its_first_sample_verifies() {
     assert_eq!(c.status, Status::Pass, "{}", show(&r));
 }
 
+/// A coin at rest almost upright (θ₀ = 1e-200, physics §12 follows θ₀ down to 1e-300) does move: |ω|
+/// ~ 1e-198 grows to ~1e-192 by t = 20. |ω| formed through its squares underflowed to 0, and `constraint`
+/// skipped it as "ω = 0 throughout" (CANNOT VERIFY); the residual's norm underflowed to 0 in the same way.
+/// Judged, it passes; a moved position still fails (the negative control of the judging).
+#[test]
+fn a_coin_at_rest_a_hair_from_upright_moves_and_is_judged() {
+    let dir = tempfile::tempdir().unwrap();
+    for theta in ["1e-200", "1e-310"] {
+        let args = [
+            "--set",
+            &format!("initial.theta={theta}"),
+            "--set",
+            "initial.omega=[0.0, 0.0, 0.0]",
+            "--duration",
+            "20",
+        ];
+        let (r, c, path) = constraint_of(dir.path(), "wobble", &args);
+        assert_eq!(r.exit_code, 0, "θ0 = {theta}: {}", show(&r));
+        assert_eq!(c.status, Status::Pass, "θ0 = {theta}: {}", show(&r));
+        assert!(c.value.unwrap() > 0.0, "{}", show(&r));
+        if theta == "1e-200" {
+            let moved = dir.path().join("moved.mcap");
+            rewrite(&path, &moved, |e| {
+                if e.topic == "/coin/position" && e.index == 1500 {
+                    let v: serde_json::Value = serde_json::from_slice(e.data).unwrap();
+                    let z = v["z"].as_f64().unwrap(); // the coin tips over in the y-z plane
+                    nudge(e.data, "z", z * 1e-3);
+                }
+            });
+            let r = verify_file(&moved, &Options::default());
+            assert_eq!(
+                status(&r, CheckId::Constraint),
+                Status::Fail,
+                "{}",
+                show(&r)
+            );
+        }
+    }
+}
+
 #[test]
 fn verify_flags_a_log_with_one_omega_sample_changed_by_1e_5() {
     let r = tampered("wobble", |e| {

@@ -6,7 +6,7 @@ use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::format::tolerances::UNIT_ROUNDOFF;
-use crate::model::{energy, CoinParams, Dissipation, DissipationModel, Inertia, State};
+use crate::model::{energy, magnitude, CoinParams, Dissipation, DissipationModel, Inertia, State};
 
 /// Smallest scale (mass, length, inertia, energy, ...) a scene may have: the model multiplies and divides
 /// pairs of scales (I_Z·Ma² in C1, C2; |R|² ~ (Mg)²) times factors up to 1e8 (tan θ, ωτ), which stay
@@ -289,7 +289,7 @@ pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollect
 
 /// W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) of a state: the fastest rate of the equations.
 fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
-    let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
+    let omega = magnitude(s.omega_x, s.omega_y, s.omega_z);
     let (sin_t, cos_t) = s.theta.sin_cos();
     let phi_dot = s.omega_y / cos_t;
     let psi_dot = s.omega_z + s.omega_y * sin_t / cos_t;
@@ -397,7 +397,7 @@ fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
     // rejected as non-finite (κ = 1e200 on `euler-disk`: P = 5e203). The same 1e150 as the scales'.
     let method = &scene.run.method;
     if method.method.is_adaptive() {
-        let rate = power.max(couple_rate(scene) * s.omega_x.hypot(s.omega_y).hypot(s.omega_z));
+        let rate = power.max(couple_rate(scene) * magnitude(s.omega_x, s.omega_y, s.omega_z));
         let max = SCALE_MAX * method.atol;
         if !(rate <= max) {
             problems.push(

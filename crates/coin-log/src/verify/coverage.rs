@@ -14,9 +14,8 @@
 use super::checks::constraint;
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
-use crate::model::{Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
+use crate::model::{magnitude, Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use crate::scene::Scene;
-use nalgebra::Vector3;
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
 /// and what to change; empty when `verify` will be able to judge the recording.
@@ -80,7 +79,7 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
         ));
     }
     let s = &scene.initial;
-    let omega = Vector3::new(s.omega_x, s.omega_y, s.omega_z).norm();
+    let omega = magnitude(s.omega_x, s.omega_y, s.omega_z);
     if omega == 0.0 && s.theta == 0.0 {
         // Upright at rest: eqs (14)–(16) give ω̇ = 0 (sin θ = 0, every other term has a factor ω, and the
         // dissipative couple is 0 at ω = 0), so ω stays 0 and the check finds nothing moving.
