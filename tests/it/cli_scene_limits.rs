@@ -222,6 +222,37 @@ fn a_dissipative_couple_beyond_double_precision_or_the_step_is_refused() {
     );
 }
 
+/// A body whose time unit is so short that even the shortest run (1 ns) is beyond 1e10 radians: the
+/// refusal said "use duration ≤ 0.999e-65" (a mantissa below 1, and a duration below the 1e-9 floor that
+/// would itself be refused); it now names τ and the units. A spin that fast asks to slow the motion.
+#[test]
+fn a_motion_no_duration_can_hold_is_refused_with_a_fix_that_works() {
+    let err = refused(
+        &[
+            "wobble",
+            "--set",
+            "body.radius=1e-75",
+            "--set",
+            "body.gravity=1e75",
+            "--atol",
+            "1e-80",
+        ],
+        &[
+            "`run.duration` = 30 times W",
+            "so would the shortest duration, 1e-9",
+            "τ = √(a/g) = 1e-75 is too short: express the scene in units where τ is nearer 1",
+        ],
+    );
+    assert!(!err.contains("use duration ≤"), "{err}");
+    refused(
+        &["straight", "--set", "initial.steady.omega_z=1e100"],
+        &[
+            "so would the shortest duration",
+            "slow the motion to W ≤ 1e19",
+        ],
+    );
+}
+
 #[test]
 fn tolerances_and_steps_beyond_what_the_integrators_deliver_are_refused() {
     refused(

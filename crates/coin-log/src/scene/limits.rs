@@ -77,6 +77,14 @@ fn short(x: f64, round: Round) -> String {
     let exponent = x.abs().log10().floor();
     let unit = 10f64.powf(exponent - 3.0);
     let scaled = x / unit;
+    // x / unit is inexact: a power of ten such as 1e-65 came out as 999.99999999999989 and printed, rounded
+    // down, as "0.999e-65". A quotient within rounding of a whole number is that number.
+    let nearest = scaled.round();
+    let scaled = if (scaled - nearest).abs() <= 4.0 * f64::EPSILON * scaled.abs() {
+        nearest
+    } else {
+        scaled
+    };
     let digits = match round {
         Round::Down => scaled.trunc(),
         Round::Up => scaled.abs().ceil().copysign(scaled),
@@ -446,7 +454,29 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
         let w = w.max(couple_rate(scene));
         check_fixed_step(scene, file.run.as_ref().and_then(|r| r.step), w, problems);
     }
-    if run.duration * w > MAX_RADIANS {
+    if run.duration * w > MAX_RADIANS && MAX_RADIANS / w < MIN_DURATION {
+        // No duration would do: even the shortest run, 1 ns, is too many radians.
+        let fix = if w * scene.params.time_unit() <= 1.0 {
+            format!(
+                "the body's own time unit τ = √(a/g) = {} is too short: express the scene in units where τ is nearer 1",
+                short(scene.params.time_unit(), Round::Nearest)
+            )
+        } else {
+            format!(
+                "slow the motion to W ≤ {}",
+                short(MAX_RADIANS / MIN_DURATION, Round::Down)
+            )
+        };
+        problems.push(
+            "run.duration",
+            number(run.duration),
+            format!(
+                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than {MAX_RADIANS:e} (≥ 5.6e10 integrator steps), and so would the shortest duration, {MIN_DURATION:e} (the log-time resolution): {fix}",
+                short(w, Round::Nearest),
+                short(run.duration * w, Round::Nearest),
+            ),
+        );
+    } else if run.duration * w > MAX_RADIANS {
         problems.push(
             "run.duration",
             number(run.duration),
@@ -561,6 +591,14 @@ mod tests {
         assert_eq!(short(2.220_446e-15, Round::Up), "2.221e-15");
         assert_eq!(short(1.609_26, Round::Nearest), "1.609");
         assert_eq!(short(-0.5, Round::Nearest), "-0.5");
+        // 1e-65 / 1e-68 is 999.99999999999989 in double precision: it printed "0.999e-65".
+        let w = 1.0 / (1e-75_f64 / 1e75).sqrt(); // 1/τ of a = 1e-75, g = 1e75
+        assert_eq!(short(1e10 / w, Round::Down), "1e-65");
+        assert_eq!(short(1e-65, Round::Up), "1e-65");
+        assert_eq!(
+            short(0.177_827_941_003_892_3 / 1.609, Round::Down),
+            "0.1105"
+        );
     }
 
     #[test]
