@@ -914,6 +914,27 @@ fn missing_channels_are_named_with_the_fix() {
     assert_eq!(coverage(&s), Vec::<String>::new());
 }
 
+/// Ω of the forecast is the rate plus its relative change at t = 0; a strong couple's braking made Ω =
+/// 1.23e8 on `euler-disk` (|ω| = 14.4, |φ̇| = 72.6), which the warning called max(|ω|, |φ̇|). It names both
+/// terms now, printed as three digits (not 72.60000000000001).
+#[test]
+fn a_forecast_rate_made_of_the_braking_says_so() {
+    let s = preset_scene(
+        "euler-disk",
+        &[
+            "body.dissipation={model=\"power-law\",coefficient=1e-12,m=10,k=0}",
+            "run.rate=4000",
+        ],
+    );
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(
+        c[0].contains("(Ω = max(|ω|, |φ̇|) + |d ln Ω/dt| = 72.6 + 123000000 = 123000000 at t = 0)"),
+        "{}",
+        c[0]
+    );
+}
+
 #[test]
 fn a_rate_that_does_not_resolve_the_motion_is_named_with_the_rate_that_does() {
     let s = preset_scene("high-spin", &["run.rate=100"]);

@@ -91,20 +91,32 @@ fn constraint_blocker(scene: &Scene) -> Option<String> {
         );
     }
     let phi_dot = (s.omega_y / s.theta.cos()).abs();
-    let rate = omega.max(phi_dot) + initial_steepness(scene, omega, phi_dot);
+    let fastest = omega.max(phi_dot);
+    let rate = fastest + initial_steepness(scene, omega, phi_dot);
     let accuracy = RunAccuracy::new(&run.method, &scene.params, run.duration, omega);
     let tol = Tolerances::derive(&accuracy, None, None).residual;
     let h = run.sample_interval();
     if constraint::resolves(h, rate, tol) {
         return None;
     }
+    // Ω is the rate plus its relative change; the change is named when it shows in the digits printed (a
+    // braking couple's: Ω = 1.23e8 on a coin whose |ω| and |φ̇| were 14 and 73 was called max(|ω|, |φ̇|)).
+    let omega_text = if digits3(rate, f64::round) == digits3(fastest, f64::round) {
+        format!("max(|ω|, |φ̇|) = {}", digits3(rate, f64::round))
+    } else {
+        format!(
+            "max(|ω|, |φ̇|) + |d ln Ω/dt| = {} + {} = {}",
+            digits3(fastest, f64::round),
+            digits3(rate - fastest, f64::round),
+            digits3(rate, f64::round)
+        )
+    };
     Some(format!(
         "will find no window the sampling resolves: at {} samples per time unit, h·Ω = {} (Ω = \
-         max(|ω|, |φ̇|) = {} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
+         {omega_text} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
          tenth of the residual tolerance {tol:.1e}; raise --rate to at least {}",
         run.rate,
         digits3(h * rate, f64::round),
-        digits3(rate, f64::round),
         constraint::truncation(h, rate),
         digits3(constraint::min_rate(rate, tol), f64::ceil)
     ))
@@ -145,5 +157,8 @@ fn digits3(x: f64, round: fn(f64) -> f64) -> f64 {
         return x;
     }
     let unit = 10f64.powf(x.abs().log10().floor() - 2.0);
-    round(x / unit) * unit
+    let rounded = round(x / unit) * unit;
+    // The product carries the unit's rounding (72.6 came out as 72.60000000000001): the three digits
+    // printed and read back are the number meant.
+    format!("{rounded:.2e}").parse().unwrap_or(rounded)
 }
