@@ -341,63 +341,9 @@ fn couple_rate(scene: &Scene) -> f64 {
 fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector) -> bool {
     let s = &scene.initial;
     let power = d.power(s.theta, s.omega_y);
-    let (kappa, m, k) = (d.coefficient(), d.m(), d.k());
+    let kappa = d.coefficient();
     if !power.is_finite() {
-        let sin_alpha = s.theta.cos();
-        let phi_dot = (s.omega_y / sin_alpha).abs();
-        let angle_factor = sin_alpha.powf(-k);
-        let rate_factor = phi_dot.powf(m);
-        let laws = format!(
-            "gives a non-finite dissipated power P = κ |φ̇|^m (sin α)^(−k) at t = 0 (κ = {}, |φ̇| = {}, sin α = {}, m = {}, k = {})",
-            number(kappa),
-            short(phi_dot, Round::Nearest),
-            short(sin_alpha, Round::Nearest),
-            number(m),
-            number(k)
-        );
-        let ln_max = f64::MAX.ln();
-        if !angle_factor.is_finite() {
-            // ln P = ln(κ |φ̇|^m) + k ln(1/sin α) < ln(MAX); the factor alone must stay finite too.
-            let ln_rest = (kappa.ln() + m * phi_dot.ln()).max(0.0);
-            let k_max = (ln_max - ln_rest) / -sin_alpha.ln();
-            problems.push(
-                "body.dissipation.k",
-                number(k),
-                format!(
-                    "{laws}: (sin α)^(−k) overflows double precision; use k < {}",
-                    short(k_max, Round::Down)
-                ),
-            );
-        } else if !rate_factor.is_finite() {
-            if d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
-                // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
-                let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
-                problems.push(
-                    "body.dissipation.m",
-                    number(m),
-                    format!(
-                        "{laws}: |φ̇|^m overflows double precision; use m < {}",
-                        short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
-                    ),
-                );
-            } else {
-                problems.push(
-                    initial_key(scene),
-                    describe_state(s),
-                    format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
-                );
-            }
-        } else {
-            let kappa_max = f64::MAX / rate_factor / angle_factor;
-            problems.push(
-                "body.dissipation.coefficient",
-                number(kappa),
-                format!(
-                    "{laws}: P overflows double precision; use coefficient < {}",
-                    short(kappa_max, Round::Down)
-                ),
-            );
-        }
+        refuse_power(scene, d, problems);
         return true;
     }
     // An adaptive method squares each component of its error estimate over its weight (≥ atol): Ẇ = P
@@ -407,7 +353,7 @@ fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
     if method.method.is_adaptive() {
         let rate = power.max(couple_rate(scene) * magnitude(s.omega_x, s.omega_y, s.omega_z));
         let max = SCALE_MAX * method.atol;
-        if !(rate <= max) {
+        if rate > max {
             problems.push(
                 "body.dissipation.coefficient",
                 number(kappa),
@@ -426,6 +372,68 @@ fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
         }
     }
     false
+}
+
+/// Reports a non-finite P = κ |φ̇|^m (sin α)^(−k) at t = 0 on the factor that overflows, with the bound
+/// ln P < ln(MAX) solved for that key.
+fn refuse_power(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector) {
+    let s = &scene.initial;
+    let (kappa, m, k) = (d.coefficient(), d.m(), d.k());
+    let sin_alpha = s.theta.cos();
+    let phi_dot = (s.omega_y / sin_alpha).abs();
+    let angle_factor = sin_alpha.powf(-k);
+    let rate_factor = phi_dot.powf(m);
+    let laws = format!(
+        "gives a non-finite dissipated power P = κ |φ̇|^m (sin α)^(−k) at t = 0 (κ = {}, |φ̇| = {}, sin α = {}, m = {}, k = {})",
+        number(kappa),
+        short(phi_dot, Round::Nearest),
+        short(sin_alpha, Round::Nearest),
+        number(m),
+        number(k)
+    );
+    let ln_max = f64::MAX.ln();
+    if !angle_factor.is_finite() {
+        // ln P = ln(κ |φ̇|^m) + k ln(1/sin α) < ln(MAX); the factor alone must stay finite too.
+        let ln_rest = (kappa.ln() + m * phi_dot.ln()).max(0.0);
+        let k_max = (ln_max - ln_rest) / -sin_alpha.ln();
+        problems.push(
+            "body.dissipation.k",
+            number(k),
+            format!(
+                "{laws}: (sin α)^(−k) overflows double precision; use k < {}",
+                short(k_max, Round::Down)
+            ),
+        );
+    } else if !rate_factor.is_finite() {
+        if d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
+            // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
+            let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
+            problems.push(
+                "body.dissipation.m",
+                number(m),
+                format!(
+                    "{laws}: |φ̇|^m overflows double precision; use m < {}",
+                    short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
+                ),
+            );
+        } else {
+            problems.push(
+                initial_key(scene),
+                describe_state(s),
+                format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
+            );
+        }
+    } else {
+        let kappa_max = f64::MAX / rate_factor / angle_factor;
+        problems.push(
+            "body.dissipation.coefficient",
+            number(kappa),
+            format!(
+                "{laws}: P overflows double precision; use coefficient < {}",
+                short(kappa_max, Round::Down)
+            ),
+        );
+    }
 }
 
 fn initial_key(scene: &Scene) -> &'static str {
