@@ -74,36 +74,52 @@ fn short(x: f64, round: Round) -> String {
     if !x.is_finite() || x == 0.0 {
         return number(x);
     }
-    let exponent = x.abs().log10().floor();
-    let unit = 10f64.powf(exponent - 3.0);
-    let scaled = x / unit;
-    // x / unit is inexact: a power of ten such as 1e-65 came out as 999.99999999999989 and printed, rounded
-    // down, as "0.999e-65". A quotient within rounding of a whole number is that number.
-    let nearest = scaled.round();
-    let scaled = if (scaled - nearest).abs() <= 4.0 * f64::EPSILON * scaled.abs() {
-        nearest
-    } else {
-        scaled
+    // Four significant digits of the correctly rounded decimal form, moved one unit towards zero (`Down`)
+    // or away from it (`Up`) when that rounding went the other way, so that a printed ceiling holds for x
+    // itself: 1e-3/τ = 9.999999999999999e-54 is below 1e-53, and the old x / 10^(e−3) came out as
+    // 999.99999999999989 for x = 1e-65 and printed "0.999e-65".
+    let magnitude = x.abs();
+    let text = format!("{magnitude:.3e}");
+    let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+    let mut digits: i64 = mantissa.replace('.', "").parse().unwrap_or(1000);
+    let mut exponent: i32 = exponent.parse().unwrap_or(0);
+    let value = |digits: i64, exponent: i32| -> f64 {
+        format!("{digits}e{}", exponent - 3)
+            .parse()
+            .unwrap_or(f64::NAN)
     };
-    let digits = match round {
-        Round::Down => scaled.trunc(),
-        Round::Up => scaled.abs().ceil().copysign(scaled),
-        Round::Nearest => scaled.round(),
-    };
-    let value = digits * unit;
-    if (1e-4..1e16).contains(&value.abs()) {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let decimals = (3.0 - exponent).max(0.0) as usize;
-        let text = format!("{value:.decimals$}");
-        if text.contains('.') {
+    match round {
+        Round::Down if value(digits, exponent) > magnitude => {
+            digits -= 1;
+            if digits < 1000 {
+                (digits, exponent) = (9999, exponent - 1);
+            }
+        }
+        Round::Up if value(digits, exponent) < magnitude => {
+            digits += 1;
+            if digits > 9999 {
+                (digits, exponent) = (1000, exponent + 1);
+            }
+        }
+        _ => {}
+    }
+    let sign = if x < 0.0 { "-" } else { "" };
+    let shown = value(digits, exponent);
+    if (1e-4..1e16).contains(&shown) {
+        #[allow(clippy::cast_sign_loss)]
+        let decimals = (3 - exponent).max(0) as usize;
+        let text = format!("{shown:.decimals$}");
+        let text = if text.contains('.') {
             text.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
             text
-        }
+        };
+        format!("{sign}{text}")
     } else {
-        let mantissa = format!("{:.3}", digits / 1000.0);
+        #[allow(clippy::cast_precision_loss)] // four digits
+        let mantissa = format!("{:.3}", digits as f64 / 1000.0);
         let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
-        format!("{mantissa}e{exponent}")
+        format!("{sign}{mantissa}e{exponent}")
     }
 }
 
@@ -600,9 +616,14 @@ mod tests {
         assert_eq!(short(1.609_26, Round::Nearest), "1.609");
         assert_eq!(short(-0.5, Round::Nearest), "-0.5");
         // 1e-65 / 1e-68 is 999.99999999999989 in double precision: it printed "0.999e-65".
-        let w = 1.0 / (1e-75_f64 / 1e75).sqrt(); // 1/τ of a = 1e-75, g = 1e75
-        assert_eq!(short(1e10 / w, Round::Down), "1e-65");
+        assert_eq!(short(1e-65, Round::Down), "1e-65");
         assert_eq!(short(1e-65, Round::Up), "1e-65");
+        // A ceiling printed rounded down holds for the number itself: 1e-3/τ for τ = 1e50 is
+        // 9.999999999999999e-54, and "use atol ≤ 1e-53" was refused as above it.
+        let ceiling = 1e-3 * (1.0 / (1e50_f64 / 1e-50).sqrt());
+        assert_eq!(short(ceiling, Round::Down), "9.999e-54");
+        assert!("9.999e-54".parse::<f64>().unwrap() <= ceiling);
+        assert_eq!(short(-999_980_016.38, Round::Down), "-999900000");
         assert_eq!(
             short(0.177_827_941_003_892_3 / 1.609, Round::Down),
             "0.1105"
