@@ -328,6 +328,27 @@ fn analyse_json_has_the_contract_fields() {
     assert_eq!(steady["verdict"], "stable");
 }
 
+/// `base_steady` is for a scene given as a perturbed steady motion (format.md: analyse --json). The
+/// `euler-disk` scene starts exactly on its centre-fixed motion, with dissipation: its state is that
+/// steady motion, not a perturbation of it (it printed "perturbed from" and repeated the steady object
+/// as base_steady). A perturbed one keeps its base; a perturbed one without dissipation too.
+#[test]
+fn a_dissipative_scene_started_on_a_steady_motion_is_not_reported_as_perturbed() {
+    let disk = analyse_json("euler-disk", &[]);
+    assert_eq!(disk["motion"], "steady");
+    assert_eq!(disk["steady"]["kind"], "centre-fixed");
+    assert!(disk["base_steady"].is_null(), "{disk}");
+    let kicked = analyse_json(
+        "euler-disk",
+        &["--set", "initial.perturbation={ theta = 1e-3 }"],
+    );
+    assert_eq!(kicked["base_steady"]["kind"], "centre-fixed", "{kicked}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(dir.path(), &["analyse", "euler-disk"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains("perturbed from"), "{text}");
+}
+
 #[test]
 fn analyse_is_right_for_steady_circles_in_and_out_of_the_band() {
     // σ² from `coin-log analyse --json` against the numerical Jacobian's eigenvalues (linearisation.rs),

@@ -153,6 +153,106 @@ fn an_initial_state_outside_the_model_is_refused_saying_what_it_needs() {
     );
 }
 
+/// A dissipative couple that is not finite at t = 0, or that an adaptive method's error estimate cannot
+/// square, or that a fixed step cannot resolve, is refused up front naming the law's key and the value
+/// that would do; each used to write a 1-sample file ending "non-finite at t = 0" (exit 1), or a "flat
+/// landing" at t = 9e-14 with rk4.
+#[test]
+fn a_dissipative_couple_beyond_double_precision_or_the_step_is_refused() {
+    let law = |l: &str| format!("body.dissipation={l}");
+    refused(
+        &[
+            "euler-disk",
+            "--set",
+            &law("{model=\"power-law\",coefficient=1e-7,m=2,k=1e300}"),
+        ],
+        &[
+            "`body.dissipation.k` = 1e300",
+            "non-finite dissipated power",
+            "use k < 439.1",
+        ],
+    );
+    // κ = 0 with an infinite (sin α)^(−k) is 0·∞ = NaN, not the conservative coin.
+    refused(
+        &[
+            "euler-disk",
+            "--set",
+            &law("{model=\"power-law\",coefficient=0,m=2,k=1e300}"),
+        ],
+        &["`body.dissipation.k` = 1e300", "use k < 439.1"],
+    );
+    refused(
+        &[
+            "euler-disk",
+            "--set",
+            &law("{model=\"power-law\",coefficient=1e-7,m=1e300,k=1}"),
+        ],
+        &[
+            "`body.dissipation.m` = 1e300",
+            "|φ̇|^m overflows",
+            "use m < 165.6",
+        ],
+    );
+    for kappa in ["1e300", "1e200"] {
+        refused(
+            &[
+                "euler-disk",
+                "--set",
+                &law(&format!("{{model=\"viscous\",coefficient={kappa}}}")),
+            ],
+            &[
+                &format!("`body.dissipation.coefficient` = {kappa}"),
+                "more than 1e150·atol = 1e138",
+                "use coefficient ≤ 4.33e131",
+            ],
+        );
+    }
+    refused(
+        &[
+            "euler-disk",
+            "--integrator",
+            "rk4",
+            "--set",
+            &law("{model=\"viscous\",coefficient=100}"),
+        ],
+        &[
+            "`run.step` = 0.0008333333333333334 is above 0.178/W = 1.11e-8",
+            "W = max(|ω|, |φ̇|, |ψ̇|, 1/τ, λ) = 16010000",
+        ],
+    );
+}
+
+/// A body whose time unit is so short that even the shortest run (1 ns) is beyond 1e10 radians: the
+/// refusal said "use duration ≤ 0.999e-65" (a mantissa below 1, and a duration below the 1e-9 floor that
+/// would itself be refused); it now names τ and the units. A spin that fast asks to slow the motion.
+#[test]
+fn a_motion_no_duration_can_hold_is_refused_with_a_fix_that_works() {
+    let err = refused(
+        &[
+            "wobble",
+            "--set",
+            "body.radius=1e-75",
+            "--set",
+            "body.gravity=1e75",
+            "--atol",
+            "1e-80",
+        ],
+        &[
+            "`run.duration` = 30 times W",
+            "so would the shortest duration, 1e-9",
+            "τ = √(a/g) = 1e-75 is too short: express the scene in units where τ is nearer 1",
+        ],
+    );
+    assert!(!err.contains("use duration ≤"), "{err}");
+    refused(
+        &["straight", "--set", "initial.steady.omega_z=1e100"],
+        &[
+            "so would the shortest duration",
+            "slow the motion to W ≤ 1e19",
+        ],
+    );
+}
+
 #[test]
 fn tolerances_and_steps_beyond_what_the_integrators_deliver_are_refused() {
     refused(

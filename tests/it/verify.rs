@@ -293,6 +293,46 @@ fn a_light_coin_braked_within_its_first_sample_verifies() {
     assert_eq!(c.status, Status::Pass, "{}", show(&r));
 }
 
+/// A coin at rest almost upright (θ₀ = 1e-200, physics §12 follows θ₀ down to 1e-300) does move: |ω|
+/// ~ 1e-198 grows to ~1e-192 by t = 20. |ω| formed through its squares underflowed to 0, and `constraint`
+/// skipped it as "ω = 0 throughout" (CANNOT VERIFY); the residual's norm underflowed to 0 in the same way.
+/// Judged, it passes; a moved position still fails (the negative control of the judging).
+#[test]
+fn a_coin_at_rest_a_hair_from_upright_moves_and_is_judged() {
+    let dir = tempfile::tempdir().unwrap();
+    for theta in ["1e-200", "1e-310"] {
+        let args = [
+            "--set",
+            &format!("initial.theta={theta}"),
+            "--set",
+            "initial.omega=[0.0, 0.0, 0.0]",
+            "--duration",
+            "20",
+        ];
+        let (r, c, path) = constraint_of(dir.path(), "wobble", &args);
+        assert_eq!(r.exit_code, 0, "θ0 = {theta}: {}", show(&r));
+        assert_eq!(c.status, Status::Pass, "θ0 = {theta}: {}", show(&r));
+        assert!(c.value.unwrap() > 0.0, "{}", show(&r));
+        if theta == "1e-200" {
+            let moved = dir.path().join("moved.mcap");
+            rewrite(&path, &moved, |e| {
+                if e.topic == "/coin/position" && e.index == 1500 {
+                    let v: serde_json::Value = serde_json::from_slice(e.data).unwrap();
+                    let z = v["z"].as_f64().unwrap(); // the coin tips over in the y-z plane
+                    nudge(e.data, "z", z * 1e-3);
+                }
+            });
+            let r = verify_file(&moved, &Options::default());
+            assert_eq!(
+                status(&r, CheckId::Constraint),
+                Status::Fail,
+                "{}",
+                show(&r)
+            );
+        }
+    }
+}
+
 #[test]
 fn verify_flags_a_log_with_one_omega_sample_changed_by_1e_5() {
     let r = tampered("wobble", |e| {
@@ -852,7 +892,8 @@ fn record_warns_after_a_run_an_event_ended_too_early_for_verify_to_judge() {
          before its duration: neither `constraint` nor `steady` will run, so the motion will not be \
          verified: `steady` does not apply (the scene does not start on an unperturbed steady motion), \
          and `constraint` will find no window the sampling resolves: at 400 samples per time unit, \
-         h·Ω = 0.221 (Ω = max(|ω|, |φ̇|) = 88.6 at t = 0), and the finite difference's error \
+         h·Ω = 0.221 (Ω = max(|ω|, |φ̇|) + |d ln Ω/dt| = 72.6 + 16 = 88.6 at t = 0), and the finite \
+         difference's error \
          4(hΩ)^8/630 = 3.7e-8 exceeds a tenth of the residual tolerance 2.4e-7; raise --rate to at \
          least 471\n"
     );
@@ -922,6 +963,27 @@ fn missing_channels_are_named_with_the_fix() {
     // A steady scene is judged by `steady` without positions.
     let s = preset_scene("circle-plus", &["record.channels=[\"omega\", \"angles\"]"]);
     assert_eq!(coverage(&s), Vec::<String>::new());
+}
+
+/// Ω of the forecast is the rate plus its relative change at t = 0; a strong couple's braking made Ω =
+/// 1.23e8 on `euler-disk` (|ω| = 14.4, |φ̇| = 72.6), which the warning called max(|ω|, |φ̇|). It names both
+/// terms now, printed as three digits (not 72.60000000000001).
+#[test]
+fn a_forecast_rate_made_of_the_braking_says_so() {
+    let s = preset_scene(
+        "euler-disk",
+        &[
+            "body.dissipation={model=\"power-law\",coefficient=1e-12,m=10,k=0}",
+            "run.rate=4000",
+        ],
+    );
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(
+        c[0].contains("(Ω = max(|ω|, |φ̇|) + |d ln Ω/dt| = 72.6 + 123000000 = 123000000 at t = 0)"),
+        "{}",
+        c[0]
+    );
 }
 
 #[test]

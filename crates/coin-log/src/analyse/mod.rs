@@ -54,8 +54,11 @@ impl Analysis {
     /// # Errors
     /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body.
     pub fn of_scene(scene: &Scene) -> Result<Self, AnalyseError> {
+        // The state is the steady motion when nothing perturbs it; a dissipative couple (which makes
+        // `unperturbed_steady` none, since the run leaves it) does not perturb the initial state.
+        let unperturbed = scene.perturbation.iter().all(|&p| p == 0.0);
         let (given, base) = match &scene.spec {
-            InitialSpec::Steady(s) if scene.unperturbed_steady().is_some() => (Some(s), None),
+            InitialSpec::Steady(s) if unperturbed => (Some(s), None),
             InitialSpec::Steady(s) => (None, Some(s)),
             InitialSpec::Explicit => (None, None),
         };

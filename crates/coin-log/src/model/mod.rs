@@ -27,6 +27,6 @@ pub use stability::{
     centre_fixed_sigma_squared, critical_spin, eigenvalues, spin_upright_sigma_squared,
     steady_sigma_squared, straight_lambda_squared, Linearisation,
 };
-pub use state::{State, StateRate, STATE_LEN};
+pub use state::{magnitude, State, StateRate, STATE_LEN};
 pub use steady::{steady_omega_y, Branch, Steady, SteadyError, SteadyFamily, SteadyKind};
 pub use turning_points::{MeasuredNutation, TurningPoints};

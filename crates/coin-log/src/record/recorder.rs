@@ -503,7 +503,7 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
 #[must_use]
 pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
     let s = &scene.initial;
-    let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
+    let omega = crate::model::magnitude(s.omega_x, s.omega_y, s.omega_z);
     let span = scene.run.duration;
     let accuracy = RunAccuracy::new(&scene.run.method, &scene.params, span, omega);
     shortfalls(scene, &accuracy)

@@ -6,7 +6,7 @@ use super::file::SceneFile;
 use super::problems::{number, ProblemCollector};
 use super::Scene;
 use crate::format::tolerances::UNIT_ROUNDOFF;
-use crate::model::{energy, reaction, CoinParams, Inertia, State};
+use crate::model::{energy, magnitude, CoinParams, Dissipation, DissipationModel, Inertia, State};
 
 /// Smallest scale (mass, length, inertia, energy, ...) a scene may have: the model multiplies and divides
 /// pairs of scales (I_Z·Ma² in C1, C2; |R|² ~ (Mg)²) times factors up to 1e8 (tan θ, ωτ), which stay
@@ -74,28 +74,52 @@ fn short(x: f64, round: Round) -> String {
     if !x.is_finite() || x == 0.0 {
         return number(x);
     }
-    let exponent = x.abs().log10().floor();
-    let unit = 10f64.powf(exponent - 3.0);
-    let scaled = x / unit;
-    let digits = match round {
-        Round::Down => scaled.trunc(),
-        Round::Up => scaled.abs().ceil().copysign(scaled),
-        Round::Nearest => scaled.round(),
+    // Four significant digits of the correctly rounded decimal form, moved one unit towards zero (`Down`)
+    // or away from it (`Up`) when that rounding went the other way, so that a printed ceiling holds for x
+    // itself: 1e-3/τ = 9.999999999999999e-54 is below 1e-53, and the old x / 10^(e−3) came out as
+    // 999.99999999999989 for x = 1e-65 and printed "0.999e-65".
+    let magnitude = x.abs();
+    let text = format!("{magnitude:.3e}");
+    let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+    let mut digits: i64 = mantissa.replace('.', "").parse().unwrap_or(1000);
+    let mut exponent: i32 = exponent.parse().unwrap_or(0);
+    let value = |digits: i64, exponent: i32| -> f64 {
+        format!("{digits}e{}", exponent - 3)
+            .parse()
+            .unwrap_or(f64::NAN)
     };
-    let value = digits * unit;
-    if (1e-4..1e16).contains(&value.abs()) {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let decimals = (3.0 - exponent).max(0.0) as usize;
-        let text = format!("{value:.decimals$}");
-        if text.contains('.') {
+    match round {
+        Round::Down if value(digits, exponent) > magnitude => {
+            digits -= 1;
+            if digits < 1000 {
+                (digits, exponent) = (9999, exponent - 1);
+            }
+        }
+        Round::Up if value(digits, exponent) < magnitude => {
+            digits += 1;
+            if digits > 9999 {
+                (digits, exponent) = (1000, exponent + 1);
+            }
+        }
+        _ => {}
+    }
+    let sign = if x < 0.0 { "-" } else { "" };
+    let shown = value(digits, exponent);
+    if (1e-4..1e16).contains(&shown) {
+        #[allow(clippy::cast_sign_loss)]
+        let decimals = (3 - exponent).max(0) as usize;
+        let text = format!("{shown:.decimals$}");
+        let text = if text.contains('.') {
             text.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
             text
-        }
+        };
+        format!("{sign}{text}")
     } else {
-        let mantissa = format!("{:.3}", digits / 1000.0);
+        #[allow(clippy::cast_precision_loss)] // four digits
+        let mantissa = format!("{:.3}", digits as f64 / 1000.0);
         let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
-        format!("{mantissa}e{exponent}")
+        format!("{sign}{mantissa}e{exponent}")
     }
 }
 
@@ -257,7 +281,8 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
             "run.step",
             &shown,
             format!(
-                "{used}is above 0.178/W = {ceiling}, where W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {ceiling}",
+                "{used}is above 0.178/W = {ceiling}, where W = {} = {} at t = 0: {}'s error (hW)⁴ would exceed 1e-3; use step ≤ {ceiling}",
+                rates_named(scene),
                 short(w, Round::Nearest),
                 run.method.method,
             ),
@@ -288,7 +313,7 @@ pub(super) fn check_rate(rate: f64, duration: f64, problems: &mut ProblemCollect
 
 /// W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) of a state: the fastest rate of the equations.
 fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
-    let omega = (s.omega_x.powi(2) + s.omega_y.powi(2) + s.omega_z.powi(2)).sqrt();
+    let omega = magnitude(s.omega_x, s.omega_y, s.omega_z);
     let (sin_t, cos_t) = s.theta.sin_cos();
     let phi_dot = s.omega_y / cos_t;
     let psi_dot = s.omega_z + s.omega_y * sin_t / cos_t;
@@ -296,6 +321,142 @@ fn fastest_rate(params: &CoinParams, s: &State) -> f64 {
         .max(phi_dot.abs())
         .max(psi_dot.abs())
         .max(1.0 / params.time_unit())
+}
+
+/// The rates W is the largest of, as the refusals name them: λ, the couple's, only with dissipation.
+fn rates_named(scene: &Scene) -> &'static str {
+    if scene.dissipation.is_some() {
+        "max(|ω|, |φ̇|, |ψ̇|, 1/τ, λ)"
+    } else {
+        "max(|ω|, |φ̇|, |ψ̇|, 1/τ)"
+    }
+}
+
+/// λ = P/(|ω|²·min(I_X, I_Z + Ma²)) at t = 0: the rate at which the dissipative couple −P ω/|ω|² changes
+/// ω (eqs (31)–(33): |ω̇|/|ω| of the couple alone, the largest of its three inertias' rates), and so the
+/// rate an explicit integrator's step must resolve (physics §11); 0 without dissipation. |ω|² as the
+/// equations form it, so that a state whose |ω|² underflows to 0 (couple 0 there) has λ = 0.
+fn couple_rate(scene: &Scene) -> f64 {
+    let Some(d) = &scene.dissipation else {
+        return 0.0;
+    };
+    let s = &scene.initial;
+    let p = &scene.params;
+    let w2 = s.omega_x * s.omega_x + s.omega_y * s.omega_y + s.omega_z * s.omega_z;
+    if w2 > 0.0 {
+        d.power(s.theta, s.omega_y) / w2 / p.inertia_x().min(p.inertia_z() + p.ma2())
+    } else {
+        0.0
+    }
+}
+
+/// With dissipation, the couple at t = 0 must be finite and, for an adaptive method, within what its error
+/// estimate can square: P = κ |φ̇|^m (sin α)^(−k) finite (k = 1e300 made (sin α)^(−k) infinite) and P,
+/// λ|ω| ≤ 1e150·atol (κ = 1e300 gave P = 3e304). Each ended the run "non-finite at t = 0" with one sample
+/// written. `true` when a problem was reported.
+fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector) -> bool {
+    let s = &scene.initial;
+    let power = d.power(s.theta, s.omega_y);
+    let kappa = d.coefficient();
+    if !power.is_finite() {
+        refuse_power(scene, d, problems);
+        return true;
+    }
+    // An adaptive method squares each component of its error estimate over its weight (≥ atol): Ẇ = P
+    // and the couple's ω̇ (λ|ω|) beyond 1e150·atol overflow it whatever the step, and every trial step is
+    // rejected as non-finite (κ = 1e200 on `euler-disk`: P = 5e203). The same 1e150 as the scales'.
+    let method = &scene.run.method;
+    if method.method.is_adaptive() {
+        let rate = power.max(couple_rate(scene) * magnitude(s.omega_x, s.omega_y, s.omega_z));
+        let max = SCALE_MAX * method.atol;
+        if rate > max {
+            problems.push(
+                "body.dissipation.coefficient",
+                number(kappa),
+                format!(
+                    "gives the couple a rate of change max(P, λ|ω|) = {} at t = 0 (P = {}, λ = P/(|ω|²·min(I_X, I_Z + Ma²)) = {}), more than {SCALE_MAX:e}·atol = {}: {}'s error estimate squares it over atol and would overflow at every step, ending the run at t = 0; use coefficient ≤ {}",
+                    short(rate, Round::Nearest),
+                    short(power, Round::Nearest),
+                    short(couple_rate(scene), Round::Nearest),
+                    short(max, Round::Nearest),
+                    method.method,
+                    // Both terms are linear in κ.
+                    short(kappa * (max / rate), Round::Down)
+                ),
+            );
+            return true;
+        }
+    }
+    false
+}
+
+/// Reports a non-finite P = κ |φ̇|^m (sin α)^(−k) at t = 0 on the factor that overflows, with the bound
+/// ln P < ln(MAX) solved for that key.
+fn refuse_power(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector) {
+    let s = &scene.initial;
+    let (kappa, m, k) = (d.coefficient(), d.m(), d.k());
+    let sin_alpha = s.theta.cos();
+    let phi_dot = (s.omega_y / sin_alpha).abs();
+    let angle_factor = sin_alpha.powf(-k);
+    let rate_factor = phi_dot.powf(m);
+    let laws = format!(
+        "gives a non-finite dissipated power P = κ |φ̇|^m (sin α)^(−k) at t = 0 (κ = {}, |φ̇| = {}, sin α = {}, m = {}, k = {})",
+        number(kappa),
+        short(phi_dot, Round::Nearest),
+        short(sin_alpha, Round::Nearest),
+        number(m),
+        number(k)
+    );
+    let ln_max = f64::MAX.ln();
+    if !angle_factor.is_finite() {
+        // ln P = ln(κ |φ̇|^m) + k ln(1/sin α) < ln(MAX); the factor alone must stay finite too.
+        let ln_rest = (kappa.ln() + m * phi_dot.ln()).max(0.0);
+        let k_max = (ln_max - ln_rest) / -sin_alpha.ln();
+        problems.push(
+            "body.dissipation.k",
+            number(k),
+            format!(
+                "{laws}: (sin α)^(−k) overflows double precision; use k < {}",
+                short(k_max, Round::Down)
+            ),
+        );
+    } else if !rate_factor.is_finite() {
+        if d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
+            // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
+            let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
+            problems.push(
+                "body.dissipation.m",
+                number(m),
+                format!(
+                    "{laws}: |φ̇|^m overflows double precision; use m < {}",
+                    short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
+                ),
+            );
+        } else {
+            problems.push(
+                initial_key(scene),
+                describe_state(s),
+                format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
+            );
+        }
+    } else {
+        let kappa_max = f64::MAX / rate_factor / angle_factor;
+        problems.push(
+            "body.dissipation.coefficient",
+            number(kappa),
+            format!(
+                "{laws}: P overflows double precision; use coefficient < {}",
+                short(kappa_max, Round::Down)
+            ),
+        );
+    }
+}
+
+fn initial_key(scene: &Scene) -> &'static str {
+    match scene.spec {
+        super::InitialSpec::Explicit => "initial.omega",
+        super::InitialSpec::Steady(_) => "initial.steady",
+    }
 }
 
 /// Checks that need the whole scene: the initial state, atol, the fixed step and the duration against
@@ -311,9 +472,35 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     if run.method.method.is_adaptive() {
         check_atol(scene, problems);
     } else {
+        // A fixed step must resolve the couple's rate too (rk4 at h·λ = 130 on `euler-disk` with κ = 100
+        // "landed flat" at t = 9e-14 with no drift shown). An adaptive step follows it as the couple
+        // decays: λ at t = 0 does not bound its work.
+        let w = w.max(couple_rate(scene));
         check_fixed_step(scene, file.run.as_ref().and_then(|r| r.step), w, problems);
     }
-    if run.duration * w > MAX_RADIANS {
+    if run.duration * w > MAX_RADIANS && MAX_RADIANS / w < MIN_DURATION {
+        // No duration would do: even the shortest run, 1 ns, is too many radians.
+        let fix = if w * scene.params.time_unit() <= 1.0 {
+            format!(
+                "the body's own time unit τ = √(a/g) = {} is too short: express the scene in units where τ is nearer 1",
+                short(scene.params.time_unit(), Round::Nearest)
+            )
+        } else {
+            format!(
+                "slow the motion to W ≤ {}",
+                short(MAX_RADIANS / MIN_DURATION, Round::Down)
+            )
+        };
+        problems.push(
+            "run.duration",
+            number(run.duration),
+            format!(
+                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than {MAX_RADIANS:e} (≥ 5.6e10 integrator steps), and so would the shortest duration, {MIN_DURATION:e} (the log-time resolution): {fix}",
+                short(w, Round::Nearest),
+                short(run.duration * w, Round::Nearest),
+            ),
+        );
+    } else if run.duration * w > MAX_RADIANS {
         problems.push(
             "run.duration",
             number(run.duration),
@@ -349,14 +536,17 @@ fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
 /// The initial state must be inside the model: finite energy and reaction, the table pushing (N > 0)
 /// and, with μ, friction within the cone (|F| < μN). Otherwise the run would end at t = 0 with one sample.
 fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
+    if let Some(d) = &scene.dissipation {
+        if check_couple(scene, d, problems) {
+            return;
+        }
+    }
     let coin = scene.coin();
     let s = &scene.initial;
     let e = energy(&coin, s).total;
-    let r = reaction(&coin, s);
-    let key = match scene.spec {
-        super::InitialSpec::Explicit => "initial.omega",
-        super::InitialSpec::Steady(_) => "initial.steady",
-    };
+    // The reaction of the equations the run integrates (with the couple's ω̇ when there is one).
+    let r = scene.dynamics().reaction(s);
+    let key = initial_key(scene);
     let value = || describe_state(s);
     let p = &scene.params;
     let weight = p.mass() * p.gravity();
@@ -425,6 +615,19 @@ mod tests {
         assert_eq!(short(2.220_446e-15, Round::Up), "2.221e-15");
         assert_eq!(short(1.609_26, Round::Nearest), "1.609");
         assert_eq!(short(-0.5, Round::Nearest), "-0.5");
+        // 1e-65 / 1e-68 is 999.99999999999989 in double precision: it printed "0.999e-65".
+        assert_eq!(short(1e-65, Round::Down), "1e-65");
+        assert_eq!(short(1e-65, Round::Up), "1e-65");
+        // A ceiling printed rounded down holds for the number itself: 1e-3/τ for τ = 1e50 is
+        // 9.999999999999999e-54, and "use atol ≤ 1e-53" was refused as above it.
+        let ceiling = 1e-3 * (1.0 / (1e50_f64 / 1e-50).sqrt());
+        assert_eq!(short(ceiling, Round::Down), "9.999e-54");
+        assert!("9.999e-54".parse::<f64>().unwrap() <= ceiling);
+        assert_eq!(short(-999_980_016.38, Round::Down), "-999900000");
+        assert_eq!(
+            short(0.177_827_941_003_892_3 / 1.609, Round::Down),
+            "0.1105"
+        );
     }
 
     #[test]

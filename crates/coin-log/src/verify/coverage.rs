@@ -14,9 +14,8 @@
 use super::checks::constraint;
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
-use crate::model::{Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
+use crate::model::{magnitude, Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
 use crate::scene::Scene;
-use nalgebra::Vector3;
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
 /// and what to change; empty when `verify` will be able to judge the recording.
@@ -89,7 +88,7 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
         ));
     }
     let s = &scene.initial;
-    let omega = Vector3::new(s.omega_x, s.omega_y, s.omega_z).norm();
+    let omega = magnitude(s.omega_x, s.omega_y, s.omega_z);
     if omega == 0.0 && s.theta == 0.0 {
         // Upright at rest: eqs (14)–(16) give ω̇ = 0 (sin θ = 0, every other term has a factor ω, and the
         // dissipative couple is 0 at ω = 0), so ω stays 0 and the check finds nothing moving.
@@ -101,20 +100,32 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
         );
     }
     let phi_dot = (s.omega_y / s.theta.cos()).abs();
-    let rate = omega.max(phi_dot) + initial_steepness(scene, omega, phi_dot);
+    let fastest = omega.max(phi_dot);
+    let rate = fastest + initial_steepness(scene, omega, phi_dot);
     let accuracy = RunAccuracy::new(&run.method, &scene.params, span, omega);
     let tol = Tolerances::derive(&accuracy, None, None).residual;
     let h = run.sample_interval();
     if constraint::resolves(h, rate, tol) {
         return None;
     }
+    // Ω is the rate plus its relative change; the change is named when it shows in the digits printed (a
+    // braking couple's: Ω = 1.23e8 on a coin whose |ω| and |φ̇| were 14 and 73 was called max(|ω|, |φ̇|)).
+    let omega_text = if digits3(rate, f64::round) == digits3(fastest, f64::round) {
+        format!("max(|ω|, |φ̇|) = {}", digits3(rate, f64::round))
+    } else {
+        format!(
+            "max(|ω|, |φ̇|) + |d ln Ω/dt| = {} + {} = {}",
+            digits3(fastest, f64::round),
+            digits3(rate - fastest, f64::round),
+            digits3(rate, f64::round)
+        )
+    };
     Some(format!(
         "will find no window the sampling resolves: at {} samples per time unit, h·Ω = {} (Ω = \
-         max(|ω|, |φ̇|) = {} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
+         {omega_text} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
          tenth of the residual tolerance {tol:.1e}; raise --rate to at least {}",
         run.rate,
         digits3(h * rate, f64::round),
-        digits3(rate, f64::round),
         constraint::truncation(h, rate),
         digits3(constraint::min_rate(rate, tol), f64::ceil)
     ))
@@ -154,14 +165,9 @@ fn digits3(x: f64, round: fn(f64) -> f64) -> f64 {
     if !x.is_finite() || x == 0.0 {
         return x;
     }
-    let exponent = x.abs().log10().floor() - 2.0;
-    // Below a unit the digits are divided by a power of ten, which rounds to the nearest double of the
-    // decimal (88.6 prints as 88.6; 886 · 0.1 printed 88.60000000000001).
-    if exponent < 0.0 {
-        let scale = 10f64.powf(-exponent);
-        round(x * scale) / scale
-    } else {
-        let unit = 10f64.powf(exponent);
-        round(x / unit) * unit
-    }
+    let unit = 10f64.powf(x.abs().log10().floor() - 2.0);
+    let rounded = round(x / unit) * unit;
+    // The product carries the unit's rounding (72.6 came out as 72.60000000000001): the three digits
+    // printed and read back are the number meant.
+    format!("{rounded:.2e}").parse().unwrap_or(rounded)
 }

@@ -17,6 +17,7 @@
 
 use super::{fmt_num, Max};
 use crate::format::tolerances::Tolerances;
+use crate::model::magnitude;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use nalgebra::Vector3;
@@ -142,7 +143,7 @@ impl ConstraintCheck {
             -a * w.x * st,
             a * (w.z * sp + w.x * ct * cp),
         );
-        let omega = Vector3::new(w.x, w.y, w.z).norm();
+        let omega = magnitude(w.x, w.y, w.z);
         self.max_omega = self.max_omega.max(omega);
         let entry = Entry {
             t: s.t,
@@ -209,7 +210,9 @@ impl ConstraintCheck {
         self.min_rate = self.min_rate.min(rate);
         let bucket = &mut self.buckets[decade(truncation(h, rate))];
         bucket.windows += 1;
-        bucket.residual.offer(residual.norm(), centre.t);
+        bucket
+            .residual
+            .offer(magnitude(residual.x, residual.y, residual.z), centre.t);
     }
 
     #[must_use]

@@ -14,9 +14,8 @@ pub use crate::model::drift::Worst as Max;
 
 use super::samples::Sample;
 use crate::format::{ResultMetadata, RunMetadata};
-use crate::model::{Chaplygin, Coin, Dynamics, Steady};
+use crate::model::{magnitude, Chaplygin, Coin, Dynamics, Steady};
 use crate::scene::Scene;
-use nalgebra::Vector3;
 
 /// What the checks know about the run besides its samples: the file's metadata.
 #[derive(Debug, Clone)]
@@ -58,7 +57,7 @@ impl RunStats {
         self.last_t = s.t;
         self.samples += 1;
         if let Some(w) = s.omega {
-            self.max_omega = self.max_omega.max(Vector3::new(w.x, w.y, w.z).norm());
+            self.max_omega = self.max_omega.max(magnitude(w.x, w.y, w.z));
         }
     }
 

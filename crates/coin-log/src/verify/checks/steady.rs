@@ -5,7 +5,7 @@
 use super::{fmt_num, worst, Context, Max};
 use crate::format::tolerances::Tolerances;
 use crate::format::RunMetadata;
-use crate::model::{Coin, Steady};
+use crate::model::{magnitude, Coin, Steady};
 use crate::scene::Scene;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
@@ -138,7 +138,7 @@ impl SteadyCheck {
                 .max((w.z - e.omega_z).abs()),
             s.t,
         );
-        self.max_omega = self.max_omega.max(Vector3::new(w.x, w.y, w.z).norm());
+        self.max_omega = self.max_omega.max(magnitude(w.x, w.y, w.z));
         let (lo, hi) = self.phi_range.get_or_insert((a.phi, a.phi));
         *lo = lo.min(a.phi);
         *hi = hi.max(a.phi);
