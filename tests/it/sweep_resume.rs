@@ -171,6 +171,35 @@ fn bytes_that_are_no_utf8_in_the_journal_spoil_their_line_not_the_resume() {
 }
 
 #[test]
+fn a_journal_of_another_sweep_with_the_same_keys_is_redone_not_kept() {
+    // Another sweep's journal (same keys, other values) and its files copied into this sweep's state:
+    // every row named its own run's file with the size and SHA-256 it was journalled with, so resume kept
+    // them all, and the catalogue held the other sweep's values under this sweep's identity.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let other = SMALL.replace("values = [0.2, 0.6, 1.0]", "values = [0.3, 0.6, 1.0]");
+    write_sweep(dir.path(), "o.toml", &other);
+    for (file, folder) in [("s.toml", "ref"), ("s.toml", "out"), ("o.toml", "other")] {
+        assert_eq!(sweep_json(dir.path(), file, folder, &["--jobs", "1"]).0, 0);
+    }
+    let (out, other) = (dir.path().join("out"), dir.path().join("other"));
+    let journal = ".coin-log-sweep/journal-0-of-1.csv";
+    std::fs::copy(other.join(journal), out.join(journal)).unwrap();
+    for name in run_files(&other) {
+        std::fs::copy(other.join(&name), out.join(&name)).unwrap();
+    }
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    // Runs 0, 1, 6 and 7 have θ = 0.2 here and 0.3 there; the others' values and files are the same.
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(4), Some(8)),
+        "{json}"
+    );
+    assert_eq!(rows(&out), rows(&dir.path().join("ref")));
+    files_match(&out, &dir.path().join("ref"));
+}
+
+#[test]
 fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let text = "base = \"wobble\"\nset = { \"run.duration\" = 0.5 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6, 0.5]\n";

@@ -309,6 +309,41 @@ fn collect_refuses_a_part_whose_row_names_another_runs_file() {
 }
 
 #[test]
+fn collect_refuses_a_part_of_another_sweep_with_the_same_keys() {
+    // Another sweep's part (same keys and columns, other values) and its files copied in: every row
+    // named its own run's file with the right size and SHA-256, so collect wrote a catalogue holding the
+    // other sweep's values under this sweep's identity. The plan gives each run's values.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let other = SMALL.replace("values = [0.2, 0.6, 1.0]", "values = [0.3, 0.6, 1.0]");
+    write_sweep(dir.path(), "o.toml", &other);
+    for (file, folder) in [("s.toml", "d"), ("o.toml", "o")] {
+        for k in 0..3 {
+            let shard = format!("{k}/3");
+            assert_eq!(sweep_json(dir.path(), file, folder, &["--shard", &shard]).0, 0);
+        }
+    }
+    let (d, o) = (dir.path().join("d"), dir.path().join("o"));
+    for name in ["catalogue.part-1-of-3.csv", "run-01.mcap", "run-07.mcap"] {
+        std::fs::copy(o.join(name), d.join(name)).unwrap();
+    }
+    let before = listing(&d);
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    for (line, run) in [(2, 1), (4, 7)] {
+        let problem = format!(
+            "`catalogue.part-1-of-3.csv` line {line}: run {run}'s row has initial.theta = `0.3`, but this \
+             sweep's run {run} has `0.2`: the part is another sweep's; delete it and run its shard again"
+        );
+        assert!(err.contains(&problem), "{err}");
+    }
+    assert_eq!(listing(&d), before, "nothing written");
+    // Shard 1 run again (its journal is this sweep's: the copied files are redone) is collected.
+    assert_eq!(sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/3"]).0, 0);
+    assert_eq!(collect(dir.path(), "d").0, 0);
+}
+
+#[test]
 fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);

@@ -3,10 +3,12 @@
 //! its row (size and SHA-256, each file read once). Nothing is written unless every check holds.
 
 use super::catalogue::RunStatus;
+use super::definition::Sweep;
 use super::error::SweepError;
 use super::folder::{self, Folder};
 use super::hash::sha256_file;
 use crate::csv;
+use crate::files::shown_name;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -59,8 +61,15 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         ));
     }
     let mut rows: BTreeMap<u64, Found> = BTreeMap::new();
+    let sweep = folder.sweep();
     for (_, name) in &parts {
-        read_part(&folder, name, &columns, runs, &mut rows, &mut problems)?;
+        let part = Part {
+            name,
+            columns: &columns,
+            runs,
+            sweep: sweep.as_ref(),
+        };
+        read_part(&folder, &part, &mut rows, &mut problems)?;
     }
     problems.extend(missing(runs, &rows));
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
@@ -85,13 +94,25 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     })
 }
 
-/// Reads one part into `rows`, noting a wrong header, unreadable lines, runs out of range and runs
-/// already in another part.
+/// A part to read, and what its rows must agree with: the plan's columns, runs and sweep (`None` when the
+/// plan does not give it back: then the values are not checked).
+struct Part<'a> {
+    name: &'a str,
+    columns: &'a [String],
+    runs: u64,
+    sweep: Option<&'a Sweep>,
+}
+
+/// Reads one part into `rows`, noting a wrong header, unreadable lines, runs out of range, rows with
+/// another run's file or values, and runs already in another part.
 fn read_part(
     folder: &Folder,
-    name: &str,
-    columns: &[String],
-    runs: u64,
+    &Part {
+        name,
+        columns,
+        runs,
+        sweep,
+    }: &Part,
     rows: &mut BTreeMap<u64, Found>,
     problems: &mut Vec<String>,
 ) -> Result<(), SweepError> {
@@ -128,6 +149,11 @@ fn read_part(
             ));
             continue;
         }
+        // A part of another sweep with the same keys, its files copied in, passes every check above.
+        if let Some(problem) = sweep.and_then(|s| other_values(s, &fields, index)) {
+            problems.push(format!("`{name}` line {}: {problem}", n + 2));
+            continue;
+        }
         if let Some(other) = rows.get(&index) {
             problems.push(format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
@@ -144,6 +170,17 @@ fn read_part(
         );
     }
     Ok(())
+}
+
+/// How a row's values differ from its run's in the sweep, if they do.
+fn other_values(sweep: &Sweep, fields: &[String], index: u64) -> Option<String> {
+    let own = sweep.cells(index);
+    let cells = fields.iter().skip(1).zip(&own);
+    let (key, (found, own)) = sweep.keys().zip(cells).find(|(_, (f, o))| f != o)?;
+    let [key, found, own] = [key, found, own].map(shown_name);
+    Some(format!(
+        "run {index}'s row has {key} = `{found}`, but this sweep's run {index} has `{own}`: the part is another sweep's; delete it and run its shard again"
+    ))
 }
 
 /// The runs no part holds, as ranges (`3, 8–12`), with how to make them.

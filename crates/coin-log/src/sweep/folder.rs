@@ -188,6 +188,11 @@ impl Folder {
         })
     }
 
+    /// The sweep the plan describes, if it gives it back ([`Sweep::from_plan`]).
+    pub fn sweep(&self) -> Option<Sweep> {
+        Sweep::from_plan(&self.plan)
+    }
+
     fn state(&self) -> PathBuf {
         self.path.join(STATE_DIR)
     }

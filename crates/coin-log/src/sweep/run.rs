@@ -3,8 +3,8 @@
 //! row journalled as it finishes; then the catalogue (or this shard's part) and, for a whole sweep,
 //! `sweep.json`.
 
-use super::catalogue::{cell, FailureKind, Prediction, Recorded, Row, RunStatus};
-use super::definition::{RunSceneError, Sweep};
+use super::catalogue::{FailureKind, Prediction, Recorded, Row, RunStatus};
+use super::definition::{self, RunSceneError, Sweep};
 use super::error::SweepError;
 use super::folder::{self, Folder, JournalRow};
 use super::hash::sha256_file;
@@ -216,9 +216,10 @@ impl Tally {
     }
 }
 
-/// The rows to keep from the journals and the runs to do. A row is kept when its file is there with
-/// the size and modification time it was journalled with, or, if only the time differs, with the same
-/// SHA-256; a failed row is kept unless it failed on I/O or `retry_failed` is set.
+/// The rows to keep from the journals and the runs to do. A row is kept when it holds its run's values
+/// and its file is there with the size and modification time it was journalled with, or, if only the
+/// time differs, with the same SHA-256; a failed row is kept unless it failed on I/O or `retry_failed`
+/// is set.
 fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resumed, SweepError> {
     let [status_at, failure_at, file_at, bytes_at, sha_at] =
         ["status", "failure", "file", "bytes", "sha256"].map(|c| folder.column(c));
@@ -229,6 +230,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         }
     }
     let mut resumed = Resumed::default();
+    let keys = sweep.keys().count();
     // Only the journalled runs: every other run of the shard is to do (a shard of 10⁹ runs is not
     // walked run by run before the first starts).
     for (index, row) in latest {
@@ -238,6 +240,11 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         };
         let retry = status == RunStatus::Failed
             && (options.retry_failed || f[failure_at] == FailureKind::Io.name());
+        // A row holds its own run's values (one of another sweep with the same keys, its journal copied
+        // in, is redone).
+        if f.get(1..=keys) != Some(&sweep.cells(index)[..]) {
+            continue;
+        }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
         let own = folder::run_file_name(index, sweep.index_width());
         let file_ok = f[file_at].is_empty()
@@ -271,10 +278,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
 fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Option<Done> {
     let started = Instant::now();
     let values = sweep.values(index);
-    let cells = match &values {
-        Ok(v) => v.iter().map(cell).collect(),
-        Err(_) => vec![String::new(); sweep.keys().count()],
-    };
+    let cells = definition::cells(&values, sweep.keys().count());
     let mut done = Done {
         row: Row::failed(index, cells, FailureKind::Scene),
         spent: Spent::default(),

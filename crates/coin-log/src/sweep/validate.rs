@@ -24,8 +24,25 @@ pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProble
     let mut c = Checker {
         problems: ProblemCollector::new(&[]),
     };
-    let places = places(&file);
     let base_table = c.base(&file.base, folder);
+    checked(c, file, base_table)
+}
+
+/// Validates a sweep file whose base scene is given as a table (a plan's, which holds it resolved).
+pub(super) fn with_base(file: SweepFile, base: toml::Table) -> Result<Sweep, SceneProblems> {
+    let c = Checker {
+        problems: ProblemCollector::new(&[]),
+    };
+    checked(c, file, Some(base))
+}
+
+/// The rest of [`sweep`], once the base scene is read (`None`: it could not be, a problem noted).
+fn checked(
+    mut c: Checker,
+    file: SweepFile,
+    base_table: Option<toml::Table>,
+) -> Result<Sweep, SceneProblems> {
+    let places = places(&file);
     let set = c.set(&file.set);
     let parsed: Vec<Option<Axis>> = (file.axis.iter().enumerate())
         .map(|(i, a)| c.axis(i, a))
