@@ -539,6 +539,9 @@ fn a_state_folder_that_is_a_link_or_a_file_and_a_dangling_output_link_are_refuse
         ("linked", "`linked`: holds `.coin-log-sweep` as a symbolic link, not the folder a sweep keeps its state in"),
         ("filed", "`filed`: holds `.coin-log-sweep` as a file, not the folder a sweep keeps its state in"),
         ("dangling", "`dangling`: is a symbolic link to `nowhere`, which does not exist: create that folder, or give -o another"),
+        // A parent on the way gave "File exists (os error 17)" and "Not a directory (os error 20)", exit 1.
+        ("dangling/sub", "`dangling/sub`: cannot be created: `dangling` is a symbolic link to `nowhere`, which does not exist: create that folder, or give -o another"),
+        ("s.toml/sub/deeper", "`s.toml/sub/deeper`: cannot be created: `s.toml` is not a folder; give -o a folder for the sweep's files"),
     ] {
         let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", out]);
         assert_eq!(code, 2, "{out}: {err}");

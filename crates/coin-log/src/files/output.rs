@@ -603,20 +603,31 @@ fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
                 )))
             }
             Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
-            // A link to nothing: creating the folder would fail with a bare "File exists".
-            Err(_) if fs::symlink_metadata(d).is_ok_and(|m| m.file_type().is_symlink()) => {
-                let to = fs::read_link(d).map_or_else(|_| "?".into(), |p| shown(&p));
-                return Err(OutputError(format!(
-                        "`{}` is a symbolic link to `{to}`, which does not exist: create the folder it \
+            Err(_) => match dangling_link(d) {
+                Some(to) => {
+                    return Err(OutputError(format!(
+                        "`{}` is a symbolic link to `{}`, which does not exist: create the folder it \
                          points to, or choose another folder with --out",
-                        shown(d)
-                    )));
-            }
-            Err(_) => created.push(d.to_path_buf()),
+                        shown(d),
+                        shown(&to)
+                    )))
+                }
+                None => created.push(d.to_path_buf()),
+            },
         }
         missing = d.parent();
     }
     Ok(created)
+}
+
+/// Where `path` points when it is a symbolic link to nothing (or to a loop of links): creating a
+/// folder there fails with a bare "File exists", so the commands that create folders name it instead.
+#[must_use]
+pub fn dangling_link(path: &Path) -> Option<PathBuf> {
+    let link = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    (link && fs::metadata(path).is_err())
+        .then(|| fs::read_link(path).ok())
+        .flatten()
 }
 
 impl Drop for OutputFolder {
