@@ -11,6 +11,7 @@ use crate::sweep::{
 use coin_log::sweep::Shard;
 use std::collections::HashMap;
 use std::path::Path;
+use std::process::Command;
 
 fn rows(path: &Path) -> Vec<Vec<String>> {
     Csv::read(path).without_wall_time()
@@ -320,7 +321,10 @@ fn collect_refuses_a_part_of_another_sweep_with_the_same_keys() {
     for (file, folder) in [("s.toml", "d"), ("o.toml", "o")] {
         for k in 0..3 {
             let shard = format!("{k}/3");
-            assert_eq!(sweep_json(dir.path(), file, folder, &["--shard", &shard]).0, 0);
+            assert_eq!(
+                sweep_json(dir.path(), file, folder, &["--shard", &shard]).0,
+                0
+            );
         }
     }
     let (d, o) = (dir.path().join("d"), dir.path().join("o"));
@@ -339,7 +343,10 @@ fn collect_refuses_a_part_of_another_sweep_with_the_same_keys() {
     }
     assert_eq!(listing(&d), before, "nothing written");
     // Shard 1 run again (its journal is this sweep's: the copied files are redone) is collected.
-    assert_eq!(sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/3"]).0, 0);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/3"]).0,
+        0
+    );
     assert_eq!(collect(dir.path(), "d").0, 0);
 }
 
@@ -557,6 +564,53 @@ fn a_state_folder_that_is_a_link_or_a_file_and_a_dangling_output_link_are_refuse
         "mine"
     );
     assert!(!d.join("nowhere").exists());
+}
+
+#[test]
+fn an_immutable_catalogue_or_append_only_folder_is_refused_before_any_run() {
+    // An immutable catalogue.csv let every run be made, then "writing `catalogue.csv`: Operation not
+    // permitted", exit 1; an append-only folder left what it could not remove. An immutable run file
+    // is a failed (I/O) row at once, not after its recording.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_sweep(d, "s.toml", SMALL);
+    assert_eq!(sweep_json(d, "s.toml", "done", &[]).0, 0);
+    std::fs::create_dir(d.join("apd")).unwrap();
+    let mut attributes = crate::support::Attributes::default();
+    std::fs::remove_file(d.join("done/run-02.mcap")).unwrap();
+    std::fs::write(d.join("done/run-03.mcap"), "changed").unwrap();
+    let set = attributes.set("+i", &d.join("done/catalogue.csv"))
+        && attributes.set("+a", &d.join("apd"))
+        && attributes.set("+i", &d.join("done/run-03.mcap"));
+    if !set {
+        // Not root, or a file system without attributes: cli_paths checks the logic of the probe.
+        return;
+    }
+    let before = listing(&d.join("done"));
+    let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", "done"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`done`: holds `done/catalogue.csv`, which is immutable, so the system lets no file be moved into place there: clear the attribute (chattr -i done/catalogue.csv), or give -o another folder"), "{err}");
+    assert_eq!(listing(&d.join("done")), before, "no run made");
+    let (code, _, err) = run_in(d, &["sweep", "collect", "done"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", "apd"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`apd`: is append-only"), "{err}");
+    assert!(listing(&d.join("apd")).is_empty(), "nothing created");
+    // The catalogue writable again: run 2 is made, run 3 (immutable) fails on I/O at once.
+    Command::new("chattr")
+        .args(["-i"])
+        .arg(d.join("done/catalogue.csv"))
+        .status()
+        .unwrap();
+    let (code, json) = sweep_json(d, "s.toml", "done", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["failed"].as_u64()),
+        (1, Some(2), Some(1)),
+        "{json}"
+    );
+    let catalogue = std::fs::read_to_string(d.join("done/catalogue.csv")).unwrap();
+    assert!(catalogue.contains("io,\"`run-03.mcap` is immutable, so the system lets no recording replace it: clear the attribute (chattr -i run-03.mcap) and run again"), "{catalogue}");
 }
 
 #[test]

@@ -346,7 +346,8 @@ verify = false
             other["identity"] = "0".repeat(64).into();
             assert_eq!(Sweep::from_plan(&other), None);
         }
-        let nan = parse("base = \"wobble\"\n[[axis]]\nkey = \"initial.theta\"\nvalues = [nan, 0.5]");
+        let nan =
+            parse("base = \"wobble\"\n[[axis]]\nkey = \"initial.theta\"\nvalues = [nan, 0.5]");
         let plan = serde_json::json!({"identity": nan.identity(), "sweep": nan.description_json()});
         assert_eq!(Sweep::from_plan(&plan), None);
         assert_eq!(

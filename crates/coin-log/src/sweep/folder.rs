@@ -150,6 +150,7 @@ impl Folder {
         if let Some(reason) = in_the_way.flatten() {
             return Err(folder_error(reason));
         }
+        refuse_attribute(path, path)?;
         fs::create_dir_all(path).map_err(SweepError::io("creating the sweep folder", path))?;
         let state = path.join(STATE_DIR);
         // Not `is_dir`, which follows a link: the state would be written wherever it points.
@@ -289,6 +290,21 @@ impl Folder {
         ))
     }
 
+    /// Refuses, before any run, a folder in which `shard`'s catalogue (or part) and `sweep.json` could
+    /// not be moved into place: [`refuse_attribute`] of each, and of the folder.
+    pub fn check_attributes(&self, shard: Shard) -> Result<(), SweepError> {
+        let own = if shard.is_all() {
+            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
+        } else {
+            vec![PART.name(shard)]
+        };
+        refuse_attribute(&self.path, &self.path)?;
+        for name in own {
+            refuse_attribute(&self.path, &self.file(&name))?;
+        }
+        Ok(())
+    }
+
     /// Deletes the temporary files a killed process of `shard` left: of its runs, and of its catalogue
     /// (for the whole sweep, also of `sweep.json`).
     pub fn remove_stale_temps(&self, shard: Shard) {
@@ -417,6 +433,26 @@ impl Folder {
             .map_err(SweepError::io("writing", &path))?;
         Ok(path)
     }
+}
+
+/// Refuses `path` (the sweep folder `folder`, or a file in it) when it is immutable or append-only
+/// (`chattr +i`, `+a`): a rename may not replace it (nor, for the folder, move a file into it), even for
+/// root, which would show only once the work was done.
+fn refuse_attribute(folder: &Path, path: &Path) -> Result<(), SweepError> {
+    let Some(attribute) = files::Attribute::of(path) else {
+        return Ok(());
+    };
+    let (name, clear) = attribute.words();
+    let what = if path == folder {
+        "is".to_string()
+    } else {
+        format!("holds `{}`, which is", files::shown(path))
+    };
+    Err(SweepError::folder(folder)(format!(
+        "{what} {name}, so the system lets no file be moved into place there: clear the attribute \
+         ({clear} {}), or give -o another folder",
+        files::shown(path)
+    )))
 }
 
 fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {

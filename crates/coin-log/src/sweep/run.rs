@@ -114,6 +114,7 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
     let _lock = folder.lock(options.shard)?;
+    folder.check_attributes(options.shard)?;
     let resumed = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
@@ -317,6 +318,13 @@ fn record_and_check(
         let what = format!("{what} `{name}`");
         move |e: std::io::Error| format!("{what}: {e}")
     };
+    // Refused after the whole run otherwise (the rename fails).
+    if let Some(attribute) = crate::files::Attribute::of(&target) {
+        let (attribute, clear) = attribute.words();
+        return Err(format!(
+            "`{name}` is {attribute}, so the system lets no recording replace it: clear the attribute ({clear} {name}) and run again"
+        ));
+    }
     let mut temp = folder::temp_file(&target).map_err(io("creating a temporary file for"))?;
     let started = Instant::now();
     let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());
