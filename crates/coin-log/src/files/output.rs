@@ -689,12 +689,14 @@ fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
             }
             Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
             Err(_) => match dangling_link(d) {
-                Some(to) => return Err(OutputError(format!(
+                Some(to) => {
+                    return Err(OutputError(format!(
                     "`{}` is a symbolic link to `{}`, which does not exist: create the folder it \
                          points to, or choose another folder with --out",
                     shown(d),
                     shown(&to)
-                ))),
+                )))
+                }
                 None => created.push(d.to_path_buf()),
             },
         }

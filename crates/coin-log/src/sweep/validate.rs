@@ -246,6 +246,19 @@ impl Checker {
                 .problems
                 .reject(name, "[]", "is empty: give at least one value");
         }
+        // A string is its cell as it is: a line break would split the run's row, which the journal and
+        // the parts hold one to a line (resume redid such a run every time, collect refused its part).
+        let broken = values
+            .iter()
+            .filter_map(toml::Value::as_str)
+            .find(|s| s.contains(['\n', '\r']));
+        if let Some(value) = broken {
+            return self.problems.reject(
+                name,
+                format!("{value:?}"),
+                "holds a line break, which no scene key takes and a catalogue row (one line) cannot hold: remove it",
+            );
+        }
         Some(values.to_vec())
     }
 
