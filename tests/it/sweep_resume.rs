@@ -200,6 +200,28 @@ fn a_journal_of_another_sweep_with_the_same_keys_is_redone_not_kept() {
 }
 
 #[test]
+fn a_catalogue_or_sweep_json_that_cannot_be_replaced_is_refused_before_any_run() {
+    // sweep.json's name held by a link: the missing run was made and the catalogue rewritten, and only
+    // then was sweep.json refused, leaving a new catalogue beside the old sweep.json's place.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let out = dir.path().join("out");
+    std::fs::remove_file(out.join("run-05.mcap")).unwrap();
+    std::fs::remove_file(out.join("sweep.json")).unwrap();
+    std::os::unix::fs::symlink("../victim", out.join("sweep.json")).unwrap();
+    let catalogue = std::fs::read(out.join("catalogue.csv")).unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "out"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("sweep.json`: is a symbolic link (to `../victim`)"),
+        "{err}"
+    );
+    assert!(!out.join("run-05.mcap").exists(), "a run was made first");
+    assert_eq!(std::fs::read(out.join("catalogue.csv")).unwrap(), catalogue);
+}
+
+#[test]
 fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let text = "base = \"wobble\"\nset = { \"run.duration\" = 0.5 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6, 0.5]\n";

@@ -515,6 +515,20 @@ fn links_in_the_sweep_folder_are_refused_never_written_through_or_replaced() {
         .is_symlink());
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me\n");
     std::fs::remove_file(&catalogue).unwrap();
+    // sweep.json's name held by a link: refused before anything is written (the catalogue was written,
+    // then sweep.json refused: half the pair).
+    let summary = link("sweep.json");
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("sweep.json`: is a symbolic link (to `"),
+        "{err}"
+    );
+    assert!(
+        !d.join("catalogue.csv").exists(),
+        "catalogue written without sweep.json"
+    );
+    std::fs::remove_file(&summary).unwrap();
     // A part that is a pipe is named once, not once per cause in the error's chain.
     let pipe = d.join("catalogue.part-9-of-10.csv");
     crate::support::mkfifo(&pipe);

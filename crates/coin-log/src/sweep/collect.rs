@@ -42,7 +42,7 @@ struct Found {
 /// Merges the catalogue parts in `dir`, hashing the files on `jobs` threads.
 pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepError> {
     let folder = Folder::existing(dir)?;
-    folder.check_attributes(super::Shard::ALL)?;
+    folder.check_outputs(super::Shard::ALL)?;
     let columns = folder.columns();
     let runs = folder.runs();
     let mut parts =

@@ -291,8 +291,10 @@ impl Folder {
     }
 
     /// Refuses, before any run, a folder in which `shard`'s catalogue (or part) and `sweep.json` could
-    /// not be moved into place: [`refuse_attribute`] of each, and of the folder.
-    pub fn check_attributes(&self, shard: Shard) -> Result<(), SweepError> {
+    /// not be moved into place, each refused as its write would refuse it (not a regular file) or by
+    /// [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
+    /// nothing, and a catalogue could be written without its `sweep.json`.
+    pub fn check_outputs(&self, shard: Shard) -> Result<(), SweepError> {
         let own = if shard.is_all() {
             vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
         } else {
@@ -300,7 +302,9 @@ impl Folder {
         };
         refuse_attribute(&self.path, &self.path)?;
         for name in own {
-            refuse_attribute(&self.path, &self.file(&name))?;
+            let path = self.file(&name);
+            files::absent_or_plain(&path).map_err(SweepError::io("writing", &path))?;
+            refuse_attribute(&self.path, &path)?;
         }
         Ok(())
     }

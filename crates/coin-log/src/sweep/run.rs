@@ -114,7 +114,7 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
     let _lock = folder.lock(options.shard)?;
-    folder.check_attributes(options.shard)?;
+    folder.check_outputs(options.shard)?;
     let resumed = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
