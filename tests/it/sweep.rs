@@ -569,6 +569,20 @@ fn a_swept_string_with_a_line_break_is_a_problem_not_a_run_redone_forever() {
 }
 
 #[test]
+fn a_long_swept_key_is_shown_cut_in_its_problem() {
+    // A key of 100 000 characters was quoted whole (a 100 kB message); `record --set` cuts it.
+    let key = format!("initial.{}", "x".repeat(100_000));
+    let err = refused(&format!(
+        "base = \"wobble\"\n[[axis]]\nkey = \"{key}\"\nvalues = [1]\n"
+    ));
+    assert!(err.len() < 2000, "{} bytes", err.len());
+    assert!(
+        err.contains("does not fit the scene key `initial.xxx"),
+        "{err}"
+    );
+}
+
+#[test]
 fn an_output_channel_list_that_every_run_would_refuse_is_a_problem() {
     // `output.channels` is fixed for all runs: an empty list or a channel listed twice passed, and every
     // run was then a failed row with the scene's complaint.

@@ -9,6 +9,7 @@ use super::definition::{
 use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
 use super::random::Distribution;
 use super::space::{linspace, logspace};
+use crate::files::shown_name;
 use crate::format::Channel;
 use crate::scene::{self, dotted, presets, ProblemCollector, SceneProblems};
 use std::fmt::Display;
@@ -592,13 +593,17 @@ impl Checker {
                     format!(
                         "replaces the whole table holding `{}` (given by {}, which applies first): give that key \
                          inside {}'s values, or sweep a key inside `{}`",
-                        earlier.key, earlier.name, later.name, later.key
+                        shown_name(&earlier.key),
+                        earlier.name,
+                        later.name,
+                        shown_name(&later.key)
                     )
                 } else if scene::other_form(&later.key).contains(&earlier.key.as_str()) {
                     format!(
                         "removes `{}` (given by {}, which applies first), the other form of the same fact: \
                          give one form only",
-                        earlier.key, earlier.name
+                        shown_name(&earlier.key),
+                        earlier.name
                     )
                 } else {
                     continue;
@@ -652,7 +657,10 @@ impl Checker {
                     self.problems.push(
                         place.values_name.clone(),
                         value.to_string(),
-                        format!("does not fit the scene key `{}`: {e}", place.key),
+                        format!(
+                            "does not fit the scene key `{}`: {e}",
+                            shown_name(&place.key)
+                        ),
                     );
                     break;
                 }
