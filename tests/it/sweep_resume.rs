@@ -200,6 +200,38 @@ fn a_journal_of_another_sweep_with_the_same_keys_is_redone_not_kept() {
 }
 
 #[test]
+fn a_journal_row_no_run_writes_is_redone_not_kept() {
+    // A finished row whose file cell was blanked had no file to check, so resume kept it: a finished
+    // run without a file in the catalogue.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
+        0
+    );
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
+        0
+    );
+    let out = dir.path().join("out");
+    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| l.replace(",run-02.mcap,", ",,"))
+        .collect();
+    std::fs::write(&journal, lines.join("\n") + "\n").unwrap();
+    std::fs::remove_file(out.join("run-02.mcap")).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(1), Some(11)),
+        "{json}"
+    );
+    assert_eq!(rows(&out), rows(&dir.path().join("ref")));
+}
+
+#[test]
 fn a_catalogue_or_sweep_json_that_cannot_be_replaced_is_refused_before_any_run() {
     // sweep.json's name held by a link: the missing run was made and the catalogue rewritten, and only
     // then was sweep.json refused, leaving a new catalogue beside the old sweep.json's place.

@@ -310,6 +310,84 @@ fn collect_refuses_a_part_whose_row_names_another_runs_file() {
 }
 
 #[test]
+fn collect_names_a_damaged_parts_first_wrong_lines_and_counts_the_rest() {
+    // 100 garbage lines gave 100 errors (300 000 gave 300 000), and bytes that are no UTF-8 gave the bare
+    // "stream did not contain valid UTF-8", no fix.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for k in 0..2 {
+        let shard = format!("{k}/2");
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
+            0
+        );
+    }
+    let part = dir.path().join("d/catalogue.part-1-of-2.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    std::fs::write(&part, text.clone() + &"garbage\n".repeat(100)).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.matches("not a row of this sweep").count(), 20, "{err}");
+    assert!(err.contains("error: d: `catalogue.part-1-of-2.csv`: 80 more lines are wrong as well: run its shard again"), "{err}");
+    // A row twice in one part: the other-sharding fix ("in both `p` and `p`") did not apply.
+    let second = text.lines().nth(1).unwrap();
+    std::fs::write(&part, format!("{text}{second}\n")).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("`catalogue.part-1-of-2.csv` line 8: run 1's row is in the part twice: the part was changed; run its shard again"), "{err}");
+    // An index written `+01` (it parses as 1): the catalogue held `+01`.
+    std::fs::write(&part, text.replacen("\n1,", "\n+01,", 1)).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`catalogue.part-1-of-2.csv` line 2: not a row of this sweep"),
+        "{err}"
+    );
+    let mut bytes = text.into_bytes();
+    bytes.extend_from_slice(b"\xff\xfe\n");
+    std::fs::write(&part, bytes).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("`catalogue.part-1-of-2.csv` is not UTF-8 text, so not a part as a shard writes it: delete it and run its shard again"), "{err}");
+}
+
+#[test]
+fn collect_refuses_a_row_no_run_writes() {
+    // A finished row with its file, size and SHA-256 blanked (and the file gone) had nothing to check,
+    // so collect wrote a catalogue with a finished run and no file; a verifying sweep's row saying
+    // `verify` = off passed as well.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for k in 0..2 {
+        let shard = format!("{k}/2");
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
+            0
+        );
+    }
+    let part = dir.path().join("d/catalogue.part-1-of-2.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    // Run 1's file, bytes and SHA-256 (no commas in them) blanked; run 3's verify cell `off`.
+    let (head, rest) = lines[1].split_once(",run-01.mcap,").unwrap();
+    let rest = rest.splitn(3, ',').nth(2).unwrap();
+    lines[1] = format!("{head},,,,{rest}");
+    assert!(lines[2].contains(",finished,"), "{}", lines[2]);
+    lines[2] = lines[2].replacen(",ok,", ",off,", 1);
+    std::fs::write(&part, lines.join("\n") + "\n").unwrap();
+    std::fs::remove_file(dir.path().join("d/run-01.mcap")).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    for needle in [
+        "`catalogue.part-1-of-2.csv` line 2: run 1's row is none a run writes (status `finished`, failure ``, file ``, verify `ok`): the part was changed; run its shard again",
+        "`catalogue.part-1-of-2.csv` line 3: run 3's row is none a run writes (status `finished`, failure ``, file `run-03.mcap`, verify `off`)",
+    ] {
+        assert!(err.contains(needle), "{err}");
+    }
+    assert!(!dir.path().join("d/catalogue.csv").exists());
+}
+
+#[test]
 fn collect_refuses_a_part_of_another_sweep_with_the_same_keys() {
     // Another sweep's part (same keys and columns, other values) and its files copied in: every row
     // named its own run's file with the right size and SHA-256, so collect wrote a catalogue holding the

@@ -2,7 +2,7 @@
 //! the one catalogue, after checking that every run is there exactly once and that every file matches
 //! its row (size and SHA-256, each file read once). Nothing is written unless every check holds.
 
-use super::catalogue::RunStatus;
+use super::catalogue::{consistent, RunStatus};
 use super::definition::Sweep;
 use super::error::SweepError;
 use super::folder::{self, Folder};
@@ -15,6 +15,9 @@ use std::sync::atomic::AtomicBool;
 
 /// Missing runs listed by number before the rest are only counted.
 const LISTED_RANGES: usize = 20;
+
+/// The wrong lines of a part named one by one before the rest are only counted.
+const LISTED_LINES: usize = 20;
 
 /// What collect found and wrote.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,6 +39,7 @@ pub struct Collected {
 /// A row as found in a part.
 struct Found {
     part: String,
+    line: usize,
     fields: Vec<String>,
 }
 
@@ -74,7 +78,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     }
     problems.extend(missing(runs, &rows));
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
-    problems.extend(check_files(&folder, &rows, at, jobs));
+    problems.extend(check_rows(&folder, sweep.as_ref(), &rows, at, jobs));
     let status_at = folder.column("status");
     let failed = rows
         .values()
@@ -105,7 +109,7 @@ struct Part<'a> {
 }
 
 /// Reads one part into `rows`, noting a wrong header, unreadable lines, runs out of range, rows with
-/// another run's file or values, and runs already in another part.
+/// another run's file or none a run writes, and runs already in another part or twice in this one.
 fn read_part(
     folder: &Folder,
     &Part {
@@ -118,23 +122,38 @@ fn read_part(
     problems: &mut Vec<String>,
 ) -> Result<(), SweepError> {
     let path = folder.file(name);
-    let text = crate::files::read_regular(&path)
-        .map_err(SweepError::io("reading the catalogue part", &path))?;
-    let file_at = folder.column("file");
+    let text = match crate::files::read_regular(&path) {
+        Ok(text) => text,
+        // Bytes that are no UTF-8: a damaged part, or no part (the bare "stream did not contain valid
+        // UTF-8" said neither, nor what to do).
+        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => {
+            problems.push(format!(
+                "`{name}` is not UTF-8 text, so not a part as a shard writes it: delete it and run its shard again"
+            ));
+            return Ok(());
+        }
+        Err(e) => return Err(SweepError::io("reading the catalogue part", &path)(e)),
+    };
+    let [file_at, status_at, failure_at, verify_at] =
+        ["file", "status", "failure", "verify"].map(|c| folder.column(c));
+    let verifies = sweep.map(|s| s.settings.verify);
     let mut lines = text.lines();
     let header = lines.next().and_then(csv::split);
     if header.as_deref() != Some(columns) {
         problems.push(format!("`{name}` does not start with this sweep's header: it is not a part of this sweep; delete it"));
         return Ok(());
     }
+    // What is wrong line by line, listed up to LISTED_LINES (a part of 300 000 garbage lines printed as
+    // many errors).
+    let mut found = Vec::new();
     for (n, line) in lines.enumerate() {
         let fields = csv::split(line).filter(|f| f.len() == columns.len());
         let index = fields
             .as_ref()
-            .and_then(|f| f[0].parse::<u64>().ok())
+            .and_then(|f| f[0].parse::<u64>().ok().filter(|i| i.to_string() == f[0]))
             .filter(|&i| i < runs);
         let (Some(fields), Some(index)) = (fields, index) else {
-            problems.push(format!(
+            found.push(format!(
                 "`{name}` line {}: not a row of this sweep: run its shard again",
                 n + 2
             ));
@@ -144,19 +163,33 @@ fn read_part(
         // pass the file checks below with another run's values.
         let (file, own) = (&fields[file_at], folder.run_file_name(index));
         if !file.is_empty() && *file != own {
-            problems.push(format!(
+            found.push(format!(
                 "`{name}` line {}: run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again",
                 n + 2
             ));
             continue;
         }
+        let [status, failure, verify] = [status_at, failure_at, verify_at].map(|at| &fields[at]);
+        if !consistent(status, failure, file, verify, verifies) {
+            let [status, failure, verify] = [status, failure, verify].map(|c| shown_name(c));
+            found.push(format!(
+                "`{name}` line {}: run {index}'s row is none a run writes (status `{status}`, failure `{failure}`, file `{}`, verify `{verify}`): the part was changed; run its shard again",
+                n + 2,
+                shown_name(file)
+            ));
+            continue;
+        }
         // A part of another sweep with the same keys, its files copied in, passes every check above.
-        if let Some(problem) = sweep.and_then(|s| other_values(s, &fields, index)) {
-            problems.push(format!("`{name}` line {}: {problem}", n + 2));
+        // Twice in this part: no shard writes that, and no other part is to blame.
+        if rows.get(&index).is_some_and(|other| other.part == name) {
+            found.push(format!(
+                "`{name}` line {}: run {index}'s row is in the part twice: the part was changed; run its shard again",
+                n + 2
+            ));
             continue;
         }
         if let Some(other) = rows.get(&index) {
-            problems.push(format!(
+            found.push(format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
                 other.part
             ));
@@ -166,9 +199,17 @@ fn read_part(
             index,
             Found {
                 part: name.to_string(),
+                line: n + 2,
                 fields,
             },
         );
+    }
+    let more = found.len().saturating_sub(LISTED_LINES);
+    problems.extend(found.into_iter().take(LISTED_LINES));
+    if more > 0 {
+        problems.push(format!(
+            "`{name}`: {more} more lines are wrong as well: run its shard again"
+        ));
     }
     Ok(())
 }
@@ -221,19 +262,29 @@ fn missing(runs: u64, rows: &BTreeMap<u64, Found>) -> Option<String> {
     ))
 }
 
-/// Each row's file against its size and SHA-256, hashed on `jobs` threads.
-fn check_files(
+/// Each row's values against its run's in the sweep (when the plan gives it back: a part of another
+/// sweep with the same keys passes every other check), and its file against its size and SHA-256, on
+/// `jobs` threads (a bounded normal draw that finds no value takes a tenth of a second to recompute).
+fn check_rows(
     folder: &Folder,
+    sweep: Option<&Sweep>,
     rows: &BTreeMap<u64, Found>,
     [file_at, bytes_at, sha_at]: [usize; 3],
     jobs: usize,
 ) -> Vec<String> {
-    let with_files: Vec<&Found> = rows
-        .values()
-        .filter(|f| !f.fields[file_at].is_empty())
-        .collect();
+    let rows: Vec<&Found> = rows.values().collect();
     let check = |found: &&Found| {
         let f = &found.fields;
+        let index = f[0].parse::<u64>().unwrap_or(0);
+        if let Some(problem) = sweep.and_then(|s| other_values(s, f, index)) {
+            return Some((
+                index,
+                format!("`{}` line {}: {problem}", found.part, found.line),
+            ));
+        }
+        if f[file_at].is_empty() {
+            return None;
+        }
         let problem = match sha256_file(&folder.file(&f[file_at])) {
             Err(e) => format!("`{}` (run {}) cannot be read: {e}", f[file_at], f[0]),
             Ok((_, len)) if len.to_string() != f[bytes_at] => format!(
@@ -246,12 +297,12 @@ fn check_files(
             ),
             Ok(_) => return None,
         };
-        Some((f[0].parse::<u64>().unwrap_or(0), problem))
+        Some((index, problem))
     };
     let mut problems = Vec::new();
     let never = AtomicBool::new(false);
-    let check_at = |i: u64| with_files.get(usize::try_from(i).ok()?).and_then(check);
-    let len = with_files.len() as u64;
+    let check_at = |i: u64| rows.get(usize::try_from(i).ok()?).and_then(check);
+    let len = rows.len() as u64;
     super::on_threads(len, jobs, &never, check_at, |b| problems.extend(b));
     problems.sort();
     problems.into_iter().map(|(_, p)| p).collect()

@@ -484,7 +484,12 @@ impl JournalRow {
         let mut fields = csv::split(line).filter(|f| f.len() == width)?;
         let mtime_ns = fields.first()?.parse().ok()?;
         fields.remove(0);
-        let index = fields.first()?.parse().ok()?;
+        let text = fields.first()?;
+        // As a run writes it (`+01` parses as 1, and the row would be kept with that index cell).
+        let index = text
+            .parse::<u64>()
+            .ok()
+            .filter(|i| i.to_string() == *text)?;
         Some(Self {
             mtime_ns,
             index,
@@ -606,6 +611,8 @@ mod tests {
         assert!(JournalRow::parse("12,0", width).is_none());
         assert!(JournalRow::parse("x,0,a", width).is_none());
         assert!(JournalRow::parse("12,\"0,a", width).is_none());
+        assert!(JournalRow::parse("12,+0,a", width).is_none());
+        assert!(JournalRow::parse("12,01,a", width).is_none());
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! row journalled as it finishes; then the catalogue (or this shard's part) and, for a whole sweep,
 //! `sweep.json`.
 
-use super::catalogue::{FailureKind, Prediction, Recorded, Row, RunStatus};
+use super::catalogue::{consistent, FailureKind, Prediction, Recorded, Row, RunStatus};
 use super::definition::{self, RunSceneError, Sweep};
 use super::error::SweepError;
 use super::folder::{self, Folder, JournalRow};
@@ -222,8 +222,9 @@ impl Tally {
 /// time differs, with the same SHA-256; a failed row is kept unless it failed on I/O or `retry_failed`
 /// is set.
 fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resumed, SweepError> {
-    let [status_at, failure_at, file_at, bytes_at, sha_at] =
-        ["status", "failure", "file", "bytes", "sha256"].map(|c| folder.column(c));
+    let [status_at, failure_at, file_at, bytes_at, sha_at, verify_at] =
+        ["status", "failure", "file", "bytes", "sha256", "verify"].map(|c| folder.column(c));
+    let verifies = Some(sweep.settings.verify);
     let mut latest: BTreeMap<u64, JournalRow> = BTreeMap::new();
     for row in folder.journal_rows()? {
         if row.index < sweep.runs() && options.shard.takes(row.index) {
@@ -244,6 +245,11 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         // A row holds its own run's values (one of another sweep with the same keys, its journal copied
         // in, is redone).
         if f.get(1..=keys) != Some(&sweep.cells(index)[..]) {
+            continue;
+        }
+        // And is one a run writes (a finished row without its file was kept, with nothing to check).
+        let cells = [status_at, failure_at, file_at, verify_at].map(|at| f[at].as_str());
+        if !consistent(cells[0], cells[1], cells[2], cells[3], verifies) {
             continue;
         }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
