@@ -335,6 +335,29 @@ fn collect_names_a_damaged_parts_first_wrong_lines_and_counts_the_rest() {
     let (code, err) = collect(dir.path(), "d");
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("`catalogue.part-1-of-2.csv` line 8: run 1's row is in the part twice: the part was changed; run its shard again"), "{err}");
+    // A run file of another size is not read: a sparse 1 TB one took half an hour to hash.
+    std::fs::write(&part, &text).unwrap();
+    let run = dir.path().join("d/run-01.mcap");
+    let kept = std::fs::read(&run).unwrap();
+    std::fs::File::options()
+        .write(true)
+        .open(&run)
+        .unwrap()
+        .set_len(1 << 40)
+        .unwrap();
+    let started = std::time::Instant::now();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`run-01.mcap` (run 1) has 1099511627776 bytes, its row"),
+        "{err}"
+    );
+    assert!(
+        started.elapsed().as_secs() < 20,
+        "read for {:?}",
+        started.elapsed()
+    );
+    std::fs::write(&run, kept).unwrap();
     // An index written `+01` (it parses as 1): the catalogue held `+01`.
     std::fs::write(&part, text.replacen("\n1,", "\n+01,", 1)).unwrap();
     let (code, err) = collect(dir.path(), "d");
