@@ -73,6 +73,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
             columns: &columns,
             runs,
             sweep: sweep.as_ref(),
+            at: ["file", "status", "failure", "verify"].map(|c| folder.column(c)),
         };
         read_part(&folder, &part, &mut rows, &mut problems)?;
     }
@@ -100,27 +101,25 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
 }
 
 /// A part to read, and what its rows must agree with: the plan's columns, runs and sweep (`None` when the
-/// plan does not give it back: then the values are not checked).
+/// plan does not give it back: then whether it verifies is not checked).
 struct Part<'a> {
     name: &'a str,
     columns: &'a [String],
     runs: u64,
     sweep: Option<&'a Sweep>,
+    /// The columns `file`, `status`, `failure`, `verify`.
+    at: [usize; 4],
 }
 
 /// Reads one part into `rows`, noting a wrong header, unreadable lines, runs out of range, rows with
 /// another run's file or none a run writes, and runs already in another part or twice in this one.
 fn read_part(
     folder: &Folder,
-    &Part {
-        name,
-        columns,
-        runs,
-        sweep,
-    }: &Part,
+    part: &Part,
     rows: &mut BTreeMap<u64, Found>,
     problems: &mut Vec<String>,
 ) -> Result<(), SweepError> {
+    let Part { name, columns, .. } = *part;
     let path = folder.file(name);
     let text = match crate::files::read_regular(&path) {
         Ok(text) => text,
@@ -134,9 +133,6 @@ fn read_part(
         }
         Err(e) => return Err(SweepError::io("reading the catalogue part", &path)(e)),
     };
-    let [file_at, status_at, failure_at, verify_at] =
-        ["file", "status", "failure", "verify"].map(|c| folder.column(c));
-    let verifies = sweep.map(|s| s.settings.verify);
     let mut lines = text.lines();
     let header = lines.next().and_then(csv::split);
     if header.as_deref() != Some(columns) {
@@ -147,39 +143,13 @@ fn read_part(
     // many errors).
     let mut found = Vec::new();
     for (n, line) in lines.enumerate() {
-        let fields = csv::split(line).filter(|f| f.len() == columns.len());
-        let index = fields
-            .as_ref()
-            .and_then(|f| f[0].parse::<u64>().ok().filter(|i| i.to_string() == f[0]))
-            .filter(|&i| i < runs);
-        let (Some(fields), Some(index)) = (fields, index) else {
-            found.push(format!(
-                "`{name}` line {}: not a row of this sweep: run its shard again",
-                n + 2
-            ));
-            continue;
+        let (index, fields) = match row(folder, part, line) {
+            Ok(row) => row,
+            Err(problem) => {
+                found.push(format!("`{name}` line {}: {problem}", n + 2));
+                continue;
+            }
         };
-        // A row names its own run's file or none: one that names another's (an edited index) would
-        // pass the file checks below with another run's values.
-        let (file, own) = (&fields[file_at], folder.run_file_name(index));
-        if !file.is_empty() && *file != own {
-            found.push(format!(
-                "`{name}` line {}: run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again",
-                n + 2
-            ));
-            continue;
-        }
-        let [status, failure, verify] = [status_at, failure_at, verify_at].map(|at| &fields[at]);
-        if !consistent(status, failure, file, verify, verifies) {
-            let [status, failure, verify] = [status, failure, verify].map(|c| shown_name(c));
-            found.push(format!(
-                "`{name}` line {}: run {index}'s row is none a run writes (status `{status}`, failure `{failure}`, file `{}`, verify `{verify}`): the part was changed; run its shard again",
-                n + 2,
-                shown_name(file)
-            ));
-            continue;
-        }
-        // A part of another sweep with the same keys, its files copied in, passes every check above.
         // Twice in this part: no shard writes that, and no other part is to blame.
         if rows.get(&index).is_some_and(|other| other.part == name) {
             found.push(format!(
@@ -212,6 +182,41 @@ fn read_part(
         ));
     }
     Ok(())
+}
+
+/// A part's line as a row of this sweep: its index and fields; else what is wrong with it. A row names its
+/// own run's file or none (one that names another's, an edited index, would pass the file checks with
+/// another run's values), and its status, failure, file and verify cells agree as a run writes them.
+fn row(folder: &Folder, part: &Part, line: &str) -> Result<(u64, Vec<String>), String> {
+    let fields = csv::split(line).filter(|f| f.len() == part.columns.len());
+    let index = fields
+        .as_ref()
+        .and_then(|f| f[0].parse::<u64>().ok().filter(|i| i.to_string() == f[0]))
+        .filter(|&i| i < part.runs);
+    let (Some(fields), Some(index)) = (fields, index) else {
+        return Err("not a row of this sweep: run its shard again".into());
+    };
+    let [file, status, failure, verify] = part.at.map(|at| &fields[at]);
+    let own = folder.run_file_name(index);
+    if !file.is_empty() && *file != own {
+        return Err(format!(
+            "run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again"
+        ));
+    }
+    if !consistent(
+        status,
+        failure,
+        file,
+        verify,
+        part.sweep.map(|s| s.settings.verify),
+    ) {
+        let [status, failure, file, verify] =
+            [status, failure, file, verify].map(|c| shown_name(c));
+        return Err(format!(
+            "run {index}'s row is none a run writes (status `{status}`, failure `{failure}`, file `{file}`, verify `{verify}`): the part was changed; run its shard again"
+        ));
+    }
+    Ok((index, fields))
 }
 
 /// How a row's values differ from its run's in the sweep, if they do.
