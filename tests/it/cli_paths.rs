@@ -60,6 +60,80 @@ fn refused(dir: &Path, target: &str, needles: &[&str]) {
 }
 
 #[test]
+fn an_immutable_or_append_only_target_or_folder_is_refused_before_the_work() {
+    // `record -o imm.mcap --overwrite` on a `chattr +i` file simulated the whole run, then failed the
+    // move and kept the finished temporary file; in an append-only folder the probe and the temporary
+    // file were left behind (neither may be removed there). statx's attributes tell before the work.
+    use coin_log::files::Attribute;
+    assert_eq!(
+        [(true, false), (true, true), (false, true), (false, false)]
+            .map(|(i, a)| Attribute::from_attributes(i, a)),
+        [
+            Some(Attribute::Immutable),
+            Some(Attribute::Immutable),
+            Some(Attribute::AppendOnly),
+            None
+        ]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert_eq!(
+        code(&coin_log(
+            d,
+            &["record", "wobble", "--duration", "1", "-o", "run.mcap"]
+        )),
+        0
+    );
+    std::fs::write(d.join("imm.mcap"), "mine").unwrap();
+    for folder in ["apd", "immdir"] {
+        std::fs::create_dir(d.join(folder)).unwrap();
+    }
+    assert_eq!(Attribute::of(&d.join("imm.mcap")), None);
+    let mut attributes = crate::support::Attributes::default();
+    let set = [("+i", "imm.mcap"), ("+a", "apd"), ("+i", "immdir")]
+        .iter()
+        .all(|&(flag, path)| attributes.set(flag, &d.join(path)));
+    if !set {
+        // Not root, or a file system without these attributes: the logic above is what is checked.
+        return;
+    }
+    assert_eq!(
+        Attribute::of(&d.join("imm.mcap")),
+        Some(Attribute::Immutable)
+    );
+    assert_eq!(Attribute::of(&d.join("apd")), Some(Attribute::AppendOnly));
+    refused(d, "imm.mcap", &[
+        "`imm.mcap` is immutable, so the system lets no file replace it, even with --overwrite: clear the attribute (chattr -i imm.mcap), or choose another file with -o",
+    ]);
+    refused(d, "apd/new.mcap", &[
+        "the folder `apd` is append-only, so the system lets no file be moved into place in it (for `apd/new.mcap`): clear the attribute (chattr -a apd), or choose another file with -o",
+    ]);
+    assert!(listing(&d.join("apd")).is_empty(), "nothing left in apd");
+    let before = listing(d);
+    for (args, says) in [
+        (
+            &["analyse", "map", "--out", "immdir"][..],
+            "the folder `immdir` is immutable",
+        ),
+        (
+            &["export", "run.mcap", "--out", "apd"],
+            "the folder `apd` is append-only",
+        ),
+        (
+            &["plot", "run.mcap", "--out", "imm.mcap", "--overwrite"],
+            "`imm.mcap` is immutable",
+        ),
+    ] {
+        let out = coin_log(d, args);
+        assert_eq!(code(&out), 1, "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(listing(d), before, "nothing created");
+    assert!(listing(&d.join("apd")).is_empty() && listing(&d.join("immdir")).is_empty());
+    assert_eq!(std::fs::read_to_string(d.join("imm.mcap")).unwrap(), "mine");
+}
+
+#[test]
 fn a_device_node_is_never_replaced_even_with_overwrite() {
     let dir = tempfile::tempdir().unwrap();
     refused(

@@ -549,6 +549,40 @@ normal = { mean = 0.0, std = 0.0, min = "x" }
 }
 
 #[test]
+fn a_swept_string_with_a_line_break_is_a_problem_not_a_run_redone_forever() {
+    // Its cell split the row over two lines of the journal and the part: resume redid the run every
+    // time, and collect refused the part ("not a row of this sweep: run its shard again", which did not
+    // help).
+    let err = refused(
+        "base = \"wobble\"\n[[axis]]\nkey = \"run.integrator\"\nvalues = [\"rk4\", \"dop\\n853\"]\n\
+         [random]\nseed = 1\ncount = 1\n[[random.draw]]\nkey = \"body.shape\"\nchoice = [\"x\\r\"]\n",
+    );
+    for (key, value) in [
+        ("axis[0].values", r#""dop\n853""#),
+        ("random.draw[0].choice", r#""x\r""#),
+    ] {
+        let problem = format!(
+            "`{key}` = {value} holds a line break, which no scene key takes and a catalogue row (one line) cannot hold: remove it"
+        );
+        assert!(err.contains(&problem), "{err}");
+    }
+}
+
+#[test]
+fn a_long_swept_key_is_shown_cut_in_its_problem() {
+    // A key of 100 000 characters was quoted whole (a 100 kB message); `record --set` cuts it.
+    let key = format!("initial.{}", "x".repeat(100_000));
+    let err = refused(&format!(
+        "base = \"wobble\"\n[[axis]]\nkey = \"{key}\"\nvalues = [1]\n"
+    ));
+    assert!(err.len() < 2000, "{} bytes", err.len());
+    assert!(
+        err.contains("does not fit the scene key `initial.xxx"),
+        "{err}"
+    );
+}
+
+#[test]
 fn an_output_channel_list_that_every_run_would_refuse_is_a_problem() {
     // `output.channels` is fixed for all runs: an empty list or a channel listed twice passed, and every
     // run was then a failed row with the scene's complaint.

@@ -171,6 +171,89 @@ fn bytes_that_are_no_utf8_in_the_journal_spoil_their_line_not_the_resume() {
 }
 
 #[test]
+fn a_journal_of_another_sweep_with_the_same_keys_is_redone_not_kept() {
+    // Another sweep's journal (same keys, other values) and its files copied into this sweep's state:
+    // every row named its own run's file with the size and SHA-256 it was journalled with, so resume kept
+    // them all, and the catalogue held the other sweep's values under this sweep's identity.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let other = SMALL.replace("values = [0.2, 0.6, 1.0]", "values = [0.3, 0.6, 1.0]");
+    write_sweep(dir.path(), "o.toml", &other);
+    for (file, folder) in [("s.toml", "ref"), ("s.toml", "out"), ("o.toml", "other")] {
+        assert_eq!(sweep_json(dir.path(), file, folder, &["--jobs", "1"]).0, 0);
+    }
+    let (out, other) = (dir.path().join("out"), dir.path().join("other"));
+    let journal = ".coin-log-sweep/journal-0-of-1.csv";
+    std::fs::copy(other.join(journal), out.join(journal)).unwrap();
+    for name in run_files(&other) {
+        std::fs::copy(other.join(&name), out.join(&name)).unwrap();
+    }
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    // Runs 0, 1, 6 and 7 have θ = 0.2 here and 0.3 there; the others' values and files are the same.
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(4), Some(8)),
+        "{json}"
+    );
+    assert_eq!(rows(&out), rows(&dir.path().join("ref")));
+    files_match(&out, &dir.path().join("ref"));
+}
+
+#[test]
+fn a_journal_row_no_run_writes_is_redone_not_kept() {
+    // A finished row whose file cell was blanked had no file to check, so resume kept it: a finished
+    // run without a file in the catalogue.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
+        0
+    );
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
+        0
+    );
+    let out = dir.path().join("out");
+    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| l.replace(",run-02.mcap,", ",,"))
+        .collect();
+    std::fs::write(&journal, lines.join("\n") + "\n").unwrap();
+    std::fs::remove_file(out.join("run-02.mcap")).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["kept"].as_u64()),
+        (0, Some(1), Some(11)),
+        "{json}"
+    );
+    assert_eq!(rows(&out), rows(&dir.path().join("ref")));
+}
+
+#[test]
+fn a_catalogue_or_sweep_json_that_cannot_be_replaced_is_refused_before_any_run() {
+    // sweep.json's name held by a link: the missing run was made and the catalogue rewritten, and only
+    // then was sweep.json refused, leaving a new catalogue beside the old sweep.json's place.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let out = dir.path().join("out");
+    std::fs::remove_file(out.join("run-05.mcap")).unwrap();
+    std::fs::remove_file(out.join("sweep.json")).unwrap();
+    std::os::unix::fs::symlink("../victim", out.join("sweep.json")).unwrap();
+    let catalogue = std::fs::read(out.join("catalogue.csv")).unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "out"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("sweep.json`: is a symbolic link (to `../victim`)"),
+        "{err}"
+    );
+    assert!(!out.join("run-05.mcap").exists(), "a run was made first");
+    assert_eq!(std::fs::read(out.join("catalogue.csv")).unwrap(), catalogue);
+}
+
+#[test]
 fn an_io_failure_is_redone_on_resume_and_other_failures_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let text = "base = \"wobble\"\nset = { \"run.duration\" = 0.5 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.3, 1.6, 0.5]\n";

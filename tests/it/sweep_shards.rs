@@ -11,6 +11,7 @@ use crate::sweep::{
 use coin_log::sweep::Shard;
 use std::collections::HashMap;
 use std::path::Path;
+use std::process::Command;
 
 fn rows(path: &Path) -> Vec<Vec<String>> {
     Csv::read(path).without_wall_time()
@@ -309,6 +310,148 @@ fn collect_refuses_a_part_whose_row_names_another_runs_file() {
 }
 
 #[test]
+fn collect_names_a_damaged_parts_first_wrong_lines_and_counts_the_rest() {
+    // 100 garbage lines gave 100 errors (300 000 gave 300 000), and bytes that are no UTF-8 gave the bare
+    // "stream did not contain valid UTF-8", no fix.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for k in 0..2 {
+        let shard = format!("{k}/2");
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
+            0
+        );
+    }
+    let part = dir.path().join("d/catalogue.part-1-of-2.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    std::fs::write(&part, text.clone() + &"garbage\n".repeat(100)).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.matches("not a row of this sweep").count(), 20, "{err}");
+    assert!(err.contains("error: d: `catalogue.part-1-of-2.csv`: 80 more lines are wrong as well: run its shard again"), "{err}");
+    // A row twice in one part: the other-sharding fix ("in both `p` and `p`") did not apply.
+    let second = text.lines().nth(1).unwrap();
+    std::fs::write(&part, format!("{text}{second}\n")).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("`catalogue.part-1-of-2.csv` line 8: run 1's row is in the part twice: the part was changed; run its shard again"), "{err}");
+    // A run file of another size is not read: a sparse 1 TB one took half an hour to hash.
+    std::fs::write(&part, &text).unwrap();
+    let run = dir.path().join("d/run-01.mcap");
+    let kept = std::fs::read(&run).unwrap();
+    std::fs::File::options()
+        .write(true)
+        .open(&run)
+        .unwrap()
+        .set_len(1 << 40)
+        .unwrap();
+    let started = std::time::Instant::now();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`run-01.mcap` (run 1) has 1099511627776 bytes, its row"),
+        "{err}"
+    );
+    assert!(
+        started.elapsed().as_secs() < 20,
+        "read for {:?}",
+        started.elapsed()
+    );
+    std::fs::write(&run, kept).unwrap();
+    // An index written `+01` (it parses as 1): the catalogue held `+01`.
+    std::fs::write(&part, text.replacen("\n1,", "\n+01,", 1)).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`catalogue.part-1-of-2.csv` line 2: not a row of this sweep"),
+        "{err}"
+    );
+    let mut bytes = text.into_bytes();
+    bytes.extend_from_slice(b"\xff\xfe\n");
+    std::fs::write(&part, bytes).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("`catalogue.part-1-of-2.csv` is not UTF-8 text, so not a part as a shard writes it: delete it and run its shard again"), "{err}");
+}
+
+#[test]
+fn collect_refuses_a_row_no_run_writes() {
+    // A finished row with its file, size and SHA-256 blanked (and the file gone) had nothing to check,
+    // so collect wrote a catalogue with a finished run and no file; a verifying sweep's row saying
+    // `verify` = off passed as well.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for k in 0..2 {
+        let shard = format!("{k}/2");
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
+            0
+        );
+    }
+    let part = dir.path().join("d/catalogue.part-1-of-2.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    // Run 1's file, bytes and SHA-256 (no commas in them) blanked; run 3's verify cell `off`.
+    let (head, rest) = lines[1].split_once(",run-01.mcap,").unwrap();
+    let rest = rest.splitn(3, ',').nth(2).unwrap();
+    lines[1] = format!("{head},,,,{rest}");
+    assert!(lines[2].contains(",finished,"), "{}", lines[2]);
+    lines[2] = lines[2].replacen(",ok,", ",off,", 1);
+    std::fs::write(&part, lines.join("\n") + "\n").unwrap();
+    std::fs::remove_file(dir.path().join("d/run-01.mcap")).unwrap();
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    for needle in [
+        "`catalogue.part-1-of-2.csv` line 2: run 1's row is none a run writes (status `finished`, failure ``, file ``, verify `ok`): the part was changed; run its shard again",
+        "`catalogue.part-1-of-2.csv` line 3: run 3's row is none a run writes (status `finished`, failure ``, file `run-03.mcap`, verify `off`)",
+    ] {
+        assert!(err.contains(needle), "{err}");
+    }
+    assert!(!dir.path().join("d/catalogue.csv").exists());
+}
+
+#[test]
+fn collect_refuses_a_part_of_another_sweep_with_the_same_keys() {
+    // Another sweep's part (same keys and columns, other values) and its files copied in: every row
+    // named its own run's file with the right size and SHA-256, so collect wrote a catalogue holding the
+    // other sweep's values under this sweep's identity. The plan gives each run's values.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let other = SMALL.replace("values = [0.2, 0.6, 1.0]", "values = [0.3, 0.6, 1.0]");
+    write_sweep(dir.path(), "o.toml", &other);
+    for (file, folder) in [("s.toml", "d"), ("o.toml", "o")] {
+        for k in 0..3 {
+            let shard = format!("{k}/3");
+            assert_eq!(
+                sweep_json(dir.path(), file, folder, &["--shard", &shard]).0,
+                0
+            );
+        }
+    }
+    let (d, o) = (dir.path().join("d"), dir.path().join("o"));
+    for name in ["catalogue.part-1-of-3.csv", "run-01.mcap", "run-07.mcap"] {
+        std::fs::copy(o.join(name), d.join(name)).unwrap();
+    }
+    let before = listing(&d);
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    for (line, run) in [(2, 1), (4, 7)] {
+        let problem = format!(
+            "`catalogue.part-1-of-3.csv` line {line}: run {run}'s row has initial.theta = `0.3`, but this \
+             sweep's run {run} has `0.2`: the part is another sweep's; delete it and run its shard again"
+        );
+        assert!(err.contains(&problem), "{err}");
+    }
+    assert_eq!(listing(&d), before, "nothing written");
+    // Shard 1 run again (its journal is this sweep's: the copied files are redone) is collected.
+    assert_eq!(
+        sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/3"]).0,
+        0
+    );
+    assert_eq!(collect(dir.path(), "d").0, 0);
+}
+
+#[test]
 fn shards_started_at_once_on_a_new_folder_share_it_as_a_job_array_does() {
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);
@@ -473,6 +616,20 @@ fn links_in_the_sweep_folder_are_refused_never_written_through_or_replaced() {
         .is_symlink());
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me\n");
     std::fs::remove_file(&catalogue).unwrap();
+    // sweep.json's name held by a link: refused before anything is written (the catalogue was written,
+    // then sweep.json refused: half the pair).
+    let summary = link("sweep.json");
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("sweep.json`: is a symbolic link (to `"),
+        "{err}"
+    );
+    assert!(
+        !d.join("catalogue.csv").exists(),
+        "catalogue written without sweep.json"
+    );
+    std::fs::remove_file(&summary).unwrap();
     // A part that is a pipe is named once, not once per cause in the error's chain.
     let pipe = d.join("catalogue.part-9-of-10.csv");
     crate::support::mkfifo(&pipe);
@@ -504,6 +661,9 @@ fn a_state_folder_that_is_a_link_or_a_file_and_a_dangling_output_link_are_refuse
         ("linked", "`linked`: holds `.coin-log-sweep` as a symbolic link, not the folder a sweep keeps its state in"),
         ("filed", "`filed`: holds `.coin-log-sweep` as a file, not the folder a sweep keeps its state in"),
         ("dangling", "`dangling`: is a symbolic link to `nowhere`, which does not exist: create that folder, or give -o another"),
+        // A parent on the way gave "File exists (os error 17)" and "Not a directory (os error 20)", exit 1.
+        ("dangling/sub", "`dangling/sub`: cannot be created: `dangling` is a symbolic link to `nowhere`, which does not exist: create that folder, or give -o another"),
+        ("s.toml/sub/deeper", "`s.toml/sub/deeper`: cannot be created: `s.toml` is not a folder; give -o a folder for the sweep's files"),
     ] {
         let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", out]);
         assert_eq!(code, 2, "{out}: {err}");
@@ -519,6 +679,53 @@ fn a_state_folder_that_is_a_link_or_a_file_and_a_dangling_output_link_are_refuse
         "mine"
     );
     assert!(!d.join("nowhere").exists());
+}
+
+#[test]
+fn an_immutable_catalogue_or_append_only_folder_is_refused_before_any_run() {
+    // An immutable catalogue.csv let every run be made, then "writing `catalogue.csv`: Operation not
+    // permitted", exit 1; an append-only folder left what it could not remove. An immutable run file
+    // is a failed (I/O) row at once, not after its recording.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_sweep(d, "s.toml", SMALL);
+    assert_eq!(sweep_json(d, "s.toml", "done", &[]).0, 0);
+    std::fs::create_dir(d.join("apd")).unwrap();
+    let mut attributes = crate::support::Attributes::default();
+    std::fs::remove_file(d.join("done/run-02.mcap")).unwrap();
+    std::fs::write(d.join("done/run-03.mcap"), "changed").unwrap();
+    let set = attributes.set("+i", &d.join("done/catalogue.csv"))
+        && attributes.set("+a", &d.join("apd"))
+        && attributes.set("+i", &d.join("done/run-03.mcap"));
+    if !set {
+        // Not root, or a file system without attributes: cli_paths checks the logic of the probe.
+        return;
+    }
+    let before = listing(&d.join("done"));
+    let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", "done"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`done`: holds `done/catalogue.csv`, which is immutable, so the system lets no file be moved into place there: clear the attribute (chattr -i done/catalogue.csv), or give -o another folder"), "{err}");
+    assert_eq!(listing(&d.join("done")), before, "no run made");
+    let (code, _, err) = run_in(d, &["sweep", "collect", "done"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run_in(d, &["sweep", "s.toml", "-o", "apd"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`apd`: is append-only"), "{err}");
+    assert!(listing(&d.join("apd")).is_empty(), "nothing created");
+    // The catalogue writable again: run 2 is made, run 3 (immutable) fails on I/O at once.
+    Command::new("chattr")
+        .args(["-i"])
+        .arg(d.join("done/catalogue.csv"))
+        .status()
+        .unwrap();
+    let (code, json) = sweep_json(d, "s.toml", "done", &[]);
+    assert_eq!(
+        (code, json["done"].as_u64(), json["failed"].as_u64()),
+        (1, Some(2), Some(1)),
+        "{json}"
+    );
+    let catalogue = std::fs::read_to_string(d.join("done/catalogue.csv")).unwrap();
+    assert!(catalogue.contains("io,\"`run-03.mcap` is immutable, so the system lets no recording replace it: clear the attribute (chattr -i run-03.mcap) and run again"), "{catalogue}");
 }
 
 #[test]

@@ -31,6 +31,39 @@ pub fn mkfifo(path: &std::path::Path) {
     );
 }
 
+/// Files given an attribute by `chattr` (`+i` immutable, `+a` append-only), cleared again when dropped,
+/// however the test ends (an immutable file cannot be deleted with its temporary folder).
+#[derive(Default)]
+pub struct Attributes(Vec<PathBuf>);
+
+impl Attributes {
+    /// `chattr flag path`; false where the system refuses it (not root, a file system without
+    /// attributes).
+    pub fn set(&mut self, flag: &str, path: &std::path::Path) -> bool {
+        let set = std::process::Command::new("chattr")
+            .arg(flag)
+            .arg(path)
+            .stderr(std::process::Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        if set {
+            self.0.push(path.to_path_buf());
+        }
+        set
+    }
+}
+
+impl Drop for Attributes {
+    fn drop(&mut self) {
+        for path in &self.0 {
+            let _ = std::process::Command::new("chattr")
+                .args(["-i", "-a"])
+                .arg(path)
+                .status();
+        }
+    }
+}
+
 /// The repository root (cargo also runs the tests there).
 pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

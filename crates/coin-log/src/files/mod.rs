@@ -8,7 +8,9 @@ pub use input::{
     absent_or_plain, absent_or_regular, open_regular, read_regular, read_toml, InputError,
     InputKind,
 };
-pub use output::{make_readable, Output, OutputError, OutputFolder, Policy};
+pub use output::{
+    dangling_link, make_readable, Attribute, Output, OutputError, OutputFolder, Policy,
+};
 
 use std::borrow::Cow;
 use std::path::Path;

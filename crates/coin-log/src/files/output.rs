@@ -112,6 +112,87 @@ pub(super) fn kind_of(meta: &Metadata) -> &'static str {
     "a special file"
 }
 
+/// An attribute by which the system forbids replacing or removing a file, or changing a folder's entries,
+/// whatever the permissions and even for root (Linux: `chattr +i`, `chattr +a`): the move into place
+/// would fail only after the work.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Attribute {
+    /// `chattr +i`: nothing may change, replace or remove it (nor, in a folder, add or rename files).
+    Immutable,
+    /// `chattr +a`: it may only grow (a folder may gain files, but none may be renamed or removed).
+    AppendOnly,
+}
+
+impl Attribute {
+    /// The attribute `path` (not followed if a link) has, if the system says; `None` where it does not.
+    #[must_use]
+    pub fn of(path: &Path) -> Option<Self> {
+        #[cfg(target_os = "linux")]
+        {
+            use rustix::fs::{statx, AtFlags, StatxAttributes, StatxFlags, CWD};
+            let stat = statx(CWD, path, AtFlags::SYMLINK_NOFOLLOW, StatxFlags::empty()).ok()?;
+            Self::from_attributes(
+                stat.stx_attributes.contains(StatxAttributes::IMMUTABLE),
+                stat.stx_attributes.contains(StatxAttributes::APPEND),
+            )
+        }
+        #[cfg(not(target_os = "linux"))]
+        {
+            let _ = path;
+            None
+        }
+    }
+
+    /// The attribute of statx's `immutable` and `append` flags (immutable first: it forbids more).
+    #[must_use]
+    pub fn from_attributes(immutable: bool, append: bool) -> Option<Self> {
+        match (immutable, append) {
+            (true, _) => Some(Self::Immutable),
+            (false, true) => Some(Self::AppendOnly),
+            (false, false) => None,
+        }
+    }
+
+    /// Its name, and the command that clears it.
+    #[must_use]
+    pub fn words(self) -> (&'static str, &'static str) {
+        match self {
+            Self::Immutable => ("immutable", "chattr -i"),
+            Self::AppendOnly => ("append-only", "chattr -a"),
+        }
+    }
+}
+
+/// Refuses a target whose folder, or which itself (when it is there), has an [`Attribute`] that forbids
+/// moving a file into place.
+fn check_attributes(target: &Path, exists: bool, policy: &Policy) -> Result<(), OutputError> {
+    let what = if policy.example.is_empty() {
+        "folder"
+    } else {
+        "file"
+    };
+    let flag = policy.flag;
+    if let Some(attribute) = exists.then(|| Attribute::of(target)).flatten() {
+        let (name, clear) = attribute.words();
+        let path = shown(target);
+        return Err(OutputError(format!(
+            "`{path}` is {name}, so the system lets no file replace it, even with --overwrite: clear the \
+             attribute ({clear} {path}), or choose another {what} with {flag}"
+        )));
+    }
+    let folder = folder_of(target);
+    if let Some(attribute) = Attribute::of(&folder) {
+        let (name, clear) = attribute.words();
+        let folder = shown(&folder);
+        return Err(OutputError(format!(
+            "the folder `{folder}` is {name}, so the system lets no file be moved into place in it (for \
+             `{}`): clear the attribute ({clear} {folder}), or choose another {what} with {flag}",
+            shown(target)
+        )));
+    }
+    Ok(())
+}
+
 /// The folder a target lives in (`.` for a bare file name).
 fn folder_of(target: &Path) -> PathBuf {
     match target.parent() {
@@ -151,7 +232,10 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
                  the folder and {fix}"
             )));
         }
-        Err(e) if e.kind() == ErrorKind::NotFound => return check_folder(target).map(|()| None),
+        Err(e) if e.kind() == ErrorKind::NotFound => {
+            check_folder(target)?;
+            return check_attributes(target, false, policy).map(|()| None);
+        }
         Err(source) => return Err(OutputError::system("use", target, &source)),
     };
     let kind = meta.file_type();
@@ -186,6 +270,7 @@ fn look_at(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputErr
             "`{path}` is {what}; writing there would replace it: {fix}"
         )));
     }
+    check_attributes(target, true, policy)?;
     Ok(Some(meta))
 }
 
@@ -611,20 +696,31 @@ fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
                 )))
             }
             Ok(_) => return Err(not_a_folder(&shown(dir), &shown(d))),
-            // A link to nothing: creating the folder would fail with a bare "File exists".
-            Err(_) if fs::symlink_metadata(d).is_ok_and(|m| m.file_type().is_symlink()) => {
-                let to = fs::read_link(d).map_or_else(|_| "?".into(), |p| shown(&p));
-                return Err(OutputError(format!(
-                        "`{}` is a symbolic link to `{to}`, which does not exist: create the folder it \
+            Err(_) => match dangling_link(d) {
+                Some(to) => {
+                    return Err(OutputError(format!(
+                    "`{}` is a symbolic link to `{}`, which does not exist: create the folder it \
                          points to, or choose another folder with --out",
-                        shown(d)
-                    )));
-            }
-            Err(_) => created.push(d.to_path_buf()),
+                    shown(d),
+                    shown(&to)
+                )))
+                }
+                None => created.push(d.to_path_buf()),
+            },
         }
         missing = d.parent();
     }
     Ok(created)
+}
+
+/// Where `path` points when it is a symbolic link to nothing (or to a loop of links): creating a
+/// folder there fails with a bare "File exists", so the commands that create folders name it instead.
+#[must_use]
+pub fn dangling_link(path: &Path) -> Option<PathBuf> {
+    let link = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    (link && fs::metadata(path).is_err())
+        .then(|| fs::read_link(path).ok())
+        .flatten()
 }
 
 impl Drop for OutputFolder {

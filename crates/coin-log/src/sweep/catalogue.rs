@@ -35,6 +35,33 @@ coin_log_names::named_enum! {
     }
 }
 
+/// Whether a row's `status`, `failure`, `file` and `verify` cells agree as a run writes them: a finished
+/// run, and one that failed in its numerics or its verdict, has a file; one that failed on its scene or
+/// on I/O has none; a file's `verify` cell is `off` exactly when the sweep does not verify (`verifies`
+/// `None`: not known, not checked).
+pub fn consistent(
+    status: &str,
+    failure: &str,
+    file: &str,
+    verify: &str,
+    verifies: Option<bool>,
+) -> bool {
+    let (finished, failed) = (RunStatus::Finished.name(), RunStatus::Failed.name());
+    let wants_file = if status == finished && failure.is_empty() {
+        true
+    } else if status == failed {
+        match failure.parse::<FailureKind>() {
+            Ok(FailureKind::Numerical | FailureKind::Verify) => true,
+            Ok(FailureKind::Scene | FailureKind::Io) => false,
+            Err(_) => return false,
+        }
+    } else {
+        return false;
+    };
+    let has_file = !file.is_empty();
+    has_file == wants_file && (!has_file || verifies.is_none_or(|v| v != (verify == "off")))
+}
+
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.
 pub fn columns<'a>(keys: impl Iterator<Item = &'a str>) -> Vec<String> {
     let blank = Row::failed(0, Vec::new(), FailureKind::Scene);

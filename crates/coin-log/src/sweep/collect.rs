@@ -2,17 +2,22 @@
 //! the one catalogue, after checking that every run is there exactly once and that every file matches
 //! its row (size and SHA-256, each file read once). Nothing is written unless every check holds.
 
-use super::catalogue::RunStatus;
+use super::catalogue::{consistent, RunStatus};
+use super::definition::Sweep;
 use super::error::SweepError;
 use super::folder::{self, Folder};
 use super::hash::sha256_file;
 use crate::csv;
+use crate::files::shown_name;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 /// Missing runs listed by number before the rest are only counted.
 const LISTED_RANGES: usize = 20;
+
+/// The wrong lines of a part named one by one before the rest are only counted.
+const LISTED_LINES: usize = 20;
 
 /// What collect found and wrote.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,12 +39,14 @@ pub struct Collected {
 /// A row as found in a part.
 struct Found {
     part: String,
+    line: usize,
     fields: Vec<String>,
 }
 
 /// Merges the catalogue parts in `dir`, hashing the files on `jobs` threads.
 pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepError> {
     let folder = Folder::existing(dir)?;
+    folder.check_outputs(super::Shard::ALL)?;
     let columns = folder.columns();
     let runs = folder.runs();
     let mut parts =
@@ -59,12 +66,20 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         ));
     }
     let mut rows: BTreeMap<u64, Found> = BTreeMap::new();
+    let sweep = folder.sweep();
     for (_, name) in &parts {
-        read_part(&folder, name, &columns, runs, &mut rows, &mut problems)?;
+        let part = Part {
+            name,
+            columns: &columns,
+            runs,
+            sweep: sweep.as_ref(),
+            at: ["file", "status", "failure", "verify"].map(|c| folder.column(c)),
+        };
+        read_part(&folder, &part, &mut rows, &mut problems)?;
     }
     problems.extend(missing(runs, &rows));
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
-    problems.extend(check_files(&folder, &rows, at, jobs));
+    problems.extend(check_rows(&folder, sweep.as_ref(), &rows, at, jobs));
     let status_at = folder.column("status");
     let failed = rows
         .values()
@@ -85,51 +100,66 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     })
 }
 
-/// Reads one part into `rows`, noting a wrong header, unreadable lines, runs out of range and runs
-/// already in another part.
+/// A part to read, and what its rows must agree with: the plan's columns, runs and sweep (`None` when the
+/// plan does not give it back: then whether it verifies is not checked).
+struct Part<'a> {
+    name: &'a str,
+    columns: &'a [String],
+    runs: u64,
+    sweep: Option<&'a Sweep>,
+    /// The columns `file`, `status`, `failure`, `verify`.
+    at: [usize; 4],
+}
+
+/// Reads one part into `rows`, noting a wrong header, unreadable lines, runs out of range, rows with
+/// another run's file or none a run writes, and runs already in another part or twice in this one.
 fn read_part(
     folder: &Folder,
-    name: &str,
-    columns: &[String],
-    runs: u64,
+    part: &Part,
     rows: &mut BTreeMap<u64, Found>,
     problems: &mut Vec<String>,
 ) -> Result<(), SweepError> {
+    let Part { name, columns, .. } = *part;
     let path = folder.file(name);
-    let text = crate::files::read_regular(&path)
-        .map_err(SweepError::io("reading the catalogue part", &path))?;
-    let file_at = folder.column("file");
+    let text = match crate::files::read_regular(&path) {
+        Ok(text) => text,
+        // Bytes that are no UTF-8: a damaged part, or no part (the bare "stream did not contain valid
+        // UTF-8" said neither, nor what to do).
+        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => {
+            problems.push(format!(
+                "`{name}` is not UTF-8 text, so not a part as a shard writes it: delete it and run its shard again"
+            ));
+            return Ok(());
+        }
+        Err(e) => return Err(SweepError::io("reading the catalogue part", &path)(e)),
+    };
     let mut lines = text.lines();
     let header = lines.next().and_then(csv::split);
     if header.as_deref() != Some(columns) {
         problems.push(format!("`{name}` does not start with this sweep's header: it is not a part of this sweep; delete it"));
         return Ok(());
     }
+    // What is wrong line by line, listed up to LISTED_LINES (a part of 300 000 garbage lines printed as
+    // many errors).
+    let mut found = Vec::new();
     for (n, line) in lines.enumerate() {
-        let fields = csv::split(line).filter(|f| f.len() == columns.len());
-        let index = fields
-            .as_ref()
-            .and_then(|f| f[0].parse::<u64>().ok())
-            .filter(|&i| i < runs);
-        let (Some(fields), Some(index)) = (fields, index) else {
-            problems.push(format!(
-                "`{name}` line {}: not a row of this sweep: run its shard again",
-                n + 2
-            ));
-            continue;
+        let (index, fields) = match row(folder, part, line) {
+            Ok(row) => row,
+            Err(problem) => {
+                found.push(format!("`{name}` line {}: {problem}", n + 2));
+                continue;
+            }
         };
-        // A row names its own run's file or none: one that names another's (an edited index) would
-        // pass the file checks below with another run's values.
-        let (file, own) = (&fields[file_at], folder.run_file_name(index));
-        if !file.is_empty() && *file != own {
-            problems.push(format!(
-                "`{name}` line {}: run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again",
+        // Twice in this part: no shard writes that, and no other part is to blame.
+        if rows.get(&index).is_some_and(|other| other.part == name) {
+            found.push(format!(
+                "`{name}` line {}: run {index}'s row is in the part twice: the part was changed; run its shard again",
                 n + 2
             ));
             continue;
         }
         if let Some(other) = rows.get(&index) {
-            problems.push(format!(
+            found.push(format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
                 other.part
             ));
@@ -139,11 +169,65 @@ fn read_part(
             index,
             Found {
                 part: name.to_string(),
+                line: n + 2,
                 fields,
             },
         );
     }
+    let more = found.len().saturating_sub(LISTED_LINES);
+    problems.extend(found.into_iter().take(LISTED_LINES));
+    if more > 0 {
+        problems.push(format!(
+            "`{name}`: {more} more lines are wrong as well: run its shard again"
+        ));
+    }
     Ok(())
+}
+
+/// A part's line as a row of this sweep: its index and fields; else what is wrong with it. A row names its
+/// own run's file or none (one that names another's, an edited index, would pass the file checks with
+/// another run's values), and its status, failure, file and verify cells agree as a run writes them.
+fn row(folder: &Folder, part: &Part, line: &str) -> Result<(u64, Vec<String>), String> {
+    let fields = csv::split(line).filter(|f| f.len() == part.columns.len());
+    let index = fields
+        .as_ref()
+        .and_then(|f| f[0].parse::<u64>().ok().filter(|i| i.to_string() == f[0]))
+        .filter(|&i| i < part.runs);
+    let (Some(fields), Some(index)) = (fields, index) else {
+        return Err("not a row of this sweep: run its shard again".into());
+    };
+    let [file, status, failure, verify] = part.at.map(|at| &fields[at]);
+    let own = folder.run_file_name(index);
+    if !file.is_empty() && *file != own {
+        return Err(format!(
+            "run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again"
+        ));
+    }
+    if !consistent(
+        status,
+        failure,
+        file,
+        verify,
+        part.sweep.map(|s| s.settings.verify),
+    ) {
+        let [status, failure, file, verify] =
+            [status, failure, file, verify].map(|c| shown_name(c));
+        return Err(format!(
+            "run {index}'s row is none a run writes (status `{status}`, failure `{failure}`, file `{file}`, verify `{verify}`): the part was changed; run its shard again"
+        ));
+    }
+    Ok((index, fields))
+}
+
+/// How a row's values differ from its run's in the sweep, if they do.
+fn other_values(sweep: &Sweep, fields: &[String], index: u64) -> Option<String> {
+    let own = sweep.cells(index);
+    let cells = fields.iter().skip(1).zip(&own);
+    let (key, (found, own)) = sweep.keys().zip(cells).find(|(_, (f, o))| f != o)?;
+    let [key, found, own] = [key, found, own].map(shown_name);
+    Some(format!(
+        "run {index}'s row has {key} = `{found}`, but this sweep's run {index} has `{own}`: the part is another sweep's; delete it and run its shard again"
+    ))
 }
 
 /// The runs no part holds, as ranges (`3, 8–12`), with how to make them.
@@ -183,20 +267,40 @@ fn missing(runs: u64, rows: &BTreeMap<u64, Found>) -> Option<String> {
     ))
 }
 
-/// Each row's file against its size and SHA-256, hashed on `jobs` threads.
-fn check_files(
+/// Each row's values against its run's in the sweep (when the plan gives it back: a part of another
+/// sweep with the same keys passes every other check), and its file against its size and SHA-256, on
+/// `jobs` threads (a bounded normal draw that finds no value takes a tenth of a second to recompute).
+fn check_rows(
     folder: &Folder,
+    sweep: Option<&Sweep>,
     rows: &BTreeMap<u64, Found>,
     [file_at, bytes_at, sha_at]: [usize; 3],
     jobs: usize,
 ) -> Vec<String> {
-    let with_files: Vec<&Found> = rows
-        .values()
-        .filter(|f| !f.fields[file_at].is_empty())
-        .collect();
+    let rows: Vec<&Found> = rows.values().collect();
     let check = |found: &&Found| {
         let f = &found.fields;
-        let problem = match sha256_file(&folder.file(&f[file_at])) {
+        let index = f[0].parse::<u64>().unwrap_or(0);
+        if let Some(problem) = sweep.and_then(|s| other_values(s, f, index)) {
+            return Some((
+                index,
+                format!("`{}` line {}: {problem}", found.part, found.line),
+            ));
+        }
+        if f[file_at].is_empty() {
+            return None;
+        }
+        let path = folder.file(&f[file_at]);
+        // The size first: a file of another size is not hashed (a sparse 20 GB file under a run's name
+        // took 40 s to read before its size was compared).
+        let size = std::fs::metadata(&path)
+            .ok()
+            .filter(std::fs::Metadata::is_file);
+        let hashed = match size.map(|m| m.len()) {
+            Some(len) if len.to_string() != f[bytes_at] => Ok((String::new(), len)),
+            _ => sha256_file(&path),
+        };
+        let problem = match hashed {
             Err(e) => format!("`{}` (run {}) cannot be read: {e}", f[file_at], f[0]),
             Ok((_, len)) if len.to_string() != f[bytes_at] => format!(
                 "`{}` (run {}) has {len} bytes, its row {}: it was changed or cut; run its shard again to redo it",
@@ -208,12 +312,12 @@ fn check_files(
             ),
             Ok(_) => return None,
         };
-        Some((f[0].parse::<u64>().unwrap_or(0), problem))
+        Some((index, problem))
     };
     let mut problems = Vec::new();
     let never = AtomicBool::new(false);
-    let check_at = |i: u64| with_files.get(usize::try_from(i).ok()?).and_then(check);
-    let len = with_files.len() as u64;
+    let check_at = |i: u64| rows.get(usize::try_from(i).ok()?).and_then(check);
+    let len = rows.len() as u64;
     super::on_threads(len, jobs, &never, check_at, |b| problems.extend(b));
     problems.sort();
     problems.into_iter().map(|(_, p)| p).collect()

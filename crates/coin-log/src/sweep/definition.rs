@@ -1,7 +1,9 @@
 //! A validated sweep (format.md: Sweep files), and what a run's index alone gives: its values, scene and
 //! file name.
 
+use super::catalogue::cell;
 use super::error::SweepError;
+use super::file::SweepFile;
 use super::random::{Distribution, Drawn, OutOfBounds};
 use super::validate;
 use crate::files::{self, InputKind};
@@ -172,6 +174,32 @@ impl Sweep {
         Ok(values)
     }
 
+    /// The catalogue's cells of the swept keys of run `index`, as its row holds them: each value as
+    /// [`cell`] writes it, or every cell empty when a bounded draw found no value.
+    pub(super) fn cells(&self, index: u64) -> Vec<String> {
+        cells(&self.values(index), self.keys().count())
+    }
+
+    /// The sweep a folder's plan describes (its `sweep` object, [`description_json`](Self::description_json),
+    /// read back as a sweep file whose base is the plan's resolved base scene), so that `collect` knows
+    /// each run's values; `None` when the plan does not give back a sweep of the plan's identity (a
+    /// value JSON cannot hold, such as NaN, which it writes as null).
+    pub(super) fn from_plan(plan: &serde_json::Value) -> Option<Self> {
+        let mut described = plan.get("sweep")?.clone();
+        let object = described.as_object_mut()?;
+        let base: toml::Table = toml::from_str(object.remove("base_scene")?.as_str()?).ok()?;
+        // The sweep file's names for what the description calls `axes` and `draws`.
+        let axes = object.remove("axes")?;
+        object.insert("axis".into(), axes);
+        if let Some(random) = object.get_mut("random").and_then(|r| r.as_object_mut()) {
+            let draws = random.remove("draws")?;
+            random.insert("draw".into(), draws);
+        }
+        let file: SweepFile = serde_json::from_value(described).ok()?;
+        let sweep = validate::with_base(file, base).ok()?;
+        (plan.get("identity")?.as_str()? == sweep.identity()).then_some(sweep)
+    }
+
     /// The resolved, validated scene of a run with these values, exactly as `coin-log record` resolves
     /// the same scene file: the base, then `set`, then the values, then `output.channels` as
     /// `record.channels`.
@@ -251,6 +279,15 @@ impl Sweep {
     }
 }
 
+/// The catalogue's cells of a run's swept values ([`Sweep::values`]); `keys` empty cells when a
+/// bounded draw found no value.
+pub(super) fn cells(values: &Result<Vec<toml::Value>, OutOfBounds>, keys: usize) -> Vec<String> {
+    match values {
+        Ok(values) => values.iter().map(cell).collect(),
+        Err(_) => vec![String::new(); keys],
+    }
+}
+
 /// The scene key `output.channels` sets.
 pub(super) const CHANNELS_KEY: &str = "record.channels";
 
@@ -300,6 +337,19 @@ verify = false
 "#;
         let parse = |text| Sweep::parse(text, std::path::Path::new("."), "pinned.toml").unwrap();
         let (full, bare) = (parse(text), parse("base = \"wobble\""));
+        // A plan gives back its sweep (collect's values), every form of it; one with a value JSON cannot
+        // hold (NaN, written as null) gives none, never another sweep.
+        for sweep in [&full, &bare] {
+            let plan = serde_json::json!({"identity": sweep.identity(), "sweep": sweep.description_json()});
+            assert_eq!(Sweep::from_plan(&plan).as_ref(), Some(sweep));
+            let mut other = plan.clone();
+            other["identity"] = "0".repeat(64).into();
+            assert_eq!(Sweep::from_plan(&other), None);
+        }
+        let nan =
+            parse("base = \"wobble\"\n[[axis]]\nkey = \"initial.theta\"\nvalues = [nan, 0.5]");
+        let plan = serde_json::json!({"identity": nan.identity(), "sweep": nan.description_json()});
+        assert_eq!(Sweep::from_plan(&plan), None);
         assert_eq!(
             full.identity(),
             "e01b1e4c1a5af169210be07931b946d2c4c1dbbfdcf467140ef95d4fc2a68346"

@@ -129,12 +129,28 @@ impl Folder {
                 "is not a folder: give -o a folder for the sweep's files".into(),
             ));
         }
-        if let (false, Ok(target)) = (path.exists(), fs::read_link(path)) {
-            return Err(folder_error(format!(
-                "is a symbolic link to `{}`, which does not exist: create that folder, or give -o another",
-                target.display()
-            )));
+        // The folder and its missing parents: a link to nothing or a file among them would make
+        // creating it fail with a bare "File exists" or "Not a directory".
+        let mut missing = path.ancestors().filter(|d| !d.as_os_str().is_empty());
+        let in_the_way = missing.find_map(|d| match fs::metadata(d) {
+            Ok(m) if m.is_dir() => Some(None),
+            Ok(_) => Some(Some(format!(
+                "cannot be created: `{}` is not a folder; give -o a folder for the sweep's files",
+                d.display()
+            ))),
+            Err(_) => files::dangling_link(d).map(|to| {
+                let (link, to) = (d.display(), to.display());
+                Some(if d == path {
+                    format!("is a symbolic link to `{to}`, which does not exist: create that folder, or give -o another")
+                } else {
+                    format!("cannot be created: `{link}` is a symbolic link to `{to}`, which does not exist: create that folder, or give -o another")
+                })
+            }),
+        });
+        if let Some(reason) = in_the_way.flatten() {
+            return Err(folder_error(reason));
         }
+        refuse_attribute(path, path)?;
         fs::create_dir_all(path).map_err(SweepError::io("creating the sweep folder", path))?;
         let state = path.join(STATE_DIR);
         // Not `is_dir`, which follows a link: the state would be written wherever it points.
@@ -186,6 +202,11 @@ impl Folder {
             path: path.to_path_buf(),
             plan: read_plan(&plan_path)?,
         })
+    }
+
+    /// The sweep the plan describes, if it gives it back ([`Sweep::from_plan`]).
+    pub fn sweep(&self) -> Option<Sweep> {
+        Sweep::from_plan(&self.plan)
     }
 
     fn state(&self) -> PathBuf {
@@ -267,6 +288,25 @@ impl Folder {
              {STATE_DIR}/{}); wait for it to end or stop it, then run again to resume",
             LOCK.name(holder)
         ))
+    }
+
+    /// Refuses, before any run, a folder in which `shard`'s catalogue (or part) and `sweep.json` could
+    /// not be moved into place, each refused as its write would refuse it (not a regular file) or by
+    /// [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
+    /// nothing, and a catalogue could be written without its `sweep.json`.
+    pub fn check_outputs(&self, shard: Shard) -> Result<(), SweepError> {
+        let own = if shard.is_all() {
+            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
+        } else {
+            vec![PART.name(shard)]
+        };
+        refuse_attribute(&self.path, &self.path)?;
+        for name in own {
+            let path = self.file(&name);
+            files::absent_or_plain(&path).map_err(SweepError::io("writing", &path))?;
+            refuse_attribute(&self.path, &path)?;
+        }
+        Ok(())
     }
 
     /// Deletes the temporary files a killed process of `shard` left: of its runs, and of its catalogue
@@ -399,6 +439,26 @@ impl Folder {
     }
 }
 
+/// Refuses `path` (the sweep folder `folder`, or a file in it) when it is immutable or append-only
+/// (`chattr +i`, `+a`): a rename may not replace it (nor, for the folder, move a file into it), even for
+/// root, which would show only once the work was done.
+fn refuse_attribute(folder: &Path, path: &Path) -> Result<(), SweepError> {
+    let Some(attribute) = files::Attribute::of(path) else {
+        return Ok(());
+    };
+    let (name, clear) = attribute.words();
+    let what = if path == folder {
+        "is".to_string()
+    } else {
+        format!("holds `{}`, which is", files::shown(path))
+    };
+    Err(SweepError::folder(folder)(format!(
+        "{what} {name}, so the system lets no file be moved into place there: clear the attribute \
+         ({clear} {}), or give -o another folder",
+        files::shown(path)
+    )))
+}
+
 fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {
     use std::io::{Read, Seek, SeekFrom};
     if file.metadata()?.len() == 0 {
@@ -424,7 +484,12 @@ impl JournalRow {
         let mut fields = csv::split(line).filter(|f| f.len() == width)?;
         let mtime_ns = fields.first()?.parse().ok()?;
         fields.remove(0);
-        let index = fields.first()?.parse().ok()?;
+        let text = fields.first()?;
+        // As a run writes it (`+01` parses as 1, and the row would be kept with that index cell).
+        let index = text
+            .parse::<u64>()
+            .ok()
+            .filter(|i| i.to_string() == *text)?;
         Some(Self {
             mtime_ns,
             index,
@@ -546,6 +611,8 @@ mod tests {
         assert!(JournalRow::parse("12,0", width).is_none());
         assert!(JournalRow::parse("x,0,a", width).is_none());
         assert!(JournalRow::parse("12,\"0,a", width).is_none());
+        assert!(JournalRow::parse("12,+0,a", width).is_none());
+        assert!(JournalRow::parse("12,01,a", width).is_none());
     }
 
     #[test]

@@ -3,8 +3,8 @@
 //! row journalled as it finishes; then the catalogue (or this shard's part) and, for a whole sweep,
 //! `sweep.json`.
 
-use super::catalogue::{cell, FailureKind, Prediction, Recorded, Row, RunStatus};
-use super::definition::{RunSceneError, Sweep};
+use super::catalogue::{consistent, FailureKind, Prediction, Recorded, Row, RunStatus};
+use super::definition::{self, RunSceneError, Sweep};
 use super::error::SweepError;
 use super::folder::{self, Folder, JournalRow};
 use super::hash::sha256_file;
@@ -114,6 +114,7 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let folder = Folder::open(dir, sweep)?;
     let _lock = folder.lock(options.shard)?;
+    folder.check_outputs(options.shard)?;
     let resumed = resume(sweep, &folder, options)?;
     folder.remove_stale_temps(options.shard);
     let mut journal = folder.journal(options.shard)?;
@@ -216,12 +217,14 @@ impl Tally {
     }
 }
 
-/// The rows to keep from the journals and the runs to do. A row is kept when its file is there with
-/// the size and modification time it was journalled with, or, if only the time differs, with the same
-/// SHA-256; a failed row is kept unless it failed on I/O or `retry_failed` is set.
+/// The rows to keep from the journals and the runs to do. A row is kept when it holds its run's values
+/// and its file is there with the size and modification time it was journalled with, or, if only the
+/// time differs, with the same SHA-256; a failed row is kept unless it failed on I/O or `retry_failed`
+/// is set.
 fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resumed, SweepError> {
-    let [status_at, failure_at, file_at, bytes_at, sha_at] =
-        ["status", "failure", "file", "bytes", "sha256"].map(|c| folder.column(c));
+    let [status_at, failure_at, file_at, bytes_at, sha_at, verify_at] =
+        ["status", "failure", "file", "bytes", "sha256", "verify"].map(|c| folder.column(c));
+    let verifies = Some(sweep.settings.verify);
     let mut latest: BTreeMap<u64, JournalRow> = BTreeMap::new();
     for row in folder.journal_rows()? {
         if row.index < sweep.runs() && options.shard.takes(row.index) {
@@ -229,6 +232,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         }
     }
     let mut resumed = Resumed::default();
+    let keys = sweep.keys().count();
     // Only the journalled runs: every other run of the shard is to do (a shard of 10⁹ runs is not
     // walked run by run before the first starts).
     for (index, row) in latest {
@@ -238,6 +242,16 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         };
         let retry = status == RunStatus::Failed
             && (options.retry_failed || f[failure_at] == FailureKind::Io.name());
+        // A row holds its own run's values (one of another sweep with the same keys, its journal copied
+        // in, is redone).
+        if f.get(1..=keys) != Some(&sweep.cells(index)[..]) {
+            continue;
+        }
+        // And is one a run writes (a finished row without its file was kept, with nothing to check).
+        let cells = [status_at, failure_at, file_at, verify_at].map(|at| f[at].as_str());
+        if !consistent(cells[0], cells[1], cells[2], cells[3], verifies) {
+            continue;
+        }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
         let own = folder::run_file_name(index, sweep.index_width());
         let file_ok = f[file_at].is_empty()
@@ -271,10 +285,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
 fn run_one(sweep: &Sweep, folder: &Folder, index: u64, stop: &AtomicBool) -> Option<Done> {
     let started = Instant::now();
     let values = sweep.values(index);
-    let cells = match &values {
-        Ok(v) => v.iter().map(cell).collect(),
-        Err(_) => vec![String::new(); sweep.keys().count()],
-    };
+    let cells = definition::cells(&values, sweep.keys().count());
     let mut done = Done {
         row: Row::failed(index, cells, FailureKind::Scene),
         spent: Spent::default(),
@@ -313,6 +324,13 @@ fn record_and_check(
         let what = format!("{what} `{name}`");
         move |e: std::io::Error| format!("{what}: {e}")
     };
+    // Refused after the whole run otherwise (the rename fails).
+    if let Some(attribute) = crate::files::Attribute::of(&target) {
+        let (attribute, clear) = attribute.words();
+        return Err(format!(
+            "`{name}` is {attribute}, so the system lets no recording replace it: clear the attribute ({clear} {name}) and run again"
+        ));
+    }
     let mut temp = folder::temp_file(&target).map_err(io("creating a temporary file for"))?;
     let started = Instant::now();
     let writer = BufWriter::with_capacity(WRITE_BUFFER, temp.as_file_mut());

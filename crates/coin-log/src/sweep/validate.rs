@@ -9,6 +9,7 @@ use super::definition::{
 use super::file::{AxisFile, DrawFile, NormalFile, OutputFile, RandomFile, SweepFile};
 use super::random::Distribution;
 use super::space::{linspace, logspace};
+use crate::files::shown_name;
 use crate::format::Channel;
 use crate::scene::{self, dotted, presets, ProblemCollector, SceneProblems};
 use std::fmt::Display;
@@ -24,8 +25,25 @@ pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProble
     let mut c = Checker {
         problems: ProblemCollector::new(&[]),
     };
-    let places = places(&file);
     let base_table = c.base(&file.base, folder);
+    checked(c, file, base_table)
+}
+
+/// Validates a sweep file whose base scene is given as a table (a plan's, which holds it resolved).
+pub(super) fn with_base(file: SweepFile, base: toml::Table) -> Result<Sweep, SceneProblems> {
+    let c = Checker {
+        problems: ProblemCollector::new(&[]),
+    };
+    checked(c, file, Some(base))
+}
+
+/// The rest of [`sweep`], once the base scene is read (`None`: it could not be, a problem noted).
+fn checked(
+    mut c: Checker,
+    file: SweepFile,
+    base_table: Option<toml::Table>,
+) -> Result<Sweep, SceneProblems> {
+    let places = places(&file);
     let set = c.set(&file.set);
     let parsed: Vec<Option<Axis>> = (file.axis.iter().enumerate())
         .map(|(i, a)| c.axis(i, a))
@@ -228,6 +246,19 @@ impl Checker {
             return self
                 .problems
                 .reject(name, "[]", "is empty: give at least one value");
+        }
+        // A string is its cell as it is: a line break would split the run's row, which the journal and
+        // the parts hold one to a line (resume redid such a run every time, collect refused its part).
+        let broken = values
+            .iter()
+            .filter_map(toml::Value::as_str)
+            .find(|s| s.contains(['\n', '\r']));
+        if let Some(value) = broken {
+            return self.problems.reject(
+                name,
+                format!("{value:?}"),
+                "holds a line break, which no scene key takes and a catalogue row (one line) cannot hold: remove it",
+            );
         }
         Some(values.to_vec())
     }
@@ -562,13 +593,17 @@ impl Checker {
                     format!(
                         "replaces the whole table holding `{}` (given by {}, which applies first): give that key \
                          inside {}'s values, or sweep a key inside `{}`",
-                        earlier.key, earlier.name, later.name, later.key
+                        shown_name(&earlier.key),
+                        earlier.name,
+                        later.name,
+                        shown_name(&later.key)
                     )
                 } else if scene::other_form(&later.key).contains(&earlier.key.as_str()) {
                     format!(
                         "removes `{}` (given by {}, which applies first), the other form of the same fact: \
                          give one form only",
-                        earlier.key, earlier.name
+                        shown_name(&earlier.key),
+                        earlier.name
                     )
                 } else {
                     continue;
@@ -622,7 +657,10 @@ impl Checker {
                     self.problems.push(
                         place.values_name.clone(),
                         value.to_string(),
-                        format!("does not fit the scene key `{}`: {e}", place.key),
+                        format!(
+                            "does not fit the scene key `{}`: {e}",
+                            shown_name(&place.key)
+                        ),
                     );
                     break;
                 }
