@@ -5,6 +5,7 @@
 
 use super::record::{self, SceneFlags, Signals};
 use super::scene_arg::load_source;
+use super::text::number;
 use super::{output, Outcome};
 use anyhow::{anyhow, Context};
 use coin_log::files::{shown, Output};
@@ -93,6 +94,13 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     let scene = record::resolve_flags(args.flags.overrides(), args.flags.encoding, &source)?;
     let pacing = Pacing::new(args.speed, !args.no_wait)
         .ok_or_else(|| anyhow!("the speed must be a finite number above 0"))?;
+    // The output first: a file that cannot be written is refused before a viewer is invited to connect
+    // (a temporary file left by a server that cannot start is removed as the error returns).
+    let mut file = args
+        .output
+        .as_ref()
+        .map(|target| record::prepare_output(target, args.overwrite, &source, &signals))
+        .transpose()?;
     let server =
         match LiveServer::start(args.host, args.port, &format!("coin-log {}", source.label)) {
             Ok(server) => server,
@@ -104,11 +112,6 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     let mut tap = LiveTap::new(&server, pacing, &signals.stop, |event| tell(event, pacing));
     tap.announce_topics(&scene.channels, args.flags.encoding);
     announce(&args, &server, &source.label);
-    let mut file = args
-        .output
-        .as_ref()
-        .map(|target| record::prepare_output(target, args.overwrite, &source, &signals))
-        .transpose()?;
     let started = Instant::now();
     let options = RecordOptions {
         compression: Compression::default(),
@@ -173,7 +176,7 @@ fn tell(event: LiveEvent, pacing: Pacing) {
         ),
         LiveEvent::Started { viewers } => errln!(
             "running at {}× real time ({viewers} viewer{} connected)",
-            pacing.speed(),
+            number(pacing.speed()),
             if viewers == 1 { "" } else { "s" }
         ),
     }
@@ -269,7 +272,7 @@ fn print_summary(
             format!(
                 "{} at {}× real time: {} messages served in {:.3} s, at worst {:.1} ms behind the clock",
                 live.url,
-                args.speed,
+                number(args.speed),
                 live.served,
                 live.clock.as_secs_f64(),
                 live.max_lag.as_secs_f64() * 1e3
@@ -287,7 +290,7 @@ fn print_summary(
             "warning: the run fell up to {:.1} s behind {}× real time (the simulation and serving were \
              slower than that); lower --speed, or --rate or --channels for fewer messages",
             live.max_lag.as_secs_f64(),
-            args.speed
+            number(args.speed)
         );
     }
     if output::stdout_failed() {

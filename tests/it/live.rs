@@ -488,6 +488,102 @@ fn ctrl_c_during_the_run_finishes_the_file_marked_interrupted() {
     );
 }
 
+/// A viewer that subscribes and then reads nothing fills its socket, and the server's task for it blocks.
+/// Before, `live --exit` then never exited once the run was over (SIGTERM only said "stopping the run"):
+/// closing the server waited for that task. It now waits a bounded time.
+#[test]
+fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut live = LiveProcess::start(
+        dir.path(),
+        &[
+            "circle-plus",
+            "--port",
+            "0",
+            "--duration",
+            "20",
+            "--rate",
+            "1000",
+            "--speed",
+            "100",
+            "--exit",
+        ],
+    );
+    let mut ws = connect(&live.url(), "foxglove.sdk.v1").unwrap();
+    let mut seen = Seen::default();
+    let start = Instant::now();
+    while seen.subscriptions.is_empty() && start.elapsed() < DEADLINE {
+        match ws.read() {
+            Ok(m) => seen.take(&mut ws, m),
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(e) => panic!("the WebSocket failed: {e}"),
+        }
+    }
+    assert!(!seen.subscriptions.is_empty(), "nothing was advertised");
+    // From here the viewer reads nothing; 200 000 messages are served to it.
+    let out = live.process.wait_within(Duration::from_secs(30));
+    assert_eq!(out.code(), 0, "stderr:\n{}", live.stderr());
+    drop(ws);
+}
+
+/// An output that cannot be written is refused before a viewer is invited to connect, and a speed is
+/// printed in a few digits: before, `-o existing.mcap` printed "serving … open it in Foxglove" and then
+/// refused, and `--speed 1e300` printed 301 digits.
+#[test]
+fn a_refused_output_is_named_before_serving_and_the_speed_is_short() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("kept.mcap"), b"mine").unwrap();
+    let out = Command::new(exe())
+        .args([
+            "live",
+            "circle-plus",
+            "--port",
+            "0",
+            "--duration",
+            "1",
+            "--no-wait",
+            "--exit",
+            "-o",
+            "kept.mcap",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("already exists"), "{stderr}");
+    assert!(!stderr.contains("serving"), "{stderr}");
+    assert_eq!(
+        std::fs::read(dir.path().join("kept.mcap")).unwrap(),
+        b"mine"
+    );
+    let out = Command::new(exe())
+        .args([
+            "live",
+            "circle-plus",
+            "--port",
+            "0",
+            "--duration",
+            "0.1",
+            "--no-wait",
+            "--exit",
+            "--speed",
+            "1e300",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("running at 1e300× real time"), "{stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(" at 1e300× real time"), "{stdout}");
+}
+
 /// Bad input is refused with exit 2 and a message naming the problem, before anything is written.
 #[test]
 fn bad_speed_host_or_busy_port_exit_2_and_write_nothing() {

@@ -14,6 +14,7 @@ use std::collections::HashMap;
 use std::io::{Seek, SeekFrom, Write};
 use std::net::IpAddr;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::time::Duration;
 
 /// The default port (the Foxglove app's default for a WebSocket connection).
 pub const DEFAULT_PORT: u16 = 8765;
@@ -21,6 +22,9 @@ pub const DEFAULT_PORT: u16 = 8765;
 /// samples; this is minutes of a default scene at real time and about 20 MB of a slow viewer's queue at
 /// most (messages are ≈ 300 bytes).
 pub const MESSAGE_BACKLOG: usize = 1 << 16;
+/// The longest [`LiveServer::stop`] waits for connections to close: a viewer that reads closes within
+/// milliseconds, one that stopped reading never does.
+pub const STOP_WAIT: Duration = Duration::from_secs(2);
 
 /// The server could not start.
 #[derive(Debug, thiserror::Error)]
@@ -174,9 +178,21 @@ impl LiveServer {
         self.handle.client_count()
     }
 
-    /// Closes every connection and stops serving.
+    /// Closes every connection and stops serving, waiting at most [`STOP_WAIT`] for the connections to
+    /// close.
     pub fn stop(self) {
-        self.handle.stop().wait_blocking();
+        let shutdown = self.handle.stop();
+        let (closed, wait) = std::sync::mpsc::channel();
+        // On a thread of its own so that the wait can end: a viewer that stopped reading keeps its task
+        // blocked on a full socket, and `live --exit` never exited (SIGTERM only said "stopping").
+        // Whatever is still open closes when the process exits.
+        let waiter = std::thread::Builder::new().spawn(move || {
+            shutdown.wait_blocking();
+            let _ = closed.send(());
+        });
+        if waiter.is_ok() {
+            let _ = wait.recv_timeout(STOP_WAIT);
+        }
     }
 }
 
