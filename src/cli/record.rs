@@ -153,7 +153,8 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
         return dry_run(&args, &scene, &source.label);
     }
     // Before simulating: say which required checks `verify` will not be able to run on this recording.
-    for warning in coin_log::verify::coverage(&scene) {
+    let coverage = coin_log::verify::coverage(&scene);
+    for warning in &coverage {
         errln!("warning: verify will not be able to judge this recording: {warning}");
     }
     warn_if_large(&args, &scene);
@@ -176,9 +177,8 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
     print_summary(&args, &scene, &source.label, &target, &summary, wall)?;
     // A run that ended early has fewer samples and a tighter tolerance than its duration promised.
     if summary.termination_time < scene.run.duration {
-        let promised = coin_log::verify::coverage(&scene);
         for warning in coin_log::verify::coverage_over(&scene, summary.termination_time) {
-            if !promised.contains(&warning) {
+            if !coverage.contains(&warning) {
                 errln!(
                     "warning: verify will not be able to judge this recording, which ended at t = {} \
                      before its duration: {warning}",

@@ -536,52 +536,26 @@ fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
 #[test]
 fn a_refused_output_is_named_before_serving_and_the_speed_is_short() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("kept.mcap"), b"mine").unwrap();
-    let out = Command::new(exe())
-        .args([
-            "live",
-            "circle-plus",
-            "--port",
-            "0",
-            "--duration",
-            "1",
-            "--no-wait",
-            "--exit",
-            "-o",
-            "kept.mcap",
-        ])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_ne!(out.status.code(), Some(0), "{stderr}");
-    assert!(stderr.contains("already exists"), "{stderr}");
-    assert!(!stderr.contains("serving"), "{stderr}");
-    assert_eq!(
-        std::fs::read(dir.path().join("kept.mcap")).unwrap(),
-        b"mine"
+    let kept = dir.path().join("kept.mcap");
+    std::fs::write(&kept, b"mine").unwrap();
+    let live = ["live", "circle-plus", "--port", "0", "--no-wait", "--exit"];
+    let (code, _, err) = super::support::record::coin_log_text(
+        &[
+            &live[..],
+            &["--duration", "1", "-o", kept.to_str().unwrap()],
+        ]
+        .concat(),
     );
-    let out = Command::new(exe())
-        .args([
-            "live",
-            "circle-plus",
-            "--port",
-            "0",
-            "--duration",
-            "0.1",
-            "--no-wait",
-            "--exit",
-            "--speed",
-            "1e300",
-        ])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stderr}");
-    assert!(stderr.contains("running at 1e300× real time"), "{stderr}");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains(" at 1e300× real time"), "{stdout}");
+    assert_ne!(code, 0, "{err}");
+    assert!(err.contains("already exists"), "{err}");
+    assert!(!err.contains("serving"), "{err}");
+    assert_eq!(std::fs::read(&kept).unwrap(), b"mine");
+    let (code, out, err) = super::support::record::coin_log_text(
+        &[&live[..], &["--duration", "0.1", "--speed", "1e300"]].concat(),
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("running at 1e300× real time"), "{err}");
+    assert!(out.contains(" at 1e300× real time"), "{out}");
 }
 
 /// Bad input is refused with exit 2 and a message naming the problem, before anything is written.

@@ -78,6 +78,33 @@ impl Row {
         }
     }
 
+    /// The promise held: every check that failed was named, and a file verify could not judge was warned
+    /// about.
+    fn assert_kept(&self) {
+        assert_ne!(
+            self.agreement(),
+            "BROKEN PROMISE",
+            "{}: {} / {}",
+            self.case,
+            self.word(),
+            self.verdict()
+        );
+        assert!(
+            self.failed.is_subset(&self.expected),
+            "{}: verify failed {:?}, record expected {:?}",
+            self.case,
+            self.failed,
+            self.expected
+        );
+        if self.verify_code != 0 && self.failed.is_empty() {
+            assert!(
+                self.cannot_judge_warned,
+                "{}: cannot verify, not warned",
+                self.case
+            );
+        }
+    }
+
     fn agreement(&self) -> &'static str {
         match (self.promised(), self.verify_code == 0) {
             (true, true) | (false, false) => "agree",
@@ -244,28 +271,7 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
         );
     }
     for r in &rows {
-        assert_ne!(
-            r.agreement(),
-            "BROKEN PROMISE",
-            "{}: {} / {}",
-            r.case,
-            r.word(),
-            r.verdict()
-        );
-        assert!(
-            r.failed.is_subset(&r.expected),
-            "{}: verify failed {:?}, record expected {:?}",
-            r.case,
-            r.failed,
-            r.expected
-        );
-        if r.verify_code != 0 && r.failed.is_empty() {
-            assert!(
-                r.cannot_judge_warned,
-                "{}: cannot verify, not warned",
-                r.case
-            );
-        }
+        r.assert_kept();
     }
     // The negative control: the cases are among the warned, and the defaults among the promised.
     for case in [
@@ -302,40 +308,31 @@ fn record_warns_of_every_file_verify_refuses_at_the_corners_of_every_integrator(
 #[test]
 fn record_warns_when_the_centre_starts_too_far_from_the_origin_for_the_constraint() {
     let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let s = |words: &[&str]| words.iter().map(|w| (*w).to_string()).collect::<Vec<_>>();
-    let mut rows = Vec::new();
-    for integrator in ["dop853", "rk4"] {
-        for x in ["1e3", "1e10"] {
-            let flags = s(&[
-                "--integrator",
-                integrator,
-                "--set",
-                &format!("initial.x={x}"),
-            ]);
-            rows.push(corner(d, format!("{integrator}: x0 = {x}"), &flags));
-        }
-    }
-    for r in &rows {
+    for r in &initial_corners(dir.path(), "x", &["1e3", "1e10"]) {
         println!("{:<24} {:<40} {}", r.case, r.word(), r.verdict());
-        assert_ne!(
-            r.agreement(),
-            "BROKEN PROMISE",
-            "{}: {}",
-            r.case,
-            r.verdict()
-        );
-        assert!(
-            r.failed.is_subset(&r.expected),
-            "{}: verify failed {:?}, record expected {:?}",
-            r.case,
-            r.failed,
-            r.expected
-        );
+        r.assert_kept();
         let far = r.case.ends_with("1e10");
         assert_eq!(r.expected.contains("constraint"), far, "{}", r.case);
         assert_eq!(r.verify_code == 0, !far, "{}: {}", r.case, r.verdict());
     }
+}
+
+/// `wobble` recorded by dop853 and rk4 with `initial.KEY` set to each of `values`, as corners named
+/// `integrator: KEY0 = value`.
+fn initial_corners(dir: &Path, key: &str, values: &[&str]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for integrator in ["dop853", "rk4"] {
+        for value in values {
+            let set = format!("initial.{key}={value}");
+            let flags = ["--integrator", integrator, "--set", &set].map(String::from);
+            rows.push(corner(
+                dir,
+                format!("{integrator}: {key}0 = {value}"),
+                &flags,
+            ));
+        }
+    }
+    rows
 }
 
 /// A heading that starts (or grows) large: φ is rounded to 2⁻⁵³ |φ| at every step, which turns the
@@ -345,36 +342,10 @@ fn record_warns_when_the_centre_starts_too_far_from_the_origin_for_the_constrain
 #[test]
 fn record_warns_when_the_heading_is_too_large_for_its_rounding() {
     let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let s = |words: &[&str]| words.iter().map(|w| (*w).to_string()).collect::<Vec<_>>();
-    let mut rows = Vec::new();
-    for integrator in ["dop853", "rk4"] {
-        for phi in ["3", "1e7", "1e12"] {
-            let flags = s(&[
-                "--integrator",
-                integrator,
-                "--set",
-                &format!("initial.phi={phi}"),
-            ]);
-            rows.push(corner(d, format!("{integrator}: phi0 = {phi}"), &flags));
-        }
-    }
+    let rows = initial_corners(dir.path(), "phi", &["3", "1e7", "1e12"]);
     for r in &rows {
         println!("{:<24} {:<44} {}", r.case, r.word(), r.verdict());
-        assert_ne!(
-            r.agreement(),
-            "BROKEN PROMISE",
-            "{}: {}",
-            r.case,
-            r.verdict()
-        );
-        assert!(
-            r.failed.is_subset(&r.expected),
-            "{}: verify failed {:?}, record expected {:?}",
-            r.case,
-            r.failed,
-            r.expected
-        );
+        r.assert_kept();
     }
     let row = |case: &str| rows.iter().find(|r| r.case == case).unwrap();
     for case in ["dop853: phi0 = 3", "rk4: phi0 = 3"] {

@@ -218,40 +218,37 @@ pub fn shortfalls(
         / (positions.sample_interval * omega);
     let order = f64::from(run.integrator.order());
     let dense_share = dense_output_share(run.integrator);
-    let dense = if dense_share > 0.0 {
-        let step_radians = epsilon.powf(order.recip()).min(run.span.max(0.0) * omega);
-        dense_share * step_radians.powf(order - 1.0)
-    } else {
-        0.0
-    };
     let heading = positions.heading + run.span.max(0.0) * positions.heading_rate;
     let heading_error = HEADING_SHARE * UNIT_ROUNDOFF * heading;
+    let accumulated = GROWTH_SHARE * growth;
     let accuracy = Cause::Accuracy { epsilon };
     let rounded = fixed.map_or(accuracy, |fixed| Cause::Rounding { fixed });
-    let interpolated = if dense_share > 0.0 {
-        Cause::DenseOutput {
-            epsilon,
-            enough: two_digits_down(
-                (0.5 * tolerances.residual / dense_share).powf(order / (order - 1.0)),
-            ),
-        }
+    let (dense, interpolated) = if dense_share > 0.0 {
+        let step_radians = epsilon.powf(order.recip()).min(run.span.max(0.0) * omega);
+        let enough = (0.5 * tolerances.residual / dense_share).powf(order / (order - 1.0));
+        (
+            dense_share * step_radians.powf(order - 1.0),
+            Cause::DenseOutput {
+                epsilon,
+                enough: two_digits_down(enough),
+            },
+        )
     } else {
-        accuracy
+        (0.0, accuracy)
     };
-    let offset_cause = Cause::Offset { positions };
     let heading_cause = Cause::Heading { heading };
     [
         judge(
             &["energy", "invariants"],
-            &[(GROWTH_SHARE * growth, accuracy), (rounding, rounded)],
+            &[(accumulated, accuracy), (rounding, rounded)],
             tolerances.energy,
         ),
         judge(
             &["constraint", "steady"],
             &[
-                (GROWTH_SHARE * growth, accuracy),
+                (accumulated, accuracy),
                 (rounding + differenced, rounded),
-                (offset, offset_cause),
+                (offset, Cause::Offset { positions }),
                 (dense, interpolated),
                 (heading_error, heading_cause),
             ],

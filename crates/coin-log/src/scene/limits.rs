@@ -478,37 +478,36 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
         let w = w.max(couple_rate(scene));
         check_fixed_step(scene, file.run.as_ref().and_then(|r| r.step), w, problems);
     }
-    if run.duration * w > MAX_RADIANS && MAX_RADIANS / w < MIN_DURATION {
-        // No duration would do: even the shortest run, 1 ns, is too many radians.
-        let fix = if w * scene.params.time_unit() <= 1.0 {
+    if run.duration * w > MAX_RADIANS {
+        let fix = if MAX_RADIANS / w >= MIN_DURATION {
             format!(
-                "the body's own time unit τ = √(a/g) = {} is too short: express the scene in units where τ is nearer 1",
-                short(scene.params.time_unit(), Round::Nearest)
+                ": use duration ≤ {}, or slow the motion",
+                short(MAX_RADIANS / w, Round::Down)
             )
         } else {
+            // No duration would do: even the shortest run, 1 ns, is too many radians.
+            let fix = if w * scene.params.time_unit() <= 1.0 {
+                format!(
+                    "the body's own time unit τ = √(a/g) = {} is too short: express the scene in units where τ is nearer 1",
+                    short(scene.params.time_unit(), Round::Nearest)
+                )
+            } else {
+                format!(
+                    "slow the motion to W ≤ {}",
+                    short(MAX_RADIANS / MIN_DURATION, Round::Down)
+                )
+            };
             format!(
-                "slow the motion to W ≤ {}",
-                short(MAX_RADIANS / MIN_DURATION, Round::Down)
+                ", and so would the shortest duration, {MIN_DURATION:e} (the log-time resolution): {fix}"
             )
         };
         problems.push(
             "run.duration",
             number(run.duration),
             format!(
-                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than {MAX_RADIANS:e} (≥ 5.6e10 integrator steps), and so would the shortest duration, {MIN_DURATION:e} (the log-time resolution): {fix}",
+                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than {MAX_RADIANS:e} (≥ 5.6e10 integrator steps){fix}",
                 short(w, Round::Nearest),
                 short(run.duration * w, Round::Nearest),
-            ),
-        );
-    } else if run.duration * w > MAX_RADIANS {
-        problems.push(
-            "run.duration",
-            number(run.duration),
-            format!(
-                "times W = max(|ω|, |φ̇|, |ψ̇|, 1/τ) = {} at t = 0 is {} radians of the fastest motion, more than {MAX_RADIANS:e} (≥ 5.6e10 integrator steps): use duration ≤ {}, or slow the motion",
-                short(w, Round::Nearest),
-                short(run.duration * w, Round::Nearest),
-                short(MAX_RADIANS / w, Round::Down)
             ),
         );
     }

@@ -26,8 +26,8 @@ pub fn coverage(scene: &Scene) -> Vec<String> {
 
 /// [`coverage`] of a recording of `scene` that ended at t = `span`: a run ended early by an event has
 /// fewer samples and a tighter residual tolerance (format.md: Tolerances) than its duration promised, so
-/// `record` asks again once it knows (Euler's disk under a viscous couple of κ = 1e-5 fell flat after 0.5
-/// of its 2000 time units, its tolerance 9.1e-7 instead of 1e-6, and no window was resolved at rate 400).
+/// `record` asks again once it knows (Euler's disk under a viscous couple of κ = 1e-4 fell flat after 0.084
+/// of its 2000 time units, its tolerance 2.4e-7 instead of 1e-6, and no window was resolved at rate 400).
 #[must_use]
 pub fn coverage_over(scene: &Scene, span: f64) -> Vec<String> {
     let mut out = Vec::new();
@@ -110,14 +110,13 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
     }
     // Ω is the rate plus its relative change; the change is named when it shows in the digits printed (a
     // braking couple's: Ω = 1.23e8 on a coin whose |ω| and |φ̇| were 14 and 73 was called max(|ω|, |φ̇|)).
-    let omega_text = if digits3(rate, f64::round) == digits3(fastest, f64::round) {
-        format!("max(|ω|, |φ̇|) = {}", digits3(rate, f64::round))
+    let (shown_rate, shown_fastest) = (digits3(rate, f64::round), digits3(fastest, f64::round));
+    let omega_text = if shown_rate == shown_fastest {
+        format!("max(|ω|, |φ̇|) = {shown_rate}")
     } else {
         format!(
-            "max(|ω|, |φ̇|) + |d ln Ω/dt| = {} + {} = {}",
-            digits3(fastest, f64::round),
+            "max(|ω|, |φ̇|) + |d ln Ω/dt| = {shown_fastest} + {} = {shown_rate}",
             digits3(rate - fastest, f64::round),
-            digits3(rate, f64::round)
         )
     };
     Some(format!(
