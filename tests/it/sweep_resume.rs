@@ -8,7 +8,7 @@ use crate::support::record::{exe, listing};
 use crate::sweep::{
     run_files, run_in, sweep_json, write_sweep, Csv, SCHEDULER_VARIABLES, SMALL, SMALL_RUNS,
 };
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
@@ -30,6 +30,18 @@ fn files_match(dir: &Path, reference: &Path) {
 fn journal_lines(dir: &Path) -> usize {
     let text = std::fs::read_to_string(dir.join(".coin-log-sweep/journal-0-of-1.csv")).unwrap();
     text.lines().count()
+}
+
+/// `SMALL` swept into `ref` and `out` in `dir`, one job each (so that the two journals are in one
+/// order); returns `out` and its journal, for a test to damage and resume.
+fn swept_twice(dir: &Path) -> (PathBuf, PathBuf) {
+    write_sweep(dir, "s.toml", SMALL);
+    for folder in ["ref", "out"] {
+        assert_eq!(sweep_json(dir, "s.toml", folder, &["--jobs", "1"]).0, 0);
+    }
+    let out = dir.join("out");
+    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    (out, journal)
 }
 
 #[test]
@@ -99,17 +111,7 @@ fn a_journal_row_that_names_another_runs_file_is_redone_not_kept() {
     // Two journal rows with their indexes swapped: each file matched its row's size and time, so resume
     // kept them, and the catalogue gave run 0 another run's values and file.
     let dir = tempfile::tempdir().unwrap();
-    write_sweep(dir.path(), "s.toml", SMALL);
-    assert_eq!(
-        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
-        0
-    );
-    assert_eq!(
-        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
-        0
-    );
-    let out = dir.path().join("out");
-    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let (out, journal) = swept_twice(dir.path());
     let text = std::fs::read_to_string(&journal).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     let at = |i: usize| {
@@ -138,17 +140,7 @@ fn bytes_that_are_no_utf8_in_the_journal_spoil_their_line_not_the_resume() {
     // A byte of damage that is no UTF-8 made every resume fail ("stream did not contain valid UTF-8",
     // exit 1, no fix); the doc leaves out a line that does not parse, and redoes its run.
     let dir = tempfile::tempdir().unwrap();
-    write_sweep(dir.path(), "s.toml", SMALL);
-    assert_eq!(
-        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
-        0
-    );
-    assert_eq!(
-        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
-        0
-    );
-    let out = dir.path().join("out");
-    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let (out, journal) = swept_twice(dir.path());
     let mut bytes = std::fs::read(&journal).unwrap();
     // Inside the third line (a row), and a line of garbage after the last.
     let third = bytes
@@ -204,17 +196,7 @@ fn a_journal_row_no_run_writes_is_redone_not_kept() {
     // A finished row whose file cell was blanked had no file to check, so resume kept it: a finished
     // run without a file in the catalogue.
     let dir = tempfile::tempdir().unwrap();
-    write_sweep(dir.path(), "s.toml", SMALL);
-    assert_eq!(
-        sweep_json(dir.path(), "s.toml", "ref", &["--jobs", "1"]).0,
-        0
-    );
-    assert_eq!(
-        sweep_json(dir.path(), "s.toml", "out", &["--jobs", "1"]).0,
-        0
-    );
-    let out = dir.path().join("out");
-    let journal = out.join(".coin-log-sweep/journal-0-of-1.csv");
+    let (out, journal) = swept_twice(dir.path());
     let text = std::fs::read_to_string(&journal).unwrap();
     let lines: Vec<String> = text
         .lines()
