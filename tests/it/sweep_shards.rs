@@ -188,12 +188,7 @@ fn collect_names_a_missing_part_a_run_in_two_parts_and_changed_files_and_then_wr
         sweep_json(dir.path(), "s.toml", "one", &["--jobs", "1"]).0,
         0
     );
-    for k in 0..3 {
-        assert_eq!(
-            sweep_json(dir.path(), "s.toml", "d", &["--shard", &format!("{k}/3")]).0,
-            0
-        );
-    }
+    all_shards(dir.path(), "s.toml", "d", 3);
     let d = dir.path().join("d");
     let part = |k: u64| d.join(format!("catalogue.part-{k}-of-3.csv"));
     let refused = |says: &[&str]| {
@@ -276,6 +271,18 @@ fn collect_names_a_missing_part_a_run_in_two_parts_and_changed_files_and_then_wr
     assert!(err.contains("holds no sweep"), "{err}");
 }
 
+/// Sweeps `file` into `folder` of `dir` as all `n` shards, one after the other, each exiting 0.
+fn all_shards(dir: &Path, file: &str, folder: &str, n: u64) {
+    for k in 0..n {
+        let shard = format!("{k}/{n}");
+        assert_eq!(
+            sweep_json(dir, file, folder, &["--shard", &shard]).0,
+            0,
+            "shard {shard}"
+        );
+    }
+}
+
 #[test]
 fn collect_refuses_a_part_whose_row_names_another_runs_file() {
     // Two rows of a part with their indexes swapped: each file still matches its row's size and
@@ -283,13 +290,7 @@ fn collect_refuses_a_part_whose_row_names_another_runs_file() {
     // that catalogue).
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);
-    for k in 0..3 {
-        let shard = format!("{k}/3");
-        assert_eq!(
-            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
-            0
-        );
-    }
+    all_shards(dir.path(), "s.toml", "d", 3);
     let part = dir.path().join("d/catalogue.part-0-of-3.csv");
     let text = std::fs::read_to_string(&part).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
@@ -315,13 +316,7 @@ fn collect_names_a_damaged_parts_first_wrong_lines_and_counts_the_rest() {
     // "stream did not contain valid UTF-8", no fix.
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);
-    for k in 0..2 {
-        let shard = format!("{k}/2");
-        assert_eq!(
-            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
-            0
-        );
-    }
+    all_shards(dir.path(), "s.toml", "d", 2);
     let part = dir.path().join("d/catalogue.part-1-of-2.csv");
     let text = std::fs::read_to_string(&part).unwrap();
     std::fs::write(&part, text.clone() + &"garbage\n".repeat(100)).unwrap();
@@ -381,13 +376,7 @@ fn collect_refuses_a_row_no_run_writes() {
     // `verify` = off passed as well.
     let dir = tempfile::tempdir().unwrap();
     write_sweep(dir.path(), "s.toml", SMALL);
-    for k in 0..2 {
-        let shard = format!("{k}/2");
-        assert_eq!(
-            sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]).0,
-            0
-        );
-    }
+    all_shards(dir.path(), "s.toml", "d", 2);
     let part = dir.path().join("d/catalogue.part-1-of-2.csv");
     let text = std::fs::read_to_string(&part).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
@@ -420,13 +409,7 @@ fn collect_refuses_a_part_of_another_sweep_with_the_same_keys() {
     let other = SMALL.replace("values = [0.2, 0.6, 1.0]", "values = [0.3, 0.6, 1.0]");
     write_sweep(dir.path(), "o.toml", &other);
     for (file, folder) in [("s.toml", "d"), ("o.toml", "o")] {
-        for k in 0..3 {
-            let shard = format!("{k}/3");
-            assert_eq!(
-                sweep_json(dir.path(), file, folder, &["--shard", &shard]).0,
-                0
-            );
-        }
+        all_shards(dir.path(), file, folder, 3);
     }
     let (d, o) = (dir.path().join("d"), dir.path().join("o"));
     for name in ["catalogue.part-1-of-3.csv", "run-01.mcap", "run-07.mcap"] {
