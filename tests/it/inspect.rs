@@ -62,40 +62,7 @@ fn copy_twice(src: &Path, dst: &Path, options: mcap::WriteOptions, topic: &str) 
         metadata: run.clone(),
     })
     .unwrap();
-    let mut ids = BTreeMap::new();
-    for m in mcap::MessageStream::new(&bytes).unwrap() {
-        let m = m.unwrap();
-        let copies = if m.channel.topic == topic { 2 } else { 1 };
-        for copy in 0..copies {
-            let id = *ids
-                .entry((m.channel.topic.clone(), copy))
-                .or_insert_with(|| {
-                    let schema = m.channel.schema.as_ref().unwrap();
-                    let sid = w
-                        .add_schema(&schema.name, &schema.encoding, &schema.data)
-                        .unwrap();
-                    // Another publisher: the writer merges an identical channel into the first.
-                    let publisher = (copy > 0).then(|| ("publisher".to_string(), copy.to_string()));
-                    w.add_channel(
-                        sid,
-                        &m.channel.topic,
-                        &m.channel.message_encoding,
-                        &publisher.into_iter().collect(),
-                    )
-                    .unwrap()
-                });
-            w.write_to_known_channel(
-                &mcap::records::MessageHeader {
-                    channel_id: id,
-                    sequence: m.sequence,
-                    log_time: m.log_time,
-                    publish_time: m.publish_time,
-                },
-                &m.data,
-            )
-            .unwrap();
-        }
-    }
+    crate::support::writers::copy_messages_twice(&bytes, &mut w, topic, |_| {});
     w.finish().unwrap();
 }
 

@@ -511,7 +511,6 @@ fn a_pipe_is_refused_with_the_reason() {
 /// one message per sample and never looking at the other channel's.
 #[test]
 fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
-    use std::collections::BTreeMap;
     let (dir, good) = recorded(&wobble(), "good.mcap");
     let path = dir.path().join("two-energies.mcap");
     let bytes = std::fs::read(&good).unwrap();
@@ -529,46 +528,10 @@ fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
     for m in metadata.iter().filter(|m| m.name == "coin-log") {
         w.write_metadata(m).unwrap();
     }
-    let mut ids: BTreeMap<(String, bool), u16> = BTreeMap::new();
-    for m in mcap::MessageStream::new(&bytes).unwrap() {
-        let m = m.unwrap();
-        let copies: &[bool] = if m.channel.topic == "/coin/energy" {
-            &[false, true]
-        } else {
-            &[false]
-        };
-        for &second in copies {
-            let id = *ids
-                .entry((m.channel.topic.clone(), second))
-                .or_insert_with(|| {
-                    let s = m.channel.schema.as_ref().unwrap();
-                    let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
-                    // Another publisher: the writer merges an identical channel into the first.
-                    let publisher = second.then(|| ("publisher".to_string(), "2".to_string()));
-                    w.add_channel(
-                        sid,
-                        &m.channel.topic,
-                        &m.channel.message_encoding,
-                        &publisher.into_iter().collect(),
-                    )
-                    .unwrap()
-                });
-            let mut data = m.data.to_vec();
-            if second {
-                crate::support::writers::nudge(&mut data, "total", 1.0);
-            }
-            w.write_to_known_channel(
-                &mcap::records::MessageHeader {
-                    channel_id: id,
-                    sequence: m.sequence,
-                    log_time: m.log_time,
-                    publish_time: m.publish_time,
-                },
-                &data,
-            )
-            .unwrap();
-        }
-    }
+    let ids =
+        crate::support::writers::copy_messages_twice(&bytes, &mut w, "/coin/energy", |data| {
+            crate::support::writers::nudge(data, "total", 1.0);
+        });
     for m in metadata.iter().filter(|m| m.name != "coin-log") {
         w.write_metadata(m).unwrap();
     }

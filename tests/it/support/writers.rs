@@ -623,6 +623,57 @@ fn copy(
     w.finish().unwrap();
 }
 
+/// Writes every message of the MCAP file `bytes` to `w`, those of `topic` twice: again on a second
+/// channel of that topic with another publisher (legal MCAP; the writer would merge an identical channel
+/// into the first), its data passed through `second`. Returns the channel ids by (topic, second copy).
+pub fn copy_messages_twice<W: Write + Seek>(
+    bytes: &[u8],
+    w: &mut mcap::Writer<W>,
+    topic: &str,
+    mut second: impl FnMut(&mut Vec<u8>),
+) -> BTreeMap<(String, bool), u16> {
+    let mut ids = BTreeMap::new();
+    for m in mcap::MessageStream::new(bytes).unwrap() {
+        let m = m.unwrap();
+        let copies: &[bool] = if m.channel.topic == topic {
+            &[false, true]
+        } else {
+            &[false]
+        };
+        for &copy in copies {
+            let id = *ids
+                .entry((m.channel.topic.clone(), copy))
+                .or_insert_with(|| {
+                    let s = m.channel.schema.as_ref().unwrap();
+                    let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+                    let publisher = copy.then(|| ("publisher".to_string(), "2".to_string()));
+                    w.add_channel(
+                        sid,
+                        &m.channel.topic,
+                        &m.channel.message_encoding,
+                        &publisher.into_iter().collect(),
+                    )
+                    .unwrap()
+                });
+            let mut data = m.data.to_vec();
+            if copy {
+                second(&mut data);
+            }
+            w.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: m.sequence,
+                    log_time: m.log_time,
+                    publish_time: m.publish_time,
+                },
+                &data,
+            )
+            .unwrap();
+        }
+    }
+    ids
+}
+
 /// Changes field `field` of a JSON message by `delta`, keeping every other byte.
 pub fn nudge(data: &mut Vec<u8>, field: &str, delta: f64) {
     let mut v: serde_json::Map<String, serde_json::Value> = serde_json::from_slice(data).unwrap();
