@@ -14,6 +14,7 @@ use coin_log::files::{shown, OutputFolder};
 use coin_log::model::nutation::Motion;
 use coin_log::model::{Coin, CoinParams, SteadyFamily};
 use coin_log::scene::{RunFile, Scene};
+use std::ffi::{OsStr, OsString};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,7 +35,7 @@ pub struct AnalyseArgs {
     command: Option<AnalyseCommand>,
     /// A built-in scene (listed by `coin-log scenes`) or a path to a `.toml` scene file.
     #[arg(required = true)]
-    scene: Option<String>,
+    scene: Option<OsString>,
     /// Print one JSON object (docs/format.md: analyse --json).
     #[arg(long)]
     json: bool,
@@ -60,7 +61,7 @@ enum AnalyseCommand {
 #[derive(Debug, clap::Args)]
 struct MapArgs {
     /// A scene whose body to map (built-in name or `.toml` file) [default: the thin disk, M = a = g = 1].
-    scene: Option<String>,
+    scene: Option<OsString>,
     /// θ0 grid A:B:N: N values from A to B, each with 0 < |θ0| < π/2 [rad].
     #[arg(long, value_name = "A:B:N", default_value = DEFAULT_THETA, allow_hyphen_values = true)]
     theta: String,
@@ -94,22 +95,25 @@ pub fn run(args: AnalyseArgs) -> anyhow::Result<Outcome> {
     }
 }
 
-/// The scene SCENE with `sets`, validated; `run.duration` (which analyse does not use) may be left out.
-fn load_scene(arg: &str, sets: &[String]) -> anyhow::Result<Scene> {
+/// The scene SCENE with `sets`, validated, and its name in messages; `run.duration` (which analyse does
+/// not use) may be left out.
+fn load_scene(arg: &OsStr, sets: &[String]) -> anyhow::Result<(String, Scene)> {
     let mut source = load_source(arg, sets)?;
     let run = source.file.run.get_or_insert_with(RunFile::default);
     if run.duration.is_none() {
         run.duration = Some(1.0);
     }
-    Scene::from_file(&source.file).map_err(|e| anyhow!("scene `{arg}`: {e}"))
+    let label = source.label;
+    let scene = Scene::from_file(&source.file).map_err(|e| anyhow!("scene `{label}`: {e}"))?;
+    Ok((label, scene))
 }
 
 /// An estimated relative error of the quadrature above which its numbers get a warning (they are
 /// ~1e-13 on ordinary scenes).
 const UNRELIABLE: f64 = 1e-2;
 
-fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> {
-    let scene = load_scene(arg, sets)?;
+fn run_scene(arg: &OsStr, sets: &[String], json: bool) -> anyhow::Result<Outcome> {
+    let (arg, scene) = load_scene(arg, sets)?;
     let analysis = Analysis::of_scene(&scene).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
     if let Some(d) = &scene.dissipation {
         errln!(
@@ -130,7 +134,7 @@ fn run_scene(arg: &str, sets: &[String], json: bool) -> anyhow::Result<Outcome> 
     if json {
         super::output::json(&analysis.json())?;
     } else {
-        for (key, value) in summary(arg, &scene, &analysis) {
+        for (key, value) in summary(&arg, &scene, &analysis) {
             outln!("{key:<16} {value}");
         }
     }
@@ -362,7 +366,7 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     let scene = args
         .scene
         .as_deref()
-        .map(|s| load_scene(s, &[]).map(|scene| (s, scene)))
+        .map(|s| load_scene(s, &[]))
         .transpose()?;
     let coin = scene
         .as_ref()
@@ -371,7 +375,11 @@ fn run_map(args: &MapArgs) -> anyhow::Result<Outcome> {
     // nothing, so that the work leaves nothing behind if it fails or a signal stops it.
     OutputFolder::check(&args.out, true, &[CSV, SVG])?;
     let started = Instant::now();
-    let map = stability_map(&coin, &options, scene.as_ref().map(|(n, s)| (*n, s)))?;
+    let map = stability_map(
+        &coin,
+        &options,
+        scene.as_ref().map(|(n, s)| (n.as_str(), s)),
+    )?;
     let csv = map.csv();
     let svg = map.svg()?;
     let elapsed = started.elapsed().as_secs_f64();

@@ -13,6 +13,7 @@ use coin_log::live::{Discard, LiveEvent, LiveServer, LiveTap, Pacing, DEFAULT_PO
 use coin_log::record::{record_with_tap, RecordOptions, RecordSummary};
 use coin_log::scene::Scene;
 use coin_log_mcap::Compression;
+use std::ffi::OsString;
 use std::io::BufWriter;
 use std::net::IpAddr;
 use std::path::PathBuf;
@@ -31,7 +32,7 @@ const SERVE_POLL: Duration = Duration::from_millis(100);
 #[derive(Debug, clap::Args)]
 pub struct LiveArgs {
     /// A built-in scene (listed by `coin-log scenes`) or a scene file, as for `record`.
-    scene: String,
+    scene: OsString,
     /// Simulated time units per second of wall time: 1 real time, 10 ten times faster, 0.1 slow motion
     /// (finite, above 0).
     #[arg(long, value_name = "X", default_value_t = 1.0, value_parser = parse_speed,

@@ -30,6 +30,19 @@ pub struct PlotArgs {
 /// Runs `coin-log plot`: exit 0 for a picture of the whole file; a file that breaks off part way is drawn
 /// up to the break, and the problem is an error (exit 1).
 pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
+    if let Some((out, kind)) = args
+        .out
+        .as_deref()
+        .and_then(|o| Some((o, other_picture(o)?)))
+    {
+        errln!(
+            "error: --out {}: plot draws SVG only, and a {kind} name would hold SVG; give --out {} and \
+             convert it afterwards if you need {kind} (rsvg-convert, Inkscape or a browser do)",
+            shown(out),
+            shown(&out.with_extension("svg")),
+        );
+        return Ok(Outcome::Unusable);
+    }
     let shown_file = shown(&args.file);
     let target = args.out.clone().unwrap_or_else(|| {
         // The stem's own bytes, not a lossy copy: a name that is not UTF-8 keeps them.
@@ -69,5 +82,23 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
             Outcome::Failure
         }
         None => Outcome::Success,
+    })
+}
+
+/// The picture format that `target`'s extension names when it is one plot does not draw (PNG, PDF, ...):
+/// `-o plot.png` wrote SVG under a PNG name without a word. Other extensions (`.svg`, `.v2`, none) pass.
+fn other_picture(target: &Path) -> Option<&'static str> {
+    let ext = target.extension()?.to_str()?.to_ascii_lowercase();
+    Some(match ext.as_str() {
+        "png" => "PNG",
+        "pdf" => "PDF",
+        "jpg" | "jpeg" => "JPEG",
+        "gif" => "GIF",
+        "webp" => "WEBP",
+        "eps" => "EPS",
+        "ps" => "PS",
+        "tif" | "tiff" => "TIFF",
+        "bmp" => "BMP",
+        _ => return None,
     })
 }

@@ -17,6 +17,7 @@ use coin_log::scene::{self, compact, FlagOverrides, Scene};
 use coin_log_mcap::Compression;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
+use std::ffi::OsString;
 use std::io::{BufWriter, IsTerminal};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -42,7 +43,7 @@ const WRITE_BUFFER: usize = 1 << 20;
 pub struct RecordArgs {
     /// A built-in scene (listed by `coin-log scenes`) or a scene file: a path (with a `/` or ending in
     /// `.toml`) is always the file; a bare name is the built-in, with a note if a file of that name is here.
-    scene: String,
+    scene: OsString,
     /// Output file [default: <scene name or file stem>.mcap in the current folder].
     #[arg(short, long, value_name = "FILE")]
     output: Option<PathBuf>,
@@ -346,9 +347,11 @@ pub(super) fn resolve_flags(
 
 /// Where the recording goes (`-o`, or the scene's stem in the current folder).
 fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
-    args.output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", source.stem)))
+    args.output.clone().unwrap_or_else(|| {
+        let mut name = source.stem.clone();
+        name.push(".mcap");
+        PathBuf::from(name)
+    })
 }
 
 /// What the recording's target may be: a regular file (replaced with `--overwrite`), never the scene.
@@ -356,7 +359,7 @@ fn output_policy(overwrite: bool, source: &SceneSource) -> Policy {
     Policy {
         overwrite,
         flag: "-o",
-        example: format!("{}.mcap", source.stem).into(),
+        example: format!("{}.mcap", source.stem.to_string_lossy()).into(),
         protect: source
             .path
             .clone()

@@ -2,12 +2,13 @@
 //! every command. A path (it holds a path separator or ends in `.toml`) is a file, whatever built-in has
 //! its stem; a bare name is the built-in of that name, and a file of that name in the current folder is
 //! then named in a note on stderr, so that it is never shadowed silently; a bare name that is no built-in
-//! is a file if one exists. [`load_source`] is the one loader of `record` and `analyse`: the scene, with
+//! is a file if one exists; a name that is not UTF-8 is no built-in's, so it is a file. [`load_source`] is the one loader of `record` and `analyse`: the scene, with
 //! the `--set KEY=VALUE` edits applied (format.md: Scene edits).
 
 use anyhow::anyhow;
 use coin_log::files::{escaped, read_toml, shown, InputKind};
 use coin_log::scene::{self, presets, SceneFile};
+use std::ffi::{OsStr, OsString};
 use std::path::{Path, PathBuf};
 
 /// The scene an argument names.
@@ -22,8 +23,11 @@ pub enum SceneArg<'a> {
 ///
 /// # Errors
 /// No built-in scene of that name and no such file.
-pub fn classify(arg: &str) -> anyhow::Result<SceneArg<'_>> {
+pub fn classify(arg: &OsStr) -> anyhow::Result<SceneArg<'_>> {
     let path = Path::new(arg);
+    let Some(arg) = arg.to_str() else {
+        return Ok(SceneArg::File(path));
+    };
     if presets::is_path(arg) || arg == "-" {
         return Ok(SceneArg::File(path));
     }
@@ -61,8 +65,8 @@ pub fn read_scene_file(path: &Path) -> anyhow::Result<String> {
 pub struct SceneSource {
     /// SCENE as given, its control characters escaped (it names the scene in messages and summaries).
     pub label: String,
-    /// The built-in name or the file's stem.
-    pub stem: String,
+    /// The built-in name or the file's stem (its own bytes: the default output keeps them).
+    pub stem: OsString,
     /// The scene with the `--set` edits applied, not yet validated.
     pub file: SceneFile,
     /// The scene file, when SCENE is one (`record` refuses to write over it).
@@ -73,15 +77,15 @@ pub struct SceneSource {
 ///
 /// # Errors
 /// No such scene, an unreadable file, or a scene or edit that does not parse.
-pub fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
+pub fn load_source(arg: &OsStr, sets: &[String]) -> anyhow::Result<SceneSource> {
     let path = match classify(arg)? {
         SceneArg::Builtin(name) => {
             let preset = presets::preset(name).unwrap_or_default();
             let file =
-                scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{arg}`: {e}"))?;
+                scene::file_with_sets(&preset, sets).map_err(|e| anyhow!("scene `{name}`: {e}"))?;
             return Ok(SceneSource {
-                label: arg.to_string(),
-                stem: arg.to_string(),
+                label: name.to_string(),
+                stem: name.into(),
                 file,
                 path: None,
             });
@@ -89,11 +93,9 @@ pub fn load_source(arg: &str, sets: &[String]) -> anyhow::Result<SceneSource> {
         SceneArg::File(path) => path,
     };
     let text = read_scene_file(path)?;
-    let label = escaped(arg).into_owned();
+    let label = shown(path);
     let file = scene::parse_with_sets(&text, sets).map_err(|e| anyhow!("scene `{label}`: {e}"))?;
-    let stem = path
-        .file_stem()
-        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned());
+    let stem = path.file_stem().unwrap_or(OsStr::new("scene")).to_owned();
     Ok(SceneSource {
         label,
         stem,

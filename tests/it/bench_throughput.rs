@@ -345,39 +345,52 @@ fn what_the_bench_did_not_write_is_never_deleted() {
     );
 }
 
-/// A duration the workload cannot record (beyond the 64-bit nanosecond log times) is refused before any
-/// run, naming --durations; it was refused by the child `record` of that duration after the others had
-/// been measured, in a message quoting the child's command line.
+/// A duration the workload cannot measure is refused before any run, naming --durations: one beyond the
+/// 64-bit nanosecond log times was refused by the child `record` of that duration after the others had
+/// been measured, in a message quoting the child's command line; one too short for verify to judge (1e-9:
+/// one sample) by the child `verify`, with "cannot verify".
 #[test]
-fn a_duration_the_workload_cannot_record_is_refused_before_any_run() {
+fn a_duration_the_workload_cannot_measure_is_refused_before_any_run() {
     let dir = tempfile::tempdir().unwrap();
-    let run = coin_log(
-        dir.path(),
-        &[
-            "bench",
-            "throughput",
-            "--durations",
+    for (durations, shown, reason) in [
+        (
             "0.01,2e10",
-            "--repeats",
-            "1",
-            "--out",
-            "o",
-        ],
-    );
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.starts_with("error: --durations: 20000000000.0 time units cannot be recorded"),
-        "{stderr}"
-    );
-    assert!(
-        stderr.contains("`run.duration` = 20000000000 is too long"),
-        "{stderr}"
-    );
-    assert!(!stderr.contains("exited with"), "{stderr}");
-    assert!(run.stdout.is_empty());
-    assert!(
-        !dir.path().join("o").exists(),
-        "nothing measured, nothing written"
-    );
+            "20000000000.0",
+            "`run.duration` = 20000000000 is too long",
+        ),
+        (
+            "0.01,1e-9",
+            "1e-9",
+            "the run has 1 on its sampling grid; give a longer duration\n",
+        ),
+    ] {
+        let run = coin_log(
+            dir.path(),
+            &[
+                "bench",
+                "throughput",
+                "--durations",
+                durations,
+                "--repeats",
+                "1",
+                "--out",
+                "o",
+            ],
+        );
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.starts_with(&format!(
+                "error: --durations: {shown} time units cannot be measured"
+            )),
+            "{stderr}"
+        );
+        assert!(stderr.contains(reason), "{stderr}");
+        assert!(!stderr.contains("exited with"), "{stderr}");
+        assert!(run.stdout.is_empty());
+        assert!(
+            !dir.path().join("o").exists(),
+            "nothing measured, nothing written"
+        );
+    }
 }

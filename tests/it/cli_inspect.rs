@@ -386,3 +386,33 @@ fn verify_totals_several_files_in_one_line() {
     assert!(!String::from_utf8_lossy(&out.stdout).contains("files:"));
     assert!(out.stderr.is_empty());
 }
+
+/// `plot` draws SVG only: `-o plot.png` wrote SVG under a PNG name without a word. It is refused before any
+/// work with exit 2 (a usage error), naming the SVG name to give, and writes nothing; an SVG name in any case,
+/// and a name whose extension is no picture format, are drawn.
+#[test]
+fn plot_refuses_an_output_named_for_another_picture_format() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(dir.path(), "wobble", &["--duration", "0.1"]);
+    for name in ["plot.png", "plot.PDF", "plot.jpeg"] {
+        let out = coin_log(dir.path(), &["plot", "wobble.mcap", "-o", name]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains("plot draws SVG only"), "{name}: {err}");
+        assert!(err.contains("give --out plot.svg"), "{name}: {err}");
+        assert!(!dir.path().join(name).exists(), "{name}");
+    }
+    assert_eq!(listing(dir.path()), ["wobble.mcap"]);
+    for name in ["plot.SVG", "plot.v2"] {
+        let out = coin_log(dir.path(), &["plot", "wobble.mcap", "-o", name]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(std::fs::read_to_string(dir.path().join(name))
+            .unwrap()
+            .starts_with("<svg"));
+    }
+}

@@ -838,3 +838,58 @@ fn a_folder_output_dash_is_refused_like_a_file_output_dash() {
     assert_eq!(code(&output), 0, "{}", stderr(&output));
     assert!(dir.path().join("-/coin-log.1").is_file());
 }
+
+/// A scene file whose name is not UTF-8 is recorded, analysed and mapped like any other (clap refused it:
+/// "invalid UTF-8 was detected in one or more arguments"), and record's default output keeps the stem's
+/// own bytes (`caf\xe9.mcap`, not a lossy `caf\u{fffd}.mcap`, which two such names would share).
+#[test]
+fn a_scene_file_whose_name_is_not_utf8_is_recorded_with_its_own_bytes() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let shown = coin_log(dir.path(), &["scenes", "--show", "wobble"]);
+    let scene = OsStr::from_bytes(b"caf\xe9.toml");
+    std::fs::write(dir.path().join(scene), &shown.stdout).unwrap();
+    let runs: [&[&OsStr]; 3] = [
+        &[
+            OsStr::new("record"),
+            scene,
+            OsStr::new("--duration"),
+            OsStr::new("1"),
+        ],
+        &[OsStr::new("analyse"), scene],
+        &[
+            OsStr::new("analyse"),
+            OsStr::new("map"),
+            scene,
+            OsStr::new("--theta"),
+            OsStr::new("0.1:0.2:2"),
+            OsStr::new("--omega-z"),
+            OsStr::new("1:2:2"),
+            OsStr::new("--out"),
+            OsStr::new("map"),
+        ],
+    ];
+    for args in runs {
+        let out = coin_log(dir.path(), args);
+        assert_eq!(
+            code(&out),
+            0,
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let recorded = OsStr::from_bytes(b"caf\xe9.mcap");
+    assert!(
+        dir.path().join(recorded).is_file(),
+        "{:?}",
+        listing(dir.path())
+    );
+    let verified = coin_log(dir.path(), &[OsStr::new("verify"), recorded]);
+    assert_eq!(
+        code(&verified),
+        0,
+        "{}",
+        String::from_utf8_lossy(&verified.stdout)
+    );
+}

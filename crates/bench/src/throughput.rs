@@ -24,6 +24,7 @@ use super::median;
 use coin_log::format::{Channel, Encoding};
 use coin_log::record::COMPRESSION_THREADS;
 use coin_log::scene::{self, presets, FlagOverrides, Scene};
+use coin_log::verify::coverage;
 use coin_log_mcap::{
     self, ChunkCompressor, Compression, MessageHeader, Visitor, DEFAULT_CHUNK_SIZE, ZSTD_LEVEL,
 };
@@ -182,7 +183,8 @@ pub fn channel_list() -> String {
 /// the scene `coin-log record` resolves from the workload's flags.
 ///
 /// # Errors
-/// [`ThroughputError::Workload`] if the scene does not validate (e.g. a duration that is not positive).
+/// [`ThroughputError::Workload`] if the scene does not validate (e.g. a duration that is not positive), or
+/// is too short for `verify` to judge its recording.
 pub fn workload_scene(duration: f64) -> Result<Scene, ThroughputError> {
     let invalid = |reason: String| ThroughputError::Workload { duration, reason };
     let file = presets::preset(SCENE).ok_or_else(|| invalid(format!("no built-in `{SCENE}`")))?;
@@ -192,7 +194,18 @@ pub fn workload_scene(duration: f64) -> Result<Scene, ThroughputError> {
         channels: Some(CHANNELS.iter().map(|c| c.name().to_string()).collect()),
         ..FlagOverrides::default()
     };
-    scene::resolve(&file, &flags).map_err(|e| invalid(e.to_string()))
+    let scene = scene::resolve(&file, &flags).map_err(|e| invalid(e.to_string()))?;
+    // The workload verifies every recording: a duration too short for verify to judge (1e-9 time units:
+    // one sample) is refused here, not by the first child `verify` after the record runs.
+    // The sentence's advice names record's flags; the bench's rate is fixed, so its own advice replaces it.
+    match coverage(&scene).first() {
+        Some(why) => Err(invalid(format!(
+            "verify could not judge the recording: {}; give a longer duration",
+            why.rsplit_once("; ")
+                .map_or(why.as_str(), |(reason, _)| reason)
+        ))),
+        None => Ok(scene),
+    }
 }
 
 /// One record run, as its `--json` summary reports it.

@@ -131,7 +131,7 @@ fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
 /// A built-in scene by name, or a scene file by path (named by its stem), by the rule of
 /// [`super::scene_arg`].
 fn load_case(arg: &str) -> anyhow::Result<BenchCase> {
-    let path = match super::scene_arg::classify(arg)? {
+    let path = match super::scene_arg::classify(arg.as_ref())? {
         super::scene_arg::SceneArg::Builtin(name) => return Ok(bench_case(name)?),
         super::scene_arg::SceneArg::File(path) => path,
     };

@@ -88,7 +88,7 @@ fn durations(args: &ThroughputArgs) -> anyhow::Result<Vec<f64>> {
     for &d in &durations {
         if let Err(ThroughputError::Workload { reason, .. }) = workload_scene(d) {
             bail!(
-                "--durations: {d:?} time units cannot be recorded by the workload ({SCENE} at {RATE} samples \
+                "--durations: {d:?} time units cannot be measured by the workload ({SCENE} at {RATE} samples \
                  per time unit): {reason}"
             );
         }
