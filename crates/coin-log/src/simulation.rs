@@ -87,11 +87,7 @@ impl CoinEvents {
 
 impl<const N: usize> EventFunctions<N> for CoinEvents {
     fn count(&self) -> usize {
-        if self.friction.is_some() {
-            3
-        } else {
-            2
-        }
+        2 + usize::from(self.friction.is_some())
     }
 
     #[inline]

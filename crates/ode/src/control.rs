@@ -198,22 +198,16 @@ impl<const N: usize> AdaptiveSteps<N> {
         }))
     }
 
-    /// The trial step `h` produced non-finite values: shrink it and count the rejection.
+    /// The trial step `h` had scaled error `err` > 1, or (`None`) produced non-finite values: shrink it
+    /// and count the rejection.
     #[inline]
-    pub fn reject_non_finite(&mut self, h: f64) {
+    pub fn reject(&mut self, h: f64, err: Option<f64>) {
         self.state.stats.rejected_steps += 1;
         self.rejected = true;
-        self.h = h * NON_FINITE_SHRINK;
-    }
-
-    /// The trial step `h` had scaled error `err` > 1: shrink it and count the rejection.
-    #[inline]
-    pub fn reject(&mut self, h: f64, err: f64) {
-        self.state.stats.rejected_steps += 1;
         let c = &self.controller;
-        let fac11 = err.powf(c.exponent);
-        self.rejected = true;
-        self.h = h / (fac11 / c.safety).min(1.0 / c.min_ratio);
+        self.h = err.map_or(h * NON_FINITE_SHRINK, |err| {
+            h / (err.powf(c.exponent) / c.safety).min(1.0 / c.min_ratio)
+        });
     }
 
     /// The step `h` to (t_new, y_new) was accepted with scaled error `err` ≤ 1: pick the next step and

@@ -335,7 +335,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
 
             let finite = err.is_finite() && all_finite(&y_new);
             if finite && err > 1.0 {
-                self.steps.reject(h, err);
+                self.steps.reject(h, Some(err));
                 continue;
             }
             if finite {
@@ -344,7 +344,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
             }
             if !finite || !all_finite(&k[12]) {
                 non_finite = true;
-                self.steps.reject_non_finite(h);
+                self.steps.reject(h, None);
                 continue;
             }
 

@@ -136,11 +136,11 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
 
             if !err.is_finite() || !all_finite(&y_stage) || !all_finite(&k[6]) {
                 non_finite = true;
-                self.steps.reject_non_finite(h);
+                self.steps.reject(h, None);
                 continue;
             }
             if err > 1.0 {
-                self.steps.reject(h, err);
+                self.steps.reject(h, Some(err));
                 continue;
             }
 

@@ -342,8 +342,6 @@ where
             if t_k > self.settings.t_end - grid_slack {
                 t_k = self.settings.t_end;
             }
-            // A grid sample closer than EVENT_SAMPLE_GAP before the event gives way to the event's own
-            // sample, so sample times stay apart by more than a nanosecond of log time.
             if t_k > t_stop || (event.is_some() && t_k > t_stop - EVENT_SAMPLE_GAP) {
                 return None;
             }

@@ -120,17 +120,14 @@ impl Analysis {
     #[must_use]
     pub fn json(&self) -> serde_json::Value {
         let o = &self.orbit;
-        let (period, precession, spin_advance) = match o.motion {
+        let (period, precession, spin_advance, flat_landing_time) = match o.motion {
             Motion::Periodic {
                 period,
                 precession,
                 spin_advance,
-            } => (Some(period), Some(precession), Some(spin_advance)),
-            _ => (None, None, None),
-        };
-        let flat_landing_time = match o.motion {
-            Motion::FlatLanding { time, .. } => Some(time),
-            _ => None,
+            } => (Some(period), Some(precession), Some(spin_advance), None),
+            Motion::FlatLanding { time, .. } => (None, None, None, Some(time)),
+            Motion::Steady => (None, None, None, None),
         };
         json!({
             "energy": o.energy,

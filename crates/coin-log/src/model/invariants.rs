@@ -317,8 +317,7 @@ fn edge_coefficients(mu: f64, x_max: f64) -> Vec<[f64; 4]> {
     })
 }
 
-/// Collects coefficients from `next(n)` until, chain by chain, the terms at `variable_max` have been
-/// decreasing for [`DECREASING_RUN`] steps and are below [`TRUNCATION`] of the sum of term magnitudes.
+/// Collects coefficients from `next(n)` until every chain's terms at `variable_max` meet [`TRUNCATION`].
 fn collect_series(variable_max: f64, mut next: impl FnMut(usize) -> [f64; 4]) -> Vec<[f64; 4]> {
     let mut out = Vec::new();
     let mut magnitude = [0.0_f64; 4];

@@ -502,9 +502,7 @@ impl<'a> Reduced<'a> {
             error,
         )
     }
-}
 
-impl Reduced<'_> {
     /// (T, ΔΦ, ΔΨ, estimated relative error) over one period between the turning points lo < hi, by the
     /// midpoint rule in u with θ = lo + (hi − lo)(1 − cos u)/2 (see the module doc).
     fn period_integrals(&self, lo: f64, hi: f64) -> (f64, f64, f64, f64) {

@@ -116,10 +116,9 @@ impl Adaptive {
         let (fine, magnitude) = self.rule(&self.fine, f, a, b, &mut out.evaluations);
         let difference = (fine - coarse).abs();
         let exhausted = depth >= MAX_DEPTH || out.evaluations >= MAX_EVALUATIONS;
-        // Both halves of a panel get the parent's difference; the pair is noise-limited when the halves
-        // together differ by more than NOISE_RATIO of it, i.e. each by more than half that, while the
-        // rules already agree to NOISE_FLOOR (an unresolved feature also keeps halves differing, but
-        // by far more).
+        // Each half gets the parent's difference: the pair is noise-limited when each half differs by
+        // more than NOISE_RATIO/2 of it while the rules agree to NOISE_FLOOR (an unresolved feature keeps
+        // halves differing by far more).
         let noisy =
             difference > 0.5 * NOISE_RATIO * parent && difference <= NOISE_FLOOR * magnitude;
         if difference <= density * (b - a).abs() || exhausted || noisy || difference.is_nan() {
