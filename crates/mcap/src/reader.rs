@@ -226,22 +226,10 @@ pub(crate) fn io_error(e: std::io::Error) -> ReadError {
     ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"))
 }
 
-/// The message for a file that ends at byte `len` inside (or just before) the record at `at`.
-fn truncated(len: u64, at: u64) -> String {
-    if len == MAGIC_LEN {
-        format!(
-            "truncated: the file ends at byte {len}, right after the MCAP magic, before the MCAP footer"
-        )
-    } else if at >= len {
-        format!(
-            "truncated: the file ends at byte {len}, after a whole record, before the MCAP footer"
-        )
-    } else {
-        format!(
-            "truncated: the file ends at byte {len} inside the record that starts at byte {at}, \
-             before the MCAP footer"
-        )
-    }
+/// A file that ends at byte `len`, `place` (`, inside the MCAP end magic`).
+fn truncated(len: u64, place: &str) -> ReadError {
+    let detail = format!("truncated: the file ends at byte {len}{place}");
+    ReadError::new(ReadErrorKind::Truncated, detail)
 }
 
 pub(crate) fn wire_error(what: &str, at: u64, e: &WireError) -> ReadError {
@@ -509,13 +497,11 @@ impl Book {
         }
         if self.in_summary && opcode != op::FOOTER {
             // Contiguous runs of one opcode form a group (what a summary offset points at).
-            let extends = matches!(self.groups.last(), Some((o, start, len)) if *o == opcode && start + len == at);
-            if extends {
-                if let Some(group) = self.groups.last_mut() {
-                    group.2 += size;
-                }
-            } else if self.groups.len() < MAX_REMEMBERED {
-                self.groups.push((opcode, at, size));
+            let room = self.groups.len() < MAX_REMEMBERED;
+            match self.groups.last_mut() {
+                Some((o, start, len)) if *o == opcode && *start + *len == at => *len += size,
+                _ if room => self.groups.push((opcode, at, size)),
+                _ => {}
             }
             if self.summary_start.is_none() {
                 self.summary_start = Some(at);
@@ -540,17 +526,12 @@ impl Book {
                     format!("not an MCAP file ({len} bytes, shorter than an MCAP header)"),
                 )
             }
-            McapError::UnexpectedEof if len < MAGIC_LEN => ReadError::new(
-                ReadErrorKind::Truncated,
-                format!(
-                    "truncated: the file ends at byte {len}, inside the MCAP magic it starts with"
-                ),
-            ),
-            McapError::UnexpectedEof if self.footer_seen => ReadError::new(
-                ReadErrorKind::Truncated,
-                format!("truncated: the file ends at byte {len}, inside the MCAP end magic"),
-            )
-            .after(read),
+            McapError::UnexpectedEof if len < MAGIC_LEN => {
+                truncated(len, ", inside the MCAP magic it starts with")
+            }
+            McapError::UnexpectedEof if self.footer_seen => {
+                truncated(len, ", inside the MCAP end magic").after(read)
+            }
             McapError::UnexpectedEof => self.past_end(at, None).after(before),
             // Within the file but beyond the budget: refused, not corrupt.
             McapError::RecordTooLarge {
@@ -599,7 +580,12 @@ impl Book {
         let len = self.s.file_len;
         let plausible = claim.as_ref().is_none_or(|(c, _)| *c <= PLAUSIBLE_RECORD);
         if !self.ahead.ends_with_magic && plausible {
-            return ReadError::new(ReadErrorKind::Truncated, truncated(len, at));
+            let place = match (len == MAGIC_LEN, at >= len) {
+                (true, _) => ", right after the MCAP magic".to_string(),
+                (false, true) => ", after a whole record".to_string(),
+                (false, false) => format!(" inside the record that starts at byte {at}"),
+            };
+            return truncated(len, &format!("{place}, before the MCAP footer"));
         }
         corrupt(match claim {
             Some((claimed, what)) => format!(
@@ -871,12 +857,7 @@ impl Book {
         let schema: Schema<'_> = parse(data, at)?;
         let (id, d) = (schema.id, Digest::of(data));
         match self.schemas.get(&id) {
-            Some((earlier, _)) if *earlier != d => {
-                let name = schema.name;
-                self.problem(|| {
-                    format!("schema {id} `{name}` at byte {at} differs from its earlier definition")
-                });
-            }
+            Some((earlier, _)) if *earlier != d => self.redefined("schema", id, &schema.name, at),
             Some(_) => {}
             None => {
                 self.kept.charge(PREFIX_LEN + data.len() as u64, 0, at)?;
@@ -902,14 +883,7 @@ impl Book {
         let c: Channel = parse(data, at)?;
         let d = Digest::of(data);
         match self.channels.get(&c.id) {
-            Some((earlier, _)) if *earlier != d => {
-                let (id, topic) = (c.id, c.topic);
-                self.problem(|| {
-                    format!(
-                        "channel {id} `{topic}` at byte {at} differs from its earlier definition"
-                    )
-                });
-            }
+            Some((earlier, _)) if *earlier != d => self.redefined("channel", c.id, &c.topic, at),
             Some(_) => {}
             None => {
                 let schema = self
@@ -934,6 +908,13 @@ impl Book {
             }
         }
         Ok(())
+    }
+
+    /// The `what` (schema, channel) `id` named `name` at byte `at` differs from its first definition.
+    fn redefined(&mut self, what: &str, id: u16, name: &str, at: u64) {
+        self.problem(|| {
+            format!("{what} {id} `{name}` at byte {at} differs from its earlier definition")
+        });
     }
 
     /// A metadata record: passed on, and remembered (up to [`MAX_REMEMBERED`]) for the metadata indexes.
@@ -1004,13 +985,11 @@ impl Book {
             }
         }
         if claimed.channel_message_counts != self.channel_counts {
-            let counts: Vec<(u16, u64)> = claimed
-                .channel_message_counts
-                .iter()
-                .map(|(k, v)| (*k, *v))
-                .collect();
-            let real_counts: Vec<(u16, u64)> =
-                self.channel_counts.iter().map(|(k, v)| (*k, *v)).collect();
+            let list = |m: &BTreeMap<u16, u64>| m.iter().map(|(k, v)| (*k, *v)).collect::<Vec<_>>();
+            let (counts, real_counts) = (
+                list(&claimed.channel_message_counts),
+                list(&self.channel_counts),
+            );
             self.problem(|| {
                 format!(
                     "statistics: channel message counts {counts:?} differ from the real {real_counts:?}"
