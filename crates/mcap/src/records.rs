@@ -80,19 +80,17 @@ impl<'a> Cursor<'a> {
 
     /// The next whole record: its opcode and body.
     pub(crate) fn record(&mut self) -> Result<(u8, &'a [u8]), WireError> {
-        let opcode = u8::parse(self, "opcode")?;
-        let len = u64::parse(self, "record length")?;
+        let (opcode, len) = self.prefix()?;
         Ok((opcode, self.take(len, "record")?))
     }
-}
 
-/// The opcode and body length of the record prefix at the start of `bytes`, if they hold one.
-pub(crate) fn prefix(bytes: &[u8]) -> Option<(u8, u64)> {
-    let mut c = Cursor::new(bytes);
-    Some((
-        u8::parse(&mut c, "opcode").ok()?,
-        u64::parse(&mut c, "record length").ok()?,
-    ))
+    /// The next record prefix: its opcode and body length.
+    pub(crate) fn prefix(&mut self) -> Result<(u8, u64), WireError> {
+        Ok((
+            u8::parse(self, "opcode")?,
+            u64::parse(self, "record length")?,
+        ))
+    }
 }
 
 /// A value of a record field: how it is parsed from, and encoded into, a record body.
