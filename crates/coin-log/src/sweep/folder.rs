@@ -484,12 +484,7 @@ impl JournalRow {
         let mut fields = csv::split(line).filter(|f| f.len() == width)?;
         let mtime_ns = fields.first()?.parse().ok()?;
         fields.remove(0);
-        let text = fields.first()?;
-        // As a run writes it (`+01` parses as 1, and the row would be kept with that index cell).
-        let index = text
-            .parse::<u64>()
-            .ok()
-            .filter(|i| i.to_string() == *text)?;
+        let index = catalogue::index_of(fields.first()?)?;
         Some(Self {
             mtime_ns,
             index,

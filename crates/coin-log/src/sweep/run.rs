@@ -249,7 +249,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         }
         // And is one a run writes (a finished row without its file was kept, with nothing to check).
         let cells = [status_at, failure_at, file_at, verify_at].map(|at| f[at].as_str());
-        if !consistent(cells[0], cells[1], cells[2], cells[3], verifies) {
+        if !consistent(cells, verifies) {
             continue;
         }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
