@@ -295,13 +295,8 @@ impl Folder {
     /// [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
     /// nothing, and a catalogue could be written without its `sweep.json`.
     pub fn check_outputs(&self, shard: Shard) -> Result<(), SweepError> {
-        let own = if shard.is_all() {
-            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
-        } else {
-            vec![PART.name(shard)]
-        };
         refuse_attribute(&self.path, &self.path)?;
-        for name in own {
+        for name in outputs(shard) {
             let path = self.file(&name);
             files::absent_or_plain(&path).map_err(SweepError::io("writing", &path))?;
             refuse_attribute(&self.path, &path)?;
@@ -315,11 +310,7 @@ impl Folder {
         let Ok(entries) = fs::read_dir(&self.path) else {
             return;
         };
-        let own = if shard.is_all() {
-            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
-        } else {
-            vec![PART.name(shard)]
-        };
+        let own = outputs(shard);
         for entry in entries.flatten() {
             // `.NAME.<random>.tmp` (temp_beside): NAME is the file it was to become.
             let name = entry.file_name();
@@ -436,6 +427,15 @@ impl Folder {
             .and_then(persist)
             .map_err(SweepError::io("writing", &path))?;
         Ok(path)
+    }
+}
+
+/// The files `shard` writes when it ends: its catalogue part, or the catalogue and `sweep.json`.
+fn outputs(shard: Shard) -> Vec<String> {
+    if shard.is_all() {
+        vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
+    } else {
+        vec![PART.name(shard)]
     }
 }
 
