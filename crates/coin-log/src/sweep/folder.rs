@@ -341,11 +341,8 @@ impl Folder {
         let mut rows = Vec::new();
         for (_, name) in journals {
             let path = self.state().join(name);
-            let bytes = files::open_regular(&path)
-                .and_then(|mut file| {
-                    let mut bytes = Vec::new();
-                    io::Read::read_to_end(&mut file, &mut bytes).map(|_| bytes)
-                })
+            let bytes = files::absent_or_regular(&path)
+                .and_then(|()| fs::read(&path))
                 .map_err(SweepError::io("reading the journal", &path))?;
             // Bytes that are no UTF-8 (a crash's or a disk's damage) spoil their line only: it is left
             // out (its run redone), as a torn line is.
