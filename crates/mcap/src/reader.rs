@@ -14,7 +14,7 @@ use crate::early_metadata::{self, Lookahead, ScanEnd};
 use crate::findings::BoundedFindings;
 use crate::prefetch::{self, Batch, ChunkError, Event};
 use crate::records::{
-    AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
+    chunk_index, AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
 };
 use crate::summary::{widen, ChannelSummary, Summary};
 use mcap::records::{
@@ -533,32 +533,25 @@ impl Book {
                 truncated(len, ", inside the MCAP end magic").after(read)
             }
             McapError::UnexpectedEof => self.past_end(at, None).after(before),
-            // Within the file but beyond the budget: refused, not corrupt.
             McapError::RecordTooLarge {
                 opcode,
                 len: claimed,
-            } if *claimed > MAX_RECORD_BYTES
-                && at.saturating_add(PREFIX_LEN).saturating_add(*claimed) <= len =>
-            {
-                ReadError::new(
-                    ReadErrorKind::TooLarge,
-                    format!(
-                        "the record (opcode {opcode:#04x}) at byte {at} is {claimed} bytes long, more \
-                         than the {} this reader accepts in one record",
+            } => {
+                let what = format!("record (opcode {opcode:#04x})");
+                let end = at.saturating_add(PREFIX_LEN).saturating_add(*claimed);
+                // Within the file but beyond the budget: refused, not corrupt.
+                let error = if *claimed > MAX_RECORD_BYTES && end <= len {
+                    let detail = format!(
+                        "the {what} at byte {at} is {claimed} bytes long, more than the {} this \
+                         reader accepts in one record",
                         budget::limit()
-                    ),
-                )
-                .after(before)
+                    );
+                    ReadError::new(ReadErrorKind::TooLarge, detail)
+                } else {
+                    self.past_end(at, Some((*claimed, what)))
+                };
+                error.after(before)
             }
-            McapError::RecordTooLarge {
-                opcode,
-                len: claimed,
-            } => self
-                .past_end(
-                    at,
-                    Some((*claimed, format!("record (opcode {opcode:#04x})"))),
-                )
-                .after(before),
             McapError::BadDataCrc { saved, calculated } => {
                 bad_crc("data", *calculated, *saved).after(read)
             }
@@ -642,25 +635,14 @@ impl Book {
     }
 
     fn chunk_record(&mut self, header: &ChunkHeader, at: u64, len: u64) {
-        *self
-            .s
-            .compressions
+        let s = &mut self.s;
+        *s.compressions
             .entry(header.compression.clone())
             .or_insert(0) += 1;
-        self.s.compressed_bytes += header.compressed_size;
-        self.s.uncompressed_bytes += header.uncompressed_size;
+        s.compressed_bytes += header.compressed_size;
+        s.uncompressed_bytes += header.uncompressed_size;
         self.chunk = Some(ChunkBook {
-            index: ChunkIndex {
-                message_start_time: header.message_start_time,
-                message_end_time: header.message_end_time,
-                chunk_start_offset: at,
-                chunk_length: PREFIX_LEN + len,
-                message_index_offsets: BTreeMap::new(),
-                message_index_length: 0,
-                compression: header.compression.clone(),
-                compressed_size: header.compressed_size,
-                uncompressed_size: header.uncompressed_size,
-            },
+            index: chunk_index(header, at, PREFIX_LEN + len),
             offset: 0,
             bounds: None,
             per_channel: BTreeMap::new(),
@@ -711,10 +693,8 @@ impl Book {
             ),
             e => corrupt(format!("corrupt chunk at byte {at}: {e}")),
         };
-        error.after(format!(
-            "judged the {} messages read before it",
-            self.s.messages
-        ))
+        let messages = self.s.messages;
+        error.after(format!("judged the {messages} messages read before it"))
     }
 
     fn message(

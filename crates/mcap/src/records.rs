@@ -396,6 +396,26 @@ impl<'a> Field<'a> for ChunkRecord<'a> {
 
 record!(ChunkRecord<'a> = op::CHUNK, "chunk");
 
+/// The chunk index entry of a chunk with `header` at byte `chunk_start_offset`, its record
+/// `chunk_length` bytes long, before its message indexes are listed.
+pub(crate) fn chunk_index(
+    header: &ChunkHeader,
+    chunk_start_offset: u64,
+    chunk_length: u64,
+) -> ChunkIndex {
+    ChunkIndex {
+        message_start_time: header.message_start_time,
+        message_end_time: header.message_end_time,
+        chunk_start_offset,
+        chunk_length,
+        message_index_offsets: BTreeMap::new(),
+        message_index_length: 0,
+        compression: header.compression.clone(),
+        compressed_size: header.compressed_size,
+        uncompressed_size: header.uncompressed_size,
+    }
+}
+
 /// An attachment record: its times, name and media type, `data`, and the CRC-32 of every byte before the
 /// CRC (0: not computed). Only read, for its framing and its CRC: coin-log writes none.
 #[derive(Debug, Clone, PartialEq, Eq)]
