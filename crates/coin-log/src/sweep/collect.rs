@@ -150,29 +150,23 @@ fn read_part(
                 continue;
             }
         };
-        // Twice in this part: no shard writes that, and no other part is to blame.
-        if rows.get(&index).is_some_and(|other| other.part == name) {
-            found.push(format!(
+        let problem = match rows.get(&index) {
+            // Twice in this part: no shard writes that, and no other part is to blame.
+            Some(other) if other.part == name => format!(
                 "`{name}` line {}: run {index}'s row is in the part twice: the part was changed; run its shard again",
                 n + 2
-            ));
-            continue;
-        }
-        if let Some(other) = rows.get(&index) {
-            found.push(format!(
+            ),
+            Some(other) => format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
                 other.part
-            ));
-            continue;
-        }
-        rows.insert(
-            index,
-            Found {
-                part: name.to_string(),
-                line: n + 2,
-                fields,
-            },
-        );
+            ),
+            None => {
+                let (part, line) = (name.to_string(), n + 2);
+                rows.insert(index, Found { part, line, fields });
+                continue;
+            }
+        };
+        found.push(problem);
     }
     let more = found.len().saturating_sub(LISTED_LINES);
     problems.extend(found.into_iter().take(LISTED_LINES));
