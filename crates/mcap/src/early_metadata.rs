@@ -8,7 +8,7 @@
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::digest::Digest;
 use crate::reader::ReadError;
-use crate::records::{self, Record, MAGIC, MAGIC_LEN, PREFIX_LEN};
+use crate::records::{Cursor, Record, MAGIC, MAGIC_LEN, PREFIX_LEN};
 use crate::summary::{bytes_at, metadata_indexes, record_at};
 use mcap::records::{op, Metadata};
 use std::io::{self, Read, Seek, SeekFrom};
@@ -92,7 +92,7 @@ pub(crate) fn find(
 fn prefix(r: &mut impl Read) -> Option<(u8, u64)> {
     let mut b = [0u8; PREFIX_LEN as usize];
     r.read_exact(&mut b).ok()?;
-    records::prefix(&b)
+    Cursor::new(&b).prefix().ok()
 }
 
 /// Reads the metadata records the index points at: in file order, each once, never two that overlap

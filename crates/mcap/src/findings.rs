@@ -44,11 +44,8 @@ impl BoundedFindings {
 
     /// Appends the other list's findings.
     pub fn extend(&mut self, other: &BoundedFindings) {
-        for p in &other.first {
-            if self.first.len() < KEPT {
-                self.first.push(p.clone());
-            }
-        }
+        let room = KEPT.saturating_sub(self.first.len());
+        self.first.extend(other.first.iter().take(room).cloned());
         self.total += other.total;
     }
 

@@ -14,7 +14,7 @@ use crate::early_metadata::{self, Lookahead, ScanEnd};
 use crate::findings::BoundedFindings;
 use crate::prefetch::{self, Batch, ChunkError, Event};
 use crate::records::{
-    AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
+    chunk_index, AttachmentRecord, Cursor, MessageRecord, Record, WireError, MAGIC_LEN, PREFIX_LEN,
 };
 use crate::summary::{widen, ChannelSummary, Summary};
 use mcap::records::{
@@ -226,22 +226,10 @@ pub(crate) fn io_error(e: std::io::Error) -> ReadError {
     ReadError::new(ReadErrorKind::Io, format!("cannot read: {e}"))
 }
 
-/// The message for a file that ends at byte `len` inside (or just before) the record at `at`.
-fn truncated(len: u64, at: u64) -> String {
-    if len == MAGIC_LEN {
-        format!(
-            "truncated: the file ends at byte {len}, right after the MCAP magic, before the MCAP footer"
-        )
-    } else if at >= len {
-        format!(
-            "truncated: the file ends at byte {len}, after a whole record, before the MCAP footer"
-        )
-    } else {
-        format!(
-            "truncated: the file ends at byte {len} inside the record that starts at byte {at}, \
-             before the MCAP footer"
-        )
-    }
+/// A file that ends at byte `len`, `place` (`, inside the MCAP end magic`).
+fn truncated(len: u64, place: &str) -> ReadError {
+    let detail = format!("truncated: the file ends at byte {len}{place}");
+    ReadError::new(ReadErrorKind::Truncated, detail)
 }
 
 pub(crate) fn wire_error(what: &str, at: u64, e: &WireError) -> ReadError {
@@ -509,13 +497,11 @@ impl Book {
         }
         if self.in_summary && opcode != op::FOOTER {
             // Contiguous runs of one opcode form a group (what a summary offset points at).
-            let extends = matches!(self.groups.last(), Some((o, start, len)) if *o == opcode && start + len == at);
-            if extends {
-                if let Some(group) = self.groups.last_mut() {
-                    group.2 += size;
-                }
-            } else if self.groups.len() < MAX_REMEMBERED {
-                self.groups.push((opcode, at, size));
+            let room = self.groups.len() < MAX_REMEMBERED;
+            match self.groups.last_mut() {
+                Some((o, start, len)) if *o == opcode && *start + *len == at => *len += size,
+                _ if room => self.groups.push((opcode, at, size)),
+                _ => {}
             }
             if self.summary_start.is_none() {
                 self.summary_start = Some(at);
@@ -540,44 +526,32 @@ impl Book {
                     format!("not an MCAP file ({len} bytes, shorter than an MCAP header)"),
                 )
             }
-            McapError::UnexpectedEof if len < MAGIC_LEN => ReadError::new(
-                ReadErrorKind::Truncated,
-                format!(
-                    "truncated: the file ends at byte {len}, inside the MCAP magic it starts with"
-                ),
-            ),
-            McapError::UnexpectedEof if self.footer_seen => ReadError::new(
-                ReadErrorKind::Truncated,
-                format!("truncated: the file ends at byte {len}, inside the MCAP end magic"),
-            )
-            .after(read),
-            McapError::UnexpectedEof => self.past_end(at, None).after(before),
-            // Within the file but beyond the budget: refused, not corrupt.
-            McapError::RecordTooLarge {
-                opcode,
-                len: claimed,
-            } if *claimed > MAX_RECORD_BYTES
-                && at.saturating_add(PREFIX_LEN).saturating_add(*claimed) <= len =>
-            {
-                ReadError::new(
-                    ReadErrorKind::TooLarge,
-                    format!(
-                        "the record (opcode {opcode:#04x}) at byte {at} is {claimed} bytes long, more \
-                         than the {} this reader accepts in one record",
-                        budget::limit()
-                    ),
-                )
-                .after(before)
+            McapError::UnexpectedEof if len < MAGIC_LEN => {
+                truncated(len, ", inside the MCAP magic it starts with")
             }
+            McapError::UnexpectedEof if self.footer_seen => {
+                truncated(len, ", inside the MCAP end magic").after(read)
+            }
+            McapError::UnexpectedEof => self.past_end(at, None).after(before),
             McapError::RecordTooLarge {
                 opcode,
                 len: claimed,
-            } => self
-                .past_end(
-                    at,
-                    Some((*claimed, format!("record (opcode {opcode:#04x})"))),
-                )
-                .after(before),
+            } => {
+                let what = format!("record (opcode {opcode:#04x})");
+                let end = at.saturating_add(PREFIX_LEN).saturating_add(*claimed);
+                // Within the file but beyond the budget: refused, not corrupt.
+                let error = if *claimed > MAX_RECORD_BYTES && end <= len {
+                    let detail = format!(
+                        "the {what} at byte {at} is {claimed} bytes long, more than the {} this \
+                         reader accepts in one record",
+                        budget::limit()
+                    );
+                    ReadError::new(ReadErrorKind::TooLarge, detail)
+                } else {
+                    self.past_end(at, Some((*claimed, what)))
+                };
+                error.after(before)
+            }
             McapError::BadDataCrc { saved, calculated } => {
                 bad_crc("data", *calculated, *saved).after(read)
             }
@@ -599,7 +573,12 @@ impl Book {
         let len = self.s.file_len;
         let plausible = claim.as_ref().is_none_or(|(c, _)| *c <= PLAUSIBLE_RECORD);
         if !self.ahead.ends_with_magic && plausible {
-            return ReadError::new(ReadErrorKind::Truncated, truncated(len, at));
+            let place = match (len == MAGIC_LEN, at >= len) {
+                (true, _) => ", right after the MCAP magic".to_string(),
+                (false, true) => ", after a whole record".to_string(),
+                (false, false) => format!(" inside the record that starts at byte {at}"),
+            };
+            return truncated(len, &format!("{place}, before the MCAP footer"));
         }
         corrupt(match claim {
             Some((claimed, what)) => format!(
@@ -656,25 +635,14 @@ impl Book {
     }
 
     fn chunk_record(&mut self, header: &ChunkHeader, at: u64, len: u64) {
-        *self
-            .s
-            .compressions
+        let s = &mut self.s;
+        *s.compressions
             .entry(header.compression.clone())
             .or_insert(0) += 1;
-        self.s.compressed_bytes += header.compressed_size;
-        self.s.uncompressed_bytes += header.uncompressed_size;
+        s.compressed_bytes += header.compressed_size;
+        s.uncompressed_bytes += header.uncompressed_size;
         self.chunk = Some(ChunkBook {
-            index: ChunkIndex {
-                message_start_time: header.message_start_time,
-                message_end_time: header.message_end_time,
-                chunk_start_offset: at,
-                chunk_length: PREFIX_LEN + len,
-                message_index_offsets: BTreeMap::new(),
-                message_index_length: 0,
-                compression: header.compression.clone(),
-                compressed_size: header.compressed_size,
-                uncompressed_size: header.uncompressed_size,
-            },
+            index: chunk_index(header, at, PREFIX_LEN + len),
             offset: 0,
             bounds: None,
             per_channel: BTreeMap::new(),
@@ -725,10 +693,8 @@ impl Book {
             ),
             e => corrupt(format!("corrupt chunk at byte {at}: {e}")),
         };
-        error.after(format!(
-            "judged the {} messages read before it",
-            self.s.messages
-        ))
+        let messages = self.s.messages;
+        error.after(format!("judged the {messages} messages read before it"))
     }
 
     fn message(
@@ -871,12 +837,7 @@ impl Book {
         let schema: Schema<'_> = parse(data, at)?;
         let (id, d) = (schema.id, Digest::of(data));
         match self.schemas.get(&id) {
-            Some((earlier, _)) if *earlier != d => {
-                let name = schema.name;
-                self.problem(|| {
-                    format!("schema {id} `{name}` at byte {at} differs from its earlier definition")
-                });
-            }
+            Some((earlier, _)) if *earlier != d => self.redefined("schema", id, &schema.name, at),
             Some(_) => {}
             None => {
                 self.kept.charge(PREFIX_LEN + data.len() as u64, 0, at)?;
@@ -902,14 +863,7 @@ impl Book {
         let c: Channel = parse(data, at)?;
         let d = Digest::of(data);
         match self.channels.get(&c.id) {
-            Some((earlier, _)) if *earlier != d => {
-                let (id, topic) = (c.id, c.topic);
-                self.problem(|| {
-                    format!(
-                        "channel {id} `{topic}` at byte {at} differs from its earlier definition"
-                    )
-                });
-            }
+            Some((earlier, _)) if *earlier != d => self.redefined("channel", c.id, &c.topic, at),
             Some(_) => {}
             None => {
                 let schema = self
@@ -934,6 +888,13 @@ impl Book {
             }
         }
         Ok(())
+    }
+
+    /// The `what` (schema, channel) `id` named `name` at byte `at` differs from its first definition.
+    fn redefined(&mut self, what: &str, id: u16, name: &str, at: u64) {
+        self.problem(|| {
+            format!("{what} {id} `{name}` at byte {at} differs from its earlier definition")
+        });
     }
 
     /// A metadata record: passed on, and remembered (up to [`MAX_REMEMBERED`]) for the metadata indexes.
@@ -1004,13 +965,11 @@ impl Book {
             }
         }
         if claimed.channel_message_counts != self.channel_counts {
-            let counts: Vec<(u16, u64)> = claimed
-                .channel_message_counts
-                .iter()
-                .map(|(k, v)| (*k, *v))
-                .collect();
-            let real_counts: Vec<(u16, u64)> =
-                self.channel_counts.iter().map(|(k, v)| (*k, *v)).collect();
+            let list = |m: &BTreeMap<u16, u64>| m.iter().map(|(k, v)| (*k, *v)).collect::<Vec<_>>();
+            let (counts, real_counts) = (
+                list(&claimed.channel_message_counts),
+                list(&self.channel_counts),
+            );
             self.problem(|| {
                 format!(
                     "statistics: channel message counts {counts:?} differ from the real {real_counts:?}"

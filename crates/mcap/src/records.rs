@@ -80,19 +80,17 @@ impl<'a> Cursor<'a> {
 
     /// The next whole record: its opcode and body.
     pub(crate) fn record(&mut self) -> Result<(u8, &'a [u8]), WireError> {
-        let opcode = u8::parse(self, "opcode")?;
-        let len = u64::parse(self, "record length")?;
+        let (opcode, len) = self.prefix()?;
         Ok((opcode, self.take(len, "record")?))
     }
-}
 
-/// The opcode and body length of the record prefix at the start of `bytes`, if they hold one.
-pub(crate) fn prefix(bytes: &[u8]) -> Option<(u8, u64)> {
-    let mut c = Cursor::new(bytes);
-    Some((
-        u8::parse(&mut c, "opcode").ok()?,
-        u64::parse(&mut c, "record length").ok()?,
-    ))
+    /// The next record prefix: its opcode and body length.
+    pub(crate) fn prefix(&mut self) -> Result<(u8, u64), WireError> {
+        Ok((
+            u8::parse(self, "opcode")?,
+            u64::parse(self, "record length")?,
+        ))
+    }
 }
 
 /// A value of a record field: how it is parsed from, and encoded into, a record body.
@@ -397,6 +395,26 @@ impl<'a> Field<'a> for ChunkRecord<'a> {
 }
 
 record!(ChunkRecord<'a> = op::CHUNK, "chunk");
+
+/// The chunk index entry of a chunk with `header` at byte `chunk_start_offset`, its record
+/// `chunk_length` bytes long, before its message indexes are listed.
+pub(crate) fn chunk_index(
+    header: &ChunkHeader,
+    chunk_start_offset: u64,
+    chunk_length: u64,
+) -> ChunkIndex {
+    ChunkIndex {
+        message_start_time: header.message_start_time,
+        message_end_time: header.message_end_time,
+        chunk_start_offset,
+        chunk_length,
+        message_index_offsets: BTreeMap::new(),
+        message_index_length: 0,
+        compression: header.compression.clone(),
+        compressed_size: header.compressed_size,
+        uncompressed_size: header.uncompressed_size,
+    }
+}
 
 /// An attachment record: its times, name and media type, `data`, and the CRC-32 of every byte before the
 /// CRC (0: not computed). Only read, for its framing and its CRC: coin-log writes none.

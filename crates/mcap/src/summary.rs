@@ -8,7 +8,7 @@
 use crate::budget::{Kept, MAX_RECORD_BYTES};
 use crate::early_metadata::{self, MAX_EARLY};
 use crate::reader::{self, bad_crc, corrupt, io_error, not_mcap, wire_error, ReadError};
-use crate::records::{self, Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
+use crate::records::{Cursor, Record, WireError, FOOTER_LEN, MAGIC, MAGIC_LEN, PREFIX_LEN};
 use mcap::records::{op, Channel, ChunkIndex, Footer, Header, MetadataIndex, Statistics};
 use mcap::Schema;
 use std::collections::BTreeMap;
@@ -169,7 +169,7 @@ pub(crate) fn record_at(
     opcode: u8,
 ) -> Option<Vec<u8>> {
     let mut record = bytes_at(source, file_len, at, length).ok()?;
-    if records::prefix(&record)? != (opcode, length - PREFIX_LEN) {
+    if Cursor::new(&record).prefix().ok()? != (opcode, length - PREFIX_LEN) {
         return None;
     }
     record.drain(..PREFIX_LEN as usize);
@@ -313,8 +313,8 @@ fn header_library(file: &mut std::fs::File, file_len: u64) -> Result<Option<Stri
     if start[..magic] != MAGIC[..magic] {
         return Err(not_mcap());
     }
-    match records::prefix(&start[magic..]) {
-        Some((op::HEADER, len)) if len <= MAX_RECORD_BYTES => {
+    match Cursor::new(&start[magic..]).prefix() {
+        Ok((op::HEADER, len)) if len <= MAX_RECORD_BYTES => {
             let body = bytes_at(file, file_len, MAGIC_LEN + PREFIX_LEN, len)?;
             let header = Header::parse_body(&body)
                 .map_err(|e| corrupt(format!("malformed header record: {e}")))?;

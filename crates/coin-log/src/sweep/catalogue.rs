@@ -39,13 +39,7 @@ coin_log_names::named_enum! {
 /// run, and one that failed in its numerics or its verdict, has a file; one that failed on its scene or
 /// on I/O has none; a file's `verify` cell is `off` exactly when the sweep does not verify (`verifies`
 /// `None`: not known, not checked).
-pub fn consistent(
-    status: &str,
-    failure: &str,
-    file: &str,
-    verify: &str,
-    verifies: Option<bool>,
-) -> bool {
+pub fn consistent([status, failure, file, verify]: [&str; 4], verifies: Option<bool>) -> bool {
     let (finished, failed) = (RunStatus::Finished.name(), RunStatus::Failed.name());
     let wants_file = if status == finished && failure.is_empty() {
         true
@@ -60,6 +54,12 @@ pub fn consistent(
     };
     let has_file = !file.is_empty();
     has_file == wants_file && (!has_file || verifies.is_none_or(|v| v != (verify == "off")))
+}
+
+/// The run index in an `index` cell as a run writes it (`+01` parses as 1, and a row kept with that
+/// cell would not be the run's).
+pub fn index_of(cell: &str) -> Option<u64> {
+    cell.parse().ok().filter(|i: &u64| i.to_string() == cell)
 }
 
 /// The catalogue's header: `index`, one column per swept key (named by the key), then the rest.

@@ -2,7 +2,7 @@
 //! the one catalogue, after checking that every run is there exactly once and that every file matches
 //! its row (size and SHA-256, each file read once). Nothing is written unless every check holds.
 
-use super::catalogue::{consistent, RunStatus};
+use super::catalogue::{consistent, index_of, RunStatus};
 use super::definition::Sweep;
 use super::error::SweepError;
 use super::folder::{self, Folder};
@@ -73,7 +73,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
             columns: &columns,
             runs,
             sweep: sweep.as_ref(),
-            at: ["file", "status", "failure", "verify"].map(|c| folder.column(c)),
+            at: ["status", "failure", "file", "verify"].map(|c| folder.column(c)),
         };
         read_part(&folder, &part, &mut rows, &mut problems)?;
     }
@@ -107,7 +107,7 @@ struct Part<'a> {
     columns: &'a [String],
     runs: u64,
     sweep: Option<&'a Sweep>,
-    /// The columns `file`, `status`, `failure`, `verify`.
+    /// The columns `status`, `failure`, `file`, `verify`.
     at: [usize; 4],
 }
 
@@ -150,29 +150,23 @@ fn read_part(
                 continue;
             }
         };
-        // Twice in this part: no shard writes that, and no other part is to blame.
-        if rows.get(&index).is_some_and(|other| other.part == name) {
-            found.push(format!(
+        let problem = match rows.get(&index) {
+            // Twice in this part: no shard writes that, and no other part is to blame.
+            Some(other) if other.part == name => format!(
                 "`{name}` line {}: run {index}'s row is in the part twice: the part was changed; run its shard again",
                 n + 2
-            ));
-            continue;
-        }
-        if let Some(other) = rows.get(&index) {
-            found.push(format!(
+            ),
+            Some(other) => format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
                 other.part
-            ));
-            continue;
-        }
-        rows.insert(
-            index,
-            Found {
-                part: name.to_string(),
-                line: n + 2,
-                fields,
-            },
-        );
+            ),
+            None => {
+                let (part, line) = (name.to_string(), n + 2);
+                rows.insert(index, Found { part, line, fields });
+                continue;
+            }
+        };
+        found.push(problem);
     }
     let more = found.len().saturating_sub(LISTED_LINES);
     problems.extend(found.into_iter().take(LISTED_LINES));
@@ -189,29 +183,20 @@ fn read_part(
 /// another run's values), and its status, failure, file and verify cells agree as a run writes them.
 fn row(folder: &Folder, part: &Part, line: &str) -> Result<(u64, Vec<String>), String> {
     let fields = csv::split(line).filter(|f| f.len() == part.columns.len());
-    let index = fields
-        .as_ref()
-        .and_then(|f| f[0].parse::<u64>().ok().filter(|i| i.to_string() == f[0]))
-        .filter(|&i| i < part.runs);
+    let index = fields.as_ref().and_then(|f| index_of(&f[0]));
+    let index = index.filter(|&i| i < part.runs);
     let (Some(fields), Some(index)) = (fields, index) else {
         return Err("not a row of this sweep: run its shard again".into());
     };
-    let [file, status, failure, verify] = part.at.map(|at| &fields[at]);
-    let own = folder.run_file_name(index);
-    if !file.is_empty() && *file != own {
+    let cells = part.at.map(|at| fields[at].as_str());
+    let (file, own) = (cells[2], folder.run_file_name(index));
+    if !file.is_empty() && file != own {
         return Err(format!(
             "run {index}'s row names the file `{file}`, not `{own}`: the part was changed; run its shard again"
         ));
     }
-    if !consistent(
-        status,
-        failure,
-        file,
-        verify,
-        part.sweep.map(|s| s.settings.verify),
-    ) {
-        let [status, failure, file, verify] =
-            [status, failure, file, verify].map(|c| shown_name(c));
+    if !consistent(cells, part.sweep.map(|s| s.settings.verify)) {
+        let [status, failure, file, verify] = cells.map(shown_name);
         return Err(format!(
             "run {index}'s row is none a run writes (status `{status}`, failure `{failure}`, file `{file}`, verify `{verify}`): the part was changed; run its shard again"
         ));

@@ -295,13 +295,8 @@ impl Folder {
     /// [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
     /// nothing, and a catalogue could be written without its `sweep.json`.
     pub fn check_outputs(&self, shard: Shard) -> Result<(), SweepError> {
-        let own = if shard.is_all() {
-            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
-        } else {
-            vec![PART.name(shard)]
-        };
         refuse_attribute(&self.path, &self.path)?;
-        for name in own {
+        for name in outputs(shard) {
             let path = self.file(&name);
             files::absent_or_plain(&path).map_err(SweepError::io("writing", &path))?;
             refuse_attribute(&self.path, &path)?;
@@ -315,11 +310,7 @@ impl Folder {
         let Ok(entries) = fs::read_dir(&self.path) else {
             return;
         };
-        let own = if shard.is_all() {
-            vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
-        } else {
-            vec![PART.name(shard)]
-        };
+        let own = outputs(shard);
         for entry in entries.flatten() {
             // `.NAME.<random>.tmp` (temp_beside): NAME is the file it was to become.
             let name = entry.file_name();
@@ -350,11 +341,8 @@ impl Folder {
         let mut rows = Vec::new();
         for (_, name) in journals {
             let path = self.state().join(name);
-            let bytes = files::open_regular(&path)
-                .and_then(|mut file| {
-                    let mut bytes = Vec::new();
-                    io::Read::read_to_end(&mut file, &mut bytes).map(|_| bytes)
-                })
+            let bytes = files::absent_or_regular(&path)
+                .and_then(|()| fs::read(&path))
                 .map_err(SweepError::io("reading the journal", &path))?;
             // Bytes that are no UTF-8 (a crash's or a disk's damage) spoil their line only: it is left
             // out (its run redone), as a torn line is.
@@ -439,6 +427,15 @@ impl Folder {
     }
 }
 
+/// The files `shard` writes when it ends: its catalogue part, or the catalogue and `sweep.json`.
+fn outputs(shard: Shard) -> Vec<String> {
+    if shard.is_all() {
+        vec![CATALOGUE_FILE.to_string(), SWEEP_JSON_FILE.to_string()]
+    } else {
+        vec![PART.name(shard)]
+    }
+}
+
 /// Refuses `path` (the sweep folder `folder`, or a file in it) when it is immutable or append-only
 /// (`chattr +i`, `+a`): a rename may not replace it (nor, for the folder, move a file into it), even for
 /// root, which would show only once the work was done.
@@ -484,12 +481,7 @@ impl JournalRow {
         let mut fields = csv::split(line).filter(|f| f.len() == width)?;
         let mtime_ns = fields.first()?.parse().ok()?;
         fields.remove(0);
-        let text = fields.first()?;
-        // As a run writes it (`+01` parses as 1, and the row would be kept with that index cell).
-        let index = text
-            .parse::<u64>()
-            .ok()
-            .filter(|i| i.to_string() == *text)?;
+        let index = catalogue::index_of(fields.first()?)?;
         Some(Self {
             mtime_ns,
             index,

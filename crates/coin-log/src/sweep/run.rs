@@ -249,7 +249,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
         }
         // And is one a run writes (a finished row without its file was kept, with nothing to check).
         let cells = [status_at, failure_at, file_at, verify_at].map(|at| f[at].as_str());
-        if !consistent(cells[0], cells[1], cells[2], cells[3], verifies) {
+        if !consistent(cells, verifies) {
             continue;
         }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
@@ -258,19 +258,16 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             || f[file_at] == own && {
                 let path = folder.file(&f[file_at]);
                 match folder::size_and_mtime(&path) {
-                    Some((size, mtime))
-                        if size.to_string() == f[bytes_at] && mtime == row.mtime_ns =>
-                    {
-                        true
-                    }
-                    Some((size, mtime)) if size.to_string() == f[bytes_at] => {
+                    Some((size, _)) if size.to_string() != f[bytes_at] => false,
+                    Some((_, mtime)) if mtime == row.mtime_ns => true,
+                    Some((_, mtime)) => {
                         let same = sha256_file(&path).is_ok_and(|(sha, _)| sha == f[sha_at]);
                         if same {
                             resumed.refreshed.push((mtime, crate::csv::line(f)));
                         }
                         same
                     }
-                    _ => false,
+                    None => false,
                 }
             };
         if !retry && file_ok {
@@ -370,13 +367,9 @@ fn record_and_check(
 
 /// An error with its causes: `writing the MCAP file failed: No space left on device`.
 fn error_chain(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        text.push_str(&format!(": {s}"));
-        source = s.source();
-    }
-    text
+    let chain = std::iter::successors(Some(e), |e| e.source());
+    let texts: Vec<String> = chain.map(ToString::to_string).collect();
+    texts.join(": ")
 }
 
 /// Finished, or failed with the kind and reason: a numerical failure first, then a verdict other than ok.
@@ -419,14 +412,10 @@ fn verify_reason(r: &FileReport) -> String {
             _ => c.id.to_string(),
         })
         .collect();
-    let mut reason = format!("verify: {}", r.verdict.name());
-    if !failing.is_empty() {
-        reason.push_str(&format!(": {}", failing.join(", ")));
-    }
-    if let Some(p) = &r.problem {
-        reason.push_str(&format!(": {p}"));
-    }
-    reason
+    let failing = (!failing.is_empty()).then(|| failing.join(", "));
+    let verdict = format!("verify: {}", r.verdict.name());
+    let parts = [Some(verdict), failing, r.problem.clone()];
+    parts.into_iter().flatten().collect::<Vec<_>>().join(": ")
 }
 
 /// What the quadrature predicts for a conservative scene (format.md: The catalogue, predicted_*).

@@ -22,27 +22,24 @@ const CHECKED_VALUES: usize = 100;
 
 /// Validates a parsed sweep file; `folder` is where a base scene path starts from.
 pub(super) fn sweep(file: SweepFile, folder: &Path) -> Result<Sweep, SceneProblems> {
-    let mut c = Checker {
-        problems: ProblemCollector::new(&[]),
-    };
-    let base_table = c.base(&file.base, folder);
-    checked(c, file, base_table)
+    let base = file.base.clone();
+    checked(file, |c| c.base(&base, folder))
 }
 
 /// Validates a sweep file whose base scene is given as a table (a plan's, which holds it resolved).
 pub(super) fn with_base(file: SweepFile, base: toml::Table) -> Result<Sweep, SceneProblems> {
-    let c = Checker {
-        problems: ProblemCollector::new(&[]),
-    };
-    checked(c, file, Some(base))
+    checked(file, |_| Some(base))
 }
 
-/// The rest of [`sweep`], once the base scene is read (`None`: it could not be, a problem noted).
+/// [`sweep`], the base scene read by `base` (`None`: it could not be, a problem noted).
 fn checked(
-    mut c: Checker,
     file: SweepFile,
-    base_table: Option<toml::Table>,
+    base: impl FnOnce(&mut Checker) -> Option<toml::Table>,
 ) -> Result<Sweep, SceneProblems> {
+    let mut c = Checker {
+        problems: ProblemCollector::new(&[]),
+    };
+    let base_table = base(&mut c);
     let places = places(&file);
     let set = c.set(&file.set);
     let parsed: Vec<Option<Axis>> = (file.axis.iter().enumerate())
