@@ -2,7 +2,7 @@
 //! memory bounded by a few records and one write buffer per table. Every value is read exactly and
 //! written by ryu, so it equals the file's bit for bit.
 
-use super::seconds_text;
+use super::{read_values, seconds_text, unreadable};
 use crate::csv;
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;
@@ -85,12 +85,6 @@ pub struct ExportError(pub String);
 
 fn written(table: &str, e: &io::Error) -> ExportError {
     ExportError(format!("writing `{table}`: {e}"))
-}
-
-fn message(topic: &str, log_time: u64, reason: impl std::fmt::Display) -> ExportError {
-    ExportError(format!(
-        "{topic}: the message at log time {log_time} ns {reason}"
-    ))
 }
 
 fn join_failed(e: &str) -> ExportError {
@@ -212,13 +206,7 @@ impl<W: Write> Exporter<'_, W> {
             out.write_all(csv::record(&columns).as_bytes())
                 .map(|()| out)
         });
-        let out = match opened {
-            Ok(out) => out,
-            Err(e) => {
-                self.fail(written(name, &e));
-                return None;
-            }
-        };
+        let out = opened.inspect_err(|e| self.fail(written(name, e))).ok()?;
         self.tables.push(Open {
             out,
             table: Table {
@@ -232,9 +220,7 @@ impl<W: Write> Exporter<'_, W> {
     }
 
     fn fail(&mut self, e: ExportError) {
-        if self.error.is_none() {
-            self.error = Some(e);
-        }
+        self.error.get_or_insert(e);
     }
 
     fn skip(&mut self, topic: &str, reason: &str) -> Target {
@@ -337,11 +323,9 @@ impl<W: Write> Exporter<'_, W> {
         table: Option<usize>,
         reader: usize,
     ) {
-        let reader = &self.readers[reader];
-        self.values.clear();
-        self.values.resize(reader.fields().len(), 0.0);
-        if let Err(e) = reader.read(data, &mut self.values) {
-            return self.fail(message(channel.topic(), h.log_time, e));
+        let at = (channel.topic(), h.log_time);
+        if let Err(e) = read_values(&self.readers[reader], data, &mut self.values, at) {
+            return self.fail(ExportError(e));
         }
         let Some(table) = table else {
             return self.join(h.log_time, channel);
@@ -358,7 +342,8 @@ impl<W: Write> Exporter<'_, W> {
             Ok(row) => row,
             Err(e) => {
                 let reason = format!("is not a foxglove.FrameTransform: {e}");
-                return self.fail(message(Channel::Tf.topic(), h.log_time, reason));
+                let topic = Channel::Tf.topic();
+                return self.fail(ExportError(unreadable(topic, h.log_time, reason)));
             }
         };
         self.line.clear();
@@ -536,7 +521,7 @@ impl<W: Write> Visitor for Exporter<'_, W> {
             None => {
                 let topic = format!("channel {}", h.channel_id);
                 let reason = "is on a channel that no channel record declares";
-                self.fail(message(&topic, h.log_time, reason));
+                self.fail(ExportError(unreadable(&topic, h.log_time, reason)));
             }
         }
         if self.error.is_some() {

@@ -291,7 +291,7 @@ fn records(
 #[allow(clippy::cast_precision_loss)]
 fn rate(messages: u64, time_range: Option<(u64, u64)>) -> Option<f64> {
     let (start, end) = time_range?;
-    (messages >= 2 && end > start).then(|| (messages - 1) as f64 / ((end - start) as f64 / 1e9))
+    (messages >= 2 && end > start).then(|| (messages - 1) as f64 / seconds(end - start))
 }
 
 fn from_summary(summary: coin_log_mcap::Summary) -> FileInfo {

@@ -2,6 +2,7 @@
 //! pass. Memory stays bounded whatever the file's length: each time series keeps at most [`POINTS`]
 //! min/max buckets (so no spike is lost), and the paths keep every k-th point with k doubling as needed.
 
+use super::read_values;
 use crate::files::shown_name;
 use crate::format::fields::FieldReader;
 use crate::format::{
@@ -52,9 +53,7 @@ struct Envelope {
 
 impl Envelope {
     fn push(&mut self, t: f64, v: f64) {
-        if self.width == 0 {
-            self.width = 1;
-        }
+        self.width = self.width.max(1);
         if self.filled == 0 || self.filled == self.width {
             if self.buckets.len() == 2 * POINTS {
                 self.halve();
@@ -124,9 +123,7 @@ struct Path2 {
 
 impl Path2 {
     fn push(&mut self, p: (f64, f64)) {
-        if self.stride == 0 {
-            self.stride = 1;
-        }
+        self.stride = self.stride.max(1);
         if self.seen.is_multiple_of(self.stride) {
             if self.points.len() == 2 * POINTS {
                 self.points = self.points.iter().step_by(2).copied().collect();
@@ -260,22 +257,16 @@ impl Collect {
 
 impl Visitor for Collect {
     fn channel(&mut self, id: u16, topic: &str, _: &str, schema: Option<&Schema<'_>>) {
-        let Some(Schema {
-            name: schema,
-            encoding,
-            data,
-            ..
-        }) = schema
-        else {
+        let Some(s) = schema else {
             return;
         };
-        let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == schema) else {
+        let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == s.name) else {
             return;
         };
         let Some(t) = c.message_type() else {
             return;
         };
-        match FieldReader::new(encoding, t, data) {
+        match FieldReader::new(&s.encoding, t, &s.data) {
             Ok((r, _)) => {
                 self.readers.insert(id, (c, r));
             }
@@ -300,25 +291,15 @@ impl Visitor for Collect {
         };
         let (channel, names) = (*channel, reader.fields());
         let mut values = std::mem::take(&mut self.values);
-        values.clear();
-        values.resize(names.len(), 0.0);
-        match reader.read(data, &mut values) {
-            Ok(()) => self.observe(
-                channel,
-                &Fields {
-                    names,
-                    values: &values,
-                },
-            ),
-            Err(e) => {
-                self.problem = Some(format!(
-                    "{}: the message at log time {} ns {e}",
-                    channel.topic(),
-                    h.log_time
-                ));
-                return ControlFlow::Break(());
-            }
+        if let Err(e) = read_values(reader, data, &mut values, (channel.topic(), h.log_time)) {
+            self.problem = Some(e);
+            return ControlFlow::Break(());
         }
+        let fields = Fields {
+            names,
+            values: &values,
+        };
+        self.observe(channel, &fields);
         self.values = values;
         ControlFlow::Continue(())
     }

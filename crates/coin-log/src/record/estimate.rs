@@ -107,7 +107,7 @@ pub fn estimate(scene: &Scene, compression: Compression, encoding: Encoding) -> 
     let updates = n.min((scene.run.duration * SCENE_RATE).ceil() as u64 + 2);
     let mut per_channel = Vec::new();
     let (mut payload, mut schemas) = (0u64, 0u64);
-    let mut seen_schemas = Vec::new();
+    let mut seen_schemas = std::collections::BTreeSet::new();
     // Bytes of a /tf message, of a /scene update and of one of its track points, of a flat message.
     let (tf, update, point, flat): (_, _, _, fn(&[&str]) -> u64) = match encoding {
         Encoding::Json => (TF_BYTES, SCENE_BYTES, TRACK_POINT_BYTES, flat_bytes),
@@ -139,8 +139,7 @@ pub fn estimate(scene: &Scene, compression: Compression, encoding: Encoding) -> 
         };
         per_channel.push((c, count));
         payload += count * (bytes + RECORD_OVERHEAD);
-        if !seen_schemas.contains(&c.schema_name()) {
-            seen_schemas.push(c.schema_name());
+        if seen_schemas.insert(c.schema_name()) {
             schemas += schema_data(c.schema_name(), encoding).map_or(0, |s| s.len() as u64);
         }
     }

@@ -654,11 +654,10 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
         {
             return Err(RecordError::Encoding { channel });
         }
-        let chaplygin = if scene.records(Channel::Invariants) {
-            Some(Chaplygin::new(&scene.params)?)
-        } else {
-            None
-        };
+        let chaplygin = scene
+            .records(Channel::Invariants)
+            .then(|| Chaplygin::new(&scene.params))
+            .transpose()?;
         let library = format!("coin-log/{}", env!("CARGO_PKG_VERSION"));
         let write_options = WriterOptions {
             workers: COMPRESSION_THREADS,

@@ -147,30 +147,19 @@ impl Judge {
         Ok(())
     }
 
-    fn run_metadata(&mut self, entries: &BTreeMap<String, String>) {
-        let run = match RunMetadata::from_map(entries) {
-            Ok(run) => run,
-            Err(e) => {
-                self.run_error = Some(format!("its `coin-log` metadata is unusable: {e}"));
-                return;
-            }
-        };
+    /// The checks' context from the `coin-log` record's `entries`, or why the file cannot be judged.
+    fn run_metadata(&mut self, entries: &BTreeMap<String, String>) -> Result<Context, String> {
+        let run = RunMetadata::from_map(entries)
+            .map_err(|e| format!("its `coin-log` metadata is unusable: {e}"))?;
         if run.format_version != FORMAT_VERSION {
-            self.run_error = Some(format!(
+            return Err(format!(
                 "its `coin-log` metadata has format_version {:?}; this tool reads {FORMAT_VERSION:?}",
                 run.format_version
             ));
-            return;
         }
-        let params = match run.params() {
-            Ok(p) => p,
-            Err(e) => {
-                self.run_error = Some(format!(
-                    "its `coin-log` metadata has unusable body parameters: {e}"
-                ));
-                return;
-            }
-        };
+        let params = run
+            .params()
+            .map_err(|e| format!("its `coin-log` metadata has unusable body parameters: {e}"))?;
         let coin = Coin::new(params);
         let dynamics = Dynamics::new(coin, run.dissipation);
         let scene = stored_scene(&run);
@@ -187,7 +176,7 @@ impl Judge {
         let steady = steady::plan(&coin, &run, &scene);
         let chaplygin = Chaplygin::new(&params)
             .map_err(|e| format!("C1, C2 cannot be evaluated for these parameters: {e}"));
-        self.ctx = Some(Context {
+        Ok(Context {
             coin,
             dynamics,
             run,
@@ -195,7 +184,7 @@ impl Judge {
             scene,
             steady,
             chaplygin,
-        });
+        })
     }
 }
 
@@ -335,7 +324,10 @@ impl Visitor for Judge {
                     .push_with(|| "more than one `coin-log` metadata record".into());
                 return;
             }
-            self.run_metadata(entries);
+            match self.run_metadata(entries) {
+                Ok(ctx) => self.ctx = Some(ctx),
+                Err(e) => self.run_error = Some(e),
+            }
         } else if name == RESULT_METADATA_NAME {
             match ResultMetadata::from_map(entries) {
                 Ok(r) => self.result = Some(r),

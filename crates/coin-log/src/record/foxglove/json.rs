@@ -71,35 +71,23 @@ impl<'a> Writer<'a> {
         self.raw(b"}");
     }
 
-    fn vector3(&mut self, x: f64, y: f64, z: f64) {
-        self.raw(b"{\"x\":");
-        self.num(x);
-        self.raw(b",\"y\":");
-        self.num(y);
-        self.raw(b",\"z\":");
-        self.num(z);
-        self.raw(b"}");
-    }
-
-    /// Foxglove's `{x, y, z, w}` are the quaternion's (i, j, k, w).
-    fn quaternion(&mut self, q: &UnitQuaternion<f64>) {
-        self.raw(b"{\"x\":");
-        self.num(q.i);
-        self.raw(b",\"y\":");
-        self.num(q.j);
-        self.raw(b",\"z\":");
-        self.num(q.k);
-        self.raw(b",\"w\":");
-        self.num(q.w);
+    /// `{"x":..,"y":..,"z":..}` of a vector's `[x, y, z]`, or with `"w":..` of a quaternion's `[i, j, k, w]`
+    /// (Foxglove's `{x, y, z, w}`).
+    fn xyzw(&mut self, values: &[f64]) {
+        let keys: [&[u8]; 4] = [b"{\"x\":", b",\"y\":", b",\"z\":", b",\"w\":"];
+        for (key, v) in keys.into_iter().zip(values) {
+            self.raw(key);
+            self.num(*v);
+        }
         self.raw(b"}");
     }
 
     /// A `Pose`: `position` and the rotation `q` as `orientation`.
     fn pose(&mut self, position: &Vector3<f64>, q: &UnitQuaternion<f64>) {
         self.raw(b"{\"position\":");
-        self.vector3(position.x, position.y, position.z);
+        self.xyzw(position.as_slice());
         self.raw(b",\"orientation\":");
-        self.quaternion(q);
+        self.xyzw(&[q.i, q.j, q.k, q.w]);
         self.raw(b"}");
     }
 
@@ -149,12 +137,12 @@ pub(super) fn transform(
     w.raw(child.as_bytes());
     w.raw(b"\",\"translation\":");
     match translation {
-        Some([x, y, z]) => w.vector3(x, y, z),
+        Some(t) => w.xyzw(&t),
         None => w.raw(b"{\"x\":0,\"y\":0,\"z\":0}"),
     }
     w.raw(b",\"rotation\":");
     match rotation {
-        Some(q) => w.quaternion(q),
+        Some(q) => w.xyzw(&[q.i, q.j, q.k, q.w]),
         None => w.raw(b"{\"x\":0,\"y\":0,\"z\":0,\"w\":1}"),
     }
     w.raw(b"}");
@@ -173,7 +161,7 @@ pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, th
         w.raw(b"{\"pose\":");
         w.pose(position, r);
         w.raw(b",\"size\":");
-        w.vector3(size[0], size[1], size[2]);
+        w.xyzw(size);
         w.raw(b",\"color\":");
         w.color(*colour);
         w.raw(b"}");
@@ -181,7 +169,7 @@ pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, th
     w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
     w.pose(&Vector3::zeros(), r);
     w.raw(b",\"size\":");
-    w.vector3(2.0, 2.0, thickness);
+    w.xyzw(&[2.0, 2.0, thickness]);
     w.raw(b",\"bottom_scale\":1,\"top_scale\":1,\"color\":");
     w.color(COIN_RGBA);
     w.raw(b"}],\"lines\":[],");
@@ -193,10 +181,10 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     let mut w = Writer::new(buf);
     w.entity_head(log_time, WORLD_FRAME, b"table");
     w.raw(b"\"cubes\":[{\"pose\":{\"position\":");
-    w.vector3(centre[0], centre[1], TABLE_TOP - 0.5 * TABLE_THICKNESS);
+    w.xyzw(&[centre[0], centre[1], TABLE_TOP - 0.5 * TABLE_THICKNESS]);
     w.raw(b",\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"size\":");
     let side = 2.0 * TABLE_HALF_SIDE;
-    w.vector3(side, side, TABLE_THICKNESS);
+    w.xyzw(&[side, side, TABLE_THICKNESS]);
     w.raw(b",\"color\":");
     w.color(TABLE_RGBA);
     w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
