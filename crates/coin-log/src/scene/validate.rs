@@ -339,20 +339,15 @@ fn initial_base(
         }
         (None, Some(theta), Some(omega)) => {
             check_theta(theta, flat_margin, problems);
-            problems
-                .vector3("initial.omega", omega)
-                .map(|[wx, wy, wz]| {
-                    (
-                        State {
-                            theta,
-                            omega_x: wx,
-                            omega_y: wy,
-                            omega_z: wz,
-                            ..State::default()
-                        },
-                        InitialSpec::Explicit,
-                    )
-                })
+            let [omega_x, omega_y, omega_z] = problems.vector3("initial.omega", omega)?;
+            let state = State {
+                theta,
+                omega_x,
+                omega_y,
+                omega_z,
+                ..State::default()
+            };
+            Some((state, InitialSpec::Explicit))
         }
         (None, None, omega) => {
             if let Some(o) = omega {
