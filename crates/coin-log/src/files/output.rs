@@ -409,8 +409,7 @@ fn umask() -> u32 {
 /// then does).
 ///
 /// # Errors
-/// As [`Output::create`]'s checks: the target is not a file that may be written or replaced, or its folder
-/// is missing.
+/// As [`Output::create`]'s checks.
 pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
     let meta = look_at(target, policy)?;
     if meta.is_some() && !policy.overwrite {
