@@ -41,14 +41,10 @@ pub fn split(line: &str) -> Option<Vec<String>> {
     let mut chars = line.chars().peekable();
     loop {
         let mut field = String::new();
-        if chars.peek() == Some(&'"') {
-            chars.next();
+        if chars.next_if_eq(&'"').is_some() {
             loop {
                 match chars.next()? {
-                    '"' if chars.peek() == Some(&'"') => {
-                        chars.next();
-                        field.push('"');
-                    }
+                    '"' if chars.next_if_eq(&'"').is_some() => field.push('"'),
                     '"' => break,
                     c => field.push(c),
                 }
@@ -57,12 +53,8 @@ pub fn split(line: &str) -> Option<Vec<String>> {
                 return None;
             }
         } else {
-            while let Some(&c) = chars.peek() {
-                if c == ',' {
-                    break;
-                }
+            while let Some(c) = chars.next_if(|&c| c != ',') {
                 field.push(c);
-                chars.next();
             }
         }
         fields.push(field);

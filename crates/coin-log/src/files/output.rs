@@ -50,16 +50,14 @@ impl Policy {
     /// What to do instead of writing to `target`, refused as `refused`. Without an example the target is a
     /// file of an output folder (`export`, `man`): the fix is another folder.
     fn fix(&self, refused: Refused, target: &Path) -> String {
-        let flag = self.flag;
-        if self.example.is_empty() {
-            return match refused {
-                Refused::Exists => {
-                    format!("pass --overwrite to replace it, or choose another folder with {flag}")
-                }
-                _ => format!("move it away, or choose another folder with {flag}"),
-            };
-        }
+        let (flag, other) = (self.flag, self.other());
         match refused {
+            Refused::Exists => {
+                format!("pass --overwrite to replace it, or choose another {other} with {flag}")
+            }
+            _ if self.example.is_empty() => {
+                format!("move it away, or choose another {other} with {flag}")
+            }
             Refused::Folder => format!(
                 "give a file name, e.g. {flag} {}",
                 shown(&target.join(&*self.example))
@@ -80,9 +78,16 @@ impl Policy {
                 };
                 format!("choose another output, e.g. {flag} {example}")
             }
-            Refused::Exists => {
-                format!("pass --overwrite to replace it, or choose another file with {flag}")
-            }
+        }
+    }
+
+    /// What a message tells the user to choose another of: a folder for the files of an output folder
+    /// (no example), else a file.
+    fn other(&self) -> &'static str {
+        if self.example.is_empty() {
+            "folder"
+        } else {
+            "file"
         }
     }
 }
@@ -166,12 +171,7 @@ impl Attribute {
 /// Refuses a target whose folder, or which itself (when it is there), has an [`Attribute`] that forbids
 /// moving a file into place.
 fn check_attributes(target: &Path, exists: bool, policy: &Policy) -> Result<(), OutputError> {
-    let what = if policy.example.is_empty() {
-        "folder"
-    } else {
-        "file"
-    };
-    let flag = policy.flag;
+    let (what, flag) = (policy.other(), policy.flag);
     if let Some(attribute) = exists.then(|| Attribute::of(target)).flatten() {
         let (name, clear) = attribute.words();
         let path = shown(target);
@@ -282,20 +282,18 @@ fn link_fix(target: &Path, policy: &Policy) -> String {
         return policy.fix(Refused::Special, target);
     }
     match fs::metadata(target) {
-        Err(e) if e.kind() == ErrorKind::NotFound => {
-            "give the path it points to, or choose another path".into()
-        }
-        Ok(meta) if meta.is_file() => "give the path it points to, or choose another path".into(),
         Ok(meta) if meta.is_dir() => format!(
             "it leads to a folder; {}",
             policy.fix(Refused::Folder, target)
         ),
-        Ok(meta) => format!(
+        Ok(meta) if !meta.is_file() => format!(
             "it leads to {}, which coin-log does not write into (nor to standard output); {}",
             kind_of(&meta),
             policy.fix(Refused::Special, target)
         ),
-        Err(_) => policy.fix(Refused::Special, target),
+        Err(e) if e.kind() != ErrorKind::NotFound => policy.fix(Refused::Special, target),
+        // A regular file, or nothing yet.
+        _ => "give the path it points to, or choose another path".into(),
     }
 }
 
@@ -411,8 +409,7 @@ fn umask() -> u32 {
 /// then does).
 ///
 /// # Errors
-/// As [`Output::create`]'s checks: the target is not a file that may be written or replaced, or its folder
-/// is missing.
+/// As [`Output::create`]'s checks.
 pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
     let meta = look_at(target, policy)?;
     if meta.is_some() && !policy.overwrite {

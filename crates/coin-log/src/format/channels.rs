@@ -155,8 +155,7 @@ impl Topic {
     /// Every topic, main topics first in the channel table's order.
     pub fn all() -> impl Iterator<Item = Topic> {
         let extras = [Self::TfStatic, Self::SceneFollow, Self::SceneTable];
-        // TRACK_LEVELS (16) fits in a u8.
-        let levels = (0..TRACK_LEVELS).map(|l| Self::SceneTrack(u8::try_from(l).unwrap_or(0)));
+        let levels = (0..=u8::MAX).take(TRACK_LEVELS).map(Self::SceneTrack);
         let rerun = [Self::RerunRobot, Self::RerunTable, Self::RerunTrack];
         Channel::ALL
             .iter()

@@ -138,10 +138,8 @@ impl FieldReader {
 fn validates(data: &[u8], fields: &[&str]) -> Result<(), String> {
     use serde_json::Value;
     let v: Value = serde_json::from_slice(data).map_err(|e| format!("is not JSON: {e}"))?;
-    if let Some(t) = v.get("type") {
-        if t.as_str() != Some("object") {
-            return Err(format!("types the messages as {t}, not an object"));
-        }
+    if let Some(t) = v.get("type").filter(|t| t.as_str() != Some("object")) {
+        return Err(format!("types the messages as {t}, not an object"));
     }
     let props = v.get("properties").and_then(Value::as_object);
     let required = v.get("required").and_then(Value::as_array);

@@ -153,11 +153,9 @@ fn number(s: &[u8]) -> Option<(f64, usize)> {
                     digits += 1;
                 }
                 scale -= i64::from(fraction);
-            } else if !fraction {
-                digits += 1;
-                scale += 1;
             } else {
                 digits += 1;
+                scale += i64::from(!fraction);
             }
             *i += 1;
         }

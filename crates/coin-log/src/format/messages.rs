@@ -219,17 +219,15 @@ macro_rules! message {
             pub fn write_json(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
                 self.check_finite()?;
                 let mut formatter = ryu::Buffer::new();
-                let mut first = true;
-                buf.push(b'{');
+                // `{` before the first field, `,` before each other.
+                let mut separator = b'{';
                 $(
-                    if !first {
-                        buf.push(b',');
-                    }
-                    first = false;
+                    buf.push(separator);
+                    separator = b',';
                     buf.extend_from_slice(concat!("\"", stringify!($field), "\":").as_bytes());
                     push_number(buf, self.$field, &mut formatter);
                 )+
-                let _ = first;
+                let _ = separator;
                 $($(
                     if let Some(v) = self.$added {
                         buf.extend_from_slice(concat!(",\"", stringify!($added), "\":").as_bytes());

@@ -4,7 +4,9 @@
 //! and a decoder that reads a `coin_log.*` message field by field by the numbers of a stored descriptor.
 
 use super::json::FieldsError;
-use super::messages::{FRAME_TRANSFORM, MESSAGE_TYPES, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID};
+use super::messages::{
+    MessageType, FRAME_TRANSFORM, MESSAGE_TYPES, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID,
+};
 use prost::encoding::{decode_key, decode_varint, WireType};
 use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
@@ -18,32 +20,24 @@ pub const PACKAGE: &str = "coin_log";
 /// one of the `foxglove.*` types it writes (FrameTransform, SceneUpdate, and PointCloud, VoxelGrid for Rerun).
 #[must_use]
 pub fn descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
-    static COIN: OnceLock<[Vec<u8>; MESSAGE_TYPES.len()]> = OnceLock::new();
-    if let Some(i) = MESSAGE_TYPES.iter().position(|t| t.schema == schema_name) {
-        let all = COIN.get_or_init(|| {
-            MESSAGE_TYPES.map(|t| coin_descriptor_set(t.schema, t.fields).encode_to_vec())
-        });
-        return Some(&all[i]);
-    }
-    foxglove_descriptor_set(schema_name)
-}
-
-fn foxglove_descriptor_set(schema_name: &str) -> Option<&'static [u8]> {
     use foxglove::messages::{FrameTransform, PointCloud, SceneUpdate, VoxelGrid};
     use foxglove::{Encode, Schema};
     type GetSchema = fn() -> Option<Schema>;
-    const SCHEMAS: [(&str, GetSchema); 4] = [
+    const FOXGLOVE: [(&str, GetSchema); 4] = [
         (FRAME_TRANSFORM, FrameTransform::get_schema),
         (SCENE_UPDATE, SceneUpdate::get_schema),
         (POINT_CLOUD, PointCloud::get_schema),
         (VOXEL_GRID, VoxelGrid::get_schema),
     ];
-    static FOXGLOVE: OnceLock<[Vec<u8>; 4]> = OnceLock::new();
-    let i = SCHEMAS.iter().position(|(name, _)| *name == schema_name)?;
-    let all = FOXGLOVE.get_or_init(|| {
-        SCHEMAS.map(|(_, get)| get().map(|s| s.data.into_owned()).unwrap_or_default())
+    static ALL: OnceLock<Vec<(&str, Vec<u8>)>> = OnceLock::new();
+    let all = ALL.get_or_init(|| {
+        let coin = MESSAGE_TYPES.map(|t| (t.schema, coin_descriptor_set(&t)));
+        let foxglove = FOXGLOVE
+            .map(|(name, get)| (name, get().map(|s| s.data.into_owned()).unwrap_or_default()));
+        coin.into_iter().chain(foxglove).collect()
     });
-    Some(&all[i])
+    let (_, data) = all.iter().find(|(name, _)| *name == schema_name)?;
+    Some(data)
 }
 
 /// The file name of a `coin_log.*` type's `.proto` (in `schemas/` and in its descriptor).
@@ -69,14 +63,16 @@ fn json_name(field: &str) -> String {
     out
 }
 
-/// The descriptor of one `coin_log.*` type: as protoc describes its `.proto` (proto3, one message of
-/// `double` fields numbered in order).
-fn coin_descriptor_set(schema_name: &str, fields: &[&str]) -> FileDescriptorSet {
-    let name = schema_name
+/// The serialized descriptor of one `coin_log.*` type: as protoc describes its `.proto` (proto3, one
+/// message of `double` fields numbered in order).
+fn coin_descriptor_set(t: &MessageType) -> Vec<u8> {
+    let name = t
+        .schema
         .strip_prefix(PACKAGE)
         .and_then(|n| n.strip_prefix('.'))
-        .unwrap_or(schema_name);
-    let field = fields
+        .unwrap_or(t.schema);
+    let field = t
+        .fields
         .iter()
         .zip(1..)
         .map(|(f, number)| FieldDescriptorProto {
@@ -90,7 +86,7 @@ fn coin_descriptor_set(schema_name: &str, fields: &[&str]) -> FileDescriptorSet 
         .collect();
     FileDescriptorSet {
         file: vec![FileDescriptorProto {
-            name: Some(proto_file_name(schema_name)),
+            name: Some(proto_file_name(t.schema)),
             package: Some(PACKAGE.to_string()),
             message_type: vec![DescriptorProto {
                 name: Some(name.to_string()),
@@ -101,6 +97,7 @@ fn coin_descriptor_set(schema_name: &str, fields: &[&str]) -> FileDescriptorSet 
             ..FileDescriptorProto::default()
         }],
     }
+    .encode_to_vec()
 }
 
 /// A stored descriptor that cannot describe a `coin_log.*` type's messages.

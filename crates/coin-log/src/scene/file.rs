@@ -90,36 +90,34 @@ pub struct DissipationFile {
 
 /// `[initial]`: an explicit state (θ and ω, optionally φ, ψ, x, z) or a steady motion, plus an optional kick.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct InitialFile {
     /// θ \[rad\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub theta: Option<f64>,
     /// (ω_X, ω_Y, ω_Z) in the lean frame [rad/time].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub omega: Option<Vec<f64>>,
     /// φ \[rad\] (default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub phi: Option<f64>,
     /// ψ \[rad\] (default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub psi: Option<f64>,
     /// Centre x \[length\] (default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub x: Option<f64>,
     /// Centre z \[length\] (default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub z: Option<f64>,
     /// A steady motion (physics §4) whose ω the solver fills in.
     #[serde(
-        default,
         skip_serializing_if = "Option::is_none",
         deserialize_with = "optional_table"
     )]
     pub steady: Option<SteadyFile>,
     /// A kick added to the initial state of either form.
     #[serde(
-        default,
         skip_serializing_if = "Option::is_none",
         deserialize_with = "optional_table"
     )]
@@ -148,55 +146,55 @@ pub struct SteadyFile {
 
 /// `perturbation = { theta = ..., omega = [...] }`: added to the initial state.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct PerturbationFile {
     /// Added to θ \[rad\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub theta: Option<f64>,
     /// Added to (ω_X, ω_Y, ω_Z) [rad/time].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub omega: Option<Vec<f64>>,
 }
 
 /// `[run]`: every key optional, defaults in [`super::defaults`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct RunFile {
     /// Duration \[time\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub duration: Option<f64>,
     /// Samples per time unit.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rate: Option<f64>,
     /// Integrator name.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub integrator: Option<String>,
     /// Relative tolerance (adaptive methods).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rtol: Option<f64>,
     /// Absolute tolerance (adaptive methods).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub atol: Option<f64>,
     /// Step (fixed-step methods) \[time\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub step: Option<f64>,
     /// Most integrator steps (format.md: Limits).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_steps: Option<u64>,
     /// The run ends at |θ| ≥ π/2 − flat_margin \[rad\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub flat_margin: Option<f64>,
 }
 
 /// `[record]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct RecordFile {
     /// Channel names.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub channels: Option<Vec<String>>,
     /// `true` adds the `rerun` channel (the coin, table and track for Rerun) to the channels.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rerun: Option<bool>,
 }
 

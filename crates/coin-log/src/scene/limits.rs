@@ -74,10 +74,8 @@ fn short(x: f64, round: Round) -> String {
     if !x.is_finite() || x == 0.0 {
         return number(x);
     }
-    // Four significant digits of the correctly rounded decimal form, moved one unit towards zero (`Down`)
-    // or away from it (`Up`) when that rounding went the other way, so that a printed ceiling holds for x
-    // itself: 1e-3/τ = 9.999999999999999e-54 is below 1e-53, and the old x / 10^(e−3) came out as
-    // 999.99999999999989 for x = 1e-65 and printed "0.999e-65".
+    // The correctly rounded decimal form, moved one unit when it rounded the wrong way for `round`, so that
+    // a printed ceiling holds for x itself (the tests show the two cases that printed wrong).
     let magnitude = x.abs();
     let text = format!("{magnitude:.3e}");
     let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
@@ -138,11 +136,12 @@ pub(super) fn check_scales(
     inertia: Inertia,
     problems: &mut ProblemCollector,
 ) -> bool {
-    let mut inputs = vec![
+    let given = [
         ("body.mass", body.mass),
         ("body.radius", body.radius),
         ("body.gravity", body.gravity),
     ];
+    let mut inputs = given.to_vec();
     if let Inertia::Explicit {
         inertia_x,
         inertia_z,
@@ -162,7 +161,7 @@ pub(super) fn check_scales(
             ok = false;
         }
     }
-    ok && check_derived_scales(body, problems)
+    ok && check_derived_scales(given, problems)
 }
 
 /// The scales formed from M, a, g: (name, exponents of M, a, g).
@@ -174,9 +173,8 @@ const DERIVED_SCALES: [(&str, [f64; 3]); 5] = [
     ("the squared speed scale a·g", [0.0, 1.0, 1.0]),
 ];
 
-fn check_derived_scales(body: &super::file::BodyFile, problems: &mut ProblemCollector) -> bool {
-    let keys = ["body.mass", "body.radius", "body.gravity"];
-    let values = [body.mass, body.radius, body.gravity];
+fn check_derived_scales(given: [(&str, f64); 3], problems: &mut ProblemCollector) -> bool {
+    let (keys, values) = (given.map(|(k, _)| k), given.map(|(_, v)| v));
     let logs = values.map(f64::log10);
     // Per key, the scales it puts out of range (a key is blamed when its share of the exponent is largest).
     let mut blamed: Vec<(usize, Vec<String>)> = Vec::new();
@@ -420,25 +418,23 @@ fn refuse_power(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
                 short(k_max, Round::Down)
             ),
         );
+    } else if !rate_factor.is_finite() && d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
+        // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
+        let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
+        problems.push(
+            "body.dissipation.m",
+            number(m),
+            format!(
+                "{laws}: |φ̇|^m overflows double precision; use m < {}",
+                short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
+            ),
+        );
     } else if !rate_factor.is_finite() {
-        if d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
-            // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
-            let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
-            problems.push(
-                "body.dissipation.m",
-                number(m),
-                format!(
-                    "{laws}: |φ̇|^m overflows double precision; use m < {}",
-                    short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
-                ),
-            );
-        } else {
-            problems.push(
-                initial_key(scene),
-                describe_state(s),
-                format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
-            );
-        }
+        problems.push(
+            initial_key(scene),
+            describe_state(s),
+            format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
+        );
     } else {
         let kappa_max = f64::MAX / rate_factor / angle_factor;
         problems.push(
@@ -545,38 +541,24 @@ fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
     let e = energy(&coin, s).total;
     // The reaction of the equations the run integrates (with the couple's ω̇ when there is one).
     let r = scene.dynamics().reaction(s);
-    let key = initial_key(scene);
-    let value = || describe_state(s);
     let p = &scene.params;
     let weight = p.mass() * p.gravity();
-    if !(e.is_finite() && r.normal.is_finite() && r.friction.is_finite()) {
-        problems.push(
-            key,
-            value(),
-            format!(
-                "gives a non-finite energy or reaction at t = 0 (E = {}, N = {}): ω is too large for double precision; keep |ω| well below 1e150/τ = {}",
-                short(e, Round::Nearest),
-                short(r.normal, Round::Nearest),
-                power_of_ten(150.0 - p.time_unit().log10())
-            ),
-        );
-        return;
-    }
-    if r.normal <= 0.0 {
-        problems.push(
-            key,
-            value(),
-            format!(
-                "gives N = {} = {}·Mg ≤ 0 at t = 0: the coin would leave the table at once (lift-off), outside the rolling model; lower the spin or the lean so that N > 0",
-                short(r.normal, Round::Nearest),
-                short(r.normal / weight, Round::Nearest)
-            ),
-        );
-        return;
-    }
-    if let Some(mu) = scene.friction {
+    let reason = if !(e.is_finite() && r.normal.is_finite() && r.friction.is_finite()) {
+        format!(
+            "gives a non-finite energy or reaction at t = 0 (E = {}, N = {}): ω is too large for double precision; keep |ω| well below 1e150/τ = {}",
+            short(e, Round::Nearest),
+            short(r.normal, Round::Nearest),
+            power_of_ten(150.0 - p.time_unit().log10())
+        )
+    } else if r.normal <= 0.0 {
+        format!(
+            "gives N = {} = {}·Mg ≤ 0 at t = 0: the coin would leave the table at once (lift-off), outside the rolling model; lower the spin or the lean so that N > 0",
+            short(r.normal, Round::Nearest),
+            short(r.normal / weight, Round::Nearest)
+        )
+    } else {
         let needed = r.friction / r.normal;
-        if needed >= mu {
+        if let Some(mu) = scene.friction.filter(|&mu| needed >= mu) {
             problems.push(
                 "body.friction",
                 number(mu),
@@ -589,7 +571,9 @@ fn check_start(scene: &Scene, problems: &mut ProblemCollector) {
                 ),
             );
         }
-    }
+        return;
+    };
+    problems.push(initial_key(scene), describe_state(s), reason);
 }
 
 fn describe_state(s: &State) -> String {

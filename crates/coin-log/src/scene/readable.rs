@@ -53,14 +53,13 @@ impl std::fmt::Display for Short {
 
 /// Copies a value (a number, string, array or inline table), rewriting its floats.
 fn rewrite_value(value: &str, out: &mut String) {
+    let bare = |c: char| c.is_ascii_alphanumeric() || "+-_.".contains(c);
     let mut rest = value;
     while let Some(c) = rest.chars().next() {
         let taken = match c {
             '"' | '\'' => string_len(rest, c),
-            c if c.is_ascii_alphanumeric() || "+-_.".contains(c) => {
-                let len = rest
-                    .find(|c: char| !(c.is_ascii_alphanumeric() || "+-_.".contains(c)))
-                    .unwrap_or(rest.len());
+            c if bare(c) => {
+                let len = rest.find(|c: char| !bare(c)).unwrap_or(rest.len());
                 let word = &rest[..len];
                 let is_float = c.is_ascii_digit() || "+-".contains(c);
                 match word.parse::<f64>() {

@@ -339,20 +339,15 @@ fn initial_base(
         }
         (None, Some(theta), Some(omega)) => {
             check_theta(theta, flat_margin, problems);
-            problems
-                .vector3("initial.omega", omega)
-                .map(|[wx, wy, wz]| {
-                    (
-                        State {
-                            theta,
-                            omega_x: wx,
-                            omega_y: wy,
-                            omega_z: wz,
-                            ..State::default()
-                        },
-                        InitialSpec::Explicit,
-                    )
-                })
+            let [omega_x, omega_y, omega_z] = problems.vector3("initial.omega", omega)?;
+            let state = State {
+                theta,
+                omega_x,
+                omega_y,
+                omega_z,
+                ..State::default()
+            };
+            Some((state, InitialSpec::Explicit))
         }
         (None, None, omega) => {
             if let Some(o) = omega {
@@ -428,17 +423,15 @@ fn check_steady_keys(steady: &SteadyFile, family: SteadyFamily, problems: &mut P
         ("branch", steady.branch.as_deref().map(quoted)),
     ];
     for (name, value) in given {
-        if let Some(v) = value {
-            if !allowed.contains(&name) {
-                problems.push(
-                    format!("initial.steady.{name}"),
-                    v,
-                    format!(
-                        "does not apply to a \"{family}\" steady motion, which takes: kind, {}",
-                        allowed.join(", ")
-                    ),
-                );
-            }
+        if let Some(v) = value.filter(|_| !allowed.contains(&name)) {
+            problems.push(
+                format!("initial.steady.{name}"),
+                v,
+                format!(
+                    "does not apply to a \"{family}\" steady motion, which takes: kind, {}",
+                    allowed.join(", ")
+                ),
+            );
         }
     }
 }
@@ -506,22 +499,19 @@ fn solve_steady(
     family: SteadyFamily,
     problems: &mut ProblemCollector,
 ) -> Option<Steady> {
-    match Steady::new(coin, kind) {
-        Ok(s) if s.state.is_finite() => Some(s),
-        Ok(s) => problems.reject(
-            "initial.steady",
-            format!("{{ kind = \"{family}\" }}"),
-            format!(
-                "has no finite solution here (ω_Y = {})",
-                number(s.state.omega_y)
-            ),
+    let reason = match Steady::new(coin, kind) {
+        Ok(s) if s.state.is_finite() => return Some(s),
+        Ok(s) => format!(
+            "has no finite solution here (ω_Y = {})",
+            number(s.state.omega_y)
         ),
-        Err(e) => problems.reject(
-            "initial.steady",
-            format!("{{ kind = \"{family}\" }}"),
-            format!("cannot be built: {e}"),
-        ),
-    }
+        Err(e) => format!("cannot be built: {e}"),
+    };
+    problems.reject(
+        "initial.steady",
+        format!("{{ kind = \"{family}\" }}"),
+        reason,
+    )
 }
 
 fn check_run(
@@ -664,24 +654,16 @@ fn listed_channels(
     for name in names {
         // `--channels "omega, angles"`: spaces around a name are not part of it.
         let name = name.trim();
-        match name.parse::<Channel>() {
-            Ok(c) if channels.contains(&c) => problems.push(
-                "record.channels",
-                quoted(name),
-                "is listed twice: list each channel once",
-            ),
-            Ok(Channel::Work) if !dissipative => problems.push(
-                "record.channels",
-                quoted(name),
-                "records the work of a dissipative couple, and the scene has none: add body.dissipation = { model = \"moffatt\", coefficient = ... } (format.md: Dissipation) or leave \"work\" out",
-            ),
-            Ok(c) => channels.push(c),
-            Err(_) => problems.push(
-                "record.channels",
-                quoted(name),
-                format!("is not a channel: use {}", Channel::names()),
-            ),
-        }
+        let reason = match name.parse::<Channel>() {
+            Ok(c) if channels.contains(&c) => "is listed twice: list each channel once".into(),
+            Ok(Channel::Work) if !dissipative => "records the work of a dissipative couple, and the scene has none: add body.dissipation = { model = \"moffatt\", coefficient = ... } (format.md: Dissipation) or leave \"work\" out".into(),
+            Ok(c) => {
+                channels.push(c);
+                continue;
+            }
+            Err(_) => format!("is not a channel: use {}", Channel::names()),
+        };
+        problems.push("record.channels", quoted(name), reason);
     }
     if names.is_empty() {
         problems.push(
