@@ -927,3 +927,34 @@ fn the_stored_scene_of_a_damaged_file_is_printed_with_exit_1_and_no_reproduction
     assert_eq!(code, 0, "{err}");
     assert!(text.contains("writes the same bytes again"), "{text}");
 }
+
+/// A frame transform that does not decode is named by its own topic: every frame-transform topic has its
+/// table, and the error said `/tf` for a message on /tf_static or /scene/follow too.
+#[test]
+fn an_undecodable_frame_transform_is_named_by_its_own_topic() {
+    let dir = tempfile::tempdir().unwrap();
+    let recorded = record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "0.1", "--channels", "tf,scene"],
+    );
+    for topic in ["/tf", "/tf_static", "/scene/follow"] {
+        let damaged = dir.path().join("damaged.mcap");
+        crate::support::writers::rewrite(&recorded, &damaged, |e| {
+            if e.topic == topic && e.index == 0 {
+                *e.data = b"{".to_vec();
+            }
+        });
+        let out = coin_log(dir.path(), &["export", "damaged.mcap", "--out", "x"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{topic}: {stderr}");
+        assert!(
+            stderr.contains(&format!("{topic}: the message at log time ")),
+            "{topic}: {stderr}"
+        );
+        assert!(
+            stderr.contains("is not a foxglove.FrameTransform"),
+            "{topic}: {stderr}"
+        );
+    }
+}

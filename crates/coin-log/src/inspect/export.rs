@@ -342,8 +342,9 @@ impl<W: Write> Exporter<'_, W> {
             Ok(row) => row,
             Err(e) => {
                 let reason = format!("is not a foxglove.FrameTransform: {e}");
-                let topic = Channel::Tf.topic();
-                return self.fail(ExportError(unreadable(topic, h.log_time, reason)));
+                // The table's one topic: /tf, /tf_static or /scene/follow (all three said /tf).
+                let topic = self.tables[table].table.topics.join(", ");
+                return self.fail(ExportError(unreadable(&topic, h.log_time, reason)));
             }
         };
         self.line.clear();

@@ -19,8 +19,8 @@ use crate::format::{
 use crate::integrate::{self, Bounds, Flow, RunOutcome, RunSettings};
 use crate::model::drift::{EnergyDrift, InvariantDrift};
 use crate::model::{
-    centre, contact_point, energy, orientation, Chaplygin, Coin, Dynamics, InvariantsError, State,
-    STATE_LEN,
+    centre, contact_point, energy, magnitude, orientation, Chaplygin, Coin, Dynamics,
+    InvariantsError, State, STATE_LEN,
 };
 use crate::scene::Scene;
 use crate::simulation::{departure_doubt, run_dynamics};
@@ -419,7 +419,7 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
     fn track(&mut self, t: f64, s: &State, total: f64, invariants: Option<(f64, f64)>) {
         let d = &mut self.drift;
         d.energy.observe(t, total);
-        let omega = (s.omega_x * s.omega_x + s.omega_y * s.omega_y + s.omega_z * s.omega_z).sqrt();
+        let omega = magnitude(s.omega_x, s.omega_y, s.omega_z);
         d.max_omega = d.max_omega.max(omega);
         d.last_theta = s.theta;
         // With dissipation C1, C2 are not conserved (physics §11): their change is no drift.
