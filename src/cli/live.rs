@@ -134,7 +134,7 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     }
     print_summary(&args, &scene, &source.label, &summary, wall, &stats)?;
     let outcome = match &args.output {
-        Some(target) => record::outcome(&summary, target),
+        Some(target) => record::outcome(&summary, &scene, target),
         None => run_outcome(&summary),
     };
     serve_final_state(&args, server, &signals);

@@ -188,7 +188,7 @@ pub fn run(args: RecordArgs) -> anyhow::Result<Outcome> {
             }
         }
     }
-    Ok(outcome(&summary, &target))
+    Ok(outcome(&summary, &scene, &target))
 }
 
 /// Recordings estimated larger than this get a warning before they start \[bytes\].
@@ -419,14 +419,12 @@ pub(super) fn persist(output: Output, signals: &Signals) -> anyhow::Result<()> {
 }
 
 /// The exit code of a finished recording; a numerical failure says where the samples stop.
-pub(super) fn outcome(summary: &RecordSummary, target: &Path) -> Outcome {
+pub(super) fn outcome(summary: &RecordSummary, scene: &Scene, target: &Path) -> Outcome {
     match &summary.failure {
         Some(f) => {
-            let fix = if summary.termination == Termination::StepBudgetSpent {
-                " (raise --max-steps, run.max_steps, or loosen --rtol/--atol)"
-            } else {
-                ""
-            };
+            let fix = summary
+                .budget_advice(scene.run.duration, scene.dissipation.is_some())
+                .map_or_else(String::new, |advice| format!(" ({advice})"));
             errln!(
                 "error: the integration failed at t = {}: {f}{fix}; `{}` holds the samples up to it",
                 number(summary.termination_time),

@@ -126,6 +126,18 @@ fn an_adaptive_run_stops_when_its_step_budget_is_spent() {
             && err.contains("--max-steps"),
         "{err}"
     );
+    // The advice names the steps the whole run needs at the pace so far: the control below takes 232.
+    let needed: f64 = err
+        .split("the whole run needs about ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no estimate: {err}"));
+    assert!((116.0..=464.0).contains(&needed), "{needed}: {err}");
+    assert!(
+        err.contains("steps: raise --max-steps (run.max_steps) with a margin above that"),
+        "{err}"
+    );
     let verify = coin_log(dir.path(), &["verify", "w.mcap", "--json"]);
     let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
     let integrity = report["files"][0]["checks"]
@@ -241,4 +253,42 @@ fn the_driver_sees_a_stop_and_a_spent_budget_between_samples() {
         (free.termination, free.stats.steps, samples),
         (RunEnd::Completed, 1000, 2)
     );
+}
+
+/// A dissipative couple strong enough makes the equations stiff: an explicit method's step stays near its
+/// stability limit whatever the tolerance, and the budget is spent at t ≈ 1e-14 of 2000 time units. The
+/// advice says that raising --max-steps cannot give the steps needed and names the coefficient; it said
+/// "raise --max-steps, run.max_steps, or loosen --rtol/--atol", which cannot work.
+#[test]
+fn a_stiff_couple_that_spends_the_budget_is_named_as_the_cause() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "record",
+            "euler-disk",
+            "--set",
+            "body.dissipation={model=\"viscous\",coefficient=3e13}",
+            "--max-steps",
+            "10000",
+            "-o",
+            "s.mcap",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the step budget of 10000 steps was spent at t = "),
+        "{err}"
+    );
+    assert!(
+        err.contains("more than raising --max-steps can give"),
+        "{err}"
+    );
+    assert!(
+        err.contains("the dissipative couple makes the equations stiff")
+            && err.contains("use a smaller body.dissipation.coefficient"),
+        "{err}"
+    );
+    assert!(!err.contains("loosen --rtol/--atol"), "{err}");
 }

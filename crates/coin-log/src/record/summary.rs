@@ -31,6 +31,10 @@ impl Failure {
     }
 }
 
+/// Steps beyond which raising `--max-steps` is no advice: 1e10 steps are about 2 hours of dop853 at
+/// 0.65 µs a step (format.md: Limits, measured on `wobble`).
+pub const SENSIBLE_STEPS: f64 = 1e10;
+
 /// What a finished recording reports: the fields of `record --json` (format.md: record, Summary), serialized
 /// flat: the integrator's counters beside the other fields, the termination by name, no failure (its
 /// termination says what it was).
@@ -78,4 +82,46 @@ struct StatsFields {
 
 fn by_name<S: Serializer>(termination: &Termination, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(termination)
+}
+
+impl RecordSummary {
+    /// What to do about a run that spent its step budget, from the pace it kept: the steps the whole
+    /// `duration` would take at that pace, and whether raising the budget can give them. A dissipative
+    /// couple strong enough makes the equations stiff, and an explicit method's step then stays near its
+    /// stability limit whatever the tolerance (`euler-disk` with a viscous κ = 3e13 took 10⁶ steps for
+    /// 1.3e-12 of its 2000 time units, where "raise --max-steps" was the advice). `None` unless the
+    /// termination is `step-budget-spent`.
+    #[must_use]
+    pub fn budget_advice(&self, duration: f64, dissipative: bool) -> Option<String> {
+        if self.termination != Termination::StepBudgetSpent {
+            return None;
+        }
+        let steps = self.stats.steps as f64;
+        let t = self.termination_time;
+        let needed = if t > 0.0 {
+            steps * (duration / t)
+        } else {
+            f64::INFINITY
+        };
+        if needed <= SENSIBLE_STEPS {
+            return Some(format!(
+                "at the pace so far the whole run needs about {} steps: raise --max-steps (run.max_steps) \
+                 with a margin above that, or loosen --rtol/--atol",
+                needed.ceil()
+            ));
+        }
+        let why = if dissipative {
+            "the dissipative couple makes the equations stiff, and an explicit method's step stays near its \
+             stability limit whatever the tolerance: use a smaller body.dissipation.coefficient or a shorter \
+             --duration"
+        } else {
+            "the motion is too fast or too near a singularity here for the integrator: use a shorter \
+             --duration or a slower motion"
+        };
+        Some(format!(
+            "at the pace so far, a mean step of {:.1e}, the whole run would need about {needed:.1e} steps, \
+             more than raising --max-steps can give ({SENSIBLE_STEPS:.0e} steps take about 2 hours); {why}",
+            t / steps
+        ))
+    }
 }
