@@ -541,3 +541,27 @@ fn samples_at_the_highest_rate_have_strictly_increasing_log_times() {
     println!("control: rate {rate:e} over {duration}: {repeats} repeated log times");
     assert!(repeats > 0, "the control should repeat log times");
 }
+
+#[test]
+fn a_steady_lean_at_the_flat_margin_is_not_told_to_roll_straight() {
+    // θ = 0 is straight rolling: the advice names that kind.
+    refused(
+        &["circle-plus", "--set", "initial.steady.theta=0"],
+        &[
+            "`initial.steady.theta` = 0 is outside 0 < |θ| < π/2 − 0.0001",
+            "use kind = \"straight\" for θ = 0",
+        ],
+    );
+    // A lean at the flat margin is too flat, not upright: "straight" would be wrong advice.
+    for theta in ["1.5707", "-1.5707"] {
+        let set = format!("initial.steady.theta={theta}");
+        let err = refused(
+            &["circle-plus", "--set", &set],
+            &[
+                &format!("`initial.steady.theta` = {theta} is outside 0 < |θ| < π/2 − 0.0001"),
+                "a rolling coin must lean less than flat",
+            ],
+        );
+        assert!(!err.contains("straight"), "{err}");
+    }
+}
