@@ -33,7 +33,7 @@ use std::time::Instant;
 pub struct AnalyseArgs {
     #[command(subcommand)]
     command: Option<AnalyseCommand>,
-    /// A built-in scene (listed by `coin-log scenes`) or a path to a `.toml` scene file.
+    /// A built-in scene (listed by `coin-log scenes`) or a scene file, as for `record`.
     #[arg(required = true)]
     scene: Option<OsString>,
     /// Print one JSON object (docs/format.md: analyse --json).
@@ -60,7 +60,8 @@ enum AnalyseCommand {
 /// Arguments of `coin-log analyse map`.
 #[derive(Debug, clap::Args)]
 struct MapArgs {
-    /// A scene whose body to map (built-in name or `.toml` file) [default: the thin disk, M = a = g = 1].
+    /// A scene whose body to map (built-in name or scene file, as for `record`) [default: the thin disk,
+    /// M = a = g = 1].
     scene: Option<OsString>,
     /// θ0 grid A:B:N: N values from A to B, each with 0 < |θ0| < π/2 [rad].
     #[arg(long, value_name = "A:B:N", default_value = DEFAULT_THETA, allow_hyphen_values = true)]

@@ -81,7 +81,8 @@ enum SweepCommand {
     ///
     /// Checks that every run is in exactly one part and that every file matches its row (size and
     /// SHA-256, each file read once); names what is missing or wrong and writes nothing if anything is
-    /// (exit 1). Exit 0 when the catalogue is written and every run finished, 1 when some failed.
+    /// (exit 1). Exit 0 when the catalogue is written and every run finished, 1 when some failed, 2 when
+    /// DIR holds no sweep.
     Collect(CollectArgs),
 }
 

@@ -541,3 +541,53 @@ fn samples_at_the_highest_rate_have_strictly_increasing_log_times() {
     println!("control: rate {rate:e} over {duration}: {repeats} repeated log times");
     assert!(repeats > 0, "the control should repeat log times");
 }
+
+#[test]
+fn a_steady_lean_at_the_flat_margin_is_not_told_to_roll_straight() {
+    // θ = 0 is straight rolling: the advice names that kind.
+    refused(
+        &["circle-plus", "--set", "initial.steady.theta=0"],
+        &[
+            "`initial.steady.theta` = 0 is outside 0 < |θ| < π/2 − 0.0001",
+            "use kind = \"straight\" for θ = 0",
+        ],
+    );
+    // A lean at the flat margin is too flat, not upright: "straight" would be wrong advice.
+    for theta in ["1.5707", "-1.5707"] {
+        let set = format!("initial.steady.theta={theta}");
+        let err = refused(
+            &["circle-plus", "--set", &set],
+            &[
+                &format!("`initial.steady.theta` = {theta} is outside 0 < |θ| < π/2 − 0.0001"),
+                "a rolling coin must lean less than flat",
+            ],
+        );
+        assert!(!err.contains("straight"), "{err}");
+    }
+}
+
+#[test]
+fn a_small_ignored_or_rounded_setting_is_shown_as_given_not_as_a_row_of_zeros() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| {
+        let mut all = vec!["record", "wobble", "--duration", "0.01", "--dry-run"];
+        all.extend_from_slice(args);
+        let out = coin_log(dir.path(), &all);
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        stderr(&out)
+    };
+    // As refusals print values (`run.duration` = 1e-10), so do the warning and the note.
+    let err = run(&["--integrator", "rk4", "--rtol", "1e-8"]);
+    assert!(
+        err.contains("warning: `run.rtol` = 1e-8 (set by `--rtol`) does not apply to rk4"),
+        "{err}"
+    );
+    let err = run(&["--step", "1e-9"]);
+    assert!(
+        err.contains("warning: `run.step` = 1e-9 (set by `--step`) does not apply to dop853"),
+        "{err}"
+    );
+    let err = run(&["--integrator", "rk4", "--rate", "300", "--step", "1e-7"]);
+    assert!(err.contains("note: step 1e-7 rounded down to "), "{err}");
+    assert!(!err.contains("0.0000"), "{err}");
+}

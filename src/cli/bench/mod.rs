@@ -76,7 +76,7 @@ struct EulerArgs {
 /// Arguments of `coin-log bench precision`.
 #[derive(Debug, clap::Args)]
 struct PrecisionArgs {
-    /// Built-in scene names or `.toml` scene files (default: wobble, circle-plus, high-spin).
+    /// Built-in scene names or scene files, as for `record` (default: wobble, circle-plus, high-spin).
     scenes: Vec<String>,
     /// Folder for `precision.csv` and `precision-<scene>.svg` (created if missing).
     #[arg(long, default_value = "bench-results")]

@@ -4,7 +4,7 @@
 
 use super::file::SceneFile;
 use super::problems::flag_of;
-use super::{defaults, Scene};
+use super::{defaults, Scene, Short};
 use crate::integrate::Method;
 use std::fmt;
 
@@ -59,7 +59,8 @@ impl fmt::Display for Note {
                 };
                 write!(
                     f,
-                    "`{key}` = {value}{by} does not apply to {method}, {uses}; ignored (stored as 0)"
+                    "`{key}` = {}{by} does not apply to {method}, {uses}; ignored (stored as 0)",
+                    Short(*value)
                 )
             }
             Self::StepRounded {
@@ -68,8 +69,9 @@ impl fmt::Display for Note {
                 interval,
             } => write!(
                 f,
-                "step {asked} rounded down to {} so that a whole number of steps ({}) fits between \
+                "step {} rounded down to {} so that a whole number of steps ({}) fits between \
                  samples (1/rate = {})",
+                Short(*asked),
                 compact(*used),
                 (interval / used).round(),
                 compact(*interval)

@@ -472,12 +472,15 @@ fn steady_kind(
             let branch = branch.unwrap_or(defaults::BRANCH);
             if theta.is_finite() && (theta == 0.0 || !leans_less_than_flat(theta, flat_margin)) {
                 let margin = flat_margin.unwrap_or(defaults::FLAT_MARGIN);
+                let why = if theta == 0.0 {
+                    "this steady motion needs a leaning coin; use kind = \"straight\" for θ = 0"
+                } else {
+                    "a rolling coin must lean less than flat"
+                };
                 problems.push(
                     "initial.steady.theta",
                     number(theta),
-                    format!(
-                        "is outside 0 < |θ| < π/2 − {margin} (run.flat_margin): this steady motion needs a leaning coin; use kind = \"straight\" for θ = 0"
-                    ),
+                    format!("is outside 0 < |θ| < π/2 − {margin} (run.flat_margin): {why}"),
                 );
             }
             if family == SteadyFamily::Circle {
