@@ -967,8 +967,8 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
         "circle-plus is a stable steady circle"
     );
     assert!(row["steady_residual"].parse::<f64>().is_ok());
-    // A refusal record warned of: the reason says so, with the checks it named (not nutation, which
-    // verify does not time with dissipation).
+    // A refusal record warned of: the reason says so, with the checks it named (not invariants, steady
+    // or nutation, which verify does not run with dissipation; it named invariants and steady).
     write_sweep(
         dir.path(),
         "loose.toml",
@@ -979,7 +979,7 @@ fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
     let row = &Csv::read(&dir.path().join("loose/catalogue.csv")).records()[0];
     assert!(
         row["reason"].starts_with("verify: failed: constraint ")
-            && row["reason"].ends_with("; record expected it: its settings allow more error than verify accepts in energy, invariants, constraint, steady (tighten rtol/atol, or step)"),
+            && row["reason"].ends_with("; record expected it: its settings allow more error than verify accepts in energy, constraint (tighten rtol/atol, or step)"),
         "{row:?}"
     );
     write_sweep(
