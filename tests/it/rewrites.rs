@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use crate::support::record::{coin_log_text, read_back, record_scene};
+use crate::support::record::{coin_log, coin_log_text, read_back, record_scene};
 use coin_log::format::RUN_METADATA_NAME;
 use serde_json::Value;
 use std::path::Path;
@@ -85,4 +85,26 @@ fn a_rewrite_grouped_by_channel_verifies_like_the_original() {
             }
         }
     }
+}
+
+/// `export --wide` of the grouped copy is refused, as documented; the error names the channel of the
+/// message the out-of-order one follows (it said `/coin/angles has a message at log time 0 ns after one
+/// at 100000000 ns`, as if /coin/angles itself were out of order, when that message was /coin/omega's).
+#[test]
+fn the_wide_error_on_a_rewrite_grouped_by_channel_names_both_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "0.1", "--channels", "omega,angles"],
+    );
+    grouped_by_channel(&original, &dir.path().join("grouped.mcap"));
+    let out = coin_log(dir.path(), &["export", "grouped.mcap", "--wide"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let says =
+        "/coin/angles has a message at log time 0 ns after one at 100000000 ns on /coin/omega: \
+                the messages are not in time order";
+    assert!(stderr.contains(says), "{says}: {stderr}");
+    assert!(!dir.path().join("grouped-csv").exists());
 }
