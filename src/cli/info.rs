@@ -132,6 +132,16 @@ fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
         "# The scene stored in `{shown}` (written by coin-log {}).\n",
         run.tool_version
     );
+    if i.problem.is_some() && i.read_to_end {
+        // Read whole, but its summary is damaged (a file from another writer's layout, or a flipped
+        // byte): `record` writes no such bytes. It said the file could not be read to its end.
+        let _ = writeln!(
+            text,
+            "# Its summary section is damaged (the error says why), so no command line writes the same \
+             bytes\n# again; the whole file was read."
+        );
+        return text;
+    }
     if i.problem.is_some() {
         // Its encoding and compression are those of the part read, and its bytes are not all known.
         let _ = writeln!(

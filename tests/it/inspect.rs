@@ -928,6 +928,49 @@ fn the_stored_scene_of_a_damaged_file_is_printed_with_exit_1_and_no_reproduction
     assert!(text.contains("writes the same bytes again"), "{text}");
 }
 
+/// `info --scene` on a file read whole whose summary is damaged (its metadata index entry points a byte
+/// past the record, as @mcap/core's unchunked writer makes it, with no summary CRC to catch it):
+/// exit 1 with the problem, as `info`, and the comment says why no command line writes the bytes without
+/// claiming that the file could not be read to its end (it said so, though the whole file was read).
+#[test]
+fn the_stored_scene_of_a_file_with_a_damaged_summary_says_the_whole_file_was_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "straight", &["--duration", "0.5"]);
+    let mut bytes = std::fs::read(&path).unwrap();
+    // The footer (opcode, length, summary_start, ...) is the 29 bytes before the end magic.
+    let footer = bytes.len() - 8 - 29;
+    let summary_start = usize::try_from(u64::from_le_bytes(
+        bytes[footer + 9..footer + 17].try_into().unwrap(),
+    ))
+    .unwrap();
+    // Walk the summary's records to the metadata index (opcode 0x0D): its first field is the offset.
+    let mut at = summary_start;
+    while bytes[at] != 0x0D {
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap());
+        at += 9 + usize::try_from(len).unwrap();
+    }
+    let offset = u64::from_le_bytes(bytes[at + 9..at + 17].try_into().unwrap());
+    bytes[at + 9..at + 17].copy_from_slice(&(offset + 1).to_le_bytes());
+    // No summary CRC (0: not computed), so that the summary reads and only the index is wrong.
+    bytes[footer + 25..footer + 29].copy_from_slice(&[0; 4]);
+    let damaged = dir.path().join("damaged.mcap");
+    std::fs::write(&damaged, &bytes).unwrap();
+    let (code, text, err) = coin_log_text(&["info", damaged.to_str().unwrap(), "--scene"]);
+    println!(
+        "exit {code}: {err}{}",
+        text.lines().take(3).collect::<Vec<_>>().join("\n")
+    );
+    assert_eq!(code, 1, "{text}{err}");
+    assert!(err.contains("the summary section is damaged"), "{err}");
+    assert!(!text.contains("could not be read to its end"), "{text}");
+    assert!(!text.contains("writes the same bytes again:"), "{text}");
+    assert!(
+        text.contains("Its summary section is damaged") && text.contains("the whole file was read"),
+        "{text}"
+    );
+    assert!(text.contains("[body]"), "the scene is printed: {text}");
+}
+
 /// A frame transform that does not decode is named by its own topic: every frame-transform topic has its
 /// table, and the error said `/tf` for a message on /tf_static or /scene/follow too.
 #[test]

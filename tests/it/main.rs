@@ -71,6 +71,7 @@ mod record_roundtrip;
 mod record_verify_agreement;
 #[cfg(feature = "external-readers")]
 mod rerun_geometry;
+mod rewrites;
 mod rk4_order;
 mod scenes;
 mod second_model;

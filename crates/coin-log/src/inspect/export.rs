@@ -379,8 +379,11 @@ impl<W: Write> Exporter<'_, W> {
             return;
         };
         let err = if log_time < row.log_time {
+            // The message it follows may be another channel's: name it (the file may well be in time
+            // order per channel, as a rewrite grouped by channel is).
+            let before = row.values.last().map_or("", |(c, _)| c.topic());
             Some(format!(
-                "{} has a message at log time {log_time} ns after one at {} ns: the messages are not in time order",
+                "{} has a message at log time {log_time} ns after one at {} ns on {before}: the messages are not in time order",
                 channel.topic(),
                 row.log_time
             ))

@@ -52,8 +52,11 @@ pub struct FileInfo {
     pub result: Result<ResultMetadata, String>,
     /// The stored scene as a file (for its description and duration), when it parses.
     pub scene: Option<SceneFile>,
-    /// Why the file could not be read to its end (then the rest describes what came before).
+    /// Why the file could not be read to its end (then the rest describes what came before), or why its
+    /// summary was not used (a damaged one: the whole file was read instead).
     pub problem: Option<String>,
+    /// The file was read to its end (from its summary, or by a streaming pass that did not break off).
+    pub read_to_end: bool,
 }
 
 impl FileInfo {
@@ -307,6 +310,7 @@ fn from_summary(summary: coin_log_mcap::Summary) -> FileInfo {
         result,
         scene,
         problem: None,
+        read_to_end: true,
     }
 }
 
@@ -337,6 +341,7 @@ fn scan(path: &Path) -> Result<FileInfo, InfoError> {
     };
     Ok(FileInfo {
         source: Source::Scan,
+        read_to_end: problem.is_none(),
         problem,
         ..from_summary(summary)
     })

@@ -325,7 +325,20 @@ impl Visitor for Judge {
                 return;
             }
             match self.run_metadata(entries) {
-                Ok(ctx) => self.ctx = Some(ctx),
+                Ok(ctx) => {
+                    // The channels the run recorded are known before the first message (the reader
+                    // passes this record on first): a sample waits for all of them, also when a
+                    // rewriting tool writes a channel's record only just before its first message,
+                    // after the messages of other channels (its samples were judged in pieces).
+                    if let Ok(scene) = &ctx.scene {
+                        for c in &scene.channels {
+                            if c.message_type().is_some() {
+                                self.assembler.declare(*c);
+                            }
+                        }
+                    }
+                    self.ctx = Some(ctx);
+                }
                 Err(e) => self.run_error = Some(e),
             }
         } else if name == RESULT_METADATA_NAME {
