@@ -2,8 +2,9 @@
 //! every command. A path (it holds a path separator or ends in `.toml`) is a file, whatever built-in has
 //! its stem; a bare name is the built-in of that name, and a file of that name in the current folder is
 //! then named in a note on stderr, so that it is never shadowed silently; a bare name that is no built-in
-//! is a file if one exists; a name that is not UTF-8 is no built-in's, so it is a file. [`load_source`] is the one loader of `record` and `analyse`: the scene, with
-//! the `--set KEY=VALUE` edits applied (format.md: Scene edits).
+//! is a file if one exists; a name that is not UTF-8 is no built-in's, so it is a file. [`load_source`]
+//! is the one loader of `record` and `analyse`: the scene, with the `--set KEY=VALUE` edits applied
+//! (format.md: Scene edits).
 
 use anyhow::anyhow;
 use coin_log::files::{escaped, read_toml, shown, InputKind};

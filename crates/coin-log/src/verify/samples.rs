@@ -73,12 +73,13 @@ pub struct Assembler {
 }
 
 impl Assembler {
-    /// Marks a channel as present in the file (its channel record was read).
+    /// Marks a channel as one whose message each sample waits for: its channel record was read, or the
+    /// stored scene records it (a scene that validates lists `work` only with dissipation).
     pub fn declare(&mut self, channel: Channel) {
         self.declared |= 1 << channel as u16;
     }
 
-    /// True when the channel is in the file.
+    /// True when the channel was declared or a message of it was pushed.
     #[must_use]
     pub fn declared(&self, channel: Channel) -> bool {
         self.declared & (1 << channel as u16) != 0
