@@ -13,6 +13,11 @@ use std::path::Path;
 /// Copies `src` into `dst`: its metadata records, then its messages sorted by channel (stable), each
 /// channel registered by the writer at its first message.
 fn grouped_by_channel(src: &Path, dst: &Path) {
+    grouped_by_channel_with(src, dst, mcap::WriteOptions::new());
+}
+
+/// [`grouped_by_channel`] written with `options`.
+fn grouped_by_channel_with(src: &Path, dst: &Path, options: mcap::WriteOptions) {
     let bytes = std::fs::read(src).unwrap();
     let file = read_back(&bytes);
     let mut messages: Vec<_> = mcap::MessageStream::new(&bytes)
@@ -21,7 +26,7 @@ fn grouped_by_channel(src: &Path, dst: &Path) {
         .collect();
     messages.sort_by_key(|m| m.channel.id);
     let out = std::io::BufWriter::new(std::fs::File::create(dst).unwrap());
-    let mut w = mcap::WriteOptions::new().create(out).unwrap();
+    let mut w = options.create(out).unwrap();
     assert!(file.metadata.contains_key(RUN_METADATA_NAME));
     for (name, (_, metadata)) in &file.metadata {
         w.write_metadata(&mcap::records::Metadata {
@@ -107,4 +112,60 @@ fn the_wide_error_on_a_rewrite_grouped_by_channel_names_both_channels() {
                 the messages are not in time order";
     assert!(stderr.contains(says), "{says}: {stderr}");
     assert!(!dir.path().join("grouped-csv").exists());
+}
+
+/// A grouped copy with more samples than verify holds while it waits for a sample's channels (4096): it
+/// judged the first 4096 `/coin/omega` samples without their angles, the rest in pieces, and passed
+/// (energy judged over 4096 samples, with another drift than the original's). It is read again in log-time
+/// order through the chunk indexes and judged like the original, with a note saying so.
+#[test]
+fn a_long_rewrite_grouped_by_channel_is_judged_in_log_time_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(dir.path(), "wobble", &["--duration", "45"]);
+    let grouped = dir.path().join("grouped.mcap");
+    grouped_by_channel(&original, &grouped);
+    let ((code, ours), (theirs_code, theirs)) = (verify_json(&original), verify_json(&grouped));
+    assert_eq!((code, theirs_code), (0, 0), "{theirs}");
+    for (x, y) in ours["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(theirs["checks"].as_array().unwrap())
+    {
+        for key in ["id", "status", "value", "tolerance"] {
+            assert_eq!(x[key], y[key], "{key}\n  original {x}\n  grouped  {y}");
+        }
+    }
+    let integrity = theirs["checks"][0]["reason"].as_str().unwrap();
+    assert!(integrity.contains(" 4501 samples"), "{integrity}");
+    assert!(
+        integrity.contains("every sample was judged in log-time order through the chunk indexes"),
+        "{integrity}"
+    );
+}
+
+/// Without chunk indexes the grouped copy cannot be read in log-time order: verify says how many samples
+/// it judged in pieces and how to have every sample judged whole, instead of a silent pass.
+#[test]
+fn a_long_unchunked_rewrite_grouped_by_channel_says_it_was_judged_in_pieces() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "wobble",
+        &["--duration", "45", "--channels", "omega,angles,energy"],
+    );
+    let grouped = dir.path().join("grouped.mcap");
+    grouped_by_channel_with(
+        &original,
+        &grouped,
+        mcap::WriteOptions::new().use_chunks(false),
+    );
+    let (_, theirs) = verify_json(&grouped);
+    let integrity = theirs["checks"][0]["reason"].as_str().unwrap();
+    for says in [
+        "samples were judged before all their channels had arrived",
+        "it has no summary that lists its chunks; rewrite it with its messages in log-time order",
+    ] {
+        assert!(integrity.contains(says), "{says}: {integrity}");
+    }
 }

@@ -114,7 +114,7 @@ pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
 
 /// Where the summary section starts and its bytes (up to the footer), its CRC checked if `check_crc`;
 /// `None` when the footer says there is none or it is larger than the reader accepts.
-fn summary_section(
+pub(crate) fn summary_section(
     file: &mut (impl Read + Seek),
     file_len: u64,
     check_crc: bool,

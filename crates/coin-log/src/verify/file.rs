@@ -7,7 +7,7 @@ use super::checks::{
     validity::ValidityCheck, Context, RunStats,
 };
 use super::report::{CheckId, CheckResult, FileReport, Status, Verdict};
-use super::samples::{Assembler, Sample};
+use super::samples::{Assembler, Sample, MAX_PENDING};
 use super::Options;
 use crate::format::channels::ROS_STRING_WIRE;
 use crate::format::fields::{FieldReader, ReaderError, Version};
@@ -20,8 +20,12 @@ use crate::format::{
 use crate::integrate::MethodConfig;
 use crate::model::{Chaplygin, Coin, Dynamics};
 use crate::scene::{self, Scene};
-use coin_log_mcap::{self, BoundedFindings, MessageHeader, ReadError, Schema, Visitor};
+use coin_log_mcap::{
+    self, read_in_log_time_order, BoundedFindings, MessageHeader, ReadError, Schema, Structure,
+    Visitor,
+};
 use std::collections::{BTreeMap, BTreeSet};
+use std::io::{Read, Seek};
 use std::ops::ControlFlow;
 use std::path::Path;
 
@@ -507,6 +511,12 @@ pub fn verify_file_with_progress(
 ) -> FileReport {
     let mut judge = Judge::default();
     let (structure, error) = coin_log_mcap::read_with_progress(path, &mut judge, progress);
+    if error.is_none() && judge.assembler.cut() > 0 {
+        match std::fs::File::open(path) {
+            Ok(file) => judge.reorder(&structure, file),
+            Err(e) => judge.reorder_failed(&format!("it cannot be opened again: {e}")),
+        }
+    }
     verdict(path.display().to_string(), judge, structure, error, options)
 }
 
@@ -516,7 +526,70 @@ pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();
     let source = std::io::Cursor::new(bytes);
     let (structure, error) = coin_log_mcap::read_from(source, bytes.len() as u64, &mut judge);
+    if error.is_none() && judge.assembler.cut() > 0 {
+        judge.reorder(&structure, std::io::Cursor::new(bytes));
+    }
     verdict(name.to_string(), judge, structure, error, options)
+}
+
+impl Judge {
+    /// Judges the samples again in log-time order, after the stream handed some out before all their
+    /// channels had arrived (the file's writer put its channels far apart, e.g. all of one channel, then
+    /// the next): the messages of the file's chunks through its chunk indexes, parsed as before, into a
+    /// fresh assembler and fresh checks. The stream's structural findings stand. When the file cannot be
+    /// read so, the stream's judgement stays and a note says how many samples it judged in pieces.
+    fn reorder(&mut self, structure: &Structure, source: impl Read + Seek) {
+        let Some(ctx) = self.ctx.as_ref() else {
+            return;
+        };
+        let (mut assembler, mut checks) = (self.assembler.afresh(), Checks::default());
+        let channels = &self.channels;
+        let mut judge = |h: &MessageHeader, data: &[u8]| {
+            let Some(Some(ChannelState {
+                kind: Kind::Coin(c, reader),
+                ..
+            })) = channels.get(usize::from(h.channel_id))
+            else {
+                return;
+            };
+            let mut s = Sample {
+                log_time: h.log_time,
+                ..Sample::default()
+            };
+            // A message that does not parse is already an integrity problem of the stream's.
+            if Self::parse(*c, reader, data, &mut s).is_ok() {
+                assembler.push(*c, &s, &mut |s| checks.observe(s, ctx));
+            }
+        };
+        let messages = structure.summary.messages;
+        let why = match read_in_log_time_order(source, structure.summary.file_len, &mut judge) {
+            Ok(Some(n)) if n == messages => {
+                assembler.finish(&mut |s| checks.observe(s, ctx));
+                let cut = self.assembler.cut();
+                self.notes.push(format!(
+                    "its channels lie far apart in the file (more than {MAX_PENDING} samples): {cut} \
+                     samples were incomplete when read in file order, so every sample was judged in \
+                     log-time order through the chunk indexes"
+                ));
+                (self.assembler, self.checks) = (assembler, checks);
+                return;
+            }
+            Ok(Some(n)) => format!("its chunks hold {n} of its {messages} messages"),
+            Ok(None) => "it has no summary that lists its chunks".to_string(),
+            Err(e) => e.to_string(),
+        };
+        self.reorder_failed(&why);
+    }
+
+    /// Notes that the samples the stream cut were judged in pieces, and `why` they were not read again.
+    fn reorder_failed(&mut self, why: &str) {
+        let cut = self.assembler.cut();
+        self.notes.push(format!(
+            "{cut} samples were judged before all their channels had arrived (the file's channels lie \
+             more than {MAX_PENDING} samples apart) and it cannot be read in log-time order: {why}; \
+             rewrite it with its messages in log-time order to judge every sample whole"
+        ));
+    }
 }
 
 fn verdict(

@@ -13,7 +13,7 @@ use crate::model::State;
 use std::collections::VecDeque;
 
 /// Most samples waiting for their other channels.
-const MAX_PENDING: usize = 4096;
+pub(super) const MAX_PENDING: usize = 4096;
 
 /// The stored values at one log time \[ns\]; `t` is the first message's.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -70,6 +70,8 @@ pub struct Assembler {
     pending: VecDeque<Sample>,
     last: [Option<u64>; Channel::ALL.len()],
     declared: u16,
+    /// Samples handed out by the cap before all declared channels had arrived.
+    cut: u64,
 }
 
 impl Assembler {
@@ -77,6 +79,22 @@ impl Assembler {
     /// stored scene records it (a scene that validates lists `work` only with dissipation).
     pub fn declare(&mut self, channel: Channel) {
         self.declared |= 1 << channel as u16;
+    }
+
+    /// An empty assembler waiting for the same channels.
+    #[must_use]
+    pub fn afresh(&self) -> Self {
+        Self {
+            declared: self.declared,
+            ..Self::default()
+        }
+    }
+
+    /// How many samples the cap ([`MAX_PENDING`]) handed out before all their channels had arrived: the
+    /// file's channels lie far apart in it.
+    #[must_use]
+    pub fn cut(&self) -> u64 {
+        self.cut
     }
 
     /// True when the channel was declared or a message of it was pushed.
@@ -131,6 +149,7 @@ impl Assembler {
                 break;
             }
             if let Some(s) = self.pending.pop_front() {
+                self.cut += u64::from(s.present != self.declared && s.log_time >= horizon);
                 out(&s);
             }
         }
