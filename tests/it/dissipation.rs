@@ -339,6 +339,44 @@ fn a_perturbed_work_channel_fails_the_energy_check() {
     }
 }
 
+/// With dissipation C1, C2 drift, so `invariants` does not judge their drift; but the stored
+/// `/coin/invariants` are still C1, C2 of the stored state, and verify holds them to 1e-12 as it does
+/// without dissipation. A short `euler-disk` file passes; with C1 changed at one sample (even its sign
+/// flipped) the `invariants` check fails. It used to be skipped whole, and the file verified `ok`.
+#[test]
+fn a_perturbed_invariants_channel_fails_with_dissipation() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("euler.mcap");
+    let (code, out, err) = coin_log_text(&[
+        "record",
+        "euler-disk",
+        "--duration",
+        "2",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    let good = verify_file(&path, &Options::default());
+    assert_eq!(good.exit_code, 0, "{}", show(&good));
+    let check = good.check(CheckId::Invariants).unwrap();
+    assert_eq!(check.status, Status::Pass, "{}", show(&good));
+    assert!(check.reason.contains("dissipation"), "{}", check.reason);
+    assert!(check.reason.contains("not judged"), "{}", check.reason);
+    let bad = dir.path().join("bad.mcap");
+    rewrite(&path, &bad, |e| {
+        if e.topic == "/coin/invariants" && e.index == 400 {
+            let c1 = serde_json::from_slice::<serde_json::Value>(e.data).unwrap()["c1"]
+                .as_f64()
+                .unwrap();
+            nudge(e.data, "c1", -2.0 * c1);
+        }
+    });
+    let r = verify_file(&bad, &Options::default());
+    println!("C1 negated at one sample:\n{}", show(&r));
+    assert_eq!(r.exit_code, 1, "{}", show(&r));
+    assert_eq!(r.check(CheckId::Invariants).unwrap().status, Status::Fail);
+}
+
 /// With μ = 0.3 the collapse ends at a located slip, |F| = μN there, at α = 0.095 (physics §11).
 #[test]
 fn with_friction_the_run_ends_at_a_located_slip() {

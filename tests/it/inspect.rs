@@ -745,6 +745,56 @@ fn a_microsecond_run_is_plotted_with_time_ticks_that_differ() {
     assert!(count("0.0") <= 1, "{texts:?}");
 }
 
+/// Values whose drift or ratio spans more than the doubles can (a stored energy of 1e300 against E0 ≈ 2.6;
+/// C1 = 1e300 at one sample; N = 1e-320, so |F|/N overflows; θ or the centre at ±1e308) are drawn, not
+/// waited on: plotters' log axis counted its decades as `usize` from a span of `inf` and looped for hours,
+/// its linear axis likewise on an infinite range, and the track panel's range of NaN panicked (found by
+/// mutation fuzzing of the readers).
+#[test]
+fn plot_finishes_on_values_that_overflow_its_axes() {
+    use crate::support::record::{coin_log_within, HANG_DEADLINE};
+    use crate::support::writers::{nudge, rewrite};
+    let dir = tempfile::tempdir().unwrap();
+    let recorded = record_scene(dir.path(), "wobble", &["--duration", "0.2"]);
+    let set = |data: &mut Vec<u8>, field: &str, to: f64| {
+        let v: serde_json::Value = serde_json::from_slice(data).unwrap();
+        nudge(data, field, to - v[field].as_f64().unwrap());
+    };
+    // (topic, field, [(message index, value)]).
+    type Damage<'a> = (&'a str, &'a str, &'a [(usize, f64)]);
+    let cases: [Damage<'_>; 6] = [
+        ("/coin/energy", "total", &[(4, 1e300)]),
+        ("/coin/angles", "theta", &[(3, 1e308), (5, -1e308)]),
+        ("/coin/invariants", "c1", &[(4, 1e300)]),
+        ("/coin/invariants", "c1", &[(0, 1e300)]),
+        ("/coin/reaction", "normal", &[(4, 1e-320)]),
+        ("/coin/position", "x", &[(3, 1e308), (5, -1e308)]),
+    ];
+    for (topic, field, values) in cases {
+        let damaged = dir.path().join("damaged.mcap");
+        rewrite(&recorded, &damaged, |e| {
+            for &(index, to) in values {
+                if e.topic == topic && e.index == index {
+                    set(e.data, field, to);
+                }
+            }
+        });
+        let svg = dir.path().join("damaged.svg");
+        let (code, _, err) = coin_log_within(
+            HANG_DEADLINE,
+            &[
+                "plot",
+                damaged.to_str().unwrap(),
+                "-o",
+                svg.to_str().unwrap(),
+                "--overwrite",
+            ],
+        );
+        assert_eq!(code, 0, "{topic} {field} {values:?}: {err}");
+        check_plot(&std::fs::read_to_string(&svg).unwrap(), "completed");
+    }
+}
+
 /// The default outputs of a file whose name is not UTF-8 are named with its stem's own bytes (`\xff.svg`,
 /// `\xff-csv`), not a lossy copy (`\u{fffd}.svg`, which two such names would share).
 #[test]

@@ -556,9 +556,54 @@ fn a_second_channel_on_a_coin_log_topic_fails_integrity() {
     assert_eq!(code, 0, "{err}");
 }
 
+/// A run that an event ended (topple: `flat-landing` at t = 1.9…) ends at its last sample, written at the
+/// event: a `coin-log.result` that moves its termination_time by 1e-6, or by half a sample interval, fails
+/// integrity. Verify let any time up to 1/rate past the last sample pass, the reach it gives a failure
+/// (found by mutating the result record of a lift-off recording by 6e-6: `ok`).
+#[test]
+fn an_event_run_whose_termination_time_is_not_its_last_sample_fails_integrity() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = record_scene(dir.path(), "topple", &[]);
+    let (code, out, err) = verify(&good);
+    assert_eq!(code, 0, "{out}{err}");
+    let bytes = std::fs::read(&good).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let result = summary
+        .metadata_indexes
+        .iter()
+        .map(|i| mcap::read::metadata(&bytes, i).unwrap())
+        .find(|m| m.name == "coin-log.result")
+        .unwrap()
+        .metadata;
+    assert_eq!(result["termination"], "flat-landing");
+    let own: f64 = result["termination_time"].parse().unwrap();
+    for delta in [1e-6, 0.005] {
+        let path = dir.path().join("moved.mcap");
+        let time = (own + delta).to_string();
+        let edit_result = |name: &str, entries: &mut std::collections::BTreeMap<String, String>| {
+            if name == "coin-log.result" {
+                entries.insert("termination_time".into(), time.clone());
+            }
+        };
+        rewrite_with_metadata(&good, &path, &edit_result, |_| {});
+        let (code, out, err) = verify(&path);
+        println!("termination_time = {time}: exit {code}\n{out}");
+        assert_eq!(code, 1, "{out}{err}");
+        assert!(
+            out.contains(&format!(
+                "metadata says termination_time = {time}, but the last sample is at t = {own}: a \
+                 run whose termination is `flat-landing` ends at its last sample"
+            )),
+            "{out}"
+        );
+    }
+}
+
 /// A `coin-log.result` record whose termination_time is not a finite time ≥ 0 (NaN, inf, -5), or not the
 /// last sample's time or a failure's before the next (1e308, 1.5 in a run of 10) fails integrity: verify
-/// judged such a file ok, and plot labelled its termination "at t = NaN".
+/// judged such a file ok, and plot labelled its termination "at t = NaN". A run that completed ends at its
+/// last sample, so 10.01 fails too (this test used to let it pass as within a failure's reach, the next
+/// grid point, though the run did not fail).
 #[test]
 fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrity() {
     let (dir, good) = recorded(&wobble(), "good.mcap");
@@ -570,7 +615,16 @@ fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrit
         .map(|i| mcap::read::metadata(&bytes, i).unwrap())
         .find_map(|m| m.metadata.get("termination_time").cloned())
         .unwrap();
-    for time in ["NaN", "inf", "-5", "1e308", "1.5", "10.01", &own] {
+    for time in [
+        "NaN",
+        "inf",
+        "-5",
+        "1e308",
+        "1.5",
+        "10.01",
+        "10.000001",
+        &own,
+    ] {
         let path = dir.path().join("result.mcap");
         let edit_result = |name: &str, entries: &mut std::collections::BTreeMap<String, String>| {
             if name != "coin-log" {
@@ -583,9 +637,6 @@ fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrit
         let complaint = "metadata says termination_time =";
         if time == own {
             // Negative control: the file's own time (its last sample's, 10) passes.
-            assert!(!out.contains(complaint), "{out}{err}");
-        } else if time == "10.01" {
-            // Just within a failure's reach (the next grid point): not this check's to judge.
             assert!(!out.contains(complaint), "{out}{err}");
         } else {
             assert_eq!(code, 1, "{out}{err}");

@@ -442,8 +442,15 @@ fn empty(area: &Area<'_>, title: &str, why: &str) -> Result<(), DrawError> {
     area.draw_text(why, &("sans-serif", 14).into_font().color(&GREY), (40, 60))
 }
 
-/// Range `lo..hi` widened by 5 % of its span on each side (a fixed span when it is empty).
+/// Range `lo..hi` widened by 5 % of its span on each side (a fixed span when it is empty). The ends are
+/// first held within ±`f64::MAX`/4, so that the span and the widened range stay finite: plotters' axes
+/// loop without end on an infinite range.
 fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
+    if lo > hi {
+        // No finite value.
+        return (-1.0, 1.0);
+    }
+    let (lo, hi) = (clamp_finite(lo), clamp_finite(hi));
     let span = hi - lo;
     if span > 0.0 {
         (lo - 0.05 * span, hi + 0.05 * span)
@@ -481,13 +488,24 @@ const WIDE_SPAN: f64 = 1e-3;
 /// The most digits after the leading one of an exponent-form tick label (it fits the label area).
 const SHORT_DIGITS: f64 = 6.0;
 
+/// `x` held within ±`f64::MAX`/4.
+fn clamp_finite(x: f64) -> f64 {
+    x.clamp(-f64::MAX / 4.0, f64::MAX / 4.0)
+}
+
+/// The least and largest finite value of `pick` over `points` (`(inf, -inf)` when there is none): a value
+/// that overflowed (an energy of 1e300 divided by its scale, |F| over N = 1e-320) is drawn at the edge,
+/// not given an infinite axis.
 fn min_max<'a>(
     points: impl Iterator<Item = &'a (f64, f64)>,
     pick: fn(&(f64, f64)) -> f64,
 ) -> (f64, f64) {
-    points.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-        (lo.min(pick(p)), hi.max(pick(p)))
-    })
+    points
+        .map(pick)
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        })
 }
 
 /// The path of the contact point and of the centre in the table plane: x across, z down the page,
@@ -602,10 +620,13 @@ impl TimeAxis<'_> {
             return empty(area, title, "the channel this needs was not recorded");
         }
         let points: Vec<Vec<(f64, f64)>> = series.iter().map(|s| s.1.points()).collect();
-        let positive = points.iter().flatten().filter(|p| p.1 > 0.0);
+        let positive = points.iter().flatten().filter(|p| p.1 >= f64::MIN_POSITIVE);
         let (lo, hi) = min_max(positive, |p| p.1);
+        // At most 300 decades between the edges: plotters counts a log axis's decades from the ratio of
+        // its ends, and loops without end when that ratio overflows.
         let (floor, top) = if hi > 0.0 {
-            (lo / 10.0, hi * 10.0)
+            let top = (hi * 10.0).min(f64::MAX);
+            ((lo / 10.0).max(f64::MIN_POSITIVE).max(top / 1e300), top)
         } else {
             (1e-17, 1e-15)
         };
@@ -630,7 +651,7 @@ impl TimeAxis<'_> {
             &mut chart,
             series,
             &points,
-            |v| v.max(floor),
+            |v| v.max(floor).min(top),
             None,
             (floor, top),
         )

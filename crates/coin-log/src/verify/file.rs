@@ -14,8 +14,8 @@ use crate::format::fields::{FieldReader, ReaderError, Version};
 use crate::format::messages::{message_type, Message, POINT_CLOUD, SCENE_UPDATE, VOXEL_GRID};
 use crate::format::tolerances::{RunAccuracy, Tolerances, RECOMPUTE_TOLERANCE};
 use crate::format::{
-    log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Topic, FORMAT_VERSION,
-    FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
+    log_time, schema_data, Channel, Encoding, ResultMetadata, RunMetadata, Termination, Topic,
+    FORMAT_VERSION, FRAME_TRANSFORM, RESULT_METADATA_NAME, ROS_STRING, RUN_METADATA_NAME,
 };
 use crate::integrate::MethodConfig;
 use crate::model::{Chaplygin, Coin, Dynamics};
@@ -688,16 +688,39 @@ impl Judge {
         }
         let stats = &self.checks.stats;
         let interval = 1.0 / ctx.run.rate;
-        match ctx.result.as_ref().map(|r| r.termination_time) {
-            Some(t) if !t.is_finite() || t < 0.0 => self.problems.push_with(|| {
+        match ctx
+            .result
+            .as_ref()
+            .map(|r| (r.termination_time, r.termination))
+        {
+            Some((t, _)) if !t.is_finite() || t < 0.0 => self.problems.push_with(|| {
                 format!(
                     "the `coin-log.result` metadata says termination_time = {t}, not a finite time \
                      ≥ 0"
                 )
             }),
-            // A run ends at its last sample or, failing, before the next grid point (format.md:
+            // A run that completed or ended at an event ends at its last sample (`record` writes one
+            // there); one that failed or was stopped, before the next grid point (format.md:
             // `coin-log.result`); only a file read whole shows its last sample.
-            Some(t) if read_whole && stats.samples > 0 && interval.is_finite() => {
+            Some((t, termination))
+                if (termination == Termination::Completed || termination.is_event())
+                    && read_whole
+                    && stats.samples > 0 =>
+            {
+                // Rounding of k/rate: far below 1e-12 of the time.
+                let slack = 1e-12 * stats.last_t.abs().max(f64::MIN_POSITIVE);
+                if (t - stats.last_t).abs() > slack {
+                    self.problems.push_with(|| {
+                        format!(
+                            "the `coin-log.result` metadata says termination_time = {t}, but the \
+                             last sample is at t = {}: a run whose termination is `{termination}` \
+                             ends at its last sample",
+                            stats.last_t
+                        )
+                    });
+                }
+            }
+            Some((t, _)) if read_whole && stats.samples > 0 && interval.is_finite() => {
                 // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
                 let slack = 1e-12 * stats.last_t.abs().max(interval);
                 if !(stats.last_t - slack..=stats.last_t + interval + slack).contains(&t) {
