@@ -1046,6 +1046,52 @@ fn a_dry_run_counts_shows_and_estimates_and_writes_nothing() {
     assert_eq!(listing(dir.path()), ["s.toml"], "a dry run writes nothing");
 }
 
+/// A `.coin-log-sweep` folder without a plan is no sweep's unless it holds nothing else (a process stopped
+/// before it published its plan): beside the user's files, or with the journal of a sweep whose plan
+/// was deleted, the sweep once went ahead, moved its runs over the user's `run-0.mcap` and appended its
+/// rows to the other sweep's journal.
+#[test]
+fn a_state_folder_without_a_plan_does_not_make_a_foreign_folder_a_sweep_s() {
+    let dir = tempfile::tempdir().unwrap();
+    let short = SMALL.replace("count = 2", "count = 1");
+    write_sweep(dir.path(), "s.toml", &short);
+    let mine = dir.path().join("mine");
+    std::fs::create_dir_all(mine.join(".coin-log-sweep")).unwrap();
+    std::fs::write(mine.join("run-0.mcap"), "precious").unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "mine"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`mine`: is not empty and holds no sweep (it has `run-0.mcap`): give -o a new or empty folder"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(mine.join("run-0.mcap")).unwrap(),
+        "precious"
+    );
+    assert_eq!(listing(&mine.join(".coin-log-sweep")), Vec::<String>::new());
+
+    // A sweep's folder whose plan was deleted: its journal is not another sweep's to append to.
+    assert_eq!(sweep_json(dir.path(), "s.toml", "old", &[]).0, 0);
+    let state = dir.path().join("old/.coin-log-sweep");
+    std::fs::remove_file(state.join("plan.json")).unwrap();
+    let journal = std::fs::read(state.join("journal-0-of-1.csv")).unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "old"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("`old`: is not empty and holds no sweep (it has `"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(state.join("journal-0-of-1.csv")).unwrap(),
+        journal
+    );
+    assert!(!state.join("plan.json").exists());
+
+    // Stopped before its plan was in place: only the plan's temporary file is there, and the sweep runs.
+    let stopped = dir.path().join("stopped/.coin-log-sweep");
+    std::fs::create_dir_all(&stopped).unwrap();
+    std::fs::write(stopped.join(".plan.json.a1B2c3.tmp"), "{").unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "stopped", &[]);
+    assert_eq!((code, json["finished"].as_u64()), (0, Some(6)), "{json}");
+}
+
 #[test]
 fn a_folder_with_other_content_or_another_sweep_is_refused_naming_the_fix() {
     let dir = tempfile::tempdir().unwrap();
