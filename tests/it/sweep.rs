@@ -614,7 +614,7 @@ uniform = [-8e307, 8e307]
 "#,
     );
     assert!(
-        err.contains("`random.draw[0].uniform` = [-1000")
+        err.contains("`random.draw[0].uniform` = [-1e308, 1.7e308] is wider")
             && err.contains("is wider than the largest double (hi − lo overflows, so every draw would be inf): narrow it, or draw log_uniform"),
         "{err}"
     );
@@ -770,6 +770,83 @@ zip = "z"
     );
     assert!(
         err.contains("`axis` gives 1200000 values in all, more than the 1000000 the axes may"),
+        "{err}"
+    );
+}
+
+/// Too many runs name what makes them too many: `random.count` at each grid point (the axes, 1000 values,
+/// were once blamed for 10¹² runs), or the grid itself.
+#[test]
+fn too_many_runs_name_the_count_or_the_grid_that_makes_them() {
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 1.0, 1000]
+[random]
+seed = 1
+count = 1000000000
+[[random.draw]]
+key = "body.thickness"
+uniform = [0.01, 0.02]
+"#,
+    );
+    assert!(
+        err.contains("`random.count` = 1000000000 runs at each of the axes' 1000 grid points give 1000000000000 runs, more than the 1000000000 a sweep may have: draw fewer runs per point"),
+        "{err}"
+    );
+    assert!(!err.contains("`axis` gives"), "{err}");
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 1.0, 100000]
+[[axis]]
+key = "initial.phi"
+linspace = [0.0, 1.0, 100000]
+"#,
+    );
+    assert!(
+        err.contains("`axis` gives 10000000000 grid points, each a run at least, more than the 1000000000 runs a sweep may have"),
+        "{err}"
+    );
+}
+
+/// A linspace whose ends are finite but whose formula overflows between them is refused with its own
+/// advice, not logspace's ("keep the exponents within ±300"), and its value as written, not 1e308 in
+/// 309 digits cut short.
+#[test]
+fn a_linspace_that_overflows_says_so_and_shows_its_value_short() {
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [-1e308, 1e308, 4]
+"#,
+    );
+    assert!(
+        err.contains("`axis[0].linspace` = [-1e308, 1e308, 4] gives -inf: first·(n − 1 − k) + last·k overflows: keep |first|·(n − 1) and |last|·(n − 1) below about 1.8e308"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("exponents") && !err.contains("00000000"),
+        "{err}"
+    );
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+logspace = [-400, 400, 3]
+"#,
+    );
+    assert!(
+        err.contains(
+            "`axis[0].logspace` = [-400, 400, 3] gives inf: keep the exponents within ±300"
+        ),
         "{err}"
     );
 }

@@ -106,8 +106,10 @@ fn axis_forms(a: &AxisFile) -> [(&'static str, bool); 3] {
     ]
 }
 
+/// A list as a problem shows it: TOML with its numbers in their shortest form (toml writes 1e308 with
+/// 309 digits, which the problem's value then cut short).
 fn array_text(values: &[toml::Value]) -> String {
-    toml::Value::Array(values.to_vec()).to_string()
+    super::catalogue::toml_text(&toml::Value::Array(values.to_vec()))
 }
 
 /// How problems name the fixed edit of `key`: `set."run.duration"`.
@@ -228,8 +230,10 @@ impl Checker {
         let at = format!("{name}.{form}");
         let values = match form {
             "values" => self.listed(&at, spec(a.values.as_ref())),
-            "linspace" => self.spaced(&at, spec(a.linspace.as_ref()), linspace),
-            _ => self.spaced(&at, spec(a.logspace.as_ref()), logspace),
+            "linspace" => self.spaced(&at, spec(a.linspace.as_ref()), linspace,
+                "first·(n − 1 − k) + last·k overflows: keep |first|·(n − 1) and |last|·(n − 1) below about 1.8e308"),
+            _ => self.spaced(&at, spec(a.logspace.as_ref()), logspace,
+                "keep the exponents within ±300"),
         }?;
         Some(Axis {
             key: a.key.trim().to_string(),
@@ -266,6 +270,7 @@ impl Checker {
         name: &str,
         spec: &[toml::Value],
         space: fn(f64, f64, u64) -> Vec<f64>,
+        overflow: &str,
     ) -> Option<Vec<toml::Value>> {
         let text = array_text(spec);
         let [first, last, n] = spec else {
@@ -290,11 +295,9 @@ impl Checker {
         };
         let values: Vec<f64> = space(first, last, n);
         if let Some(bad) = values.iter().find(|x| !x.is_finite()) {
-            return self.problems.reject(
-                name,
-                text,
-                format!("gives {bad}: keep the exponents within ±300"),
-            );
+            return self
+                .problems
+                .reject(name, text, format!("gives {bad}: {overflow}"));
         }
         Some(values.into_iter().map(toml::Value::Float).collect())
     }
@@ -673,12 +676,31 @@ impl Checker {
                 "gives {values} values in all, more than the {MAX_AXIS_VALUES} the axes may (sweep.json lists them): \
                  draw the densest keys at random ([[random.draw]]), or split the sweep"));
         }
-        let mut factors = sweep.lengths().chain([sweep.per_point()]);
-        let runs = factors.try_fold(1u64, u64::checked_mul);
-        if runs.is_none_or(|r| r > MAX_RUNS) {
-            let what = runs.map_or_else(|| "more than 2⁶⁴".to_string(), |r| r.to_string());
-            self.problems.push("axis", "", format!(
-                "gives {what} runs, more than the {MAX_RUNS} a sweep may have: sweep fewer values, or split the sweep"));
+        let text =
+            |n: Option<u64>| n.map_or_else(|| "more than 2⁶⁴".to_string(), |n| n.to_string());
+        let points = sweep.lengths().try_fold(1u64, u64::checked_mul);
+        let runs = points.and_then(|p| p.checked_mul(sweep.per_point()));
+        // The grid alone, or `random.count` runs at each of its points: the problem names the factor
+        // that makes them too many (the axes were once blamed for the count's runs).
+        match points {
+            Some(points) if points <= MAX_RUNS => {
+                if runs.is_none_or(|r| r > MAX_RUNS) {
+                    self.problems.push(
+                        "random.count",
+                        sweep.per_point().to_string(),
+                        format!(
+                            "runs at each of the axes' {points} grid points give {} runs, more than the \
+                             {MAX_RUNS} a sweep may have: draw fewer runs per point, sweep fewer values, \
+                             or split the sweep",
+                            text(runs)
+                        ),
+                    );
+                }
+            }
+            _ => self.problems.push("axis", "", format!(
+                "gives {} grid points, each a run at least, more than the {MAX_RUNS} runs a sweep may have: \
+                 sweep fewer values, or split the sweep",
+                text(points))),
         }
     }
 }
