@@ -442,11 +442,23 @@ fn print_preview(sweep: &Sweep, shard: Shard, jobs: usize, keys: &[&str], p: &Pr
     if p.runs > p.first.len() as u64 {
         outln!("  … ({} more)", p.runs - p.first.len() as u64);
     }
+    // Runs without a valid scene make no file: of all 200 runs invalid, "0 B in 200 files" was said.
+    let files = if p.invalid == 0 || p.sampled == 0 {
+        counted(p.runs, "file")
+    } else {
+        #[allow(
+            clippy::cast_precision_loss,
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss
+        )] // an estimate, at most the runs
+        let valid =
+            (p.runs as f64 * (p.sampled - p.invalid) as f64 / p.sampled as f64).round() as u64;
+        format!("about {} (runs with a valid scene)", counted(valid, "file"))
+    };
     outln!(
-        "estimate: {} messages, about {} in {}, about {:.0} s with {} (a rough guide: {} messages/s per job)",
+        "estimate: {} messages, about {} in {files}, about {:.0} s with {} (a rough guide: {} messages/s per job)",
         p.messages,
         size(p.bytes),
-        counted(p.runs, "file"),
         p.seconds.ceil(),
         counted(jobs, "job"),
         sweep::MESSAGES_PER_SECOND

@@ -851,6 +851,42 @@ logspace = [-400, 400, 3]
     );
 }
 
+/// The dry run's file count leaves out the runs it found without a valid scene, which make no file
+/// (every run invalid was "about 0 B in 4 files"); a sweep of valid runs keeps its exact count.
+#[test]
+fn a_dry_run_counts_no_file_for_runs_without_a_valid_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep =
+        "base = \"wobble\"\n[[axis]]\nkey = \"body.mass\"\nvalues = [-1.0, 0.0, -2.0, -3.0]\n";
+    write_sweep(dir.path(), "bad.toml", sweep);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "bad.toml", "--dry-run"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("about 0 B in about 0 files (runs with a valid scene)"),
+        "{out}"
+    );
+    assert!(
+        out.contains("invalid scenes: 4 of the 4 runs checked"),
+        "{out}"
+    );
+    let half = sweep.replace("-1.0, 0.0", "1.0, 2.0");
+    write_sweep(dir.path(), "half.toml", &half);
+    let (_, out, _) = run_in(dir.path(), &["sweep", "half.toml", "--dry-run"]);
+    assert!(
+        out.contains(" in about 2 files (runs with a valid scene)"),
+        "{out}"
+    );
+    write_sweep(
+        dir.path(),
+        "good.toml",
+        &sweep
+            .replace("-2.0, -3.0", "2.0, 3.0")
+            .replace("-1.0, 0.0", "1.0, 4.0"),
+    );
+    let (_, out, _) = run_in(dir.path(), &["sweep", "good.toml", "--dry-run"]);
+    assert!(out.contains(" in 4 files, about"), "{out}");
+}
+
 #[test]
 fn keys_that_are_no_scene_keys_or_collide_are_refused_naming_them() {
     let err = refused(
