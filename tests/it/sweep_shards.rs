@@ -283,6 +283,28 @@ fn all_shards(dir: &Path, file: &str, folder: &str, n: u64) {
     }
 }
 
+/// `collect` on a folder swept whole says that the sweep wrote the catalogue itself, instead of calling
+/// every run missing and advising to run "the shards that hold them" again (which, one shard being the
+/// whole sweep, wrote no part either, so collect refused for ever); the catalogue is left as it was.
+#[test]
+fn collect_on_a_folder_swept_whole_says_the_sweep_wrote_its_catalogue() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "w", &[]).0, 0);
+    let catalogue = std::fs::read(dir.path().join("w/catalogue.csv")).unwrap();
+    let (code, err) = collect(dir.path(), "w");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("it was swept whole, not in shards, so the sweep wrote its catalogue.csv and sweep.json itself"), "{err}");
+    assert!(
+        !err.contains("in no part") && !err.contains("run the shards"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("w/catalogue.csv")).unwrap(),
+        catalogue
+    );
+}
+
 #[test]
 fn collect_refuses_a_part_whose_row_names_another_runs_file() {
     // Two rows of a part with their indexes swapped: each file still matches its row's size and

@@ -240,6 +240,12 @@ impl Folder {
         run_file_name(index, usize::try_from(width).unwrap_or(1))
     }
 
+    /// Whether the whole sweep (no `--shard`, or 1 shard) was run in this folder: it has that journal.
+    pub fn swept_whole(&self) -> bool {
+        let journal = self.state().join(JOURNAL.name(Shard::ALL));
+        fs::symlink_metadata(journal).is_ok()
+    }
+
     /// The catalogue's columns in the plan.
     pub fn columns(&self) -> Vec<String> {
         let columns = self.plan["columns"].as_array().into_iter().flatten();
