@@ -446,3 +446,24 @@ normal = { mean = 1.0, std = 1e-300, min = 5.0, max = 6.0 }
         );
     }
 }
+
+/// A sweep resumed on its folder reads the plan in place and does not write it again: publishing it
+/// wrote a temporary file first, so a state folder that takes no new file (full disk, `chattr +i`)
+/// failed "writing the sweep's plan" when the plan was there all along, and a finished sweep could not
+/// even be looked at again.
+#[test]
+fn a_resume_reads_the_plan_in_place_without_writing_it_again() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let mut attributes = crate::support::Attributes::default();
+    if !attributes.set("+i", &dir.path().join("out/.coin-log-sweep")) {
+        return; // Not root, or a file system without attributes.
+    }
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["kept"].as_u64(), json["done"].as_u64()),
+        (0, Some(SMALL_RUNS as u64), Some(0)),
+        "{json}"
+    );
+}

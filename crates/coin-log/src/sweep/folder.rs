@@ -189,7 +189,14 @@ impl Folder {
             }
         }
         let plan = plan_json(sweep);
-        match publish_new(&plan_path, format!("{plan}\n").as_bytes()) {
+        // A plan in place is read, not written again: publishing writes a temporary file first, which
+        // on a full disk failed as "writing the sweep's plan" when the plan was there all along.
+        let published = if fs::symlink_metadata(&plan_path).is_ok() {
+            Err(io::ErrorKind::AlreadyExists.into())
+        } else {
+            publish_new(&plan_path, format!("{plan}\n").as_bytes())
+        };
+        match published {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
                 let held = read_plan(&plan_path)?;
