@@ -835,6 +835,33 @@ linspace = [-1e308, 1e308, 4]
         !err.contains("exponents") && !err.contains("00000000"),
         "{err}"
     );
+    // Every value a problem shows is in that form: a set value, a listed value, a normal's bounds.
+    let err = refused(
+        r#"
+base = "wobble"
+[random]
+seed = 1
+count = 1
+[[random.draw]]
+key = "body.friction"
+normal = { mean = 0.5, std = 1.0, min = 1e300, max = -1e300 }
+"#,
+    );
+    assert!(
+        err.contains("{ min = 1e300, max = -1e300 } has min ≥ max"),
+        "{err}"
+    );
+    assert!(!err.contains("00000000"), "{err}");
+    let err = refused("base = \"wobble\"\nset = { \"run.integrator\" = 1e300 }\n");
+    assert!(
+        err.contains("`set.\"run.integrator\"` = 1e300 does not fit the scene"),
+        "{err}"
+    );
+    let err = refused("base = \"wobble\"\n[[axis]]\nkey = \"run.integrator\"\nvalues = [1e300]\n");
+    assert!(
+        err.contains("`axis[0].values` = 1e300 does not fit the scene key `run.integrator`"),
+        "{err}"
+    );
     let err = refused(
         r#"
 base = "wobble"

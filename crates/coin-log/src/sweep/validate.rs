@@ -3,6 +3,7 @@
 //! it to the base scene and reading the result as a scene file; whether the values give a *valid* scene
 //! is each run's business (an invalid combination is a failed run, not a bad sweep file).
 
+use super::catalogue::toml_text;
 use super::definition::{
     Axis, Draw, Random, Settings, Sweep, CHANNELS_KEY, MAX_AXIS_VALUES, MAX_RUNS,
 };
@@ -109,7 +110,7 @@ fn axis_forms(a: &AxisFile) -> [(&'static str, bool); 3] {
 /// A list as a problem shows it: TOML with its numbers in their shortest form (toml writes 1e308 with
 /// 309 digits, which the problem's value then cut short).
 fn array_text(values: &[toml::Value]) -> String {
-    super::catalogue::toml_text(&toml::Value::Array(values.to_vec()))
+    toml_text(&toml::Value::Array(values.to_vec()))
 }
 
 /// How problems name the fixed edit of `key`: `set."run.duration"`.
@@ -158,7 +159,7 @@ impl Checker {
             if !dotted(key) {
                 self.problems.push(
                     set_name(key),
-                    value.to_string(),
+                    toml_text(value),
                     "is not a dotted scene key like \"run.duration\"",
                 );
             } else if let (Some(inner), false) = (value.as_table(), key.contains('.')) {
@@ -168,7 +169,7 @@ impl Checker {
                 );
                 self.problems.push(
                     format!("set.{key}"),
-                    value.to_string(),
+                    toml_text(value),
                     format!(
                         "is a table: TOML reads an unquoted dotted key as nested tables, which would \
                          replace the whole `{key}` table; quote the key so that it names one scene key: \
@@ -341,7 +342,7 @@ impl Checker {
         if seed.is_none() {
             self.problems.push(
                 "random.seed",
-                r.seed.to_string(),
+                toml_text(&r.seed),
                 "must be a whole number from 0 to 9223372036854775807",
             );
         }
@@ -349,7 +350,7 @@ impl Checker {
         if count.is_none() {
             self.problems.push(
                 "random.count",
-                r.count.to_string(),
+                toml_text(&r.count),
                 format!("must be a whole number of runs per grid point, 1 … {MAX_RUNS}"),
             );
         }
@@ -432,7 +433,7 @@ impl Checker {
             number(v).filter(|&x| ok(x)).or_else(|| {
                 let key = format!("{name}.{key}");
                 self.problems
-                    .reject(key, v.to_string(), format!("must be {need}"))
+                    .reject(key, toml_text(v), format!("must be {need}"))
             })
         };
         let mean = value("mean", &n.mean, "a finite number", f64::is_finite);
@@ -450,7 +451,11 @@ impl Checker {
         if min >= max {
             return self.problems.reject(
                 name,
-                format!("{{ min = {min}, max = {max} }}"),
+                format!(
+                    "{{ min = {}, max = {} }}",
+                    toml_text(&min.into()),
+                    toml_text(&max.into())
+                ),
                 "has min ≥ max: give min < max",
             );
         }
@@ -628,7 +633,7 @@ impl Checker {
             if let Err(e) = fits(base, key, value) {
                 self.problems.push(
                     set_name(key),
-                    value.to_string(),
+                    toml_text(value),
                     format!("does not fit the scene: {e}"),
                 );
             }
@@ -656,7 +661,7 @@ impl Checker {
                 if let Err(e) = fits(&with_set, &place.key, value) {
                     self.problems.push(
                         place.values_name.clone(),
-                        value.to_string(),
+                        toml_text(value),
                         format!(
                             "does not fit the scene key `{}`: {e}",
                             shown_name(&place.key)
