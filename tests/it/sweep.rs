@@ -914,6 +914,21 @@ fn a_dry_run_counts_no_file_for_runs_without_a_valid_scene() {
     assert!(out.contains(" in 4 files, about"), "{out}");
 }
 
+/// A float seed within the range but not below 9e15 is refused saying why (it was refused with the
+/// range alone, which 9e15 is in); a whole float below it is taken as the integer.
+#[test]
+fn a_float_seed_is_refused_saying_to_write_it_as_an_integer() {
+    let sweep = |seed: &str| {
+        format!("base = \"wobble\"\n[random]\nseed = {seed}\ncount = 1\n[[random.draw]]\nkey = \"initial.theta\"\nuniform = [0.1, 0.2]\n")
+    };
+    let err = refused(&sweep("9e15"));
+    assert!(err.contains("`random.seed` = 9000000000000000.0 must be a whole number from 0 to 9223372036854775807, written as an integer (a float is taken only below 9e15"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", &sweep("7.0"));
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "--dry-run"]);
+    assert_eq!(code, 0, "{err}");
+}
+
 #[test]
 fn keys_that_are_no_scene_keys_or_collide_are_refused_naming_them() {
     let err = refused(

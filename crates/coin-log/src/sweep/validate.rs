@@ -343,7 +343,13 @@ impl Checker {
             self.problems.push(
                 "random.seed",
                 toml_text(&r.seed),
-                "must be a whole number from 0 to 9223372036854775807",
+                // A whole float within the range (9e15) was refused with the range alone.
+                if r.seed.is_float() {
+                    "must be a whole number from 0 to 9223372036854775807, written as an integer (a \
+                     float is taken only below 9e15, where doubles hold every whole number)"
+                } else {
+                    "must be a whole number from 0 to 9223372036854775807"
+                },
             );
         }
         let count = whole(&r.count).filter(|&c| (1..=MAX_RUNS).contains(&c));
