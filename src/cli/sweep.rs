@@ -165,6 +165,21 @@ fn shard(args: &SweepArgs) -> Result<Shard, sweep::ShardError> {
         return Ok(shard);
     }
     let from_environment = Shard::from_environment(|k| std::env::var(k).ok(), args.shard_count)?;
+    // A task resubmitted alone (`sbatch --array=7`) is a one-task array, which is the whole sweep: it
+    // would redo no shard 7 of 16 and write the catalogue instead of that shard's part, so collect
+    // would still miss the part.
+    let task = std::env::var("SLURM_ARRAY_TASK_ID").ok();
+    let task = task.filter(|t| t.trim().parse::<u64>().is_ok_and(|t| t > 0));
+    if let (Some(task), Some(shard)) = (task, from_environment) {
+        if shard.is_all() {
+            errln!(
+                "warning: this job array has one task (SLURM_ARRAY_TASK_ID = {}), so it makes the whole \
+                 sweep (shard 0/1) and writes catalogue.csv, not a part; to redo shard {0} of an array of \
+                 N tasks, pass --shard {0}/N",
+                task.trim()
+            );
+        }
+    }
     Ok(from_environment.unwrap_or(Shard::ALL))
 }
 
