@@ -220,14 +220,19 @@ fn install_signals(running: Arc<AtomicBool>) -> anyhow::Result<Arc<AtomicBool>> 
             )]
             std::process::exit(130);
         }
+        // Said over the progress bar, which is cleared first (the message once ran on from its line).
+        let say = |message: &str| match DRAWN_BAR.get() {
+            Some(bar) => bar.suspend(|| errln!("{message}")),
+            None => errln!("{message}"),
+        };
         if !flag.swap(true, Ordering::SeqCst) {
-            errln!(
+            say(
                 "stopping: no new runs; the runs in progress are discarded (redone on resume) and the \
-                 catalogue of what finished is written (signal again to quit at once)"
+                 catalogue of what finished is written (signal again to quit at once)",
             );
             return;
         }
-        errln!("stopped again: quitting at once; run the sweep again to resume it");
+        say("stopped again: quitting at once; run the sweep again to resume it");
         #[allow(
             clippy::disallowed_methods,
             reason = "a second signal quits at once; no final name holds a half file, and resume removes the temporary ones"
@@ -237,6 +242,9 @@ fn install_signals(running: Arc<AtomicBool>) -> anyhow::Result<Arc<AtomicBool>> 
     .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;
     Ok(stop)
 }
+
+/// The sweep's progress bar once it is drawn, for the signal handler to print over.
+static DRAWN_BAR: std::sync::OnceLock<ProgressBar> = std::sync::OnceLock::new();
 
 /// The progress bar: runs done of those to do, failed, ETA; on stderr when it is a terminal, after a
 /// second.
@@ -264,6 +272,7 @@ impl Bar {
     fn update(&self, p: &Progress) {
         if self.terminal && self.bar.is_hidden() && self.started.elapsed() > PROGRESS_DELAY {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            let _ = DRAWN_BAR.set(self.bar.clone());
         }
         self.bar.set_length(p.todo);
         self.bar.set_position(p.done);
