@@ -165,6 +165,21 @@ fn shard(args: &SweepArgs) -> Result<Shard, sweep::ShardError> {
         return Ok(shard);
     }
     let from_environment = Shard::from_environment(|k| std::env::var(k).ok(), args.shard_count)?;
+    // A task resubmitted alone (`sbatch --array=7`) is a one-task array, which is the whole sweep: it
+    // would redo no shard 7 of 16 and write the catalogue instead of that shard's part, so collect
+    // would still miss the part.
+    let task = std::env::var("SLURM_ARRAY_TASK_ID").ok();
+    let task = task.filter(|t| t.trim().parse::<u64>().is_ok_and(|t| t > 0));
+    if let (Some(task), Some(shard)) = (task, from_environment) {
+        if shard.is_all() {
+            errln!(
+                "warning: this job array has one task (SLURM_ARRAY_TASK_ID = {}), so it makes the whole \
+                 sweep (shard 0/1) and writes catalogue.csv, not a part; to redo shard {0} of an array of \
+                 N tasks, pass --shard {0}/N",
+                task.trim()
+            );
+        }
+    }
     Ok(from_environment.unwrap_or(Shard::ALL))
 }
 
@@ -205,14 +220,19 @@ fn install_signals(running: Arc<AtomicBool>) -> anyhow::Result<Arc<AtomicBool>> 
             )]
             std::process::exit(130);
         }
+        // Said over the progress bar, which is cleared first (the message once ran on from its line).
+        let say = |message: &str| match DRAWN_BAR.get() {
+            Some(bar) => bar.suspend(|| errln!("{message}")),
+            None => errln!("{message}"),
+        };
         if !flag.swap(true, Ordering::SeqCst) {
-            errln!(
+            say(
                 "stopping: no new runs; the runs in progress are discarded (redone on resume) and the \
-                 catalogue of what finished is written (signal again to quit at once)"
+                 catalogue of what finished is written (signal again to quit at once)",
             );
             return;
         }
-        errln!("stopped again: quitting at once; run the sweep again to resume it");
+        say("stopped again: quitting at once; run the sweep again to resume it");
         #[allow(
             clippy::disallowed_methods,
             reason = "a second signal quits at once; no final name holds a half file, and resume removes the temporary ones"
@@ -222,6 +242,9 @@ fn install_signals(running: Arc<AtomicBool>) -> anyhow::Result<Arc<AtomicBool>> 
     .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;
     Ok(stop)
 }
+
+/// The sweep's progress bar once it is drawn, for the signal handler to print over.
+static DRAWN_BAR: std::sync::OnceLock<ProgressBar> = std::sync::OnceLock::new();
 
 /// The progress bar: runs done of those to do, failed, ETA; on stderr when it is a terminal, after a
 /// second.
@@ -249,6 +272,7 @@ impl Bar {
     fn update(&self, p: &Progress) {
         if self.terminal && self.bar.is_hidden() && self.started.elapsed() > PROGRESS_DELAY {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            let _ = DRAWN_BAR.set(self.bar.clone());
         }
         self.bar.set_length(p.todo);
         self.bar.set_position(p.done);
@@ -442,11 +466,23 @@ fn print_preview(sweep: &Sweep, shard: Shard, jobs: usize, keys: &[&str], p: &Pr
     if p.runs > p.first.len() as u64 {
         outln!("  … ({} more)", p.runs - p.first.len() as u64);
     }
+    // Runs without a valid scene make no file: of all 200 runs invalid, "0 B in 200 files" was said.
+    let files = if p.invalid == 0 || p.sampled == 0 {
+        counted(p.runs, "file")
+    } else {
+        #[allow(
+            clippy::cast_precision_loss,
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss
+        )] // an estimate, at most the runs
+        let valid =
+            (p.runs as f64 * (p.sampled - p.invalid) as f64 / p.sampled as f64).round() as u64;
+        format!("about {} (runs with a valid scene)", counted(valid, "file"))
+    };
     outln!(
-        "estimate: {} messages, about {} in {}, about {:.0} s with {} (a rough guide: {} messages/s per job)",
+        "estimate: {} messages, about {} in {files}, about {:.0} s with {} (a rough guide: {} messages/s per job)",
         p.messages,
         size(p.bytes),
-        counted(p.runs, "file"),
         p.seconds.ceil(),
         counted(jobs, "job"),
         sweep::MESSAGES_PER_SECOND

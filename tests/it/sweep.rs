@@ -614,7 +614,7 @@ uniform = [-8e307, 8e307]
 "#,
     );
     assert!(
-        err.contains("`random.draw[0].uniform` = [-1000")
+        err.contains("`random.draw[0].uniform` = [-1e308, 1.7e308] is wider")
             && err.contains("is wider than the largest double (hi − lo overflows, so every draw would be inf): narrow it, or draw log_uniform"),
         "{err}"
     );
@@ -772,6 +772,161 @@ zip = "z"
         err.contains("`axis` gives 1200000 values in all, more than the 1000000 the axes may"),
         "{err}"
     );
+}
+
+/// Too many runs name what makes them too many: `random.count` at each grid point (the axes, 1000 values,
+/// were once blamed for 10¹² runs), or the grid itself.
+#[test]
+fn too_many_runs_name_the_count_or_the_grid_that_makes_them() {
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 1.0, 1000]
+[random]
+seed = 1
+count = 1000000000
+[[random.draw]]
+key = "body.thickness"
+uniform = [0.01, 0.02]
+"#,
+    );
+    assert!(
+        err.contains("`random.count` = 1000000000 runs at each of the axes' 1000 grid points give 1000000000000 runs, more than the 1000000000 a sweep may have: draw fewer runs per point"),
+        "{err}"
+    );
+    assert!(!err.contains("`axis` gives"), "{err}");
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [0.1, 1.0, 100000]
+[[axis]]
+key = "initial.phi"
+linspace = [0.0, 1.0, 100000]
+"#,
+    );
+    assert!(
+        err.contains("`axis` gives 10000000000 grid points, each a run at least, more than the 1000000000 runs a sweep may have"),
+        "{err}"
+    );
+}
+
+/// A linspace whose ends are finite but whose formula overflows between them is refused with its own
+/// advice, not logspace's ("keep the exponents within ±300"), and its value as written, not 1e308 in
+/// 309 digits cut short.
+#[test]
+fn a_linspace_that_overflows_says_so_and_shows_its_value_short() {
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+linspace = [-1e308, 1e308, 4]
+"#,
+    );
+    assert!(
+        err.contains("`axis[0].linspace` = [-1e308, 1e308, 4] gives -inf: first·(n − 1 − k) + last·k overflows: keep |first|·(n − 1) and |last|·(n − 1) below about 1.8e308"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("exponents") && !err.contains("00000000"),
+        "{err}"
+    );
+    // Every value a problem shows is in that form: a set value, a listed value, a normal's bounds.
+    let err = refused(
+        r#"
+base = "wobble"
+[random]
+seed = 1
+count = 1
+[[random.draw]]
+key = "body.friction"
+normal = { mean = 0.5, std = 1.0, min = 1e300, max = -1e300 }
+"#,
+    );
+    assert!(
+        err.contains("{ min = 1e300, max = -1e300 } has min ≥ max"),
+        "{err}"
+    );
+    assert!(!err.contains("00000000"), "{err}");
+    let err = refused("base = \"wobble\"\nset = { \"run.integrator\" = 1e300 }\n");
+    assert!(
+        err.contains("`set.\"run.integrator\"` = 1e300 does not fit the scene"),
+        "{err}"
+    );
+    let err = refused("base = \"wobble\"\n[[axis]]\nkey = \"run.integrator\"\nvalues = [1e300]\n");
+    assert!(
+        err.contains("`axis[0].values` = 1e300 does not fit the scene key `run.integrator`"),
+        "{err}"
+    );
+    let err = refused(
+        r#"
+base = "wobble"
+[[axis]]
+key = "initial.theta"
+logspace = [-400, 400, 3]
+"#,
+    );
+    assert!(
+        err.contains(
+            "`axis[0].logspace` = [-400, 400, 3] gives inf: keep the exponents within ±300"
+        ),
+        "{err}"
+    );
+}
+
+/// The dry run's file count leaves out the runs it found without a valid scene, which make no file
+/// (every run invalid was "about 0 B in 4 files"); a sweep of valid runs keeps its exact count.
+#[test]
+fn a_dry_run_counts_no_file_for_runs_without_a_valid_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep =
+        "base = \"wobble\"\n[[axis]]\nkey = \"body.mass\"\nvalues = [-1.0, 0.0, -2.0, -3.0]\n";
+    write_sweep(dir.path(), "bad.toml", sweep);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "bad.toml", "--dry-run"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("about 0 B in about 0 files (runs with a valid scene)"),
+        "{out}"
+    );
+    assert!(
+        out.contains("invalid scenes: 4 of the 4 runs checked"),
+        "{out}"
+    );
+    let half = sweep.replace("-1.0, 0.0", "1.0, 2.0");
+    write_sweep(dir.path(), "half.toml", &half);
+    let (_, out, _) = run_in(dir.path(), &["sweep", "half.toml", "--dry-run"]);
+    assert!(
+        out.contains(" in about 2 files (runs with a valid scene)"),
+        "{out}"
+    );
+    write_sweep(
+        dir.path(),
+        "good.toml",
+        &sweep
+            .replace("-2.0, -3.0", "2.0, 3.0")
+            .replace("-1.0, 0.0", "1.0, 4.0"),
+    );
+    let (_, out, _) = run_in(dir.path(), &["sweep", "good.toml", "--dry-run"]);
+    assert!(out.contains(" in 4 files, about"), "{out}");
+}
+
+/// A float seed within the range but not below 9e15 is refused saying why (it was refused with the
+/// range alone, which 9e15 is in); a whole float below it is taken as the integer.
+#[test]
+fn a_float_seed_is_refused_saying_to_write_it_as_an_integer() {
+    let sweep = |seed: &str| {
+        format!("base = \"wobble\"\n[random]\nseed = {seed}\ncount = 1\n[[random.draw]]\nkey = \"initial.theta\"\nuniform = [0.1, 0.2]\n")
+    };
+    let err = refused(&sweep("9e15"));
+    assert!(err.contains("`random.seed` = 9000000000000000.0 must be a whole number from 0 to 9223372036854775807, written as an integer (a float is taken only below 9e15"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", &sweep("7.0"));
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "--dry-run"]);
+    assert_eq!(code, 0, "{err}");
 }
 
 #[test]
@@ -1044,6 +1199,52 @@ fn a_dry_run_counts_shows_and_estimates_and_writes_nothing() {
     assert_eq!(j["first"][0]["values"]["initial.theta"], "0.2");
     assert!(j["estimated_bytes"].as_u64().unwrap() > 10_000 && j["invalid"] == 0);
     assert_eq!(listing(dir.path()), ["s.toml"], "a dry run writes nothing");
+}
+
+/// A `.coin-log-sweep` folder without a plan is no sweep's unless it holds nothing else (a process stopped
+/// before it published its plan): beside the user's files, or with the journal of a sweep whose plan
+/// was deleted, the sweep once went ahead, moved its runs over the user's `run-0.mcap` and appended its
+/// rows to the other sweep's journal.
+#[test]
+fn a_state_folder_without_a_plan_does_not_make_a_foreign_folder_a_sweep_s() {
+    let dir = tempfile::tempdir().unwrap();
+    let short = SMALL.replace("count = 2", "count = 1");
+    write_sweep(dir.path(), "s.toml", &short);
+    let mine = dir.path().join("mine");
+    std::fs::create_dir_all(mine.join(".coin-log-sweep")).unwrap();
+    std::fs::write(mine.join("run-0.mcap"), "precious").unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "mine"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`mine`: is not empty and holds no sweep (it has `run-0.mcap`): give -o a new or empty folder"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(mine.join("run-0.mcap")).unwrap(),
+        "precious"
+    );
+    assert_eq!(listing(&mine.join(".coin-log-sweep")), Vec::<String>::new());
+
+    // A sweep's folder whose plan was deleted: its journal is not another sweep's to append to.
+    assert_eq!(sweep_json(dir.path(), "s.toml", "old", &[]).0, 0);
+    let state = dir.path().join("old/.coin-log-sweep");
+    std::fs::remove_file(state.join("plan.json")).unwrap();
+    let journal = std::fs::read(state.join("journal-0-of-1.csv")).unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "old"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("`old`: is not empty and holds no sweep (it has `"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(state.join("journal-0-of-1.csv")).unwrap(),
+        journal
+    );
+    assert!(!state.join("plan.json").exists());
+
+    // Stopped before its plan was in place: only the plan's temporary file is there, and the sweep runs.
+    let stopped = dir.path().join("stopped/.coin-log-sweep");
+    std::fs::create_dir_all(&stopped).unwrap();
+    std::fs::write(stopped.join(".plan.json.a1B2c3.tmp"), "{").unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "stopped", &[]);
+    assert_eq!((code, json["finished"].as_u64()), (0, Some(6)), "{json}");
 }
 
 #[test]

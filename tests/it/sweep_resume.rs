@@ -446,3 +446,60 @@ normal = { mean = 1.0, std = 1e-300, min = 5.0, max = 6.0 }
         );
     }
 }
+
+/// A sweep resumed on its folder reads the plan in place and does not write it again: publishing it
+/// wrote a temporary file first, so a state folder that takes no new file (full disk, `chattr +i`)
+/// failed "writing the sweep's plan" when the plan was there all along, and a finished sweep could not
+/// even be looked at again.
+#[test]
+fn a_resume_reads_the_plan_in_place_without_writing_it_again() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let mut attributes = crate::support::Attributes::default();
+    if !attributes.set("+i", &dir.path().join("out/.coin-log-sweep")) {
+        return; // Not root, or a file system without attributes.
+    }
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
+    assert_eq!(
+        (code, json["kept"].as_u64(), json["done"].as_u64()),
+        (0, Some(SMALL_RUNS as u64), Some(0)),
+        "{json}"
+    );
+}
+
+/// On a terminal, the first signal's message is printed over the progress bar, which is cleared first:
+/// it once ran on from the bar's line (`… 5/40 runs, 0 failed, 4s (eta 26s)      stopping: no new runs`).
+/// Run under `script` (a pseudo-terminal); skipped where there is none, or when the bar was not drawn yet.
+#[test]
+fn the_stop_message_starts_its_own_line_under_the_progress_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = "base = \"wobble\"\nset = { \"run.duration\" = 300.0 }\n[[axis]]\nkey = \"initial.theta\"\nlinspace = [0.3, 1.0, 40]\n";
+    write_sweep(dir.path(), "s.toml", sweep);
+    let script = format!(
+        "'{}' sweep s.toml -o out --jobs 2 & p=$!\nsleep 3\nkill -INT $p\nwait $p\n",
+        exe().display()
+    );
+    std::fs::write(dir.path().join("interrupt.sh"), script).unwrap();
+    let Ok(out) = Command::new("script")
+        .args(["-qec", "sh interrupt.sh", "/dev/null"])
+        .current_dir(dir.path())
+        .stdin(Stdio::null())
+        .output()
+    else {
+        return; // No `script`.
+    };
+    let text = String::from_utf8_lossy(&out.stdout);
+    let Some(at) = text.find("stopping: no new runs") else {
+        return; // No pseudo-terminal, or the sweep ended first.
+    };
+    let before = &text[..at];
+    if !before.contains(" runs, ") {
+        return; // The bar was not drawn yet (a slow machine).
+    }
+    assert!(
+        before.ends_with("\u{1b}[2K") || before.ends_with('\n'),
+        "the message runs on from the bar: {:?}",
+        &before[before.len().saturating_sub(80)..]
+    );
+}

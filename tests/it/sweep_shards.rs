@@ -83,6 +83,28 @@ fn the_shards_of_every_count_make_each_run_once_and_collect_to_the_one_process_c
     }
 }
 
+/// A task resubmitted alone (`sbatch --array=7`, which README once advised) is a one-task array: the
+/// whole sweep, writing the catalogue and no part 7. It says so, naming `--shard 7/N`; a one-task array
+/// numbered 0 (`--array=0`) is a plain whole sweep, without a word.
+#[test]
+fn a_task_resubmitted_alone_is_warned_that_it_makes_the_whole_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let alone = [
+        ("SLURM_ARRAY_TASK_ID", "7"),
+        ("SLURM_ARRAY_TASK_MIN", "7"),
+        ("SLURM_ARRAY_TASK_MAX", "7"),
+        ("SLURM_ARRAY_TASK_COUNT", "1"),
+    ];
+    let (code, out, err) = run_with_env(dir.path(), &["sweep", "s.toml", "--dry-run"], &alone);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(err.contains("warning: this job array has one task (SLURM_ARRAY_TASK_ID = 7), so it makes the whole sweep (shard 0/1) and writes catalogue.csv, not a part; to redo shard 7 of an array of N tasks, pass --shard 7/N"), "{err}");
+    let zero = alone.map(|(k, v)| (k, if v == "7" { "0" } else { v }));
+    let (code, _, err) = run_with_env(dir.path(), &["sweep", "s.toml", "--dry-run"], &zero);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+}
+
 #[test]
 fn slurm_array_variables_and_a_kubernetes_index_pick_the_shard() {
     let dir = tempfile::tempdir().unwrap();
@@ -281,6 +303,28 @@ fn all_shards(dir: &Path, file: &str, folder: &str, n: u64) {
             "shard {shard}"
         );
     }
+}
+
+/// `collect` on a folder swept whole says that the sweep wrote the catalogue itself, instead of calling
+/// every run missing and advising to run "the shards that hold them" again (which, one shard being the
+/// whole sweep, wrote no part either, so collect refused for ever); the catalogue is left as it was.
+#[test]
+fn collect_on_a_folder_swept_whole_says_the_sweep_wrote_its_catalogue() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "w", &[]).0, 0);
+    let catalogue = std::fs::read(dir.path().join("w/catalogue.csv")).unwrap();
+    let (code, err) = collect(dir.path(), "w");
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("it was swept whole, not in shards, so the sweep wrote its catalogue.csv and sweep.json itself"), "{err}");
+    assert!(
+        !err.contains("in no part") && !err.contains("run the shards"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("w/catalogue.csv")).unwrap(),
+        catalogue
+    );
 }
 
 #[test]

@@ -115,7 +115,7 @@ pub fn cell(value: &toml::Value) -> String {
 
 /// A value as TOML, with its numbers in their shortest form: toml writes a float in full positional
 /// notation (1e300 with 301 digits, 1e-7 as 0.0000001), which the contract's number format is not.
-fn toml_text(value: &toml::Value) -> String {
+pub(super) fn toml_text(value: &toml::Value) -> String {
     let list = |items: Vec<String>| items.join(", ");
     match value {
         toml::Value::Float(x) if x.is_finite() => number(*x),

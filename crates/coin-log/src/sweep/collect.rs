@@ -59,7 +59,17 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
             dir.display()
         ));
     }
-    if parts.is_empty() {
+    // A folder swept whole has no parts: the sweep wrote its catalogue itself. Running "the shards that
+    // hold" its runs, as the list of missing runs advised, wrote no part either (one shard is the whole).
+    if parts.is_empty() && folder.swept_whole() {
+        problems.push(format!(
+            "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: it was swept whole, not in shards, so the \
+             sweep wrote its catalogue.csv and sweep.json itself (collect merges the parts of shards, \
+             --shard K/N); to bring them up to date, run `coin-log sweep SWEEP.toml -o DIR` again: it \
+             resumes",
+            dir.display()
+        ));
+    } else if parts.is_empty() {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: run the shards first, `coin-log sweep SWEEP.toml -o DIR --shard K/N`",
             dir.display()
@@ -77,7 +87,9 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         };
         read_part(&folder, &part, &mut rows, &mut problems)?;
     }
-    problems.extend(missing(runs, &rows));
+    if !parts.is_empty() {
+        problems.extend(missing(runs, &rows));
+    }
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
     problems.extend(check_rows(&folder, sweep.as_ref(), &rows, at, jobs));
     let status_at = folder.column("status");

@@ -162,21 +162,41 @@ impl Folder {
                 if state_kind.is_ok_and(|t| t.is_symlink()) { "symbolic link" } else { "file" }
             )));
         }
+        let plan_path = state.join(PLAN_FILE);
+        let not_empty = |name: String| {
+            folder_error(format!(
+                "is not empty and holds no sweep (it has `{name}`): give -o a new or empty folder"
+            ))
+        };
         if state_kind.is_err() {
             let entries =
                 fs::read_dir(path).map_err(SweepError::io("reading the sweep folder", path))?;
             if let Some(other) = entries.flatten().find(|e| e.file_name() != STATE_DIR) {
-                return Err(folder_error(format!(
-                    "is not empty and holds no sweep (it has `{}`): give -o a new or empty folder",
-                    other.file_name().to_string_lossy()
-                )));
+                return Err(not_empty(other.file_name().to_string_lossy().into_owned()));
             }
             fs::create_dir_all(&state)
                 .map_err(SweepError::io("creating the sweep's state folder", &state))?;
+        } else if fs::symlink_metadata(&plan_path).is_err() {
+            // A state folder without a plan is left only by a process stopped before it published the
+            // plan, and then holds nothing else (but the plan's temporary file). Anything more was not
+            // made by a sweep (a journal or run files of a folder whose plan was deleted, the user's
+            // own files), and the sweep would append to it and move its files over them. Another
+            // process may have published the plan (and started its runs) since: then it is a sweep's.
+            if let Some(other) = foreign_entry(path, &state) {
+                if fs::symlink_metadata(&plan_path).is_err() {
+                    return Err(not_empty(other));
+                }
+            }
         }
         let plan = plan_json(sweep);
-        let plan_path = state.join(PLAN_FILE);
-        match publish_new(&plan_path, format!("{plan}\n").as_bytes()) {
+        // A plan in place is read, not written again: publishing writes a temporary file first, which
+        // on a full disk failed as "writing the sweep's plan" when the plan was there all along.
+        let published = if fs::symlink_metadata(&plan_path).is_ok() {
+            Err(io::ErrorKind::AlreadyExists.into())
+        } else {
+            publish_new(&plan_path, format!("{plan}\n").as_bytes())
+        };
+        match published {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
                 let held = read_plan(&plan_path)?;
@@ -225,6 +245,12 @@ impl Folder {
     pub fn run_file_name(&self, index: u64) -> String {
         let width = self.plan["index_width"].as_u64().unwrap_or(1);
         run_file_name(index, usize::try_from(width).unwrap_or(1))
+    }
+
+    /// Whether the whole sweep (no `--shard`, or 1 shard) was run in this folder: it has that journal.
+    pub fn swept_whole(&self) -> bool {
+        let journal = self.state().join(JOURNAL.name(Shard::ALL));
+        fs::symlink_metadata(journal).is_ok()
     }
 
     /// The catalogue's columns in the plan.
@@ -425,6 +451,29 @@ impl Folder {
             .map_err(SweepError::io("writing", &path))?;
         Ok(path)
     }
+}
+
+/// The first entry of the sweep folder `path`, or of its state folder `state`, that a sweep without a
+/// plan yet cannot have made: anything but the state folder and the plan's temporary files.
+fn foreign_entry(path: &Path, state: &Path) -> Option<String> {
+    let names = |dir: &Path| -> Vec<String> {
+        fs::read_dir(dir).map_or_else(
+            |_| Vec::new(),
+            |entries| {
+                let names = entries.flatten().map(|e| e.file_name());
+                names.map(|n| n.to_string_lossy().into_owned()).collect()
+            },
+        )
+    };
+    let plan_temp = |name: &str| {
+        name.strip_prefix(&format!(".{PLAN_FILE}."))
+            .is_some_and(|rest| rest.ends_with(".tmp"))
+    };
+    let outside = names(path).into_iter().find(|n| n != STATE_DIR);
+    outside.or_else(|| {
+        let inside = names(state).into_iter().find(|n| !plan_temp(n));
+        inside.map(|n| format!("{STATE_DIR}/{n}"))
+    })
 }
 
 /// The files `shard` writes when it ends: its catalogue part, or the catalogue and `sweep.json`.

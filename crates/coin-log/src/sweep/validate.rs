@@ -3,6 +3,7 @@
 //! it to the base scene and reading the result as a scene file; whether the values give a *valid* scene
 //! is each run's business (an invalid combination is a failed run, not a bad sweep file).
 
+use super::catalogue::toml_text;
 use super::definition::{
     Axis, Draw, Random, Settings, Sweep, CHANNELS_KEY, MAX_AXIS_VALUES, MAX_RUNS,
 };
@@ -106,8 +107,10 @@ fn axis_forms(a: &AxisFile) -> [(&'static str, bool); 3] {
     ]
 }
 
+/// A list as a problem shows it: TOML with its numbers in their shortest form (toml writes 1e308 with
+/// 309 digits, which the problem's value then cut short).
 fn array_text(values: &[toml::Value]) -> String {
-    toml::Value::Array(values.to_vec()).to_string()
+    toml_text(&toml::Value::Array(values.to_vec()))
 }
 
 /// How problems name the fixed edit of `key`: `set."run.duration"`.
@@ -156,7 +159,7 @@ impl Checker {
             if !dotted(key) {
                 self.problems.push(
                     set_name(key),
-                    value.to_string(),
+                    toml_text(value),
                     "is not a dotted scene key like \"run.duration\"",
                 );
             } else if let (Some(inner), false) = (value.as_table(), key.contains('.')) {
@@ -166,7 +169,7 @@ impl Checker {
                 );
                 self.problems.push(
                     format!("set.{key}"),
-                    value.to_string(),
+                    toml_text(value),
                     format!(
                         "is a table: TOML reads an unquoted dotted key as nested tables, which would \
                          replace the whole `{key}` table; quote the key so that it names one scene key: \
@@ -228,8 +231,10 @@ impl Checker {
         let at = format!("{name}.{form}");
         let values = match form {
             "values" => self.listed(&at, spec(a.values.as_ref())),
-            "linspace" => self.spaced(&at, spec(a.linspace.as_ref()), linspace),
-            _ => self.spaced(&at, spec(a.logspace.as_ref()), logspace),
+            "linspace" => self.spaced(&at, spec(a.linspace.as_ref()), linspace,
+                "first·(n − 1 − k) + last·k overflows: keep |first|·(n − 1) and |last|·(n − 1) below about 1.8e308"),
+            _ => self.spaced(&at, spec(a.logspace.as_ref()), logspace,
+                "keep the exponents within ±300"),
         }?;
         Some(Axis {
             key: a.key.trim().to_string(),
@@ -266,6 +271,7 @@ impl Checker {
         name: &str,
         spec: &[toml::Value],
         space: fn(f64, f64, u64) -> Vec<f64>,
+        overflow: &str,
     ) -> Option<Vec<toml::Value>> {
         let text = array_text(spec);
         let [first, last, n] = spec else {
@@ -290,11 +296,9 @@ impl Checker {
         };
         let values: Vec<f64> = space(first, last, n);
         if let Some(bad) = values.iter().find(|x| !x.is_finite()) {
-            return self.problems.reject(
-                name,
-                text,
-                format!("gives {bad}: keep the exponents within ±300"),
-            );
+            return self
+                .problems
+                .reject(name, text, format!("gives {bad}: {overflow}"));
         }
         Some(values.into_iter().map(toml::Value::Float).collect())
     }
@@ -338,15 +342,21 @@ impl Checker {
         if seed.is_none() {
             self.problems.push(
                 "random.seed",
-                r.seed.to_string(),
-                "must be a whole number from 0 to 9223372036854775807",
+                toml_text(&r.seed),
+                // A whole float within the range (9e15) was refused with the range alone.
+                if r.seed.is_float() {
+                    "must be a whole number from 0 to 9223372036854775807, written as an integer (a \
+                     float is taken only below 9e15, where doubles hold every whole number)"
+                } else {
+                    "must be a whole number from 0 to 9223372036854775807"
+                },
             );
         }
         let count = whole(&r.count).filter(|&c| (1..=MAX_RUNS).contains(&c));
         if count.is_none() {
             self.problems.push(
                 "random.count",
-                r.count.to_string(),
+                toml_text(&r.count),
                 format!("must be a whole number of runs per grid point, 1 … {MAX_RUNS}"),
             );
         }
@@ -429,7 +439,7 @@ impl Checker {
             number(v).filter(|&x| ok(x)).or_else(|| {
                 let key = format!("{name}.{key}");
                 self.problems
-                    .reject(key, v.to_string(), format!("must be {need}"))
+                    .reject(key, toml_text(v), format!("must be {need}"))
             })
         };
         let mean = value("mean", &n.mean, "a finite number", f64::is_finite);
@@ -447,7 +457,11 @@ impl Checker {
         if min >= max {
             return self.problems.reject(
                 name,
-                format!("{{ min = {min}, max = {max} }}"),
+                format!(
+                    "{{ min = {}, max = {} }}",
+                    toml_text(&min.into()),
+                    toml_text(&max.into())
+                ),
                 "has min ≥ max: give min < max",
             );
         }
@@ -625,7 +639,7 @@ impl Checker {
             if let Err(e) = fits(base, key, value) {
                 self.problems.push(
                     set_name(key),
-                    value.to_string(),
+                    toml_text(value),
                     format!("does not fit the scene: {e}"),
                 );
             }
@@ -653,7 +667,7 @@ impl Checker {
                 if let Err(e) = fits(&with_set, &place.key, value) {
                     self.problems.push(
                         place.values_name.clone(),
-                        value.to_string(),
+                        toml_text(value),
                         format!(
                             "does not fit the scene key `{}`: {e}",
                             shown_name(&place.key)
@@ -673,12 +687,31 @@ impl Checker {
                 "gives {values} values in all, more than the {MAX_AXIS_VALUES} the axes may (sweep.json lists them): \
                  draw the densest keys at random ([[random.draw]]), or split the sweep"));
         }
-        let mut factors = sweep.lengths().chain([sweep.per_point()]);
-        let runs = factors.try_fold(1u64, u64::checked_mul);
-        if runs.is_none_or(|r| r > MAX_RUNS) {
-            let what = runs.map_or_else(|| "more than 2⁶⁴".to_string(), |r| r.to_string());
-            self.problems.push("axis", "", format!(
-                "gives {what} runs, more than the {MAX_RUNS} a sweep may have: sweep fewer values, or split the sweep"));
+        let text =
+            |n: Option<u64>| n.map_or_else(|| "more than 2⁶⁴".to_string(), |n| n.to_string());
+        let points = sweep.lengths().try_fold(1u64, u64::checked_mul);
+        let runs = points.and_then(|p| p.checked_mul(sweep.per_point()));
+        // The grid alone, or `random.count` runs at each of its points: the problem names the factor
+        // that makes them too many (the axes were once blamed for the count's runs).
+        match points {
+            Some(points) if points <= MAX_RUNS => {
+                if runs.is_none_or(|r| r > MAX_RUNS) {
+                    self.problems.push(
+                        "random.count",
+                        sweep.per_point().to_string(),
+                        format!(
+                            "runs at each of the axes' {points} grid points give {} runs, more than the \
+                             {MAX_RUNS} a sweep may have: draw fewer runs per point, sweep fewer values, \
+                             or split the sweep",
+                            text(runs)
+                        ),
+                    );
+                }
+            }
+            _ => self.problems.push("axis", "", format!(
+                "gives {} grid points, each a run at least, more than the {MAX_RUNS} runs a sweep may have: \
+                 sweep fewer values, or split the sweep",
+                text(points))),
         }
     }
 }
