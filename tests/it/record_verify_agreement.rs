@@ -449,3 +449,39 @@ fn record_warns_when_samples_are_too_close_for_an_adaptive_methods_rounding() {
         r.assert_kept();
     }
 }
+
+/// A steady motion does not nutate, and verify skips `nutation` on an unperturbed steady start:
+/// `circle-plus --rtol 1e-3 --atol 1e-3` was promised to fail it all the same.
+#[test]
+fn a_steady_run_is_not_promised_to_fail_the_nutation_it_skips() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = [
+        "record",
+        "circle-plus",
+        "--rtol",
+        "1e-3",
+        "--atol",
+        "1e-3",
+        "-o",
+        "c.mcap",
+        "--json",
+    ];
+    let out = coin_log(dir.path(), &record);
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let expected: Vec<&str> = summary["expected_to_fail"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        expected,
+        ["energy", "invariants", "constraint", "steady"],
+        "{summary}"
+    );
+    let verify = coin_log(dir.path(), &["verify", "c.mcap", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
+    let checks = report["files"][0]["checks"].as_array().unwrap();
+    let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
+    assert_eq!(nutation["status"], "skip", "{nutation}");
+}
