@@ -593,3 +593,27 @@ fn a_small_ignored_or_rounded_setting_is_shown_as_given_not_as_a_row_of_zeros() 
     assert!(err.contains("note: step 1e-7 rounded down to "), "{err}");
     assert!(!err.contains("0.0000"), "{err}");
 }
+
+/// A couple too fast for an adaptive method's error estimate is as much the atol's doing as κ's:
+/// `euler-disk --atol 5e-324` was told only to lower κ to 4.25e-181. The refusal now names the atol that
+/// does, and that atol is accepted.
+#[test]
+fn a_couple_refused_for_a_tiny_atol_names_the_atol_that_does() {
+    let err = refused(
+        &["euler-disk", "--atol", "5e-324"],
+        &["use coefficient ≤ 4.25e-181, or atol ≥ "],
+    );
+    let atol = err
+        .split("or atol ≥ ")
+        .nth(1)
+        .unwrap()
+        .split(|c: char| c.is_whitespace() || c == '(')
+        .next()
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &["record", "euler-disk", "--atol", atol, "--dry-run"],
+    );
+    assert_eq!(code(&out), 0, "--atol {atol}: {}", stderr(&out));
+}
