@@ -1007,9 +1007,9 @@ fn a_rate_that_does_not_resolve_the_motion_is_named_with_the_rate_that_does() {
 
 /// The rate advised is one `record` accepts. Euler's disk under a viscous κ = 1e6 changes ω at 1.6e11 a
 /// time unit: `record` advised `--rate` 6.39e11, which it then refused (samples 1 ns apart allow at most
-/// ~1e9), and now says no rate can do it and what can. Under κ = 10 over 1e5 time units the rate it
-/// needs, 1.6e7, is allowed but not for so long (1e11 samples at most): the advice shortens the duration
-/// too, and followed it is accepted and resolves the motion.
+/// ~1e9), and now says no rate resolves the start and what can help. Under κ = 10 over 1e5 time units
+/// the rate it needs, 1.6e7, is allowed but not for so long (1e11 samples at most): the advice shortens
+/// the duration too, and followed it is accepted and resolves the motion.
 #[test]
 fn the_rate_advised_to_resolve_the_motion_is_one_record_accepts() {
     let viscous =
@@ -1020,9 +1020,10 @@ fn the_rate_advised_to_resolve_the_motion_is_one_record_accepts() {
     assert!(!c[0].contains("raise --rate"), "{}", c[0]);
     assert!(
         c[0].ends_with(
-            "no --rate can do that: it takes at least 639000000000 samples per time unit, and samples \
-             1 ns apart (the log-time resolution) allow at most 999999333; slow the motion, or express \
-             the scene in a shorter time unit"
+            "no --rate resolves the motion as it starts: that takes at least 639000000000 samples per \
+             time unit, and samples 1 ns apart (the log-time resolution) allow at most 999999333; slow \
+             the motion, or express the scene in a shorter time unit (a motion that slows down later \
+             may still be judged where a rate allowed resolves it)"
         ),
         "{}",
         c[0]

@@ -136,14 +136,16 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
 /// What to do for a recording of `duration` to resolve the motion at `needed` samples per time unit: raise
 /// --rate, where a rate that high is allowed (samples ≥ 1 ns apart, at most [`MAX_SAMPLES`] in all;
 /// format.md: Keys), and otherwise what can help instead (an advice of 6.39e11 on `euler-disk` under a
-/// viscous κ = 1e6 was refused as it stood).
+/// viscous κ = 1e6 was refused as it stood). The rates are those at t = 0: that couple's braking is a
+/// transient, and at rate 911 verify judged the windows after it.
 fn rate_fix(needed: f64, duration: f64) -> String {
     let highest = limits::max_rate(duration).floor();
     if needed > highest {
         return format!(
-            "no --rate can do that: it takes at least {needed} samples per time unit, and samples 1 ns \
-             apart (the log-time resolution) allow at most {highest}; slow the motion, or express the \
-             scene in a shorter time unit"
+            "no --rate resolves the motion as it starts: that takes at least {needed} samples per time \
+             unit, and samples 1 ns apart (the log-time resolution) allow at most {highest}; slow the \
+             motion, or express the scene in a shorter time unit (a motion that slows down later may \
+             still be judged where a rate allowed resolves it)"
         );
     }
     if needed * duration > MAX_SAMPLES {
