@@ -1136,3 +1136,35 @@ fn a_couple_that_brakes_within_a_sample_from_the_start_is_warned_of() {
         Vec::<String>::new()
     );
 }
+
+/// verify's own advice for a file whose sampling resolves no window is a rate `record` accepts, or says
+/// none is: `wobble` spinning at ω_Z = 5e8, sampled 1e6 a time unit, was told "at least 2.66e9".
+#[test]
+fn verify_advises_no_rate_beyond_the_one_nanosecond_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(
+        dir.path(),
+        "wobble",
+        &[
+            "--set",
+            "initial.omega=[0,0,5e8]",
+            "--duration",
+            "2e-5",
+            "--rate",
+            "1e6",
+        ],
+    );
+    let r = verify_file(&path, &Options::default());
+    let c = r
+        .checks
+        .iter()
+        .find(|c| c.id == CheckId::Constraint)
+        .unwrap();
+    assert_eq!(c.status, Status::Skip, "{}", c.reason);
+    assert!(!c.reason.contains("--rate (at least"), "{}", c.reason);
+    assert!(
+        c.reason.contains("no --rate resolves it: that takes at least 2.66e9 samples per time unit, and samples 1 ns apart (the log-time resolution) allow at most 999999999"),
+        "{}",
+        c.reason
+    );
+}
