@@ -797,3 +797,56 @@ fn an_unreliable_quadrature_is_warned_about() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// Straight rolling at ω_Z = 1 (stable) tilted by θ₀ nutates between θ₀ and 2θ₀ with the period of the
+/// linearisation, 4.9672941328980 (unit scales), however small θ₀ is. The turning-point search stopped
+/// its bisection after 200 halvings, 1e-12 above θ₀: at θ₀ = 1e-100 it gave θ up to 3.1e-73 and a period
+/// of 1.4e14, with an estimated error of 3e-11. Below ~1e-154 θ² leaves the normal doubles and the
+/// quadrature loses its digits (θ₀ = 1e-200 gave a period of 0, estimated 0): the estimate now says so,
+/// and analyse warns.
+#[test]
+fn a_tiny_tilt_nutates_with_the_linear_period_or_is_said_unreliable() {
+    for theta in ["1e-20", "1e-100", "1e-150"] {
+        let v = analyse_json(
+            "straight",
+            &[
+                "--set",
+                &format!("initial.theta={theta}"),
+                "--set",
+                "initial.omega=[0,0,1]",
+            ],
+        );
+        let theta: f64 = theta.parse().unwrap();
+        let period = v["period"].as_f64().unwrap();
+        check_relative("period", period, 4.967_294_132_898, 1e-11);
+        check_relative(
+            "theta_max",
+            v["theta_max"].as_f64().unwrap(),
+            2.0 * theta,
+            1e-11,
+        );
+        assert!(v["quadrature_error"].as_f64().unwrap() < 1e-12, "{v}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &[
+            "analyse",
+            "straight",
+            "--json",
+            "--set",
+            "initial.theta=1e-200",
+            "--set",
+            "initial.omega=[0,0,1]",
+        ],
+    );
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["quadrature_error"].as_f64(), Some(1.0), "{v}");
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("the quadrature's estimated relative error is 1.0e0"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -163,6 +163,43 @@ fn the_estimate_holds_within_its_factor_on_real_recordings() {
     println!("worst factor {worst:.2} (allowed {ACCURACY})");
 }
 
+/// The dry run's samples are the recording's where the end falls off the grid: a rate slower than one
+/// sample per duration (t = 0 and the end, 2 samples, was 1), an end within 2 ns of a grid point (which
+/// gives way to the end, was counted apart) and one 100 ns past a grid point on a long grid (was taken
+/// for the grid point).
+#[test]
+fn the_dry_run_counts_the_samples_of_ends_off_the_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    for (duration, rate) in [
+        ("1", "1e-10"),
+        ("1.0000000015", "1"),
+        ("100.0000001", "100"),
+    ] {
+        let args = [
+            "record",
+            "wobble",
+            "--channels",
+            "omega",
+            "--duration",
+            duration,
+            "--rate",
+            rate,
+        ];
+        let (code, out, err) = coin_log_text(&[&args[..], &["--dry-run", "--json"]].concat());
+        assert_eq!(code, 0, "{err}");
+        let estimate: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let path = record_scene(dir.path(), "wobble", &args[2..]);
+        let file = read_back(&std::fs::read(&path).unwrap());
+        let stored = file.on_topic("/coin/omega").len() as u64;
+        assert_eq!(
+            estimate["samples"].as_u64(),
+            Some(stored),
+            "--duration {duration} --rate {rate}"
+        );
+        assert_eq!(estimate["messages"].as_u64(), Some(stored));
+    }
+}
+
 /// A recording estimated above 1 GiB warns on stderr before it starts (stopped right after the warning).
 #[test]
 fn a_recording_above_a_gibibyte_is_warned_about() {

@@ -8,6 +8,7 @@
 
 use crate::support::record::{coin_log, listing, read_back};
 use coin_log::format::{RunMetadata, RUN_METADATA_NAME};
+use coin_log::scene::{self, presets, Scene};
 use std::path::Path;
 use std::process::Output;
 
@@ -172,15 +173,16 @@ fn a_dissipative_couple_beyond_double_precision_or_the_step_is_refused() {
             "use k < 439.1",
         ],
     );
-    // κ = 0 with an infinite (sin α)^(−k) is 0·∞ = NaN, not the conservative coin.
-    refused(
-        &[
-            "euler-disk",
-            "--set",
-            &law("{model=\"power-law\",coefficient=0,m=2,k=1e300}"),
-        ],
-        &["`body.dissipation.k` = 1e300", "use k < 439.1"],
-    );
+    // κ = 0 makes P = 0 however large (sin α)^(−k) is: the conservative coin. (It used to be refused
+    // here as 0·∞ = NaN, the artefact Dissipation::power no longer makes.)
+    let scene = scene::file_with_sets(
+        &presets::preset("euler-disk").unwrap(),
+        &[law("{model=\"power-law\",coefficient=0,m=2,k=1e300}")],
+    )
+    .unwrap();
+    let scene = Scene::from_file(&scene).unwrap();
+    let d = scene.dissipation.unwrap();
+    assert_eq!(d.power(scene.initial.theta, scene.initial.omega_y), 0.0);
     refused(
         &[
             "euler-disk",
@@ -590,4 +592,28 @@ fn a_small_ignored_or_rounded_setting_is_shown_as_given_not_as_a_row_of_zeros() 
     let err = run(&["--integrator", "rk4", "--rate", "300", "--step", "1e-7"]);
     assert!(err.contains("note: step 1e-7 rounded down to "), "{err}");
     assert!(!err.contains("0.0000"), "{err}");
+}
+
+/// A couple too fast for an adaptive method's error estimate is as much the atol's doing as κ's:
+/// `euler-disk --atol 5e-324` was told only to lower κ to 4.25e-181. The refusal now names the atol that
+/// does, and that atol is accepted.
+#[test]
+fn a_couple_refused_for_a_tiny_atol_names_the_atol_that_does() {
+    let err = refused(
+        &["euler-disk", "--atol", "5e-324"],
+        &["use coefficient ≤ 4.25e-181, or atol ≥ "],
+    );
+    let atol = err
+        .split("or atol ≥ ")
+        .nth(1)
+        .unwrap()
+        .split(|c: char| c.is_whitespace() || c == '(')
+        .next()
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &["record", "euler-disk", "--atol", atol, "--dry-run"],
+    );
+    assert_eq!(code(&out), 0, "--atol {atol}: {}", stderr(&out));
 }

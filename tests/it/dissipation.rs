@@ -596,3 +596,25 @@ fn the_couple_vanishes_at_rest_without_nan() {
     let conservative = Coin::new(CoinParams::unit_disk()).angular_acceleration(0.3, 0.0, 0.0, 0.0);
     assert_eq!(r.acceleration, conservative);
 }
+
+/// P = κ |φ̇|^m (sin α)^(−k) is 0 without φ̇ and finite wherever its value is, even where a factor is not:
+/// with k = 400, (sin α)^(−k) overflows below α = 0.18, and `topple` (released without spin, φ̇ = 0
+/// throughout) ended "non-finite at t = 1.75" (exit 1) with W = 0, its P = 0·∞; it now lands flat. With
+/// κ = 1e-300 the product at α = 0.12 is 2e67 though the angle factor alone overflows.
+#[test]
+fn the_power_is_zero_without_phi_dot_and_finite_where_its_value_is() {
+    let d = Dissipation::new(DissipationModel::PowerLaw, 1e-10, 1.0, 400.0).unwrap();
+    assert_eq!(d.power(1.45, 0.0), 0.0);
+    let d = Dissipation::new(DissipationModel::PowerLaw, 1e-300, 1.0, 400.0).unwrap();
+    let theta: f64 = 1.45;
+    let expected = (1e-300f64.ln() - 400.0 * theta.cos().ln()).exp();
+    let p = d.power(theta, theta.cos());
+    assert!(
+        (p / expected - 1.0).abs() < 1e-10,
+        "{p:e} against {expected:e}"
+    );
+    let law = "body.dissipation={model=\"power-law\",coefficient=1e-10,m=1,k=400}";
+    let scene = preset("topple", &[law]);
+    let (_, summary) = record_to_memory(&scene, &RecordOptions::default());
+    assert_eq!(summary.termination.name(), "flat-landing");
+}

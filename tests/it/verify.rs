@@ -1005,6 +1005,48 @@ fn a_rate_that_does_not_resolve_the_motion_is_named_with_the_rate_that_does() {
     assert_eq!(coverage(&s).len(), 1);
 }
 
+/// The rate advised is one `record` accepts. Euler's disk under a viscous κ = 1e6 changes ω at 1.6e11 a
+/// time unit: `record` advised `--rate` 6.39e11, which it then refused (samples 1 ns apart allow at most
+/// ~1e9), and now says no rate resolves the start and what can help. Under κ = 10 over 1e5 time units
+/// the rate it needs, 1.6e7, is allowed but not for so long (1e11 samples at most): the advice shortens
+/// the duration too, and followed it is accepted and resolves the motion.
+#[test]
+fn the_rate_advised_to_resolve_the_motion_is_one_record_accepts() {
+    let viscous =
+        |kappa: &str| format!("body.dissipation={{model=\"viscous\",coefficient={kappa}}}");
+    let s = preset_scene("euler-disk", &[&viscous("1e6"), "run.duration=1"]);
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(!c[0].contains("raise --rate"), "{}", c[0]);
+    assert!(
+        c[0].ends_with(
+            "no --rate resolves the motion as it starts: that takes at least 639000000000 samples per \
+             time unit, and samples 1 ns apart (the log-time resolution) allow at most 999999333; slow \
+             the motion, or express the scene in a shorter time unit (a motion that slows down later \
+             may still be judged where a rate allowed resolves it)"
+        ),
+        "{}",
+        c[0]
+    );
+    let s = preset_scene("euler-disk", &[&viscous("10"), "run.duration=1e5"]);
+    let c = coverage(&s);
+    assert_eq!(c.len(), 1, "{c:?}");
+    let fix = c[0].rsplit("raise --rate to at least ").next().unwrap();
+    let (rate, duration) = fix
+        .split_once(" and shorten --duration to at most ")
+        .unwrap();
+    let duration = duration.split_once(' ').unwrap().0;
+    let s = preset_scene(
+        "euler-disk",
+        &[
+            &viscous("10"),
+            &format!("run.duration={duration}"),
+            &format!("run.rate={rate}"),
+        ],
+    );
+    assert_eq!(coverage(&s), Vec::<String>::new());
+}
+
 /// A steady circle kicked by a small δω_X nutates with a small amplitude, and the integrator keeps ω to
 /// ε of the state's scale, not of that amplitude: the turning points are timed no better than its error
 /// over ω_X's slope. Before, `circle-plus` kicked by 1e-5 (dop853 at its defaults, its ω within 1.6e-11
@@ -1092,5 +1134,37 @@ fn a_couple_that_brakes_within_a_sample_from_the_start_is_warned_of() {
     assert_eq!(
         coverage(&preset_scene("euler-disk", &[])),
         Vec::<String>::new()
+    );
+}
+
+/// verify's own advice for a file whose sampling resolves no window is a rate `record` accepts, or says
+/// none is: `wobble` spinning at ω_Z = 5e8, sampled 1e6 a time unit, was told "at least 2.66e9".
+#[test]
+fn verify_advises_no_rate_beyond_the_one_nanosecond_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(
+        dir.path(),
+        "wobble",
+        &[
+            "--set",
+            "initial.omega=[0,0,5e8]",
+            "--duration",
+            "2e-5",
+            "--rate",
+            "1e6",
+        ],
+    );
+    let r = verify_file(&path, &Options::default());
+    let c = r
+        .checks
+        .iter()
+        .find(|c| c.id == CheckId::Constraint)
+        .unwrap();
+    assert_eq!(c.status, Status::Skip, "{}", c.reason);
+    assert!(!c.reason.contains("--rate (at least"), "{}", c.reason);
+    assert!(
+        c.reason.contains("no --rate resolves it: that takes at least 2.66e9 samples per time unit, and samples 1 ns apart (the log-time resolution) allow at most 999999999"),
+        "{}",
+        c.reason
     );
 }

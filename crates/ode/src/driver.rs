@@ -115,6 +115,34 @@ fn sample_time(settings: &RunSettings, k: u64) -> f64 {
     settings.t0 + k as f64 * settings.sample_interval
 }
 
+/// How close to t_end a grid point is taken for t_end itself: the grid t0 + k·interval rarely hits t_end
+/// exactly, and a point within [`EVENT_SAMPLE_GAP`] of it would share its log time.
+fn grid_slack(interval: f64) -> f64 {
+    (1e-9 * interval).max(EVENT_SAMPLE_GAP)
+}
+
+/// The samples a run from `t0` that reaches `t_end` writes at `interval` (what [`run`] calls `observe`
+/// with): t0, the grid points t0 + k·interval (k ≥ 1) more than the slack before t_end, and t_end.
+#[must_use]
+#[allow(
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss,
+    clippy::cast_precision_loss
+)]
+pub fn samples_to_end(t0: f64, t_end: f64, interval: f64) -> u64 {
+    let limit = t_end - grid_slack(interval);
+    let at = |k: u64| t0 + k as f64 * interval;
+    // The grid points k ≥ 1 at or before `limit`: the quotient's floor, corrected for its rounding.
+    let mut k = ((limit - t0) / interval).floor().max(0.0) as u64;
+    while k > 0 && at(k) > limit {
+        k -= 1;
+    }
+    while at(k + 1) <= limit {
+        k += 1;
+    }
+    k + 2
+}
+
 /// Integrates `sys` from `y0`, calling `observe(t, y)` at every sample time, until t_end, an event, a
 /// failure, `observe` returns [`Flow::Stop`], the step budget is spent or the stop flag is raised.
 pub fn run<const N: usize, S, M, E, O>(
@@ -335,7 +363,7 @@ where
     fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<RunEnd> {
         // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly), and
         // so is one within EVENT_SAMPLE_GAP of it: two samples that close would share a log time.
-        let grid_slack = (1e-9 * self.settings.sample_interval).max(EVENT_SAMPLE_GAP);
+        let grid_slack = grid_slack(self.settings.sample_interval);
         let t_stop = event.map_or(t_new, |(_, t)| t);
         loop {
             let mut t_k = sample_time(self.settings, self.k);

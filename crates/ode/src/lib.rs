@@ -19,7 +19,9 @@ mod rk4;
 pub use coin_log_names::UnknownName;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
-pub use driver::{run, Bounds, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings};
+pub use driver::{
+    run, samples_to_end, Bounds, EventFunctions, Flow, NoEvents, RunEnd, RunOutcome, RunSettings,
+};
 pub use gauss4::Gauss4;
 pub use method::{run_method, run_method_bounded, Method, MethodConfig};
 pub use rk4::Rk4;

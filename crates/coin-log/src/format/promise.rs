@@ -5,7 +5,7 @@
 //!   drifts and residuals   ≈ [`GROWTH_SHARE`] · ε (1 + T/τ)
 //!   nutation (relative)    ≈ [`NUTATION_SHARE`] · ε + [`NUTATION_GROWTH`] · ε (1 + T/τ)
 //!   rounding of n steps    ≈ [`ROUNDING_SHARE`] · n · 2⁻⁵³       (fixed-step methods; n = T/h)
-//!   rounding differenced   ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ / (Δt Ω)  (fixed-step methods, constraint)
+//!   rounding differenced   ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ / (Δt Ω)  (every method, constraint)
 //!   offset differenced     ≈ [`DIFFERENCE_GAIN`] · 2⁻⁵³ · (1 + k) X / (a Δt Ω)  (every method, constraint;
 //!                            X = max(|x₀|, |z₀|), k the fixed steps per sample, 0 for adaptive methods)
 //!   heading rounding       ≈ [`HEADING_SHARE`] · 2⁻⁵³ · Φ   (every method, constraint and nutation;
@@ -68,7 +68,10 @@ pub const HEADING_SHARE: f64 = 50.0;
 /// Gain of the constraint's 8th-order central difference on independent rounding of its samples:
 /// 2 Σ|wₖ| = 2 (4/5 + 1/5 + 4/105 + 1/280) = 2.08. Measured on `wobble` at the highest rate (samples 1 ns
 /// apart, over 1e-3 time units): rk4 and gauss4 fail `constraint`, whose floor 1e-10 this puts below
-/// 2.08·2⁻⁵³/(1e-9·1.54) = 1.5e-7, while dop853 and dopri5 pass.
+/// 2.08·2⁻⁵³/(1e-9·1.54) = 1.5e-7. An adaptive method's dense output rounds its positions at every sample
+/// too, by about 2⁻⁵³ of a step's increment: dop853 reached 8.5e-8 there (0.57 of this), 8.6e-9 at
+/// 1e-8 apart, 3.1e-9 on `high-spin` (0.67), and failed at rtol 1e-12 (tolerance 1e-9) without a word
+/// before.
 pub const DIFFERENCE_GAIN: f64 = 2.08;
 
 /// Why a check is expected to fail.
@@ -98,6 +101,12 @@ pub enum Cause {
     Heading {
         /// The largest |φ| expected, |φ₀| + T |φ̇₀| \[rad\].
         heading: f64,
+    },
+    /// Samples so close together that the rounding of the positions an adaptive method's dense output
+    /// gives, differenced over them, exceeds the constraint's tolerance.
+    Sampling {
+        /// Distance between samples Δt.
+        sample_interval: f64,
     },
     /// The centre starts so far from the origin that the rounding of its stored coordinates, differenced
     /// over samples close together, exceeds the constraint's tolerance.
@@ -156,6 +165,13 @@ impl fmt::Display for Shortfall {
                  verify judges by; start from initial.phi within a turn of 0, or record a shorter run",
                 self.predicted, self.tolerance
             ),
+            Cause::Sampling { sample_interval } => write!(
+                f,
+                "samples {sample_interval:.1e} apart are so close that the rounding of the positions \
+                 between the integrator's steps, differenced over them, is about {:.1e}, above the \
+                 tolerance {:.1e} verify judges by; take a lower --rate",
+                self.predicted, self.tolerance
+            ),
             Cause::Offset { positions } => write!(
                 f,
                 "the centre starts {:.1e} radii from the origin, and the rounding of its stored coordinates, \
@@ -208,9 +224,9 @@ pub fn shortfalls(
     let fixed_steps = fixed.map(|f| f.steps);
     let rounding = fixed_steps.map_or(0.0, |n| ROUNDING_SHARE * n * UNIT_ROUNDOFF);
     let omega = run.max_omega.max(1.0 / run.time_unit);
-    let differenced = fixed.map_or(0.0, |f| {
-        DIFFERENCE_GAIN * UNIT_ROUNDOFF / (f.sample_interval * omega)
-    });
+    // Every stored position is rounded: at a fixed step's end, or by the dense output between steps.
+    let interval = fixed.map_or(positions.sample_interval, |f| f.sample_interval);
+    let differenced = DIFFERENCE_GAIN * UNIT_ROUNDOFF / (interval * omega);
     // A fixed-step method rounds the coordinates at each of its steps between two samples, an adaptive
     // one's dense output once per sample.
     let roundings = 1.0 + fixed.map_or(0.0, |f| (f.sample_interval / run.step).round());
@@ -222,7 +238,12 @@ pub fn shortfalls(
     let heading_error = HEADING_SHARE * UNIT_ROUNDOFF * heading;
     let accumulated = GROWTH_SHARE * growth;
     let accuracy = Cause::Accuracy { epsilon };
-    let rounded = fixed.map_or(accuracy, |fixed| Cause::Rounding { fixed });
+    let rounded = fixed.map_or(
+        Cause::Sampling {
+            sample_interval: positions.sample_interval,
+        },
+        |fixed| Cause::Rounding { fixed },
+    );
     let (dense, interpolated) = if dense_share > 0.0 {
         let step_radians = epsilon.powf(order.recip()).min(run.span.max(0.0) * omega);
         let enough = (0.5 * tolerances.residual / dense_share).powf(order / (order - 1.0));

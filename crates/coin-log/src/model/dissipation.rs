@@ -163,13 +163,26 @@ impl Dissipation {
     /// (eq (18)) and sin α = cos |θ| = cos θ.
     ///
     /// Finite wherever the rolling model is (|θ| < π/2: the run ends at the flat landing before cos θ
-    /// reaches 0), and 0 when ω_Y = 0 (m ≥ 1).
+    /// reaches 0) and P itself is below the largest double, and 0 when ω_Y = 0 (m ≥ 1).
+    ///
+    /// A factor may overflow where the product does not: (sin α)^(−k) of k = 400 is infinite below
+    /// α = 0.18, which made P = 0·∞ = NaN on a coin released without spin (`topple`, ended "non-finite" at
+    /// α = 0.18 with W = 0). So P is 0 when |φ̇|^m is, and a product that overflowed is taken by its
+    /// logarithm; elsewhere the product is as it always was.
     #[must_use]
     #[inline]
     pub fn power(&self, theta: f64, omega_y: f64) -> f64 {
         let cos_t = theta.cos();
         let phi_dot = omega_y / cos_t;
-        self.coefficient * phi_dot.abs().powf(self.m) * cos_t.powf(-self.k)
+        let rate_factor = phi_dot.abs().powf(self.m);
+        if rate_factor == 0.0 {
+            return 0.0;
+        }
+        let power = self.coefficient * rate_factor * cos_t.powf(-self.k);
+        if power.is_finite() {
+            return power;
+        }
+        (self.coefficient.ln() + self.m * phi_dot.abs().ln() - self.k * cos_t.ln()).exp()
     }
 }
 

@@ -152,11 +152,18 @@ impl Adaptive {
     }
 }
 
+/// The most halvings [`bisect`] takes: from the widest bracket of doubles (2·1.8e308) to adjacent
+/// subnormals, 1024 + 1074 binary orders and the 53 bits of a significand.
+const MAX_HALVINGS: usize = 1024 + 1074 + 53;
+
 /// The boundary between `inside` (where `is_inside` holds) and `outside`, by bisection down to adjacent
-/// floating-point numbers (at most 200 halvings). Returns the last point found inside and the first
-/// outside.
+/// floating-point numbers. Returns the last point found inside and the first outside.
+///
+/// Halving reaches adjacent numbers in 53 steps plus one per binary order of magnitude the boundary lies
+/// below the bracket's width: at most [`MAX_HALVINGS`]. (A cap of 200 stopped `analyse` 1e-12 above
+/// θ₀ = 1e-100 at 3.1e-73, 1e27 times the turning point 2e-100, with a period of 1.4e14 for 4.97.)
 pub fn bisect(is_inside: impl Fn(f64) -> bool, mut inside: f64, mut outside: f64) -> (f64, f64) {
-    for _ in 0..200 {
+    for _ in 0..MAX_HALVINGS {
         let mid = 0.5 * (inside + outside);
         if mid == inside || mid == outside {
             break;

@@ -71,15 +71,11 @@ pub struct Estimate {
     pub bytes: u64,
 }
 
-/// Samples of a completed run: t = k / rate for k = 0 … ⌊duration·rate⌋, and t = duration when it is off
-/// the grid.
+/// Samples of a completed run: t = 0, the grid points t = k / rate before the end, and t = duration, by
+/// the driver's own rule (a grid point within 2 ns of the end gives way to it).
 #[must_use]
-#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 pub fn samples(duration: f64, rate: f64) -> u64 {
-    let last = duration * rate;
-    let k = (last * (1.0 + 1e-12)).floor();
-    let off_grid = (last - k).abs() > 1e-9 * last.max(1.0);
-    k as u64 + 1 + u64::from(off_grid)
+    coin_log_ode::samples_to_end(0.0, duration, 1.0 / rate)
 }
 
 /// Bytes of one message of a flat `coin_log.*` channel with `fields` (`t` first).
@@ -170,6 +166,21 @@ mod tests {
         assert_eq!(samples(0.3, 10.0), 4, "0.3·10 is 3 up to rounding");
         assert_eq!(samples(0.25, 10.0), 4, "t = 0, 0.1, 0.2 and the end 0.25");
         assert_eq!(samples(3.0, 200.0), 601);
+        assert_eq!(
+            samples(1.0, 1e-10),
+            2,
+            "t = 0 and the end, with no grid point between"
+        );
+        assert_eq!(
+            samples(1.000_000_001_5, 1.0),
+            2,
+            "t = 1 is 1.5 ns before the end: it gives way"
+        );
+        assert_eq!(
+            samples(100.000_000_1, 100.0),
+            10_002,
+            "t = 100 is 100 ns before the end"
+        );
     }
 
     #[test]

@@ -368,11 +368,21 @@ fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
         let rate = power.max(couple_rate(scene) * magnitude(s.omega_x, s.omega_y, s.omega_z));
         let max = SCALE_MAX * method.atol;
         if rate > max {
+            // The bound is linear in atol too: an atol tiny for the scene (`--atol 5e-324`) is the
+            // problem as much as κ, and a larger one, where allowed (check_atol), does as well.
+            let p = &scene.params;
+            let atol_max = ATOL_MAX_FRACTION * 1f64.min(p.radius()).min(1.0 / p.time_unit());
+            let atol_needed = rate / SCALE_MAX;
+            let or_atol = if atol_needed <= atol_max {
+                format!(", or atol ≥ {}", short(atol_needed, Round::Up))
+            } else {
+                String::new()
+            };
             problems.push(
                 "body.dissipation.coefficient",
                 number(kappa),
                 format!(
-                    "gives the couple a rate of change max(P, λ|ω|) = {} at t = 0 (P = {}, λ = P/(|ω|²·min(I_X, I_Z + Ma²)) = {}), more than {SCALE_MAX:e}·atol = {}: {}'s error estimate squares it over atol and would overflow at every step, ending the run at t = 0; use coefficient ≤ {}",
+                    "gives the couple a rate of change max(P, λ|ω|) = {} at t = 0 (P = {}, λ = P/(|ω|²·min(I_X, I_Z + Ma²)) = {}), more than {SCALE_MAX:e}·atol = {}: {}'s error estimate squares it over atol and would overflow at every step, ending the run at t = 0; use coefficient ≤ {}{or_atol}",
                     short(rate, Round::Nearest),
                     short(power, Round::Nearest),
                     short(couple_rate(scene), Round::Nearest),

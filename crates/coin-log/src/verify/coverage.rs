@@ -15,7 +15,7 @@ use super::checks::constraint;
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
 use crate::model::{magnitude, Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
-use crate::scene::Scene;
+use crate::scene::{limits, Scene, MAX_SAMPLES};
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
 /// and what to change; empty when `verify` will be able to judge the recording.
@@ -122,12 +122,40 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
     Some(format!(
         "will find no window the sampling resolves: at {} samples per time unit, h·Ω = {} (Ω = \
          {omega_text} at t = 0), and the finite difference's error 4(hΩ)^8/630 = {:.1e} exceeds a \
-         tenth of the residual tolerance {tol:.1e}; raise --rate to at least {}",
+         tenth of the residual tolerance {tol:.1e}; {}",
         run.rate,
         digits3(h * rate, f64::round),
         constraint::truncation(h, rate),
-        digits3(constraint::min_rate(rate, tol), f64::ceil)
+        rate_fix(
+            digits3(constraint::min_rate(rate, tol), f64::ceil),
+            run.duration
+        )
     ))
+}
+
+/// What to do for a recording of `duration` to resolve the motion at `needed` samples per time unit: raise
+/// --rate, where a rate that high is allowed (samples ≥ 1 ns apart, at most [`MAX_SAMPLES`] in all;
+/// format.md: Keys), and otherwise what can help instead (an advice of 6.39e11 on `euler-disk` under a
+/// viscous κ = 1e6 was refused as it stood). The rates are those at t = 0: that couple's braking is a
+/// transient, and at rate 911 verify judged the windows after it.
+fn rate_fix(needed: f64, duration: f64) -> String {
+    let highest = limits::max_rate(duration).floor();
+    if needed > highest {
+        return format!(
+            "no --rate resolves the motion as it starts: that takes at least {needed} samples per time \
+             unit, and samples 1 ns apart (the log-time resolution) allow at most {highest}; slow the \
+             motion, or express the scene in a shorter time unit (a motion that slows down later may \
+             still be judged where a rate allowed resolves it)"
+        );
+    }
+    if needed * duration > MAX_SAMPLES {
+        return format!(
+            "raise --rate to at least {needed} and shorten --duration to at most {} (a recording holds \
+             at most {MAX_SAMPLES:e} samples)",
+            digits3(MAX_SAMPLES / needed, f64::floor)
+        );
+    }
+    format!("raise --rate to at least {needed}")
 }
 
 /// |d ln Ω/dt| at t = 0 for Ω = max(|ω|, |φ̇|), the relative change the check adds to the rate of each

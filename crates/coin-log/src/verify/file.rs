@@ -634,7 +634,8 @@ fn verdict(
         c.energy.finish(&tol, &ctx),
         c.invariants.finish(&tol, &ctx),
         c.steady.finish(&ctx, &tol),
-        c.constraint.finish(ctx.coin.params().radius(), &tol),
+        c.constraint
+            .finish(ctx.coin.params().radius(), &tol, c.stats.span()),
         c.consistency.finish(),
         c.validity.finish(&ctx),
         c.nutation.finish(&ctx, &tol, &c.stats),

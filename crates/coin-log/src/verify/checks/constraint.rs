@@ -18,6 +18,7 @@
 use super::{fmt_num, Max};
 use crate::format::tolerances::Tolerances;
 use crate::model::magnitude;
+use crate::scene::limits::max_rate;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use nalgebra::Vector3;
@@ -99,6 +100,21 @@ pub fn min_rate(rate: f64, tol: f64) -> f64 {
     let largest = 10f64.powi(-i32::try_from(d).unwrap_or(i32::MAX));
     let h = (largest * 630.0 / TRUNCATION_SAFETY).powf(0.125) / rate;
     1.0 / h
+}
+
+/// What to record instead at `needed` samples per time unit, over a recording of `span`: a higher
+/// --rate where one that high is allowed (samples ≥ 1 ns apart, format.md: Keys), otherwise what can
+/// help (`wobble` spinning at ω_Z = 5e8 was told "at least 2.66e9", which record refuses).
+fn rate_advice(needed: f64, span: f64) -> String {
+    let highest = max_rate(span).floor();
+    if needed > highest {
+        format!(
+            "no --rate resolves it: that takes at least {} samples per time unit, and samples 1 ns apart (the log-time resolution) allow at most {highest}; slow the motion, or express the scene in a shorter time unit",
+            fmt_num(needed)
+        )
+    } else {
+        format!("record at a higher --rate (at least {})", fmt_num(needed))
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -216,7 +232,9 @@ impl ConstraintCheck {
     }
 
     #[must_use]
-    pub fn finish(&self, a: f64, tol: &Tolerances) -> CheckResult {
+    /// The result over the windows seen, `a` the radius and `span` the recorded span (for the highest
+    /// rate a recording that long allows, if a higher one is needed).
+    pub fn finish(&self, a: f64, tol: &Tolerances, span: f64) -> CheckResult {
         if self.samples < WINDOW as u64 {
             return CheckResult::skip(
                 CheckId::Constraint,
@@ -246,10 +264,10 @@ impl ConstraintCheck {
             return CheckResult::skip(
                 CheckId::Constraint,
                 format!(
-                    "the sampling does not resolve the motion: at h = {} the finite difference's truncation error 4(hΩ)^8/630, Ω = max(|ω|, |φ̇|) + its rate of change, exceeds a tenth of the tolerance {} in all {skipped} windows; record at a higher --rate (at least {})",
+                    "the sampling does not resolve the motion: at h = {} the finite difference's truncation error 4(hΩ)^8/630, Ω = max(|ω|, |φ̇|) + its rate of change, exceeds a tenth of the tolerance {} in all {skipped} windows; {}",
                     fmt_num(self.min_h),
                     fmt_num(tol.residual),
-                    fmt_num(min_rate(self.min_rate, tol.residual).ceil())
+                    rate_advice(min_rate(self.min_rate, tol.residual).ceil(), span)
                 ),
             );
         }
