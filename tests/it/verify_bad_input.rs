@@ -653,3 +653,42 @@ fn a_result_record_with_a_non_finite_or_negative_termination_time_fails_integrit
         }
     }
 }
+
+/// The result record's termination_alpha is α = π/2 − |θ| at the last sample with dissipation and null
+/// without: a euler-disk file whose α was moved (0.19… → 6.19…, found by fuzzing), or a wobble file
+/// given one, verified ok; each now fails integrity naming the value and what it should be.
+#[test]
+fn a_termination_alpha_that_is_not_the_last_samples_fails_integrity() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, alpha, says) in [
+        ("euler-disk", "6.2", "but the last sample's θ = "),
+        (
+            "euler-disk",
+            "",
+            "has no termination_alpha, which a run with dissipation records",
+        ),
+        (
+            "wobble",
+            "0.5",
+            "termination_alpha = 0.5, but the run has no dissipation",
+        ),
+    ] {
+        let good = record_scene(dir.path(), scene, &["--duration", "0.5"]);
+        let (code, out, err) = verify(&good);
+        assert_eq!(code, 0, "{out}{err}");
+        let path = dir.path().join("edited.mcap");
+        let edit_result = |name: &str, entries: &mut std::collections::BTreeMap<String, String>| {
+            if name == "coin-log.result" {
+                if alpha.is_empty() {
+                    entries.remove("termination_alpha");
+                } else {
+                    entries.insert("termination_alpha".into(), alpha.into());
+                }
+            }
+        };
+        rewrite_with_metadata(&good, &path, &edit_result, |_| {});
+        let (code, out, err) = verify(&path);
+        assert_eq!(code, 1, "{scene} {alpha}: {out}{err}");
+        assert!(out.contains(says), "{says}: {out}");
+    }
+}

@@ -740,12 +740,50 @@ impl Judge {
             }),
             _ => {}
         }
+        self.termination_alpha(ctx, read_whole);
         let mut problems = structure.problems.clone();
         problems.extend(&self.problems);
         if let Some(p) = read_problem {
             problems.push_with(|| p.clone());
         }
         problems
+    }
+}
+
+impl Judge {
+    /// The result record's `termination_alpha`: α = π/2 − |θ| at the last sample with dissipation (record
+    /// computes it from the very θ it stores, so they agree to the rounding of one subtraction), null
+    /// without. Judged when the file was read whole and its last sample has the angles.
+    fn termination_alpha(&mut self, ctx: &Context, read_whole: bool) {
+        let Some(alpha) = ctx.result.as_ref().map(|r| r.termination_alpha) else {
+            return;
+        };
+        let problem = match (
+            alpha,
+            ctx.run.dissipation.is_some(),
+            self.checks.stats.last_theta,
+        ) {
+            (Some(a), false, _) => format!(
+                "the `coin-log.result` metadata says termination_alpha = {a}, but the run has no \
+                 dissipation (it is null without)"
+            ),
+            (None, true, Some(_)) if read_whole => "the `coin-log.result` metadata has no \
+                termination_alpha, which a run with dissipation records"
+                .to_string(),
+            (Some(a), true, Some(theta)) if read_whole => {
+                let expected = std::f64::consts::FRAC_PI_2 - theta.abs();
+                // One rounding of π/2 − |θ| is below 2.2e-16; 1e-12 as the other recomputed values.
+                if (a - expected).abs() <= RECOMPUTE_TOLERANCE {
+                    return;
+                }
+                format!(
+                    "the `coin-log.result` metadata says termination_alpha = {a}, but the last sample's \
+                     θ = {theta} gives α = π/2 − |θ| = {expected}"
+                )
+            }
+            _ => return,
+        };
+        self.problems.push_with(|| problem);
     }
 }
 

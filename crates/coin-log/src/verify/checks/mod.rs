@@ -48,6 +48,8 @@ pub struct RunStats {
     pub samples: u64,
     /// max|ω| over samples with ω.
     pub max_omega: f64,
+    /// θ of the last sample, when it has the angles.
+    pub last_theta: Option<f64>,
 }
 
 impl RunStats {
@@ -56,6 +58,7 @@ impl RunStats {
         self.first_t.get_or_insert(s.t);
         self.last_t = s.t;
         self.samples += 1;
+        self.last_theta = s.angles.map(|a| a.theta);
         if let Some(w) = s.omega {
             self.max_omega = self.max_omega.max(magnitude(w.x, w.y, w.z));
         }
