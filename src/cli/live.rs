@@ -90,6 +90,10 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
     let signals = Signals::install()?;
     if args.output.is_none() {
         signals.on_first_signal("stopping the run (signal again to quit at once)");
+        signals.on_second_signal(
+            "stopped again: quitting at once",
+            Outcome::Interrupted.code(),
+        );
     }
     let source = load_source(&args.scene, &args.flags.set)?;
     let scene = record::resolve_flags(args.flags.overrides(), args.flags.encoding, &source)?;
@@ -137,6 +141,13 @@ pub fn run(args: LiveArgs) -> anyhow::Result<Outcome> {
         Some(target) => record::outcome(&summary, &scene, target),
         None => run_outcome(&summary),
     };
+    // The run is over and its file complete: a signal now only closes the server, and a second one while
+    // it closes abandons nothing.
+    signals.on_first_signal("stopping the server");
+    signals.on_second_signal(
+        "stopped again: quitting at once (the run was over)",
+        outcome.code(),
+    );
     serve_final_state(&args, server, &signals);
     Ok(outcome)
 }
@@ -308,7 +319,6 @@ fn serve_final_state(args: &LiveArgs, server: LiveServer, signals: &Signals) {
             std::thread::sleep(DRAIN);
         }
     } else {
-        signals.on_first_signal("stopping the server");
         errln!(
             "the run is over; still serving its final state at {} (Ctrl-C to stop)",
             server.url()

@@ -256,6 +256,10 @@ pub(super) struct Signals {
     /// What the first signal says it does (`live` says more than "finishing the file").
     #[cfg_attr(not(feature = "live"), allow(dead_code))]
     first: Arc<Mutex<&'static str>>,
+    /// What a second signal says as it quits at once, and the exit code (`live`: once the run is over its
+    /// file is complete and nothing is abandoned).
+    #[cfg_attr(not(feature = "live"), allow(dead_code))]
+    again: Arc<Mutex<(&'static str, u8)>>,
     /// The temporary file while it exists (locked while it is created and moved into place).
     temp: Arc<Mutex<Option<PathBuf>>>,
 }
@@ -267,7 +271,12 @@ impl Signals {
         let first = Arc::new(Mutex::new(
             "stopping: finishing the file with what was recorded (signal again to abandon it)",
         ));
+        let again = Arc::new(Mutex::new((
+            "stopped again: the recording is abandoned and nothing is written",
+            130,
+        )));
         let (flag, slot, said) = (Arc::clone(&stop), Arc::clone(&temp), Arc::clone(&first));
+        let quit = Arc::clone(&again);
         ctrlc::set_handler(move || {
             if !flag.swap(true, Ordering::SeqCst) {
                 errln!("{}", *said.lock().unwrap_or_else(PoisonError::into_inner));
@@ -277,15 +286,27 @@ impl Signals {
             if let Some(path) = slot.as_ref() {
                 let _ = std::fs::remove_file(path);
             }
-            errln!("stopped again: the recording is abandoned and nothing is written");
+            let (message, code) = *quit.lock().unwrap_or_else(PoisonError::into_inner);
+            errln!("{message}");
             #[allow(
                 clippy::disallowed_methods,
                 reason = "a second signal abandons the run at once; its temporary file is removed above"
             )]
-            std::process::exit(130);
+            std::process::exit(i32::from(code));
         })
         .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")?;
-        Ok(Self { stop, temp, first })
+        Ok(Self {
+            stop,
+            temp,
+            first,
+            again,
+        })
+    }
+
+    /// What a second signal will say as it quits at once, and the exit code, from now on.
+    #[cfg_attr(not(feature = "live"), allow(dead_code))]
+    pub(super) fn on_second_signal(&self, message: &'static str, code: u8) {
+        *self.again.lock().unwrap_or_else(PoisonError::into_inner) = (message, code);
     }
 
     /// What the first signal will say it does from now on.

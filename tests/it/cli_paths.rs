@@ -294,6 +294,34 @@ fn a_bench_out_that_is_no_folder_is_named_before_measuring() {
     assert_eq!(std::fs::read(dir.path().join("plain")).unwrap(), b"x");
 }
 
+/// A result file of a bench that is a pipe, a folder or a link is refused with a fix that works for a
+/// folder's files: before, it said "choose a file path, e.g. --out bench-results" (--out takes a folder)
+/// or "give the path it points to" (the bench names its files; no flag gives one).
+#[test]
+fn a_bench_result_file_that_cannot_be_replaced_gets_a_folder_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    std::fs::create_dir_all(root.join("pipe")).unwrap();
+    mkfifo(&root.join("pipe/euler.csv"));
+    std::fs::create_dir_all(root.join("folder/euler.svg")).unwrap();
+    std::fs::create_dir_all(root.join("link")).unwrap();
+    std::os::unix::fs::symlink(root.join("elsewhere.svg"), root.join("link/euler.svg")).unwrap();
+    for out in ["pipe", "folder", "link"] {
+        let output = coin_log(root, &["bench", "euler", "--out", out]);
+        let err = stderr(&output);
+        assert_eq!(code(&output), 1, "{out}: {err}");
+        assert!(
+            err.contains("move it away, or choose another folder with --out"),
+            "{out}: {err}"
+        );
+        assert!(
+            !err.contains("file path") && !err.contains("points to"),
+            "{out}: {err}"
+        );
+    }
+    assert!(!root.join("elsewhere.svg").exists());
+}
+
 #[test]
 fn a_folder_without_write_permission_fails_before_simulating() {
     use std::os::unix::fs::PermissionsExt;

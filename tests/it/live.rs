@@ -530,6 +530,73 @@ fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
     drop(ws);
 }
 
+/// Once the run is over its file is complete: Ctrl-C closes the server, which waits up to 2 s for a viewer
+/// that stopped reading, and a second Ctrl-C in that time quits. Before, that second signal said "the
+/// recording is abandoned and nothing is written" and exited 130, while the file was there, finished.
+#[test]
+fn a_second_ctrl_c_after_the_run_abandons_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut live = LiveProcess::start(
+        dir.path(),
+        &[
+            "circle-plus",
+            "--port",
+            "0",
+            "--duration",
+            "20",
+            "--rate",
+            "1000",
+            "--speed",
+            "100",
+            "-o",
+            "done.mcap",
+        ],
+    );
+    let mut ws = connect(&live.url(), "foxglove.sdk.v1").unwrap();
+    let mut seen = Seen::default();
+    let start = Instant::now();
+    while seen.subscriptions.is_empty() && start.elapsed() < DEADLINE {
+        match ws.read() {
+            Ok(m) => seen.take(&mut ws, m),
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(e) => panic!("the WebSocket failed: {e}"),
+        }
+    }
+    assert!(!seen.subscriptions.is_empty(), "nothing was advertised");
+    // From here the viewer reads nothing, so closing the server waits for it.
+    live.wait_for("still serving its final state");
+    let kill = |live: &LiveProcess| {
+        Command::new("kill")
+            .args(["-INT", &live.process.id().to_string()])
+            .status()
+            .unwrap()
+    };
+    assert!(kill(&live).success());
+    live.wait_for("stopping the server");
+    assert!(
+        kill(&live).success(),
+        "live exited before the second signal"
+    );
+    let out = live.process.wait_within(DEADLINE);
+    let stderr = live.stderr();
+    assert_eq!(out.code(), 0, "stderr:\n{stderr}");
+    assert!(
+        stderr.contains("stopped again: quitting at once"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("nothing is written"), "{stderr}");
+    let file = read_back(&std::fs::read(dir.path().join("done.mcap")).unwrap());
+    assert_eq!(
+        file.metadata["coin-log.result"].1["termination"], "completed",
+        "stderr:\n{stderr}"
+    );
+    drop(ws);
+}
+
 /// An output that cannot be written is refused before a viewer is invited to connect, and a speed is
 /// printed in a few digits: before, `-o existing.mcap` printed "serving … open it in Foxglove" and then
 /// refused, and `--speed 1e300` printed 301 digits.

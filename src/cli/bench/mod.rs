@@ -115,11 +115,13 @@ fn create_dir(out: &Path, files: &[String]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The result files replace an earlier run's (never a link, pipe or device: files::output).
+/// The result files replace an earlier run's (never a link, pipe or device: files::output). No example:
+/// the files are named by the bench, so a refused one is moved away or another folder chosen (an example
+/// made the fixes "choose a file path, e.g. --out bench-results" and "give the path it points to").
 const POLICY: Policy = Policy {
     overwrite: true,
     flag: "--out",
-    example: std::borrow::Cow::Borrowed("bench-results"),
+    example: std::borrow::Cow::Borrowed(""),
     protect: None,
 };
 
