@@ -488,27 +488,22 @@ fn ctrl_c_during_the_run_finishes_the_file_marked_interrupted() {
     );
 }
 
-/// A viewer that subscribes and then reads nothing fills its socket, and the server's task for it blocks.
-/// Before, `live --exit` then never exited once the run was over (SIGTERM only said "stopping the run"):
-/// closing the server waited for that task. It now waits a bounded time.
-#[test]
-fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut live = LiveProcess::start(
-        dir.path(),
-        &[
-            "circle-plus",
-            "--port",
-            "0",
-            "--duration",
-            "20",
-            "--rate",
-            "1000",
-            "--speed",
-            "100",
-            "--exit",
-        ],
-    );
+/// `circle-plus` served fast: 20 000 samples at 100 times real time.
+const FAST_CIRCLE: &[&str] = &[
+    "circle-plus",
+    "--port",
+    "0",
+    "--duration",
+    "20",
+    "--rate",
+    "1000",
+    "--speed",
+    "100",
+];
+
+/// A viewer of `live` that has read until it subscribed (the server advertises, the viewer subscribes to
+/// every channel); the caller then stops reading from it.
+fn subscribed_viewer(live: &LiveProcess) -> WebSocket<TcpStream> {
     let mut ws = connect(&live.url(), "foxglove.sdk.v1").unwrap();
     let mut seen = Seen::default();
     let start = Instant::now();
@@ -524,6 +519,17 @@ fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
         }
     }
     assert!(!seen.subscriptions.is_empty(), "nothing was advertised");
+    ws
+}
+
+/// A viewer that subscribes and then reads nothing fills its socket, and the server's task for it blocks.
+/// Before, `live --exit` then never exited once the run was over (SIGTERM only said "stopping the run"):
+/// closing the server waited for that task. It now waits a bounded time.
+#[test]
+fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut live = LiveProcess::start(dir.path(), &[FAST_CIRCLE, &["--exit"]].concat());
+    let ws = subscribed_viewer(&live);
     // From here the viewer reads nothing; 200 000 messages are served to it.
     let out = live.process.wait_within(Duration::from_secs(30));
     assert_eq!(out.code(), 0, "stderr:\n{}", live.stderr());
@@ -536,37 +542,8 @@ fn a_viewer_that_stops_reading_does_not_keep_live_exit_from_exiting() {
 #[test]
 fn a_second_ctrl_c_after_the_run_abandons_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let mut live = LiveProcess::start(
-        dir.path(),
-        &[
-            "circle-plus",
-            "--port",
-            "0",
-            "--duration",
-            "20",
-            "--rate",
-            "1000",
-            "--speed",
-            "100",
-            "-o",
-            "done.mcap",
-        ],
-    );
-    let mut ws = connect(&live.url(), "foxglove.sdk.v1").unwrap();
-    let mut seen = Seen::default();
-    let start = Instant::now();
-    while seen.subscriptions.is_empty() && start.elapsed() < DEADLINE {
-        match ws.read() {
-            Ok(m) => seen.take(&mut ws, m),
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) => {}
-            Err(e) => panic!("the WebSocket failed: {e}"),
-        }
-    }
-    assert!(!seen.subscriptions.is_empty(), "nothing was advertised");
+    let mut live = LiveProcess::start(dir.path(), &[FAST_CIRCLE, &["-o", "done.mcap"]].concat());
+    let ws = subscribed_viewer(&live);
     // From here the viewer reads nothing, so closing the server waits for it.
     live.wait_for("still serving its final state");
     let kill = |live: &LiveProcess| {
