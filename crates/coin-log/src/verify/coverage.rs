@@ -15,7 +15,7 @@ use super::checks::constraint;
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
 use crate::model::{magnitude, Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
-use crate::scene::{limits, Scene, MAX_SAMPLES};
+use crate::scene::{Scene, MAX_SAMPLES};
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
 /// and what to change; empty when `verify` will be able to judge the recording.
@@ -139,13 +139,10 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
 /// viscous κ = 1e6 was refused as it stood). The rates are those at t = 0: that couple's braking is a
 /// transient, and at rate 911 verify judged the windows after it.
 fn rate_fix(needed: f64, duration: f64) -> String {
-    let highest = limits::max_rate(duration).floor();
-    if needed > highest {
+    let what = "the motion as it starts";
+    if let Some(none) = constraint::no_rate_resolves(what, needed, &needed.to_string(), duration) {
         return format!(
-            "no --rate resolves the motion as it starts: that takes at least {needed} samples per time \
-             unit, and samples 1 ns apart (the log-time resolution) allow at most {highest}; slow the \
-             motion, or express the scene in a shorter time unit (a motion that slows down later may \
-             still be judged where a rate allowed resolves it)"
+            "{none} (a motion that slows down later may still be judged where a rate allowed resolves it)"
         );
     }
     if needed * duration > MAX_SAMPLES {

@@ -102,19 +102,26 @@ pub fn min_rate(rate: f64, tol: f64) -> f64 {
     1.0 / h
 }
 
-/// What to record instead at `needed` samples per time unit, over a recording of `span`: a higher
-/// --rate where one that high is allowed (samples ≥ 1 ns apart, format.md: Keys), otherwise what can
-/// help (`wobble` spinning at ω_Z = 5e8 was told "at least 2.66e9", which record refuses).
-fn rate_advice(needed: f64, span: f64) -> String {
+/// Why no --rate resolves `what` over a recording of `span` when that takes `needed` samples per time unit
+/// (shown as `shown`), if none does: samples are at least 1 ns apart (format.md: Keys). verify and record's
+/// prediction both advise a higher rate otherwise (`wobble` spinning at ω_Z = 5e8 was told "at least
+/// 2.66e9", which record refuses).
+pub fn no_rate_resolves(what: &str, needed: f64, shown: &str, span: f64) -> Option<String> {
     let highest = max_rate(span).floor();
-    if needed > highest {
+    (needed > highest).then(|| {
         format!(
-            "no --rate resolves it: that takes at least {} samples per time unit, and samples 1 ns apart (the log-time resolution) allow at most {highest}; slow the motion, or express the scene in a shorter time unit",
-            fmt_num(needed)
+            "no --rate resolves {what}: that takes at least {shown} samples per time unit, and samples 1 ns \
+             apart (the log-time resolution) allow at most {highest}; slow the motion, or express the scene \
+             in a shorter time unit"
         )
-    } else {
-        format!("record at a higher --rate (at least {})", fmt_num(needed))
-    }
+    })
+}
+
+/// What to record instead at `needed` samples per time unit, over a recording of `span`.
+fn rate_advice(needed: f64, span: f64) -> String {
+    let shown = fmt_num(needed);
+    no_rate_resolves("it", needed, &shown, span)
+        .unwrap_or_else(|| format!("record at a higher --rate (at least {shown})"))
 }
 
 #[derive(Debug, Clone)]
