@@ -10,7 +10,7 @@
 
 use crate::support::newton_euler::{Couple, Dissipating, NewtonEuler, NE_LEN};
 use crate::support::physics::{self, rate_unit};
-use crate::support::record::{coin_log_text, read_back, record_to_memory};
+use crate::support::record::{coin_log_text, read_back, record_scene, record_to_memory};
 use crate::support::writers::{nudge, rewrite};
 use coin_log::format::metadata::DISSIPATION_KEYS;
 use coin_log::format::{Channel, RESULT_METADATA_NAME, RUN_METADATA_NAME};
@@ -346,16 +346,7 @@ fn a_perturbed_work_channel_fails_the_energy_check() {
 #[test]
 fn a_perturbed_invariants_channel_fails_with_dissipation() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("euler.mcap");
-    let (code, out, err) = coin_log_text(&[
-        "record",
-        "euler-disk",
-        "--duration",
-        "2",
-        "-o",
-        path.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{out}{err}");
+    let path = record_scene(dir.path(), "euler-disk", &["--duration", "2"]);
     let good = verify_file(&path, &Options::default());
     assert_eq!(good.exit_code, 0, "{}", show(&good));
     let check = good.check(CheckId::Invariants).unwrap();
