@@ -689,7 +689,7 @@ verify = false
 }
 
 #[test]
-fn a_system_that_refuses_threads_fails_runs_not_the_sweep() {
+fn a_system_that_refuses_threads_still_finishes_every_run() {
     // Under a limit on processes (a cluster's pids limit, `ulimit -u`), spawning the sweep's workers and
     // a verification's reading thread panicked ("failed to spawn thread"), killing the sweep with
     // nothing catalogued. The limit binds root only through another user: setpriv, where there is one.
@@ -730,13 +730,19 @@ fn a_system_that_refuses_threads_fails_runs_not_the_sweep() {
         .unwrap();
     let err = String::from_utf8_lossy(&output.stderr);
     assert!(!err.contains("panicked"), "{err}");
-    assert!(
-        matches!(output.status.code(), Some(0 | 1)),
-        "{:?}: {err}",
-        output.status
-    );
     let catalogue = Csv::read(&dir.path().join("out/catalogue.csv"));
     assert_eq!(catalogue.rows.len(), SMALL_RUNS * 5, "{err}");
+    // And every run is done: a run also needs a thread of its own (verify's reading thread), so the
+    // sweep leaves half of what the system gave it idle, and a writer refused a compression thread
+    // compresses on its own (35 of 40 runs failed "Resource temporarily unavailable" before).
+    for r in catalogue.records() {
+        assert_eq!(
+            (r["status"].as_str(), r["verify"].as_str()),
+            ("finished", "ok"),
+            "{r:?}\n{err}"
+        );
+    }
+    assert_eq!(output.status.code(), Some(0), "{err}");
 }
 
 #[test]

@@ -429,9 +429,12 @@ fn the_bytes_do_not_depend_on_the_worker_count_or_the_run() {
         let (one, _) = write_file(&options(compression, 4096, 1), 10_000).unwrap();
         let (again, _) = write_file(&options(compression, 4096, 1), 10_000).unwrap();
         let (three, _) = write_file(&options(compression, 4096, 3), 10_000).unwrap();
+        // None: what a writer does when the system refuses it a thread.
+        let (none, _) = write_file(&options(compression, 4096, 0), 10_000).unwrap();
         println!("{compression:?}: {} bytes", one.len());
         assert!(one == again, "{compression:?}: two runs differ");
         assert!(one == three, "{compression:?}: 1 and 3 workers differ");
+        assert!(one == none, "{compression:?}: 1 worker and none differ");
     }
 }
 

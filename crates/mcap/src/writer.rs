@@ -68,7 +68,8 @@ pub struct WriterOptions {
     pub compression: Compression,
     /// A chunk is closed once its uncompressed records reach this many bytes (at least 1).
     pub chunk_size: usize,
-    /// Compression worker threads (at least 1). The bytes do not depend on it.
+    /// Compression worker threads; 0 compresses on the writer's own thread. The bytes do not depend on
+    /// it.
     pub workers: usize,
     /// The Header's `library`.
     pub library: String,
@@ -169,21 +170,25 @@ struct Worker {
 struct Workers(Vec<Worker>);
 
 impl Workers {
-    fn spawn(count: usize, compression: Compression) -> Result<Self, WriteError> {
+    /// Up to `count` workers: as many as the system gives. It may refuse a thread (its limit on processes
+    /// or threads, met by many writers at once); with none, the writer compresses on its own thread, to
+    /// the same bytes.
+    fn spawn(count: usize, compression: Compression) -> Self {
         let mut workers = Self(Vec::with_capacity(count));
-        for number in 0..count.max(1) {
+        for number in 0..count {
             let (job_sender, job_receiver) = mpsc::channel::<Job>();
             let (done_sender, done_receiver) = mpsc::channel::<Job>();
-            let thread = std::thread::Builder::new()
+            let spawned = std::thread::Builder::new()
                 .name(format!("mcap-compress-{number}"))
-                .spawn(move || compress_chunks(compression, &job_receiver, &done_sender))?;
+                .spawn(move || compress_chunks(compression, &job_receiver, &done_sender));
+            let Ok(thread) = spawned else { break };
             workers.0.push(Worker {
                 jobs: job_sender,
                 done: done_receiver,
                 thread,
             });
         }
-        Ok(workers)
+        workers
     }
 
     fn len(&self) -> usize {
@@ -329,6 +334,8 @@ pub struct McapWriter<W: Write> {
     chunk: Vec<u8>,
     meta: ChunkMeta,
     workers: Workers,
+    /// Compresses on this thread when the system gave no worker.
+    compressor: ChunkCompressor,
     /// Chunks sent since the start (chunk n goes to worker n mod workers), and of them not written yet.
     dispatched: usize,
     in_flight: usize,
@@ -351,10 +358,10 @@ impl<W: Write> McapWriter<W> {
     /// Writes the magic and the Header record and starts the compression workers.
     ///
     /// # Errors
-    /// [`WriteError`] if a worker thread cannot be started or the header is too long.
+    /// [`WriteError`] if the header is too long or cannot be written.
     pub fn new(writer: W, options: &WriterOptions) -> Result<Self, WriteError> {
         let chunk_size = options.chunk_size.max(1);
-        let workers = Workers::spawn(options.workers, options.compression)?;
+        let workers = Workers::spawn(options.workers, options.compression);
         let mut this = Self {
             out: Output {
                 inner: BufWriter::with_capacity(OUTPUT_BUFFER, writer),
@@ -367,6 +374,7 @@ impl<W: Write> McapWriter<W> {
             meta: ChunkMeta::default(),
             in_flight: 0,
             workers,
+            compressor: ChunkCompressor::new(options.compression),
             dispatched: 0,
             free: Vec::new(),
             scratch: Vec::new(),
@@ -588,7 +596,7 @@ impl<W: Write> McapWriter<W> {
         if self.chunk.is_empty() {
             return Ok(());
         }
-        while self.in_flight >= self.workers.len() * IN_FLIGHT_PER_WORKER {
+        while self.in_flight > 0 && self.in_flight >= self.workers.len() * IN_FLIGHT_PER_WORKER {
             self.collect(true)?;
         }
         let mut job = self.free.pop().unwrap_or_else(|| Job {
@@ -605,6 +613,11 @@ impl<W: Write> McapWriter<W> {
                 channel_id: channel.id,
                 records: Vec::new(),
             });
+        }
+        if self.workers.len() == 0 {
+            job.crc = crc32fast::hash(&job.records);
+            job.result = self.compressor.compress(&job.records, &mut job.compressed);
+            return self.written(job);
         }
         let worker = &self.workers.0[self.dispatched % self.workers.len()];
         worker.jobs.send(job).map_err(|_| WriteError::WorkerLost)?;
@@ -629,7 +642,7 @@ impl<W: Write> McapWriter<W> {
         }
         // The oldest chunk in flight went to the worker of its number.
         let worker = &self.workers.0[(self.dispatched - self.in_flight) % self.workers.len()];
-        let mut job = if wait {
+        let job = if wait {
             worker.done.recv().map_err(|_| WriteError::WorkerLost)?
         } else {
             match worker.done.try_recv() {
@@ -639,7 +652,13 @@ impl<W: Write> McapWriter<W> {
             }
         };
         self.in_flight -= 1;
-        if let Err(e) = job.result {
+        self.written(job)?;
+        Ok(true)
+    }
+
+    /// Writes a compressed chunk and keeps its buffers.
+    fn written(&mut self, mut job: Job) -> Result<(), WriteError> {
+        if let Err(e) = mem::replace(&mut job.result, Ok(())) {
             return Err(WriteError::Compress(e));
         }
         self.write_chunk(&job)?;
@@ -647,7 +666,7 @@ impl<W: Write> McapWriter<W> {
         job.compressed.clear();
         job.meta.clear();
         self.free.push(job);
-        Ok(true)
+        Ok(())
     }
 
     /// Writes a Chunk record and its MessageIndex records, and notes its ChunkIndex.

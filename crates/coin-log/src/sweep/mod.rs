@@ -29,7 +29,7 @@ pub use shard::{Shard, ShardError};
 pub use space::{linspace, logspace};
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc;
+use std::sync::{mpsc, PoisonError, RwLock};
 
 /// Calls `work` on each position 0 … `len` − 1 on up to `jobs` threads until `stop` is set (`None`: no
 /// result for it); `handle` gets the results on the calling thread as they come, in batches of those that
@@ -60,7 +60,14 @@ fn on_threads<R: Send>(
         }
         None
     };
-    let worker = |sender: mpsc::Sender<R>| {
+    // How many of the threads work, set once all are spawned: the system may refuse a thread (its limit
+    // on processes or threads), and then half of those it gave stay idle, since a run needs one more
+    // thread while it runs (verify's reading thread; the writer compresses on its own without one).
+    let gate = RwLock::new(0_usize);
+    let worker = |number: usize, sender: mpsc::Sender<R>| {
+        if number >= *gate.read().unwrap_or_else(PoisonError::into_inner) {
+            return;
+        }
         while let Some(result) = next_result() {
             if sender.send(result).is_err() {
                 break;
@@ -68,18 +75,27 @@ fn on_threads<R: Send>(
         }
     };
     std::thread::scope(|scope| {
-        let mut spawned = 0;
-        for _ in 0..threads.max(1) {
+        let mut working = gate.write().unwrap_or_else(PoisonError::into_inner);
+        let mut spawned: usize = 0;
+        let mut refused = false;
+        for number in 0..threads.max(1) {
             let sender = sender.clone();
             let worker = &worker;
-            // The system may refuse a thread (its limit on processes or threads): go on with those
-            // it gave (scope.spawn would panic).
-            let thread = std::thread::Builder::new().spawn_scoped(scope, move || worker(sender));
+            // Not scope.spawn, which panics when refused.
+            let thread =
+                std::thread::Builder::new().spawn_scoped(scope, move || worker(number, sender));
             if thread.is_err() {
+                refused = true;
                 break;
             }
             spawned += 1;
         }
+        *working = if refused {
+            spawned.div_ceil(2)
+        } else {
+            spawned
+        };
+        drop(working);
         drop(sender);
         if spawned == 0 {
             // Not one thread: the work is done here, each result handled as it comes.
