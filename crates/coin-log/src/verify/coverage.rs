@@ -11,11 +11,11 @@
 //! while one that cannot be resolved at the start is in practice not resolved anywhere (the steady and
 //! high-spin scenes keep their rates).
 
-use super::checks::constraint;
+use super::checks::constraint::{self, digits3};
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
 use crate::model::{magnitude, Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
-use crate::scene::{Scene, MAX_SAMPLES};
+use crate::scene::Scene;
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
 /// and what to change; empty when `verify` will be able to judge the recording.
@@ -134,8 +134,8 @@ fn constraint_blocker(scene: &Scene, span: f64) -> Option<String> {
 }
 
 /// What to do for a recording of `duration` to resolve the motion at `needed` samples per time unit: raise
-/// --rate, where a rate that high is allowed (samples ≥ 1 ns apart, at most [`MAX_SAMPLES`] in all;
-/// format.md: Keys), and otherwise what can help instead (an advice of 6.39e11 on `euler-disk` under a
+/// --rate, where a rate that high is allowed (samples ≥ 1 ns apart; with a shorter duration past
+/// [`crate::scene::MAX_SAMPLES`] in all; format.md: Keys), and otherwise what can help instead (an advice of 6.39e11 on `euler-disk` under a
 /// viscous κ = 1e6 was refused as it stood). The rates are those at t = 0: that couple's braking is a
 /// transient, and at rate 911 verify judged the windows after it.
 fn rate_fix(needed: f64, duration: f64) -> String {
@@ -145,14 +145,8 @@ fn rate_fix(needed: f64, duration: f64) -> String {
             "{none} (a motion that slows down later may still be judged where a rate allowed resolves it)"
         );
     }
-    if needed * duration > MAX_SAMPLES {
-        return format!(
-            "raise --rate to at least {needed} and shorten --duration to at most {} (a recording holds \
-             at most {MAX_SAMPLES:e} samples)",
-            digits3(MAX_SAMPLES / needed, f64::floor)
-        );
-    }
-    format!("raise --rate to at least {needed}")
+    let shorter = constraint::shorter_duration(needed, duration);
+    format!("raise --rate to at least {needed}{shorter}")
 }
 
 /// |d ln Ω/dt| at t = 0 for Ω = max(|ω|, |φ̇|), the relative change the check adds to the rate of each
@@ -182,16 +176,4 @@ fn initial_steepness(scene: &Scene, omega: f64, phi_dot: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// `x` rounded by `round` to 3 significant digits (`f64::ceil` for a rate that is enough).
-fn digits3(x: f64, round: fn(f64) -> f64) -> f64 {
-    if !x.is_finite() || x == 0.0 {
-        return x;
-    }
-    let unit = 10f64.powf(x.abs().log10().floor() - 2.0);
-    let rounded = round(x / unit) * unit;
-    // The product carries the unit's rounding (72.6 came out as 72.60000000000001): the three digits
-    // printed and read back are the number meant.
-    format!("{rounded:.2e}").parse().unwrap_or(rounded)
 }

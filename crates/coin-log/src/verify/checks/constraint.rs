@@ -19,6 +19,7 @@ use super::{fmt_num, Max};
 use crate::format::tolerances::Tolerances;
 use crate::model::magnitude;
 use crate::scene::limits::max_rate;
+use crate::scene::MAX_SAMPLES;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 use nalgebra::Vector3;
@@ -117,11 +118,39 @@ pub fn no_rate_resolves(what: &str, needed: f64, shown: &str, span: f64) -> Opti
     })
 }
 
+/// What a rate of `needed` over `span` takes besides: a shorter --duration, where that many samples pass
+/// the most a recording holds ([`MAX_SAMPLES`]), else nothing.
+pub fn shorter_duration(needed: f64, span: f64) -> String {
+    if needed * span > MAX_SAMPLES {
+        let at_most = digits3(MAX_SAMPLES / needed, f64::floor);
+        format!(
+            " and shorten --duration to at most {at_most} (a recording holds at most {MAX_SAMPLES:e} \
+             samples)"
+        )
+    } else {
+        String::new()
+    }
+}
+
+/// `x` rounded by `round` to 3 significant digits (`f64::ceil` for a rate that is enough).
+pub fn digits3(x: f64, round: fn(f64) -> f64) -> f64 {
+    if !x.is_finite() || x == 0.0 {
+        return x;
+    }
+    let unit = 10f64.powf(x.abs().log10().floor() - 2.0);
+    let rounded = round(x / unit) * unit;
+    // The product carries the unit's rounding (72.6 came out as 72.60000000000001): the three digits
+    // printed and read back are the number meant.
+    format!("{rounded:.2e}").parse().unwrap_or(rounded)
+}
+
 /// What to record instead at `needed` samples per time unit, over a recording of `span`.
 fn rate_advice(needed: f64, span: f64) -> String {
     let shown = fmt_num(needed);
-    no_rate_resolves("it", needed, &shown, span)
-        .unwrap_or_else(|| format!("record at a higher --rate (at least {shown})"))
+    no_rate_resolves("it", needed, &shown, span).unwrap_or_else(|| {
+        let shorter = shorter_duration(needed, span);
+        format!("record at a higher --rate (at least {shown}){shorter}")
+    })
 }
 
 #[derive(Debug, Clone)]
@@ -310,6 +339,21 @@ impl ConstraintCheck {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_rate_whose_samples_a_recording_cannot_hold_comes_with_a_shorter_duration() {
+        // 5e8 per time unit over 1000 is 5e11 samples, past the 1e11 a recording holds: the advice names
+        // the duration that holds them (200); over 100, 5e10 fit and the rate alone is the advice.
+        assert_eq!(
+            rate_advice(5e8, 1000.0),
+            "record at a higher --rate (at least 5.00e8) and shorten --duration to at most 200 (a \
+             recording holds at most 1e11 samples)"
+        );
+        assert_eq!(
+            rate_advice(5e8, 100.0),
+            "record at a higher --rate (at least 5.00e8)"
+        );
+    }
 
     #[test]
     fn the_eighth_difference_of_the_velocities_cancels_the_differences_leading_error() {
