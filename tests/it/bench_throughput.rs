@@ -9,6 +9,7 @@
     clippy::cast_sign_loss
 )]
 
+use crate::support::process::Process;
 use crate::support::record::{coin_log, exe};
 use crate::support::repo;
 use coin_log::record::{self, RecordOptions};
@@ -20,6 +21,7 @@ use coin_log_mcap::Compression;
 use std::io::Cursor;
 use std::process::Command;
 use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
 
 fn row<'a>(rows: &'a [ThroughputRow], workload_starts: &str, quantity: &str) -> &'a ThroughputRow {
     rows.iter()
@@ -393,4 +395,48 @@ fn a_duration_the_workload_cannot_measure_is_refused_before_any_run() {
             "nothing measured, nothing written"
         );
     }
+}
+
+/// SIGTERM to the bench alone (a scheduler's stop, `kill PID`) killed it and left its recording, with its
+/// child `record` running on. Now the child is stopped as the signal stops it, the recordings are removed,
+/// nothing else is written, and the bench exits 130.
+#[test]
+fn a_signal_stops_the_bench_and_its_child_and_removes_the_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mut bench = Process::start(
+        Command::new(exe())
+            .args([
+                "bench",
+                "throughput",
+                "--durations",
+                "200",
+                "--repeats",
+                "1",
+            ])
+            .arg("--out")
+            .arg(&out),
+    );
+    let entries = || std::fs::read_dir(&out).map_or(0, Iterator::count);
+    let started = Instant::now();
+    while entries() == 0 {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "no recording appeared"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let status = Command::new("kill")
+        .args(["-TERM", &bench.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success(), "the bench ended before the signal");
+    let ended = bench.wait_within(Duration::from_secs(60));
+    assert_eq!(ended.status.code(), Some(130), "{}", ended.stderr);
+    assert!(ended.stderr.contains("interrupted"), "{}", ended.stderr);
+    // A child left running would still move its file into place.
+    std::thread::sleep(Duration::from_millis(500));
+    let left: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}\n{}", ended.stderr);
 }

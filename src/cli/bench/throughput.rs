@@ -15,7 +15,8 @@ use coin_log_bench::throughput::{
 };
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::time::Instant;
 
 /// Arguments of `coin-log bench throughput`.
@@ -52,6 +53,7 @@ pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
         check(&recording_path(&args.out, *d), &POLICY)?;
     }
     let exe = std::env::current_exe().context("locating the coin-log binary")?;
+    install_signals()?;
     let result = measure(
         &exe,
         &args.out,
@@ -63,6 +65,11 @@ pub fn run(args: &ThroughputArgs) -> anyhow::Result<Outcome> {
         for d in &durations {
             let _ = fs::remove_file(recording_path(&args.out, *d));
         }
+    }
+    if STOP.load(Ordering::SeqCst) {
+        let kept = if args.keep { "kept" } else { "removed" };
+        errln!("interrupted: the recordings are {kept} and throughput.csv is not written");
+        return Ok(Outcome::Interrupted);
     }
     let report = result?;
     outln!("cores available: {}", report.cores);
@@ -134,6 +141,44 @@ fn record_and_verify(
     Ok(runs.rows()?)
 }
 
+/// Set by SIGINT, SIGTERM or SIGHUP: the child running is stopped as that signal stops it (a recording
+/// is finished, then removed with the others) and no other starts. Before, a signal to this process
+/// alone killed it and left its recordings, and its child running on.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// The running child's process id (0: none), for the signal handler to pass the signal on.
+static CHILD: AtomicU32 = AtomicU32::new(0);
+
+/// The first signal stops the bench as [`STOP`] says; a second quits at once.
+fn install_signals() -> anyhow::Result<()> {
+    ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            errln!("stopped again: quitting at once; the recordings may be left in the output folder");
+            #[allow(
+                clippy::disallowed_methods,
+                reason = "a second signal quits at once, as its message says"
+            )]
+            std::process::exit(130);
+        }
+        errln!(
+            "stopping: the run in progress is stopped and the recordings are cleaned up (signal again \
+             to quit at once)"
+        );
+        // The child is not reaped before CHILD is cleared, so the id is still its own.
+        terminate(CHILD.load(Ordering::SeqCst));
+    })
+    .context("cannot install the handler of SIGINT, SIGTERM and SIGHUP")
+}
+
+/// Sends SIGTERM to process `pid` (none for 0).
+fn terminate(pid: u32) {
+    #[cfg(unix)]
+    if let Ok(pid @ 1..) = i32::try_from(pid) {
+        let pid = nix::unistd::Pid::from_raw(pid);
+        let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM);
+    }
+}
+
 /// Runs a child `coin-log` and returns its parsed JSON stdout and wall time; it must exit 0.
 #[allow(
     clippy::disallowed_methods,
@@ -141,11 +186,24 @@ fn record_and_verify(
 )]
 fn child_json(exe: &Path, args: &[String]) -> anyhow::Result<(serde_json::Value, f64)> {
     let command = format!("{} {}", exe.display(), args.join(" "));
+    if STOP.load(Ordering::SeqCst) {
+        bail!("interrupted before `{command}`");
+    }
     let start = Instant::now();
-    let output = Command::new(exe)
+    let child = Command::new(exe)
         .args(args)
-        .output()
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
         .map_err(|e| anyhow!("cannot run `{command}`: {e}"))?;
+    CHILD.store(child.id(), Ordering::SeqCst);
+    // A signal that came between the check above and the store is passed on here.
+    if STOP.load(Ordering::SeqCst) {
+        terminate(child.id());
+    }
+    let output = child.wait_with_output();
+    CHILD.store(0, Ordering::SeqCst);
+    let output = output.map_err(|e| anyhow!("cannot run `{command}`: {e}"))?;
     let wall = start.elapsed().as_secs_f64();
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {
