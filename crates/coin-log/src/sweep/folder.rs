@@ -487,22 +487,23 @@ fn outputs(shard: Shard) -> Vec<String> {
 
 /// Refuses `path` (the sweep folder `folder`, or a file in it) when it is immutable or append-only
 /// (`chattr +i`, `+a`): a rename may not replace it (nor, for the folder, move a file into it), even for
-/// root, which would show only once the work was done.
+/// root, which would show only once the work was done. The folder is one that cannot hold the sweep; a
+/// file in it is an I/O error writing it, as when it is a folder or a link.
 fn refuse_attribute(folder: &Path, path: &Path) -> Result<(), SweepError> {
     let Some(attribute) = files::Attribute::of(path) else {
         return Ok(());
     };
     let (name, clear) = attribute.words();
-    let what = if path == folder {
-        "is".to_string()
-    } else {
-        format!("holds `{}`, which is", files::shown(path))
-    };
-    Err(SweepError::folder(folder)(format!(
-        "{what} {name}, so the system lets no file be moved into place there: clear the attribute \
-         ({clear} {}), or give -o another folder",
+    let why = format!(
+        "is {name}, so the system lets no file be moved into place there: clear the attribute ({clear} \
+         {}), or give -o another folder",
         files::shown(path)
-    )))
+    );
+    if path == folder {
+        return Err(SweepError::folder(folder)(why));
+    }
+    let denied = io::Error::new(io::ErrorKind::PermissionDenied, why);
+    Err(SweepError::io("writing", path)(denied))
 }
 
 fn last_byte(file: &File, path: &Path) -> io::Result<Option<u8>> {
