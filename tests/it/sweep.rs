@@ -698,36 +698,18 @@ fn a_system_that_refuses_threads_still_finishes_every_run() {
     write_sweep(dir.path(), "s.toml", &text);
     let mode = std::os::unix::fs::PermissionsExt::from_mode(0o777);
     std::fs::set_permissions(dir.path(), mode).unwrap();
-    // prlimit and setpriv are util-linux's; as root the limit binds only another user.
-    let root = std::process::Command::new("id")
-        .arg("-u")
-        .output()
-        .unwrap()
-        .stdout
-        == b"0\n";
-    let mut args = vec!["--nproc=40:40".to_string(), "--".to_string()];
-    if root {
-        args.extend(
-            [
-                "setpriv",
-                "--reuid=65534",
-                "--regid=65534",
-                "--clear-groups",
-            ]
-            .map(String::from),
-        );
-    }
-    args.push(exe().display().to_string());
-    args.extend(["sweep", "s.toml", "-o", "out", "--jobs", "200"].map(String::from));
+    // prlimit is util-linux's; as root the limit binds only another user.
+    let nobody = crate::support::unprivileged(&exe());
     let mut command = std::process::Command::new("prlimit");
+    command
+        .args(["--nproc=40:40", "--"])
+        .arg(nobody.get_program())
+        .args(nobody.get_args())
+        .args(["sweep", "s.toml", "-o", "out", "--jobs", "200"]);
     for v in SCHEDULER_VARIABLES {
         command.env_remove(v);
     }
-    let output = command
-        .args(&args)
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
+    let output = command.current_dir(dir.path()).output().unwrap();
     let err = String::from_utf8_lossy(&output.stderr);
     assert!(!err.contains("panicked"), "{err}");
     let catalogue = Csv::read(&dir.path().join("out/catalogue.csv"));

@@ -4,7 +4,7 @@
 //! changed, cut or lost file, and then writes nothing.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use crate::support::record::listing;
+use crate::support::record::{exe, listing};
 use crate::sweep::{
     run_files, run_in, run_with_env, sweep_json, write_sweep, Csv, SMALL, SMALL_RUNS,
 };
@@ -878,4 +878,39 @@ fn a_slurm_array_with_a_step_is_refused_naming_the_dense_form() {
         ("SLURM_ARRAY_TASK_COUNT", "4"),
     ]);
     assert!(Shard::from_environment(bad, None).is_err());
+}
+
+#[test]
+fn collect_in_a_folder_it_may_not_write_in_is_refused_before_reading_a_run() {
+    // collect read and hashed every run file, then failed writing the catalogue ("Permission denied"):
+    // on a dataset of gigabytes, minutes for nothing. A run file it may not read shows which came first.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    for shard in ["0/2", "1/2"] {
+        assert_eq!(
+            sweep_json(dir.path(), "s.toml", "d", &["--shard", shard]).0,
+            0
+        );
+    }
+    let d = dir.path().join("d");
+    let mode = |path: &Path, mode: u32| {
+        let mode = std::os::unix::fs::PermissionsExt::from_mode(mode);
+        std::fs::set_permissions(path, mode).unwrap();
+    };
+    mode(dir.path(), 0o755);
+    mode(&d, 0o555);
+    mode(&d.join("run-00.mcap"), 0o200);
+    let output = crate::support::unprivileged(&exe())
+        .args(["sweep", "collect", "d"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    mode(&d, 0o755);
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("writing `d/catalogue.csv`: Permission denied"),
+        "{err}"
+    );
+    assert!(!err.contains("run-00"), "a run was read first: {err}");
 }

@@ -20,6 +20,23 @@ pub mod writers;
 use std::io::{Cursor, Seek, SeekFrom, Write};
 use std::path::PathBuf;
 
+/// `program` run as a user other than root where the tests run as root (`setpriv` to nobody, 65534), so
+/// that permissions and limits on processes bind as they do for users; as a user, as that user.
+pub fn unprivileged(program: &std::path::Path) -> std::process::Command {
+    let root = std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| o.stdout == b"0\n");
+    if !root {
+        return std::process::Command::new(program);
+    }
+    let mut command = std::process::Command::new("setpriv");
+    command
+        .args(["--reuid=65534", "--regid=65534", "--clear-groups"])
+        .arg(program);
+    command
+}
+
 /// Makes a named pipe at `path` (the tests put pipes where a file is read or written, to show it is
 /// refused without blocking).
 pub fn mkfifo(path: &std::path::Path) {

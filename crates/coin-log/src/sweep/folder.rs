@@ -317,8 +317,8 @@ impl Folder {
     }
 
     /// Refuses, before any run, a folder in which `shard`'s catalogue (or part) and `sweep.json` could
-    /// not be moved into place, each refused as its write would refuse it (not a regular file) or by
-    /// [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
+    /// not be moved into place, each refused as its write would refuse it (not a regular file, no
+    /// temporary file beside it) or by [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
     /// nothing, and a catalogue could be written without its `sweep.json`.
     pub fn check_outputs(&self, shard: Shard) -> Result<(), SweepError> {
         refuse_attribute(&self.path, &self.path)?;
@@ -326,6 +326,9 @@ impl Folder {
             let path = self.file(&name);
             files::absent_or_plain(&path).map_err(SweepError::io("writing", &path))?;
             refuse_attribute(&self.path, &path)?;
+            // The temporary file it is written through: a folder we may not write in (permissions, a
+            // read-only mount) failed only at the end, once every file was hashed.
+            temp_file(&path).map_err(SweepError::io("writing", &path))?;
         }
         Ok(())
     }
