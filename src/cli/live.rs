@@ -76,12 +76,24 @@ fn parse_speed(s: &str) -> Result<f64, String> {
 }
 
 fn parse_host(s: &str) -> Result<IpAddr, String> {
-    s.trim().parse().map_err(|_| {
-        format!(
-            "`{s}` is not an IP address; use 127.0.0.1 (this machine only), 0.0.0.0 (every interface) \
-             or one interface's address"
-        )
-    })
+    let use_instead =
+        "use 127.0.0.1 (this machine only), 0.0.0.0 (every interface) or one interface's \
+                       address";
+    let host: IpAddr = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not an IP address; {use_instead}"))?;
+    // The system lets a server bind these, and then no viewer can ever connect: live waited forever.
+    let group = match host {
+        IpAddr::V4(v4) => v4.is_broadcast() || v4.is_multicast(),
+        IpAddr::V6(v6) => v6.is_multicast(),
+    };
+    if group {
+        return Err(format!(
+            "`{s}` is a broadcast or multicast address, which no viewer can connect to; {use_instead}"
+        ));
+    }
+    Ok(host)
 }
 
 /// Runs `coin-log live`: load → resolve → serve → record and serve at the pace → summary → serve the final

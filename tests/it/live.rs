@@ -608,12 +608,16 @@ fn bad_speed_host_or_busy_port_exit_2_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let busy = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let port = busy.local_addr().unwrap().port().to_string();
-    let cases: [(&[&str], &str); 6] = [
+    // A broadcast or multicast host was bound, and live waited for a viewer that cannot connect.
+    let cases: [(&[&str], &str); 9] = [
         (&["--speed", "0"], "speed"),
         (&["--speed", "-2"], "speed"),
         (&["--speed", "nan"], "speed"),
         (&["--speed", "fast"], "not a number"),
         (&["--host", "my-laptop"], "not an IP address"),
+        (&["--host", "255.255.255.255"], "broadcast or multicast"),
+        (&["--host", "224.0.0.1"], "broadcast or multicast"),
+        (&["--host", "ff02::1"], "broadcast or multicast"),
         (&["--port", &port], "in use"),
     ];
     for (args, needle) in cases {
