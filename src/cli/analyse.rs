@@ -13,6 +13,7 @@ use coin_log::analyse::{motion_name, Analysis, Stability, SteadyAnalysis};
 use coin_log::files::{shown, OutputFolder};
 use coin_log::model::nutation::Motion;
 use coin_log::model::{Coin, CoinParams, SteadyFamily};
+use coin_log::scene::limits::MIN_DURATION;
 use coin_log::scene::{RunFile, Scene};
 use std::ffi::{OsStr, OsString};
 use std::io::Write;
@@ -96,14 +97,18 @@ pub fn run(args: AnalyseArgs) -> anyhow::Result<Outcome> {
     }
 }
 
-/// The scene SCENE with `sets`, validated, and its name in messages; `run.duration` (which analyse does
-/// not use) may be left out.
+/// The scene SCENE with `sets`, validated, and its name in messages. Of the run settings analyse uses
+/// only `run.flat_margin`: the others (duration, rate, integrator, tolerances, budget) are left out, so
+/// that a value only record refuses does not refuse the analysis (a spin of 1e9 with the scene's duration
+/// 30 was refused for its samples). The duration stands at the shortest, which bounds no motion.
 fn load_scene(arg: &OsStr, sets: &[String]) -> anyhow::Result<(String, Scene)> {
     let mut source = load_source(arg, sets)?;
-    let run = source.file.run.get_or_insert_with(RunFile::default);
-    if run.duration.is_none() {
-        run.duration = Some(1.0);
-    }
+    let flat_margin = source.file.run.as_ref().and_then(|r| r.flat_margin);
+    source.file.run = Some(RunFile {
+        duration: Some(MIN_DURATION),
+        flat_margin,
+        ..RunFile::default()
+    });
     let label = source.label;
     let scene = Scene::from_file(&source.file).map_err(|e| anyhow!("scene `{label}`: {e}"))?;
     Ok((label, scene))

@@ -237,6 +237,33 @@ fn analyse_json(scene: &str, args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+#[test]
+fn the_run_settings_analyse_does_not_use_do_not_refuse_the_analysis() {
+    // A spin of 1e9 was refused for its samples over the scene's duration, which analyse never takes;
+    // a rate or tolerance only record refuses did the same. The analysis is the scene's without them, and
+    // flat_margin, which analyse uses, is still checked.
+    let plain = analyse_json("circle-plus", &[]);
+    let unused = [
+        "--set=run.rate=1e12",
+        "--set=run.rtol=1",
+        "--set=run.duration=1e300",
+        "--set=run.integrator=none-such",
+    ];
+    assert_eq!(analyse_json("circle-plus", &unused), plain);
+    let fast = [
+        "--set=initial.steady={kind=\"spin-upright\",omega_y=1e9}",
+        "--set=run.duration=30",
+    ];
+    assert_eq!(analyse_json("circle-plus", &fast)["motion"], "steady");
+    let dir = tempfile::tempdir().unwrap();
+    let out = coin_log(
+        dir.path(),
+        &["analyse", "circle-plus", "--set=run.flat_margin=2"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`run.flat_margin` = 2"));
+}
+
 /// The termination time of `coin-log record SCENE` (from its summary line "termination ... at t = X").
 fn recorded_termination(scene: &str) -> (String, f64) {
     let dir = tempfile::tempdir().unwrap();
