@@ -719,6 +719,46 @@ fn plot_draws_every_panel_and_marks_the_termination() {
     assert_eq!(out.status.code(), Some(1));
 }
 
+/// A description may hold U+FFFE and U+FFFF (`record` refuses only control characters), which XML 1.0
+/// does not allow in a document: plot wrote them into the title as they were, and the SVG was not
+/// well-formed (Python's parser: "not well-formed (invalid token)"). They are drawn escaped, as a message
+/// shows a control character.
+#[test]
+fn plot_escapes_the_characters_xml_does_not_allow() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, toml, err) = coin_log_text(&["scenes", "--show", "circle-plus"]);
+    assert_eq!(code, 0, "{err}");
+    let toml: String = toml
+        .lines()
+        .map(|l| {
+            if l.starts_with("description") {
+                "description = \"odd \\uFFFE \\uFFFF <&> ]]> end\"".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let scene = dir.path().join("odd.toml");
+    std::fs::write(&scene, toml).unwrap();
+    record_scene(dir.path(), scene.to_str().unwrap(), &["--duration", "0.1"]);
+    let out = coin_log(dir.path(), &["plot", "odd.toml.mcap", "-o", "odd.svg"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(dir.path().join("odd.svg")).unwrap();
+    let texts = svg_texts(&svg);
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.starts_with("odd \\u{fffe} \\u{ffff} <&> ]]> end")),
+        "{texts:?}"
+    );
+}
+
 /// A run of a microsecond: every time panel's ticks tell the times apart (plotters' own labels, 5 decimals
 /// without an exponent, printed `0.0` on every tick: 56 of them on the page).
 #[test]
