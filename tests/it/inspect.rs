@@ -759,6 +759,65 @@ fn plot_escapes_the_characters_xml_does_not_allow() {
     );
 }
 
+/// A scene in units where a = g = 1e70 (within the limits `record` accepts) was plotted with tick labels
+/// and settings of 70 and more digits (`-6000000000000000435188618289175410756950246457879131733109260932874240.0`,
+/// `a = 10000000000000000000000000000000000000000000000000000000000000000000000`), far wider than the
+/// label area: large values are written in exponent form, as `info` writes them (`a = 1e70`).
+#[test]
+fn plot_writes_large_values_in_exponent_form() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "circle-plus",
+        &[
+            "--duration",
+            "0.5",
+            "--set",
+            "body.radius=1e70",
+            "--set",
+            "body.gravity=1e70",
+        ],
+    );
+    let out = coin_log(dir.path(), &["plot", "circle-plus.mcap"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let texts = svg_texts(&std::fs::read_to_string(dir.path().join("circle-plus.svg")).unwrap());
+    let longest_number = |t: &str| {
+        t.split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0)
+    };
+    for t in &texts {
+        assert!(longest_number(t) < 20, "a number of 20 digits or more: {t}");
+    }
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.contains("a = 1e70, g = 1e70, I_X = 2.5e139, I_Z = 5e139")),
+        "{texts:?}"
+    );
+    // The track panel's ticks (of the order of 1e70) are labelled in exponent form, and the one at 0,
+    // which plotters computes as about 1e55 off, as 0.
+    let large = texts
+        .iter()
+        .filter(|t| t.contains('e') && t.parse::<f64>().is_ok_and(|v| v.abs() >= 1e60))
+        .count();
+    assert!(large >= 8, "{large} large ticks: {texts:?}");
+    assert!(
+        !texts.iter().any(
+            |t| t.parse::<f64>().is_ok_and(|v| v != 0.0 && v.abs() < 1e60)
+                && t.contains('e')
+                && !t.contains("e-")
+        ),
+        "{texts:?}"
+    );
+}
+
 /// A run of a microsecond: every time panel's ticks tell the times apart (plotters' own labels, 5 decimals
 /// without an exponent, printed `0.0` on every tick: 56 of them on the page).
 #[test]
