@@ -60,7 +60,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
         let given = path.display().to_string();
         match read(path) {
             Ok(i) => {
-                failed |= i.problem.is_some();
+                // Described up to the break on stdout, and named on stderr as every error is: exit 1
+                // with nothing on stderr left a script that keeps stderr without the reason.
+                if let Some(problem) = &i.problem {
+                    failed = true;
+                    errln!("error: {}: {problem}", shown(path));
+                }
                 if args.json {
                     json_files.push(serde_json::to_value(i.json(&given))?);
                 } else {
@@ -99,10 +104,12 @@ fn read(path: &Path) -> Result<FileInfo, String> {
 /// `--scene`: the stored scene, after comment lines saying where it comes from and how to reproduce it.
 fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
     let [path] = args.files.as_slice() else {
-        bail!(
-            "--scene prints the scene of one file; {} were given",
+        // A usage error (exit 2), as `--scene --json` is clap's.
+        errln!(
+            "error: --scene prints the scene of one file; {} were given",
             args.files.len()
         );
+        return Ok(Outcome::Unusable);
     };
     let shown = shown(path);
     let i = read(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;

@@ -239,6 +239,39 @@ fn info_describes_a_truncated_file_up_to_the_break_and_refuses_a_non_mcap_file()
     assert!(err.contains("not an MCAP file"), "{err}");
 }
 
+/// A file that breaks off part way is described up to the break on stdout and exits 1; the error is on
+/// stderr too, as `plot` and `info --scene` put it there: with stdout in a file or a pipe, exit 1 came with
+/// nothing on stderr.
+#[test]
+fn info_names_the_problem_of_a_truncated_file_on_stderr() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "circle-plus", &["--duration", "1"]);
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(dir.path().join("half.mcap"), &bytes[..bytes.len() / 2]).unwrap();
+    for json in [false, true] {
+        let mut args = vec!["info", "half.mcap"];
+        if json {
+            args.push("--json");
+        }
+        let out = coin_log(dir.path(), &args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.starts_with("error: half.mcap: ") && err.contains("truncated"),
+            "--json {json}: {err}"
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("truncated"));
+    }
+    // A whole file: nothing on stderr.
+    let out = coin_log(dir.path(), &["info", "circle-plus.mcap"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// `info F --scene > s.toml && record s.toml -o G` writes G equal to F byte for byte, for every built-in
 /// scene; the description and every default survive, and the scene file's name does not enter the file.
 #[test]
@@ -318,7 +351,8 @@ fn the_stored_scene_names_a_non_default_compression() {
         original.to_str().unwrap(),
         original.to_str().unwrap(),
     ]);
-    assert_eq!(code, 1);
+    // A usage error (exit 2, as `--scene --json` is clap's), not a failure to read a file (exit 1).
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("one file"), "{err}");
 }
 
