@@ -133,7 +133,8 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
 
 /// The comment lines before `--scene`'s TOML: the `coin-log record` command line that writes the file's
 /// bytes again from that text (every setting the scene does not hold: encoding and compression), or why
-/// no command can (mixed encodings or compressions, or a file that could not be read to its end).
+/// no command can (mixed encodings or compressions, a file that could not be read to its end, or one
+/// whose header names another library).
 fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
     let mut text = format!(
         "# The scene stored in `{shown}` (written by coin-log {}).\n",
@@ -165,6 +166,19 @@ fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
             text,
             "# Its encoding ({encoding}) and compression ({compression}) are not those of one `coin-log \
              record`,\n# so no command line writes the same bytes again."
+        );
+        return text;
+    }
+    // `record` names itself in the header: a file whose header names another library was rewritten by
+    // another program (Python's or Rust's `mcap` writer), whatever it kept or changed.
+    let library = &i.summary.library;
+    if *library != format!("coin-log/{}", run.tool_version) {
+        let _ = writeln!(
+            text,
+            "# Its header names the library `{}`, not coin-log {}: another program wrote these bytes,\n# so \
+             no command line writes the same bytes again.",
+            shown_name(library),
+            run.tool_version
         );
         return text;
     }

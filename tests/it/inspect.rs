@@ -356,6 +356,39 @@ fn the_stored_scene_names_a_non_default_compression() {
     assert!(err.contains("one file"), "{err}");
 }
 
+/// A file another program rewrote (its header's library is not `coin-log/<version>`) holds the scene that
+/// coin-log recorded, but not bytes that `coin-log record` writes: `--scene` said "this writes the same
+/// bytes again" for a copy by Python's or Rust's `mcap` writer, even one that kept a single sample. It now
+/// names the library and gives no command line.
+#[test]
+fn the_stored_scene_of_a_rewritten_file_claims_no_reproduction() {
+    // The command line's start (src/cli/info.rs: REPRODUCE).
+    const REPRODUCE: &str = "#     coin-log record ";
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--compression", "lz4", "--duration", "0.5"],
+    );
+    let copy = dir.path().join("copy.mcap");
+    copy_with(&original, &copy, mcap::WriteOptions::new());
+    let (code, text, err) = coin_log_text(&["info", copy.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!text.contains(REPRODUCE), "{text}");
+    assert!(
+        text.contains("`another-writer`") && text.contains("no command line"),
+        "{text}"
+    );
+    assert!(
+        text.contains("[body]"),
+        "the scene is still printed: {text}"
+    );
+    // The original still has its command line.
+    let (code, text, err) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(text.contains(REPRODUCE), "{text}");
+}
+
 /// The rows of a CSV table: the header and the fields of each line (no quoting in number tables).
 fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
