@@ -159,7 +159,7 @@ fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
         );
         return text;
     }
-    let (encoding, compression) = (i.encoding(), i.compression());
+    let (encoding, compression) = (i.recorded_encoding(), i.compression());
     let named = |word: &str, names: &[&str]| names.contains(&word);
     if !named(&encoding, Encoding::NAMES) || !named(&compression, Compression::NAMES) {
         let _ = writeln!(

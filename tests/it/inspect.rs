@@ -389,6 +389,41 @@ fn the_stored_scene_of_a_rewritten_file_claims_no_reproduction() {
     assert!(text.contains(REPRODUCE), "{text}");
 }
 
+/// A recording with the `rerun` channel (Protobuf, with `/rerun/robot_description` in CDR in every file,
+/// as `record` writes it) is reproduced by `record --encoding protobuf`: `--scene` said its encoding was
+/// `mixed (cdr, protobuf)`, "not those of one `coin-log record`", and gave no command line.
+#[test]
+fn the_stored_scene_of_a_rerun_recording_gives_its_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--rerun", "--encoding", "protobuf", "--duration", "0.5"],
+    );
+    let (code, text, err) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        text.contains(
+            "#     coin-log record SCENE.toml -o OUT.mcap --encoding protobuf --compression zstd"
+        ),
+        "{text}"
+    );
+    std::fs::write(dir.path().join("s.toml"), &text).unwrap();
+    let again = dir.path().join("again.mcap");
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        dir.path().join("s.toml").to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+        "--encoding",
+        "protobuf",
+        "--compression",
+        "zstd",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(std::fs::read(&original).unwrap() == std::fs::read(&again).unwrap());
+}
+
 /// The rows of a CSV table: the header and the fields of each line (no quoting in number tables).
 fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
