@@ -60,7 +60,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<Outcome> {
         let given = path.display().to_string();
         match read(path) {
             Ok(i) => {
-                failed |= i.problem.is_some();
+                // Described up to the break on stdout, and named on stderr as every error is: exit 1
+                // with nothing on stderr left a script that keeps stderr without the reason.
+                if let Some(problem) = &i.problem {
+                    failed = true;
+                    errln!("error: {}: {problem}", shown(path));
+                }
                 if args.json {
                     json_files.push(serde_json::to_value(i.json(&given))?);
                 } else {
@@ -99,10 +104,12 @@ fn read(path: &Path) -> Result<FileInfo, String> {
 /// `--scene`: the stored scene, after comment lines saying where it comes from and how to reproduce it.
 fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
     let [path] = args.files.as_slice() else {
-        bail!(
-            "--scene prints the scene of one file; {} were given",
+        // A usage error (exit 2), as `--scene --json` is clap's.
+        errln!(
+            "error: --scene prints the scene of one file; {} were given",
             args.files.len()
         );
+        return Ok(Outcome::Unusable);
     };
     let shown = shown(path);
     let i = read(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
@@ -126,7 +133,8 @@ fn scene(args: &InfoArgs) -> anyhow::Result<Outcome> {
 
 /// The comment lines before `--scene`'s TOML: the `coin-log record` command line that writes the file's
 /// bytes again from that text (every setting the scene does not hold: encoding and compression), or why
-/// no command can (mixed encodings or compressions, or a file that could not be read to its end).
+/// no command can (mixed encodings or compressions, a file that could not be read to its end, or one
+/// whose header names another library).
 fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
     let mut text = format!(
         "# The scene stored in `{shown}` (written by coin-log {}).\n",
@@ -151,13 +159,26 @@ fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
         );
         return text;
     }
-    let (encoding, compression) = (i.encoding(), i.compression());
+    let (encoding, compression) = (i.recorded_encoding(), i.compression());
     let named = |word: &str, names: &[&str]| names.contains(&word);
     if !named(&encoding, Encoding::NAMES) || !named(&compression, Compression::NAMES) {
         let _ = writeln!(
             text,
             "# Its encoding ({encoding}) and compression ({compression}) are not those of one `coin-log \
              record`,\n# so no command line writes the same bytes again."
+        );
+        return text;
+    }
+    // `record` names itself in the header: a file whose header names another library was rewritten by
+    // another program (Python's or Rust's `mcap` writer), whatever it kept or changed.
+    let library = &i.summary.library;
+    if *library != format!("coin-log/{}", run.tool_version) {
+        let _ = writeln!(
+            text,
+            "# Its header names the library `{}`, not coin-log {}: another program wrote these bytes,\n# so \
+             no command line writes the same bytes again.",
+            shown_name(library),
+            run.tool_version
         );
         return text;
     }

@@ -239,6 +239,39 @@ fn info_describes_a_truncated_file_up_to_the_break_and_refuses_a_non_mcap_file()
     assert!(err.contains("not an MCAP file"), "{err}");
 }
 
+/// A file that breaks off part way is described up to the break on stdout and exits 1; the error is on
+/// stderr too, as `plot` and `info --scene` put it there: with stdout in a file or a pipe, exit 1 came with
+/// nothing on stderr.
+#[test]
+fn info_names_the_problem_of_a_truncated_file_on_stderr() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = record_scene(dir.path(), "circle-plus", &["--duration", "1"]);
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(dir.path().join("half.mcap"), &bytes[..bytes.len() / 2]).unwrap();
+    for json in [false, true] {
+        let mut args = vec!["info", "half.mcap"];
+        if json {
+            args.push("--json");
+        }
+        let out = coin_log(dir.path(), &args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.starts_with("error: half.mcap: ") && err.contains("truncated"),
+            "--json {json}: {err}"
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("truncated"));
+    }
+    // A whole file: nothing on stderr.
+    let out = coin_log(dir.path(), &["info", "circle-plus.mcap"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// `info F --scene > s.toml && record s.toml -o G` writes G equal to F byte for byte, for every built-in
 /// scene; the description and every default survive, and the scene file's name does not enter the file.
 #[test]
@@ -318,8 +351,77 @@ fn the_stored_scene_names_a_non_default_compression() {
         original.to_str().unwrap(),
         original.to_str().unwrap(),
     ]);
-    assert_eq!(code, 1);
+    // A usage error (exit 2, as `--scene --json` is clap's), not a failure to read a file (exit 1).
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("one file"), "{err}");
+}
+
+/// A file another program rewrote (its header's library is not `coin-log/<version>`) holds the scene that
+/// coin-log recorded, but not bytes that `coin-log record` writes: `--scene` said "this writes the same
+/// bytes again" for a copy by Python's or Rust's `mcap` writer, even one that kept a single sample. It now
+/// names the library and gives no command line.
+#[test]
+fn the_stored_scene_of_a_rewritten_file_claims_no_reproduction() {
+    // The command line's start (src/cli/info.rs: REPRODUCE).
+    const REPRODUCE: &str = "#     coin-log record ";
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--compression", "lz4", "--duration", "0.5"],
+    );
+    let copy = dir.path().join("copy.mcap");
+    copy_with(&original, &copy, mcap::WriteOptions::new());
+    let (code, text, err) = coin_log_text(&["info", copy.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!text.contains(REPRODUCE), "{text}");
+    assert!(
+        text.contains("`another-writer`") && text.contains("no command line"),
+        "{text}"
+    );
+    assert!(
+        text.contains("[body]"),
+        "the scene is still printed: {text}"
+    );
+    // The original still has its command line.
+    let (code, text, err) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(text.contains(REPRODUCE), "{text}");
+}
+
+/// A recording with the `rerun` channel (Protobuf, with `/rerun/robot_description` in CDR in every file,
+/// as `record` writes it) is reproduced by `record --encoding protobuf`: `--scene` said its encoding was
+/// `mixed (cdr, protobuf)`, "not those of one `coin-log record`", and gave no command line.
+#[test]
+fn the_stored_scene_of_a_rerun_recording_gives_its_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = record_scene(
+        dir.path(),
+        "circle-plus",
+        &["--rerun", "--encoding", "protobuf", "--duration", "0.5"],
+    );
+    let (code, text, err) = coin_log_text(&["info", original.to_str().unwrap(), "--scene"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        text.contains(
+            "#     coin-log record SCENE.toml -o OUT.mcap --encoding protobuf --compression zstd"
+        ),
+        "{text}"
+    );
+    std::fs::write(dir.path().join("s.toml"), &text).unwrap();
+    let again = dir.path().join("again.mcap");
+    let (code, _, err) = coin_log_text(&[
+        "record",
+        dir.path().join("s.toml").to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+        "--encoding",
+        "protobuf",
+        "--compression",
+        "zstd",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(std::fs::read(&original).unwrap() == std::fs::read(&again).unwrap());
 }
 
 /// The rows of a CSV table: the header and the fields of each line (no quoting in number tables).
@@ -717,6 +819,105 @@ fn plot_draws_every_panel_and_marks_the_termination() {
     std::fs::write(dir.path().join("other.mcap"), b"\x89MCAP0\r\n").unwrap();
     let out = coin_log(dir.path(), &["plot", "other.mcap"]);
     assert_eq!(out.status.code(), Some(1));
+}
+
+/// A description may hold U+FFFE and U+FFFF (`record` refuses only control characters), which XML 1.0
+/// does not allow in a document: plot wrote them into the title as they were, and the SVG was not
+/// well-formed (Python's parser: "not well-formed (invalid token)"). They are drawn escaped, as a message
+/// shows a control character.
+#[test]
+fn plot_escapes_the_characters_xml_does_not_allow() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, toml, err) = coin_log_text(&["scenes", "--show", "circle-plus"]);
+    assert_eq!(code, 0, "{err}");
+    let toml: String = toml
+        .lines()
+        .map(|l| {
+            if l.starts_with("description") {
+                "description = \"odd \\uFFFE \\uFFFF <&> ]]> end\"".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let scene = dir.path().join("odd.toml");
+    std::fs::write(&scene, toml).unwrap();
+    record_scene(dir.path(), scene.to_str().unwrap(), &["--duration", "0.1"]);
+    let out = coin_log(dir.path(), &["plot", "odd.toml.mcap", "-o", "odd.svg"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(dir.path().join("odd.svg")).unwrap();
+    let texts = svg_texts(&svg);
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.starts_with("odd \\u{fffe} \\u{ffff} <&> ]]> end")),
+        "{texts:?}"
+    );
+}
+
+/// A scene in units where a = g = 1e70 (within the limits `record` accepts) was plotted with tick labels
+/// and settings of 70 and more digits (`-6000000000000000435188618289175410756950246457879131733109260932874240.0`,
+/// `a = 10000000000000000000000000000000000000000000000000000000000000000000000`), far wider than the
+/// label area: large values are written in exponent form, as `info` writes them (`a = 1e70`).
+#[test]
+fn plot_writes_large_values_in_exponent_form() {
+    let dir = tempfile::tempdir().unwrap();
+    record_scene(
+        dir.path(),
+        "circle-plus",
+        &[
+            "--duration",
+            "0.5",
+            "--set",
+            "body.radius=1e70",
+            "--set",
+            "body.gravity=1e70",
+        ],
+    );
+    let out = coin_log(dir.path(), &["plot", "circle-plus.mcap"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let texts = svg_texts(&std::fs::read_to_string(dir.path().join("circle-plus.svg")).unwrap());
+    let longest_number = |t: &str| {
+        t.split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0)
+    };
+    for t in &texts {
+        assert!(longest_number(t) < 20, "a number of 20 digits or more: {t}");
+    }
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.contains("a = 1e70, g = 1e70, I_X = 2.5e139, I_Z = 5e139")),
+        "{texts:?}"
+    );
+    // The track panel's ticks (of the order of 1e70) are labelled in exponent form, and the one at 0,
+    // which plotters computes as about 1e55 off, as 0.
+    let large = texts
+        .iter()
+        .filter(|t| t.contains('e') && t.parse::<f64>().is_ok_and(|v| v.abs() >= 1e60))
+        .count();
+    assert!(large >= 8, "{large} large ticks: {texts:?}");
+    assert!(
+        !texts.iter().any(
+            |t| t.parse::<f64>().is_ok_and(|v| v != 0.0 && v.abs() < 1e60)
+                && t.contains('e')
+                && !t.contains("e-")
+        ),
+        "{texts:?}"
+    );
 }
 
 /// A run of a microsecond: every time panel's ticks tell the times apart (plotters' own labels, 5 decimals

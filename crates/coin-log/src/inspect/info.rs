@@ -3,6 +3,7 @@
 //! that describes a file breaking off part way up to the break. The summary is taken as the file states
 //! it: `verify` is what checks it.
 
+use crate::format::channels::{Topic, ROS_STRING_WIRE};
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
 use coin_log_mcap::{self, MessageHeader, ReadError, Visitor};
@@ -95,6 +96,25 @@ impl FileInfo {
             [] => "no channels".into(),
             [one] => (*one).to_string(),
             more => format!("mixed ({})", more.join(", ")),
+        }
+    }
+
+    /// The message encoding `coin-log record` was given for this file (`--encoding`): that of every channel
+    /// but `/rerun/robot_description`, which `record` writes in CDR in every file (Rerun's URDF decoder
+    /// reads no other form); otherwise as [`Self::encoding`].
+    #[must_use]
+    pub fn recorded_encoding(&self) -> String {
+        let robot = Topic::RerunRobot.name();
+        let set: std::collections::BTreeSet<&str> = self
+            .summary
+            .channels
+            .iter()
+            .filter(|c| !(c.topic == robot && c.message_encoding == ROS_STRING_WIRE.2))
+            .map(|c| c.message_encoding.as_str())
+            .collect();
+        match set.into_iter().collect::<Vec<_>>().as_slice() {
+            [one] => (*one).to_string(),
+            _ => self.encoding(),
         }
     }
 

@@ -366,14 +366,25 @@ fn title(c: &Collect, run: &RunMetadata, name: &str, broken: Option<&str>) -> (S
     };
     let friction = run
         .friction
-        .map_or_else(|| "no μ".to_string(), |m| format!("μ = {m}"));
+        .map_or_else(|| "no μ".to_string(), |m| format!("μ = {}", number(m)));
     (
         format!("{name}: {end}"),
         format!(
             "{description} — M = {}, a = {}, g = {}, I_X = {}, I_Z = {}, {friction}; {} rtol {:e} atol {:e}, rate {}",
-            run.mass, run.radius, run.gravity, run.inertia_x, run.inertia_z, run.integrator, run.rtol, run.atol, run.rate
+            number(run.mass), number(run.radius), number(run.gravity), number(run.inertia_x),
+            number(run.inertia_z), run.integrator, run.rtol, run.atol, number(run.rate)
         ),
     )
+}
+
+/// `v` in its shortest form: as `{}` writes it (`1`, `0.25`) within 1e-4 … 1e16, in exponent form
+/// beyond (`1e70`, not 71 digits; `2.5e-7`, not `0.00000025`), as `info` writes the settings.
+fn number(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e16).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
 }
 
 fn draw(
@@ -464,21 +475,27 @@ fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
 /// wide enough for those to tell the ticks apart, as on every ordinary recording; otherwise, for a short
 /// span near 0 (the time axis of a run of a microsecond, where plotters' would print `0.0` on every tick),
 /// each tick in exponent form with the few significant digits its step needs. A value constant to
-/// rounding (θ of a steady motion) keeps plotters' labels, which show the value.
+/// rounding (θ of a steady motion) keeps plotters' labels, which show the value. Values of [`LARGE`] and
+/// beyond are in exponent form too (at most [`SHORT_DIGITS`] digits after the leading one): plotters'
+/// labels write every digit, 70 of them for a track in units where a = 1e70.
 fn tick_label(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     let span = (hi - lo).abs();
     // Ticks are about a tenth of the span apart: the digits between the largest value's leading digit and
     // the step's.
     let decade = |x: f64| x.log10().floor();
-    let digits = decade(lo.abs().max(hi.abs())) - decade(span / 10.0);
-    let digits = (span < WIDE_SPAN && digits <= SHORT_DIGITS).then(|| {
+    let largest = lo.abs().max(hi.abs());
+    let digits = decade(largest) - decade(span / 10.0);
+    let short = span < WIDE_SPAN && digits <= SHORT_DIGITS;
+    let digits = (short || largest >= LARGE).then(|| {
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let digits = digits.max(0.0) as usize;
+        let digits = digits.clamp(0.0, SHORT_DIGITS) as usize;
         digits
     });
     move |v: &f64| match digits {
         None => <RangedCoordf64 as plotters::coord::ranged1d::ValueFormatter<f64>>::format(v),
-        Some(_) if *v == 0.0 => "0".to_string(),
+        // Plotters computes ticks as sums of steps: the one at 0 can be off by rounding (-9.2e54 on an
+        // axis of ±2e70).
+        Some(_) if v.abs() <= 1e-12 * span => "0".to_string(),
         Some(d) => format!("{v:.d$e}"),
     }
 }
@@ -487,6 +504,8 @@ fn tick_label(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
 const WIDE_SPAN: f64 = 1e-3;
 /// The most digits after the leading one of an exponent-form tick label (it fits the label area).
 const SHORT_DIGITS: f64 = 6.0;
+/// The magnitude from which tick labels are in exponent form (`1.5e6`, not `1500000.0`).
+const LARGE: f64 = 1e6;
 
 /// `x` held within ±`f64::MAX`/4.
 fn clamp_finite(x: f64) -> f64 {
