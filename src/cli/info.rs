@@ -6,7 +6,7 @@ use anyhow::bail;
 use coin_log::files::input::check;
 use coin_log::files::{shown, shown_name, InputKind};
 use coin_log::format::metadata::number_string as n;
-use coin_log::format::{Encoding, RunMetadata, Termination};
+use coin_log::format::{header_library, Encoding, RunMetadata, Termination};
 use coin_log::inspect::info::{self, FileInfo};
 use coin_log::inspect::seconds_text;
 use coin_log_mcap::Compression;
@@ -172,7 +172,7 @@ fn reproduction(shown: &str, i: &FileInfo, run: &RunMetadata) -> String {
     // `record` names itself in the header: a file whose header names another library was rewritten by
     // another program (Python's or Rust's `mcap` writer), whatever it kept or changed.
     let library = &i.summary.library;
-    if *library != format!("coin-log/{}", run.tool_version) {
+    if *library != header_library(&run.tool_version) {
         let _ = writeln!(
             text,
             "# Its header names the library `{}`, not coin-log {}: another program wrote these bytes,\n# so \

@@ -281,6 +281,12 @@ record! {
     }
 }
 
+/// The Header's `library` in a file coin-log `version` records: `coin-log/0.1.0`.
+#[must_use]
+pub fn header_library(version: &str) -> String {
+    format!("coin-log/{version}")
+}
+
 impl RunMetadata {
     /// The body the record stores.
     ///

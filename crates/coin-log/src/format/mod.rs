@@ -19,8 +19,8 @@ pub use channels::{schema_data, Channel, Topic, ROS_STRING, TRACK_LEVELS};
 pub use encoding::Encoding;
 pub use messages::{schema_bytes, FRAME_TRANSFORM, SCENE_UPDATE};
 pub use metadata::{
-    MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION, RESULT_METADATA_NAME,
-    RUN_METADATA_NAME,
+    header_library, MetadataError, ResultMetadata, RunMetadata, FORMAT_VERSION,
+    RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 pub use termination::Termination;
 pub use time::{log_time, TimeError};

@@ -13,7 +13,7 @@ use crate::format::messages::{
 use crate::format::promise::{self, Shortfall};
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::{
-    log_time, Channel, Encoding, ResultMetadata, Termination, TimeError, Topic,
+    header_library, log_time, Channel, Encoding, ResultMetadata, Termination, TimeError, Topic,
     RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Bounds, Flow, RunOutcome, RunSettings};
@@ -671,7 +671,7 @@ impl<'t, W: Write + Seek, T: Tap> Sampler<'t, W, T> {
             .records(Channel::Invariants)
             .then(|| Chaplygin::new(&scene.params))
             .transpose()?;
-        let library = format!("coin-log/{}", env!("CARGO_PKG_VERSION"));
+        let library = header_library(env!("CARGO_PKG_VERSION"));
         let write_options = WriterOptions {
             workers: COMPRESSION_THREADS,
             ..WriterOptions::new(options.compression, library)
