@@ -105,6 +105,65 @@ fn a_task_resubmitted_alone_is_warned_that_it_makes_the_whole_sweep() {
     assert!(!err.contains("warning"), "{err}");
 }
 
+/// examples/slurm-sweep.sh's advice for a failed task, followed literally: an array of 4 tasks loses task
+/// 2, the array its header says to submit again is run (its `--array=0-15` read as this array's 0-3; an
+/// index alone as that task alone, which the header once advised), and then collect must pass. An array
+/// of one index is the whole sweep: it wrote catalogue.csv, no part 2, and collect still missed shard 2.
+#[test]
+fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let script = crate::support::repo().join("examples/slurm-sweep.sh");
+    let header = std::fs::read_to_string(&script).unwrap();
+    let advice = &header[header
+        .find("redone by")
+        .expect("the header says how a failed task is redone")..];
+    let array = advice
+        .split("--array=")
+        .nth(1)
+        .expect("the advice names an array");
+    let array: String = array
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '-')
+        .collect();
+    // The tasks of an array numbered MIN … MAX, run in turn as Slurm would, with its variables.
+    let task = |id: u64, min: u64, max: u64| {
+        let out = Command::new("bash")
+            .arg(&script)
+            .args(["s.toml", "shared"])
+            .current_dir(dir.path())
+            .env("COIN_LOG", crate::support::record::exe())
+            .envs([
+                ("SLURM_ARRAY_TASK_ID", id.to_string()),
+                ("SLURM_ARRAY_TASK_MIN", min.to_string()),
+                ("SLURM_ARRAY_TASK_MAX", max.to_string()),
+                ("SLURM_ARRAY_TASK_COUNT", (max - min + 1).to_string()),
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "task {id}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    for id in [0, 1, 3] {
+        task(id, 0, 3);
+    }
+    match array.as_str() {
+        "0-15" => (0..4).for_each(|id| task(id, 0, 3)),
+        one if one.parse::<u64>().is_ok() => task(2, 2, 2),
+        other => panic!(
+            "the header's advice names --array={other}, neither the whole array nor one index"
+        ),
+    }
+    let (code, err) = collect(dir.path(), "shared");
+    assert_eq!(
+        code, 0,
+        "collect after the example's advice (--array={array}): {err}"
+    );
+}
+
 #[test]
 fn slurm_array_variables_and_a_kubernetes_index_pick_the_shard() {
     let dir = tempfile::tempdir().unwrap();
