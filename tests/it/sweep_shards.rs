@@ -472,6 +472,29 @@ fn collect_names_a_damaged_parts_first_wrong_lines_and_counts_the_rest() {
     assert!(err.contains("`catalogue.part-1-of-2.csv` is not UTF-8 text, so not a part as a shard writes it: delete it and run its shard again"), "{err}");
 }
 
+/// Runs of an earlier sharding beyond the first 20 of a part were counted as "more lines are wrong as
+/// well: run its shard again", which mends nothing (the shard writes its part as it was, still beside the
+/// earlier sharding's): they are counted as runs in another part, with the fix that works.
+#[test]
+fn collect_counts_the_unlisted_runs_of_an_earlier_sharding_with_their_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let many = SMALL.replace("count = 2", "count = 16");
+    write_sweep(dir.path(), "s.toml", &many);
+    all_shards(dir.path(), "s.toml", "d", 2);
+    all_shards(dir.path(), "s.toml", "d", 4);
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    // 96 runs: each part of 4 holds 24, every one also in a part of 2; 20 named, 4 counted.
+    assert!(err.contains("error: d: run 0 is in both `catalogue.part-0-of-2.csv` and `catalogue.part-0-of-4.csv`: delete the parts of an earlier sharding"), "{err}");
+    assert!(err.contains("error: d: `catalogue.part-0-of-4.csv`: 4 more of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"), "{err}");
+    assert!(!err.contains("run its shard again"), "{err}");
+    for k in 0..2 {
+        std::fs::remove_file(dir.path().join(format!("d/catalogue.part-{k}-of-2.csv"))).unwrap();
+    }
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 0, "the fix given works: {err}");
+}
+
 #[test]
 fn collect_refuses_a_row_no_run_writes() {
     // A finished row with its file, size and SHA-256 blanked (and the file gone) had nothing to check,

@@ -152,26 +152,27 @@ fn read_part(
         return Ok(());
     }
     // What is wrong line by line, listed up to LISTED_LINES (a part of 300 000 garbage lines printed as
-    // many errors).
-    let mut found = Vec::new();
+    // many errors); each with whether it is a run another part holds too, which running this part's
+    // shard again does not mend (the part of an earlier sharding must go).
+    let mut found: Vec<(bool, String)> = Vec::new();
     for (n, line) in lines.enumerate() {
         let (index, fields) = match row(folder, part, line) {
             Ok(row) => row,
             Err(problem) => {
-                found.push(format!("`{name}` line {}: {problem}", n + 2));
+                found.push((false, format!("`{name}` line {}: {problem}", n + 2)));
                 continue;
             }
         };
         let problem = match rows.get(&index) {
             // Twice in this part: no shard writes that, and no other part is to blame.
-            Some(other) if other.part == name => format!(
+            Some(other) if other.part == name => (false, format!(
                 "`{name}` line {}: run {index}'s row is in the part twice: the part was changed; run its shard again",
                 n + 2
-            ),
-            Some(other) => format!(
+            )),
+            Some(other) => (true, format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
                 other.part
-            ),
+            )),
             None => {
                 let (part, line) = (name.to_string(), n + 2);
                 rows.insert(index, Found { part, line, fields });
@@ -180,11 +181,18 @@ fn read_part(
         };
         found.push(problem);
     }
-    let more = found.len().saturating_sub(LISTED_LINES);
-    problems.extend(found.into_iter().take(LISTED_LINES));
-    if more > 0 {
+    let unlisted = found.split_off(found.len().min(LISTED_LINES));
+    problems.extend(found.into_iter().map(|(_, problem)| problem));
+    let elsewhere = unlisted.iter().filter(|(elsewhere, _)| *elsewhere).count();
+    let wrong = unlisted.len() - elsewhere;
+    if wrong > 0 {
         problems.push(format!(
-            "`{name}`: {more} more lines are wrong as well: run its shard again"
+            "`{name}`: {wrong} more lines are wrong as well: run its shard again"
+        ));
+    }
+    if elsewhere > 0 {
+        problems.push(format!(
+            "`{name}`: {elsewhere} more of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"
         ));
     }
     Ok(())
