@@ -941,6 +941,30 @@ fn slurm_and_kubernetes_variables_give_the_shard() {
     );
 }
 
+/// `--shard-count` in a Slurm job array (copied from the Kubernetes command, say) was ignored without a
+/// word: an array of 2 tasks given `--shard-count 4` cut the sweep in 2 shards. A count that differs
+/// from the array's size is refused before anything is written; the same count is accepted.
+#[test]
+fn a_shard_count_that_does_not_match_the_slurm_array_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let task = [
+        ("SLURM_ARRAY_TASK_ID", "1"),
+        ("SLURM_ARRAY_TASK_MIN", "0"),
+        ("SLURM_ARRAY_TASK_MAX", "1"),
+        ("SLURM_ARRAY_TASK_COUNT", "2"),
+    ];
+    let args = ["sweep", "s.toml", "-o", "d", "--shard-count", "4"];
+    let (code, out, err) = run_with_env(dir.path(), &args, &task);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("--shard-count 4 does not match this Slurm job array of 2 tasks, whose size is the number of shards: submit --array=0-3 for 4 shards, or leave --shard-count out"), "{err}");
+    assert!(!dir.path().join("d").exists(), "nothing written");
+    let args = ["sweep", "s.toml", "-o", "d", "--shard-count", "2", "--json"];
+    let (code, out, err) = run_with_env(dir.path(), &args, &task);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("\"shard\":\"1/2\""), "{out}");
+}
+
 #[test]
 fn a_slurm_array_with_a_step_is_refused_naming_the_dense_form() {
     let stepped = env(&[
