@@ -15,7 +15,9 @@
 # every task resumes, keeping the runs already on disk, and the tasks that were done find nothing to do. (An
 # array of that index alone would be an array of one task, which makes the whole sweep and writes no part.)
 # With afterok, collect runs only if every task succeeded; --kill-on-invalid-dep cancels it otherwise,
-# instead of leaving it pending forever.
+# instead of leaving it pending forever. A task also fails (exit 1) when some of its runs failed for their
+# values (`failure` scene, numerical or verify in its part): those recur, so run `coin-log sweep collect DIR`
+# yourself then; it writes the catalogue with those rows (and exits 1 too).
 #
 # Adjust the #SBATCH lines to your cluster (partition, account, time limit); more CPUs per task make each
 # task record that many runs at once.

@@ -164,6 +164,54 @@ fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
     );
 }
 
+/// A shard whose runs fail for their values exits 1 every time it is submitted again (those failures
+/// recur, and only I/O failures are redone), so README's `sbatch --wait ... && collect` and the example's
+/// `afterok` never collected such a sweep, and README's only advice for a failed task (submit the array
+/// again) looped. collect itself writes the catalogue with the failed rows: README and the example say
+/// to run it then.
+#[test]
+fn shards_whose_runs_fail_for_their_values_fail_every_time_and_collect_is_run_by_hand() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = SMALL.replace("choice = [0.04, 0.06]", "choice = [0.04, -0.06]");
+    write_sweep(dir.path(), "s.toml", &bad);
+    for _ in 0..2 {
+        for k in 0..2 {
+            let shard = format!("{k}/2");
+            let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]);
+            assert_eq!(code, 1, "{json}");
+            assert!(json["failed"].as_u64() > Some(0), "{json}");
+        }
+    }
+    let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "0/2"]);
+    assert_eq!(
+        (code, json["done"].as_u64()),
+        (1, Some(0)),
+        "submitting again redoes nothing: {json}"
+    );
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        dir.path().join("d/catalogue.csv").is_file(),
+        "collect wrote the catalogue"
+    );
+    let readme = std::fs::read_to_string(crate::support::repo().join("README.md")).unwrap();
+    let readme = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        readme.contains("A task also exits 1 when some of its runs failed for their values"),
+        "README"
+    );
+    assert!(
+        readme.contains("run `coin-log sweep collect /shared/lean-sweep` yourself then"),
+        "README"
+    );
+    let example =
+        std::fs::read_to_string(crate::support::repo().join("examples/slurm-sweep.sh")).unwrap();
+    assert!(
+        example.contains("so run `coin-log sweep collect DIR`\n# yourself then"),
+        "examples/slurm-sweep.sh"
+    );
+}
+
 #[test]
 fn slurm_array_variables_and_a_kubernetes_index_pick_the_shard() {
     let dir = tempfile::tempdir().unwrap();
