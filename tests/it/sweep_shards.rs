@@ -709,6 +709,12 @@ fn a_shard_that_a_running_sweep_makes_is_refused_and_collect_waits_for_it() {
     let (code, err) = collect(dir.path(), "d");
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("shard 1/2 is still running in `"), "{err}");
+    // Its runs are in no part yet, as expected while it runs: advising to run that shard again (which
+    // is refused while it runs) was premature.
+    assert!(
+        !err.contains("in no part") && !err.contains("run the shards"),
+        "{err}"
+    );
     // Negative control: once the lock is released, the same commands go through.
     drop(held);
     let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/2"]);

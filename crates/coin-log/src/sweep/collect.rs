@@ -53,7 +53,10 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         (folder::PART.list(dir)).map_err(SweepError::io("reading the sweep folder", dir))?;
     parts.sort_by_key(|(s, _)| (s.count(), s.index()));
     let mut problems = Vec::new();
-    if let Some(shard) = folder.held_lock(|_| true) {
+    // While a shard runs, its part is yet to come: advising to run the shards of the runs in no part
+    // (which a second process on that shard is refused) would be premature.
+    let running = folder.held_lock(|_| true);
+    if let Some(shard) = running {
         problems.push(format!(
             "shard {shard} is still running in `{}`: collect when every shard has ended",
             dir.display()
@@ -61,7 +64,8 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     }
     // A folder swept whole has no parts: the sweep wrote its catalogue itself. Running "the shards that
     // hold" its runs, as the list of missing runs advised, wrote no part either (one shard is the whole).
-    if parts.is_empty() && folder.swept_whole() {
+    let none = parts.is_empty() && running.is_none();
+    if none && folder.swept_whole() {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: it was swept whole, not in shards, so the \
              sweep wrote its catalogue.csv and sweep.json itself (collect merges the parts of shards, \
@@ -69,7 +73,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
              resumes",
             dir.display()
         ));
-    } else if parts.is_empty() {
+    } else if none {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: run the shards first, `coin-log sweep SWEEP.toml -o DIR --shard K/N`",
             dir.display()
@@ -87,7 +91,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         };
         read_part(&folder, &part, &mut rows, &mut problems)?;
     }
-    if !parts.is_empty() {
+    if !parts.is_empty() && running.is_none() {
         problems.extend(missing(runs, &rows));
     }
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
