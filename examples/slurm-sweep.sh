@@ -11,9 +11,13 @@
 # The array's size is the number of shards: coin-log sweep reads SLURM_ARRAY_TASK_ID and
 # SLURM_ARRAY_TASK_COUNT (or MIN and MAX) when --shard is not given, and a run's parameters depend only on
 # the sweep file and its index, so any array size gives the same catalogue. A task that fails (or a node
-# lost) is redone by resubmitting that index (`sbatch --array=5 ...`): the sweep resumes, keeping the runs
-# already on disk. With afterok, collect runs only if every task succeeded; --kill-on-invalid-dep cancels it
-# otherwise, instead of leaving it pending forever.
+# lost) is redone by submitting the same array again (`sbatch --array=0-15 ...`, then collect as above):
+# every task resumes, keeping the runs already on disk, and the tasks that were done find nothing to do. (An
+# array of that index alone would be an array of one task, which makes the whole sweep and writes no part.)
+# With afterok, collect runs only if every task succeeded; --kill-on-invalid-dep cancels it otherwise,
+# instead of leaving it pending forever. A task also fails (exit 1) when some of its runs failed for their
+# values (`failure` scene, numerical or verify in its part): those recur, so run `coin-log sweep collect DIR`
+# yourself then; it writes the catalogue with those rows (and exits 1 too).
 #
 # Adjust the #SBATCH lines to your cluster (partition, account, time limit); more CPUs per task make each
 # task record that many runs at once.

@@ -105,6 +105,113 @@ fn a_task_resubmitted_alone_is_warned_that_it_makes_the_whole_sweep() {
     assert!(!err.contains("warning"), "{err}");
 }
 
+/// examples/slurm-sweep.sh's advice for a failed task, followed literally: an array of 4 tasks loses task
+/// 2, the array its header says to submit again is run (its `--array=0-15` read as this array's 0-3; an
+/// index alone as that task alone, which the header once advised), and then collect must pass. An array
+/// of one index is the whole sweep: it wrote catalogue.csv, no part 2, and collect still missed shard 2.
+#[test]
+fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let script = crate::support::repo().join("examples/slurm-sweep.sh");
+    let header = std::fs::read_to_string(&script).unwrap();
+    let advice = &header[header
+        .find("redone by")
+        .expect("the header says how a failed task is redone")..];
+    let array = advice
+        .split("--array=")
+        .nth(1)
+        .expect("the advice names an array");
+    let array: String = array
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '-')
+        .collect();
+    // The tasks of an array numbered MIN … MAX, run in turn as Slurm would, with its variables.
+    let task = |id: u64, min: u64, max: u64| {
+        let out = Command::new("bash")
+            .arg(&script)
+            .args(["s.toml", "shared"])
+            .current_dir(dir.path())
+            .env("COIN_LOG", crate::support::record::exe())
+            .envs([
+                ("SLURM_ARRAY_TASK_ID", id.to_string()),
+                ("SLURM_ARRAY_TASK_MIN", min.to_string()),
+                ("SLURM_ARRAY_TASK_MAX", max.to_string()),
+                ("SLURM_ARRAY_TASK_COUNT", (max - min + 1).to_string()),
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "task {id}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    for id in [0, 1, 3] {
+        task(id, 0, 3);
+    }
+    match array.as_str() {
+        "0-15" => (0..4).for_each(|id| task(id, 0, 3)),
+        one if one.parse::<u64>().is_ok() => task(2, 2, 2),
+        other => panic!(
+            "the header's advice names --array={other}, neither the whole array nor one index"
+        ),
+    }
+    let (code, err) = collect(dir.path(), "shared");
+    assert_eq!(
+        code, 0,
+        "collect after the example's advice (--array={array}): {err}"
+    );
+}
+
+/// A shard whose runs fail for their values exits 1 every time it is submitted again (those failures
+/// recur, and only I/O failures are redone), so README's `sbatch --wait ... && collect` and the example's
+/// `afterok` never collected such a sweep, and README's only advice for a failed task (submit the array
+/// again) looped. collect itself writes the catalogue with the failed rows: README and the example say
+/// to run it then.
+#[test]
+fn shards_whose_runs_fail_for_their_values_fail_every_time_and_collect_is_run_by_hand() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = SMALL.replace("choice = [0.04, 0.06]", "choice = [0.04, -0.06]");
+    write_sweep(dir.path(), "s.toml", &bad);
+    for _ in 0..2 {
+        for k in 0..2 {
+            let shard = format!("{k}/2");
+            let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", &shard]);
+            assert_eq!(code, 1, "{json}");
+            assert!(json["failed"].as_u64() > Some(0), "{json}");
+        }
+    }
+    let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "0/2"]);
+    assert_eq!(
+        (code, json["done"].as_u64()),
+        (1, Some(0)),
+        "submitting again redoes nothing: {json}"
+    );
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        dir.path().join("d/catalogue.csv").is_file(),
+        "collect wrote the catalogue"
+    );
+    let readme = std::fs::read_to_string(crate::support::repo().join("README.md")).unwrap();
+    let readme = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        readme.contains("A task also exits 1 when some of its runs failed for their values"),
+        "README"
+    );
+    assert!(
+        readme.contains("run `coin-log sweep collect /shared/lean-sweep` yourself then"),
+        "README"
+    );
+    let example =
+        std::fs::read_to_string(crate::support::repo().join("examples/slurm-sweep.sh")).unwrap();
+    assert!(
+        example.contains("so run `coin-log sweep collect DIR`\n# yourself then"),
+        "examples/slurm-sweep.sh"
+    );
+}
+
 #[test]
 fn slurm_array_variables_and_a_kubernetes_index_pick_the_shard() {
     let dir = tempfile::tempdir().unwrap();
@@ -413,6 +520,29 @@ fn collect_names_a_damaged_parts_first_wrong_lines_and_counts_the_rest() {
     assert!(err.contains("`catalogue.part-1-of-2.csv` is not UTF-8 text, so not a part as a shard writes it: delete it and run its shard again"), "{err}");
 }
 
+/// Runs of an earlier sharding beyond the first 20 of a part were counted as "more lines are wrong as
+/// well: run its shard again", which mends nothing (the shard writes its part as it was, still beside the
+/// earlier sharding's): they are counted as runs in another part, with the fix that works.
+#[test]
+fn collect_counts_the_unlisted_runs_of_an_earlier_sharding_with_their_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let many = SMALL.replace("count = 2", "count = 16");
+    write_sweep(dir.path(), "s.toml", &many);
+    all_shards(dir.path(), "s.toml", "d", 2);
+    all_shards(dir.path(), "s.toml", "d", 4);
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    // 96 runs: each part of 4 holds 24, every one also in a part of 2; 20 named, 4 counted.
+    assert!(err.contains("error: d: run 0 is in both `catalogue.part-0-of-2.csv` and `catalogue.part-0-of-4.csv`: delete the parts of an earlier sharding"), "{err}");
+    assert!(err.contains("error: d: `catalogue.part-0-of-4.csv`: 4 more of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"), "{err}");
+    assert!(!err.contains("run its shard again"), "{err}");
+    for k in 0..2 {
+        std::fs::remove_file(dir.path().join(format!("d/catalogue.part-{k}-of-2.csv"))).unwrap();
+    }
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 0, "the fix given works: {err}");
+}
+
 #[test]
 fn collect_refuses_a_row_no_run_writes() {
     // A finished row with its file, size and SHA-256 blanked (and the file gone) had nothing to check,
@@ -579,6 +709,12 @@ fn a_shard_that_a_running_sweep_makes_is_refused_and_collect_waits_for_it() {
     let (code, err) = collect(dir.path(), "d");
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("shard 1/2 is still running in `"), "{err}");
+    // Its runs are in no part yet, as expected while it runs: advising to run that shard again (which
+    // is refused while it runs) was premature.
+    assert!(
+        !err.contains("in no part") && !err.contains("run the shards"),
+        "{err}"
+    );
     // Negative control: once the lock is released, the same commands go through.
     drop(held);
     let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/2"]);
@@ -859,6 +995,30 @@ fn slurm_and_kubernetes_variables_give_the_shard() {
         "JOB_COMPLETION_INDEX=5 is not below --shard-count 3: give --shard-count the Job's completions \
          (its pods are indexed 0 … completions − 1)"
     );
+}
+
+/// `--shard-count` in a Slurm job array (copied from the Kubernetes command, say) was ignored without a
+/// word: an array of 2 tasks given `--shard-count 4` cut the sweep in 2 shards. A count that differs
+/// from the array's size is refused before anything is written; the same count is accepted.
+#[test]
+fn a_shard_count_that_does_not_match_the_slurm_array_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    let task = [
+        ("SLURM_ARRAY_TASK_ID", "1"),
+        ("SLURM_ARRAY_TASK_MIN", "0"),
+        ("SLURM_ARRAY_TASK_MAX", "1"),
+        ("SLURM_ARRAY_TASK_COUNT", "2"),
+    ];
+    let args = ["sweep", "s.toml", "-o", "d", "--shard-count", "4"];
+    let (code, out, err) = run_with_env(dir.path(), &args, &task);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("--shard-count 4 does not match this Slurm job array of 2 tasks, whose size is the number of shards: submit --array=0-3 for 4 shards, or leave --shard-count out"), "{err}");
+    assert!(!dir.path().join("d").exists(), "nothing written");
+    let args = ["sweep", "s.toml", "-o", "d", "--shard-count", "2", "--json"];
+    let (code, out, err) = run_with_env(dir.path(), &args, &task);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("\"shard\":\"1/2\""), "{out}");
 }
 
 #[test]

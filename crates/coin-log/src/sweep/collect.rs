@@ -53,7 +53,10 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         (folder::PART.list(dir)).map_err(SweepError::io("reading the sweep folder", dir))?;
     parts.sort_by_key(|(s, _)| (s.count(), s.index()));
     let mut problems = Vec::new();
-    if let Some(shard) = folder.held_lock(|_| true) {
+    // While a shard runs, its part is yet to come: advising to run the shards of the runs in no part
+    // (which a second process on that shard is refused) would be premature.
+    let running = folder.held_lock(|_| true);
+    if let Some(shard) = running {
         problems.push(format!(
             "shard {shard} is still running in `{}`: collect when every shard has ended",
             dir.display()
@@ -61,7 +64,8 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     }
     // A folder swept whole has no parts: the sweep wrote its catalogue itself. Running "the shards that
     // hold" its runs, as the list of missing runs advised, wrote no part either (one shard is the whole).
-    if parts.is_empty() && folder.swept_whole() {
+    let none = parts.is_empty() && running.is_none();
+    if none && folder.swept_whole() {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: it was swept whole, not in shards, so the \
              sweep wrote its catalogue.csv and sweep.json itself (collect merges the parts of shards, \
@@ -69,7 +73,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
              resumes",
             dir.display()
         ));
-    } else if parts.is_empty() {
+    } else if none {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: run the shards first, `coin-log sweep SWEEP.toml -o DIR --shard K/N`",
             dir.display()
@@ -87,7 +91,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         };
         read_part(&folder, &part, &mut rows, &mut problems)?;
     }
-    if !parts.is_empty() {
+    if !parts.is_empty() && running.is_none() {
         problems.extend(missing(runs, &rows));
     }
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));
@@ -152,26 +156,27 @@ fn read_part(
         return Ok(());
     }
     // What is wrong line by line, listed up to LISTED_LINES (a part of 300 000 garbage lines printed as
-    // many errors).
-    let mut found = Vec::new();
+    // many errors); each with whether it is a run another part holds too, which running this part's
+    // shard again does not mend (the part of an earlier sharding must go).
+    let mut found: Vec<(bool, String)> = Vec::new();
     for (n, line) in lines.enumerate() {
         let (index, fields) = match row(folder, part, line) {
             Ok(row) => row,
             Err(problem) => {
-                found.push(format!("`{name}` line {}: {problem}", n + 2));
+                found.push((false, format!("`{name}` line {}: {problem}", n + 2)));
                 continue;
             }
         };
         let problem = match rows.get(&index) {
             // Twice in this part: no shard writes that, and no other part is to blame.
-            Some(other) if other.part == name => format!(
+            Some(other) if other.part == name => (false, format!(
                 "`{name}` line {}: run {index}'s row is in the part twice: the part was changed; run its shard again",
                 n + 2
-            ),
-            Some(other) => format!(
+            )),
+            Some(other) => (true, format!(
                 "run {index} is in both `{}` and `{name}`: delete the parts of an earlier sharding (shards of one N make each run once)",
                 other.part
-            ),
+            )),
             None => {
                 let (part, line) = (name.to_string(), n + 2);
                 rows.insert(index, Found { part, line, fields });
@@ -180,11 +185,18 @@ fn read_part(
         };
         found.push(problem);
     }
-    let more = found.len().saturating_sub(LISTED_LINES);
-    problems.extend(found.into_iter().take(LISTED_LINES));
-    if more > 0 {
+    let unlisted = found.split_off(found.len().min(LISTED_LINES));
+    problems.extend(found.into_iter().map(|(_, problem)| problem));
+    let elsewhere = unlisted.iter().filter(|(elsewhere, _)| *elsewhere).count();
+    let wrong = unlisted.len() - elsewhere;
+    if wrong > 0 {
         problems.push(format!(
-            "`{name}`: {more} more lines are wrong as well: run its shard again"
+            "`{name}`: {wrong} more lines are wrong as well: run its shard again"
+        ));
+    }
+    if elsewhere > 0 {
+        problems.push(format!(
+            "`{name}`: {elsewhere} more of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"
         ));
     }
     Ok(())

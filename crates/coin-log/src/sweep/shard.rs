@@ -119,13 +119,23 @@ impl Shard {
                 .transpose()
         };
         if let Some(id) = number(SLURM_TASK_ID)? {
-            return slurm(
+            let shard = slurm(
                 id,
                 number(SLURM_TASK_MIN)?,
                 number(SLURM_TASK_MAX)?,
                 number(SLURM_TASK_COUNT)?,
-            )
-            .map(Some);
+            )?;
+            // --shard-count is Kubernetes' count; in a job array the array's size is N, and a count
+            // given beside it that differs was silently ignored (the sweep cut in other shards than asked).
+            return match kubernetes_count {
+                Some(count) if count != shard.count => Err(ShardError(format!(
+                    "--shard-count {count} does not match this Slurm job array of {} tasks, whose size is the \
+                     number of shards: submit --array=0-{} for {count} shards, or leave --shard-count out",
+                    shard.count,
+                    count.saturating_sub(1)
+                ))),
+                _ => Ok(Some(shard)),
+            };
         }
         match (number(KUBERNETES_INDEX)?, kubernetes_count) {
             (Some(index), Some(count)) if index >= count => Err(ShardError(format!(
