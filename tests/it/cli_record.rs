@@ -70,6 +70,32 @@ fn a_value_of_the_wrong_type_is_refused_naming_key_and_value() {
     refused(VALID, &["--set", "run.rate=fast"], &["run.rate", "fast"]);
 }
 
+/// A `--set` VALUE that is not TOML is taken as a bare string (`--set body.shape=hoop`); where a number
+/// belongs, serde's "invalid type: string" alone hid why the number became a string (`1e400` overflows
+/// TOML's floats, `.5` is no TOML number, and an empty value is none): the error says so and names the edit.
+#[test]
+fn a_set_number_that_is_not_toml_is_refused_saying_why() {
+    refused(
+        VALID,
+        &["--set", "run.duration=1e400"],
+        &["`run.duration`", "`--set run.duration=1e400`", "overflowed"],
+    );
+    refused(
+        VALID,
+        &["--set", "initial.theta=.5"],
+        &[
+            "`initial.theta`",
+            "`--set initial.theta=.5`",
+            "not a TOML value",
+        ],
+    );
+    refused(
+        VALID,
+        &["--set", "initial.theta="],
+        &["`--set initial.theta=` gives an empty value"],
+    );
+}
+
 #[test]
 fn a_nan_is_refused_naming_key_and_value() {
     refused(
