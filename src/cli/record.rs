@@ -380,6 +380,7 @@ fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
 fn output_policy(overwrite: bool, source: &SceneSource) -> Policy {
     Policy {
         overwrite,
+        overwrite_flag: true,
         flag: "-o",
         example: format!("{}.mcap", source.stem.to_string_lossy()).into(),
         protect: source
