@@ -96,6 +96,27 @@ fn a_set_number_that_is_not_toml_is_refused_saying_why() {
     );
 }
 
+/// A channel named many times, or an empty item given twice, is one problem, not one per repeat:
+/// `--channels omega,omega,…` 5000 times printed 4999 identical lines, and `--channels ,` two.
+#[test]
+fn a_repeated_channel_is_one_problem() {
+    let many = vec!["omega"; 5000].join(",");
+    for (list, says) in [
+        (many.as_str(), "`record.channels` = \"omega\" is listed 5000 times: list each channel once (set by `--channels`)"),
+        ("omega,angles,omega", "`record.channels` = \"omega\" is listed twice"),
+        (",", "`record.channels` = \"\" is not a channel"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("bad.toml"), VALID).unwrap();
+        let out = coin_log(dir.path(), &["record", "bad.toml", "--channels", list]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), 1, "{err}");
+        assert!(err.contains(says), "{err}");
+        assert_eq!(err.matches("record.channels").count(), 1, "one problem: {err}");
+        assert_eq!(listing(dir.path()), ["bad.toml"]);
+    }
+}
+
 #[test]
 fn a_nan_is_refused_naming_key_and_value() {
     refused(
