@@ -80,7 +80,9 @@ struct MapArgs {
         long,
         value_name = "+|-|both",
         default_value = "both",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        hide_possible_values = true,
+        value_parser = super::Suggested(&["+", "-", "both"])
     )]
     branch: String,
     /// Folder for stability-map.csv and stability-map.svg (created if missing; the files are replaced).

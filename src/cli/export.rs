@@ -81,6 +81,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<Outcome> {
     });
     // Dropped on an error: every table and the folders it created go with it.
     let mut folder = OutputFolder::create(&dir, args.overwrite)?
+        .with_overwrite_flag()
         .protecting(&args.file, "the recording being exported");
     let progress = FileProgress::new(&shown_file, len);
     let layout = if args.wide {

@@ -212,6 +212,34 @@ pub(crate) fn named<
     clap::builder::PossibleValuesParser::new(T::NAMES).try_map(|s| s.parse::<T>())
 }
 
+/// The clap value parser of a name checked later, by the scene or the command with its own message and exit
+/// code (`--integrator`, `analyse map --branch`): it takes any text, as clap's plain string parser does,
+/// and offers `names` to shell completion, which without possible values completes file names instead.
+/// Give the argument `hide_possible_values = true`: its help already lists the names.
+#[derive(Clone)]
+pub(crate) struct Suggested(pub &'static [&'static str]);
+
+impl clap::builder::TypedValueParser for Suggested {
+    type Value = String;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<String, clap::Error> {
+        clap::builder::StringValueParser::new().parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(
+        &self,
+    ) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        Some(Box::new(
+            self.0.iter().map(|n| clap::builder::PossibleValue::new(*n)),
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::Cli;

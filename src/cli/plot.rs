@@ -55,6 +55,7 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<Outcome> {
     });
     let policy = Policy {
         overwrite: args.overwrite,
+        overwrite_flag: true,
         flag: "--out",
         example: "plot.svg".into(),
         protect: Some((args.file.clone(), "the recording being plotted")),

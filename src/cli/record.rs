@@ -76,7 +76,8 @@ pub struct SceneFlags {
     #[arg(long, value_name = "R")]
     pub rate: Option<f64>,
     /// Integrator: rk4, dopri5, dop853, gauss4 (overrides `run.integrator`; scene default dop853).
-    #[arg(long, value_name = "NAME")]
+    #[arg(long, value_name = "NAME", hide_possible_values = true,
+          value_parser = super::Suggested(coin_log::integrate::Method::NAMES))]
     pub integrator: Option<String>,
     #[arg(long, value_name = "X", help = help::rtol())]
     pub rtol: Option<f64>,
@@ -379,6 +380,7 @@ fn output_path(args: &RecordArgs, source: &SceneSource) -> PathBuf {
 fn output_policy(overwrite: bool, source: &SceneSource) -> Policy {
     Policy {
         overwrite,
+        overwrite_flag: true,
         flag: "-o",
         example: format!("{}.mcap", source.stem.to_string_lossy()).into(),
         protect: source

@@ -877,3 +877,28 @@ fn a_tiny_tilt_nutates_with_the_linear_period_or_is_said_unreliable() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A circle leaning almost upright has ω_Y0 ~ 1/θ₀, which overflows as surely as a fast one: the refusal
+/// said "too fast or too near flat" for θ₀ = 1e-300, which is neither; it names the upright side too.
+#[test]
+fn a_map_too_near_upright_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "analyse",
+        "map",
+        "--theta",
+        "1e-300:1e-299:3",
+        "--omega-z",
+        "0:2:3",
+    ];
+    let output = coin_log(dir.path(), &args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("θ0 = 1e-300"), "{stderr}");
+    assert!(stderr.contains("too near upright"), "{stderr}");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing written"
+    );
+}

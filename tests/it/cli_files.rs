@@ -604,6 +604,7 @@ fn export_of_a_file_without_coin_log_channels_exits_non_zero() {
 fn policy(overwrite: bool) -> Policy {
     Policy {
         overwrite,
+        overwrite_flag: true,
         flag: "-o",
         example: "x.txt".into(),
         protect: None,

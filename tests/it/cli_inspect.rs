@@ -322,6 +322,14 @@ fn bash_completion_completes_the_flags_and_values_of_subcommands() {
             "json protobuf",
         ),
         ("coin-log sweep collect --j", "collect", "--jobs --json"),
+        // Names the scene or the command checks itself (exit 1, its own message) are still offered,
+        // not the file names the shell falls back to.
+        (
+            "coin-log record wobble --integrator ''",
+            "--integrator",
+            "rk4 dopri5 dop853 gauss4",
+        ),
+        ("coin-log analyse map --branch ''", "--branch", "+ - both"),
     ] {
         let cur = words.rsplit(' ').next().unwrap();
         let line = format!(

@@ -133,6 +133,45 @@ fn an_immutable_or_append_only_target_or_folder_is_refused_before_the_work() {
     assert_eq!(std::fs::read_to_string(d.join("imm.mcap")).unwrap(), "mine");
 }
 
+/// `man`, `analyse map` and `bench` always replace their own files and have no `--overwrite`: refusing an
+/// immutable page or map, they told the user the system allowed no replacement "even with --overwrite",
+/// a flag they do not take. Only `record`, `plot`, `export` (and `live`) have it to name.
+#[test]
+fn an_immutable_file_of_a_command_without_overwrite_does_not_name_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for folder in ["pages", "map"] {
+        std::fs::create_dir(d.join(folder)).unwrap();
+    }
+    std::fs::write(d.join("pages/coin-log.1"), "mine").unwrap();
+    std::fs::write(d.join("map/stability-map.csv"), "mine").unwrap();
+    let mut attributes = crate::support::Attributes::default();
+    if !["pages/coin-log.1", "map/stability-map.csv"]
+        .iter()
+        .all(|path| attributes.set("+i", &d.join(path)))
+    {
+        // Not root, or a file system without these attributes.
+        return;
+    }
+    for (args, says) in [
+        (
+            &["man", "--out", "pages"][..],
+            "`pages/coin-log.1` is immutable, so the system lets no file replace it: clear the attribute (chattr -i pages/coin-log.1), or choose another folder with --out",
+        ),
+        (
+            &["analyse", "map", "--theta", "0.1:1:2", "--omega-z", "0:1:2", "--out", "map"],
+            "`map/stability-map.csv` is immutable, so the system lets no file replace it: clear the attribute (chattr -i map/stability-map.csv), or choose another folder with --out",
+        ),
+    ] {
+        let out = coin_log(d, args);
+        assert_eq!(code(&out), 1, "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("--overwrite"), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(listing(&d.join("pages")), ["coin-log.1"]);
+    assert_eq!(listing(&d.join("map")), ["stability-map.csv"]);
+}
+
 #[test]
 fn a_device_node_is_never_replaced_even_with_overwrite() {
     let dir = tempfile::tempdir().unwrap();

@@ -70,6 +70,53 @@ fn a_value_of_the_wrong_type_is_refused_naming_key_and_value() {
     refused(VALID, &["--set", "run.rate=fast"], &["run.rate", "fast"]);
 }
 
+/// A `--set` VALUE that is not TOML is taken as a bare string (`--set body.shape=hoop`); where a number
+/// belongs, serde's "invalid type: string" alone hid why the number became a string (`1e400` overflows
+/// TOML's floats, `.5` is no TOML number, and an empty value is none): the error says so and names the edit.
+#[test]
+fn a_set_number_that_is_not_toml_is_refused_saying_why() {
+    refused(
+        VALID,
+        &["--set", "run.duration=1e400"],
+        &["`run.duration`", "`--set run.duration=1e400`", "overflowed"],
+    );
+    refused(
+        VALID,
+        &["--set", "initial.theta=.5"],
+        &[
+            "`initial.theta`",
+            "`--set initial.theta=.5`",
+            "not a TOML value",
+        ],
+    );
+    refused(
+        VALID,
+        &["--set", "initial.theta="],
+        &["`--set initial.theta=` gives an empty value"],
+    );
+}
+
+/// A channel named many times, or an empty item given twice, is one problem, not one per repeat:
+/// `--channels omega,omega,…` 5000 times printed 4999 identical lines, and `--channels ,` two.
+#[test]
+fn a_repeated_channel_is_one_problem() {
+    let many = vec!["omega"; 5000].join(",");
+    for (list, says) in [
+        (many.as_str(), "`record.channels` = \"omega\" is listed 5000 times: list each channel once (set by `--channels`)"),
+        ("omega,angles,omega", "`record.channels` = \"omega\" is listed twice"),
+        (",", "`record.channels` = \"\" is not a channel"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("bad.toml"), VALID).unwrap();
+        let out = coin_log(dir.path(), &["record", "bad.toml", "--channels", list]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), 1, "{err}");
+        assert!(err.contains(says), "{err}");
+        assert_eq!(err.matches("record.channels").count(), 1, "one problem: {err}");
+        assert_eq!(listing(dir.path()), ["bad.toml"]);
+    }
+}
+
 #[test]
 fn a_nan_is_refused_naming_key_and_value() {
     refused(

@@ -120,6 +120,7 @@ fn create_dir(out: &Path, files: &[String]) -> anyhow::Result<()> {
 /// made the fixes "choose a file path, e.g. --out bench-results" and "give the path it points to").
 const POLICY: Policy = Policy {
     overwrite: true,
+    overwrite_flag: false,
     flag: "--out",
     example: std::borrow::Cow::Borrowed(""),
     protect: None,

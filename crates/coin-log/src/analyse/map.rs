@@ -37,7 +37,7 @@ pub enum MapError {
         points: usize,
     },
     /// A grid point whose ω_Y0 or σ² is not a finite number in double precision.
-    #[error("the circle θ0 = {}, ω_Z0 = {} ({branch} branch) gives ω_Y0 = {}, σ² = {}: too fast or too near flat for double precision; narrow --theta or --omega-z", Short(*theta0), Short(*omega_z0), Short(*omega_y0), Short(*sigma_squared))]
+    #[error("the circle θ0 = {}, ω_Z0 = {} ({branch} branch) gives ω_Y0 = {}, σ² = {}: too fast, too near upright or too near flat for double precision; narrow --theta or --omega-z", Short(*theta0), Short(*omega_z0), Short(*omega_y0), Short(*sigma_squared))]
     NonFinite {
         /// θ₀ \[rad\].
         theta0: f64,

@@ -17,6 +17,9 @@ pub struct Policy {
     /// An existing regular file may be replaced (`--overwrite`, or a command that always replaces its own
     /// files).
     pub overwrite: bool,
+    /// The command has `--overwrite`, which messages may then name; false for a command that always
+    /// replaces its own files and has no such flag (`man`, `analyse map`, `bench`).
+    pub overwrite_flag: bool,
     /// The flag that names the target (`-o`, `--out`), for the fixes messages suggest.
     pub flag: &'static str,
     /// A file name to suggest instead of a folder or a special file (`wobble.mcap`).
@@ -175,9 +178,14 @@ fn check_attributes(target: &Path, exists: bool, policy: &Policy) -> Result<(), 
     if let Some(attribute) = exists.then(|| Attribute::of(target)).flatten() {
         let (name, clear) = attribute.words();
         let path = shown(target);
+        let even = if policy.overwrite_flag {
+            ", even with --overwrite"
+        } else {
+            ""
+        };
         return Err(OutputError(format!(
-            "`{path}` is {name}, so the system lets no file replace it, even with --overwrite: clear the \
-             attribute ({clear} {path}), or choose another {what} with {flag}"
+            "`{path}` is {name}, so the system lets no file replace it{even}: clear the attribute \
+             ({clear} {path}), or choose another {what} with {flag}"
         )));
     }
     let folder = folder_of(target);
@@ -563,6 +571,8 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
 pub struct OutputFolder {
     dir: PathBuf,
     overwrite: bool,
+    /// The command has `--overwrite` ([`Policy::overwrite_flag`]).
+    overwrite_flag: bool,
     /// A file no output may replace, and what it is ([`Policy::protect`]).
     protect: Option<(PathBuf, &'static str)>,
     outputs: Vec<Output>,
@@ -582,6 +592,7 @@ impl OutputFolder {
         let mut folder = Self {
             dir: dir.to_path_buf(),
             overwrite,
+            overwrite_flag: false,
             protect: None,
             outputs: Vec::new(),
             created: Vec::new(),
@@ -615,6 +626,13 @@ impl OutputFolder {
         &self.dir
     }
 
+    /// The command has `--overwrite`, which messages may name ([`Policy::overwrite_flag`]).
+    #[must_use]
+    pub fn with_overwrite_flag(mut self) -> Self {
+        self.overwrite_flag = true;
+        self
+    }
+
     /// No file of the folder may replace `file` (the input being read, however reached), `what` saying
     /// what it is: [`Policy::protect`].
     #[must_use]
@@ -630,6 +648,7 @@ impl OutputFolder {
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
         let policy = Policy {
             protect: self.protect.clone(),
+            overwrite_flag: self.overwrite_flag,
             ..folder_policy(self.overwrite)
         };
         let mut output = Output::create(&self.dir.join(name), &policy)?;

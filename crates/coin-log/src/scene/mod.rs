@@ -269,7 +269,7 @@ fn with_sets(mut table: toml::Table, sets: &[String]) -> Result<SceneFile, Scene
     for set in sets {
         apply_set(&mut table, set)?;
     }
-    file_from_table(table)
+    file_from_table(table).map_err(|e| overrides::explain_bare_strings(e, sets))
 }
 
 /// A scene table (after edits) as a raw scene file, not yet validated (serde's message on one line).

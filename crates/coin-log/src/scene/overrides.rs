@@ -123,11 +123,55 @@ fn remove(table: &mut toml::Table, key: &str) {
 
 /// VALUE as TOML, else as a bare string.
 fn parse_value(raw: &str) -> toml::Value {
-    let parsed = toml::from_str::<toml::Table>(&format!("value = {raw}"))
-        .ok()
-        .filter(|t| t.len() == 1)
-        .and_then(|mut t| t.remove("value"));
-    parsed.unwrap_or_else(|| toml::Value::String(raw.to_string()))
+    toml_value(raw).unwrap_or_else(|_| toml::Value::String(raw.to_string()))
+}
+
+/// VALUE as one TOML value, or why it is not one (the TOML reader's words).
+fn toml_value(raw: &str) -> Result<toml::Value, String> {
+    let mut table = toml::from_str::<toml::Table>(&format!("value = {raw}"))
+        .map_err(|e| e.message().trim().to_string())?;
+    match table.remove("value") {
+        Some(value) if table.is_empty() => Ok(value),
+        _ => Err("it is more than one value".into()),
+    }
+}
+
+/// `error`, from reading a scene edited by `sets`, with a word on each VALUE that is not TOML and that the
+/// error quotes as a string of the wrong type: `--set run.duration=1e400` is taken as the bare string
+/// "1e400" (TOML's numbers end at 1.8e308), and serde's "invalid type: string" alone would not say why a
+/// number became a string.
+pub(crate) fn explain_bare_strings(error: SceneError, sets: &[String]) -> SceneError {
+    let SceneError::Parse(message) = error else {
+        return error;
+    };
+    let mut explained = message.clone();
+    for set in sets {
+        let Some((key, raw)) = set.split_once('=') else {
+            continue;
+        };
+        let raw = raw.trim();
+        let Err(reason) = toml_value(raw) else {
+            continue;
+        };
+        // serde's words for a string where another type belongs: `invalid type: string "1e400"`. A word
+        // (`fast`) says enough itself; a VALUE meant as a number or an array is told why it is none.
+        if !message.contains(&format!("invalid type: string {raw:?}")) {
+            continue;
+        }
+        let key = key.trim();
+        let example = "e.g. a number 0.5 or 1e-3, an array [0.0, 0.2, 1.5]";
+        if raw.is_empty() {
+            explained.push_str(&format!(
+                "; `--set {key}=` gives an empty value: write one after `=`, {example}"
+            ));
+        } else if raw.starts_with(|c: char| c.is_ascii_digit() || "+-.[{".contains(c)) {
+            explained.push_str(&format!(
+                "; `--set {key}={raw}`: `{raw}` is not a TOML value ({reason}), so it was taken as a bare \
+                 string: write it as TOML, {example}"
+            ));
+        }
+    }
+    SceneError::Parse(explained)
 }
 
 /// The explicit `record` flags that override scene keys (applied after `--set`).

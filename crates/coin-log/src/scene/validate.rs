@@ -654,11 +654,21 @@ fn listed_channels(
     };
     let before = problems.list.len();
     let mut channels = Vec::new();
+    // Each name's problem once: `--channels omega,omega,…` 5000 times printed 4999 lines, `,` two.
+    let mut reported: Vec<&str> = Vec::new();
     for name in names {
         // `--channels "omega, angles"`: spaces around a name are not part of it.
         let name = name.trim();
+        if reported.contains(&name) {
+            continue;
+        }
         let reason = match name.parse::<Channel>() {
-            Ok(c) if channels.contains(&c) => "is listed twice: list each channel once".into(),
+            Ok(c) if channels.contains(&c) => {
+                match names.iter().filter(|n| n.trim() == name).count() {
+                    2 => "is listed twice: list each channel once".into(),
+                    n => format!("is listed {n} times: list each channel once"),
+                }
+            }
             Ok(Channel::Work) if !dissipative => "records the work of a dissipative couple, and the scene has none: add body.dissipation = { model = \"moffatt\", coefficient = ... } (format.md: Dissipation) or leave \"work\" out".into(),
             Ok(c) => {
                 channels.push(c);
@@ -666,6 +676,7 @@ fn listed_channels(
             }
             Err(_) => format!("is not a channel: use {}", Channel::names()),
         };
+        reported.push(name);
         problems.push("record.channels", quoted(name), reason);
     }
     if names.is_empty() {
