@@ -82,7 +82,7 @@ struct MapArgs {
         default_value = "both",
         allow_hyphen_values = true,
         hide_possible_values = true,
-        value_parser = super::Suggested(&["+", "-", "both"])
+        value_parser = super::Suggested(Branches::NAMES)
     )]
     branch: String,
     /// Folder for stability-map.csv and stability-map.svg (created if missing; the files are replaced).

@@ -167,6 +167,11 @@ impl Branches {
     }
 }
 
+impl Branches {
+    /// The names `from_str` takes, as `--branch` offers them (`plus` and `minus` are read too).
+    pub const NAMES: &'static [&'static str] = &["+", "-", "both"];
+}
+
 impl FromStr for Branches {
     type Err = MapError;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
