@@ -387,6 +387,10 @@ pub fn regular_file(path: &Path, stdin: bool) -> Result<std::fs::Metadata, ReadE
     Ok(meta)
 }
 
+/// Tries more to start the reading thread when the system refuses it, [`SPAWN_PAUSE`] apart: 2 s in all.
+const SPAWN_RETRIES: u32 = 100;
+const SPAWN_PAUSE: std::time::Duration = std::time::Duration::from_millis(20);
+
 fn read_into(
     file: impl Read + Send,
     file_len: u64,
@@ -398,11 +402,25 @@ fn read_into(
     let (to_consumer, batches) = mpsc::sync_channel(prefetch::QUEUE);
     // Room for every batch, so that handing one back never blocks.
     let (to_producer, recycled) = mpsc::sync_channel(prefetch::POOL);
+    // Taken by the thread that starts; left for the next try by one the system refuses.
+    let inputs = std::sync::Mutex::new(Some((file, to_consumer, recycled)));
     std::thread::scope(|scope| {
-        // The system may refuse a thread (its limits on threads or memory): an error, not a panic.
-        let spawned = std::thread::Builder::new().spawn_scoped(scope, move || {
-            prefetch::produce(file, file_len, to_consumer, recycled);
-        });
+        let produce = || {
+            let taken = inputs.lock().map(|mut i| i.take());
+            if let Ok(Some((file, to_consumer, recycled))) = taken {
+                prefetch::produce(file, file_len, to_consumer, recycled);
+            }
+        };
+        // The system may refuse a thread (its limit on processes or threads, EAGAIN), often for as long
+        // as others of the same user run: tried again for a while, then an error, never a panic.
+        let mut spawned = std::thread::Builder::new().spawn_scoped(scope, produce);
+        for _ in 0..SPAWN_RETRIES {
+            if spawned.is_ok() {
+                break;
+            }
+            std::thread::sleep(SPAWN_PAUSE);
+            spawned = std::thread::Builder::new().spawn_scoped(scope, produce);
+        }
         let worker = spawned.map_err(|e| {
             ReadError::new(
                 ReadErrorKind::Io,
