@@ -22,7 +22,8 @@ with the reason it could not run.
 Default tolerances, from the recorded integrator settings: with tau = sqrt(a/g), T the recorded span,
 W = max(max|omega|, 1/tau) and eps = max(rtol, atol/a) for adaptive methods, or for fixed-step methods
 of order p with step h (rk4, gauss4: p = 4) eps = (h W)^p (only the settings the method uses count):
-  energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau)))
+  energy (and invariant) drift:   min(1e-6, max(1e-12, 100 eps (1 + T/tau))); the invariant one
+                                  times max(1, sqrt(g/a)/(|C1_0| + |C2_0|))
   constraint and steady residual: min(1e-6, max(1e-10, 1000 eps (1 + T/tau)))
   nutation period and advance:    min(1e-6, max(1e-11, 100 eps)), plus the quadrature's and the
                                   interpolation's error estimates and the turning points' timing

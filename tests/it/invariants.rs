@@ -8,6 +8,7 @@
 //! Richardson-extrapolated; the difference between the two runs is printed as the reference's own error.
 
 use crate::support::physics::wobble;
+use crate::support::record::coin_log;
 use coin_log::integrate::{run_method, Flow, Method, MethodConfig, RunEnd, RunSettings};
 use coin_log::model::{
     energy, Chaplygin, Coin, CoinParams, Inertia, Invariants, InvariantsError, State,
@@ -637,4 +638,47 @@ fn mu_beyond_the_limit_is_refused_with_its_value() {
     let err = Chaplygin::new(&p).unwrap_err();
     assert!(matches!(err, InvariantsError::MuTooLarge { .. }));
     assert!(err.to_string().contains("500"));
+}
+
+/// A coin released with a tiny spin has tiny C₀ but falls at rates of order √(g/a), which the
+/// integrator's error on C follows: `wobble` with ω_Z = 1e-8 erred on C by 1e-13, a drift of 1.7e-5
+/// relative to |C1₀| + |C2₀| (format.md's definition), and verify failed the file record had promised to
+/// pass. The tolerance is widened by √(g/a)/(|C1₀| + |C2₀|); a tight --energy-tol still fails it.
+#[test]
+fn a_coin_released_with_a_tiny_spin_is_judged_against_the_natural_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("v.mcap");
+    let p = path.to_str().unwrap();
+    let set = "initial.omega=[0.0,0.0,1e-8]";
+    let out = coin_log(
+        dir.path(),
+        &["record", "wobble", "--set", set, "-o", p, "--json"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        summary["expected_to_fail"],
+        serde_json::json!([]),
+        "{summary}"
+    );
+    let verify = coin_log(dir.path(), &["verify", p]);
+    let text = String::from_utf8_lossy(&verify.stdout);
+    assert_eq!(verify.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("the energy tolerance × √(g/a)/(|C1_0| + |C2_0|)"),
+        "{text}"
+    );
+    // Negative control: 1e-20 widened by ~1e8 is far below the drift.
+    let tight = coin_log(
+        dir.path(),
+        &["verify", p, "--energy-tol", "1e-20", "--json"],
+    );
+    let json: serde_json::Value = serde_json::from_slice(&tight.stdout).unwrap();
+    let checks = json["files"][0]["checks"].as_array().unwrap();
+    let invariants = checks.iter().find(|c| c["id"] == "invariants").unwrap();
+    assert_eq!(invariants["status"], "fail", "{invariants}");
 }
