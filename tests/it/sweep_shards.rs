@@ -715,6 +715,15 @@ fn a_shard_that_a_running_sweep_makes_is_refused_and_collect_waits_for_it() {
         !err.contains("in no part") && !err.contains("run the shards"),
         "{err}"
     );
+    // Every running shard is named: two arrays on one folder, only the first was.
+    let other = hold_lock(&folder, "3/4");
+    let (code, err) = collect(dir.path(), "d");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("shards 1/2, 3/4 are still running in `"),
+        "{err}"
+    );
+    drop(other);
     // Negative control: once the lock is released, the same commands go through.
     drop(held);
     let (code, json) = sweep_json(dir.path(), "s.toml", "d", &["--shard", "1/2"]);

@@ -55,16 +55,24 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     let mut problems = Vec::new();
     // While a shard runs, its part is yet to come: advising to run the shards of the runs in no part
     // (which a second process on that shard is refused) would be premature.
-    let running = folder.held_lock(|_| true);
-    if let Some(shard) = running {
-        problems.push(format!(
+    let running = folder.held_locks(|_| true);
+    // Every one of them: the first alone hid the others (two arrays of 2 and 4 on one folder).
+    let names: Vec<String> = running.iter().map(ToString::to_string).collect();
+    match names.as_slice() {
+        [] => {}
+        [shard] => problems.push(format!(
             "shard {shard} is still running in `{}`: collect when every shard has ended",
             dir.display()
-        ));
+        )),
+        many => problems.push(format!(
+            "shards {} are still running in `{}`: collect when every shard has ended",
+            many.join(", "),
+            dir.display()
+        )),
     }
     // A folder swept whole has no parts: the sweep wrote its catalogue itself. Running "the shards that
     // hold" its runs, as the list of missing runs advised, wrote no part either (one shard is the whole).
-    let none = parts.is_empty() && running.is_none();
+    let none = parts.is_empty() && running.is_empty();
     if none && folder.swept_whole() {
         problems.push(format!(
             "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: it was swept whole, not in shards, so the \
@@ -91,7 +99,7 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
         };
         read_part(&folder, &part, &mut rows, &mut problems)?;
     }
-    if !parts.is_empty() && running.is_none() {
+    if !parts.is_empty() && running.is_empty() {
         problems.extend(missing(runs, &rows));
     }
     let at = ["file", "bytes", "sha256"].map(|c| folder.column(c));

@@ -285,22 +285,29 @@ impl Folder {
                 Err(fs::TryLockError::Error(_)) => return Ok(ShardLock { _file: None }),
             }
         }
-        if let Some(other) = self.held_lock(|other| other != shard && other.overlaps(shard)) {
+        let others = self.held_locks(|other| other != shard && other.overlaps(shard));
+        if let Some(&other) = others.first() {
             return Err(self.busy(shard, other));
         }
         Ok(ShardLock { _file: Some(file) })
     }
 
-    /// The first shard whose lock another process holds, among those `wanted` takes.
-    pub fn held_lock(&self, wanted: impl Fn(Shard) -> bool) -> Option<Shard> {
-        let locks = LOCK.list(&self.state()).ok()?;
-        let mut wanted = locks.into_iter().filter(|&(s, _)| wanted(s));
-        wanted.find_map(|(other, name)| {
-            let file = files::open_regular(&self.state().join(name)).ok()?;
-            // Shared, so that two processes looking at once do not see each other; dropped at once.
-            let held = matches!(file.try_lock_shared(), Err(fs::TryLockError::WouldBlock));
-            held.then_some(other)
-        })
+    /// The shards whose locks other processes hold, among those `wanted` takes, by count and index.
+    pub fn held_locks(&self, wanted: impl Fn(Shard) -> bool) -> Vec<Shard> {
+        let Ok(locks) = LOCK.list(&self.state()) else {
+            return Vec::new();
+        };
+        let wanted = locks.into_iter().filter(|&(s, _)| wanted(s));
+        let mut held: Vec<Shard> = wanted
+            .filter_map(|(other, name)| {
+                let file = files::open_regular(&self.state().join(name)).ok()?;
+                // Shared, so that two processes looking at once do not see each other; dropped at once.
+                let held = matches!(file.try_lock_shared(), Err(fs::TryLockError::WouldBlock));
+                held.then_some(other)
+            })
+            .collect();
+        held.sort_by_key(|s| (s.count(), s.index()));
+        held
     }
 
     fn busy(&self, shard: Shard, holder: Shard) -> SweepError {
