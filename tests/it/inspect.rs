@@ -1252,3 +1252,33 @@ fn an_undecodable_frame_transform_is_named_by_its_own_topic() {
         );
     }
 }
+
+#[test]
+fn plot_gives_a_tiny_track_a_scale() {
+    // Plotters puts one tick on an axis narrower than about 2.2e-16: a track where a = 1e-70 had one
+    // label on each axis, no scale at all. It is now drawn in units of a power of ten, its ticks
+    // labelled in the true values.
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = ["body.radius=1e-70", "body.gravity=1e-70"];
+    let mut args = vec!["--duration", "2", "--atol", "1e-75"];
+    for set in &tiny {
+        args.extend(["--set", set]);
+    }
+    record_scene(dir.path(), "circle-plus", &args);
+    let out = coin_log(dir.path(), &["plot", "circle-plus.mcap"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let texts = svg_texts(&std::fs::read_to_string(dir.path().join("circle-plus.svg")).unwrap());
+    let ticks: Vec<f64> = texts
+        .iter()
+        .filter_map(|t| t.trim().parse::<f64>().ok())
+        .filter(|v| *v != 0.0 && v.abs() < 1e-60)
+        .collect();
+    assert!(ticks.len() >= 8, "{ticks:?}: {texts:?}");
+    // The track lies within a few radii (R_C = 5.2 a) of the origin.
+    assert!(ticks.iter().all(|v| v.abs() < 2e-69), "{ticks:?}");
+}

@@ -507,6 +507,15 @@ const SHORT_DIGITS: f64 = 6.0;
 /// The magnitude from which tick labels are in exponent form (`1.5e6`, not `1500000.0`).
 const LARGE: f64 = 1e6;
 
+/// The widest span of a track drawn in units of a power of ten ([`track`]): far above plotters' limit
+/// (2.2e-16), far below any track of an ordinary scale.
+const TINY_SPAN: f64 = 1e-12;
+
+/// `label` of a value drawn in units of `unit`.
+fn in_units(unit: f64, label: impl Fn(&f64) -> String) -> impl Fn(&f64) -> String {
+    move |v: &f64| label(&(v * unit))
+}
+
 /// `x` held within ±`f64::MAX`/4.
 fn clamp_finite(x: f64) -> f64 {
     x.clamp(-f64::MAX / 4.0, f64::MAX / 4.0)
@@ -541,6 +550,19 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), DrawError> {
     let all = || contact.iter().chain(&centre);
     let (x0, x1) = padded(min_max(all(), |p| p.0));
     let (z0, z1) = padded(min_max(all(), |p| p.1));
+    // Plotters puts one tick on an axis narrower than about 2.2e-16 (a track where a = 1e-70): such a
+    // track is drawn in units of a power of ten near its span, and its ticks labelled in the true values.
+    let span = (x1 - x0).max(z1 - z0);
+    let unit = if span < TINY_SPAN {
+        10f64.powf(span.log10().floor())
+    } else {
+        1.0
+    };
+    let scaled = |points: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        points.iter().map(|&(x, z)| (x / unit, z / unit)).collect()
+    };
+    let (contact, centre) = (scaled(&contact), scaled(&centre));
+    let (x0, x1, z0, z1) = (x0 / unit, x1 / unit, z0 / unit, z1 / unit);
     // Equal axes: widen the shorter range to the plotting area's aspect ratio.
     let (label_x, label_y, margin) = (40u32, 60u32, 12u32);
     let (w, h) = area.dim_in_pixel();
@@ -559,8 +581,14 @@ fn track(area: &Area<'_>, c: &Collect) -> Result<(), DrawError> {
         .configure_mesh()
         .x_desc("x")
         .y_desc("z (down the page: the view from above)")
-        .x_label_formatter(&tick_label(xc - hx, xc + hx))
-        .y_label_formatter(&tick_label(zc - hz, zc + hz))
+        .x_label_formatter(&in_units(
+            unit,
+            tick_label(unit * (xc - hx), unit * (xc + hx)),
+        ))
+        .y_label_formatter(&in_units(
+            unit,
+            tick_label(unit * (zc - hz), unit * (zc + hz)),
+        ))
         .draw()?;
     for (label, points, colour) in [
         ("contact track", &contact, BLUE),
