@@ -126,11 +126,13 @@ fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
         .chars()
         .take_while(|c| c.is_ascii_digit() || *c == '-')
         .collect();
-    // The tasks of an array numbered MIN … MAX, run in turn as Slurm would, with its variables.
-    let task = |id: u64, min: u64, max: u64| {
+    // The tasks of an array numbered MIN … MAX, run in turn as Slurm would, with its variables, into
+    // `folder` with sweep options `extra`.
+    let task_into = |folder: &str, id: u64, min: u64, max: u64, extra: &[&str]| {
         let out = Command::new("bash")
             .arg(&script)
-            .args(["s.toml", "shared"])
+            .args(["s.toml", folder])
+            .args(extra)
             .current_dir(dir.path())
             .env("COIN_LOG", crate::support::record::exe())
             .envs([
@@ -147,6 +149,7 @@ fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
             String::from_utf8_lossy(&out.stderr)
         );
     };
+    let task = |id: u64, min: u64, max: u64| task_into("shared", id, min, max, &[]);
     for id in [0, 1, 3] {
         task(id, 0, 3);
     }
@@ -161,6 +164,17 @@ fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
     assert_eq!(
         code, 0,
         "collect after the example's advice (--array={array}): {err}"
+    );
+    // The one-task array given its shard, as the header and the one-task warning say: the script takes
+    // options after DIR (it took exactly two arguments, so the warning's --shard K/N could not be given).
+    for id in [0, 1, 3] {
+        task_into("alone", id, 0, 3, &[]);
+    }
+    task_into("alone", 2, 2, 2, &["--shard", "2/4"]);
+    let (code, err) = collect(dir.path(), "alone");
+    assert_eq!(
+        code, 0,
+        "collect after the one task given --shard 2/4: {err}"
     );
 }
 
