@@ -21,6 +21,9 @@ toppled = runs[runs["termination"] == "flat-landing"].sort_values("initial.theta
 print(f"{len(toppled)} of {len(runs)} runs toppled")
 print(toppled[["index", "initial.theta", "t_end"]].to_string(index=False))
 
+if toppled.empty:
+    sys.exit(0)  # nothing toppled: no channel to read (a sweep of spinning coins, or too short a duration)
+
 # The lean θ(t) of the run that toppled first, from its /coin/angles channel.
 first = toppled.loc[toppled["t_end"].idxmin()]
 with open(folder / first["file"], "rb") as f:

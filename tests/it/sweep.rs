@@ -1081,6 +1081,28 @@ fn a_base_scene_file_is_found_beside_the_sweep_file_and_an_invalid_combination_i
 }
 
 #[test]
+fn a_run_that_cannot_be_verified_says_why_in_its_reason() {
+    // Sampled too coarsely for the constraint check (and no steady scene): the catalogue's reason used to
+    // end in "each check's reason says why and what to record", naming reasons it did not hold.
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = "base = \"wobble\"\nset = { \"run.duration\" = 0.5, \"run.rate\" = 20.0, \"initial.omega\" = [0.0, 0.0, 0.0], \"initial.theta\" = 0.67 }\n";
+    write_sweep(dir.path(), "low.toml", sweep);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "low.toml", "-o", "low"]);
+    assert_eq!(code, 1, "{out}{err}");
+    let row = &Csv::read(&dir.path().join("low/catalogue.csv")).records()[0];
+    assert_eq!(row["verify"], "cannot-verify", "{row:?}");
+    let reason = &row["reason"];
+    assert!(
+        reason.starts_with(
+            "verify: cannot-verify: cannot verify: the required check constraint or steady"
+        ) && reason.contains("constraint skipped: the sampling does not resolve the motion")
+            && reason.contains("record at a higher --rate")
+            && reason.contains("steady skipped: not a steady scene"),
+        "{reason}"
+    );
+}
+
+#[test]
 fn a_run_that_cannot_be_verified_fails_and_verification_can_be_off() {
     let dir = tempfile::tempdir().unwrap();
     let base = "base = \"circle-plus\"\nset = { \"run.duration\" = 1.0 }\n[output]\nchannels = [\"energy\"]\n";

@@ -71,3 +71,28 @@ fn the_python_example_picks_the_toppled_runs_and_reads_a_channel_of_one() {
         "the last sample is at t_end: {last}"
     );
 }
+
+#[test]
+fn the_python_example_says_so_when_no_run_toppled() {
+    // It used to end in a pandas traceback (argmin of an empty sequence) and exit 1.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("spin.toml"),
+        "base = \"wobble\"\nset = { \"run.duration\" = 1.0, \"run.rate\" = 200.0 }\n[[axis]]\nkey = \"initial.theta\"\nvalues = [0.5, 0.6]\n",
+    )
+    .unwrap();
+    let (code, out, err) = run_in(dir.path(), &["sweep", "spin.toml", "-o", "spin"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let script = repo().join("examples/sweep_catalogue.py");
+    let run = run_tool(
+        Command::new(python())
+            .arg(&script)
+            .arg("spin")
+            .current_dir(dir.path()),
+        "run scripts/test",
+    );
+    let (stdout, stderr) = (&run.stdout, &run.stderr);
+    assert!(run.status.success(), "{stdout}{stderr}");
+    assert!(stderr.trim().is_empty(), "{stderr}");
+    assert!(stdout.starts_with("0 of 2 runs toppled\n"), "{stdout}");
+}

@@ -14,7 +14,7 @@ use crate::format::{promise, Termination};
 use crate::model::nutation::Motion;
 use crate::record::{self, RecordSummary};
 use crate::scene::Scene;
-use crate::verify::{self, FileReport, Status, Verdict};
+use crate::verify::{self, CheckId, FileReport, Status, Verdict};
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::PathBuf;
@@ -414,7 +414,28 @@ fn verify_reason(r: &FileReport) -> String {
         .collect();
     let failing = (!failing.is_empty()).then(|| failing.join(", "));
     let verdict = format!("verify: {}", r.verdict.name());
-    let parts = [Some(verdict), failing, r.problem.clone()];
+    // The problem of a file that cannot be verified defers to "each check's reason": the catalogue has
+    // no other place for them, so the skipped required checks' reasons (what to record) follow it.
+    let skipped: Vec<String> = if r.verdict == Verdict::CannotVerify {
+        r.checks
+            .iter()
+            .filter(|c| {
+                c.status == Status::Skip
+                    && matches!(
+                        c.id,
+                        CheckId::Integrity
+                            | CheckId::Energy
+                            | CheckId::Constraint
+                            | CheckId::Steady
+                    )
+            })
+            .map(|c| format!("{} skipped: {}", c.id, c.reason))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let skipped = (!skipped.is_empty()).then(|| skipped.join("; "));
+    let parts = [Some(verdict), failing, r.problem.clone(), skipped];
     parts.into_iter().flatten().collect::<Vec<_>>().join(": ")
 }
 
