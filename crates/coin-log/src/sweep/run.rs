@@ -419,16 +419,7 @@ fn verify_reason(r: &FileReport) -> String {
     let skipped: Vec<String> = if r.verdict == Verdict::CannotVerify {
         r.checks
             .iter()
-            .filter(|c| {
-                c.status == Status::Skip
-                    && matches!(
-                        c.id,
-                        CheckId::Integrity
-                            | CheckId::Energy
-                            | CheckId::Constraint
-                            | CheckId::Steady
-                    )
-            })
+            .filter(|c| c.status == Status::Skip && CheckId::REQUIRED.contains(&c.id))
             .map(|c| format!("{} skipped: {}", c.id, c.reason))
             .collect()
     } else {

@@ -809,12 +809,13 @@ fn missing_required(results: &[CheckResult]) -> Option<String> {
             .iter()
             .any(|r| r.id == id && r.status == Status::Skip)
     };
-    let mut missing: Vec<&str> = [CheckId::Integrity, CheckId::Energy]
+    let [integrity, energy, constraint, steady] = CheckId::REQUIRED;
+    let mut missing: Vec<&str> = [integrity, energy]
         .into_iter()
         .filter(|id| skipped(*id))
         .map(CheckId::name)
         .collect();
-    if skipped(CheckId::Constraint) && skipped(CheckId::Steady) {
+    if skipped(constraint) && skipped(steady) {
         missing.push("constraint or steady (the motion)");
     }
     (!missing.is_empty()).then(|| {

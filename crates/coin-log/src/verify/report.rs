@@ -28,6 +28,17 @@ coin_log_names::named_enum! {
     }
 }
 
+impl CheckId {
+    /// The checks a file must run to be verified (format.md: verify): integrity, energy, and constraint
+    /// or steady (the motion).
+    pub const REQUIRED: [Self; 4] = [
+        Self::Integrity,
+        Self::Energy,
+        Self::Constraint,
+        Self::Steady,
+    ];
+}
+
 coin_log_names::named_enum! {
     /// Outcome of one check.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
