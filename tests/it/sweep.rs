@@ -1354,3 +1354,43 @@ fn the_hash_of_abc_is_the_fips_example() {
         "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
     );
 }
+
+#[test]
+fn a_stop_request_with_no_run_left_is_not_an_interruption() {
+    // A SIGINT that came after the last run ended still made the sweep "interrupted" (exit 130), so a
+    // Slurm afterok skipped collect. Here the stop is set before a resume that has nothing left to do.
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let sweep = Sweep::load(&dir.path().join("s.toml")).unwrap();
+    let options = coin_log::sweep::RunOptions {
+        jobs: 1,
+        shard: coin_log::sweep::Shard::ALL,
+        retry_failed: false,
+    };
+    let stop = std::sync::atomic::AtomicBool::new(true);
+    let outcome = coin_log::sweep::run(
+        &sweep,
+        &dir.path().join("out"),
+        &options,
+        &stop,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(
+        (outcome.pending, outcome.interrupted),
+        (0, false),
+        "{outcome:?}"
+    );
+    // Negative control: with a run left, the same request is an interruption.
+    std::fs::remove_file(dir.path().join("out/run-00.mcap")).unwrap();
+    let outcome = coin_log::sweep::run(
+        &sweep,
+        &dir.path().join("out"),
+        &options,
+        &stop,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(outcome.interrupted && outcome.pending == 1, "{outcome:?}");
+}

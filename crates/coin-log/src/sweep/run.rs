@@ -64,7 +64,8 @@ pub struct SweepOutcome {
     pub kept: u64,
     /// Runs done now (finished or failed).
     pub done: u64,
-    /// Whether a stop request ended it early.
+    /// Whether a stop request ended it early: with runs left without a row (one that came after the
+    /// last run ended nothing early, and exited 130, so that `afterok` skipped collect).
     pub interrupted: bool,
     /// The catalogue written (`catalogue.csv`, or this shard's part).
     pub catalogue: PathBuf,
@@ -208,7 +209,7 @@ impl Tally {
             pending,
             kept: self.kept,
             done: self.progress.done,
-            interrupted: stop.load(Ordering::SeqCst),
+            interrupted: stop.load(Ordering::SeqCst) && pending > 0,
             catalogue,
             summary,
             record_seconds: self.record_seconds,
