@@ -527,3 +527,43 @@ fn a_run_that_lands_flat_is_not_promised_to_fail_the_nutation_it_skips() {
         }
     }
 }
+
+/// Verify skips `nutation` with fewer than 8 samples a period ("undersampled"): `wobble` (T = 2.75) for
+/// 10⁴ time units at 2 samples a unit was promised to fail it all the same (its drift over the long run
+/// is above the nutation tolerance).
+#[test]
+fn an_undersampled_run_is_not_promised_to_fail_the_nutation_it_skips() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = [
+        "record",
+        "wobble",
+        "--duration",
+        "10000",
+        "--rate",
+        "2",
+        "--channels",
+        "omega,angles,position",
+        "-o",
+        "u.mcap",
+        "--json",
+    ];
+    let out = coin_log(dir.path(), &record);
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let expected = &summary["expected_to_fail"];
+    assert!(
+        !expected.as_array().unwrap().iter().any(|c| c == "nutation"),
+        "{summary}"
+    );
+    let verify = coin_log(dir.path(), &["verify", "u.mcap", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
+    let checks = report["files"][0]["checks"].as_array().unwrap();
+    let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
+    assert_eq!(nutation["status"], "skip", "{nutation}");
+    assert!(
+        nutation["reason"]
+            .as_str()
+            .unwrap()
+            .starts_with("undersampled"),
+        "{nutation}"
+    );
+}

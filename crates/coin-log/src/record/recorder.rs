@@ -25,6 +25,7 @@ use crate::model::{
 };
 use crate::scene::Scene;
 use crate::simulation::{departure_doubt, run_dynamics};
+use crate::verify::MIN_SAMPLES_PER_PERIOD;
 use coin_log_mcap::{Compression, McapWriter, WriteError, WriterOptions};
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
@@ -541,17 +542,23 @@ fn shortfalls(scene: &Scene, accuracy: &RunAccuracy) -> Vec<Shortfall> {
     shortfalls
 }
 
-/// Whether the quadrature of physics §10 from the initial state finds a nutation period, as verify's
-/// `nutation` check computes it from the first stored state: a coin that lands flat (or a state with no
-/// orbit) has none, and the check is skipped.
+/// Whether the quadrature of physics §10 from the initial state finds a nutation period that the samples
+/// resolve, as verify's `nutation` check computes it from the first stored state: a coin that lands flat
+/// (or a state with no orbit) has none, and fewer than [`MIN_SAMPLES_PER_PERIOD`] samples a period are
+/// "undersampled"; verify skips the check either way. (A period within 1e-9 of the sampling limit still
+/// counts as resolved, so rounding of the stored times cannot make verify run a check not named.)
 fn nutates(scene: &Scene) -> bool {
     let coin = scene.coin();
+    let resolved =
+        |period: f64| period >= MIN_SAMPLES_PER_PERIOD * scene.run.sample_interval() * (1.0 - 1e-9);
     Chaplygin::new(coin.params())
         .ok()
         .and_then(|chaplygin| {
             Orbit::new(&coin, &chaplygin, &scene.initial, scene.run.flat_margin).ok()
         })
-        .is_some_and(|orbit| matches!(orbit.motion, Motion::Periodic { .. }))
+        .is_some_and(
+            |orbit| matches!(orbit.motion, Motion::Periodic { period, .. } if resolved(period)),
+        )
 }
 
 /// Where the centre and the heading start, how fast the heading turns, and how far apart the stored
