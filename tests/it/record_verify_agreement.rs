@@ -485,3 +485,85 @@ fn a_steady_run_is_not_promised_to_fail_the_nutation_it_skips() {
     let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
     assert_eq!(nutation["status"], "skip", "{nutation}");
 }
+
+/// A coin that lands flat has no nutation period, and verify skips `nutation` ("there is no period"):
+/// `topple --rtol 1e-6 --atol 1e-8` and `lift-off` (which the quadrature lands flat) were promised to
+/// fail it all the same. The warning, the summary and the metadata now name only `constraint`, which
+/// fails.
+#[test]
+fn a_run_that_lands_flat_is_not_promised_to_fail_the_nutation_it_skips() {
+    let dir = tempfile::tempdir().unwrap();
+    for scene in ["topple", "lift-off"] {
+        let file = format!("{scene}.mcap");
+        let record = [
+            "record", scene, "--rtol", "1e-6", "--atol", "1e-8", "-o", &file, "--json",
+        ];
+        let out = coin_log(dir.path(), &record);
+        let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let expected: Vec<&str> = summary["expected_to_fail"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_str().unwrap())
+            .collect();
+        assert!(!expected.contains(&"nutation"), "{scene}: {summary}");
+        let warning = String::from_utf8_lossy(&out.stderr);
+        assert!(!warning.contains("`nutation`"), "{scene}: {warning}");
+        let verify = coin_log(dir.path(), &["verify", &file, "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
+        for c in report["files"][0]["checks"].as_array().unwrap() {
+            let id = c["id"].as_str().unwrap();
+            match c["status"].as_str().unwrap() {
+                "skip" => assert!(
+                    !expected.contains(&id),
+                    "{scene}: {id} is named, and skipped"
+                ),
+                "fail" => assert!(
+                    expected.contains(&id),
+                    "{scene}: {id} fails, and was not named"
+                ),
+                _ => {}
+            }
+        }
+    }
+}
+
+/// Verify skips `nutation` with fewer than 8 samples a period ("undersampled"): `wobble` (T = 2.75) for
+/// 10⁴ time units at 2 samples a unit was promised to fail it all the same (its drift over the long run
+/// is above the nutation tolerance).
+#[test]
+fn an_undersampled_run_is_not_promised_to_fail_the_nutation_it_skips() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = [
+        "record",
+        "wobble",
+        "--duration",
+        "10000",
+        "--rate",
+        "2",
+        "--channels",
+        "omega,angles,position",
+        "-o",
+        "u.mcap",
+        "--json",
+    ];
+    let out = coin_log(dir.path(), &record);
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let expected = &summary["expected_to_fail"];
+    assert!(
+        !expected.as_array().unwrap().iter().any(|c| c == "nutation"),
+        "{summary}"
+    );
+    let verify = coin_log(dir.path(), &["verify", "u.mcap", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
+    let checks = report["files"][0]["checks"].as_array().unwrap();
+    let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
+    assert_eq!(nutation["status"], "skip", "{nutation}");
+    assert!(
+        nutation["reason"]
+            .as_str()
+            .unwrap()
+            .starts_with("undersampled"),
+        "{nutation}"
+    );
+}

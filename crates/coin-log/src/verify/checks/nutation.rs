@@ -22,7 +22,7 @@ use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
 /// Fewest samples per nutation period for the crossings to be interpolated.
-const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
+pub(crate) const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
 /// The interpolation bound may use at most this share of the tolerance, or the file is undersampled.
 const INTERPOLATION_SHARE: f64 = 0.1;
 /// Smallest θ range worth measuring \[rad\]: below it the crossings of ω_X are the integrator's noise.
