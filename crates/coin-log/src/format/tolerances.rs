@@ -21,6 +21,9 @@ pub const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 pub const RECOMPUTE_TOLERANCE: f64 = 1e-12;
 /// Relative tolerance of N ≥ 0 and |F| ≤ μN, in units of Mg (rounding only).
 pub const VALIDITY_TOLERANCE: f64 = 1e-12;
+/// Fewest samples per nutation period for verify's `nutation` check to interpolate the crossings; record's
+/// prediction names the check only above it.
+pub const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
 
 /// The tolerances one file is judged with, and the ε they were derived from (the module doc's formulas).
 #[allow(missing_docs)]

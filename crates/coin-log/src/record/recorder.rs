@@ -11,7 +11,7 @@ use crate::format::messages::{
     NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::promise::{self, Shortfall};
-use crate::format::tolerances::{RunAccuracy, Tolerances};
+use crate::format::tolerances::{RunAccuracy, Tolerances, MIN_SAMPLES_PER_PERIOD};
 use crate::format::{
     header_library, log_time, Channel, Encoding, ResultMetadata, Termination, TimeError, Topic,
     RESULT_METADATA_NAME, RUN_METADATA_NAME,
@@ -25,7 +25,6 @@ use crate::model::{
 };
 use crate::scene::Scene;
 use crate::simulation::{departure_doubt, run_dynamics};
-use crate::verify::MIN_SAMPLES_PER_PERIOD;
 use coin_log_mcap::{Compression, McapWriter, WriteError, WriterOptions};
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};

@@ -4,8 +4,6 @@
 //! log time into samples, and each check keeps running maxima and a short window.
 
 mod checks;
-/// Fewest samples per nutation period for verify's `nutation` check (record's prediction skips it too).
-pub(crate) use checks::nutation::MIN_SAMPLES_PER_PERIOD;
 mod coverage;
 mod file;
 mod report;

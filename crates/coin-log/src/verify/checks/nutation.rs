@@ -14,15 +14,13 @@
 
 use super::{fmt_num, worst, Context, RunStats};
 use crate::format::promise::GROWTH_SHARE;
-use crate::format::tolerances::Tolerances;
+use crate::format::tolerances::{Tolerances, MIN_SAMPLES_PER_PERIOD};
 use crate::model::nutation::{Motion, Orbit};
 use crate::model::{State, TurningPoints};
 use crate::scene::defaults;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
-/// Fewest samples per nutation period for the crossings to be interpolated.
-pub(crate) const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
 /// The interpolation bound may use at most this share of the tolerance, or the file is undersampled.
 const INTERPOLATION_SHARE: f64 = 0.1;
 /// Smallest θ range worth measuring \[rad\]: below it the crossings of ω_X are the integrator's noise.
