@@ -450,6 +450,30 @@ fn record_warns_when_samples_are_too_close_for_an_adaptive_methods_rounding() {
     }
 }
 
+/// The summary `record ... --json` printed, and the checks it names in `expected_to_fail`.
+fn record_summary(out: &std::process::Output) -> (serde_json::Value, Vec<String>) {
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let expected = summary["expected_to_fail"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    (summary, expected)
+}
+
+/// `verify FILE --json` in `dir`: the file's checks.
+fn verify_checks(dir: &std::path::Path, file: &str) -> Vec<serde_json::Value> {
+    let verify = coin_log(dir, &["verify", file, "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
+    report["files"][0]["checks"].as_array().unwrap().clone()
+}
+
+/// The check `id` of `checks`.
+fn check<'a>(checks: &'a [serde_json::Value], id: &str) -> &'a serde_json::Value {
+    checks.iter().find(|c| c["id"] == id).unwrap()
+}
+
 /// A steady motion does not nutate, and verify skips `nutation` on an unperturbed steady start:
 /// `circle-plus --rtol 1e-3 --atol 1e-3` was promised to fail it all the same.
 #[test]
@@ -466,23 +490,14 @@ fn a_steady_run_is_not_promised_to_fail_the_nutation_it_skips() {
         "c.mcap",
         "--json",
     ];
-    let out = coin_log(dir.path(), &record);
-    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let expected: Vec<&str> = summary["expected_to_fail"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c.as_str().unwrap())
-        .collect();
+    let (summary, expected) = record_summary(&coin_log(dir.path(), &record));
     assert_eq!(
         expected,
         ["energy", "invariants", "constraint", "steady"],
         "{summary}"
     );
-    let verify = coin_log(dir.path(), &["verify", "c.mcap", "--json"]);
-    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
-    let checks = report["files"][0]["checks"].as_array().unwrap();
-    let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
+    let checks = verify_checks(dir.path(), "c.mcap");
+    let nutation = check(&checks, "nutation");
     assert_eq!(nutation["status"], "skip", "{nutation}");
 }
 
@@ -499,19 +514,12 @@ fn a_run_that_lands_flat_is_not_promised_to_fail_the_nutation_it_skips() {
             "record", scene, "--rtol", "1e-6", "--atol", "1e-8", "-o", &file, "--json",
         ];
         let out = coin_log(dir.path(), &record);
-        let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        let expected: Vec<&str> = summary["expected_to_fail"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|c| c.as_str().unwrap())
-            .collect();
+        let (summary, expected) = record_summary(&out);
+        let expected: Vec<&str> = expected.iter().map(String::as_str).collect();
         assert!(!expected.contains(&"nutation"), "{scene}: {summary}");
         let warning = String::from_utf8_lossy(&out.stderr);
         assert!(!warning.contains("`nutation`"), "{scene}: {warning}");
-        let verify = coin_log(dir.path(), &["verify", &file, "--json"]);
-        let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
-        for c in report["files"][0]["checks"].as_array().unwrap() {
+        for c in &verify_checks(dir.path(), &file) {
             let id = c["id"].as_str().unwrap();
             match c["status"].as_str().unwrap() {
                 "skip" => assert!(
@@ -548,16 +556,10 @@ fn an_undersampled_run_is_not_promised_to_fail_the_nutation_it_skips() {
         "--json",
     ];
     let out = coin_log(dir.path(), &record);
-    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let expected = &summary["expected_to_fail"];
-    assert!(
-        !expected.as_array().unwrap().iter().any(|c| c == "nutation"),
-        "{summary}"
-    );
-    let verify = coin_log(dir.path(), &["verify", "u.mcap", "--json"]);
-    let report: serde_json::Value = serde_json::from_slice(&verify.stdout).unwrap();
-    let checks = report["files"][0]["checks"].as_array().unwrap();
-    let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
+    let (summary, expected) = record_summary(&out);
+    assert!(!expected.iter().any(|c| c == "nutation"), "{summary}");
+    let checks = verify_checks(dir.path(), "u.mcap");
+    let nutation = check(&checks, "nutation");
     assert_eq!(nutation["status"], "skip", "{nutation}");
     assert!(
         nutation["reason"]

@@ -325,8 +325,8 @@ impl Folder {
 
     /// Refuses, before any run, a folder in which `shard`'s catalogue (or part) and `sweep.json` could
     /// not be moved into place, each refused as its write would refuse it (not a regular file, no
-    /// temporary file beside it) or by [`refuse_attribute`], and the folder by the latter: found at the end, the work was done for
-    /// nothing, and a catalogue could be written without its `sweep.json`.
+    /// temporary file beside it) or by [`refuse_attribute`], and the folder by the latter: found at the
+    /// end, the work was done for nothing, and a catalogue could be written without its `sweep.json`.
     pub fn check_outputs(&self, shard: Shard) -> Result<(), SweepError> {
         refuse_attribute(&self.path, &self.path)?;
         for name in outputs(shard) {
