@@ -160,6 +160,14 @@ struct Job {
     result: io::Result<()>,
 }
 
+impl Job {
+    /// The records' CRC-32 and them compressed: a worker's part, or the writer's without one.
+    fn compress(&mut self, compressor: &mut ChunkCompressor) {
+        self.crc = crc32fast::hash(&self.records);
+        self.result = compressor.compress(&self.records, &mut self.compressed);
+    }
+}
+
 struct Worker {
     jobs: Sender<Job>,
     done: Receiver<Job>,
@@ -221,8 +229,7 @@ impl Drop for Workers {
 fn compress_chunks(compression: Compression, jobs: &Receiver<Job>, done: &Sender<Job>) {
     let mut compressor = ChunkCompressor::new(compression);
     while let Ok(mut job) = jobs.recv() {
-        job.crc = crc32fast::hash(&job.records);
-        job.result = compressor.compress(&job.records, &mut job.compressed);
+        job.compress(&mut compressor);
         if done.send(job).is_err() {
             break;
         }
@@ -615,8 +622,7 @@ impl<W: Write> McapWriter<W> {
             });
         }
         if self.workers.len() == 0 {
-            job.crc = crc32fast::hash(&job.records);
-            job.result = self.compressor.compress(&job.records, &mut job.compressed);
+            job.compress(&mut self.compressor);
             return self.written(job);
         }
         let worker = &self.workers.0[self.dispatched % self.workers.len()];
