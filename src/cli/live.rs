@@ -77,8 +77,7 @@ fn parse_speed(s: &str) -> Result<f64, String> {
 
 fn parse_host(s: &str) -> Result<IpAddr, String> {
     let use_instead =
-        "use 127.0.0.1 (this machine only), 0.0.0.0 (every interface) or one interface's \
-                       address";
+        "use 127.0.0.1 (this machine only), 0.0.0.0 (every interface) or one interface's address";
     let host: IpAddr = s
         .trim()
         .parse()

@@ -59,8 +59,9 @@ pub fn svg_page(
 
 /// `svg` with U+FFFE, U+FFFF (which XML 1.0 does not allow in a document) and the control characters
 /// other than tab, LF and CR (C0 ones it does not allow, C1 ones it discourages) escaped as
-/// [`crate::files::escaped`] writes a control character (`\u{fffe}`): plotters escapes `<`, `&` and quotes but writes text as given, and a scene's description
-/// (which `record` accepts with U+FFFE) made the SVG not well-formed.
+/// [`crate::files::escaped`] writes a control character (`\u{fffe}`): plotters escapes `<`, `&` and
+/// quotes but writes text as given, and a scene's description (which `record` accepts with U+FFFE) made
+/// the SVG not well-formed.
 fn xml_chars(svg: String) -> String {
     let bad = |c: char| {
         matches!(c, '\u{fffe}' | '\u{ffff}') || (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
