@@ -316,7 +316,7 @@ fn sweep_json_holds_the_resolved_sweep_and_the_counts() {
     );
     assert_eq!(
         s["random"],
-        serde_json::json!({"seed": 11, "count": 2, "draws": [{"key": "body.thickness", "choice": [0.04, 0.06]}]})
+        serde_json::json!({"generator": 2, "seed": 11, "count": 2, "draws": [{"key": "body.thickness", "choice": [0.04, 0.06]}]})
     );
     assert_eq!(
         s["output"],
@@ -1286,6 +1286,30 @@ fn a_folder_with_other_content_or_another_sweep_is_refused_naming_the_fix() {
         &format!("# the same sweep\n{SMALL}"),
     );
     let (code, json) = sweep_json(dir.path(), "same.toml", "out", &[]);
+    assert_eq!((code, json["done"].as_u64()), (0, Some(0)), "{json}");
+}
+
+/// A folder whose draws came from generator 1 (its plan names no generator: made before generator 2 mixed
+/// the seed first) is refused, not resumed with other values; the same plan naming generator 2 resumes.
+#[test]
+fn a_folder_of_another_generator_is_refused_not_resumed_with_other_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sweep(dir.path(), "s.toml", SMALL);
+    assert_eq!(sweep_json(dir.path(), "s.toml", "out", &[]).0, 0);
+    let plan_path = dir.path().join("out/.coin-log-sweep/plan.json");
+    let plan = std::fs::read_to_string(&plan_path).unwrap();
+    let old = plan.replace("\"generator\":2,", "");
+    assert_ne!(old, plan, "the plan names its generator: {plan}");
+    std::fs::write(&plan_path, &old).unwrap();
+    let (code, _, err) = run_in(dir.path(), &["sweep", "s.toml", "-o", "out"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("holds a sweep whose random draws come from generator 1, and this coin-log draws with generator 2")
+            && err.contains("finish it with the coin-log that started it, or start over in a new folder"),
+        "{err}"
+    );
+    std::fs::write(&plan_path, plan).unwrap();
+    let (code, json) = sweep_json(dir.path(), "s.toml", "out", &[]);
     assert_eq!((code, json["done"].as_u64()), (0, Some(0)), "{json}");
 }
 

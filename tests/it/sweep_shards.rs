@@ -186,7 +186,8 @@ fn the_example_job_scripts_advice_for_a_failed_task_makes_collect_pass() {
 #[test]
 fn shards_whose_runs_fail_for_their_values_fail_every_time_and_collect_is_run_by_hand() {
     let dir = tempfile::tempdir().unwrap();
-    let bad = SMALL.replace("choice = [0.04, 0.06]", "choice = [0.04, -0.06]");
+    // Every draw fails (a negative thickness), so that each shard has failed runs whatever the draws.
+    let bad = SMALL.replace("choice = [0.04, 0.06]", "choice = [-0.04, -0.06]");
     write_sweep(dir.path(), "s.toml", &bad);
     for _ in 0..2 {
         for k in 0..2 {

@@ -4,7 +4,7 @@
 use super::catalogue::cell;
 use super::error::SweepError;
 use super::file::SweepFile;
-use super::random::{Distribution, Drawn, OutOfBounds};
+use super::random::{Distribution, Drawn, OutOfBounds, GENERATOR};
 use super::validate;
 use crate::files::{self, InputKind};
 use crate::format::Encoding;
@@ -183,7 +183,7 @@ impl Sweep {
     /// The sweep a folder's plan describes (its `sweep` object, [`description_json`](Self::description_json),
     /// read back as a sweep file whose base is the plan's resolved base scene), so that `collect` knows
     /// each run's values; `None` when the plan does not give back a sweep of the plan's identity (a
-    /// value JSON cannot hold, such as NaN, which it writes as null).
+    /// value JSON cannot hold, such as NaN, which it writes as null) or draws with another generator.
     pub(super) fn from_plan(plan: &serde_json::Value) -> Option<Self> {
         let mut described = plan.get("sweep")?.clone();
         let object = described.as_object_mut()?;
@@ -192,6 +192,8 @@ impl Sweep {
         let axes = object.remove("axes")?;
         object.insert("axis".into(), axes);
         if let Some(random) = object.get_mut("random").and_then(|r| r.as_object_mut()) {
+            // Draws of another generator are not this one's (a sweep file has no such key).
+            (random.remove("generator")? == GENERATOR).then_some(())?;
             let draws = random.remove("draws")?;
             random.insert("draw".into(), draws);
         }
@@ -257,7 +259,7 @@ impl Sweep {
         };
         let random = self.random.as_ref().map(|r| {
             let draws: Vec<_> = r.draws.iter().map(draw).collect();
-            serde_json::json!({"seed": r.seed, "count": r.count, "draws": draws})
+            serde_json::json!({"generator": GENERATOR, "seed": r.seed, "count": r.count, "draws": draws})
         });
         let set: BTreeMap<&str, &toml::Value> =
             self.set.iter().map(|(k, v)| (k.as_str(), v)).collect();
@@ -346,13 +348,21 @@ verify = false
             other["identity"] = "0".repeat(64).into();
             assert_eq!(Sweep::from_plan(&other), None);
         }
+        // A plan of generator 1's draws (no generator named) gives no sweep of this generator's.
+        let mut old =
+            serde_json::json!({"identity": full.identity(), "sweep": full.description_json()});
+        old["sweep"]["random"]
+            .as_object_mut()
+            .unwrap()
+            .remove("generator");
+        assert_eq!(Sweep::from_plan(&old), None);
         let nan =
             parse("base = \"wobble\"\n[[axis]]\nkey = \"initial.theta\"\nvalues = [nan, 0.5]");
         let plan = serde_json::json!({"identity": nan.identity(), "sweep": nan.description_json()});
         assert_eq!(Sweep::from_plan(&plan), None);
         assert_eq!(
             full.identity(),
-            "e01b1e4c1a5af169210be07931b946d2c4c1dbbfdcf467140ef95d4fc2a68346"
+            "158dca438908767017ae46cec088c76e674fa32a2b3e8dd3ab489895c0754ddc"
         );
         assert_eq!(
             bare.identity(),

@@ -5,6 +5,7 @@
 use super::catalogue;
 use super::definition::Sweep;
 use super::error::SweepError;
+use super::random;
 use super::shard::Shard;
 use crate::csv;
 use crate::files;
@@ -596,6 +597,16 @@ fn check_same(
 ) -> Result<(), SweepError> {
     let error = |reason| Err(SweepError::folder(folder)(reason));
     let text = |v: &serde_json::Value, key: &str| v[key].as_str().unwrap_or_default().to_string();
+    // A plan written before the generator was named drew with generator 1.
+    let random = &held["sweep"]["random"];
+    let generator = random["generator"].as_u64().unwrap_or(1);
+    if random.is_object() && plan["sweep"]["random"].is_object() && generator != random::GENERATOR {
+        return error(format!(
+            "holds a sweep whose random draws come from generator {generator}, and this coin-log draws with \
+             generator {} (format.md: Random draws): its remaining runs would get other values; finish it \
+             with the coin-log that started it, or start over in a new folder",
+            random::GENERATOR));
+    }
     if text(held, "identity") != text(plan, "identity") {
         return error(format!(
             "holds another sweep (identity {}, this one {}): its sweep file, its base scene or its settings \

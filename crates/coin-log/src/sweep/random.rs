@@ -1,8 +1,15 @@
 //! The random draws of a sweep: a counter-based generator from splitmix64, so that a run's values depend
 //! only on the seed, the run's index and the draw's index. Its numbers are part of the contract, written
 //! out here (not taken from a crate) as format.md defines them (Sweep files, Random draws, to the bit).
+//!
+//! Generator 2 mixes the seed before the run's index is added: generator 1 added them, so that seeds s
+//! and s + k drew the same values k runs apart. A sweep's description names its generator, and a folder
+//! of another generator is refused rather than resumed with other draws.
 
 use crate::format::metadata::number_string;
+
+/// The generator [`word`] implements, named in a sweep's description (format.md: sweep.json).
+pub const GENERATOR: u64 = 2;
 
 /// splitmix64's increment, ⌊2⁶⁴/φ⌋.
 const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -25,7 +32,7 @@ fn step(h: u64, x: u64) -> u64 {
 /// The `n`-th random word of draw `draw` of run `run`.
 #[must_use]
 pub fn word(seed: u64, run: u64, draw: u64, n: u64) -> u64 {
-    step(step(step(seed, run), draw), n)
+    step(step(step(step(0, seed), run), draw), n)
 }
 
 /// A word as a uniform number in [0, 1): its top 53 bits times 2⁻⁵³.
@@ -126,35 +133,31 @@ mod tests {
             "splitmix64(0)'s first output"
         );
         let cases = [
-            (
-                (0, 0, 0, 0),
-                0x2382_75bc_38fc_be91,
-                0.138_709_410_145_554_27,
-            ),
+            ((0, 0, 0, 0), 0x2130_748a_aac8_0268, 0.129_645_618_299_747_4),
             (
                 (42, 0, 0, 0),
-                0x6310_bf04_d820_7f46,
-                0.386_974_276_240_040_9,
+                0xc161_29ec_d0dc_5b93,
+                0.755_388_851_467_487_9,
             ),
             (
                 (42, 1, 0, 0),
-                0x9bb6_c981_ed5e_f223,
-                0.608_257_860_394_015_4,
+                0x15f4_1633_3358_1662,
+                0.085_755_717_754_494_98,
             ),
             (
                 (42, 0, 1, 0),
-                0x2ce0_2c4e_e4d2_ea09,
-                0.175_295_609_723_274_4,
+                0x79ac_3b16_dbc3_b641,
+                0.475_284_283_714_940_47,
             ),
             (
                 (42, 0, 0, 1),
-                0xb682_ee25_ce24_109e,
-                0.712_935_337_285_799_4,
+                0x6bd1_8687_32f4_640c,
+                0.421_165_855_414_942_2,
             ),
             (
                 ((1 << 63) - 1, 999, 3, 7),
-                0xb103_0064_3a16_ce5a,
-                0.691_452_049_703_083_5,
+                0x4988_aa24_143a_7af2,
+                0.287_241_586_502_412_6,
             ),
         ];
         for ((seed, run, draw, n), expected, u) in cases {
@@ -162,6 +165,18 @@ mod tests {
             assert_eq!(w, expected, "word({seed}, {run}, {draw}, {n}) = {w:#x}");
             assert_eq!(unit(w).to_bits(), f64::to_bits(u), "unit of {w:#x}");
         }
+    }
+
+    /// Neighbouring seeds draw apart: generator 1 (seed and run index added before mixing) gave seeds 1 and
+    /// 2 the same draws one run apart, 1999 of 2000 (the control); generator 2 shares none.
+    #[test]
+    fn neighbouring_seeds_share_no_draws() {
+        let shared = |word: &dyn Fn(u64, u64) -> u64| {
+            let one: std::collections::HashSet<u64> = (0..2000).map(|i| word(1, i)).collect();
+            (0..2000).filter(|&i| one.contains(&word(2, i))).count()
+        };
+        assert_eq!(shared(&|seed, run| step(step(step(seed, run), 0), 0)), 1999);
+        assert_eq!(shared(&|seed, run| word(seed, run, 0, 0)), 0);
     }
 
     #[test]
