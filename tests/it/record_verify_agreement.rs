@@ -536,6 +536,39 @@ fn a_run_that_lands_flat_is_not_promised_to_fail_the_nutation_it_skips() {
     }
 }
 
+/// Verify skips `nutation` when the integrator's error in ω times its turning points worse than 1e-6 of T
+/// (a nutation of 0.3 in ω_X at rtol 1e-5): `wobble --rtol 1e-5 --atol 1e-7` was promised to fail it all
+/// the same. The summary and the metadata, which know max|ω_X| after the run, now leave it out.
+#[test]
+fn a_nutation_too_small_to_time_is_not_promised_to_fail() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = [
+        "record", "wobble", "--rtol", "1e-5", "--atol", "1e-7", "-o", "w.mcap", "--json",
+    ];
+    let out = coin_log(dir.path(), &record);
+    let (summary, expected) = record_summary(&out);
+    assert!(!expected.iter().any(|c| c == "nutation"), "{summary}");
+    let checks = verify_checks(dir.path(), "w.mcap");
+    let nutation = checks.iter().find(|c| c["id"] == "nutation").unwrap();
+    assert_eq!(nutation["status"], "skip", "{nutation}");
+    assert!(
+        nutation["reason"]
+            .as_str()
+            .unwrap()
+            .contains("too small for the recorded accuracy"),
+        "{nutation}"
+    );
+    for c in &checks {
+        let id = c["id"].as_str().unwrap();
+        let named = expected.iter().any(|e| e == id);
+        match c["status"].as_str().unwrap() {
+            "skip" => assert!(!named, "{id} is named, and skipped"),
+            "fail" => assert!(named, "{id} fails, and was not named"),
+            _ => {}
+        }
+    }
+}
+
 /// Verify skips `nutation` with fewer than 8 samples a period ("undersampled"): `wobble` (T = 2.75) for
 /// 10⁴ time units at 2 samples a unit was promised to fail it all the same (its drift over the long run
 /// is above the nutation tolerance).

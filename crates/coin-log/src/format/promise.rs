@@ -32,6 +32,30 @@ pub const NUTATION_SHARE: f64 = 1.0;
 /// promised a pass against 1.5e-6; `wobble` at 1e-6 (dopri5) 0.011; 10 000 time units at 1e-10 (dopri5)
 /// 0.0042. The largest, doubled.
 pub const NUTATION_GROWTH: f64 = 0.02;
+/// Largest timing bound ([`nutation_timing`]) verify's `nutation` accepts: the ceiling of every default
+/// tolerance (format.md: Tolerances). Above it the nutation is too small for the recorded accuracy to time,
+/// and verify skips the check.
+pub const MAX_NUTATION_TIMING: f64 = 1e-6;
+
+/// The error in ω a run integrated to ε over `span` reaches: [`GROWTH_SHARE`] ε (1 + T/τ) W, W =
+/// max(max|ω|, 1/τ) the state's scale (the share `record` predicts for the drifts).
+#[must_use]
+pub fn omega_error(epsilon: f64, span: f64, time_unit: f64, max_omega: f64) -> f64 {
+    let growth = 1.0 + span.max(0.0) / time_unit;
+    GROWTH_SHARE * epsilon * growth * max_omega.max(1.0 / time_unit)
+}
+
+/// Relative error of T and ΔΦ from the timing of the turning points: ω_X off by `omega_error` moves a
+/// zero of ω_X by omega_error / |ω̇_X|, |ω̇_X| = A σ at a zero of a nutation of amplitude A = max|ω_X| and
+/// frequency σ = 2π/T; the first and last turning points of a span each move so, 2 of them over `span`.
+/// Measured on `circle-plus` kicked by δω_X = 1e-5 … 1.5e-8 (dop853 and dopri5, defaults): the error is
+/// 1/65 … 1/3 of this bound, and 2.6e-8 … 1.2e-4 against the 1e-8 of the nutation tolerance alone.
+#[must_use]
+pub fn nutation_timing(omega_error: f64, max_omega_x: f64, period: f64, span: f64) -> f64 {
+    let sigma = std::f64::consts::TAU / period;
+    2.0 * omega_error / (max_omega_x * sigma * span)
+}
+
 /// Rounding per fixed step, in units of 2⁻⁵³: each step's increment h·f is rounded into y, with a bias
 /// once h·f is far below y's last digits. Measured on `wobble` with rk4 over 0.01 time units: 1e7 steps
 /// drift 2.2e-14 in C1, C2 (2e-5 a step), 1e8 steps 8.9e-12 (8e-4 a step); 5e-4 puts them on either side of

@@ -222,6 +222,8 @@ struct Drift {
     steady_residual: f64,
     /// max|ω| over the samples (for the tolerance `verify` will derive).
     max_omega: f64,
+    /// max|ω_X| over the samples: the nutation's amplitude, which `verify`'s timing bound divides by.
+    max_omega_x: f64,
 }
 
 impl Drift {
@@ -245,6 +247,7 @@ impl Drift {
             time_unit: params.time_unit(),
             steady_residual: 0.0,
             max_omega: 0.0,
+            max_omega_x: 0.0,
         }
     }
 }
@@ -422,6 +425,7 @@ impl<W: Write + Seek, T: Tap> Sampler<'_, W, T> {
         d.energy.observe(t, total);
         let omega = magnitude(s.omega_x, s.omega_y, s.omega_z);
         d.max_omega = d.max_omega.max(omega);
+        d.max_omega_x = d.max_omega_x.max(s.omega_x.abs());
         d.last_theta = s.theta;
         // With dissipation C1, C2 are not conserved (physics §11): their change is no drift.
         if let (Some((c1, c2)), None) = (invariants, self.dynamics.dissipation()) {
@@ -487,7 +491,7 @@ pub fn record_with_tap<W: Write + Seek, T: Tap>(
         sampler.drift.max_omega,
     );
     let tolerance = Tolerances::derive(&accuracy, None, None).energy;
-    let shortfalls = shortfalls(scene, &accuracy);
+    let shortfalls = shortfalls(scene, &accuracy, Some(sampler.drift.max_omega_x));
     let doubt = departure_doubt(&scene.coin(), &scene.initial).filter(|_| termination.is_event());
     sampler.finish(
         outcome.stats,
@@ -507,7 +511,7 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
     let omega = crate::model::magnitude(s.omega_x, s.omega_y, s.omega_z);
     let span = scene.run.duration;
     let accuracy = RunAccuracy::new(&scene.run.method, &scene.params, span, omega);
-    shortfalls(scene, &accuracy)
+    shortfalls(scene, &accuracy, None)
 }
 
 /// [`promise::shortfalls`] of a recording of `scene` integrated as `accuracy`, naming only checks verify
@@ -517,7 +521,9 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
 /// skips it otherwise: "there is no period"). `wobble --rtol 1e-7` promised that `steady` would fail,
 /// Euler's disk, 14 000 time units long, `nutation`, `circle-plus --rtol 1e-3 --atol 1e-3` `nutation`,
 /// and `topple --rtol 1e-6 --atol 1e-8`, which lands flat, `nutation`, all of which verify skipped.
-fn shortfalls(scene: &Scene, accuracy: &RunAccuracy) -> Vec<Shortfall> {
+/// After the run, `max_omega_x` (max|ω_X| over the samples) also leaves out a `nutation` that verify will
+/// skip as too small to time (`wobble --rtol 1e-5 --atol 1e-7`: 5.5e-6 of T, above 1e-6).
+fn shortfalls(scene: &Scene, accuracy: &RunAccuracy, max_omega_x: Option<f64>) -> Vec<Shortfall> {
     let mut shortfalls = promise::shortfalls(
         accuracy,
         fixed_steps(scene, accuracy.span),
@@ -525,7 +531,7 @@ fn shortfalls(scene: &Scene, accuracy: &RunAccuracy) -> Vec<Shortfall> {
     );
     let dissipative = scene.dissipation.is_some();
     let steady = scene.unperturbed_steady().is_some();
-    let nutates = || nutates(scene);
+    let nutates = || nutates(scene, accuracy, max_omega_x);
     let runs = |check: &str| match check {
         "steady" => steady,
         "invariants" => !dissipative,
@@ -545,18 +551,30 @@ fn shortfalls(scene: &Scene, accuracy: &RunAccuracy) -> Vec<Shortfall> {
 /// resolve, as verify's `nutation` check computes it from the first stored state: a coin that lands flat
 /// (or a state with no orbit) has none, and fewer than [`MIN_SAMPLES_PER_PERIOD`] samples a period are
 /// "undersampled"; verify skips the check either way. (A period within 1e-9 of the sampling limit still
-/// counts as resolved, so rounding of the stored times cannot make verify run a check not named.)
-fn nutates(scene: &Scene) -> bool {
+/// counts as resolved, so rounding of the stored times cannot make verify run a check not named.) With
+/// `max_omega_x` known, a nutation whose timing bound exceeds the one verify accepts does not count: the
+/// bound here takes the run's whole span, which is at least the span verify measures between turning
+/// points, so it is at most verify's, and a nutation left out here is one verify skips.
+fn nutates(scene: &Scene, accuracy: &RunAccuracy, max_omega_x: Option<f64>) -> bool {
     let coin = scene.coin();
     let resolved =
         |period: f64| period >= MIN_SAMPLES_PER_PERIOD * scene.run.sample_interval() * (1.0 - 1e-9);
+    let timed = |period: f64| {
+        max_omega_x.is_none_or(|amplitude| {
+            let a = accuracy;
+            let epsilon = Tolerances::derive(a, None, None).epsilon;
+            let error = promise::omega_error(epsilon, a.span, a.time_unit, a.max_omega);
+            promise::nutation_timing(error, amplitude, period, a.span)
+                <= promise::MAX_NUTATION_TIMING
+        })
+    };
     Chaplygin::new(coin.params())
         .ok()
         .and_then(|chaplygin| {
             Orbit::new(&coin, &chaplygin, &scene.initial, scene.run.flat_margin).ok()
         })
         .is_some_and(
-            |orbit| matches!(orbit.motion, Motion::Periodic { period, .. } if resolved(period)),
+            |orbit| matches!(orbit.motion, Motion::Periodic { period, .. } if resolved(period) && timed(period)),
         )
 }
 

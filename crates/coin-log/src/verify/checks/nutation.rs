@@ -8,12 +8,12 @@
 //!
 //! **Tolerance**: the integrator's share (format.md: verify, Tolerances) plus the quadrature's own error
 //! estimate plus the meter's bound on its interpolation error ([`TurningPoints::interpolation_error`])
-//! plus the timing bound ([`timing_error`]): the integrator keeps ω to ε of the state's scale W, not of
+//! plus the timing bound ([`nutation_timing`]): the integrator keeps ω to ε of the state's scale W, not of
 //! the nutation's own amplitude, so a small nutation's turning points are timed no better than that error
 //! over ω_X's slope there.
 
 use super::{fmt_num, worst, Context, RunStats};
-use crate::format::promise::GROWTH_SHARE;
+use crate::format::promise::{nutation_timing, omega_error, MAX_NUTATION_TIMING};
 use crate::format::tolerances::{Tolerances, MIN_SAMPLES_PER_PERIOD};
 use crate::model::nutation::{Motion, Orbit};
 use crate::model::{State, TurningPoints};
@@ -25,9 +25,6 @@ use crate::verify::samples::Sample;
 const INTERPOLATION_SHARE: f64 = 0.1;
 /// Smallest θ range worth measuring \[rad\]: below it the crossings of ω_X are the integrator's noise.
 const MIN_AMPLITUDE: f64 = 1e-8;
-/// Largest timing bound ([`timing_error`]) the check accepts: the ceiling of every default tolerance
-/// (format.md: Tolerances). Above it the nutation is too small for the recorded accuracy to time.
-const MAX_TIMING: f64 = 1e-6;
 
 #[derive(Debug, Default, Clone)]
 pub struct NutationCheck {
@@ -98,9 +95,8 @@ impl NutationCheck {
             ));
         }
         let time_unit = ctx.coin.params().time_unit();
-        let growth = 1.0 + (stats.last_t - stats.first_t.unwrap_or(0.0)).max(0.0) / time_unit;
-        let scale = stats.max_omega.max(1.0 / time_unit);
-        let omega_error = GROWTH_SHARE * tol.epsilon * growth * scale;
+        let span = stats.last_t - stats.first_t.unwrap_or(0.0);
+        let omega_error = omega_error(tol.epsilon, span, time_unit, stats.max_omega);
         self.compare(&orbit, (period, precession), tol, omega_error)
     }
 
@@ -139,10 +135,10 @@ impl NutationCheck {
                 fmt_num(tol.nutation)
             ));
         }
-        let timing = timing_error(omega_error, self.max_omega_x, period, measured.span);
-        if timing > MAX_TIMING {
+        let timing = nutation_timing(omega_error, self.max_omega_x, period, measured.span);
+        if timing > MAX_NUTATION_TIMING {
             return Err(format!(
-                "the nutation is too small for the recorded accuracy: ω_X swings by {} only, and an error of {} in ω (0.1 ε (1 + T/τ) W, what the integrator's errors reach) times its turning points to {} of T, above {MAX_TIMING:e}; record with a tighter --rtol/--atol (--step) or a larger nutation",
+                "the nutation is too small for the recorded accuracy: ω_X swings by {} only, and an error of {} in ω (0.1 ε (1 + T/τ) W, what the integrator's errors reach) times its turning points to {} of T, above {MAX_NUTATION_TIMING:e}; record with a tighter --rtol/--atol (--step) or a larger nutation",
                 fmt_num(self.max_omega_x),
                 fmt_num(omega_error),
                 fmt_num(timing)
@@ -177,19 +173,6 @@ impl NutationCheck {
             ),
         ))
     }
-}
-
-/// Relative error of T and ΔΦ from the timing of the turning points: the recorded ω_X may be off by
-/// `omega_error` = 0.1 ε (1 + T_run/τ) W (the error an integrator held to ε reaches over the run, the
-/// share [`GROWTH_SHARE`] `record` predicts for the drifts, format.md: What record promises), which
-/// moves a zero of ω_X by omega_error / |ω̇_X|, |ω̇_X| = A σ at a zero of a nutation of amplitude
-/// A = max|ω_X| and frequency σ = 2π/T; the first and last turning points of a span each move so, 2 of
-/// them over `span`.
-/// Measured on `circle-plus` kicked by δω_X = 1e-5 … 1.5e-8 (dop853 and dopri5, defaults): the error is
-/// 1/65 … 1/3 of this bound, and 2.6e-8 … 1.2e-4 against the 1e-8 of the nutation tolerance alone.
-fn timing_error(omega_error: f64, max_omega_x: f64, period: f64, span: f64) -> f64 {
-    let sigma = std::f64::consts::TAU / period;
-    2.0 * omega_error / (max_omega_x * sigma * span)
 }
 
 /// The flat margin of the stored scene (the default when the scene cannot be read).
