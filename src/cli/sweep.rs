@@ -252,6 +252,8 @@ struct Bar {
     bar: ProgressBar,
     started: Instant,
     terminal: bool,
+    /// Whether the first failed run was reported.
+    warned: std::cell::Cell<bool>,
 }
 
 impl Bar {
@@ -266,10 +268,19 @@ impl Bar {
             bar,
             started: Instant::now(),
             terminal: std::io::stderr().is_terminal(),
+            warned: std::cell::Cell::new(false),
         }
     }
 
     fn update(&self, p: &Progress) {
+        if let Some((index, why)) = &p.first_failure {
+            if !self.warned.replace(true) {
+                errln!(
+                    "warning: run {index} failed: {why}; runs like it will fail too: Ctrl-C stops the \
+                     sweep and keeps what finished, and the catalogue gives each failed run's reason"
+                );
+            }
+        }
         if self.terminal && self.bar.is_hidden() && self.started.elapsed() > PROGRESS_DELAY {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
             let _ = DRAWN_BAR.set(self.bar.clone());

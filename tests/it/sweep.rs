@@ -1100,6 +1100,23 @@ fn a_run_that_cannot_be_verified_says_why_in_its_reason() {
             && reason.contains("steady skipped: not a steady scene"),
         "{reason}"
     );
+    // Said while the sweep runs (it used to learn it only from the catalogue at the end), once; a sweep
+    // whose runs all finish says nothing of the kind.
+    let warning = "warning: run 0 failed: verify: cannot-verify: cannot verify: the required check";
+    assert_eq!(err.matches(warning).count(), 1, "{err}");
+    assert!(
+        err.contains("record at a higher --rate (at least "),
+        "{err}"
+    );
+    assert!(
+        err.contains("runs like it will fail too: Ctrl-C stops the sweep and keeps what finished"),
+        "{err}"
+    );
+    let fine = sweep.replace("\"run.rate\" = 20.0", "\"run.rate\" = 400.0");
+    write_sweep(dir.path(), "fine.toml", &fine);
+    let (code, out, err) = run_in(dir.path(), &["sweep", "fine.toml", "-o", "fine"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!err.contains("failed"), "{err}");
 }
 
 #[test]

@@ -37,7 +37,7 @@ pub struct RunOptions {
 }
 
 /// Where a sweep stands, after each run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Progress {
     /// This shard's runs.
     pub runs: u64,
@@ -47,6 +47,9 @@ pub struct Progress {
     pub done: u64,
     /// Rows of this shard that are failed, so far (kept and new).
     pub failed: u64,
+    /// The first run this invocation saw fail: its index and its row's reason, led by the `failure` kind,
+    /// so that a front end can say so while the runs like it are still ahead.
+    pub first_failure: Option<(u64, String)>,
 }
 
 /// How a sweep invocation ended.
@@ -132,6 +135,7 @@ pub fn run(
             todo: runs - kept.len() as u64,
             done: 0,
             failed: resumed.failed,
+            first_failure: None,
         },
         record_seconds: 0.0,
         verify_seconds: 0.0,
@@ -178,7 +182,16 @@ impl Tally {
         self.record_seconds += done.spent.record_seconds;
         self.verify_seconds += done.spent.verify_seconds;
         self.progress.done += 1;
-        self.progress.failed += u64::from(done.row.status == RunStatus::Failed);
+        let row = &done.row;
+        if let (Some(failure), None) = (row.failure, &self.progress.first_failure) {
+            let why = if row.reason.starts_with(failure.name()) {
+                row.reason.clone()
+            } else {
+                format!("{}: {}", failure.name(), row.reason)
+            };
+            self.progress.first_failure = Some((row.index, why));
+        }
+        self.progress.failed += u64::from(row.status == RunStatus::Failed);
         self.held.insert(done.row.index, line);
     }
 
