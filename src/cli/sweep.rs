@@ -275,10 +275,11 @@ impl Bar {
     fn update(&self, p: &Progress) {
         if let Some((index, why)) = &p.first_failure {
             if !self.warned.replace(true) {
-                errln!(
+                // Above the bar, not through it.
+                self.bar.suspend(|| errln!(
                     "warning: run {index} failed: {why}; runs like it will fail too: Ctrl-C stops the \
                      sweep and keeps what finished, and the catalogue gives each failed run's reason"
-                );
+                ));
             }
         }
         if self.terminal && self.bar.is_hidden() && self.started.elapsed() > PROGRESS_DELAY {
