@@ -261,11 +261,10 @@ impl Judge {
         judged
     }
 
-    /// Judges the samples again in log-time order, after the stream handed some out before all their
-    /// channels had arrived (the file's writer put its channels far apart, e.g. all of one channel, then
-    /// the next): the messages of the file's chunks through its chunk indexes, parsed as before, into a
-    /// fresh assembler and fresh checks. The stream's structural findings stand. When the file cannot be
-    /// read so, the stream's judgement stays and a note says how many samples it judged in pieces.
+    /// Judges the samples again in log-time order (format.md: verify) after the stream cut some: the
+    /// messages of the file's chunks through its chunk indexes, parsed as before, into a fresh assembler
+    /// and fresh checks; the stream's structural findings stand. A file that cannot be read so keeps the
+    /// stream's judgement, and a note says how many samples it judged in pieces.
     fn reorder(&mut self, structure: &Structure, source: impl Read + Seek) {
         let Some(ctx) = self.ctx.as_ref() else {
             return;

@@ -11,7 +11,6 @@ use crate::model::energy;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
-/// Running state of the energy check.
 #[derive(Debug, Default, Clone)]
 pub struct EnergyCheck {
     drift: Option<EnergyDrift>,
@@ -25,7 +24,6 @@ pub struct EnergyCheck {
 }
 
 impl EnergyCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Some(state) = s.state() else { return };
         let e = energy(&ctx.coin, &state);
@@ -60,7 +58,6 @@ impl EnergyCheck {
         }
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, tol: &Tolerances, ctx: &Context) -> CheckResult {
         let Some(energy_drift) = self.drift else {

@@ -7,7 +7,6 @@ use crate::model::drift::InvariantDrift;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
-/// Running state of the invariants check.
 #[derive(Debug, Default, Clone)]
 pub struct InvariantsCheck {
     drift: Option<InvariantDrift>,
