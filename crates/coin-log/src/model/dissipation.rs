@@ -125,25 +125,15 @@ impl Dissipation {
         })
     }
 
-    /// The model.
-    #[must_use]
-    pub fn model(&self) -> DissipationModel {
-        self.model
-    }
-    /// κ [energy·time^(1−m)], the scene's `coefficient`.
-    #[must_use]
-    pub fn coefficient(&self) -> f64 {
-        self.coefficient
-    }
-    /// m, the exponent of |φ̇|.
-    #[must_use]
-    pub fn m(&self) -> f64 {
-        self.m
-    }
-    /// k, the exponent of 1/sin α.
-    #[must_use]
-    pub fn k(&self) -> f64 {
-        self.k
+    getters! {
+        /// The model.
+        model: DissipationModel,
+        /// κ [energy·time^(1−m)], the scene's `coefficient`.
+        coefficient: f64,
+        /// m, the exponent of |φ̇|.
+        m: f64,
+        /// k, the exponent of 1/sin α.
+        k: f64,
     }
 
     /// p = −m/2 − k: along the centre-fixed family P ∝ (sin α)^p (physics §11, eq (36)).
