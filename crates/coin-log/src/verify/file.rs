@@ -344,57 +344,49 @@ impl Judge {
             });
         }
         let stats = &self.checks.stats;
-        let interval = 1.0 / ctx.run.rate;
-        match ctx
+        let (last, interval) = (stats.last_t, 1.0 / ctx.run.rate);
+        let judged = read_whole && stats.samples > 0;
+        let says = "the `coin-log.result` metadata says termination_time =";
+        let problem = match ctx
             .result
             .as_ref()
             .map(|r| (r.termination_time, r.termination))
         {
-            Some((t, _)) if !t.is_finite() || t < 0.0 => self.problems.push_with(|| {
-                format!(
-                    "the `coin-log.result` metadata says termination_time = {t}, not a finite time \
-                     ≥ 0"
-                )
+            None => read_whole.then(|| {
+                "no `coin-log.result` metadata record (the run did not finish writing)".to_string()
             }),
+            Some((t, _)) if !t.is_finite() || t < 0.0 => {
+                Some(format!("{says} {t}, not a finite time ≥ 0"))
+            }
             // A run that completed or ended at an event ends at its last sample (`record` writes one
             // there); one that failed or was stopped, before the next grid point (format.md:
             // `coin-log.result`); only a file read whole shows its last sample.
             Some((t, termination))
-                if (termination == Termination::Completed || termination.is_event())
-                    && read_whole
-                    && stats.samples > 0 =>
+                if (termination == Termination::Completed || termination.is_event()) && judged =>
             {
                 // Rounding of k/rate: far below 1e-12 of the time.
-                let slack = 1e-12 * stats.last_t.abs().max(f64::MIN_POSITIVE);
-                if (t - stats.last_t).abs() > slack {
-                    self.problems.push_with(|| {
-                        format!(
-                            "the `coin-log.result` metadata says termination_time = {t}, but the \
-                             last sample is at t = {}: a run whose termination is `{termination}` \
-                             ends at its last sample",
-                            stats.last_t
-                        )
-                    });
-                }
+                let slack = 1e-12 * last.abs().max(f64::MIN_POSITIVE);
+                ((t - last).abs() > slack).then(|| {
+                    format!(
+                        "{says} {t}, but the last sample is at t = {last}: a run whose termination \
+                         is `{termination}` ends at its last sample"
+                    )
+                })
             }
-            Some((t, _)) if read_whole && stats.samples > 0 && interval.is_finite() => {
+            Some((t, _)) if judged && interval.is_finite() => {
                 // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
-                let slack = 1e-12 * stats.last_t.abs().max(interval);
-                if !(stats.last_t - slack..=stats.last_t + interval + slack).contains(&t) {
-                    self.problems.push_with(|| {
-                        format!(
-                            "the `coin-log.result` metadata says termination_time = {t}, but the \
-                             last sample is at t = {}: a run ends at its last sample or, failing, \
-                             before the next, 1/rate = {interval} later",
-                            stats.last_t
-                        )
-                    });
-                }
+                let slack = 1e-12 * last.abs().max(interval);
+                (!(last - slack..=last + interval + slack).contains(&t)).then(|| {
+                    format!(
+                        "{says} {t}, but the last sample is at t = {last}: a run ends at its last \
+                         sample or, failing, before the next, 1/rate = {interval} later"
+                    )
+                })
             }
-            None if read_whole => self.problems.push_with(|| {
-                "no `coin-log.result` metadata record (the run did not finish writing)".into()
-            }),
-            _ => {}
+            Some(_) => None,
+        };
+        if let Some(p) = problem {
+            self.problems.push_with(|| p);
         }
         self.termination_alpha(ctx, read_whole);
         let mut problems = structure.problems.clone();
@@ -790,9 +782,8 @@ fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances 
     Tolerances::derive(&accuracy, options.energy_tol, options.residual_tol)
 }
 
-/// format.md: a file in which `integrity`, `energy` or both `constraint` and `steady` could not run cannot
-/// be verified, whatever else passed. Says which, or `None` when the required checks ran; the skipped
-/// checks keep their status and their reasons (which say what to record).
+/// Which of the required checks (format.md: verify) could not run, whatever else passed, or `None`; the
+/// skipped checks keep their status and their reasons (which say what to record).
 fn missing_required(results: &[CheckResult]) -> Option<String> {
     let skipped = |id: CheckId| {
         results

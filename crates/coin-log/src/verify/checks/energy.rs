@@ -97,24 +97,18 @@ impl EnergyCheck {
             ),
             _ => format!("drift max|E - E0|/max(|E0|, Mga) = {}", fmt_num(drift)),
         };
-        let missing = if self.without_work > 0 {
-            format!(
+        let mut reason = format!(
+            "{which} is the worst measure: {quantity} over {} samples (worst at t = {}, tolerance {}){stored}",
+            self.samples,
+            fmt_num(energy_drift.worst_time()),
+            fmt_num(tol.energy),
+        );
+        if self.without_work > 0 {
+            reason += &format!(
                 "; {} samples without /coin/work not judged",
                 self.without_work
-            )
-        } else {
-            String::new()
-        };
-        CheckResult::measured(
-            CheckId::Energy,
-            value,
-            tolerance,
-            format!(
-                "{which} is the worst measure: {quantity} over {} samples (worst at t = {}, tolerance {}){stored}{missing}",
-                self.samples,
-                fmt_num(energy_drift.worst_time()),
-                fmt_num(tol.energy),
-            ),
-        )
+            );
+        }
+        CheckResult::measured(CheckId::Energy, value, tolerance, reason)
     }
 }
