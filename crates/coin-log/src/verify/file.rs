@@ -123,7 +123,7 @@ struct Judge {
 }
 
 impl Judge {
-    /// Reads a message of `coin_log.*` channel `c`, logged at `log_time`, strictly into a sample of it alone.
+    /// Reads a message of `coin_log.*` channel `c` logged at `log_time` strictly into a sample of its own.
     fn parse(c: Channel, r: &FieldReader, log_time: u64, data: &[u8]) -> Result<Sample, String> {
         fn read<M: Message>(
             r: &FieldReader,
