@@ -165,9 +165,7 @@ impl Branches {
             Self::Both => Branch::ALL,
         }
     }
-}
 
-impl Branches {
     /// The names `from_str` takes, as `--branch` offers them (`plus` and `minus` are read too).
     pub const NAMES: &'static [&'static str] = &["+", "-", "both"];
 }

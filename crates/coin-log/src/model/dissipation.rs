@@ -125,25 +125,15 @@ impl Dissipation {
         })
     }
 
-    /// The model.
-    #[must_use]
-    pub fn model(&self) -> DissipationModel {
-        self.model
-    }
-    /// κ [energy·time^(1−m)], the scene's `coefficient`.
-    #[must_use]
-    pub fn coefficient(&self) -> f64 {
-        self.coefficient
-    }
-    /// m, the exponent of |φ̇|.
-    #[must_use]
-    pub fn m(&self) -> f64 {
-        self.m
-    }
-    /// k, the exponent of 1/sin α.
-    #[must_use]
-    pub fn k(&self) -> f64 {
-        self.k
+    getters! {
+        /// The model.
+        model: DissipationModel,
+        /// κ [energy·time^(1−m)], the scene's `coefficient`.
+        coefficient: f64,
+        /// m, the exponent of |φ̇|.
+        m: f64,
+        /// k, the exponent of 1/sin α.
+        k: f64,
     }
 
     /// p = −m/2 − k: along the centre-fixed family P ∝ (sin α)^p (physics §11, eq (36)).
@@ -160,15 +150,11 @@ impl Dissipation {
     }
 
     /// The dissipated power P = κ |φ̇|^m (sin α)^(−k) at lean θ and ω_Y (eq (34)), with φ̇ = ω_Y / cos θ
-    /// (eq (18)) and sin α = cos |θ| = cos θ.
-    ///
-    /// Finite wherever the rolling model is (|θ| < π/2: the run ends at the flat landing before cos θ
-    /// reaches 0) and P itself is below the largest double, and 0 when ω_Y = 0 (m ≥ 1).
-    ///
-    /// A factor may overflow where the product does not: (sin α)^(−k) of k = 400 is infinite below
-    /// α = 0.18, which made P = 0·∞ = NaN on a coin released without spin (`topple`, ended "non-finite" at
-    /// α = 0.18 with W = 0). So P is 0 when |φ̇|^m is, and a product that overflowed is taken by its
-    /// logarithm; elsewhere the product is as it always was.
+    /// (eq (18)) and sin α = cos θ: finite wherever the rolling model is (|θ| < π/2, the run ends at the flat
+    /// landing) and P is below the largest double, 0 when ω_Y = 0 (m ≥ 1). A factor may overflow where the
+    /// product does not: (sin α)^(−k) of k = 400 is infinite below α = 0.18, which made P = 0·∞ = NaN on a
+    /// coin released without spin (`topple` ended "non-finite" at α = 0.18 with W = 0). So P is 0 when
+    /// |φ̇|^m is, and a product that overflowed is taken by its logarithm; elsewhere it is as it always was.
     #[must_use]
     #[inline]
     pub fn power(&self, theta: f64, omega_y: f64) -> f64 {
@@ -271,14 +257,6 @@ impl DissipativeCoin {
         dydt[5] = rates.acceleration.z; // (33)
         dydt[WORK_INDEX] = rates.power; // (34)
     }
-
-    /// The table's reaction (physics §3) with the accelerations of eqs (31)–(33): the couple is a pure
-    /// torque, so R = M dv/dt + Mg e_y as before, but dv/dt follows the dissipative ω̇.
-    #[must_use]
-    pub fn reaction(&self, s: &State) -> Reaction {
-        let rates = self.rates(s.theta, s.omega_x, s.omega_y, s.omega_z);
-        reaction_with(&self.coin, s, rates.acceleration)
-    }
 }
 
 /// How the coin moves: conservative (eqs (14)–(19)) or with a dissipative couple (eqs (30)–(34)). The
@@ -331,12 +309,20 @@ impl Dynamics {
         }
     }
 
-    /// The table's reaction at a state (physics §3, §11).
+    /// (ω̇_X, ω̇_Y, ω̇_Z) at a state: eqs (14)–(16), or (31)–(33) with the couple.
+    #[must_use]
+    pub fn angular_acceleration(&self, s: &State) -> AngularAcceleration {
+        let (theta, wx, wy, wz) = (s.theta, s.omega_x, s.omega_y, s.omega_z);
+        match self {
+            Self::Conservative(c) => c.angular_acceleration(theta, wx, wy, wz),
+            Self::Dissipative(d) => d.rates(theta, wx, wy, wz).acceleration,
+        }
+    }
+
+    /// The table's reaction at a state (physics §3, §11): the couple is a pure torque, so R = M dv/dt +
+    /// Mg e_y as without it, but dv/dt follows the dissipative ω̇.
     #[must_use]
     pub fn reaction(&self, s: &State) -> Reaction {
-        match self {
-            Self::Conservative(c) => super::derived::reaction(c, s),
-            Self::Dissipative(d) => d.reaction(s),
-        }
+        reaction_with(self.coin(), s, self.angular_acceleration(s))
     }
 }

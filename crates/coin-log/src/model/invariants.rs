@@ -141,22 +141,17 @@ impl Chaplygin {
         Ok(chaplygin)
     }
 
-    /// μ = I_Z Ma² / (I_X (I_Z + Ma²)) (physics §6).
-    #[must_use]
-    pub fn mu(&self) -> f64 {
-        self.mu
+    getters! {
+        /// μ = I_Z Ma² / (I_X (I_Z + Ma²)) (physics §6).
+        mu: f64,
+        /// |s| where the two expansions meet (½ for μ ≤ 4): exposed so tests can probe both sides of it.
+        split_sin: f64,
     }
 
     /// k = (I_Z + Ma²)/(Ma²) (physics §6).
     #[must_use]
     pub fn k(&self) -> f64 {
         1.0 / self.inverse_k
-    }
-
-    /// |s| where the two expansions meet (½ for μ ≤ 4): exposed so tests can probe both sides of it.
-    #[must_use]
-    pub fn split_sin(&self) -> f64 {
-        self.split_sin
     }
 
     /// Number of series terms summed on each side of the split (about the cost of one evaluation).

@@ -1,6 +1,17 @@
 //! The rolling coin: parameters, state, equations of motion and derived quantities (physics §1–§6).
 //! Pure functions; no I/O and no knowledge of integrators or files.
 
+/// Getters that return a field by value: `getters! { /// Its doc. name: Type, ... }`.
+macro_rules! getters {
+    ($($(#[$attr:meta])* $name:ident: $ty:ty),* $(,)?) => {$(
+        $(#[$attr])*
+        #[must_use]
+        pub fn $name(&self) -> $ty {
+            self.$name
+        }
+    )*};
+}
+
 mod derived;
 mod dissipation;
 pub mod drift;

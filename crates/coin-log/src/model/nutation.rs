@@ -812,25 +812,20 @@ fn extreme(lo: f64, hi: f64, h: impl Fn(f64) -> f64) -> Extremum {
             h2 = h(x2);
         }
     }
-    [
+    let mut m = Extremum {
+        value: f64::NEG_INFINITY,
+        theta: lo,
+    };
+    for (value, theta) in [
         (best_value, at(best)),
         (h1, x1),
         (h2, x2),
         (h(lo), lo),
         (h(hi), hi),
-    ]
-    .into_iter()
-    .fold(
-        Extremum {
-            value: f64::NEG_INFINITY,
-            theta: lo,
-        },
-        |m, (value, theta)| {
-            if value > m.value {
-                Extremum { value, theta }
-            } else {
-                m
-            }
-        },
-    )
+    ] {
+        if value > m.value {
+            m = Extremum { value, theta };
+        }
+    }
+    m
 }

@@ -110,31 +110,19 @@ impl CoinParams {
         }
     }
 
-    /// Mass M \[mass\].
-    #[must_use]
-    pub fn mass(&self) -> f64 {
-        self.mass
+    getters! {
+        /// Mass M \[mass\].
+        mass: f64,
+        /// Radius a \[length\].
+        radius: f64,
+        /// Gravitational acceleration g [length/time²].
+        gravity: f64,
+        /// Moment of inertia about a diameter, I_X = I_Y [mass·length²].
+        inertia_x: f64,
+        /// Moment of inertia about the symmetry axis, I_Z [mass·length²].
+        inertia_z: f64,
     }
-    /// Radius a \[length\].
-    #[must_use]
-    pub fn radius(&self) -> f64 {
-        self.radius
-    }
-    /// Gravitational acceleration g [length/time²].
-    #[must_use]
-    pub fn gravity(&self) -> f64 {
-        self.gravity
-    }
-    /// Moment of inertia about a diameter, I_X = I_Y [mass·length²].
-    #[must_use]
-    pub fn inertia_x(&self) -> f64 {
-        self.inertia_x
-    }
-    /// Moment of inertia about the symmetry axis, I_Z [mass·length²].
-    #[must_use]
-    pub fn inertia_z(&self) -> f64 {
-        self.inertia_z
-    }
+
     /// M a² [mass·length²].
     #[must_use]
     pub fn ma2(&self) -> f64 {

@@ -49,12 +49,11 @@ const NOISE_FLOOR: f64 = 1e-10;
 /// Most integrand evaluations of one [`Adaptive::integrate`]; past it every panel is accepted as it is.
 const MAX_EVALUATIONS: usize = 200_000;
 
-/// Adaptive Gauss–Legendre quadrature: on each panel a 10- and a 20-point rule; a panel whose two
-/// estimates differ by more than the tolerance's share is halved. For integrands that are analytic on
-/// the panel the 20-point rule is then far more accurate than the difference says, so the difference is
-/// an error bound in practice. Halving a panel of an analytic integrand shrinks the difference by orders
-/// of magnitude; where it does not shrink by at least `NOISE_RATIO`, the difference is the integrand's
-/// rounding noise, which no further halving removes, and the panel is accepted.
+/// Adaptive Gauss–Legendre quadrature: a panel whose 10- and 20-point rules differ by more than the
+/// tolerance's share is halved. On an analytic integrand the 20-point rule is then far more accurate than
+/// the difference, an error bound in practice, and halving shrinks the difference by orders of magnitude;
+/// where it does not shrink by at least `NOISE_RATIO`, the difference is the integrand's rounding noise,
+/// which no further halving removes, and the panel is accepted.
 #[derive(Debug, Clone)]
 pub(super) struct Adaptive {
     coarse: Vec<(f64, f64)>,

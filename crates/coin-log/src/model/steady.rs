@@ -164,24 +164,17 @@ pub fn steady_omega_y(coin: &Coin, theta: f64, omega_z: f64, branch: Branch) -> 
 }
 
 fn check_finite(kind: &'static str, name: &'static str, value: f64) -> Result<(), SteadyError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(SteadyError::NotFinite { kind, name, value })
-    }
+    let error = SteadyError::NotFinite { kind, name, value };
+    value.is_finite().then_some(()).ok_or(error)
 }
 
 fn check_lean(kind: &'static str, theta: f64) -> Result<(), SteadyError> {
     let ok = theta.is_finite() && theta != 0.0 && theta.abs() < std::f64::consts::FRAC_PI_2;
-    if ok {
-        Ok(())
-    } else {
-        Err(SteadyError::Theta {
-            kind,
-            theta,
-            range: "0 < |theta| < pi/2 (a leaning coin; use `straight` for theta = 0)",
-        })
-    }
+    ok.then_some(()).ok_or(SteadyError::Theta {
+        kind,
+        theta,
+        range: "0 < |theta| < pi/2 (a leaning coin; use `straight` for theta = 0)",
+    })
 }
 
 impl Steady {
@@ -211,15 +204,8 @@ impl Steady {
             SteadyKind::CentreFixed { theta, branch } => {
                 check_lean(name, theta)?;
                 let magnitude = (p.energy_scale() * theta.cos() / p.inertia_x()).sqrt();
-                (
-                    theta,
-                    if branch == Branch::Plus {
-                        magnitude
-                    } else {
-                        -magnitude
-                    },
-                    0.0,
-                )
+                let sign = if branch == Branch::Plus { 1.0 } else { -1.0 };
+                (theta, sign * magnitude, 0.0)
             }
             SteadyKind::Circle {
                 theta,

@@ -1,18 +1,14 @@
-//! The nutation of a motion measured from its samples: the turning points of θ, and from them the period
-//! T and the heading advance per period ΔΦ. A pure function of the samples, so that verify's `nutation`
-//! check (stored samples) and the benchmarks (simulated ones) measure alike.
+//! The nutation of a motion measured from its samples, streaming with O(1) state, alike for verify's
+//! `nutation` check (stored samples) and the benchmarks (simulated ones): θ's turning points are where
+//! ω_X = θ̇ changes sign between two samples, at the root of the quintic Hermite interpolant of ω_X with
+//! ω̇_X from eq (14) and ω̈_X = A ω_X + B ω̇_Y + C ω̇_Z (A, B, C its partial derivatives, physics §9: exact,
+//! as eq (14) has no ω_X), φ there by that of φ with φ̇ = ω_Y / cos θ, φ̈ = (ω̇_Y + ω_X ω_Y tan θ)/cos θ.
+//! T and ΔΦ are the mean spacing of like turning points.
 //!
-//! **Measurement**, streaming with O(1) state: the turning points of θ are where ω_X = θ̇ changes sign
-//! between two samples; the crossing time is the root of the quintic Hermite interpolant of ω_X with its
-//! first two derivatives (ω̇_X from eq (14), ω̈_X = A ω_X + B ω̇_Y + C ω̇_Z with A, B, C the partial
-//! derivatives of eq (14), physics §9: exact, since eq (14) does not contain ω_X), and φ there the quintic
-//! Hermite interpolant of φ with φ̇ = ω_Y / cos θ and φ̈ = (ω̇_Y + ω_X ω_Y tan θ)/cos θ.
-//!
-//! **Accuracy**: the quintic Hermite interpolant errs by h⁶/46080·max|ω_X⁽⁶⁾| for samples h apart, with
-//! ω_X⁽⁶⁾ ≈ σ⁶ max|ω_X| for the nutation frequency σ, over a slope σ max|ω_X|: each turning point is off
-//! by about h⁶σ⁵/46080 in time ([`TurningPoints::interpolation_error`]). With the cubic Hermite
-//! interpolant (h⁴σ³/384) the 1 kHz `high-spin` and the 10 Hz `long-horizon` recordings were too coarse to
-//! judge at 1e-8; with the quintic their bounds are 2e-13 and 3e-11.
+//! **Accuracy**: the interpolant errs by h⁶/46080·max|ω_X⁽⁶⁾| for samples h apart, ω_X⁽⁶⁾ ≈ σ⁶ max|ω_X|,
+//! over a slope σ max|ω_X|: h⁶σ⁵/46080 in time ([`TurningPoints::interpolation_error`]). With the cubic
+//! Hermite interpolant (h⁴σ³/384) the 1 kHz `high-spin` and the 10 Hz `long-horizon` recordings were too
+//! coarse to judge at 1e-8; with the quintic their bounds are 2e-13 and 3e-11.
 
 use super::equations::Coin;
 use super::stability::Linearisation;

@@ -1,20 +1,16 @@
 //! What `verify` will be able to judge in a recording of a scene, predicted before anything is recorded:
 //! the required checks (`energy`, and `constraint` or `steady`; format.md: verify) that will not run, why,
-//! and what to change. `record` warns with these sentences, so that a user learns before a long run, not
-//! from a "cannot verify" afterwards.
-//!
-//! The prediction uses what the checks themselves use: the channels they need, and for `constraint` the
-//! rule that leaves out windows the sampling does not resolve ([`constraint::resolves`]), applied to the
-//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|) plus its relative rate of change |d ln Ω/dt| there (the check adds
-//! each window's), with the default residual tolerance the file's settings will give.
-//! The rates at t = 0 stand for the run's: a motion that speeds up later loses only its later windows,
-//! while one that cannot be resolved at the start is in practice not resolved anywhere (the steady and
-//! high-spin scenes keep their rates).
+//! and what to change, which `record` warns with, so that a user learns before a long run, not from a
+//! "cannot verify" afterwards. It uses what the checks use: the channels they need, and `constraint`'s rule
+//! for unresolved windows ([`constraint::resolves`]) at the default residual tolerance, applied to the
+//! rates at t = 0, Ω₀ = max(|ω₀|, |φ̇₀|) plus |d ln Ω/dt| there. Those stand for the run's: a motion that
+//! speeds up later loses only its later windows, while one unresolved at the start is in practice
+//! unresolved throughout (the steady and high-spin scenes keep their rates).
 
 use super::checks::constraint::{self, digits3};
 use crate::format::tolerances::{RunAccuracy, Tolerances};
 use crate::format::Channel;
-use crate::model::{magnitude, Dynamics, DISSIPATIVE_STATE_LEN, STATE_LEN};
+use crate::model::magnitude;
 use crate::scene::Scene;
 
 /// One sentence per required check that will not be able to run on a recording of `scene`, saying why
@@ -154,22 +150,11 @@ fn rate_fix(needed: f64, duration: f64) -> String {
 /// from the first instant, and one strong enough changes the rates within a sample.
 fn initial_steepness(scene: &Scene, omega: f64, phi_dot: f64) -> f64 {
     let s = &scene.initial;
-    let mut y = [0.0; DISSIPATIVE_STATE_LEN];
-    y[..STATE_LEN].copy_from_slice(&s.to_array());
-    let mut dydt = [0.0; DISSIPATIVE_STATE_LEN];
-    match scene.dynamics() {
-        Dynamics::Conservative(coin) => {
-            let mut rate = [0.0; STATE_LEN];
-            coin.derivative(&s.to_array(), &mut rate);
-            dydt[..STATE_LEN].copy_from_slice(&rate);
-        }
-        Dynamics::Dissipative(coin) => coin.derivative(&y, &mut dydt),
-    }
-    let (dx, dy, dz) = (dydt[3], dydt[4], dydt[5]);
+    let acc = scene.dynamics().angular_acceleration(s);
     let steepness = if phi_dot > omega {
-        dy / s.omega_y + s.theta.tan() * s.omega_x
+        acc.y / s.omega_y + s.theta.tan() * s.omega_x
     } else {
-        (s.omega_x * dx + s.omega_y * dy + s.omega_z * dz) / (omega * omega)
+        (s.omega_x * acc.x + s.omega_y * acc.y + s.omega_z * acc.z) / (omega * omega)
     };
     if steepness.is_finite() {
         steepness.abs()

@@ -123,8 +123,8 @@ struct Judge {
 }
 
 impl Judge {
-    /// Reads a message of `coin_log.*` channel `c` strictly into its field of `s`, and `s.t`.
-    fn parse(c: Channel, r: &FieldReader, data: &[u8], s: &mut Sample) -> Result<(), String> {
+    /// Reads a message of `coin_log.*` channel `c` logged at `log_time` strictly into a sample of its own.
+    fn parse(c: Channel, r: &FieldReader, log_time: u64, data: &[u8]) -> Result<Sample, String> {
         fn read<M: Message>(
             r: &FieldReader,
             data: &[u8],
@@ -134,6 +134,10 @@ impl Judge {
             *slot = Some(m);
             Ok(m.t())
         }
+        let mut s = Sample {
+            log_time,
+            ..Sample::default()
+        };
         s.t = match c {
             Channel::Omega => read(r, data, &mut s.omega),
             Channel::Angles => read(r, data, &mut s.angles),
@@ -148,7 +152,7 @@ impl Judge {
                 Err("is not a coin_log message".into())
             }
         }?;
-        Ok(())
+        Ok(s)
     }
 
     /// The checks' context from the `coin-log` record's `entries`, or why the file cannot be judged.
@@ -189,6 +193,243 @@ impl Judge {
             steady,
             chaplygin,
         })
+    }
+
+    /// Judges a channel's schema: its encoding, and its bytes against this tool's (or the versions its
+    /// messages may follow).
+    fn schema(&mut self, schema: &Schema<'_>) -> SchemaJudged {
+        let (name, encoding, data) = (
+            schema.name.as_str(),
+            schema.encoding.as_str(),
+            &schema.data[..],
+        );
+        let Some(e) = Encoding::from_schema_encoding(encoding) else {
+            self.problems.push_with(|| {
+                format!(
+                    "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
+                    Encoding::Json.schema_encoding(),
+                    Encoding::Protobuf.schema_encoding()
+                )
+            });
+            return SchemaJudged::default();
+        };
+        let mut judged = SchemaJudged {
+            encoding: Some(e),
+            ..SchemaJudged::default()
+        };
+        let Some(t) = message_type(name) else {
+            match schema_data(name, e) {
+                Some(ours) if ours == data => {}
+                Some(_) => self.notes.push(format!(
+                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
+                )),
+                None => self
+                    .problems
+                    .push_with(|| format!("schema `{name}` is not one of coin-log's")),
+            }
+            return judged;
+        };
+        let (reader, version) = match FieldReader::new(encoding, t, data) {
+            Ok(r) => r,
+            Err(ReaderError::Descriptor(e)) => {
+                self.problems
+                    .push_with(|| format!("schema `{name}` (protobuf) {e}"));
+                return judged;
+            }
+            Err(ReaderError::Encoding(_)) => return judged,
+        };
+        match version {
+            Version::Ours => {}
+            Version::Other if e == Encoding::Json => self.notes.push(format!(
+                "schema `{name}` is another version than this tool's; the messages conform to it"
+            )),
+            Version::Other => self.notes.push(format!(
+                "schema `{name}` is another version than this tool's; its messages are read by the field numbers it declares"
+            )),
+            Version::First => {
+                judged.first_version = true;
+                self.notes.push(format!(
+                    "schema `{name}` is the first version of the type, without the fields added since ({})",
+                    t.fields[t.first_fields.len()..].join(", ")
+                ));
+            }
+            Version::Nonconforming(why) => self.problems.push_with(|| {
+                format!("schema `{name}` is another version than this tool's and {why}")
+            }),
+        }
+        judged.reader = (e == Encoding::Protobuf).then_some(reader);
+        judged
+    }
+
+    /// Judges the samples again in log-time order (format.md: verify) after the stream cut some: the
+    /// messages of the file's chunks through its chunk indexes, parsed as before, into a fresh assembler
+    /// and fresh checks; the stream's structural findings stand. A file that cannot be read so keeps the
+    /// stream's judgement, and a note says how many samples it judged in pieces.
+    fn reorder(&mut self, structure: &Structure, source: impl Read + Seek) {
+        let Some(ctx) = self.ctx.as_ref() else {
+            return;
+        };
+        let (mut assembler, mut checks) = (self.assembler.afresh(), Checks::default());
+        let channels = &self.channels;
+        let mut judge = |h: &MessageHeader, data: &[u8]| {
+            let Some(Some(ChannelState {
+                kind: Kind::Coin(c, reader),
+                ..
+            })) = channels.get(usize::from(h.channel_id))
+            else {
+                return;
+            };
+            // A message that does not parse is already an integrity problem of the stream's.
+            if let Ok(s) = Self::parse(*c, reader, h.log_time, data) {
+                assembler.push(*c, &s, &mut |s| checks.observe(s, ctx));
+            }
+        };
+        let messages = structure.summary.messages;
+        let why = match read_in_log_time_order(source, structure.summary.file_len, &mut judge) {
+            Ok(Some(n)) if n == messages => {
+                assembler.finish(&mut |s| checks.observe(s, ctx));
+                let cut = self.assembler.cut();
+                self.notes.push(format!(
+                    "its channels lie far apart in the file (more than {MAX_PENDING} samples): {cut} \
+                     samples were incomplete when read in file order, so every sample was judged in \
+                     log-time order through the chunk indexes"
+                ));
+                (self.assembler, self.checks) = (assembler, checks);
+                return;
+            }
+            Ok(Some(n)) => format!("its chunks hold {n} of its {messages} messages"),
+            Ok(None) => "it has no summary that lists its chunks".to_string(),
+            Err(e) => e.to_string(),
+        };
+        self.reorder_failed(&why);
+    }
+
+    /// Notes that the samples the stream cut were judged in pieces, and `why` they were not read again.
+    fn reorder_failed(&mut self, why: &str) {
+        let cut = self.assembler.cut();
+        self.notes.push(format!(
+            "{cut} samples were judged before all their channels had arrived (the file's channels lie \
+             more than {MAX_PENDING} samples apart) and it cannot be read in log-time order: {why}; \
+             rewrite it with its messages in log-time order to judge every sample whole"
+        ));
+    }
+
+    /// Why a file without a usable `coin-log` metadata record is not judged.
+    fn not_coin_log(&mut self, library: &str) -> String {
+        self.run_error.take().unwrap_or_else(|| {
+            let by = if library.is_empty() {
+                String::new()
+            } else {
+                format!(" (written by `{library}`)")
+            };
+            format!("not a coin-log file: it has no `coin-log` metadata record{by}")
+        })
+    }
+
+    /// Every integrity problem: the reader's, the judge's, the result record's, and the read error's.
+    fn all_problems(
+        &mut self,
+        structure: &Structure,
+        ctx: &Context,
+        read_whole: bool,
+        read_problem: Option<&String>,
+    ) -> BoundedFindings {
+        if let Some(e) = &self.result_error {
+            self.problems
+                .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
+        }
+        if ctx.run.dissipation.is_none() && self.assembler.declared(Channel::Work) {
+            self.problems.push_with(|| {
+                "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
+            });
+        }
+        let stats = &self.checks.stats;
+        let (last, interval) = (stats.last_t, 1.0 / ctx.run.rate);
+        let judged = read_whole && stats.samples > 0;
+        let says = "the `coin-log.result` metadata says termination_time =";
+        let problem = match ctx
+            .result
+            .as_ref()
+            .map(|r| (r.termination_time, r.termination))
+        {
+            None => read_whole.then(|| {
+                "no `coin-log.result` metadata record (the run did not finish writing)".to_string()
+            }),
+            Some((t, _)) if !t.is_finite() || t < 0.0 => {
+                Some(format!("{says} {t}, not a finite time ≥ 0"))
+            }
+            // A run that completed or ended at an event ends at its last sample (`record` writes one
+            // there); one that failed or was stopped, before the next grid point (format.md:
+            // `coin-log.result`); only a file read whole shows its last sample.
+            Some((t, termination))
+                if (termination == Termination::Completed || termination.is_event()) && judged =>
+            {
+                // Rounding of k/rate: far below 1e-12 of the time.
+                let slack = 1e-12 * last.abs().max(f64::MIN_POSITIVE);
+                ((t - last).abs() > slack).then(|| {
+                    format!(
+                        "{says} {t}, but the last sample is at t = {last}: a run whose termination \
+                         is `{termination}` ends at its last sample"
+                    )
+                })
+            }
+            Some((t, _)) if judged && interval.is_finite() => {
+                // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
+                let slack = 1e-12 * last.abs().max(interval);
+                (!(last - slack..=last + interval + slack).contains(&t)).then(|| {
+                    format!(
+                        "{says} {t}, but the last sample is at t = {last}: a run ends at its last \
+                         sample or, failing, before the next, 1/rate = {interval} later"
+                    )
+                })
+            }
+            Some(_) => None,
+        };
+        if let Some(p) = problem {
+            self.problems.push_with(|| p);
+        }
+        self.termination_alpha(ctx, read_whole);
+        let mut problems = structure.problems.clone();
+        problems.extend(&self.problems);
+        if let Some(p) = read_problem {
+            problems.push_with(|| p.clone());
+        }
+        problems
+    }
+
+    /// The result record's `termination_alpha`: α = π/2 − |θ| at the last sample with dissipation (record
+    /// computes it from the very θ it stores, so they agree to the rounding of one subtraction), null
+    /// without. Judged when the file was read whole and its last sample has the angles.
+    fn termination_alpha(&mut self, ctx: &Context, read_whole: bool) {
+        let Some(alpha) = ctx.result.as_ref().map(|r| r.termination_alpha) else {
+            return;
+        };
+        let problem = match (
+            alpha,
+            ctx.run.dissipation.is_some(),
+            self.checks.stats.last_theta,
+        ) {
+            (Some(a), false, _) => format!(
+                "the `coin-log.result` metadata says termination_alpha = {a}, but the run has no \
+                 dissipation (it is null without)"
+            ),
+            (None, true, Some(_)) if read_whole => "the `coin-log.result` metadata has no \
+                termination_alpha, which a run with dissipation records"
+                .to_string(),
+            (Some(a), true, Some(theta)) if read_whole => {
+                let expected = std::f64::consts::FRAC_PI_2 - theta.abs();
+                // One rounding of π/2 − |θ| is below 2.2e-16; 1e-12 as the other recomputed values.
+                if (a - expected).abs() <= RECOMPUTE_TOLERANCE {
+                    return;
+                }
+                format!(
+                    "the `coin-log.result` metadata says termination_alpha = {a}, but the last sample's \
+                     θ = {theta} gives α = π/2 − |θ| = {expected}"
+                )
+            }
+            _ => return,
+        };
+        self.problems.push_with(|| problem);
     }
 }
 
@@ -390,15 +631,14 @@ impl Visitor for Judge {
         channel.last = Some(lt);
         match &channel.kind {
             Kind::Coin(c, reader) => {
-                let mut s = Sample {
-                    log_time: lt,
-                    ..Sample::default()
+                let s = match Self::parse(*c, reader, lt, data) {
+                    Ok(s) => s,
+                    Err(e) => {
+                        self.problems
+                            .push_with(|| format!("{topic}: message at {lt} ns {e}"));
+                        return ControlFlow::Continue(());
+                    }
                 };
-                if let Err(e) = Self::parse(*c, reader, data, &mut s) {
-                    self.problems
-                        .push_with(|| format!("{topic}: message at {lt} ns {e}"));
-                    return ControlFlow::Continue(());
-                }
                 match log_time(s.t) {
                     Ok(expected) if expected == lt => {}
                     Ok(expected) => {
@@ -427,74 +667,6 @@ impl Visitor for Judge {
     }
 }
 
-impl Judge {
-    /// Judges a channel's schema: its encoding, and its bytes against this tool's (or the versions its
-    /// messages may follow).
-    fn schema(&mut self, schema: &Schema<'_>) -> SchemaJudged {
-        let (name, encoding, data) = (
-            schema.name.as_str(),
-            schema.encoding.as_str(),
-            &schema.data[..],
-        );
-        let Some(e) = Encoding::from_schema_encoding(encoding) else {
-            self.problems.push_with(|| {
-                format!(
-                    "schema `{name}` has encoding {encoding:?}; coin-log writes {:?} or {:?}",
-                    Encoding::Json.schema_encoding(),
-                    Encoding::Protobuf.schema_encoding()
-                )
-            });
-            return SchemaJudged::default();
-        };
-        let mut judged = SchemaJudged {
-            encoding: Some(e),
-            ..SchemaJudged::default()
-        };
-        let Some(t) = message_type(name) else {
-            match schema_data(name, e) {
-                Some(ours) if ours == data => {}
-                Some(_) => self.notes.push(format!(
-                    "schema `{name}` differs from this tool's copy (Foxglove type, not validated)"
-                )),
-                None => self
-                    .problems
-                    .push_with(|| format!("schema `{name}` is not one of coin-log's")),
-            }
-            return judged;
-        };
-        let (reader, version) = match FieldReader::new(encoding, t, data) {
-            Ok(r) => r,
-            Err(ReaderError::Descriptor(e)) => {
-                self.problems
-                    .push_with(|| format!("schema `{name}` (protobuf) {e}"));
-                return judged;
-            }
-            Err(ReaderError::Encoding(_)) => return judged,
-        };
-        match version {
-            Version::Ours => {}
-            Version::Other if e == Encoding::Json => self.notes.push(format!(
-                "schema `{name}` is another version than this tool's; the messages conform to it"
-            )),
-            Version::Other => self.notes.push(format!(
-                "schema `{name}` is another version than this tool's; its messages are read by the field numbers it declares"
-            )),
-            Version::First => {
-                judged.first_version = true;
-                self.notes.push(format!(
-                    "schema `{name}` is the first version of the type, without the fields added since ({})",
-                    t.fields[t.first_fields.len()..].join(", ")
-                ));
-            }
-            Version::Nonconforming(why) => self.problems.push_with(|| {
-                format!("schema `{name}` is another version than this tool's and {why}")
-            }),
-        }
-        judged.reader = (e == Encoding::Protobuf).then_some(reader);
-        judged
-    }
-}
-
 /// Judges one file. Never fails: an unreadable file is a report with exit code 2 and the reason in
 /// [`FileReport::problem`].
 #[must_use]
@@ -510,14 +682,9 @@ pub fn verify_file_with_progress(
     progress: &(dyn Fn(u64) + Sync),
 ) -> FileReport {
     let mut judge = Judge::default();
-    let (structure, error) = coin_log_mcap::read_with_progress(path, &mut judge, progress);
-    if error.is_none() && judge.assembler.cut() > 0 {
-        match std::fs::File::open(path) {
-            Ok(file) => judge.reorder(&structure, file),
-            Err(e) => judge.reorder_failed(&format!("it cannot be opened again: {e}")),
-        }
-    }
-    verdict(path.display().to_string(), judge, structure, error, options)
+    let read = coin_log_mcap::read_with_progress(path, &mut judge, progress);
+    let shown = path.display().to_string();
+    verdict(shown, judge, read, || std::fs::File::open(path), options)
 }
 
 /// Judges an MCAP file held in memory, named `name` in the report (for tests and fuzzing).
@@ -525,80 +692,25 @@ pub fn verify_file_with_progress(
 pub fn verify_bytes(name: &str, bytes: &[u8], options: &Options) -> FileReport {
     let mut judge = Judge::default();
     let source = std::io::Cursor::new(bytes);
-    let (structure, error) = coin_log_mcap::read_from(source, bytes.len() as u64, &mut judge);
-    if error.is_none() && judge.assembler.cut() > 0 {
-        judge.reorder(&structure, std::io::Cursor::new(bytes));
-    }
-    verdict(name.to_string(), judge, structure, error, options)
+    let read = coin_log_mcap::read_from(source, bytes.len() as u64, &mut judge);
+    let again = || Ok(std::io::Cursor::new(bytes));
+    verdict(name.to_string(), judge, read, again, options)
 }
 
-impl Judge {
-    /// Judges the samples again in log-time order, after the stream handed some out before all their
-    /// channels had arrived (the file's writer put its channels far apart, e.g. all of one channel, then
-    /// the next): the messages of the file's chunks through its chunk indexes, parsed as before, into a
-    /// fresh assembler and fresh checks. The stream's structural findings stand. When the file cannot be
-    /// read so, the stream's judgement stays and a note says how many samples it judged in pieces.
-    fn reorder(&mut self, structure: &Structure, source: impl Read + Seek) {
-        let Some(ctx) = self.ctx.as_ref() else {
-            return;
-        };
-        let (mut assembler, mut checks) = (self.assembler.afresh(), Checks::default());
-        let channels = &self.channels;
-        let mut judge = |h: &MessageHeader, data: &[u8]| {
-            let Some(Some(ChannelState {
-                kind: Kind::Coin(c, reader),
-                ..
-            })) = channels.get(usize::from(h.channel_id))
-            else {
-                return;
-            };
-            let mut s = Sample {
-                log_time: h.log_time,
-                ..Sample::default()
-            };
-            // A message that does not parse is already an integrity problem of the stream's.
-            if Self::parse(*c, reader, data, &mut s).is_ok() {
-                assembler.push(*c, &s, &mut |s| checks.observe(s, ctx));
-            }
-        };
-        let messages = structure.summary.messages;
-        let why = match read_in_log_time_order(source, structure.summary.file_len, &mut judge) {
-            Ok(Some(n)) if n == messages => {
-                assembler.finish(&mut |s| checks.observe(s, ctx));
-                let cut = self.assembler.cut();
-                self.notes.push(format!(
-                    "its channels lie far apart in the file (more than {MAX_PENDING} samples): {cut} \
-                     samples were incomplete when read in file order, so every sample was judged in \
-                     log-time order through the chunk indexes"
-                ));
-                (self.assembler, self.checks) = (assembler, checks);
-                return;
-            }
-            Ok(Some(n)) => format!("its chunks hold {n} of its {messages} messages"),
-            Ok(None) => "it has no summary that lists its chunks".to_string(),
-            Err(e) => e.to_string(),
-        };
-        self.reorder_failed(&why);
-    }
-
-    /// Notes that the samples the stream cut were judged in pieces, and `why` they were not read again.
-    fn reorder_failed(&mut self, why: &str) {
-        let cut = self.assembler.cut();
-        self.notes.push(format!(
-            "{cut} samples were judged before all their channels had arrived (the file's channels lie \
-             more than {MAX_PENDING} samples apart) and it cannot be read in log-time order: {why}; \
-             rewrite it with its messages in log-time order to judge every sample whole"
-        ));
-    }
-}
-
-fn verdict(
+/// The report on what `judge` read (read `again` in log-time order if the stream judged samples in pieces).
+fn verdict<R: Read + Seek>(
     shown: String,
     mut judge: Judge,
-    structure: coin_log_mcap::Structure,
-    error: Option<ReadError>,
+    (structure, error): (Structure, Option<ReadError>),
+    again: impl FnOnce() -> std::io::Result<R>,
     options: &Options,
 ) -> FileReport {
+    if error.is_none() && judge.assembler.cut() > 0 {
+        match again() {
+            Ok(source) => judge.reorder(&structure, source),
+            Err(e) => judge.reorder_failed(&format!("it cannot be opened again: {e}")),
+        }
+    }
     let read_whole = error.is_none();
     // A truncated or corrupt file is judged on what could be read, and is unusable (exit 2).
     let read_problem = match ReadError::broken_off(error) {
@@ -657,136 +769,6 @@ fn verdict(
     }
 }
 
-impl Judge {
-    /// Why a file without a usable `coin-log` metadata record is not judged.
-    fn not_coin_log(&mut self, library: &str) -> String {
-        self.run_error.take().unwrap_or_else(|| {
-            let by = if library.is_empty() {
-                String::new()
-            } else {
-                format!(" (written by `{library}`)")
-            };
-            format!("not a coin-log file: it has no `coin-log` metadata record{by}")
-        })
-    }
-
-    /// Every integrity problem: the reader's, the judge's, the result record's, and the read error's.
-    fn all_problems(
-        &mut self,
-        structure: &coin_log_mcap::Structure,
-        ctx: &Context,
-        read_whole: bool,
-        read_problem: Option<&String>,
-    ) -> BoundedFindings {
-        if let Some(e) = &self.result_error {
-            self.problems
-                .push_with(|| format!("the `coin-log.result` metadata is unusable: {e}"));
-        }
-        if ctx.run.dissipation.is_none() && self.assembler.declared(Channel::Work) {
-            self.problems.push_with(|| {
-                "the file has /coin/work but its `coin-log` metadata has no dissipation (a conservative run has no dissipated work)".into()
-            });
-        }
-        let stats = &self.checks.stats;
-        let interval = 1.0 / ctx.run.rate;
-        match ctx
-            .result
-            .as_ref()
-            .map(|r| (r.termination_time, r.termination))
-        {
-            Some((t, _)) if !t.is_finite() || t < 0.0 => self.problems.push_with(|| {
-                format!(
-                    "the `coin-log.result` metadata says termination_time = {t}, not a finite time \
-                     ≥ 0"
-                )
-            }),
-            // A run that completed or ended at an event ends at its last sample (`record` writes one
-            // there); one that failed or was stopped, before the next grid point (format.md:
-            // `coin-log.result`); only a file read whole shows its last sample.
-            Some((t, termination))
-                if (termination == Termination::Completed || termination.is_event())
-                    && read_whole
-                    && stats.samples > 0 =>
-            {
-                // Rounding of k/rate: far below 1e-12 of the time.
-                let slack = 1e-12 * stats.last_t.abs().max(f64::MIN_POSITIVE);
-                if (t - stats.last_t).abs() > slack {
-                    self.problems.push_with(|| {
-                        format!(
-                            "the `coin-log.result` metadata says termination_time = {t}, but the \
-                             last sample is at t = {}: a run whose termination is `{termination}` \
-                             ends at its last sample",
-                            stats.last_t
-                        )
-                    });
-                }
-            }
-            Some((t, _)) if read_whole && stats.samples > 0 && interval.is_finite() => {
-                // Rounding of k/rate and of the failing step's time: far below 1e-12 of either.
-                let slack = 1e-12 * stats.last_t.abs().max(interval);
-                if !(stats.last_t - slack..=stats.last_t + interval + slack).contains(&t) {
-                    self.problems.push_with(|| {
-                        format!(
-                            "the `coin-log.result` metadata says termination_time = {t}, but the \
-                             last sample is at t = {}: a run ends at its last sample or, failing, \
-                             before the next, 1/rate = {interval} later",
-                            stats.last_t
-                        )
-                    });
-                }
-            }
-            None if read_whole => self.problems.push_with(|| {
-                "no `coin-log.result` metadata record (the run did not finish writing)".into()
-            }),
-            _ => {}
-        }
-        self.termination_alpha(ctx, read_whole);
-        let mut problems = structure.problems.clone();
-        problems.extend(&self.problems);
-        if let Some(p) = read_problem {
-            problems.push_with(|| p.clone());
-        }
-        problems
-    }
-}
-
-impl Judge {
-    /// The result record's `termination_alpha`: α = π/2 − |θ| at the last sample with dissipation (record
-    /// computes it from the very θ it stores, so they agree to the rounding of one subtraction), null
-    /// without. Judged when the file was read whole and its last sample has the angles.
-    fn termination_alpha(&mut self, ctx: &Context, read_whole: bool) {
-        let Some(alpha) = ctx.result.as_ref().map(|r| r.termination_alpha) else {
-            return;
-        };
-        let problem = match (
-            alpha,
-            ctx.run.dissipation.is_some(),
-            self.checks.stats.last_theta,
-        ) {
-            (Some(a), false, _) => format!(
-                "the `coin-log.result` metadata says termination_alpha = {a}, but the run has no \
-                 dissipation (it is null without)"
-            ),
-            (None, true, Some(_)) if read_whole => "the `coin-log.result` metadata has no \
-                termination_alpha, which a run with dissipation records"
-                .to_string(),
-            (Some(a), true, Some(theta)) if read_whole => {
-                let expected = std::f64::consts::FRAC_PI_2 - theta.abs();
-                // One rounding of π/2 − |θ| is below 2.2e-16; 1e-12 as the other recomputed values.
-                if (a - expected).abs() <= RECOMPUTE_TOLERANCE {
-                    return;
-                }
-                format!(
-                    "the `coin-log.result` metadata says termination_alpha = {a}, but the last sample's \
-                     θ = {theta} gives α = π/2 − |θ| = {expected}"
-                )
-            }
-            _ => return,
-        };
-        self.problems.push_with(|| problem);
-    }
-}
-
 /// The tolerances of this file: derived from its recorded settings and span, or the flags'.
 fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances {
     let run = &ctx.run;
@@ -800,9 +782,8 @@ fn tolerances(ctx: &Context, stats: &RunStats, options: &Options) -> Tolerances 
     Tolerances::derive(&accuracy, options.energy_tol, options.residual_tol)
 }
 
-/// format.md: a file in which `integrity`, `energy` or both `constraint` and `steady` could not run cannot
-/// be verified, whatever else passed. Says which, or `None` when the required checks ran; the skipped
-/// checks keep their status and their reasons (which say what to record).
+/// Which of the required checks (format.md: verify) could not run, whatever else passed, or `None`; the
+/// skipped checks keep their status and their reasons (which say what to record).
 fn missing_required(results: &[CheckResult]) -> Option<String> {
     let skipped = |id: CheckId| {
         results
@@ -848,9 +829,8 @@ mod tests {
         };
         m.write_json(&mut buf).unwrap();
         let parse = |data, first| {
-            let mut s = Sample::default();
             let r = FieldReader::json(&ReactionMessage::TYPE, first);
-            Judge::parse(Channel::Reaction, &r, data, &mut s).map(|()| s)
+            Judge::parse(Channel::Reaction, &r, 0, data)
         };
         let s = parse(&buf, false).unwrap();
         assert_eq!(s.t.to_bits(), 0.5_f64.to_bits());
@@ -871,11 +851,7 @@ mod tests {
             let text: Vec<String> = t.fields.iter().map(|f| format!("\"{f}\":1")).collect();
             let text = format!("{{{}}}", text.join(","));
             let r = FieldReader::json(t, false);
-            let mut s = Sample::default();
-            assert!(
-                Judge::parse(*c, &r, text.as_bytes(), &mut s).is_ok(),
-                "{text}"
-            );
+            assert!(Judge::parse(*c, &r, 0, text.as_bytes()).is_ok(), "{text}");
         }
     }
 }

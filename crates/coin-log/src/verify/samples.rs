@@ -1,8 +1,6 @@
-//! Samples: the messages of all `coin_log.*` channels that share one log time, assembled while streaming.
-//!
-//! Messages of one time usually arrive together, so the queue holds one or two samples; it is capped so that
-//! a file whose channels are far apart in time still verifies in bounded memory (samples are then judged
-//! with the channels that had arrived).
+//! Samples (format.md: verify): the messages of all `coin_log.*` channels that share one log time,
+//! assembled while streaming. Messages of one time usually arrive together, so the queue holds one or two
+//! samples; its cap bounds the memory where a file's channels lie far apart.
 
 use crate::format::messages::{
     Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Position, QuaternionMessage,

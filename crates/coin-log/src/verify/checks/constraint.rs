@@ -1,19 +1,10 @@
-//! `constraint`: the coin rolls without slipping. The centre's velocity is taken from the stored positions
-//! by an 8th-order central finite difference over 9 equally spaced samples and compared with the rolling
-//! constraint's v = a(−ω_Z e_X + ω_X e_Z) from the stored ω and angles (physics §2, the ẋ, ẏ, ż there).
-//! The residual is max|v_fd − v| / (a max|ω|).
-//!
-//! The difference's leading error, −h⁸x⁽⁹⁾/630, is cancelled by the eighth difference of the constraint's
-//! velocities over the window (Δ⁸v/630). Whether the sampling resolves a window is still judged by that
-//! leading term, a conservative bound on what is left: about (hΩ)⁸/630 relative to the velocity, with Ω
-//! the fastest rate the positions move at. That is the heading rate φ̇ and the rates in ω, and faster when
-//! those rates themselves change fast (a coin sinking flat from θ = 1.5 doubled φ̇ every 0.05 time units,
-//! and windows judged by max(|ω|, |φ̇|) alone erred 30 times beyond the estimate, 2.5e-7 against a
-//! tolerance of 2e-7). So Ω = r + g + 3 min(√|Δg/h|, g) over the window, r = max(|ω|, |φ̇|) and
-//! g = |Δ ln r|/h from sample to sample (see `difference`). Windows where 4 (hΩ)⁸/630 exceeds a tenth of
-//! the tolerance are left out (and counted); if none is left the check is skipped and says so. Ω comes
-//! from the stored rates, not from the differences, so that noise in a tampered file cannot make its
-//! windows look unresolved.
+//! `constraint`: the coin rolls without slipping (format.md: verify, Checks, gives the residual, its
+//! correction by Δ⁸v/630 and the windows left out). Whether the sampling resolves a window is still judged
+//! by the uncorrected leading term (hΩ)⁸/630, a conservative bound on what the correction leaves, with
+//! Ω = r + g + 3 min(√|Δg/h|, g) (see `difference`), not r = max(|ω|, |φ̇|) alone: a coin sinking flat from
+//! θ = 1.5 doubled φ̇ every 0.05 time units, and windows judged by r alone erred 30 times beyond the
+//! estimate, 2.5e-7 against a tolerance of 2e-7. Ω comes from the stored rates, not from the differences,
+//! so that noise in a tampered file cannot make its windows look unresolved.
 
 use super::{fmt_num, Max};
 use crate::format::tolerances::Tolerances;

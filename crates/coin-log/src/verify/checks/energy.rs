@@ -11,7 +11,6 @@ use crate::model::energy;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
-/// Running state of the energy check.
 #[derive(Debug, Default, Clone)]
 pub struct EnergyCheck {
     drift: Option<EnergyDrift>,
@@ -25,7 +24,6 @@ pub struct EnergyCheck {
 }
 
 impl EnergyCheck {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample, ctx: &Context) {
         let Some(state) = s.state() else { return };
         let e = energy(&ctx.coin, &state);
@@ -60,7 +58,6 @@ impl EnergyCheck {
         }
     }
 
-    /// The result.
     #[must_use]
     pub fn finish(&self, tol: &Tolerances, ctx: &Context) -> CheckResult {
         let Some(energy_drift) = self.drift else {
@@ -100,24 +97,18 @@ impl EnergyCheck {
             ),
             _ => format!("drift max|E - E0|/max(|E0|, Mga) = {}", fmt_num(drift)),
         };
-        let missing = if self.without_work > 0 {
-            format!(
+        let mut reason = format!(
+            "{which} is the worst measure: {quantity} over {} samples (worst at t = {}, tolerance {}){stored}",
+            self.samples,
+            fmt_num(energy_drift.worst_time()),
+            fmt_num(tol.energy),
+        );
+        if self.without_work > 0 {
+            reason += &format!(
                 "; {} samples without /coin/work not judged",
                 self.without_work
-            )
-        } else {
-            String::new()
-        };
-        CheckResult::measured(
-            CheckId::Energy,
-            value,
-            tolerance,
-            format!(
-                "{which} is the worst measure: {quantity} over {} samples (worst at t = {}, tolerance {}){stored}{missing}",
-                self.samples,
-                fmt_num(energy_drift.worst_time()),
-                fmt_num(tol.energy),
-            ),
-        )
+            );
+        }
+        CheckResult::measured(CheckId::Energy, value, tolerance, reason)
     }
 }

@@ -7,7 +7,6 @@ use crate::model::drift::InvariantDrift;
 use crate::verify::report::{CheckId, CheckResult};
 use crate::verify::samples::Sample;
 
-/// Running state of the invariants check.
 #[derive(Debug, Default, Clone)]
 pub struct InvariantsCheck {
     drift: Option<InvariantDrift>,
@@ -89,15 +88,10 @@ impl InvariantsCheck {
         let natural = 1.0 / ctx.coin.params().time_unit();
         let widened = (natural / invariant_drift.scale).max(1.0);
         let drift_tol = tol.energy * widened;
-        let drift_tol_said = if widened > 1.0 {
-            format!(
-                "{}, the energy tolerance × √(g/a)/(|C1_0| + |C2_0|) = {}",
-                fmt_num(drift_tol),
-                fmt_num(widened)
-            )
-        } else {
-            format!("{}, the energy tolerance", fmt_num(drift_tol))
-        };
+        let mut drift_tol_said = format!("{}, the energy tolerance", fmt_num(drift_tol));
+        if widened > 1.0 {
+            drift_tol_said += &format!(" × √(g/a)/(|C1_0| + |C2_0|) = {}", fmt_num(widened));
+        }
         let agreed = (self.stored > 0).then_some((agreement, RECOMPUTE_TOLERANCE, "agreement"));
         let (value, tolerance, which) = worst((drift, drift_tol, "drift"), agreed.as_slice());
         CheckResult::measured(

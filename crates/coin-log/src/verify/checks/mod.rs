@@ -40,11 +40,8 @@ pub struct Context {
 /// Run-wide quantities the tolerances and scales need.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RunStats {
-    /// First sample time.
     pub first_t: Option<f64>,
-    /// Last sample time.
     pub last_t: f64,
-    /// Samples seen.
     pub samples: u64,
     /// max|ω| over samples with ω.
     pub max_omega: f64,
@@ -53,7 +50,6 @@ pub struct RunStats {
 }
 
 impl RunStats {
-    /// Accounts for one sample.
     pub fn observe(&mut self, s: &Sample) {
         self.first_t.get_or_insert(s.t);
         self.last_t = s.t;
@@ -64,7 +60,6 @@ impl RunStats {
         }
     }
 
-    /// Recorded span T.
     #[must_use]
     pub fn span(&self) -> f64 {
         self.first_t.map_or(0.0, |t0| self.last_t - t0)

@@ -1,16 +1,8 @@
 //! `nutation`: the nutation period T and the heading advance per period ΔΦ, measured from the stored angles
-//! and angular velocity, against the quadrature of physics §10 from the first stored state. Energy and the
+//! and ω ([`TurningPoints`]), against the quadrature of physics §10 from the first stored state;
+//! format.md (verify, Checks) gives the measurement and the four terms of the tolerance. Energy and the
 //! integrals C1, C2 are blind to an error of phase or timing (a recording whose clock runs 1e-6 fast keeps
 //! every value on the right orbit); this check is not.
-//!
-//! **Measurement**: θ's turning points from the samples ([`TurningPoints`], the quintic Hermite
-//! interpolant of ω_X and φ between samples); T and ΔΦ are the mean spacing of like turning points.
-//!
-//! **Tolerance**: the integrator's share (format.md: verify, Tolerances) plus the quadrature's own error
-//! estimate plus the meter's bound on its interpolation error ([`TurningPoints::interpolation_error`])
-//! plus the timing bound ([`nutation_timing`]): the integrator keeps ω to ε of the state's scale W, not of
-//! the nutation's own amplitude, so a small nutation's turning points are timed no better than that error
-//! over ω_X's slope there.
 
 use super::{fmt_num, worst, Context, RunStats};
 use crate::format::promise::{nutation_timing, omega_error, MAX_NUTATION_TIMING};

@@ -92,26 +92,18 @@ impl ValidityCheck {
             );
         };
         let lift = -n_min;
+        let normal = format!("min N/(Mg) = {} (t = {})", fmt_num(n_min), fmt_num(n_t));
         let (value, mut reason) = match ctx.run.friction {
             Some(mu) => (
                 lift.max(this.slip.value),
                 format!(
-                    "min N/(Mg) = {} (t = {}), max (|F| - μN)/(Mg) = {} (t = {}, μ = {})",
-                    fmt_num(n_min),
-                    fmt_num(n_t),
+                    "{normal}, max (|F| - μN)/(Mg) = {} (t = {}, μ = {})",
                     fmt_num(this.slip.value),
                     fmt_num(this.slip.t),
                     fmt_num(mu)
                 ),
             ),
-            None => (
-                lift,
-                format!(
-                    "min N/(Mg) = {} (t = {}); no μ, friction not judged",
-                    fmt_num(n_min),
-                    fmt_num(n_t)
-                ),
-            ),
+            None => (lift, format!("{normal}; no μ, friction not judged")),
         };
         reason.push_str(&format!("; {} samples", this.samples));
         if let Some(event) = judged_to {
