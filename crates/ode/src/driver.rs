@@ -361,8 +361,6 @@ where
     /// Emits the grid samples up to the step's end, or strictly before the event; `Some` when the run
     /// ends on one of them (t_end reached, or the observer stopped).
     fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<RunEnd> {
-        // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly), and
-        // so is one within EVENT_SAMPLE_GAP of it: two samples that close would share a log time.
         let grid_slack = grid_slack(self.settings.sample_interval);
         let t_stop = event.map_or(t_new, |(_, t)| t);
         loop {

@@ -73,10 +73,8 @@ pub enum StepError {
 
 /// One integration method: takes accepted steps and interpolates within the last one.
 pub trait Stepper<const N: usize> {
-    /// Starts at (t0, y0). `t_end` lets adaptive methods bound their initial step.
-    ///
-    /// # Errors
-    /// [`StepError::NonFinite`] if f(t0, y0) is not finite.
+    /// Starts at (t0, y0) (`t_end` bounds an adaptive method's first step); [`StepError::NonFinite`] if
+    /// f(t0, y0) is not finite.
     fn init<S: OdeSystem<N>>(
         &mut self,
         sys: &S,
@@ -85,10 +83,8 @@ pub trait Stepper<const N: usize> {
         t_end: f64,
     ) -> Result<(), StepError>;
 
-    /// Takes one accepted step that ends no later than `t_limit`.
-    ///
-    /// # Errors
-    /// A [`StepError`]; the stepper then still holds the last good step.
+    /// Takes one accepted step that ends no later than `t_limit`; after a [`StepError`] the stepper still
+    /// holds the last good step.
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError>;
 
     /// Where the stepper stands.
