@@ -254,10 +254,8 @@ impl ChunkCompressor {
         }
     }
 
-    /// Replaces `out` with the compressed `records` (leaves it empty for [`Compression::None`]).
-    ///
-    /// # Errors
-    /// The compressor's error (in practice only when out of memory).
+    /// Replaces `out` with the compressed `records` (leaves it empty for [`Compression::None`]); fails
+    /// with the compressor's error (in practice only when out of memory).
     pub fn compress(&mut self, records: &[u8], out: &mut Vec<u8>) -> io::Result<()> {
         out.clear();
         match self.compression {
@@ -362,10 +360,8 @@ pub struct McapWriter<W: Write> {
 }
 
 impl<W: Write> McapWriter<W> {
-    /// Writes the magic and the Header record and starts the compression workers.
-    ///
-    /// # Errors
-    /// [`WriteError`] if the header is too long or cannot be written.
+    /// Writes the magic and the Header record and starts the compression workers; fails if the header
+    /// is too long or cannot be written.
     pub fn new(writer: W, options: &WriterOptions) -> Result<Self, WriteError> {
         let chunk_size = options.chunk_size.max(1);
         let workers = Workers::spawn(options.workers, options.compression);
@@ -404,10 +400,8 @@ impl<W: Write> McapWriter<W> {
     }
 
     /// Registers a schema and returns its id (1, 2, …); a schema equal to an earlier one gets its id.
-    /// The Schema record goes into the open chunk (and into the summary).
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure, past 65535 schemas, or for a field too long for MCAP.
+    /// The Schema record goes into the open chunk (and into the summary). Fails past 65535 schemas or for
+    /// a field too long for MCAP.
     pub fn add_schema(
         &mut self,
         name: &str,
@@ -437,11 +431,8 @@ impl<W: Write> McapWriter<W> {
 
     /// Registers a channel and returns its id (1, 2, …); a channel equal to an earlier one gets its id.
     /// `schema_id` is 0 (no schema) or an id from [`add_schema`](Self::add_schema). The Channel record
-    /// goes into the open chunk (and into the summary).
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure, for an unknown schema, past 65535 channels, or for a
-    /// field too long for MCAP.
+    /// goes into the open chunk (and into the summary). Fails for an unknown schema, past 65535
+    /// channels, or for a field too long for MCAP.
     pub fn add_channel(
         &mut self,
         schema_id: u16,
@@ -485,11 +476,8 @@ impl<W: Write> McapWriter<W> {
         Ok(id)
     }
 
-    /// Appends a Message record to the open chunk; hands the chunk to a worker once it is full.
-    ///
-    /// # Errors
-    /// [`WriteError`] for an unknown channel, after an earlier failure, or when writing an earlier
-    /// chunk fails.
+    /// Appends a Message record to the open chunk; hands the chunk to a worker once it is full. Fails
+    /// for an unknown channel or when writing an earlier chunk fails.
     #[inline]
     pub fn write_message(
         &mut self,
@@ -526,9 +514,6 @@ impl<W: Write> McapWriter<W> {
 
     /// Writes a Metadata record to the data section, after every chunk so far (the open chunk is closed
     /// and written first).
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure or when writing fails.
     pub fn write_metadata(
         &mut self,
         name: &str,
@@ -558,9 +543,6 @@ impl<W: Write> McapWriter<W> {
 
     /// Writes the open chunk, waits for the workers, writes DataEnd, the summary section, the footer and
     /// the closing magic, flushes, and returns the output with the file's length in bytes.
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure or when writing or flushing fails.
     pub fn finish(mut self) -> Result<(W, u64), WriteError> {
         self.check()?;
         self.guard(|w| {
