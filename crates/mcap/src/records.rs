@@ -58,15 +58,13 @@ impl<'a> Cursor<'a> {
 
     #[inline]
     pub(crate) fn take(&mut self, n: u64, field: &'static str) -> Result<&'a [u8], WireError> {
-        let err = WireError::Short {
-            field,
-            needed: n,
-            available: self.data.len() as u64,
+        let Some(n) = usize::try_from(n).ok().filter(|&n| n <= self.data.len()) else {
+            return Err(WireError::Short {
+                field,
+                needed: n,
+                available: self.data.len() as u64,
+            });
         };
-        let n = usize::try_from(n).map_err(|_| err.clone())?;
-        if n > self.data.len() {
-            return Err(err);
-        }
         let (head, tail) = self.data.split_at(n);
         self.data = tail;
         Ok(head)
