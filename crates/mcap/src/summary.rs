@@ -15,18 +15,15 @@ use std::collections::BTreeMap;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-/// One channel as the summary lists it.
+/// One channel as the summary lists it: its `id`, `topic`, `schema_name` (`""` without a schema),
+/// `message_encoding` and the `messages` on it (from the statistics).
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct ChannelSummary {
-    /// Channel id.
     pub id: u16,
-    /// Topic.
     pub topic: String,
-    /// Schema name (`""` without a schema).
     pub schema_name: String,
-    /// Message encoding.
     pub message_encoding: String,
-    /// Messages on the channel, from the statistics.
     pub messages: u64,
 }
 

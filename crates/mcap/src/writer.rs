@@ -90,6 +90,7 @@ impl WriterOptions {
 
 /// Writing the file failed; the output is unusable.
 #[derive(Debug, thiserror::Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum WriteError {
     /// The output refused a write (disk full, file gone, …).
     #[error(transparent)]
@@ -103,32 +104,18 @@ pub enum WriteError {
     /// An earlier call failed; the file cannot be completed.
     #[error("the MCAP writer failed earlier; the file cannot be completed")]
     AlreadyFailed,
-    /// More schemas or channels than ids.
+    /// More schemas or channels (`what`) than ids.
     #[error("too many {what} for one MCAP file (at most 65535)")]
-    TooMany {
-        /// "schemas" or "channels".
-        what: &'static str,
-    },
+    TooMany { what: &'static str },
     /// A message on a channel id that [`McapWriter::add_channel`] never returned.
     #[error("a message on channel {channel_id}, which was never added")]
-    UnknownChannel {
-        /// The id.
-        channel_id: u16,
-    },
+    UnknownChannel { channel_id: u16 },
     /// A channel whose schema id [`McapWriter::add_schema`] never returned.
     #[error("a channel refers to schema {schema_id}, which was never added")]
-    UnknownSchema {
-        /// The id.
-        schema_id: u16,
-    },
+    UnknownSchema { schema_id: u16 },
     /// A string, byte array or map longer than an MCAP length field (u32) can say.
     #[error("a {what} of {len} bytes is too long for an MCAP record")]
-    TooLong {
-        /// What was too long.
-        what: &'static str,
-        /// Its length.
-        len: usize,
-    },
+    TooLong { what: &'static str, len: usize },
 }
 
 /// What the calling thread knows about a chunk; reused from chunk to chunk.
