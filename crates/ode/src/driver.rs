@@ -78,21 +78,14 @@ pub struct Bounds<'a> {
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "each variant's doc names its fields")]
 pub enum RunEnd {
     /// Reached t_end.
     Completed,
-    /// Event function `index` crossed zero at `t`; the last sample is at `t`.
-    Event {
-        /// Which event function.
-        index: usize,
-        /// Located time.
-        t: f64,
-    },
-    /// The observer asked to stop at `t`.
-    Stopped {
-        /// Time of the last sample.
-        t: f64,
-    },
+    /// Event function `index` crossed zero at the located time `t`; the last sample is at `t`.
+    Event { index: usize, t: f64 },
+    /// Stopped (by the observer or the stop flag) at `t`, the time of the last sample.
+    Stopped { t: f64 },
     /// A numerical failure; samples up to the last good step were emitted.
     Failed(StepError),
 }

@@ -97,16 +97,14 @@ pub trait Stepper<const N: usize> {
     fn interpolate(&self, t: f64, out: &mut [f64; N]);
 }
 
-/// The last accepted step of a [`Stepper`] and its work so far.
+/// The last accepted step of a [`Stepper`], from `t_prev` to `t` (the state `y` at `t`), and the work so
+/// far (`stats`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct StepperState<const N: usize> {
-    /// Time at the end of the last accepted step.
     pub t: f64,
-    /// Time at its start.
     pub t_prev: f64,
-    /// State at `t`.
     pub y: [f64; N],
-    /// Work counters.
     pub stats: Stats,
 }
 
