@@ -51,10 +51,8 @@ pub(crate) struct Lookahead {
 }
 
 /// Looks for the metadata records of the MCAP file of `len` bytes in `source` (see the module doc),
-/// counting them in `kept`. Leaves the source at an unspecified position.
-///
-/// # Errors
-/// [`ReadError`] (too large) when the metadata found exceeds the budget.
+/// counting them in `kept` (an error when they exceed the budget). Leaves the source at an unspecified
+/// position.
 pub(crate) fn find(
     source: &mut (impl Read + Seek),
     len: u64,
@@ -97,10 +95,8 @@ fn prefix(r: &mut impl Read) -> Option<(u8, u64)> {
 
 /// Reads the metadata records the index points at: in file order, each once, never two that overlap
 /// (so that no byte is read twice), each checked to be a metadata record of the indexed length, and
-/// counted in `kept`. `None` when an entry points at no such record (a repeated entry counts as valid).
-///
-/// # Errors
-/// [`ReadError`] (too large) when they exceed the budget.
+/// counted in `kept` (an error when they exceed the budget). `None` when an entry points at no such
+/// record (a repeated entry counts as valid).
 pub(crate) fn read_indexed(
     source: &mut (impl Read + Seek),
     len: u64,
@@ -205,6 +201,11 @@ mod tests {
         out
     }
 
+    /// What [`find`] learns of the file `f`.
+    fn look(f: &[u8]) -> Lookahead {
+        find(&mut IoCursor::new(f), f.len() as u64, &mut Kept::default()).unwrap()
+    }
+
     fn metadata() -> Vec<u8> {
         encoded(&Metadata {
             name: "coin-log".into(),
@@ -258,7 +259,7 @@ mod tests {
     fn a_late_metadata_record_is_found_through_the_index_and_by_the_scan() {
         for indexed in [true, false] {
             let (f, at) = file(5000, indexed);
-            let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default()).unwrap();
+            let p = look(&f);
             assert_eq!(p.indexed, indexed);
             assert!(p.ends_with_magic && p.magic_prefix && p.scan_end.is_none());
             assert_eq!(p.metadata.len(), 1, "indexed {indexed}");
@@ -273,13 +274,7 @@ mod tests {
         let (f, _) = file(5000, true);
         // Cut inside the chunk (after the magic and the 21-byte header record): its claimed length runs
         // past the end.
-        let cut = &f[..3000];
-        let p = find(
-            &mut IoCursor::new(cut),
-            cut.len() as u64,
-            &mut Kept::default(),
-        )
-        .unwrap();
+        let p = look(&f[..3000]);
         assert!(!p.ends_with_magic && p.metadata.is_empty());
         assert_eq!(
             p.scan_end,
@@ -289,7 +284,7 @@ mod tests {
             })
         );
         // Cut inside a record prefix, and inside the magic.
-        let p = find(&mut IoCursor::new(&f[..12]), 12, &mut Kept::default()).unwrap();
+        let p = look(&f[..12]);
         assert_eq!(
             p.scan_end,
             Some(ScanEnd::Cut {
@@ -297,7 +292,7 @@ mod tests {
                 claimed: None
             })
         );
-        let p = find(&mut IoCursor::new(&f[..5]), 5, &mut Kept::default()).unwrap();
+        let p = look(&f[..5]);
         assert!(p.magic_prefix && p.scan_end.is_none());
     }
 
@@ -313,7 +308,7 @@ mod tests {
             f.extend(index(at, m_len));
         }
         f.extend(footer(summary_start));
-        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default()).unwrap();
+        let p = look(&f);
         assert!(p.indexed);
         assert_eq!(p.metadata.len(), 1);
     }
@@ -325,7 +320,7 @@ mod tests {
         let tail = f.len() - 8 - FOOTER_LEN as usize;
         let entry = (tail - 9 - 8 - 8 - 4 - 8) + 9;
         f[entry..entry + 8].copy_from_slice(&29u64.to_le_bytes());
-        let p = find(&mut IoCursor::new(&f), f.len() as u64, &mut Kept::default()).unwrap();
+        let p = look(&f);
         assert!(!p.indexed);
         assert_eq!(p.metadata.len(), 1);
         assert_eq!(p.metadata[0].at, at);

@@ -19,11 +19,8 @@ impl BoundedFindings {
         if self.first.len() < KEPT {
             let mut finding = describe();
             if finding.len() > LONGEST {
-                let mut end = LONGEST;
-                while !finding.is_char_boundary(end) {
-                    end -= 1;
-                }
-                finding.truncate(end);
+                let end = (0..=LONGEST).rfind(|&i| finding.is_char_boundary(i));
+                finding.truncate(end.unwrap_or(0));
                 finding.push('…');
             }
             self.first.push(finding);

@@ -27,11 +27,9 @@ const MAX_CHUNKS: usize = 16_384;
 /// Calls `on_message` with every message of the chunks of the MCAP file of `len` bytes in `source`, in
 /// log-time order (the file's order among equal times). Returns how many: `None` when the file has no
 /// summary listing its chunks (a summary is optional; messages outside chunks are not listed either, so
-/// a caller compares the count with the file's).
-///
-/// # Errors
-/// [`ReadError`]: the summary or a chunk cannot be read or is corrupt; [`ReadErrorKind::TooLarge`] when
-/// the chunks that overlap in time would hold more than [`ORDERED_CHUNK_BYTES`] at once.
+/// a caller compares the count with the file's). Fails if the summary or a chunk cannot be read or is
+/// corrupt, and ([`ReadErrorKind::TooLarge`]) if the chunks that overlap in time would hold more than
+/// [`ORDERED_CHUNK_BYTES`] at once.
 pub fn read_in_log_time_order(
     mut source: impl Read + Seek,
     len: u64,

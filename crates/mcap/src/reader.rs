@@ -362,10 +362,8 @@ pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), ReadError> {
 }
 
 /// The metadata of `path` if it is a regular file (links followed), looked at without opening it: an MCAP
-/// file is read by seeking. `stdin`: the path names standard input (the refusal says so).
-///
-/// # Errors
-/// [`ReadError`] ([`ReadErrorKind::Io`]) if the path cannot be looked at or is not a regular file.
+/// file is read by seeking. `stdin`: the path names standard input (the refusal says so). Fails
+/// ([`ReadErrorKind::Io`]) if the path cannot be looked at or is not a regular file.
 pub fn regular_file(path: &Path, stdin: bool) -> Result<std::fs::Metadata, ReadError> {
     let meta = std::fs::metadata(path).map_err(io_error)?;
     if meta.is_dir() {

@@ -58,15 +58,13 @@ impl<'a> Cursor<'a> {
 
     #[inline]
     pub(crate) fn take(&mut self, n: u64, field: &'static str) -> Result<&'a [u8], WireError> {
-        let err = WireError::Short {
-            field,
-            needed: n,
-            available: self.data.len() as u64,
+        let Some(n) = usize::try_from(n).ok().filter(|&n| n <= self.data.len()) else {
+            return Err(WireError::Short {
+                field,
+                needed: n,
+                available: self.data.len() as u64,
+            });
         };
-        let n = usize::try_from(n).map_err(|_| err.clone())?;
-        if n > self.data.len() {
-            return Err(err);
-        }
         let (head, tail) = self.data.split_at(n);
         self.data = tail;
         Ok(head)
@@ -444,13 +442,14 @@ codec!(AttachmentRecord<'a> = op::ATTACHMENT, "attachment" {
 mod tests {
     use super::*;
 
-    /// Encodes `r` and parses it back.
-    fn round_trip<T: for<'a> Record<'a> + PartialEq + std::fmt::Debug>(r: &T) {
+    /// Encodes `r`, checks that it parses back, and returns its body (leaked: a test's few bytes).
+    fn round_trip<T: Record<'static> + PartialEq + std::fmt::Debug>(r: &T) -> &'static [u8] {
         let mut out = Vec::new();
         r.encode_record(&mut out).unwrap();
-        let (opcode, body) = Cursor::new(&out).record().unwrap();
+        let (opcode, body) = Cursor::new(out.leak()).record().unwrap();
         assert_eq!(opcode, T::OPCODE);
         assert_eq!(&T::parse_body(body).unwrap(), r);
+        body
     }
 
     #[test]
@@ -488,19 +487,13 @@ mod tests {
             data: LongBytes(b"hello"),
             crc: 7,
         };
-        let mut out = Vec::new();
-        a.encode_record(&mut out).unwrap();
-        let (opcode, body) = Cursor::new(&out).record().unwrap();
-        assert_eq!(opcode, op::ATTACHMENT);
-        assert_eq!(AttachmentRecord::parse_body(body).unwrap(), a);
-        assert_eq!(a.crc_covered_len(), body.len() - 4);
+        assert_eq!(a.crc_covered_len(), round_trip(&a).len() - 4);
     }
 
     #[test]
     fn the_footer_is_as_long_as_declared() {
-        let mut out = Vec::new();
-        Footer::default().encode_record(&mut out).unwrap();
-        assert_eq!(out.len() as u64, FOOTER_LEN);
+        let body = round_trip(&Footer::default());
+        assert_eq!(PREFIX_LEN + body.len() as u64, FOOTER_LEN);
     }
 
     #[test]

@@ -15,18 +15,15 @@ use std::collections::BTreeMap;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-/// One channel as the summary lists it.
+/// One channel as the summary lists it: its `id`, `topic`, `schema_name` (`""` without a schema),
+/// `message_encoding` and the `messages` on it (from the statistics).
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct ChannelSummary {
-    /// Channel id.
     pub id: u16,
-    /// Topic.
     pub topic: String,
-    /// Schema name (`""` without a schema).
     pub schema_name: String,
-    /// Message encoding.
     pub message_encoding: String,
-    /// Messages on the channel, from the statistics.
     pub messages: u64,
 }
 
@@ -69,11 +66,8 @@ pub(crate) fn widen(bounds: Option<(u64, u64)>, t: u64) -> (u64, u64) {
 /// summary has no statistics record or lists fewer channels, schemas, chunk indexes or metadata indexes
 /// than its statistics count (MCAP makes each group optional: the Python writer can leave out the
 /// channels and schemas, or the chunk or metadata indexes), or it is larger than the largest record the
-/// reader accepts.
-///
-/// # Errors
-/// [`ReadError`] if the file cannot be read, is not MCAP, or its footer, summary (CRC included) or a
-/// record it points at is malformed or beyond the reader's budget.
+/// reader accepts. Fails if the file cannot be read, is not MCAP, or its footer, summary (CRC included)
+/// or a record it points at is malformed or beyond the reader's budget.
 pub fn read_summary(path: &Path) -> Result<Option<Summary>, ReadError> {
     let (mut file, file_len) = reader::open(path)?;
     let Some(library) = header_library(&mut file, file_len)? else {

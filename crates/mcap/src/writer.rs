@@ -90,6 +90,7 @@ impl WriterOptions {
 
 /// Writing the file failed; the output is unusable.
 #[derive(Debug, thiserror::Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum WriteError {
     /// The output refused a write (disk full, file gone, …).
     #[error(transparent)]
@@ -103,32 +104,18 @@ pub enum WriteError {
     /// An earlier call failed; the file cannot be completed.
     #[error("the MCAP writer failed earlier; the file cannot be completed")]
     AlreadyFailed,
-    /// More schemas or channels than ids.
+    /// More schemas or channels (`what`) than ids.
     #[error("too many {what} for one MCAP file (at most 65535)")]
-    TooMany {
-        /// "schemas" or "channels".
-        what: &'static str,
-    },
+    TooMany { what: &'static str },
     /// A message on a channel id that [`McapWriter::add_channel`] never returned.
     #[error("a message on channel {channel_id}, which was never added")]
-    UnknownChannel {
-        /// The id.
-        channel_id: u16,
-    },
+    UnknownChannel { channel_id: u16 },
     /// A channel whose schema id [`McapWriter::add_schema`] never returned.
     #[error("a channel refers to schema {schema_id}, which was never added")]
-    UnknownSchema {
-        /// The id.
-        schema_id: u16,
-    },
+    UnknownSchema { schema_id: u16 },
     /// A string, byte array or map longer than an MCAP length field (u32) can say.
     #[error("a {what} of {len} bytes is too long for an MCAP record")]
-    TooLong {
-        /// What was too long.
-        what: &'static str,
-        /// Its length.
-        len: usize,
-    },
+    TooLong { what: &'static str, len: usize },
 }
 
 /// What the calling thread knows about a chunk; reused from chunk to chunk.
@@ -254,10 +241,8 @@ impl ChunkCompressor {
         }
     }
 
-    /// Replaces `out` with the compressed `records` (leaves it empty for [`Compression::None`]).
-    ///
-    /// # Errors
-    /// The compressor's error (in practice only when out of memory).
+    /// Replaces `out` with the compressed `records` (leaves it empty for [`Compression::None`]); fails
+    /// with the compressor's error (in practice only when out of memory).
     pub fn compress(&mut self, records: &[u8], out: &mut Vec<u8>) -> io::Result<()> {
         out.clear();
         match self.compression {
@@ -362,10 +347,8 @@ pub struct McapWriter<W: Write> {
 }
 
 impl<W: Write> McapWriter<W> {
-    /// Writes the magic and the Header record and starts the compression workers.
-    ///
-    /// # Errors
-    /// [`WriteError`] if the header is too long or cannot be written.
+    /// Writes the magic and the Header record and starts the compression workers; fails if the header
+    /// is too long or cannot be written.
     pub fn new(writer: W, options: &WriterOptions) -> Result<Self, WriteError> {
         let chunk_size = options.chunk_size.max(1);
         let workers = Workers::spawn(options.workers, options.compression);
@@ -404,10 +387,8 @@ impl<W: Write> McapWriter<W> {
     }
 
     /// Registers a schema and returns its id (1, 2, …); a schema equal to an earlier one gets its id.
-    /// The Schema record goes into the open chunk (and into the summary).
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure, past 65535 schemas, or for a field too long for MCAP.
+    /// The Schema record goes into the open chunk (and into the summary). Fails past 65535 schemas or for
+    /// a field too long for MCAP.
     pub fn add_schema(
         &mut self,
         name: &str,
@@ -437,11 +418,8 @@ impl<W: Write> McapWriter<W> {
 
     /// Registers a channel and returns its id (1, 2, …); a channel equal to an earlier one gets its id.
     /// `schema_id` is 0 (no schema) or an id from [`add_schema`](Self::add_schema). The Channel record
-    /// goes into the open chunk (and into the summary).
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure, for an unknown schema, past 65535 channels, or for a
-    /// field too long for MCAP.
+    /// goes into the open chunk (and into the summary). Fails for an unknown schema, past 65535
+    /// channels, or for a field too long for MCAP.
     pub fn add_channel(
         &mut self,
         schema_id: u16,
@@ -485,11 +463,8 @@ impl<W: Write> McapWriter<W> {
         Ok(id)
     }
 
-    /// Appends a Message record to the open chunk; hands the chunk to a worker once it is full.
-    ///
-    /// # Errors
-    /// [`WriteError`] for an unknown channel, after an earlier failure, or when writing an earlier
-    /// chunk fails.
+    /// Appends a Message record to the open chunk; hands the chunk to a worker once it is full. Fails
+    /// for an unknown channel or when writing an earlier chunk fails.
     #[inline]
     pub fn write_message(
         &mut self,
@@ -526,9 +501,6 @@ impl<W: Write> McapWriter<W> {
 
     /// Writes a Metadata record to the data section, after every chunk so far (the open chunk is closed
     /// and written first).
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure or when writing fails.
     pub fn write_metadata(
         &mut self,
         name: &str,
@@ -558,9 +530,6 @@ impl<W: Write> McapWriter<W> {
 
     /// Writes the open chunk, waits for the workers, writes DataEnd, the summary section, the footer and
     /// the closing magic, flushes, and returns the output with the file's length in bytes.
-    ///
-    /// # Errors
-    /// [`WriteError`] after an earlier failure or when writing or flushing fails.
     pub fn finish(mut self) -> Result<(W, u64), WriteError> {
         self.check()?;
         self.guard(|w| {

@@ -29,23 +29,21 @@ const LAST_STEP_STRETCH: f64 = 1.01;
 /// Smallest remembered error, so the Lund factor cannot explode after a zero-error step (`facold`).
 const MIN_OLD_ERROR: f64 = 1e-4;
 
-/// Step-size controller parameters of Hairer's codes: new step h·min(1/fac_min, max(1/fac_max,
-/// err^expo / err_old^β / safety)) with expo = 1/(q+1) − 0.75·β·(stabilisation) as in `dopri5.f`/`dop853.f`.
+/// Step-size controller of Hairer's codes (`dopri5.f`, `dop853.f`): new step h / clamp(err^exponent /
+/// err_old^β / safety, 1/max_ratio, 1/min_ratio), the ratios bounding new/old step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Controller {
     pub safety: f64,
-    /// Smallest and largest ratio new/old step.
     pub min_ratio: f64,
     pub max_ratio: f64,
-    /// Exponent applied to the current error, 1/(q+1) − (stabilisation)·β.
+    /// 1/(q+1) − c·β, c = 0.75 in `dopri5.f`, 0.2 in `dop853.f`.
     pub exponent: f64,
     /// Lund stabilisation β.
     pub beta: f64,
 }
 
-/// The last accepted step of an adaptive pair and its step size, and what both pairs do around their
-/// stages: the start, the trial step towards `t_limit`, the underflow test, the error weights, the new
-/// step after a rejection or an acceptance, and the continuous extension.
+/// The last accepted step of an adaptive pair, its step size, and all that both pairs do around their
+/// stages.
 #[derive(Debug, Clone)]
 pub(crate) struct AdaptiveSteps<const N: usize> {
     pub state: StepperState<N>,
@@ -82,10 +80,7 @@ impl<const N: usize> AdaptiveSteps<N> {
 
     /// Starts a run from (t0, y0) to `t_end` for a method of order `order`: resets `state` and the
     /// controller, writes f(t0, y0) into `f0` and guesses the first step (two right-hand side
-    /// evaluations).
-    ///
-    /// # Errors
-    /// [`StepError::NonFinite`] if y0 or f(t0, y0) is not finite.
+    /// evaluations); [`StepError::NonFinite`] if y0 or f(t0, y0) is not finite.
     pub fn start<S: OdeSystem<N>>(
         &mut self,
         sys: &S,
@@ -170,12 +165,9 @@ impl<const N: usize> AdaptiveSteps<N> {
     }
 
     /// The next trial step from `state.t` as (h, t_new), or `None` when it has reached `t_limit`. A step
-    /// within 1 % of `t_limit` is stretched to end exactly there.
-    ///
-    /// # Errors
-    /// When the step no longer advances `t` (0.1·|h| ≤ ε·|t|, or h not a positive finite number):
-    /// [`StepError::NonFinite`] if non-finite trials shrank it (`non_finite`),
-    /// [`StepError::StepSizeUnderflow`] otherwise.
+    /// within 1 % of `t_limit` is stretched to end exactly there. A step that no longer advances `t`
+    /// (0.1·|h| ≤ ε·|t|, or h not positive and finite) is [`StepError::NonFinite`] if non-finite trials
+    /// shrank it (`non_finite`), [`StepError::StepSizeUnderflow`] otherwise.
     #[inline]
     pub fn trial(&self, t_limit: f64, non_finite: bool) -> Result<Option<(f64, f64)>, StepError> {
         let t = self.state.t;

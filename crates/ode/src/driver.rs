@@ -78,21 +78,14 @@ pub struct Bounds<'a> {
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "each variant's doc names its fields")]
 pub enum RunEnd {
     /// Reached t_end.
     Completed,
-    /// Event function `index` crossed zero at `t`; the last sample is at `t`.
-    Event {
-        /// Which event function.
-        index: usize,
-        /// Located time.
-        t: f64,
-    },
-    /// The observer asked to stop at `t`.
-    Stopped {
-        /// Time of the last sample.
-        t: f64,
-    },
+    /// Event function `index` crossed zero at the located time `t`; the last sample is at `t`.
+    Event { index: usize, t: f64 },
+    /// Stopped (by the observer or the stop flag) at `t`, the time of the last sample.
+    Stopped { t: f64 },
     /// A numerical failure; samples up to the last good step were emitted.
     Failed(StepError),
 }
@@ -111,8 +104,8 @@ pub struct RunOutcome {
 /// Sample time number `k`: t0 + k·interval, computed afresh (never accumulated) so the grid does not drift.
 #[inline]
 #[allow(clippy::cast_precision_loss)]
-fn sample_time(settings: &RunSettings, k: u64) -> f64 {
-    settings.t0 + k as f64 * settings.sample_interval
+fn sample_time(t0: f64, interval: f64, k: u64) -> f64 {
+    t0 + k as f64 * interval
 }
 
 /// How close to t_end a grid point is taken for t_end itself: the grid t0 + k·interval rarely hits t_end
@@ -124,14 +117,10 @@ fn grid_slack(interval: f64) -> f64 {
 /// The samples a run from `t0` that reaches `t_end` writes at `interval` (what [`run`] calls `observe`
 /// with): t0, the grid points t0 + k·interval (k ≥ 1) more than the slack before t_end, and t_end.
 #[must_use]
-#[allow(
-    clippy::cast_possible_truncation,
-    clippy::cast_sign_loss,
-    clippy::cast_precision_loss
-)]
+#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 pub fn samples_to_end(t0: f64, t_end: f64, interval: f64) -> u64 {
     let limit = t_end - grid_slack(interval);
-    let at = |k: u64| t0 + k as f64 * interval;
+    let at = |k| sample_time(t0, interval, k);
     // The grid points k ≥ 1 at or before `limit`: the quotient's floor, corrected for its rounding.
     let mut k = ((limit - t0) / interval).floor().max(0.0) as u64;
     while k > 0 && at(k) > limit {
@@ -361,12 +350,10 @@ where
     /// Emits the grid samples up to the step's end, or strictly before the event; `Some` when the run
     /// ends on one of them (t_end reached, or the observer stopped).
     fn samples_up_to(&mut self, t_new: f64, event: Option<(usize, f64)>) -> Option<RunEnd> {
-        // A grid point this close to t_end is t_end (the grid t0 + k·interval rarely hits it exactly), and
-        // so is one within EVENT_SAMPLE_GAP of it: two samples that close would share a log time.
         let grid_slack = grid_slack(self.settings.sample_interval);
         let t_stop = event.map_or(t_new, |(_, t)| t);
         loop {
-            let mut t_k = sample_time(self.settings, self.k);
+            let mut t_k = sample_time(self.settings.t0, self.settings.sample_interval, self.k);
             if t_k > self.settings.t_end - grid_slack {
                 t_k = self.settings.t_end;
             }

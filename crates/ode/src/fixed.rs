@@ -36,9 +36,7 @@ impl<const N: usize> FixedSteps<N> {
         }
     }
 
-    /// Starts the clock at `t0` with state `y0`, evaluating f(t0, y0) (one right-hand side evaluation).
-    ///
-    /// # Errors
+    /// Starts the clock at `t0` with state `y0`, evaluating f(t0, y0) (one right-hand side evaluation);
     /// [`StepError::NonFinite`] if y0 or f(t0, y0) is not finite.
     pub fn start<S: OdeSystem<N>>(
         &mut self,
@@ -74,11 +72,8 @@ impl<const N: usize> FixedSteps<N> {
     }
 
     /// Accepts the step to (`t_new`, `y_new`) returned by [`FixedSteps::next_end`], evaluating
-    /// f(t_new, y_new) (one right-hand side evaluation, counted).
-    ///
-    /// # Errors
-    /// [`StepError::NonFinite`] (at the start of the step, which is kept) if y_new or its derivative is
-    /// not finite.
+    /// f(t_new, y_new) (one right-hand side evaluation, counted); [`StepError::NonFinite`] (at the start
+    /// of the step, which is kept) if y_new or its derivative is not finite.
     #[inline]
     pub fn accept<S: OdeSystem<N>>(
         &mut self,

@@ -242,42 +242,36 @@ impl<const N: usize> Stepper<N> for Gauss4<N> {
         let t = self.steps.state.t;
         let h = end.0 - t;
         // First attempt with the kept Jacobian; if it fails, once more with a fresh one.
-        let mut failure = (0, f64::NAN);
-        let mut solution = None;
-        for _attempt in 0..2 {
+        let z = loop {
             let fresh = self.jacobian_stale;
             if fresh {
                 self.update_jacobian(sys);
             }
             #[allow(clippy::float_cmp)] // exact: the LU was built for this very step value
             let lu_current = self.h_lu == h;
-            if !lu_current && !self.factor(h) {
-                failure = (0, f64::INFINITY);
+            let (iterations, residual) = if !lu_current && !self.factor(h) {
+                (0, f64::INFINITY)
             } else {
                 let mut z = self.initial_guess(h);
                 match self.newton(sys, h, &mut z) {
-                    Ok(()) => {
-                        solution = Some(z);
-                        break;
-                    }
-                    Err(e) => failure = e,
+                    Ok(()) => break z,
+                    Err(e) => e,
                 }
-            }
+            };
             self.jacobian_stale = true;
+            // Failed with an up-to-date Jacobian: another one will not help.
             if fresh {
-                break; // failed with an up-to-date Jacobian: another one will not help
+                return Err(if residual.is_nan() {
+                    StepError::NonFinite { t }
+                } else {
+                    StepError::NewtonFailure {
+                        t,
+                        h,
+                        iterations,
+                        residual,
+                    }
+                });
             }
-        }
-        let Some(z) = solution else {
-            if failure.1.is_nan() {
-                return Err(StepError::NonFinite { t });
-            }
-            return Err(StepError::NewtonFailure {
-                t,
-                h,
-                iterations: failure.0,
-                residual: failure.1,
-            });
         };
 
         // y₁ = y₀ + h·Σ bᵢ f(Yᵢ) = y₀ + bᵀA⁻¹Z = y₀ + √3·(Z₂ − Z₁), from the final (round-off exact) Z

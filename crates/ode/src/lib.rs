@@ -73,10 +73,8 @@ pub enum StepError {
 
 /// One integration method: takes accepted steps and interpolates within the last one.
 pub trait Stepper<const N: usize> {
-    /// Starts at (t0, y0). `t_end` lets adaptive methods bound their initial step.
-    ///
-    /// # Errors
-    /// [`StepError::NonFinite`] if f(t0, y0) is not finite.
+    /// Starts at (t0, y0) (`t_end` bounds an adaptive method's first step); [`StepError::NonFinite`] if
+    /// f(t0, y0) is not finite.
     fn init<S: OdeSystem<N>>(
         &mut self,
         sys: &S,
@@ -85,10 +83,8 @@ pub trait Stepper<const N: usize> {
         t_end: f64,
     ) -> Result<(), StepError>;
 
-    /// Takes one accepted step that ends no later than `t_limit`.
-    ///
-    /// # Errors
-    /// A [`StepError`]; the stepper then still holds the last good step.
+    /// Takes one accepted step that ends no later than `t_limit`; after a [`StepError`] the stepper still
+    /// holds the last good step.
     fn step<S: OdeSystem<N>>(&mut self, sys: &S, t_limit: f64) -> Result<(), StepError>;
 
     /// Where the stepper stands.
@@ -101,16 +97,14 @@ pub trait Stepper<const N: usize> {
     fn interpolate(&self, t: f64, out: &mut [f64; N]);
 }
 
-/// The last accepted step of a [`Stepper`] and its work so far.
+/// The last accepted step of a [`Stepper`], from `t_prev` to `t` (the state `y` at `t`), and the work so
+/// far (`stats`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct StepperState<const N: usize> {
-    /// Time at the end of the last accepted step.
     pub t: f64,
-    /// Time at its start.
     pub t_prev: f64,
-    /// State at `t`.
     pub y: [f64; N],
-    /// Work counters.
     pub stats: Stats,
 }
 

@@ -40,16 +40,14 @@ impl Method {
     }
 }
 
-/// A method with its settings: tolerances for adaptive methods, the step for fixed-step ones.
+/// A `method` with its settings: the tolerances `rtol` and `atol` for adaptive methods, the `step` for
+/// fixed-step ones.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct MethodConfig {
-    /// The method.
     pub method: Method,
-    /// Relative tolerance (adaptive methods).
     pub rtol: f64,
-    /// Absolute tolerance (adaptive methods).
     pub atol: f64,
-    /// Step (fixed-step methods).
     pub step: f64,
 }
 
