@@ -8,12 +8,12 @@ use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
     drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Message,
-    NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
+    Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::promise::{self, Shortfall};
 use crate::format::tolerances::{RunAccuracy, Tolerances, MIN_SAMPLES_PER_PERIOD};
 use crate::format::{
-    header_library, log_time, Channel, Encoding, ResultMetadata, Termination, TimeError, Topic,
+    header_library, log_time, Channel, Encoding, ResultMetadata, Termination, Topic,
     RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Bounds, Flow, RunOutcome, RunSettings};
@@ -93,14 +93,9 @@ impl From<WriteError> for SampleError {
         Self::Write(e)
     }
 }
-impl From<NonFiniteField> for SampleError {
-    fn from(e: NonFiniteField) -> Self {
-        Self::Failure(Failure::Message(e))
-    }
-}
-impl From<TimeError> for SampleError {
-    fn from(e: TimeError) -> Self {
-        Self::Failure(Failure::Time(e))
+impl<E: Into<Failure>> From<E> for SampleError {
+    fn from(e: E) -> Self {
+        Self::Failure(e.into())
     }
 }
 
