@@ -9,6 +9,7 @@ use super::{
 };
 use crate::format::messages::push_number;
 use nalgebra::{UnitQuaternion, Vector3};
+use std::io::Write as _;
 
 const IDENTITY_POSE: &[u8] =
     br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
@@ -47,19 +48,9 @@ impl<'a> Writer<'a> {
         self.buf.push(b'}');
     }
 
-    fn uint(&mut self, mut n: u64) {
-        let mut digits = [0u8; 20];
-        let mut i = digits.len();
-        loop {
-            i -= 1;
-            // n % 10 < 10 always fits in a u8.
-            digits[i] = b'0' + u8::try_from(n % 10).unwrap_or(0);
-            n /= 10;
-            if n == 0 {
-                break;
-            }
-        }
-        self.buf.extend_from_slice(&digits[i..]);
+    fn uint(&mut self, n: u64) {
+        // Writing into a Vec cannot fail.
+        let _ = write!(self.buf, "{n}");
     }
 
     /// `{"sec":S,"nsec":N}` of a log time in ns.
