@@ -13,15 +13,13 @@ use std::ops::ControlFlow;
 use std::path::Path;
 
 /// One channel of a file (an entry of `info --json`'s `channels`).
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChannelReport {
-    /// Topic.
     pub topic: String,
     /// Schema name (`""` without a schema).
     pub schema: String,
-    /// Message encoding.
     pub message_encoding: String,
-    /// Messages on the channel.
     pub messages: u64,
     /// Messages per second of log time (per time unit of a coin-log scene) over the file's time span:
     /// (messages − 1) / span; `None` with fewer than two messages or a zero span.
