@@ -60,26 +60,20 @@ pub enum RecordError {
     #[error("the `invariants` channel cannot be recorded for this body")]
     Invariants(#[from] InvariantsError),
     /// The run is longer than Foxglove's Protobuf timestamps reach (u32 seconds).
+    #[allow(missing_docs)]
     #[error(
         "the run lasts {duration} time units, longer than the {max} seconds a Protobuf timestamp of Foxglove's \
          schemas holds; record it with --encoding json, or shorten run.duration"
     )]
-    TooLongForProtobuf {
-        /// The scene's duration.
-        duration: f64,
-        /// The longest.
-        max: f64,
-    },
+    TooLongForProtobuf { duration: f64, max: f64 },
     /// A channel the file's encoding cannot carry (`rerun` is for Rerun, which decodes Protobuf).
+    #[allow(missing_docs)]
     #[error(
         "the `{channel}` channel is recorded in {} only (Rerun's MCAP importer decodes Protobuf, not JSON): \
          record it with --encoding protobuf, or leave `{channel}` out",
         channel.encodings().iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
     )]
-    Encoding {
-        /// The channel.
-        channel: Channel,
-    },
+    Encoding { channel: Channel },
 }
 
 /// Why writing a sample stopped the run.
@@ -506,12 +500,11 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
 }
 
 /// [`promise::shortfalls`] of a recording of `scene` integrated as `accuracy`, naming only checks verify
-/// will run on it (format.md: verify): `steady` only on an unperturbed steady start, `nutation` never on
-/// one (a steady motion does not nutate), and with dissipation neither `invariants` nor `nutation` (E, C1
-/// and C2 change), and `nutation` only when the quadrature from the initial state finds a period (verify
-/// skips it otherwise: "there is no period"). `wobble --rtol 1e-7` promised that `steady` would fail,
-/// Euler's disk, 14 000 time units long, `nutation`, `circle-plus --rtol 1e-3 --atol 1e-3` `nutation`,
-/// and `topple --rtol 1e-6 --atol 1e-8`, which lands flat, `nutation`, all of which verify skipped.
+/// will run on it (format.md: verify): `steady` only on an unperturbed steady start; `invariants` and
+/// `nutation` only without dissipation (E, C1, C2 change), `nutation` only off a steady start (which does
+/// not nutate) and when the quadrature finds a period (else "there is no period"). Skipped checks were
+/// promised by `wobble --rtol 1e-7` (`steady`), Euler's disk (14 000 time units), `circle-plus --rtol 1e-3
+/// --atol 1e-3` and `topple --rtol 1e-6 --atol 1e-8`, which lands flat (`nutation`).
 fn shortfalls(scene: &Scene, accuracy: &RunAccuracy) -> Vec<Shortfall> {
     let mut shortfalls = promise::shortfalls(
         accuracy,
@@ -596,9 +589,8 @@ fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Fai
     }
 }
 
-/// Runs the scene's integrator, writing each sample one sample late (so that the last one can be flagged
-/// as last), reporting progress and honouring `stop`. Returns the integrator's outcome and the error that
-/// stopped writing, if one did.
+/// Runs the scene's integrator, writing each sample one sample late (module docs), reporting progress and
+/// honouring `stop`; returns the integrator's outcome and the error that stopped writing, if one did.
 fn integrate_into<W: Write + Seek, T: Tap>(
     scene: &Scene,
     sampler: &mut Sampler<'_, W, T>,
