@@ -53,6 +53,16 @@ impl<'a> Writer<'a> {
         let _ = write!(self.buf, "{n}");
     }
 
+    /// Each of `items` as `write` writes it, separated by commas.
+    fn list<T>(&mut self, items: impl IntoIterator<Item = T>, mut write: impl FnMut(&mut Self, T)) {
+        for (i, item) in items.into_iter().enumerate() {
+            if i > 0 {
+                self.raw(b",");
+            }
+            write(self, item);
+        }
+    }
+
     /// `{"sec":S,"nsec":N}` of a log time in ns.
     fn time(&mut self, log_time: u64) {
         self.raw(b"{\"sec\":");
@@ -145,18 +155,15 @@ pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, th
     let mut w = Writer::new(buf);
     w.entity_head(log_time, FOLLOW_FRAME, b"coin");
     w.raw(b"\"cubes\":[");
-    for (i, (position, size, colour)) in coin_marks(r, thickness).iter().enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
+    w.list(coin_marks(r, thickness), |w, (position, size, colour)| {
         w.raw(b"{\"pose\":");
-        w.pose(position, r);
+        w.pose(&position, r);
         w.raw(b",\"size\":");
-        w.xyzw(size);
+        w.xyzw(&size);
         w.raw(b",\"color\":");
-        w.color(*colour);
+        w.color(colour);
         w.raw(b"}");
-    }
+    });
     w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
     w.pose(&Vector3::zeros(), r);
     w.raw(b",\"size\":");
@@ -179,12 +186,7 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     w.raw(b",\"color\":");
     w.color(TABLE_RGBA);
     w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
-    for major in [false, true] {
-        if major {
-            w.raw(b",");
-        }
-        grid(&mut w, centre, major);
-    }
+    w.list([false, true], |w, major| grid(w, centre, major));
     w.raw(b"],");
     w.entity_tail();
 }
@@ -196,14 +198,11 @@ fn grid(w: &mut Writer, centre: [f64; 2], major: bool) {
     w.raw(b"},\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"thickness\":");
     w.num(GRID_WIDTHS[usize::from(major)]);
     w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, (a, b)) in grid_segments(centre, major).enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
+    w.list(grid_segments(centre, major), |w, (a, b)| {
         w.point(a[0], a[1]);
         w.raw(b",");
         w.point(b[0], b[1]);
-    }
+    });
     w.raw(b"],\"color\":");
     w.color(GRID_RGBA[usize::from(major)]);
     w.raw(b",\"colors\":[],\"indices\":[]}");
@@ -218,12 +217,7 @@ pub(super) fn track(buf: &mut Vec<u8>, log_time: u64, points: &[TrackPoint]) {
     w.raw(b",\"thickness\":");
     w.num(TRACK_WIDTH);
     w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, p) in points.iter().enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
-        w.point(p.x, p.y);
-    }
+    w.list(points, |w, p| w.point(p.x, p.y));
     w.raw(b"],\"color\":");
     w.color(TRACK_RGBA);
     w.raw(b",\"colors\":[],\"indices\":[]}],");
