@@ -104,17 +104,14 @@ pub(super) fn kind_of(meta: &Metadata) -> &'static str {
     {
         use std::os::unix::fs::FileTypeExt;
         let t = meta.file_type();
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_fifo() {
-            return "a named pipe";
-        }
-        if t.is_socket() {
-            return "a socket";
+        let kinds = [
+            (t.is_char_device(), "a character device"),
+            (t.is_block_device(), "a block device"),
+            (t.is_fifo(), "a named pipe"),
+            (t.is_socket(), "a socket"),
+        ];
+        if let Some((_, what)) = kinds.into_iter().find(|(is, _)| *is) {
+            return what;
         }
     }
     "a special file"
