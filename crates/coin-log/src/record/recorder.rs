@@ -571,22 +571,18 @@ fn fixed_steps(scene: &Scene, span: f64) -> Option<promise::FixedSteps> {
 
 /// How the integration ended, as the file records it: termination, its time, and the failure if any.
 fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Failure>) {
-    let termination = Termination::of_run(end);
-    match end {
-        integrate::RunEnd::Completed => (termination, t_last, None),
-        integrate::RunEnd::Event { t, .. } | integrate::RunEnd::Stopped { t } => {
-            (termination, *t, None)
-        }
-        integrate::RunEnd::Failed(e) => {
-            let t = match e {
-                integrate::StepError::NonFinite { t }
-                | integrate::StepError::StepSizeUnderflow { t, .. }
-                | integrate::StepError::NewtonFailure { t, .. }
-                | integrate::StepError::BudgetSpent { t, .. } => *t,
-            };
-            (termination, t, Some(Failure::Step(e.clone())))
-        }
-    }
+    use integrate::{RunEnd, StepError};
+    let (t, failure) = match end {
+        RunEnd::Completed => (t_last, None),
+        RunEnd::Event { t, .. } | RunEnd::Stopped { t } => (*t, None),
+        RunEnd::Failed(e) => match e {
+            StepError::NonFinite { t }
+            | StepError::StepSizeUnderflow { t, .. }
+            | StepError::NewtonFailure { t, .. }
+            | StepError::BudgetSpent { t, .. } => (*t, Some(Failure::Step(e.clone()))),
+        },
+    };
+    (Termination::of_run(end), t, failure)
 }
 
 /// Runs the scene's integrator, writing each sample one sample late (module docs), reporting progress and
