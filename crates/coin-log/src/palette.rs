@@ -66,18 +66,10 @@ fn xml_chars(svg: String) -> String {
     let bad = |c: char| {
         matches!(c, '\u{fffe}' | '\u{ffff}') || (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
     };
-    if !svg.chars().any(bad) {
-        return svg;
+    match crate::files::escape_where(&svg, bad, |c| c.escape_unicode().to_string()) {
+        std::borrow::Cow::Owned(escaped) => escaped,
+        std::borrow::Cow::Borrowed(_) => svg,
     }
-    svg.chars()
-        .map(|c| {
-            if bad(c) {
-                c.escape_unicode().to_string()
-            } else {
-                c.to_string()
-            }
-        })
-        .collect()
 }
 
 /// The legend of `chart`'s labelled series at `position`, on a light box with a black border.

@@ -25,20 +25,20 @@ pub fn shown(path: &Path) -> String {
 /// `text` with its control characters escaped as [`shown`] does (for paths already held as text).
 #[must_use]
 pub fn escaped(text: &str) -> Cow<'_, str> {
-    if !text.chars().any(char::is_control) {
+    escape_where(text, char::is_control, |c| c.escape_default().to_string())
+}
+
+/// `text` with each character that is `bad` written as `escape` writes it.
+pub(crate) fn escape_where(
+    text: &str,
+    bad: impl Fn(char) -> bool,
+    escape: impl Fn(char) -> String,
+) -> Cow<'_, str> {
+    if !text.chars().any(&bad) {
         return Cow::Borrowed(text);
     }
-    Cow::Owned(
-        text.chars()
-            .map(|c| {
-                if c.is_control() {
-                    c.escape_default().to_string()
-                } else {
-                    c.to_string()
-                }
-            })
-            .collect(),
-    )
+    let each = |c| if bad(c) { escape(c) } else { c.to_string() };
+    Cow::Owned(text.chars().map(each).collect())
 }
 
 /// The most characters of a name or a quoted line that a message or a table shows: crafted inputs held

@@ -104,17 +104,14 @@ pub(super) fn kind_of(meta: &Metadata) -> &'static str {
     {
         use std::os::unix::fs::FileTypeExt;
         let t = meta.file_type();
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_fifo() {
-            return "a named pipe";
-        }
-        if t.is_socket() {
-            return "a socket";
+        let kinds = [
+            (t.is_char_device(), "a character device"),
+            (t.is_block_device(), "a block device"),
+            (t.is_fifo(), "a named pipe"),
+            (t.is_socket(), "a socket"),
+        ];
+        if let Some((_, what)) = kinds.into_iter().find(|(is, _)| *is) {
+            return what;
         }
     }
     "a special file"
@@ -570,11 +567,8 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
 #[derive(Debug)]
 pub struct OutputFolder {
     dir: PathBuf,
-    overwrite: bool,
-    /// The command has `--overwrite` ([`Policy::overwrite_flag`]).
-    overwrite_flag: bool,
-    /// A file no output may replace, and what it is ([`Policy::protect`]).
-    protect: Option<(PathBuf, &'static str)>,
+    /// The policy of each file.
+    policy: Policy,
     outputs: Vec<Output>,
     /// The folders this created, deepest first.
     created: Vec<PathBuf>,
@@ -591,9 +585,7 @@ impl OutputFolder {
         // Created from the top down; on failure, what was created is removed (by `Drop`).
         let mut folder = Self {
             dir: dir.to_path_buf(),
-            overwrite,
-            overwrite_flag: false,
-            protect: None,
+            policy: folder_policy(overwrite),
             outputs: Vec::new(),
             created: Vec::new(),
         };
@@ -629,7 +621,7 @@ impl OutputFolder {
     /// The command has `--overwrite`, which messages may name ([`Policy::overwrite_flag`]).
     #[must_use]
     pub fn with_overwrite_flag(mut self) -> Self {
-        self.overwrite_flag = true;
+        self.policy.overwrite_flag = true;
         self
     }
 
@@ -637,7 +629,7 @@ impl OutputFolder {
     /// what it is: [`Policy::protect`].
     #[must_use]
     pub fn protecting(mut self, file: &Path, what: &'static str) -> Self {
-        self.protect = Some((file.to_path_buf(), what));
+        self.policy.protect = Some((file.to_path_buf(), what));
         self
     }
 
@@ -646,12 +638,7 @@ impl OutputFolder {
     /// # Errors
     /// As [`Output::create`].
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
-        let policy = Policy {
-            protect: self.protect.clone(),
-            overwrite_flag: self.overwrite_flag,
-            ..folder_policy(self.overwrite)
-        };
-        let mut output = Output::create(&self.dir.join(name), &policy)?;
+        let mut output = Output::create(&self.dir.join(name), &self.policy)?;
         let file = output
             .file()
             .try_clone()

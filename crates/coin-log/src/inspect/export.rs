@@ -59,11 +59,10 @@ pub struct Table {
 }
 
 /// A channel not exported, and why.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Skipped {
-    /// Topic.
     pub topic: String,
-    /// Why.
     pub reason: String,
 }
 

@@ -6,22 +6,20 @@
 use crate::format::channels::{Topic, ROS_STRING_WIRE};
 use crate::format::{ResultMetadata, RunMetadata, RESULT_METADATA_NAME, RUN_METADATA_NAME};
 use crate::scene::SceneFile;
-use coin_log_mcap::{self, MessageHeader, ReadError, Visitor};
+use coin_log_mcap::{self, ChannelSummary, MessageHeader, ReadError, Visitor};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 use std::path::Path;
 
 /// One channel of a file (an entry of `info --json`'s `channels`).
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChannelReport {
-    /// Topic.
     pub topic: String,
     /// Schema name (`""` without a schema).
     pub schema: String,
-    /// Message encoding.
     pub message_encoding: String,
-    /// Messages on the channel.
     pub messages: u64,
     /// Messages per second of log time (per time unit of a coin-log scene) over the file's time span:
     /// (messages − 1) / span; `None` with fewer than two messages or a zero span.
@@ -85,14 +83,7 @@ impl FileInfo {
     /// channels`.
     #[must_use]
     pub fn encoding(&self) -> String {
-        let set: std::collections::BTreeSet<&str> = self
-            .summary
-            .channels
-            .iter()
-            .map(|c| c.message_encoding.as_str())
-            .collect();
-        let list: Vec<&str> = set.into_iter().collect();
-        match list.as_slice() {
+        match self.encodings(|_| true).as_slice() {
             [] => "no channels".into(),
             [one] => (*one).to_string(),
             more => format!("mixed ({})", more.join(", ")),
@@ -105,17 +96,18 @@ impl FileInfo {
     #[must_use]
     pub fn recorded_encoding(&self) -> String {
         let robot = Topic::RerunRobot.name();
-        let set: std::collections::BTreeSet<&str> = self
-            .summary
-            .channels
-            .iter()
-            .filter(|c| !(c.topic == robot && c.message_encoding == ROS_STRING_WIRE.2))
-            .map(|c| c.message_encoding.as_str())
-            .collect();
-        match set.into_iter().collect::<Vec<_>>().as_slice() {
+        let cdr = |c: &ChannelSummary| c.topic == robot && c.message_encoding == ROS_STRING_WIRE.2;
+        match self.encodings(|c| !cdr(c)).as_slice() {
             [one] => (*one).to_string(),
             _ => self.encoding(),
         }
+    }
+
+    /// The distinct message encodings of the channels `keep` keeps, sorted.
+    fn encodings(&self, keep: impl Fn(&ChannelSummary) -> bool) -> Vec<&str> {
+        let channels = self.summary.channels.iter().filter(|c| keep(c));
+        let set: BTreeSet<&str> = channels.map(|c| c.message_encoding.as_str()).collect();
+        set.into_iter().collect()
     }
 
     /// The channels, by id, with their message rates.

@@ -257,22 +257,18 @@ impl Collect {
 
 impl Visitor for Collect {
     fn channel(&mut self, id: u16, topic: &str, _: &str, schema: Option<&Schema<'_>>) {
-        let Some(s) = schema else {
-            return;
-        };
-        let Some(c) = Channel::from_topic(topic).filter(|c| c.schema_name() == s.name) else {
-            return;
-        };
-        let Some(t) = c.message_type() else {
-            return;
-        };
-        match FieldReader::new(&s.encoding, t, &s.data) {
-            Ok((r, _)) => {
+        let reader = schema.and_then(|s| {
+            let c = Channel::from_topic(topic).filter(|c| c.schema_name() == s.name)?;
+            Some((c, FieldReader::new(&s.encoding, c.message_type()?, &s.data)))
+        });
+        match reader {
+            Some((c, Ok((r, _)))) => {
                 self.readers.insert(id, (c, r));
             }
-            Err(e) => {
+            Some((_, Err(e))) => {
                 self.problem.get_or_insert_with(|| format!("{topic}: {e}"));
             }
+            None => {}
         }
     }
     fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {

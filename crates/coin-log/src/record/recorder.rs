@@ -8,12 +8,12 @@ use super::foxglove::{Foxglove3d, FoxgloveBatch, PROTOBUF_MAX_SECONDS};
 use super::summary::{Failure, RecordSummary};
 use crate::format::messages::{
     drift_eps, friction_ratio, Angles, AngularVelocity, EnergyMessage, InvariantsMessage, Message,
-    NonFiniteField, Position, QuaternionMessage, ReactionMessage, WorkMessage,
+    Position, QuaternionMessage, ReactionMessage, WorkMessage,
 };
 use crate::format::promise::{self, Shortfall};
 use crate::format::tolerances::{RunAccuracy, Tolerances, MIN_SAMPLES_PER_PERIOD};
 use crate::format::{
-    header_library, log_time, Channel, Encoding, ResultMetadata, Termination, TimeError, Topic,
+    header_library, log_time, Channel, Encoding, ResultMetadata, Termination, Topic,
     RESULT_METADATA_NAME, RUN_METADATA_NAME,
 };
 use crate::integrate::{self, Bounds, Flow, RunOutcome, RunSettings};
@@ -60,26 +60,20 @@ pub enum RecordError {
     #[error("the `invariants` channel cannot be recorded for this body")]
     Invariants(#[from] InvariantsError),
     /// The run is longer than Foxglove's Protobuf timestamps reach (u32 seconds).
+    #[allow(missing_docs)]
     #[error(
         "the run lasts {duration} time units, longer than the {max} seconds a Protobuf timestamp of Foxglove's \
          schemas holds; record it with --encoding json, or shorten run.duration"
     )]
-    TooLongForProtobuf {
-        /// The scene's duration.
-        duration: f64,
-        /// The longest.
-        max: f64,
-    },
+    TooLongForProtobuf { duration: f64, max: f64 },
     /// A channel the file's encoding cannot carry (`rerun` is for Rerun, which decodes Protobuf).
+    #[allow(missing_docs)]
     #[error(
         "the `{channel}` channel is recorded in {} only (Rerun's MCAP importer decodes Protobuf, not JSON): \
          record it with --encoding protobuf, or leave `{channel}` out",
         channel.encodings().iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
     )]
-    Encoding {
-        /// The channel.
-        channel: Channel,
-    },
+    Encoding { channel: Channel },
 }
 
 /// Why writing a sample stopped the run.
@@ -93,14 +87,9 @@ impl From<WriteError> for SampleError {
         Self::Write(e)
     }
 }
-impl From<NonFiniteField> for SampleError {
-    fn from(e: NonFiniteField) -> Self {
-        Self::Failure(Failure::Message(e))
-    }
-}
-impl From<TimeError> for SampleError {
-    fn from(e: TimeError) -> Self {
-        Self::Failure(Failure::Time(e))
+impl<E: Into<Failure>> From<E> for SampleError {
+    fn from(e: E) -> Self {
+        Self::Failure(e.into())
     }
 }
 
@@ -515,14 +504,13 @@ pub fn expected_shortfalls(scene: &Scene) -> Vec<Shortfall> {
 }
 
 /// [`promise::shortfalls`] of a recording of `scene` integrated as `accuracy`, naming only checks verify
-/// will run on it (format.md: verify): `steady` only on an unperturbed steady start, `nutation` never on
-/// one (a steady motion does not nutate), and with dissipation neither `invariants` nor `nutation` (E, C1
-/// and C2 change), and `nutation` only when the quadrature from the initial state finds a period (verify
-/// skips it otherwise: "there is no period"). `wobble --rtol 1e-7` promised that `steady` would fail,
-/// Euler's disk, 14 000 time units long, `nutation`, `circle-plus --rtol 1e-3 --atol 1e-3` `nutation`,
-/// and `topple --rtol 1e-6 --atol 1e-8`, which lands flat, `nutation`, all of which verify skipped.
-/// After the run, `max_omega_x` (max|ω_X| over the samples) also leaves out a `nutation` that verify will
-/// skip as too small to time (`wobble --rtol 1e-5 --atol 1e-7`: 5.5e-6 of T, above 1e-6).
+/// will run on it (format.md: verify): `steady` only on an unperturbed steady start; `invariants` and
+/// `nutation` only without dissipation (E, C1, C2 change), `nutation` only off a steady start (which does
+/// not nutate) and when the quadrature finds a period (else "there is no period"). Skipped checks were
+/// promised by `wobble --rtol 1e-7` (`steady`), Euler's disk (14 000 time units), `circle-plus --rtol 1e-3
+/// --atol 1e-3` and `topple --rtol 1e-6 --atol 1e-8`, which lands flat (`nutation`). After the run,
+/// `max_omega_x` (max|ω_X| over the samples) also leaves out a `nutation` too small to time
+/// (`wobble --rtol 1e-5 --atol 1e-7`: 5.5e-6 of T, above 1e-6).
 fn shortfalls(scene: &Scene, accuracy: &RunAccuracy, max_omega_x: Option<f64>) -> Vec<Shortfall> {
     let mut shortfalls = promise::shortfalls(
         accuracy,
@@ -601,27 +589,22 @@ fn fixed_steps(scene: &Scene, span: f64) -> Option<promise::FixedSteps> {
 
 /// How the integration ended, as the file records it: termination, its time, and the failure if any.
 fn ending(end: &integrate::RunEnd, t_last: f64) -> (Termination, f64, Option<Failure>) {
-    let termination = Termination::of_run(end);
-    match end {
-        integrate::RunEnd::Completed => (termination, t_last, None),
-        integrate::RunEnd::Event { t, .. } | integrate::RunEnd::Stopped { t } => {
-            (termination, *t, None)
-        }
-        integrate::RunEnd::Failed(e) => {
-            let t = match e {
-                integrate::StepError::NonFinite { t }
-                | integrate::StepError::StepSizeUnderflow { t, .. }
-                | integrate::StepError::NewtonFailure { t, .. }
-                | integrate::StepError::BudgetSpent { t, .. } => *t,
-            };
-            (termination, t, Some(Failure::Step(e.clone())))
-        }
-    }
+    use integrate::{RunEnd, StepError};
+    let (t, failure) = match end {
+        RunEnd::Completed => (t_last, None),
+        RunEnd::Event { t, .. } | RunEnd::Stopped { t } => (*t, None),
+        RunEnd::Failed(e) => match e {
+            StepError::NonFinite { t }
+            | StepError::StepSizeUnderflow { t, .. }
+            | StepError::NewtonFailure { t, .. }
+            | StepError::BudgetSpent { t, .. } => (*t, Some(Failure::Step(e.clone()))),
+        },
+    };
+    (Termination::of_run(end), t, failure)
 }
 
-/// Runs the scene's integrator, writing each sample one sample late (so that the last one can be flagged
-/// as last), reporting progress and honouring `stop`. Returns the integrator's outcome and the error that
-/// stopped writing, if one did.
+/// Runs the scene's integrator, writing each sample one sample late (module docs), reporting progress and
+/// honouring `stop`; returns the integrator's outcome and the error that stopped writing, if one did.
 fn integrate_into<W: Write + Seek, T: Tap>(
     scene: &Scene,
     sampler: &mut Sampler<'_, W, T>,

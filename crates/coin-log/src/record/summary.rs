@@ -14,10 +14,10 @@ pub enum Failure {
     Step(StepError),
     /// A derived quantity of a sample (energy, reaction, ...) was not finite.
     #[error(transparent)]
-    Message(NonFiniteField),
+    Message(#[from] NonFiniteField),
     /// A sample time had no log time.
     #[error(transparent)]
-    Time(TimeError),
+    Time(#[from] TimeError),
 }
 
 impl Failure {

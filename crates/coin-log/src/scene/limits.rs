@@ -416,46 +416,32 @@ fn refuse_power(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
         number(k)
     );
     let ln_max = f64::MAX.ln();
-    if !angle_factor.is_finite() {
+    let bound = |name: &str, max: f64| format!("use {name} < {}", short(max, Round::Down));
+    let (key, value, factor, fix) = if !angle_factor.is_finite() {
         // ln P = ln(κ |φ̇|^m) + k ln(1/sin α) < ln(MAX); the factor alone must stay finite too.
         let ln_rest = (kappa.ln() + m * phi_dot.ln()).max(0.0);
         let k_max = (ln_max - ln_rest) / -sin_alpha.ln();
-        problems.push(
+        (
             "body.dissipation.k",
             number(k),
-            format!(
-                "{laws}: (sin α)^(−k) overflows double precision; use k < {}",
-                short(k_max, Round::Down)
-            ),
-        );
+            "(sin α)^(−k)",
+            bound("k", k_max),
+        )
     } else if !rate_factor.is_finite() && d.model() == DissipationModel::PowerLaw && phi_dot > 1.0 {
         // ln P = ln(κ (sin α)^(−k)) + m ln|φ̇| < ln(MAX), and m ≥ 1.
         let ln_rest = (kappa.ln() + angle_factor.ln()).max(0.0);
-        problems.push(
-            "body.dissipation.m",
-            number(m),
-            format!(
-                "{laws}: |φ̇|^m overflows double precision; use m < {}",
-                short((ln_max - ln_rest) / phi_dot.ln(), Round::Down)
-            ),
-        );
+        let m_max = (ln_max - ln_rest) / phi_dot.ln();
+        ("body.dissipation.m", number(m), "|φ̇|^m", bound("m", m_max))
     } else if !rate_factor.is_finite() {
-        problems.push(
-            initial_key(scene),
-            describe_state(s),
-            format!("{laws}: |φ̇|^m overflows double precision; lower the spin"),
-        );
+        let fix = "lower the spin".to_string();
+        (initial_key(scene), describe_state(s), "|φ̇|^m", fix)
     } else {
         let kappa_max = f64::MAX / rate_factor / angle_factor;
-        problems.push(
-            "body.dissipation.coefficient",
-            number(kappa),
-            format!(
-                "{laws}: P overflows double precision; use coefficient < {}",
-                short(kappa_max, Round::Down)
-            ),
-        );
-    }
+        let fix = bound("coefficient", kappa_max);
+        ("body.dissipation.coefficient", number(kappa), "P", fix)
+    };
+    let reason = format!("{laws}: {factor} overflows double precision; {fix}");
+    problems.push(key, value, reason);
 }
 
 fn initial_key(scene: &Scene) -> &'static str {

@@ -60,14 +60,10 @@ pub enum SceneError {
     /// The TOML does not parse or does not fit the scene's keys and types (serde's message, alone).
     #[error("{0}")]
     Parse(String),
-    /// A `--set KEY=VALUE` that cannot be applied.
+    /// A `--set KEY=VALUE` (`arg`, as given) that cannot be applied, and why.
+    #[allow(missing_docs)]
     #[error("`--set {arg}`: {reason}")]
-    Set {
-        /// The argument as given.
-        arg: String,
-        /// What is wrong.
-        reason: String,
-    },
+    Set { arg: String, reason: String },
     /// Values out of range, missing or contradictory; every problem found (at least one).
     #[error("{0}")]
     Invalid(SceneProblems),

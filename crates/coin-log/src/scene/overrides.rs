@@ -174,26 +174,19 @@ pub(crate) fn explain_bare_strings(error: SceneError, sets: &[String]) -> SceneE
     SceneError::Parse(explained)
 }
 
-/// The explicit `record` flags that override scene keys (applied after `--set`).
+/// The explicit `record` flags that override scene keys (applied after `--set`): `--<field>` (`-` for `_`)
+/// sets `run.<field>`, `--channels` `record.channels` and `--rerun` `record.rerun = true`.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FlagOverrides {
-    /// `--duration` → `run.duration`.
     pub duration: Option<f64>,
-    /// `--rate` → `run.rate`.
     pub rate: Option<f64>,
-    /// `--integrator` → `run.integrator`.
     pub integrator: Option<String>,
-    /// `--rtol` → `run.rtol`.
     pub rtol: Option<f64>,
-    /// `--atol` → `run.atol`.
     pub atol: Option<f64>,
-    /// `--step` → `run.step`.
     pub step: Option<f64>,
-    /// `--max-steps` → `run.max_steps`.
     pub max_steps: Option<u64>,
-    /// `--channels` → `record.channels`.
     pub channels: Option<Vec<String>>,
-    /// `--rerun` → `record.rerun = true`.
     pub rerun: bool,
 }
 

@@ -9,6 +9,7 @@ use super::{
 };
 use crate::format::messages::push_number;
 use nalgebra::{UnitQuaternion, Vector3};
+use std::io::Write as _;
 
 const IDENTITY_POSE: &[u8] =
     br#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
@@ -47,19 +48,19 @@ impl<'a> Writer<'a> {
         self.buf.push(b'}');
     }
 
-    fn uint(&mut self, mut n: u64) {
-        let mut digits = [0u8; 20];
-        let mut i = digits.len();
-        loop {
-            i -= 1;
-            // n % 10 < 10 always fits in a u8.
-            digits[i] = b'0' + u8::try_from(n % 10).unwrap_or(0);
-            n /= 10;
-            if n == 0 {
-                break;
+    fn uint(&mut self, n: u64) {
+        // Writing into a Vec cannot fail.
+        let _ = write!(self.buf, "{n}");
+    }
+
+    /// Each of `items` as `write` writes it, separated by commas.
+    fn list<T>(&mut self, items: impl IntoIterator<Item = T>, mut write: impl FnMut(&mut Self, T)) {
+        for (i, item) in items.into_iter().enumerate() {
+            if i > 0 {
+                self.raw(b",");
             }
+            write(self, item);
         }
-        self.buf.extend_from_slice(&digits[i..]);
     }
 
     /// `{"sec":S,"nsec":N}` of a log time in ns.
@@ -154,18 +155,15 @@ pub(super) fn coin(buf: &mut Vec<u8>, log_time: u64, r: &UnitQuaternion<f64>, th
     let mut w = Writer::new(buf);
     w.entity_head(log_time, FOLLOW_FRAME, b"coin");
     w.raw(b"\"cubes\":[");
-    for (i, (position, size, colour)) in coin_marks(r, thickness).iter().enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
+    w.list(coin_marks(r, thickness), |w, (position, size, colour)| {
         w.raw(b"{\"pose\":");
-        w.pose(position, r);
+        w.pose(&position, r);
         w.raw(b",\"size\":");
-        w.xyzw(size);
+        w.xyzw(&size);
         w.raw(b",\"color\":");
-        w.color(*colour);
+        w.color(colour);
         w.raw(b"}");
-    }
+    });
     w.raw(b"],\"spheres\":[],\"cylinders\":[{\"pose\":");
     w.pose(&Vector3::zeros(), r);
     w.raw(b",\"size\":");
@@ -188,12 +186,7 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
     w.raw(b",\"color\":");
     w.color(TABLE_RGBA);
     w.raw(b"}],\"spheres\":[],\"cylinders\":[],\"lines\":[");
-    for major in [false, true] {
-        if major {
-            w.raw(b",");
-        }
-        grid(&mut w, centre, major);
-    }
+    w.list([false, true], |w, major| grid(w, centre, major));
     w.raw(b"],");
     w.entity_tail();
 }
@@ -205,14 +198,11 @@ fn grid(w: &mut Writer, centre: [f64; 2], major: bool) {
     w.raw(b"},\"orientation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}},\"thickness\":");
     w.num(GRID_WIDTHS[usize::from(major)]);
     w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, (a, b)) in grid_segments(centre, major).enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
+    w.list(grid_segments(centre, major), |w, (a, b)| {
         w.point(a[0], a[1]);
         w.raw(b",");
         w.point(b[0], b[1]);
-    }
+    });
     w.raw(b"],\"color\":");
     w.color(GRID_RGBA[usize::from(major)]);
     w.raw(b",\"colors\":[],\"indices\":[]}");
@@ -227,12 +217,7 @@ pub(super) fn track(buf: &mut Vec<u8>, log_time: u64, points: &[TrackPoint]) {
     w.raw(b",\"thickness\":");
     w.num(TRACK_WIDTH);
     w.raw(b",\"scale_invariant\":true,\"points\":[");
-    for (i, p) in points.iter().enumerate() {
-        if i > 0 {
-            w.raw(b",");
-        }
-        w.point(p.x, p.y);
-    }
+    w.list(points, |w, p| w.point(p.x, p.y));
     w.raw(b"],\"color\":");
     w.color(TRACK_RGBA);
     w.raw(b",\"colors\":[],\"indices\":[]}],");

@@ -150,8 +150,7 @@ pub(super) fn table(buf: &mut Vec<u8>, log_time: u64, centre: [f64; 2]) {
             scale_invariant: true,
             points,
             color: color(GRID_RGBA[usize::from(major)]),
-            colors: Vec::new(),
-            indices: Vec::new(),
+            ..LinePrimitive::default()
         });
     }
     update(e).encode_raw(buf);
@@ -168,8 +167,7 @@ pub(super) fn track(buf: &mut Vec<u8>, log_time: u64, points: &[TrackPoint]) {
         scale_invariant: true,
         points: line,
         color: color(TRACK_RGBA),
-        colors: Vec::new(),
-        indices: Vec::new(),
+        ..LinePrimitive::default()
     });
     update(e).encode_raw(buf);
 }

@@ -46,9 +46,9 @@ pub(crate) struct TrackPoint {
 }
 
 /// The track's levels and the points not yet in any level.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Track {
-    levels: Vec<Vec<TrackPoint>>,
+    levels: [Vec<TrackPoint>; TRACK_LEVELS],
     /// Points since the previous update.
     pending: Vec<TrackPoint>,
     /// The last point given (the chain's end once an update has taken it).
@@ -63,22 +63,6 @@ pub(crate) struct Track {
     keep: Vec<bool>,
     errors: Vec<f64>,
     stack: Vec<(usize, usize)>,
-}
-
-impl Default for Track {
-    fn default() -> Self {
-        Self {
-            levels: vec![Vec::new(); TRACK_LEVELS],
-            pending: Vec::with_capacity(64),
-            last: None,
-            end: None,
-            updates: 0,
-            merged: Vec::new(),
-            keep: Vec::new(),
-            errors: Vec::new(),
-            stack: Vec::new(),
-        }
-    }
 }
 
 impl Track {
