@@ -39,7 +39,7 @@ pub struct ExportArgs {
     /// One table `samples.csv`: t, then `<channel>.<field>` for every coin_log channel, one row per sample.
     #[arg(long)]
     wide: bool,
-    /// Replace tables that exist in DIR.
+    /// Replace tables that exist in DIR (other CSV files there are left alone, and named in a warning).
     #[arg(long)]
     overwrite: bool,
     /// Print what was written as one JSON object: `{"file", "out", "messages", "tables": [{"name",
@@ -95,7 +95,31 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<Outcome> {
     let summary = result.map_err(|e| anyhow!("{shown_file}: {e}"))?;
     folder.commit()?;
     report(args, &dir, &summary)?;
+    warn_of_other_tables(&dir, &summary);
     Ok(Outcome::Success)
+}
+
+/// Names the CSV files in `dir` this export did not write (an earlier export of another recording, with
+/// other channels, into the same folder): they are left alone, since they may be the user's, but read
+/// beside this export's tables they would mix two recordings.
+fn warn_of_other_tables(dir: &Path, summary: &ExportSummary) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut others: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|name| name.ends_with(".csv") && !summary.tables.iter().any(|t| t.name == *name))
+        .collect();
+    if others.is_empty() {
+        return;
+    }
+    others.sort();
+    errln!(
+        "warning: {} also holds {}, which this export did not write (an earlier export of another \
+         recording?): remove them, or export into an empty folder, before reading the tables together",
+        shown(dir),
+        others.join(", ")
+    );
 }
 
 fn report(args: &ExportArgs, dir: &Path, s: &ExportSummary) -> anyhow::Result<()> {

@@ -599,6 +599,38 @@ fn export_of_a_file_without_coin_log_channels_exits_non_zero() {
     assert_eq!(listing(dir.path()), ["other.mcap"], "no folder left");
 }
 
+/// `export --overwrite` into a folder that holds a table this export does not write (another recording's
+/// channel) replaces its own tables, leaves the other one alone and names it on stderr; the control, the
+/// same export into the folder without it, warns of nothing.
+#[test]
+fn export_names_the_tables_in_its_folder_that_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = crate::support::record::record_scene(dir.path(), "straight", &["--duration", "0.1"]);
+    let file = file.to_str().unwrap();
+    let (code, _, err) = run(dir.path(), &["export", file, "--out", "t"], Stdio::null());
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        !err.contains("warning"),
+        "nothing else in the folder: {err}"
+    );
+    std::fs::write(dir.path().join("t/extra.csv"), "t,x\n0,1\n").unwrap();
+    let (code, _, err) = run(
+        dir.path(),
+        &["export", file, "--out", "t", "--overwrite"],
+        Stdio::null(),
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning: t also holds extra.csv, which this export did not write"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("t/extra.csv")).unwrap(),
+        "t,x\n0,1\n",
+        "left alone"
+    );
+}
+
 // The library's policies (coin_log::files) without a child process.
 
 fn policy(overwrite: bool) -> Policy {
