@@ -19,16 +19,14 @@ const LISTED_RANGES: usize = 20;
 /// The wrong lines of a part named one by one before the rest are only counted.
 const LISTED_LINES: usize = 20;
 
-/// What collect found and wrote.
+/// What collect found and wrote: the sweep's `runs`, the `parts` read (by name), the rows `finished` and
+/// `failed`.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct Collected {
-    /// The sweep's runs.
     pub runs: u64,
-    /// The parts read, by name.
     pub parts: Vec<String>,
-    /// Rows finished.
     pub finished: u64,
-    /// Rows failed.
     pub failed: u64,
     /// What is missing or wrong, one sentence each; empty when the catalogue was written.
     pub problems: Vec<String>,

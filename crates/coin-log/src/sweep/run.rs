@@ -36,36 +36,33 @@ pub struct RunOptions {
     pub retry_failed: bool,
 }
 
-/// Where a sweep stands, after each run.
+/// Where a sweep stands, after each run: of this shard's `runs`, the `todo` ones of this invocation (the
+/// rest were done before) and the `done` ones of those so far; the shard's rows `failed` so far (kept and
+/// new).
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[allow(missing_docs)]
 pub struct Progress {
-    /// This shard's runs.
     pub runs: u64,
-    /// Runs to do in this invocation (the rest were done before).
     pub todo: u64,
-    /// Of those, done so far.
     pub done: u64,
-    /// Rows of this shard that are failed, so far (kept and new).
     pub failed: u64,
     /// The first run this invocation saw fail: its index and its row's reason, led by the `failure` kind,
     /// so that a front end can say so while the runs like it are still ahead.
     pub first_failure: Option<(u64, String)>,
 }
 
-/// How a sweep invocation ended.
+/// How a sweep invocation ended: of this shard's `runs`, the rows `finished` and `failed` and the runs
+/// `pending` without a row (interrupted, or not started); the rows `kept` from an earlier invocation
+/// (resume) and the runs `done` now (finished or failed); the seconds spent recording and verifying,
+/// summed over the runs done now.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct SweepOutcome {
-    /// This shard's runs.
     pub runs: u64,
-    /// Rows finished.
     pub finished: u64,
-    /// Rows failed.
     pub failed: u64,
-    /// Runs without a row (interrupted, or not started).
     pub pending: u64,
-    /// Rows kept from an earlier invocation (resume).
     pub kept: u64,
-    /// Runs done now (finished or failed).
     pub done: u64,
     /// Whether a stop request ended it early: with runs left without a row (one that came after the
     /// last run ended nothing early, and exited 130, so that `afterok` skipped collect).
@@ -74,9 +71,7 @@ pub struct SweepOutcome {
     pub catalogue: PathBuf,
     /// `sweep.json`, for a whole sweep.
     pub summary: Option<PathBuf>,
-    /// Seconds spent in recording, summed over the runs done now.
     pub record_seconds: f64,
-    /// Seconds spent in verifying, summed over the runs done now.
     pub verify_seconds: f64,
 }
 
