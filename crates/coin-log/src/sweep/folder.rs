@@ -133,20 +133,20 @@ impl Folder {
         // The folder and its missing parents: a link to nothing or a file among them would make
         // creating it fail with a bare "File exists" or "Not a directory".
         let mut missing = path.ancestors().filter(|d| !d.as_os_str().is_empty());
-        let in_the_way = missing.find_map(|d| match fs::metadata(d) {
-            Ok(m) if m.is_dir() => Some(None),
-            Ok(_) => Some(Some(format!(
-                "cannot be created: `{}` is not a folder; give -o a folder for the sweep's files",
-                d.display()
-            ))),
-            Err(_) => files::dangling_link(d).map(|to| {
-                let (link, to) = (d.display(), to.display());
-                Some(if d == path {
-                    format!("is a symbolic link to `{to}`, which does not exist: create that folder, or give -o another")
-                } else {
-                    format!("cannot be created: `{link}` is a symbolic link to `{to}`, which does not exist: create that folder, or give -o another")
-                })
-            }),
+        let in_the_way = missing.find_map(|d| {
+            let why = match fs::metadata(d) {
+                Ok(m) if m.is_dir() => return Some(None),
+                Ok(_) => "is not a folder; give -o a folder for the sweep's files".to_string(),
+                Err(_) => format!(
+                    "is a symbolic link to `{}`, which does not exist: create that folder, or give -o another",
+                    files::dangling_link(d)?.display()
+                ),
+            };
+            Some(Some(if d == path {
+                why
+            } else {
+                format!("cannot be created: `{}` {why}", d.display())
+            }))
         });
         if let Some(reason) = in_the_way.flatten() {
             return Err(folder_error(reason));
