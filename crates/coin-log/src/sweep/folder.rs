@@ -29,7 +29,7 @@ const FORMAT_VERSION: &str = "1";
 const MTIME_COLUMN: &str = "mtime_ns";
 
 /// `run-<index>.mcap`, the index zero-padded to `width` digits.
-pub fn run_file_name(index: u64, width: usize) -> String {
+fn run_file_name(index: u64, width: usize) -> String {
     format!("run-{index:0width$}.mcap")
 }
 

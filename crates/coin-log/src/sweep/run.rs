@@ -262,7 +262,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             continue;
         }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
-        let own = folder::run_file_name(index, sweep.index_width());
+        let own = folder.run_file_name(index);
         let file_ok = f[file_at].is_empty()
             || f[file_at] == own && {
                 let path = folder.file(&f[file_at]);
@@ -324,7 +324,7 @@ fn record_and_check(
     stop: &AtomicBool,
     row: &mut Row,
 ) -> Result<Option<Spent>, String> {
-    let name = folder::run_file_name(row.index, sweep.index_width());
+    let name = folder.run_file_name(row.index);
     let target = folder.file(&name);
     let io = |what: &str| {
         let what = format!("{what} `{name}`");
