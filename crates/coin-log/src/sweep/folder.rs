@@ -467,22 +467,17 @@ impl Folder {
 /// The first entry of the sweep folder `path`, or of its state folder `state`, that a sweep without a
 /// plan yet cannot have made: anything but the state folder and the plan's temporary files.
 fn foreign_entry(path: &Path, state: &Path) -> Option<String> {
-    let names = |dir: &Path| -> Vec<String> {
-        fs::read_dir(dir).map_or_else(
-            |_| Vec::new(),
-            |entries| {
-                let names = entries.flatten().map(|e| e.file_name());
-                names.map(|n| n.to_string_lossy().into_owned()).collect()
-            },
-        )
+    let names = |dir: &Path| {
+        let entries = fs::read_dir(dir).into_iter().flatten().flatten();
+        entries.map(|e| e.file_name().to_string_lossy().into_owned())
     };
     let plan_temp = |name: &str| {
         name.strip_prefix(&format!(".{PLAN_FILE}."))
             .is_some_and(|rest| rest.ends_with(".tmp"))
     };
-    let outside = names(path).into_iter().find(|n| n != STATE_DIR);
+    let outside = names(path).find(|n| n != STATE_DIR);
     outside.or_else(|| {
-        let inside = names(state).into_iter().find(|n| !plan_temp(n));
+        let inside = names(state).find(|n| !plan_temp(n));
         inside.map(|n| format!("{STATE_DIR}/{n}"))
     })
 }
