@@ -425,15 +425,11 @@ fn verify_reason(r: &FileReport) -> String {
     let verdict = format!("verify: {}", r.verdict.name());
     // The problem of a file that cannot be verified defers to "each check's reason": the catalogue has
     // no other place for them, so the skipped required checks' reasons (what to record) follow it.
-    let skipped: Vec<String> = if r.verdict == Verdict::CannotVerify {
-        r.checks
-            .iter()
-            .filter(|c| c.status == Status::Skip && CheckId::REQUIRED.contains(&c.id))
-            .map(|c| format!("{} skipped: {}", c.id, c.reason))
-            .collect()
-    } else {
-        Vec::new()
-    };
+    let cannot = r.verdict == Verdict::CannotVerify;
+    let skipped: Vec<String> = (r.checks.iter())
+        .filter(|c| cannot && c.status == Status::Skip && CheckId::REQUIRED.contains(&c.id))
+        .map(|c| format!("{} skipped: {}", c.id, c.reason))
+        .collect();
     let skipped = (!skipped.is_empty()).then(|| skipped.join("; "));
     let parts = [Some(verdict), failing, r.problem.clone(), skipped];
     parts.into_iter().flatten().collect::<Vec<_>>().join(": ")
