@@ -193,15 +193,12 @@ fn read_part(
     problems.extend(found.into_iter().map(|(_, problem)| problem));
     let elsewhere = unlisted.iter().filter(|(elsewhere, _)| *elsewhere).count();
     let wrong = unlisted.len() - elsewhere;
-    if wrong > 0 {
-        problems.push(format!(
-            "`{name}`: {wrong} more lines are wrong as well: run its shard again"
-        ));
-    }
-    if elsewhere > 0 {
-        problems.push(format!(
-            "`{name}`: {elsewhere} more of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"
-        ));
+    let more = [
+        (wrong, "lines are wrong as well: run its shard again"),
+        (elsewhere, "of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"),
+    ];
+    for (count, what) in more.into_iter().filter(|&(count, _)| count > 0) {
+        problems.push(format!("`{name}`: {count} more {what}"));
     }
     Ok(())
 }
