@@ -1,7 +1,6 @@
-//! The catalogue (format.md: The catalogue): one row per run, as CSV that pandas, polars and DuckDB read
-//! in one line (RFC 4180: a field is quoted when it holds a comma, a quote or a line break; numbers in
-//! their shortest round-trip form). Every column but `wall_time_s` depends only on the sweep and the
-//! run's index, so that a sharded sweep's collected catalogue equals the one-process one.
+//! The catalogue, one CSV row per run (format.md: The catalogue, which gives its CSV and its columns).
+//! Every column but `wall_time_s` depends only on the sweep and the run's index, so that a sharded
+//! sweep's collected catalogue equals the one-process one.
 
 use crate::format::metadata::number_string as number;
 use crate::format::Termination;
