@@ -24,15 +24,14 @@ use std::time::Instant;
 /// Write buffer in front of each run's file (as `record`'s: the writer issues many small writes).
 const WRITE_BUFFER: usize = 1 << 20;
 
-/// How to run a sweep.
+/// How to run a sweep: `jobs` runs at once (threads, ≥ 1), the `shard`'s runs, and whether to redo failed
+/// runs on resume (`retry_failed`; runs that failed for a reason other than I/O are kept otherwise: their
+/// failure is a property of their values).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
 pub struct RunOptions {
-    /// Runs at once (threads), ≥ 1.
     pub jobs: usize,
-    /// The runs to take.
     pub shard: Shard,
-    /// Redo failed runs on resume (runs that failed for a reason other than I/O are kept otherwise:
-    /// their failure is a property of their values).
     pub retry_failed: bool,
 }
 
