@@ -127,9 +127,8 @@ pub fn run(
         progress: Progress {
             runs,
             todo: runs - kept.len() as u64,
-            done: 0,
             failed: resumed.failed,
-            first_failure: None,
+            ..Progress::default()
         },
         record_seconds: 0.0,
         verify_seconds: 0.0,
