@@ -1,7 +1,6 @@
-//! The catalogue (format.md: The catalogue): one row per run, as CSV that pandas, polars and DuckDB read
-//! in one line (RFC 4180: a field is quoted when it holds a comma, a quote or a line break; numbers in
-//! their shortest round-trip form). Every column but `wall_time_s` depends only on the sweep and the
-//! run's index, so that a sharded sweep's collected catalogue equals the one-process one.
+//! The catalogue, one CSV row per run (format.md: The catalogue, which gives its CSV and its columns).
+//! Every column but `wall_time_s` depends only on the sweep and the run's index, so that a sharded
+//! sweep's collected catalogue equals the one-process one.
 
 use crate::format::metadata::number_string as number;
 use crate::format::Termination;
@@ -40,17 +39,11 @@ coin_log_names::named_enum! {
 /// on I/O has none; a file's `verify` cell is `off` exactly when the sweep does not verify (`verifies`
 /// `None`: not known, not checked).
 pub fn consistent([status, failure, file, verify]: [&str; 4], verifies: Option<bool>) -> bool {
-    let (finished, failed) = (RunStatus::Finished.name(), RunStatus::Failed.name());
-    let wants_file = if status == finished && failure.is_empty() {
-        true
-    } else if status == failed {
-        match failure.parse::<FailureKind>() {
-            Ok(FailureKind::Numerical | FailureKind::Verify) => true,
-            Ok(FailureKind::Scene | FailureKind::Io) => false,
-            Err(_) => return false,
-        }
-    } else {
-        return false;
+    let wants_file = match (status.parse(), failure.parse()) {
+        (Ok(RunStatus::Finished), _) if failure.is_empty() => true,
+        (Ok(RunStatus::Failed), Ok(FailureKind::Numerical | FailureKind::Verify)) => true,
+        (Ok(RunStatus::Failed), Ok(FailureKind::Scene | FailureKind::Io)) => false,
+        _ => return false,
     };
     let has_file = !file.is_empty();
     has_file == wants_file && (!has_file || verifies.is_none_or(|v| v != (verify == "off")))

@@ -19,16 +19,14 @@ const LISTED_RANGES: usize = 20;
 /// The wrong lines of a part named one by one before the rest are only counted.
 const LISTED_LINES: usize = 20;
 
-/// What collect found and wrote.
+/// What collect found and wrote: the sweep's `runs`, the `parts` read (by name), the rows `finished` and
+/// `failed`.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct Collected {
-    /// The sweep's runs.
     pub runs: u64,
-    /// The parts read, by name.
     pub parts: Vec<String>,
-    /// Rows finished.
     pub finished: u64,
-    /// Rows failed.
     pub failed: u64,
     /// What is missing or wrong, one sentence each; empty when the catalogue was written.
     pub problems: Vec<String>,
@@ -58,32 +56,30 @@ pub fn collect(dir: &std::path::Path, jobs: usize) -> Result<Collected, SweepErr
     let running = folder.held_locks(|_| true);
     // Every one of them: the first alone hid the others (two arrays of 2 and 4 on one folder).
     let names: Vec<String> = running.iter().map(ToString::to_string).collect();
-    match names.as_slice() {
-        [] => {}
-        [shard] => problems.push(format!(
-            "shard {shard} is still running in `{}`: collect when every shard has ended",
+    if !names.is_empty() {
+        let (shards, are) = if names.len() == 1 {
+            ("shard", "is")
+        } else {
+            ("shards", "are")
+        };
+        problems.push(format!(
+            "{shards} {} {are} still running in `{}`: collect when every shard has ended",
+            names.join(", "),
             dir.display()
-        )),
-        many => problems.push(format!(
-            "shards {} are still running in `{}`: collect when every shard has ended",
-            many.join(", "),
-            dir.display()
-        )),
+        ));
     }
     // A folder swept whole has no parts: the sweep wrote its catalogue itself. Running "the shards that
     // hold" its runs, as the list of missing runs advised, wrote no part either (one shard is the whole).
-    let none = parts.is_empty() && running.is_empty();
-    if none && folder.swept_whole() {
+    if parts.is_empty() && running.is_empty() {
+        let what = if folder.swept_whole() {
+            "it was swept whole, not in shards, so the sweep wrote its catalogue.csv and sweep.json itself \
+             (collect merges the parts of shards, --shard K/N); to bring them up to date, run `coin-log \
+             sweep SWEEP.toml -o DIR` again: it resumes"
+        } else {
+            "run the shards first, `coin-log sweep SWEEP.toml -o DIR --shard K/N`"
+        };
         problems.push(format!(
-            "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: it was swept whole, not in shards, so the \
-             sweep wrote its catalogue.csv and sweep.json itself (collect merges the parts of shards, \
-             --shard K/N); to bring them up to date, run `coin-log sweep SWEEP.toml -o DIR` again: it \
-             resumes",
-            dir.display()
-        ));
-    } else if none {
-        problems.push(format!(
-            "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: run the shards first, `coin-log sweep SWEEP.toml -o DIR --shard K/N`",
+            "no catalogue parts (catalogue.part-K-of-N.csv) in `{}`: {what}",
             dir.display()
         ));
     }
@@ -197,15 +193,12 @@ fn read_part(
     problems.extend(found.into_iter().map(|(_, problem)| problem));
     let elsewhere = unlisted.iter().filter(|(elsewhere, _)| *elsewhere).count();
     let wrong = unlisted.len() - elsewhere;
-    if wrong > 0 {
-        problems.push(format!(
-            "`{name}`: {wrong} more lines are wrong as well: run its shard again"
-        ));
-    }
-    if elsewhere > 0 {
-        problems.push(format!(
-            "`{name}`: {elsewhere} more of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"
-        ));
+    let more = [
+        (wrong, "lines are wrong as well: run its shard again"),
+        (elsewhere, "of its runs are in another part as well: delete the parts of an earlier sharding (shards of one N make each run once)"),
+    ];
+    for (count, what) in more.into_iter().filter(|&(count, _)| count > 0) {
+        problems.push(format!("`{name}`: {count} more {what}"));
     }
     Ok(())
 }
@@ -318,18 +311,17 @@ fn check_rows(
             _ => sha256_file(&path),
         };
         let problem = match hashed {
-            Err(e) => format!("`{}` (run {}) cannot be read: {e}", f[file_at], f[0]),
+            Err(e) => format!("cannot be read: {e}"),
             Ok((_, len)) if len.to_string() != f[bytes_at] => format!(
-                "`{}` (run {}) has {len} bytes, its row {}: it was changed or cut; run its shard again to redo it",
-                f[file_at], f[0], f[bytes_at]
+                "has {len} bytes, its row {}: it was changed or cut; run its shard again to redo it",
+                f[bytes_at]
             ),
-            Ok((sha, _)) if sha != f[sha_at] => format!(
-                "`{}` (run {}) does not match its row's SHA-256: it was changed; run its shard again to redo it",
-                f[file_at], f[0]
-            ),
+            Ok((sha, _)) if sha != f[sha_at] => {
+                "does not match its row's SHA-256: it was changed; run its shard again to redo it".into()
+            }
             Ok(_) => return None,
         };
-        Some((index, problem))
+        Some((index, format!("`{}` (run {}) {problem}", f[file_at], f[0])))
     };
     let mut problems = Vec::new();
     let never = AtomicBool::new(false);

@@ -5,49 +5,37 @@ use crate::scene::SceneProblems;
 use std::path::PathBuf;
 
 /// A sweep file that cannot be used, a folder that cannot hold the sweep, or an I/O error on the sweep's
-/// own files (the catalogue, the journal, the state).
+/// own files (the catalogue, the journal, the state). `path` is the file or folder, `label` the sweep file
+/// as named, `source` the cause.
 #[derive(Debug, thiserror::Error)]
+#[allow(missing_docs)]
 pub enum SweepError {
     /// The sweep file cannot be read.
     #[error("cannot read sweep file `{}`: {source}", path.display())]
     Read {
-        /// The file.
         path: PathBuf,
-        /// The cause.
         source: crate::files::InputError,
     },
-    /// The sweep file is not TOML or does not fit the sweep's keys and types (serde's message, alone).
+    /// The sweep file is not TOML or does not fit the sweep's keys and types (serde's `message`, alone).
     #[error("sweep file `{label}`: {message}")]
-    Parse {
-        /// The sweep file as named.
-        label: String,
-        /// What is wrong, and where.
-        message: String,
-    },
-    /// Values out of range, missing or contradictory: every problem found, each with its key.
+    Parse { label: String, message: String },
+    /// Values out of range, missing or contradictory: every problem found (at least one; boxed: a list
+    /// is large beside the other variants), each with its key.
     #[error("sweep file `{label}`: {problems}")]
     Invalid {
-        /// The sweep file as named.
         label: String,
-        /// Every problem (at least one; boxed: a list is large beside the other variants).
         problems: Box<SceneProblems>,
     },
-    /// The output folder cannot hold this sweep (not empty, another sweep's, another version's).
+    /// The output folder cannot hold this sweep (not empty, another sweep's, another version's): the
+    /// `reason`, and what to do.
     #[error("`{}`: {reason}", path.display())]
-    Folder {
-        /// The folder.
-        path: PathBuf,
-        /// Why, and what to do.
-        reason: String,
-    },
-    /// Reading or writing one of the sweep's own files failed.
+    Folder { path: PathBuf, reason: String },
+    /// Reading or writing one of the sweep's own files failed; `what` was being done (`writing the
+    /// catalogue`).
     #[error("{what} `{}`: {source}", path.display())]
     Io {
-        /// What was being done (`writing the catalogue`).
         what: &'static str,
-        /// The file.
         path: PathBuf,
-        /// The cause.
         source: std::io::Error,
     },
 }

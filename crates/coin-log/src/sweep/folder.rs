@@ -29,7 +29,7 @@ const FORMAT_VERSION: &str = "1";
 const MTIME_COLUMN: &str = "mtime_ns";
 
 /// `run-<index>.mcap`, the index zero-padded to `width` digits.
-pub fn run_file_name(index: u64, width: usize) -> String {
+fn run_file_name(index: u64, width: usize) -> String {
     format!("run-{index:0width$}.mcap")
 }
 
@@ -133,20 +133,20 @@ impl Folder {
         // The folder and its missing parents: a link to nothing or a file among them would make
         // creating it fail with a bare "File exists" or "Not a directory".
         let mut missing = path.ancestors().filter(|d| !d.as_os_str().is_empty());
-        let in_the_way = missing.find_map(|d| match fs::metadata(d) {
-            Ok(m) if m.is_dir() => Some(None),
-            Ok(_) => Some(Some(format!(
-                "cannot be created: `{}` is not a folder; give -o a folder for the sweep's files",
-                d.display()
-            ))),
-            Err(_) => files::dangling_link(d).map(|to| {
-                let (link, to) = (d.display(), to.display());
-                Some(if d == path {
-                    format!("is a symbolic link to `{to}`, which does not exist: create that folder, or give -o another")
-                } else {
-                    format!("cannot be created: `{link}` is a symbolic link to `{to}`, which does not exist: create that folder, or give -o another")
-                })
-            }),
+        let in_the_way = missing.find_map(|d| {
+            let why = match fs::metadata(d) {
+                Ok(m) if m.is_dir() => return Some(None),
+                Ok(_) => "is not a folder; give -o a folder for the sweep's files".to_string(),
+                Err(_) => format!(
+                    "is a symbolic link to `{}`, which does not exist: create that folder, or give -o another",
+                    files::dangling_link(d)?.display()
+                ),
+            };
+            Some(Some(if d == path {
+                why
+            } else {
+                format!("cannot be created: `{}` {why}", d.display())
+            }))
         });
         if let Some(reason) = in_the_way.flatten() {
             return Err(folder_error(reason));
@@ -467,22 +467,17 @@ impl Folder {
 /// The first entry of the sweep folder `path`, or of its state folder `state`, that a sweep without a
 /// plan yet cannot have made: anything but the state folder and the plan's temporary files.
 fn foreign_entry(path: &Path, state: &Path) -> Option<String> {
-    let names = |dir: &Path| -> Vec<String> {
-        fs::read_dir(dir).map_or_else(
-            |_| Vec::new(),
-            |entries| {
-                let names = entries.flatten().map(|e| e.file_name());
-                names.map(|n| n.to_string_lossy().into_owned()).collect()
-            },
-        )
+    let names = |dir: &Path| {
+        let entries = fs::read_dir(dir).into_iter().flatten().flatten();
+        entries.map(|e| e.file_name().to_string_lossy().into_owned())
     };
     let plan_temp = |name: &str| {
         name.strip_prefix(&format!(".{PLAN_FILE}."))
             .is_some_and(|rest| rest.ends_with(".tmp"))
     };
-    let outside = names(path).into_iter().find(|n| n != STATE_DIR);
+    let outside = names(path).find(|n| n != STATE_DIR);
     outside.or_else(|| {
-        let inside = names(state).into_iter().find(|n| !plan_temp(n));
+        let inside = names(state).find(|n| !plan_temp(n));
         inside.map(|n| format!("{STATE_DIR}/{n}"))
     })
 }

@@ -45,7 +45,7 @@ fn on_threads<R: Send>(
 ) {
     let next = AtomicU64::new(0);
     let (sender, receiver) = mpsc::channel();
-    let threads = usize::try_from(len.max(1)).map_or(jobs, |len| jobs.clamp(1, len));
+    let threads = usize::try_from(len.max(1)).map_or(jobs.max(1), |len| jobs.clamp(1, len));
     // The next position's result, skipping those without one; `None` once `stop` is set or every
     // position is taken.
     let next_result = || {
@@ -76,21 +76,17 @@ fn on_threads<R: Send>(
     };
     std::thread::scope(|scope| {
         let mut working = gate.write().unwrap_or_else(PoisonError::into_inner);
-        let mut spawned: usize = 0;
-        let mut refused = false;
-        for number in 0..threads.max(1) {
-            let sender = sender.clone();
-            let worker = &worker;
-            // Not scope.spawn, which panics when refused.
-            let thread =
-                std::thread::Builder::new().spawn_scoped(scope, move || worker(number, sender));
-            if thread.is_err() {
-                refused = true;
-                break;
-            }
-            spawned += 1;
-        }
-        *working = if refused {
+        let spawned = (0..threads)
+            .take_while(|&number| {
+                let (sender, worker) = (sender.clone(), &worker);
+                // Not scope.spawn, which panics when refused.
+                let builder = std::thread::Builder::new();
+                builder
+                    .spawn_scoped(scope, move || worker(number, sender))
+                    .is_ok()
+            })
+            .count();
+        *working = if spawned < threads {
             spawned.div_ceil(2)
         } else {
             spawned

@@ -15,24 +15,20 @@ pub const SAMPLED_RUNS: u64 = 1000;
 /// zstd). Long or stiff runs integrate more slowly per message, so this is a rough guide only.
 pub const MESSAGES_PER_SECOND: f64 = 250_000.0;
 
-/// What a dry run shows.
+/// What a dry run shows: the shard's `runs`; the `first` runs' indexes and swept values (as catalogue
+/// cells); of the `sampled` runs whose scenes were resolved, how many give no valid scene (`invalid`) and
+/// the first of them with its reason; the shard's `messages`, `bytes` and wall time with `jobs` at once
+/// (`seconds`), estimated from the sampled runs scaled up.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct Preview {
-    /// The shard's runs.
     pub runs: u64,
-    /// The first runs: index and the swept keys' values, as catalogue cells.
     pub first: Vec<(u64, Vec<String>)>,
-    /// Runs whose scenes were resolved.
     pub sampled: u64,
-    /// Of those, how many give no valid scene, and the first of them with its reason.
     pub invalid: u64,
-    /// The first invalid run and why.
     pub first_invalid: Option<(u64, String)>,
-    /// Estimated messages of the shard's runs (sampled runs scaled up).
     pub messages: u64,
-    /// Estimated bytes of the shard's files.
     pub bytes: u64,
-    /// Estimated wall time with `jobs` at once \[s\].
     pub seconds: f64,
 }
 

@@ -24,48 +24,44 @@ use std::time::Instant;
 /// Write buffer in front of each run's file (as `record`'s: the writer issues many small writes).
 const WRITE_BUFFER: usize = 1 << 20;
 
-/// How to run a sweep.
+/// How to run a sweep: `jobs` runs at once (threads, ≥ 1), the `shard`'s runs, and whether to redo failed
+/// runs on resume (`retry_failed`; runs that failed for a reason other than I/O are kept otherwise: their
+/// failure is a property of their values).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
 pub struct RunOptions {
-    /// Runs at once (threads), ≥ 1.
     pub jobs: usize,
-    /// The runs to take.
     pub shard: Shard,
-    /// Redo failed runs on resume (runs that failed for a reason other than I/O are kept otherwise:
-    /// their failure is a property of their values).
     pub retry_failed: bool,
 }
 
-/// Where a sweep stands, after each run.
+/// Where a sweep stands, after each run: of this shard's `runs`, the `todo` ones of this invocation (the
+/// rest were done before) and the `done` ones of those so far; the shard's rows `failed` so far (kept and
+/// new).
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[allow(missing_docs)]
 pub struct Progress {
-    /// This shard's runs.
     pub runs: u64,
-    /// Runs to do in this invocation (the rest were done before).
     pub todo: u64,
-    /// Of those, done so far.
     pub done: u64,
-    /// Rows of this shard that are failed, so far (kept and new).
     pub failed: u64,
     /// The first run this invocation saw fail: its index and its row's reason, led by the `failure` kind,
     /// so that a front end can say so while the runs like it are still ahead.
     pub first_failure: Option<(u64, String)>,
 }
 
-/// How a sweep invocation ended.
+/// How a sweep invocation ended: of this shard's `runs`, the rows `finished` and `failed` and the runs
+/// `pending` without a row (interrupted, or not started); the rows `kept` from an earlier invocation
+/// (resume) and the runs `done` now (finished or failed); the seconds spent recording and verifying,
+/// summed over the runs done now.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct SweepOutcome {
-    /// This shard's runs.
     pub runs: u64,
-    /// Rows finished.
     pub finished: u64,
-    /// Rows failed.
     pub failed: u64,
-    /// Runs without a row (interrupted, or not started).
     pub pending: u64,
-    /// Rows kept from an earlier invocation (resume).
     pub kept: u64,
-    /// Runs done now (finished or failed).
     pub done: u64,
     /// Whether a stop request ended it early: with runs left without a row (one that came after the
     /// last run ended nothing early, and exited 130, so that `afterok` skipped collect).
@@ -74,9 +70,7 @@ pub struct SweepOutcome {
     pub catalogue: PathBuf,
     /// `sweep.json`, for a whole sweep.
     pub summary: Option<PathBuf>,
-    /// Seconds spent in recording, summed over the runs done now.
     pub record_seconds: f64,
-    /// Seconds spent in verifying, summed over the runs done now.
     pub verify_seconds: f64,
 }
 
@@ -133,9 +127,8 @@ pub fn run(
         progress: Progress {
             runs,
             todo: runs - kept.len() as u64,
-            done: 0,
             failed: resumed.failed,
-            first_failure: None,
+            ..Progress::default()
         },
         record_seconds: 0.0,
         verify_seconds: 0.0,
@@ -267,7 +260,7 @@ fn resume(sweep: &Sweep, folder: &Folder, options: &RunOptions) -> Result<Resume
             continue;
         }
         // A row names its own run's file or none (one naming another's, an edited index, is redone).
-        let own = folder::run_file_name(index, sweep.index_width());
+        let own = folder.run_file_name(index);
         let file_ok = f[file_at].is_empty()
             || f[file_at] == own && {
                 let path = folder.file(&f[file_at]);
@@ -329,7 +322,7 @@ fn record_and_check(
     stop: &AtomicBool,
     row: &mut Row,
 ) -> Result<Option<Spent>, String> {
-    let name = folder::run_file_name(row.index, sweep.index_width());
+    let name = folder.run_file_name(row.index);
     let target = folder.file(&name);
     let io = |what: &str| {
         let what = format!("{what} `{name}`");
@@ -430,15 +423,11 @@ fn verify_reason(r: &FileReport) -> String {
     let verdict = format!("verify: {}", r.verdict.name());
     // The problem of a file that cannot be verified defers to "each check's reason": the catalogue has
     // no other place for them, so the skipped required checks' reasons (what to record) follow it.
-    let skipped: Vec<String> = if r.verdict == Verdict::CannotVerify {
-        r.checks
-            .iter()
-            .filter(|c| c.status == Status::Skip && CheckId::REQUIRED.contains(&c.id))
-            .map(|c| format!("{} skipped: {}", c.id, c.reason))
-            .collect()
-    } else {
-        Vec::new()
-    };
+    let cannot = r.verdict == Verdict::CannotVerify;
+    let skipped: Vec<String> = (r.checks.iter())
+        .filter(|c| cannot && c.status == Status::Skip && CheckId::REQUIRED.contains(&c.id))
+        .map(|c| format!("{} skipped: {}", c.id, c.reason))
+        .collect();
     let skipped = (!skipped.is_empty()).then(|| skipped.join("; "));
     let parts = [Some(verdict), failing, r.problem.clone(), skipped];
     parts.into_iter().flatten().collect::<Vec<_>>().join(": ")

@@ -25,12 +25,6 @@ pub struct Shard {
 #[error("{0}")]
 pub struct ShardError(String);
 
-impl Default for Shard {
-    fn default() -> Self {
-        Self::ALL
-    }
-}
-
 impl Shard {
     /// Every run: shard 0 of 1.
     pub const ALL: Self = Self { index: 0, count: 1 };
@@ -100,11 +94,9 @@ impl Shard {
     /// `None` outside a job array. Slurm: K = `SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN` (0 when not
     /// set), N = `SLURM_ARRAY_TASK_MAX` − `SLURM_ARRAY_TASK_MIN` + 1, or `SLURM_ARRAY_TASK_COUNT`; an
     /// array with a step or a list, whose ids are not K = 0 … N − 1 apart from MIN, is refused. Kubernetes:
-    /// K = `JOB_COMPLETION_INDEX`, N = `kubernetes_count` (the Job's `completions`).
-    ///
-    /// # Errors
-    /// A variable that is no number, an array that does not number its tasks densely, or a Kubernetes
-    /// index without its count (or a count without an index).
+    /// K = `JOB_COMPLETION_INDEX`, N = `kubernetes_count` (the Job's `completions`). An error for a
+    /// variable that is no number, an array that does not number its tasks densely, or a Kubernetes index
+    /// without its count (or a count without an index).
     pub fn from_environment(
         var: impl Fn(&str) -> Option<String>,
         kubernetes_count: Option<u64>,

@@ -476,14 +476,16 @@ impl Checker {
     fn settings(&mut self, o: &OutputFile) -> Settings {
         let encoding = self.named("encoding", o.encoding.as_deref());
         let compression = self.named("compression", o.compression.as_deref());
-        for (i, c) in o.channels.iter().flatten().enumerate() {
-            if let Err(e) = c.trim().parse::<Channel>() {
+        let channels: Option<Vec<String>> =
+            (o.channels.as_ref()).map(|l| l.iter().map(|c| c.trim().to_string()).collect());
+        let given = o.channels.iter().flatten().zip(channels.iter().flatten());
+        for (i, (c, trimmed)) in given.enumerate() {
+            if let Err(e) = trimmed.parse::<Channel>() {
                 self.problems
                     .push("output.channels", format!("\"{c}\""), e.to_string());
             }
             // Fixed for every run, so a list the scene refuses would fail them all: said here.
-            let listed = o.channels.iter().flatten().take(i);
-            if listed.map(|l| l.trim()).any(|l| l == c.trim()) {
+            if channels.iter().flatten().take(i).any(|l| l == trimmed) {
                 self.problems.push(
                     "output.channels",
                     format!("\"{c}\""),
@@ -499,10 +501,7 @@ impl Checker {
             );
         }
         Settings {
-            channels: o
-                .channels
-                .as_ref()
-                .map(|l| l.iter().map(|c| c.trim().to_string()).collect()),
+            channels,
             encoding,
             compression,
             verify: o.verify.unwrap_or(true),
