@@ -370,10 +370,8 @@ fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
         if rate > max {
             // The bound is linear in atol too: an atol tiny for the scene (`--atol 5e-324`) is the
             // problem as much as κ, and a larger one, where allowed (check_atol), does as well.
-            let p = &scene.params;
-            let atol_max = ATOL_MAX_FRACTION * 1f64.min(p.radius()).min(1.0 / p.time_unit());
             let atol_needed = rate / SCALE_MAX;
-            let or_atol = if atol_needed <= atol_max {
+            let or_atol = if atol_needed <= atol_max(&scene.params) {
                 format!(", or atol ≥ {}", short(atol_needed, Round::Up))
             } else {
                 String::new()
@@ -505,11 +503,15 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     }
 }
 
+/// The largest atol: [`ATOL_MAX_FRACTION`] of the smallest natural scale of the state.
+fn atol_max(p: &CoinParams) -> f64 {
+    ATOL_MAX_FRACTION * 1f64.min(p.radius()).min(1.0 / p.time_unit())
+}
+
 fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
     let p = &scene.params;
     let atol = scene.run.method.atol;
-    let smallest = 1f64.min(p.radius()).min(1.0 / p.time_unit());
-    let max = ATOL_MAX_FRACTION * smallest;
+    let max = atol_max(p);
     if atol > max {
         let max = short(max, Round::Down);
         problems.push(
