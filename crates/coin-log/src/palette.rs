@@ -39,10 +39,7 @@ pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 pub type DrawError = DrawingAreaErrorKind<std::io::Error>;
 
 /// An SVG document of `size` pixels: a white page with what `draw` puts on it (plotters' SVG backend:
-/// no fonts are needed, text is written as SVG `<text>`).
-///
-/// # Errors
-/// The first error of `draw` or of the backend.
+/// no fonts are needed, text is written as SVG `<text>`), or the first error of `draw` or the backend.
 pub fn svg_page(
     size: (u32, u32),
     draw: impl FnOnce(&Area<'_>) -> Result<(), DrawError>,
@@ -72,10 +69,8 @@ fn xml_chars(svg: String) -> String {
     }
 }
 
-/// The legend of `chart`'s labelled series at `position`, on a light box with a black border.
-///
-/// # Errors
-/// The backend's.
+/// The legend of `chart`'s labelled series at `position`, on a light box with a black border (or the
+/// backend's error).
 pub fn legend_box<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     position: SeriesLabelPosition,
