@@ -246,8 +246,8 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
     let shown = number(given.unwrap_or(h));
     #[allow(clippy::float_cmp)] // exactly the question: does t + h round back to t?
     let stuck = duration + h == duration;
-    // The same relative slack as the step's fitting to the sample grid: 0.001/1e-10 is 1e7 steps, not 1e7 + 1.
-    let steps = (duration / h * (1.0 - 1e-12)).ceil();
+    // The step's fitting to the sample grid counts steps so too: 0.001/1e-10 is 1e7 steps, not 1e7 + 1.
+    let steps = super::validate::steps_over(duration, h);
     #[allow(clippy::cast_precision_loss)]
     let max = run.max_steps as f64;
     let too_many = if stuck {
