@@ -55,18 +55,25 @@ pub fn svg_page(
 }
 
 /// `svg` with U+FFFE, U+FFFF (which XML 1.0 does not allow in a document) and the control characters
-/// other than tab, LF and CR (C0 ones it does not allow, C1 ones it discourages) escaped as
-/// [`crate::files::escaped`] writes a control character (`\u{fffe}`): plotters escapes `<`, `&` and
-/// quotes but writes text as given, and a scene's description (which `record` accepts with U+FFFE) made
-/// the SVG not well-formed.
+/// other than tab, LF and CR (C0 ones it does not allow, C1 ones it discourages) escaped (`\u{fffe}`):
+/// plotters escapes `<`, `&` and quotes but writes text as given, and a scene's description (which
+/// `record` accepts with U+FFFE) made the SVG not well-formed. (Not through `files`' escaping: `palette`
+/// and `files` are modules of one layer, docs/architecture.md.)
 fn xml_chars(svg: String) -> String {
     let bad = |c: char| {
         matches!(c, '\u{fffe}' | '\u{ffff}') || (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
     };
-    match crate::files::escape_where(&svg, bad, |c| c.escape_unicode().to_string()) {
-        std::borrow::Cow::Owned(escaped) => escaped,
-        std::borrow::Cow::Borrowed(_) => svg,
+    if !svg.contains(bad) {
+        return svg;
     }
+    let each = |c: char| {
+        if bad(c) {
+            c.escape_unicode().to_string()
+        } else {
+            c.to_string()
+        }
+    };
+    svg.chars().map(each).collect()
 }
 
 /// The legend of `chart`'s labelled series at `position`, on a light box with a black border (or the
