@@ -153,14 +153,12 @@ pub fn absent_or_plain(path: &Path) -> io::Result<()> {
     }
 }
 
-/// The regular file at `path` opened for reading, as [`absent_or_regular`] allows (or its error, or that
-/// of opening it).
+/// Opens the file at `path` for reading, if [`absent_or_regular`] allows (its error, or the open's).
 pub fn open_regular(path: &Path) -> io::Result<File> {
     absent_or_regular(path).and_then(|()| File::open(path))
 }
 
-/// The regular file at `path` read as text, as [`open_regular`] opens it (or its error, or that of
-/// reading it: not UTF-8).
+/// Reads the file at `path` as text, opened by [`open_regular`] (its error, or the read's: not UTF-8).
 pub fn read_regular(path: &Path) -> io::Result<String> {
     let mut text = String::new();
     open_regular(path)?.read_to_string(&mut text)?;

@@ -467,8 +467,7 @@ impl Output {
         })
     }
 
-    /// Writes `bytes` to `target` by [`Output::create`] and [`Output::commit`], failing as they or the
-    /// write do.
+    /// Writes `bytes` to `target` by [`Output::create`] and [`Output::commit`] (failing as they do).
     pub fn write(target: &Path, policy: &Policy, bytes: &[u8]) -> Result<(), OutputError> {
         let mut output = Self::create(target, policy)?;
         output
@@ -556,7 +555,6 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
 #[derive(Debug)]
 pub struct OutputFolder {
     dir: PathBuf,
-    /// The policy of each file.
     policy: Policy,
     outputs: Vec<Output>,
     /// The folders this created, deepest first.
@@ -617,8 +615,7 @@ impl OutputFolder {
         self
     }
 
-    /// Starts the file `name` in the folder (failing as [`Output::create`]); returns a handle to write it
-    /// through.
+    /// Starts the file `name` in the folder by [`Output::create`]; returns a handle to write it through.
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
         let mut output = Output::create(&self.dir.join(name), &self.policy)?;
         let file = output
