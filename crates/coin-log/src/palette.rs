@@ -39,10 +39,7 @@ pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 pub type DrawError = DrawingAreaErrorKind<std::io::Error>;
 
 /// An SVG document of `size` pixels: a white page with what `draw` puts on it (plotters' SVG backend:
-/// no fonts are needed, text is written as SVG `<text>`).
-///
-/// # Errors
-/// The first error of `draw` or of the backend.
+/// no fonts are needed, text is written as SVG `<text>`), or the first error of `draw` or the backend.
 pub fn svg_page(
     size: (u32, u32),
     draw: impl FnOnce(&Area<'_>) -> Result<(), DrawError>,
@@ -58,24 +55,29 @@ pub fn svg_page(
 }
 
 /// `svg` with U+FFFE, U+FFFF (which XML 1.0 does not allow in a document) and the control characters
-/// other than tab, LF and CR (C0 ones it does not allow, C1 ones it discourages) escaped as
-/// [`crate::files::escaped`] writes a control character (`\u{fffe}`): plotters escapes `<`, `&` and
-/// quotes but writes text as given, and a scene's description (which `record` accepts with U+FFFE) made
-/// the SVG not well-formed.
+/// other than tab, LF and CR (C0 ones it does not allow, C1 ones it discourages) escaped (`\u{fffe}`):
+/// plotters escapes `<`, `&` and quotes but writes text as given, and a scene's description (which
+/// `record` accepts with U+FFFE) made the SVG not well-formed. (Not through `files`' escaping: `palette`
+/// and `files` are modules of one layer, docs/architecture.md.)
 fn xml_chars(svg: String) -> String {
     let bad = |c: char| {
         matches!(c, '\u{fffe}' | '\u{ffff}') || (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
     };
-    match crate::files::escape_where(&svg, bad, |c| c.escape_unicode().to_string()) {
-        std::borrow::Cow::Owned(escaped) => escaped,
-        std::borrow::Cow::Borrowed(_) => svg,
+    if !svg.contains(bad) {
+        return svg;
     }
+    let each = |c: char| {
+        if bad(c) {
+            c.escape_unicode().to_string()
+        } else {
+            c.to_string()
+        }
+    };
+    svg.chars().map(each).collect()
 }
 
-/// The legend of `chart`'s labelled series at `position`, on a light box with a black border.
-///
-/// # Errors
-/// The backend's.
+/// The legend of `chart`'s labelled series at `position`, on a light box with a black border (or the
+/// backend's error).
 pub fn legend_box<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     position: SeriesLabelPosition,

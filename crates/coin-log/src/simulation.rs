@@ -63,8 +63,7 @@ pub struct CoinEvents {
 }
 
 impl CoinEvents {
-    /// Events for `dynamics`, flat landing at |θ| = π/2 − `flat_margin`, slip when `friction` (μ) is
-    /// given.
+    /// Events for `dynamics`: flat landing at |θ| = π/2 − `flat_margin`, slip when `friction` (μ) is given.
     #[must_use]
     pub fn new(dynamics: impl Into<Dynamics>, flat_margin: f64, friction: Option<f64>) -> Self {
         Self {

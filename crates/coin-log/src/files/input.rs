@@ -43,9 +43,7 @@ fn what(kind: InputKind) -> &'static str {
 const STDIN_PATHS: [&str; 3] = ["/dev/stdin", "/dev/fd/0", "/proc/self/fd/0"];
 
 /// Checks that `path` names a regular file (following links), without opening it; returns its metadata.
-///
-/// # Errors
-/// [`InputError`]: `-`, a path that cannot be looked at, a folder, a pipe, a device or a socket.
+/// Refuses `-`, a path that cannot be looked at, a folder, a pipe, a device or a socket.
 pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
     if path.as_os_str() == "-" {
         return Err(InputError(
@@ -74,12 +72,9 @@ pub fn check(path: &Path, kind: InputKind) -> Result<Metadata, InputError> {
     Ok(meta)
 }
 
-/// Reads the scene or sweep file at `path` as text: a regular file of at most [`SCENE_MAX_BYTES`] (the
-/// bound holds while reading too, for files that grow or whose size the system does not report, like
-/// `/proc` files).
-///
-/// # Errors
-/// As [`check`]; a file above the limit, one that cannot be read, or that is not UTF-8.
+/// Reads the scene or sweep file at `path` as text: a regular file ([`check`]) of at most
+/// [`SCENE_MAX_BYTES`] (the bound holds while reading too, for files that grow or whose size the system
+/// does not report, like `/proc` files), that can be read and is UTF-8.
 pub fn read_toml(path: &Path, kind: InputKind) -> Result<String, InputError> {
     check(path, kind)?;
     let mut bytes = Vec::new();
@@ -127,10 +122,8 @@ fn not_utf8(bytes: &[u8], valid: usize, kind: InputKind) -> InputError {
 
 /// Ok if `path` is absent or a regular file (following links): for the files a command keeps in a folder
 /// of its own (a sweep's journal, plan and catalogue parts), which a crafted folder could replace with a
-/// pipe that blocks an open or a device that never ends.
-///
-/// # Errors
-/// [`io::ErrorKind::InvalidInput`] naming what the path is instead; another error of looking at it.
+/// pipe that blocks an open or a device that never ends. Else [`io::ErrorKind::InvalidInput`] naming what
+/// the path is instead, or the error of looking at it.
 pub fn absent_or_regular(path: &Path) -> io::Result<()> {
     match fs::metadata(path) {
         Ok(meta) if meta.is_file() => Ok(()),
@@ -145,10 +138,8 @@ pub fn absent_or_regular(path: &Path) -> io::Result<()> {
 
 /// Ok if `path` is absent or a regular file itself, not a link to one: for the files a command writes in a
 /// folder of its own (a sweep's journal, catalogue and summary), where through a link an append would go
-/// to the file it points to and a move into place would replace the link with a plain file.
-///
-/// # Errors
-/// As [`absent_or_regular`], and [`io::ErrorKind::InvalidInput`] for a symbolic link.
+/// to the file it points to and a move into place would replace the link with a plain file. Errors as
+/// [`absent_or_regular`], and [`io::ErrorKind::InvalidInput`] for a symbolic link.
 pub fn absent_or_plain(path: &Path) -> io::Result<()> {
     match fs::symlink_metadata(path) {
         Ok(meta) if meta.file_type().is_symlink() => Err(io::Error::new(
@@ -162,18 +153,12 @@ pub fn absent_or_plain(path: &Path) -> io::Result<()> {
     }
 }
 
-/// The regular file at `path` opened for reading, as [`absent_or_regular`] allows.
-///
-/// # Errors
-/// As [`absent_or_regular`], or of opening it.
+/// Opens the file at `path` for reading, if [`absent_or_regular`] allows (its error, or the open's).
 pub fn open_regular(path: &Path) -> io::Result<File> {
     absent_or_regular(path).and_then(|()| File::open(path))
 }
 
-/// The regular file at `path` read as text, as [`absent_or_regular`] allows.
-///
-/// # Errors
-/// As [`open_regular`], or of reading it (not UTF-8).
+/// Reads the file at `path` as text, opened by [`open_regular`] (its error, or the read's: not UTF-8).
 pub fn read_regular(path: &Path) -> io::Result<String> {
     let mut text = String::new();
     open_regular(path)?.read_to_string(&mut text)?;

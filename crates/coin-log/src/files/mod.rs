@@ -25,19 +25,16 @@ pub fn shown(path: &Path) -> String {
 /// `text` with its control characters escaped as [`shown`] does (for paths already held as text).
 #[must_use]
 pub fn escaped(text: &str) -> Cow<'_, str> {
-    escape_where(text, char::is_control, |c| c.escape_default().to_string())
-}
-
-/// `text` with each character that is `bad` written as `escape` writes it.
-pub(crate) fn escape_where(
-    text: &str,
-    bad: impl Fn(char) -> bool,
-    escape: impl Fn(char) -> String,
-) -> Cow<'_, str> {
-    if !text.chars().any(&bad) {
+    if !text.contains(char::is_control) {
         return Cow::Borrowed(text);
     }
-    let each = |c| if bad(c) { escape(c) } else { c.to_string() };
+    let each = |c: char| {
+        if c.is_control() {
+            c.escape_default().to_string()
+        } else {
+            c.to_string()
+        }
+    };
     Cow::Owned(text.chars().map(each).collect())
 }
 

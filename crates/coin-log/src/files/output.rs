@@ -408,13 +408,10 @@ fn umask() -> u32 {
         .unwrap_or(0o022)
 }
 
-/// Checks `target` against `policy` as [`Output::create`] does, creating nothing (for a command that works
-/// long before it writes, `bench`, so that a target it would refuse at the end is refused first); returns
-/// its metadata when it is a regular file that may be replaced, `None` when it does not exist (its folder
-/// then does).
-///
-/// # Errors
-/// As [`Output::create`]'s checks.
+/// Checks `target` against `policy` as [`Output::create`] does, failing as its checks do, creating nothing
+/// (for a command that works long before it writes, `bench`, so that a target it would refuse at the end is
+/// refused first); returns its metadata when it is a regular file that may be replaced, `None` when it does
+/// not exist (its folder then does).
 pub fn check(target: &Path, policy: &Policy) -> Result<Option<Metadata>, OutputError> {
     let meta = look_at(target, policy)?;
     if meta.is_some() && !policy.overwrite {
@@ -435,12 +432,9 @@ pub struct Output {
 }
 
 impl Output {
-    /// Checks `target` against `policy` and creates the temporary file beside it; nothing is left behind
-    /// if this fails.
-    ///
-    /// # Errors
-    /// [`OutputError`]: the target is not a file that may be written or replaced, its folder is missing,
-    /// or the system refuses the name or the folder.
+    /// Checks `target` against `policy` and creates the temporary file beside it; fails, leaving nothing
+    /// behind, when the target is not a file that may be written or replaced, its folder is missing, or
+    /// the system refuses the name or the folder.
     pub fn create(target: &Path, policy: &Policy) -> Result<Self, OutputError> {
         let existing = check(target, policy)?;
         let folder = folder_of(target);
@@ -473,10 +467,7 @@ impl Output {
         })
     }
 
-    /// Writes `bytes` to `target` by [`Output::create`] and [`Output::commit`].
-    ///
-    /// # Errors
-    /// As [`Output::create`], writing, and [`Output::commit`].
+    /// Writes `bytes` to `target` by [`Output::create`] and [`Output::commit`] (failing as they do).
     pub fn write(target: &Path, policy: &Policy, bytes: &[u8]) -> Result<(), OutputError> {
         let mut output = Self::create(target, policy)?;
         output
@@ -509,12 +500,9 @@ impl Output {
         OutputError::system("write", &self.target, &source)
     }
 
-    /// Syncs the finished file, makes it readable and moves it into place. If the target no longer takes
-    /// it or the move fails, the file is kept under its temporary name and the error says where.
-    ///
-    /// # Errors
-    /// [`OutputError`] if the file cannot be synced (it is then removed: it is not finished), or was not
-    /// moved into place.
+    /// Syncs the finished file, makes it readable and moves it into place. Fails if the file cannot be
+    /// synced (it is then removed: it is not finished), or was not moved into place: when the target no
+    /// longer takes it or the move fails, the file is kept under its temporary name and the error says where.
     pub fn commit(self) -> Result<(), OutputError> {
         self.temp
             .as_file()
@@ -567,7 +555,6 @@ fn keep(temp: NamedTempFile, reason: String) -> OutputError {
 #[derive(Debug)]
 pub struct OutputFolder {
     dir: PathBuf,
-    /// The policy of each file.
     policy: Policy,
     outputs: Vec<Output>,
     /// The folders this created, deepest first.
@@ -575,11 +562,8 @@ pub struct OutputFolder {
 }
 
 impl OutputFolder {
-    /// Opens `dir` for outputs, creating it (and missing parents) if needed; `overwrite` lets the files
-    /// replace regular files of the same names.
-    ///
-    /// # Errors
-    /// [`OutputError`] if `dir` (or a parent) is not a folder or cannot be created.
+    /// Opens `dir` for outputs, creating it (and missing parents) if needed, failing if it or a parent is
+    /// not a folder or cannot be created; `overwrite` lets the files replace regular files of the same names.
     pub fn create(dir: &Path, overwrite: bool) -> Result<Self, OutputError> {
         let mut created = missing_folders(dir)?;
         // Created from the top down; on failure, what was created is removed (by `Drop`).
@@ -597,12 +581,10 @@ impl OutputFolder {
         Ok(folder)
     }
 
-    /// Checks, creating nothing, what [`OutputFolder::create`] and [`OutputFolder::file`] would: for a
-    /// command that works long before it writes (`analyse map`), so that a refused --out is refused
-    /// before the work, and the work leaves nothing behind if it fails or is stopped by a signal.
-    ///
-    /// # Errors
-    /// As [`OutputFolder::create`], and as [`Output::create`]'s checks for each of `names`.
+    /// Checks, creating nothing, what [`OutputFolder::create`] and [`OutputFolder::file`] would for each of
+    /// `names`, failing as they do: for a command that works long before it writes (`analyse map`), so that
+    /// a refused --out is refused before the work, and the work leaves nothing behind if it fails or is
+    /// stopped by a signal.
     pub fn check(dir: &Path, overwrite: bool, names: &[&str]) -> Result<(), OutputError> {
         if missing_folders(dir)?.is_empty() {
             for name in names {
@@ -633,10 +615,7 @@ impl OutputFolder {
         self
     }
 
-    /// Starts the file `name` in the folder; returns a handle to write it through.
-    ///
-    /// # Errors
-    /// As [`Output::create`].
+    /// Starts the file `name` in the folder by [`Output::create`]; returns a handle to write it through.
     pub fn file(&mut self, name: &str) -> Result<File, OutputError> {
         let mut output = Output::create(&self.dir.join(name), &self.policy)?;
         let file = output
@@ -648,10 +627,7 @@ impl OutputFolder {
     }
 
     /// Checks every target again, then moves every file into place: either all land, or (unless a move
-    /// itself fails) none does.
-    ///
-    /// # Errors
-    /// [`OutputError`] as for [`Output::commit`].
+    /// itself fails) none does, failing as [`Output::commit`].
     pub fn commit(mut self) -> Result<(), OutputError> {
         for output in &self.outputs {
             check(&output.target, &output.policy)?;
@@ -673,10 +649,8 @@ fn folder_policy(overwrite: bool) -> Policy {
     }
 }
 
-/// The folders missing on the way to `dir`, deepest first (none if it exists).
-///
-/// # Errors
-/// [`OutputError`] if `dir` or a parent is not a folder, or is a link to nothing.
+/// The folders missing on the way to `dir`, deepest first (none if it exists); fails if `dir` or a parent
+/// is not a folder, or is a link to nothing.
 fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
     if dir.as_os_str() == "-" {
         // As for a file output `-`: one who writes `--out -` expects standard output, not a folder `-`.

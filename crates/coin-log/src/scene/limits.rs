@@ -246,8 +246,8 @@ fn check_fixed_step(scene: &Scene, given: Option<f64>, w: f64, problems: &mut Pr
     let shown = number(given.unwrap_or(h));
     #[allow(clippy::float_cmp)] // exactly the question: does t + h round back to t?
     let stuck = duration + h == duration;
-    // The same relative slack as the step's fitting to the sample grid: 0.001/1e-10 is 1e7 steps, not 1e7 + 1.
-    let steps = (duration / h * (1.0 - 1e-12)).ceil();
+    // The step's fitting to the sample grid counts steps so too: 0.001/1e-10 is 1e7 steps, not 1e7 + 1.
+    let steps = super::validate::steps_over(duration, h);
     #[allow(clippy::cast_precision_loss)]
     let max = run.max_steps as f64;
     let too_many = if stuck {
@@ -370,10 +370,8 @@ fn check_couple(scene: &Scene, d: &Dissipation, problems: &mut ProblemCollector)
         if rate > max {
             // The bound is linear in atol too: an atol tiny for the scene (`--atol 5e-324`) is the
             // problem as much as κ, and a larger one, where allowed (check_atol), does as well.
-            let p = &scene.params;
-            let atol_max = ATOL_MAX_FRACTION * 1f64.min(p.radius()).min(1.0 / p.time_unit());
             let atol_needed = rate / SCALE_MAX;
-            let or_atol = if atol_needed <= atol_max {
+            let or_atol = if atol_needed <= atol_max(&scene.params) {
                 format!(", or atol ≥ {}", short(atol_needed, Round::Up))
             } else {
                 String::new()
@@ -505,11 +503,15 @@ pub(super) fn check_resolved(scene: &Scene, file: &SceneFile, problems: &mut Pro
     }
 }
 
+/// The largest atol: [`ATOL_MAX_FRACTION`] of the smallest natural scale of the state.
+fn atol_max(p: &CoinParams) -> f64 {
+    ATOL_MAX_FRACTION * 1f64.min(p.radius()).min(1.0 / p.time_unit())
+}
+
 fn check_atol(scene: &Scene, problems: &mut ProblemCollector) {
     let p = &scene.params;
     let atol = scene.run.method.atol;
-    let smallest = 1f64.min(p.radius()).min(1.0 / p.time_unit());
-    let max = ATOL_MAX_FRACTION * smallest;
+    let max = atol_max(p);
     if atol > max {
         let max = short(max, Round::Down);
         problems.push(

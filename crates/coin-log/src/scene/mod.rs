@@ -28,17 +28,15 @@ use crate::format::{Channel, RunMetadata, FORMAT_VERSION};
 use crate::integrate::MethodConfig;
 use crate::model::{Coin, CoinParams, Dissipation, Dynamics, Inertia, State, Steady};
 
-/// Defaults of the optional scene keys (format.md: Scene files).
+/// Defaults of the optional scene keys, each the key of its name (format.md: Keys).
+#[allow(missing_docs)]
 pub mod defaults {
-    /// Samples per time unit.
     pub const RATE: f64 = 100.0;
-    /// Integrator name.
     pub const INTEGRATOR: &str = "dop853";
     /// Relative tolerance: close to what dop853 can deliver in double precision over tens of time units.
     pub const RTOL: f64 = 1e-10;
     /// Absolute tolerance: two digits below RTOL so that components through zero do not starve the step.
     pub const ATOL: f64 = 1e-12;
-    /// Fixed step for rk4/gauss4, before being rounded down to divide 1/rate.
     pub const STEP: f64 = 1e-3;
     /// Most integrator steps of a run (format.md: Limits): about 15 s of rk4 and a minute of dop853 (0.15
     /// and 0.65 µs a step), 10⁴ times what the longest built-in scene takes with dop853.
@@ -47,7 +45,6 @@ pub mod defaults {
     pub const FLAT_MARGIN: f64 = 1e-4;
     /// Display thickness, a fraction of the radius (a 500-yen coin is 1.8 mm thick for 13.25 mm radius).
     pub const THICKNESS: f64 = 0.05;
-    /// Steady branch when none is given.
     pub const BRANCH: crate::model::Branch = crate::model::Branch::Plus;
 }
 
@@ -78,20 +75,17 @@ pub enum InitialSpec {
     Steady(Steady),
 }
 
-/// Duration, sampling and integration settings.
+/// Duration, sampling and integration settings: the `[run]` keys of their names, validated (format.md:
+/// Keys).
+#[allow(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunConfig {
-    /// Duration \[time\], > 0.
     pub duration: f64,
-    /// Samples per time unit, > 0.
     pub rate: f64,
     /// Method with the settings it uses: rtol and atol for adaptive methods (step 0), the step actually
     /// used for fixed-step ones, rounded down to divide 1/rate (rtol and atol 0).
     pub method: MethodConfig,
-    /// The run ends at |θ| ≥ π/2 − flat_margin \[rad\].
     pub flat_margin: f64,
-    /// Most integrator steps: a fixed-step run needing more is refused, an adaptive one stops when they
-    /// are spent (termination `step-budget-spent`).
     pub max_steps: u64,
 }
 
@@ -103,30 +97,26 @@ impl RunConfig {
     }
 }
 
-/// A validated scene: everything the recorder needs, nothing left to check.
+/// A validated scene: everything the recorder needs, nothing left to check; a field without a doc is the
+/// key (or table) of its name (format.md: Keys), resolved.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
-    /// One line.
     pub description: String,
     /// M, a, g, I_X, I_Z.
     pub params: CoinParams,
     /// How the inertia was given (kept to write the scene back).
     pub inertia: Inertia,
-    /// μ, if given.
     pub friction: Option<f64>,
-    /// Display thickness, fraction of a.
     pub thickness: f64,
-    /// The dissipative couple (physics §11), if any.
     pub dissipation: Option<Dissipation>,
     /// The state at t = 0, perturbation included.
     pub initial: State,
     /// The state before the perturbation (the explicit state or the steady motion, with φ, ψ, x, z).
     pub base: State,
-    /// How the initial state was specified.
     pub spec: InitialSpec,
     /// The perturbation (θ, ω_X, ω_Y, ω_Z) added to the initial state; zeros when none.
     pub perturbation: [f64; 4],
-    /// Run settings.
     pub run: RunConfig,
     /// Channels to record, in the contract's order, each once.
     pub channels: Vec<Channel>,

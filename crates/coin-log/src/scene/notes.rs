@@ -9,27 +9,23 @@ use crate::integrate::Method;
 use std::fmt;
 
 /// One thing resolving did to what was asked.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum Note {
-    /// A setting the method does not use (`run.step` for adaptive methods, `run.rtol` and `run.atol` for
-    /// fixed-step ones): ignored and stored as 0, never used to loosen `verify`'s tolerances. A warning.
+    /// A `key` that `method` does not use (`run.step` for adaptive methods, `run.rtol` and `run.atol` for
+    /// fixed-step ones), given as `value` (by `flag`, if one did): ignored and stored as 0, never used to
+    /// loosen `verify`'s tolerances. A warning.
     Ignored {
-        /// The key (`run.rtol`).
         key: &'static str,
-        /// The value given.
         value: f64,
-        /// The flag that set it, if one did.
         flag: Option<&'static str>,
-        /// The method that ignores it.
         method: Method,
     },
-    /// The fixed step, rounded down so that a whole number of steps fits between samples.
+    /// The fixed step `asked` (or the default), rounded down to `used` so that a whole number of steps fits
+    /// between samples (`interval`, 1/rate).
     StepRounded {
-        /// The step asked for (or the default).
         asked: f64,
-        /// The step used.
         used: f64,
-        /// The sample interval 1/rate.
         interval: f64,
     },
 }

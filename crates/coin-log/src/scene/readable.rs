@@ -24,8 +24,7 @@ pub fn readable_toml(text: &str) -> String {
     out
 }
 
-/// A float as a TOML literal: positional between 1e-4 and 1e16 (`0.5`, `100.0`), otherwise the shortest
-/// exponent form (`1e-10`, `2.220446049250313e-15`); either reads back to `x` exactly.
+/// A float as a TOML literal: [`Short`], with `.0` where that is a whole number without exponent (`100.0`).
 fn float_literal(x: f64) -> String {
     let text = Short(x).to_string();
     if x.is_finite() && !text.contains(['.', 'e']) {

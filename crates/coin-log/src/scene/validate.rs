@@ -607,12 +607,15 @@ fn used_settings(method: Method, rtol: f64, atol: f64, step: f64, rate: f64) -> 
 }
 
 /// The largest step ≤ `step` that divides the sample interval into a whole number of steps, so that fixed
-/// steps land on the sample grid. A relative slack of 1e-12 keeps 0.01/0.001 = 10.000000000000002 at 10.
-#[allow(clippy::cast_precision_loss)]
+/// steps land on the sample grid.
 fn fitted_step(step: f64, interval: f64) -> f64 {
-    let ratio = interval / step;
-    let steps = (ratio * (1.0 - 1e-12)).ceil().max(1.0);
-    interval / steps
+    interval / steps_over(interval, step).max(1.0)
+}
+
+/// The number of steps `step` takes over `span`: a relative slack of 1e-12 keeps 0.01/0.001 =
+/// 10.000000000000002 at 10.
+pub(super) fn steps_over(span: f64, step: f64) -> f64 {
+    (span / step * (1.0 - 1e-12)).ceil()
 }
 
 /// The channels of a scene that lists none: all ten, and `work` with dissipation (format.md: Channels).
