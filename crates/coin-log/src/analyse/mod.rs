@@ -49,10 +49,8 @@ pub struct Analysis {
 }
 
 impl Analysis {
-    /// The analysis of a scene's initial state (the scene's flat margin and μ apply).
-    ///
-    /// # Errors
-    /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body.
+    /// The analysis of a scene's initial state (the scene's flat margin and μ apply); fails when C1, C2
+    /// cannot be evaluated for the body.
     pub fn of_scene(scene: &Scene) -> Result<Self, AnalyseError> {
         // The state is the steady motion when nothing perturbs it; a dissipative couple (which makes
         // `unperturbed_steady` none, since the run leaves it) does not perturb the initial state.
@@ -75,10 +73,8 @@ impl Analysis {
     }
 
     /// The analysis of `state`; `given` is the steady motion the state is known to be (then it is
-    /// analysed as steady whatever rounding says).
-    ///
-    /// # Errors
-    /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body or the state is not rolling.
+    /// analysed as steady whatever rounding says); fails when C1, C2 cannot be evaluated for the body or
+    /// the state is not rolling.
     pub fn of_state(
         coin: &Coin,
         state: &State,

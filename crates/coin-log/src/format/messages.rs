@@ -133,10 +133,8 @@ pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
 
 /// What the recorder and the readers need of every `coin_log.*` message type.
 pub trait Message: Copy + serde::de::DeserializeOwned {
-    /// Appends this message to `buf` in `encoding`.
-    ///
-    /// # Errors
-    /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+    /// Appends this message to `buf` in `encoding`; fails ([`NonFiniteField`]) if a field is NaN or
+    /// infinite, leaving `buf` as it was.
     fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField>;
     /// The message of the field values `v` in schema order (0 past its end); without the added fields
     /// when `first` (a schema of the type's first version).
@@ -211,11 +209,8 @@ macro_rules! message {
                 Ok(())
             }
 
-            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an added
-            /// field only when it is `Some`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an
+            /// added field only when it is `Some`; fails as [`Message::write`] does.
             pub fn write_json(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
                 self.check_finite()?;
                 let mut formatter = ryu::Buffer::new();

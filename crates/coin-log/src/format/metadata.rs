@@ -238,10 +238,7 @@ macro_rules! record {
                 map
             }
 
-            /// Reads the record back.
-            ///
-            /// # Errors
-            /// [`MetadataError`] naming the first missing or malformed key.
+            /// Reads the record back, or fails naming the first missing or malformed key.
             pub fn from_map(map: &BTreeMap<String, String>) -> Result<Self, MetadataError> {
                 Ok(Self {
                     $( $field: read($record, map, stringify!($field))?, )+
@@ -288,10 +285,7 @@ pub fn header_library(version: &str) -> String {
 }
 
 impl RunMetadata {
-    /// The body the record stores.
-    ///
-    /// # Errors
-    /// Each parameter that is unusable, joined by "; ".
+    /// The body the record stores; `Err` lists each parameter that is unusable, joined by "; ".
     pub fn params(&self) -> Result<CoinParams, String> {
         let inertia = Inertia::Explicit {
             inertia_x: self.inertia_x,

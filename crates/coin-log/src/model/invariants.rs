@@ -98,10 +98,8 @@ pub struct Chaplygin {
 }
 
 impl Chaplygin {
-    /// Precomputes the expansions of physics §6 for `params`.
-    ///
-    /// # Errors
-    /// [`InvariantsError::MuTooLarge`] if μ > 100 (no real body).
+    /// Precomputes the expansions of physics §6 for `params`; fails ([`InvariantsError::MuTooLarge`]) if
+    /// μ > 100 (no real body).
     pub fn new(params: &CoinParams) -> Result<Self, InvariantsError> {
         let ma2 = params.ma2();
         let iz = params.inertia_z();

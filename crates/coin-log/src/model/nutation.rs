@@ -115,7 +115,8 @@ pub struct Orbit {
 }
 
 impl Orbit {
-    /// The motion of `state` for `coin`, with the flat landing at |θ| = π/2 − `flat_margin`.
+    /// The motion of `state` for `coin`, with the flat landing at |θ| = π/2 − `flat_margin`; fails
+    /// ([`NutationError::BadState`]) for a non-finite state or one at or beyond the flat margin.
     ///
     /// ```
     /// use coin_log::model::{Chaplygin, Coin, CoinParams, State};
@@ -127,9 +128,6 @@ impl Orbit {
     /// assert!(matches!(orbit.motion, Motion::Periodic { .. }));
     /// assert!(orbit.theta_min < 0.5 && 0.5 < orbit.theta_max);
     /// ```
-    ///
-    /// # Errors
-    /// [`NutationError::BadState`] for a non-finite state or one at or beyond the flat margin.
     pub fn new(
         coin: &Coin,
         chaplygin: &Chaplygin,

@@ -178,7 +178,8 @@ fn check_lean(kind: &'static str, theta: f64) -> Result<(), SteadyError> {
 }
 
 impl Steady {
-    /// Builds the steady motion `kind` for `coin`.
+    /// Builds the steady motion `kind` for `coin`; fails when θ is outside the range where the motion
+    /// exists, or a rate is not finite.
     ///
     /// ```
     /// use coin_log::model::{Branch, Coin, CoinParams, Steady, SteadyKind};
@@ -186,9 +187,6 @@ impl Steady {
     /// let s = Steady::new(&coin, SteadyKind::Circle { theta: 0.3, omega_z: 1.0, branch: Branch::Plus }).unwrap();
     /// assert!((s.r_g.unwrap() - 4.897855).abs() < 1e-6); // physics §4 example
     /// ```
-    ///
-    /// # Errors
-    /// [`SteadyError`] when θ is outside the range where the motion exists, or a rate is not finite.
     pub fn new(coin: &Coin, kind: SteadyKind) -> Result<Self, SteadyError> {
         let p = coin.params();
         let name = kind.family().name();
