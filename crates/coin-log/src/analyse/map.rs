@@ -133,14 +133,12 @@ impl std::fmt::Display for Grid {
     }
 }
 
-/// Which branches a map covers.
+/// Which branches a map covers: the + root only, the − root only, or both.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs, reason = "the enum's doc names each variant")]
 pub enum Branches {
-    /// The + root only.
     Plus,
-    /// The − root only.
     Minus,
-    /// Both.
     Both,
 }
 

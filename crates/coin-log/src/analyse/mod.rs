@@ -30,12 +30,12 @@ pub enum AnalyseError {
     Nutation(#[from] NutationError),
 }
 
-/// The analysis of one initial state.
+/// The analysis of one initial `state` (the scene's) of the body `coin`, with the scene's μ, `friction`,
+/// if given.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names the fields without one")]
 pub struct Analysis {
-    /// The body.
     pub coin: Coin,
-    /// The state analysed (the scene's initial state).
     pub state: State,
     /// The motion by quadrature: E, C1, C2, θ range, period and heading advance, N and |F|/N.
     pub orbit: Orbit,
@@ -44,7 +44,6 @@ pub struct Analysis {
     /// The steady motion a perturbed steady scene starts from, analysed (its σ is the nutation
     /// frequency of small perturbations); `None` otherwise.
     pub base_steady: Option<SteadyAnalysis>,
-    /// μ of the scene, if given.
     pub friction: Option<f64>,
 }
 

@@ -17,25 +17,20 @@ pub const FORMAT_VERSION: &str = "1";
 
 /// A metadata record that cannot be read back.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum MetadataError {
     /// A required key is absent.
     #[error("metadata `{record}` has no key `{key}`")]
     Missing {
-        /// Record name.
         record: &'static str,
-        /// Key.
         key: &'static str,
     },
-    /// A value does not parse.
+    /// A value does not parse: the `reason` says why, and what would.
     #[error("metadata `{record}`: `{key}` = {value:?}: {reason}")]
     Invalid {
-        /// Record name.
         record: &'static str,
-        /// Key.
         key: &'static str,
-        /// Value found.
         value: String,
-        /// Why it does not parse, and what would.
         reason: String,
     },
 }

@@ -26,18 +26,14 @@ const MU_MAX: f64 = 100.0;
 
 /// Why the integrals cannot be built for these parameters.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum InvariantsError {
-    /// μ is larger than 100 (`max`).
+    /// The parameters' μ is larger than 100 (`max`).
     #[error(
         "μ = I_Z·Ma²/(I_X·(I_Z + Ma²)) = {mu} is above {max}, where C1, C2 cannot be evaluated accurately; \
          every real body has I_Z ≤ 2·I_X and μ < 2, so check inertia_x and inertia_z"
     )]
-    MuTooLarge {
-        /// The parameters' μ.
-        mu: f64,
-        /// The largest accepted μ, 100.
-        max: f64,
-    },
+    MuTooLarge { mu: f64, max: f64 },
 }
 
 /// The two Chaplygin–Appell integrals of one state (physics §6).
