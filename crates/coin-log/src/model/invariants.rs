@@ -278,11 +278,11 @@ fn horner(coefficients: &[[f64; 4]], z: f64) -> [f64; 4] {
 fn centre_coefficients(mu: f64, t_max: f64) -> Vec<[f64; 4]> {
     let mut even = 1.0; // E_n = a_{2n}
     let mut odd = 1.0; // O_n = a_{2n+1}
+    let next = |a: f64, m: f64| a * (m * m + m + mu) / ((m + 2.0) * (m + 1.0));
     collect_series(t_max, |n| {
         let m = index_f64(2 * n);
-        let even_next = even * (m * m + m + mu) / ((m + 2.0) * (m + 1.0));
         let m1 = m + 1.0;
-        let odd_next = odd * (m1 * m1 + m1 + mu) / ((m1 + 2.0) * (m1 + 1.0));
+        let (even_next, odd_next) = (next(even, m), next(odd, m1));
         let term = [even, (m + 2.0) * even_next, odd, m1 * odd];
         even = even_next;
         odd = odd_next;
