@@ -19,35 +19,27 @@ pub const MAX_POINTS: usize = 4_000_000;
 
 /// Why a map cannot be made.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's doc")]
 pub enum MapError {
-    /// A grid flag that does not parse or is out of range.
+    /// A grid `flag` (`--theta`, `--omega-z`) whose `value` does not parse or is out of range: the
+    /// `reason` says what is wrong and what would do.
     #[error("`{flag} {value}`: {reason}")]
     Grid {
-        /// The flag (`--theta`, `--omega-z`).
         flag: &'static str,
-        /// The value given.
         value: String,
-        /// What is wrong and what would do.
         reason: String,
     },
-    /// More points than [`MAX_POINTS`].
+    /// More `points` (θ₀ count × ω_Z0 count × branches) than [`MAX_POINTS`].
     #[error("{points} grid points is more than {MAX_POINTS}: use fewer points per axis")]
-    TooLarge {
-        /// θ₀ count × ω_Z0 count × branches.
-        points: usize,
-    },
-    /// A grid point whose ω_Y0 or σ² is not a finite number in double precision.
+    TooLarge { points: usize },
+    /// A grid point (fields as in [`MapPoint`], the branch by name) whose ω_Y0 or σ² is not a finite
+    /// number in double precision.
     #[error("the circle θ0 = {}, ω_Z0 = {} ({branch} branch) gives ω_Y0 = {}, σ² = {}: too fast, too near upright or too near flat for double precision; narrow --theta or --omega-z", Short(*theta0), Short(*omega_z0), Short(*omega_y0), Short(*sigma_squared))]
     NonFinite {
-        /// θ₀ \[rad\].
         theta0: f64,
-        /// ω_Z0 [rad/time].
         omega_z0: f64,
-        /// `+` or `-`.
         branch: &'static str,
-        /// ω_Y0 [rad/time].
         omega_y0: f64,
-        /// σ² [1/time²].
         sigma_squared: f64,
     },
     /// `--branch` other than `+`, `-` or `both`.
@@ -58,22 +50,19 @@ pub enum MapError {
     Plot(String),
 }
 
-/// `A:B:N`: N values from A to B, equally spaced (N = 1: A alone).
+/// `A:B:N`: N = `count` values (1 ..= [`MAX_COUNT`]) from A = `from` to B = `to`, equally spaced (N = 1:
+/// A alone).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct Grid {
-    /// First value.
     pub from: f64,
-    /// Last value.
     pub to: f64,
-    /// Number of values, 1 ..= [`MAX_COUNT`].
     pub count: usize,
 }
 
 impl Grid {
-    /// Parses `A:B:N` given to `flag`.
-    ///
-    /// # Errors
-    /// [`MapError::Grid`] naming the flag, the value and the expected form.
+    /// Parses `A:B:N` given to `flag`, or fails ([`MapError::Grid`]) naming the flag, the value and the
+    /// expected form.
     pub fn parse(flag: &'static str, text: &str) -> Result<Self, MapError> {
         let error = |reason: String| MapError::Grid {
             flag,
@@ -144,14 +133,12 @@ impl std::fmt::Display for Grid {
     }
 }
 
-/// Which branches a map covers.
+/// Which branches a map covers: the + root only, the − root only, or both.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs, reason = "the enum's doc names each variant")]
 pub enum Branches {
-    /// The + root only.
     Plus,
-    /// The − root only.
     Minus,
-    /// Both.
     Both,
 }
 
@@ -182,14 +169,13 @@ impl FromStr for Branches {
     }
 }
 
-/// The grid of a map.
+/// The grid of a map: the θ₀ values `theta` \[rad\], each 0 < |θ₀| < π/2, the ω_Z0 values `omega_z`
+/// [rad/time], and the roots of the steady family, `branches`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct MapOptions {
-    /// θ₀ values \[rad\]; each must satisfy 0 < |θ₀| < π/2.
     pub theta: Grid,
-    /// ω_Z0 values [rad/time].
     pub omega_z: Grid,
-    /// Which roots of the steady family.
     pub branches: Branches,
 }
 
@@ -199,10 +185,8 @@ pub const DEFAULT_THETA: &str = "0.0075:1.5:200";
 pub const DEFAULT_OMEGA_Z: &str = "0:2:200";
 
 impl MapOptions {
-    /// Checks the grid: every θ₀ leaning (0 < |θ₀| < π/2), at most [`MAX_POINTS`] points.
-    ///
-    /// # Errors
-    /// [`MapError`] naming the flag and the allowed range.
+    /// Checks the grid: every θ₀ leaning (0 < |θ₀| < π/2), at most [`MAX_POINTS`] points, or fails
+    /// naming the flag and the allowed range.
     pub fn validate(&self) -> Result<(), MapError> {
         let (lo, hi) = self.theta.bounds();
         let leaning = |t: f64| t != 0.0 && t.abs() < FRAC_PI_2;
@@ -241,73 +225,60 @@ impl Default for MapOptions {
     }
 }
 
-/// One steady circle of the map.
+/// One steady circle of the map: the lean `theta0` \[rad\], the spin `omega_z0` and, on the root `branch`
+/// of the steady family, `omega_y0` [rad/time], its σ² of eq (21) `sigma_squared` [1/time²] and its
+/// `verdict`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct MapPoint {
-    /// θ₀ \[rad\].
     pub theta0: f64,
-    /// ω_Z0 [rad/time].
     pub omega_z0: f64,
-    /// The root of the steady family.
     pub branch: Branch,
-    /// ω_Y0 on that root [rad/time].
     pub omega_y0: f64,
-    /// σ², eq (21) [1/time²].
     pub sigma_squared: f64,
-    /// Stable, unstable or marginal.
     pub verdict: Stability,
 }
 
-/// A steady circle with σ² = 0.
+/// A steady circle with σ² = 0: `theta0`, `omega_z0`, `omega_y0` and `branch` as in [`MapPoint`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct BoundaryPoint {
-    /// θ₀ \[rad\].
     pub theta0: f64,
-    /// ω_Z0 [rad/time].
     pub omega_z0: f64,
-    /// ω_Y0 [rad/time].
     pub omega_y0: f64,
-    /// The root of the steady family it lies on.
     pub branch: Branch,
 }
 
-/// A built-in (or the given) scene's steady motion on the map.
+/// A built-in (or the given) scene's steady motion on the map: the scene's `name`, `theta0` \[rad\] (0
+/// for straight rolling and the upright spin), `omega_z0` in the map body's units [rad/time], the
+/// `branch` whose panel shows it (straight rolling: the root it continues) and its `verdict`.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct ScenePoint {
-    /// The scene's name.
     pub name: String,
-    /// θ₀ \[rad\] (0 for straight rolling and the upright spin).
     pub theta0: f64,
-    /// ω_Z0 in the map body's units [rad/time].
     pub omega_z0: f64,
-    /// The branch whose panel shows it (straight rolling: the root it continues).
     pub branch: Branch,
-    /// Its verdict.
     pub verdict: Stability,
 }
 
-/// The stability map: the grid's points, the boundary and the band's closing points, ω_c and the scenes.
+/// The stability map of the body `coin` over the grid `options`: its `points` (θ₀-major, then ω_Z0,
+/// then branch, + first), ω_c of straight rolling (`critical_spin`, physics §5), the `closures` where
+/// the two edges of an unstable band meet (the folds of the boundary) and the `scenes`' steady motions.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct StabilityMap {
-    /// The body.
     pub coin: Coin,
-    /// The grid.
     pub options: MapOptions,
-    /// θ₀-major, then ω_Z0, then branch (+ first).
     pub points: Vec<MapPoint>,
-    /// ω_c of straight rolling (physics §5).
     pub critical_spin: f64,
-    /// Where the two edges of an unstable band meet (the folds of the boundary).
     pub closures: Vec<BoundaryPoint>,
-    /// The scenes' steady motions.
     pub scenes: Vec<ScenePoint>,
 }
 
-/// σ² and its verdict for the circle (θ₀, ω_Z0) on `branch`.
-///
-/// # Errors
-/// [`MapError::NonFinite`] where ω_Y0 or σ² overflows (σ² grows as ω_Z0² tan²θ₀: ω_Z0 = 1e154 made it
-/// `inf` and the − branch `NaN`, which the CSV would have called "marginal" and "unstable").
+/// σ² and its verdict for the circle (θ₀, ω_Z0) on `branch`; fails ([`MapError::NonFinite`]) where ω_Y0
+/// or σ² overflows (σ² grows as ω_Z0² tan²θ₀: ω_Z0 = 1e154 made it `inf` and the − branch `NaN`, which
+/// the CSV would have called "marginal" and "unstable").
 fn map_point(
     coin: &Coin,
     theta0: f64,
@@ -336,12 +307,9 @@ fn map_point(
     })
 }
 
-/// The map over `options`' grid for `coin`, with the built-in scenes of the same shape and `extra`
-/// (a scene of the caller's) placed on it.
-///
-/// # Errors
-/// [`MapError`] for a grid that [`MapOptions::validate`] refuses, or a circle of it that double
-/// precision cannot hold ([`MapError::NonFinite`]).
+/// The map over `options`' grid for `coin`, with the built-in scenes of the same shape and `extra` (a
+/// scene of the caller's) placed on it. Fails for a grid that [`MapOptions::validate`] refuses, or a
+/// circle of it that double precision cannot hold ([`MapError::NonFinite`]).
 pub fn stability_map(
     coin: &Coin,
     options: &MapOptions,

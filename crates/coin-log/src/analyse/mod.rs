@@ -30,12 +30,12 @@ pub enum AnalyseError {
     Nutation(#[from] NutationError),
 }
 
-/// The analysis of one initial state.
+/// The analysis of one initial `state` (the scene's) of the body `coin`, with the scene's μ, `friction`,
+/// if given.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names the fields without one")]
 pub struct Analysis {
-    /// The body.
     pub coin: Coin,
-    /// The state analysed (the scene's initial state).
     pub state: State,
     /// The motion by quadrature: E, C1, C2, θ range, period and heading advance, N and |F|/N.
     pub orbit: Orbit,
@@ -44,15 +44,12 @@ pub struct Analysis {
     /// The steady motion a perturbed steady scene starts from, analysed (its σ is the nutation
     /// frequency of small perturbations); `None` otherwise.
     pub base_steady: Option<SteadyAnalysis>,
-    /// μ of the scene, if given.
     pub friction: Option<f64>,
 }
 
 impl Analysis {
-    /// The analysis of a scene's initial state (the scene's flat margin and μ apply).
-    ///
-    /// # Errors
-    /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body.
+    /// The analysis of a scene's initial state (the scene's flat margin and μ apply); fails when C1, C2
+    /// cannot be evaluated for the body.
     pub fn of_scene(scene: &Scene) -> Result<Self, AnalyseError> {
         // The state is the steady motion when nothing perturbs it; a dissipative couple (which makes
         // `unperturbed_steady` none, since the run leaves it) does not perturb the initial state.
@@ -75,10 +72,8 @@ impl Analysis {
     }
 
     /// The analysis of `state`; `given` is the steady motion the state is known to be (then it is
-    /// analysed as steady whatever rounding says).
-    ///
-    /// # Errors
-    /// [`AnalyseError`] when C1, C2 cannot be evaluated for the body or the state is not rolling.
+    /// analysed as steady whatever rounding says); fails when C1, C2 cannot be evaluated for the body or
+    /// the state is not rolling.
     pub fn of_state(
         coin: &Coin,
         state: &State,

@@ -22,10 +22,8 @@ const DECADES: (f64, f64) = (-4.0, 2.0);
 const CURVE_SAMPLES: usize = 1200;
 
 impl StabilityMap {
-    /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes.
-    ///
-    /// # Errors
-    /// [`MapError::Plot`] if drawing fails (it does not for a validated grid).
+    /// `stability-map.svg`: one panel per branch, σ² by colour, the boundary, ω_c and the scenes; fails
+    /// ([`MapError::Plot`]) if drawing does (it does not for a validated grid).
     pub fn svg(&self) -> Result<String, MapError> {
         let branches = self.options.branches.list();
         let panels = u32::try_from(branches.len()).unwrap_or(1);

@@ -40,10 +40,7 @@ pub fn slow_change_time_scale(coin: &Coin, law: &Dissipation, alpha0: f64) -> f6
 }
 
 /// The law of `model` whose time scale from `alpha0` is `time_scale` (the inverse of
-/// [`slow_change_time_scale`] in κ).
-///
-/// # Errors
-/// [`DissipationError`] for `power-law` (no fixed exponents) or a κ that is not valid.
+/// [`slow_change_time_scale`] in κ); fails for `power-law` (no fixed exponents) or a κ that is not valid.
 pub fn coefficient_for(
     coin: &Coin,
     model: DissipationModel,

@@ -37,16 +37,15 @@ impl Stability {
     }
 }
 
-/// A steady motion, analysed (physics §4, §9).
+/// A steady motion, analysed (physics §4, §9): the motion `steady` (its kind, state, rates and radii),
+/// N = `normal` \[force\] (= Mg on every steady motion), |F| = `friction` \[force\] (the centripetal
+/// force of the centre's circle), and σ² of eq (21), `sigma_squared` [1/time²].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names the fields without one")]
 pub struct SteadyAnalysis {
-    /// The motion: its kind (family and branch), state, rates and radii.
     pub steady: Steady,
-    /// N \[force\] (= Mg on every steady motion).
     pub normal: f64,
-    /// |F| \[force\], the centripetal force of the centre's circle.
     pub friction: f64,
-    /// σ², eq (21) [1/time²].
     pub sigma_squared: f64,
     /// The size of the terms σ² is the sum of (its rounding is a few ulp of this).
     pub sigma_scale: f64,

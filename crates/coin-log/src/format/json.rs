@@ -39,6 +39,7 @@ pub(crate) fn parse_numbers_into(data: &[u8], fields: &[&str], out: &mut [f64]) 
 
 /// A message that is not a flat JSON object with exactly the expected numeric fields.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum FieldsError {
     /// Not JSON, or not an object.
     #[error("is not a JSON object: {0}")]
@@ -55,14 +56,9 @@ pub enum FieldsError {
     /// A field given twice (JSON leaves its value undefined; `verify` refuses it too).
     #[error("has the field `{0}` twice")]
     Repeated(String),
-    /// A field whose value is not a finite number.
+    /// A field whose value (as JSON) is not a finite number.
     #[error("has `{field}` = {value}, not a finite number")]
-    NotNumber {
-        /// The field.
-        field: String,
-        /// Its JSON value.
-        value: String,
-    },
+    NotNumber { field: String, value: String },
 }
 
 /// Reads the flat object `data` into `out` in the order of `fields` (`out.len() == fields.len()`),

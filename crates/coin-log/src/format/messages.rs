@@ -9,12 +9,10 @@ use serde::Deserialize;
 /// A number that JSON cannot carry.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error("field `{field}` of a `{schema}` message is {value}; messages carry finite numbers only")]
+#[allow(missing_docs, reason = "each field is named in the message")]
 pub struct NonFiniteField {
-    /// Schema name.
     pub schema: &'static str,
-    /// Field name.
     pub field: &'static str,
-    /// The value.
     pub value: f64,
 }
 
@@ -133,10 +131,8 @@ pub fn schema_bytes(schema_name: &str) -> Option<&'static [u8]> {
 
 /// What the recorder and the readers need of every `coin_log.*` message type.
 pub trait Message: Copy + serde::de::DeserializeOwned {
-    /// Appends this message to `buf` in `encoding`.
-    ///
-    /// # Errors
-    /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+    /// Appends this message to `buf` in `encoding`; fails ([`NonFiniteField`]) if a field is NaN or
+    /// infinite, leaving `buf` as it was.
     fn write(&self, encoding: Encoding, buf: &mut Vec<u8>) -> Result<(), NonFiniteField>;
     /// The message of the field values `v` in schema order (0 past its end); without the added fields
     /// when `first` (a schema of the type's first version).
@@ -177,18 +173,19 @@ macro_rules! message {
                 json_schema: include_bytes!(concat!("../../../../schemas/", $schema, ".json")),
             };
 
+            /// The field values in schema order, `None` for an added field the message lacks.
+            #[inline]
+            fn values(&self) -> impl Iterator<Item = Option<f64>> {
+                [$(Some(self.$field)),+ $($(, self.$added)+)?].into_iter()
+            }
+
             /// `Err` naming the first field that is NaN or infinite.
             fn check_finite(&self) -> Result<(), NonFiniteField> {
-                $(
-                    if !self.$field.is_finite() {
-                        return Err(NonFiniteField { schema: $schema, field: stringify!($field), value: self.$field });
+                for (&field, value) in Self::TYPE.fields.iter().zip(self.values()) {
+                    if let Some(value) = value.filter(|v| !v.is_finite()) {
+                        return Err(NonFiniteField { schema: $schema, field, value });
                     }
-                )+
-                $($(
-                    if let Some(v) = self.$added.filter(|v| !v.is_finite()) {
-                        return Err(NonFiniteField { schema: $schema, field: stringify!($added), value: v });
-                    }
-                )+)?
+                }
                 Ok(())
             }
 
@@ -196,48 +193,35 @@ macro_rules! message {
             /// schema (t = 1), zeros included; an added field only when it is `Some`.
             pub(crate) fn write_protobuf(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
                 self.check_finite()?;
-                let mut number = 0_u32;
-                $(
-                    number += 1;
-                    put_double(buf, number, self.$field);
-                )+
-                $($(
-                    number += 1;
-                    if let Some(v) = self.$added {
+                for (number, value) in (1..).zip(self.values()) {
+                    if let Some(v) = value {
                         put_double(buf, number, v);
                     }
-                )+)?
-                let _ = number;
+                }
                 Ok(())
             }
 
-            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an added
-            /// field only when it is `Some`.
-            ///
-            /// # Errors
-            /// [`NonFiniteField`] if a field is NaN or infinite; `buf` is then left as it was.
+            /// Appends this message as one compact JSON object to `buf`: the fields in schema order, an
+            /// added field only when it is `Some`; fails as [`Message::write`] does.
             pub fn write_json(&self, buf: &mut Vec<u8>) -> Result<(), NonFiniteField> {
+                /// Each field's `"name":`, in schema order.
+                const KEYS: &[&str] = &[$(concat!("\"", stringify!($field), "\":")),+
+                    $($(, concat!("\"", stringify!($added), "\":"))+)?];
                 self.check_finite()?;
                 let mut formatter = ryu::Buffer::new();
                 // `{` before the first field, `,` before each other.
                 let mut separator = b'{';
-                $(
-                    buf.push(separator);
-                    separator = b',';
-                    buf.extend_from_slice(concat!("\"", stringify!($field), "\":").as_bytes());
-                    push_number(buf, self.$field, &mut formatter);
-                )+
-                let _ = separator;
-                $($(
-                    if let Some(v) = self.$added {
-                        buf.extend_from_slice(concat!(",\"", stringify!($added), "\":").as_bytes());
+                for (key, value) in KEYS.iter().zip(self.values()) {
+                    if let Some(v) = value {
+                        buf.push(separator);
+                        separator = b',';
+                        buf.extend_from_slice(key.as_bytes());
                         push_number(buf, v, &mut formatter);
                     }
-                )+)?
+                }
                 buf.push(b'}');
                 Ok(())
             }
-
         }
 
         impl Message for $name {

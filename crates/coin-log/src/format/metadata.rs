@@ -17,25 +17,20 @@ pub const FORMAT_VERSION: &str = "1";
 
 /// A metadata record that cannot be read back.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum MetadataError {
     /// A required key is absent.
     #[error("metadata `{record}` has no key `{key}`")]
     Missing {
-        /// Record name.
         record: &'static str,
-        /// Key.
         key: &'static str,
     },
-    /// A value does not parse.
+    /// A value does not parse: the `reason` says why, and what would.
     #[error("metadata `{record}`: `{key}` = {value:?}: {reason}")]
     Invalid {
-        /// Record name.
         record: &'static str,
-        /// Key.
         key: &'static str,
-        /// Value found.
         value: String,
-        /// Why it does not parse, and what would.
         reason: String,
     },
 }
@@ -238,10 +233,7 @@ macro_rules! record {
                 map
             }
 
-            /// Reads the record back.
-            ///
-            /// # Errors
-            /// [`MetadataError`] naming the first missing or malformed key.
+            /// Reads the record back, or fails naming the first missing or malformed key.
             pub fn from_map(map: &BTreeMap<String, String>) -> Result<Self, MetadataError> {
                 Ok(Self {
                     $( $field: read($record, map, stringify!($field))?, )+
@@ -288,10 +280,7 @@ pub fn header_library(version: &str) -> String {
 }
 
 impl RunMetadata {
-    /// The body the record stores.
-    ///
-    /// # Errors
-    /// Each parameter that is unusable, joined by "; ".
+    /// The body the record stores; `Err` lists each parameter that is unusable, joined by "; ".
     pub fn params(&self) -> Result<CoinParams, String> {
         let inertia = Inertia::Explicit {
             inertia_x: self.inertia_x,

@@ -98,59 +98,43 @@ pub const HEADING_SHARE: f64 = 50.0;
 /// before.
 pub const DIFFERENCE_GAIN: f64 = 2.08;
 
-/// Why a check is expected to fail.
+/// Why a check is expected to fail: `epsilon` is the tolerances' ε, `sample_interval` the distance Δt
+/// between samples.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(
+    missing_docs,
+    reason = "the enum's and each variant's doc name the fields"
+)]
 pub enum Cause {
     /// The accuracy asked for (ε) is looser than the tolerance's ceiling allows.
-    Accuracy {
-        /// ε of the tolerances.
-        epsilon: f64,
-    },
-    /// The rounding of very many fixed steps, or of fixed steps differenced over samples very close
+    Accuracy { epsilon: f64 },
+    /// The rounding of very many `fixed` steps, or of fixed steps differenced over samples very close
     /// together, exceeds the tolerance's floor.
-    Rounding {
-        /// The steps.
-        fixed: FixedSteps,
-    },
+    Rounding { fixed: FixedSteps },
     /// The dense output of an adaptive method, differentiated for the rolling constraint, errs by more
-    /// than the tolerance.
-    DenseOutput {
-        /// ε of the tolerances.
-        epsilon: f64,
-        /// The ε at which this error is half the tolerance (the other half left to the other errors).
-        enough: f64,
-    },
-    /// The heading φ grows so large that its rounding changes the velocity's direction and the heading
-    /// advance by more than the tolerance.
-    Heading {
-        /// The largest |φ| expected, |φ₀| + T |φ̇₀| \[rad\].
-        heading: f64,
-    },
+    /// than the tolerance; it is half the tolerance (the other half left to the other errors) at the ε
+    /// `enough`.
+    DenseOutput { epsilon: f64, enough: f64 },
+    /// The `heading` φ grows so large (|φ₀| + T |φ̇₀| \[rad\] expected at most) that its rounding changes
+    /// the velocity's direction and the heading advance by more than the tolerance.
+    Heading { heading: f64 },
     /// Samples so close together that the rounding of the positions an adaptive method's dense output
     /// gives, differenced over them, exceeds the constraint's tolerance.
-    Sampling {
-        /// Distance between samples Δt.
-        sample_interval: f64,
-    },
-    /// The centre starts so far from the origin that the rounding of its stored coordinates, differenced
-    /// over samples close together, exceeds the constraint's tolerance.
-    Offset {
-        /// The stored positions.
-        positions: Positions,
-    },
+    Sampling { sample_interval: f64 },
+    /// The centre starts so far from the origin that the rounding of its stored coordinates
+    /// (`positions`), differenced over samples close together, exceeds the constraint's tolerance.
+    Offset { positions: Positions },
 }
 
-/// Checks expected to fail on a recording, with the error predicted and the tolerance they will be judged
-/// by.
+/// The `checks` (their ids, format.md: verify) expected to fail on a recording, with the error
+/// `predicted`, verify's default `tolerance` they will be judged by, and the `cause`, the larger share of
+/// the prediction.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct Shortfall {
-    /// The check ids (format.md: verify).
     pub checks: &'static [&'static str],
-    /// The predicted error.
     pub predicted: f64,
-    /// verify's default tolerance.
     pub tolerance: f64,
-    /// The larger share of the prediction.
     pub cause: Cause,
 }
 
@@ -207,12 +191,12 @@ impl fmt::Display for Shortfall {
     }
 }
 
-/// The fixed steps of a run, as far as their rounding goes.
+/// The fixed steps of a run, as far as their rounding goes: the `steps` over the span and the distance
+/// Δt between samples, `sample_interval`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct FixedSteps {
-    /// Steps over the span.
     pub steps: f64,
-    /// Distance between samples Δt.
     pub sample_interval: f64,
 }
 

@@ -102,6 +102,7 @@ fn coin_descriptor_set(t: &MessageType) -> Vec<u8> {
 
 /// A stored descriptor that cannot describe a `coin_log.*` type's messages.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum SchemaError {
     /// Not a serialized `FileDescriptorSet`.
     #[error("is not a serialized FileDescriptorSet: {0}")]
@@ -112,14 +113,9 @@ pub enum SchemaError {
     /// A field of the type is not declared.
     #[error("does not declare field `{0}`")]
     Missing(String),
-    /// A field declared with another type or as repeated.
+    /// A field declared with another type or as repeated (`what` it is declared as).
     #[error("declares `{field}` as {what}, the messages have one double")]
-    WrongType {
-        /// The field.
-        field: String,
-        /// What it is declared as.
-        what: String,
-    },
+    WrongType { field: String, what: String },
 }
 
 /// Reads `coin_log.*` messages into f64 slices by the field numbers a stored descriptor gives.
@@ -167,16 +163,17 @@ impl MessageDecoder {
                 .iter()
                 .find(|d| d.name.as_deref() == Some(field))
                 .ok_or_else(|| SchemaError::Missing((*field).to_string()))?;
-            if d.r#type() != Type::Double || d.label() == Label::Repeated {
-                return Err(SchemaError::WrongType {
-                    field: (*field).to_string(),
-                    what: format!("{:?} {:?}", d.label(), d.r#type()).to_lowercase(),
-                });
-            }
-            let number = u32::try_from(d.number()).map_err(|_| SchemaError::WrongType {
+            let wrong = |what: String| SchemaError::WrongType {
                 field: (*field).to_string(),
-                what: format!("field number {}", d.number()),
-            })?;
+                what,
+            };
+            if d.r#type() != Type::Double || d.label() == Label::Repeated {
+                return Err(wrong(
+                    format!("{:?} {:?}", d.label(), d.r#type()).to_lowercase(),
+                ));
+            }
+            let number = u32::try_from(d.number())
+                .map_err(|_| wrong(format!("field number {}", d.number())))?;
             wanted.push((number, index));
         }
         let other = message

@@ -13,16 +13,14 @@ pub struct TimeError {
 /// Largest t whose nanoseconds fit in a u64 with margin.
 const MAX_TIME: f64 = 1.8e10;
 
-/// log_time = round(t·10⁹) ns, checked: t finite, ≥ 0, and small enough for a u64.
+/// log_time = round(t·10⁹) ns, checked: t finite, ≥ 0, and small enough for a u64 ([`TimeError`] for a
+/// NaN, negative or too large t).
 ///
 /// ```
 /// assert_eq!(coin_log::format::log_time(1.5).unwrap(), 1_500_000_000);
 /// assert_eq!(coin_log::format::log_time(0.01).unwrap(), 10_000_000);
 /// assert!(coin_log::format::log_time(-1.0).is_err());
 /// ```
-///
-/// # Errors
-/// [`TimeError`] for a NaN, negative or too large t.
 #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 pub fn log_time(t: f64) -> Result<u64, TimeError> {
     if t.is_finite() && (0.0..MAX_TIME).contains(&t) {

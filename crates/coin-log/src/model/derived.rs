@@ -45,14 +45,13 @@ pub fn contact_point(coin: &Coin, s: &State) -> Vector3<f64> {
     Vector3::new(s.x - a * st * sp, 0.0, s.z - a * st * cp)
 }
 
-/// Energy split into its parts [mass·length²/time²].
+/// Energy split into its `kinetic` and `potential` parts and their `total` [mass·length²/time²]
+/// ([`energy`] gives the formulas).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct Energy {
-    /// Kinetic + potential.
     pub total: f64,
-    /// ½Ma²(ω_X² + ω_Z²) + ½(I_X(ω_X² + ω_Y²) + I_Z ω_Z²).
     pub kinetic: f64,
-    /// M g a cos θ.
     pub potential: f64,
 }
 

@@ -82,7 +82,8 @@ pub struct Dissipation {
 }
 
 impl Dissipation {
-    /// A preset's law with coefficient κ (the preset fixes m and k).
+    /// A preset's law with coefficient κ (the preset fixes m and k); fails for a bad κ: `power-law` has
+    /// no fixed exponents and is refused as m = NaN.
     ///
     /// ```
     /// use coin_log::model::{Dissipation, DissipationModel};
@@ -90,18 +91,13 @@ impl Dissipation {
     /// assert_eq!((d.m(), d.k(), d.angle_exponent()), (2.0, 1.0, -2.0));
     /// assert_eq!(d.predicted_exponent(), 1.0 / 3.0);
     /// ```
-    ///
-    /// # Errors
-    /// [`DissipationError`] for a bad κ; `power-law` has no fixed exponents and is refused as m = NaN.
     pub fn preset(model: DissipationModel, coefficient: f64) -> Result<Self, DissipationError> {
         let (m, k) = model.exponents().unwrap_or((f64::NAN, f64::NAN));
         Self::new(model, coefficient, m, k)
     }
 
-    /// A law with explicit exponents (`power-law`, or a preset with its own m, k).
-    ///
-    /// # Errors
-    /// [`DissipationError`] naming the first bad value.
+    /// A law with explicit exponents (`power-law`, or a preset with its own m, k); fails naming the first
+    /// bad value.
     pub fn new(
         model: DissipationModel,
         coefficient: f64,

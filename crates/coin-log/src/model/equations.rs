@@ -20,14 +20,12 @@ pub struct Coin {
     rolling_z: f64,
 }
 
-/// Angular accelerations (ω̇_X, ω̇_Y, ω̇_Z), eqs (14)–(16).
+/// Angular accelerations (ω̇_X, ω̇_Y, ω̇_Z) = (`x`, `y`, `z`) [rad/time²], eqs (14)–(16).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct AngularAcceleration {
-    /// ω̇_X [rad/time²].
     pub x: f64,
-    /// ω̇_Y [rad/time²].
     pub y: f64,
-    /// ω̇_Z [rad/time²].
     pub z: f64,
 }
 

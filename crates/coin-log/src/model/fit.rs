@@ -7,14 +7,12 @@ const SCAN: (f64, f64, usize) = (1e-7, 1e4, 221);
 /// Golden-section refinement steps of t₀ in [`power_law`].
 const REFINE_STEPS: usize = 100;
 
-/// The least-squares line y = intercept + slope·x.
+/// The least-squares line y = intercept + slope·x, and the sum of its squared residuals, `residual`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct FittedLine {
-    /// Its slope.
     pub slope: f64,
-    /// Its value at x = 0.
     pub intercept: f64,
-    /// The sum of the squared residuals.
     pub residual: f64,
 }
 
@@ -67,14 +65,12 @@ pub fn log_log_slope(points: &[(f64, f64)]) -> Option<f64> {
     line(&logs).map(|l| l.slope)
 }
 
-/// The fitted law α = A |t₀ − t|^n.
+/// The fitted law α = A |t₀ − t|^n: n = `exponent`, A = `amplitude`, `t0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names the fields without one")]
 pub struct PowerLaw {
-    /// n.
     pub exponent: f64,
-    /// A.
     pub amplitude: f64,
-    /// t₀.
     pub t0: f64,
     /// True when t₀ lies after the points (a finite-time singularity), false before them (a decay).
     pub singular: bool,

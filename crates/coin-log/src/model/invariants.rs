@@ -26,18 +26,14 @@ const MU_MAX: f64 = 100.0;
 
 /// Why the integrals cannot be built for these parameters.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum InvariantsError {
-    /// μ is larger than 100 (`max`).
+    /// The parameters' μ is larger than 100 (`max`).
     #[error(
         "μ = I_Z·Ma²/(I_X·(I_Z + Ma²)) = {mu} is above {max}, where C1, C2 cannot be evaluated accurately; \
          every real body has I_Z ≤ 2·I_X and μ < 2, so check inertia_x and inertia_z"
     )]
-    MuTooLarge {
-        /// The parameters' μ.
-        mu: f64,
-        /// The largest accepted μ, 100.
-        max: f64,
-    },
+    MuTooLarge { mu: f64, max: f64 },
 }
 
 /// The two Chaplygin–Appell integrals of one state (physics §6).
@@ -98,10 +94,8 @@ pub struct Chaplygin {
 }
 
 impl Chaplygin {
-    /// Precomputes the expansions of physics §6 for `params`.
-    ///
-    /// # Errors
-    /// [`InvariantsError::MuTooLarge`] if μ > 100 (no real body).
+    /// Precomputes the expansions of physics §6 for `params`; fails ([`InvariantsError::MuTooLarge`]) if
+    /// μ > 100 (no real body).
     pub fn new(params: &CoinParams) -> Result<Self, InvariantsError> {
         let ma2 = params.ma2();
         let iz = params.inertia_z();
@@ -284,11 +278,11 @@ fn horner(coefficients: &[[f64; 4]], z: f64) -> [f64; 4] {
 fn centre_coefficients(mu: f64, t_max: f64) -> Vec<[f64; 4]> {
     let mut even = 1.0; // E_n = a_{2n}
     let mut odd = 1.0; // O_n = a_{2n+1}
+    let next = |a: f64, m: f64| a * (m * m + m + mu) / ((m + 2.0) * (m + 1.0));
     collect_series(t_max, |n| {
         let m = index_f64(2 * n);
-        let even_next = even * (m * m + m + mu) / ((m + 2.0) * (m + 1.0));
         let m1 = m + 1.0;
-        let odd_next = odd * (m1 * m1 + m1 + mu) / ((m1 + 2.0) * (m1 + 1.0));
+        let (even_next, odd_next) = (next(even, m), next(odd, m1));
         let term = [even, (m + 2.0) * even_next, odd, m1 * odd];
         even = even_next;
         odd = odd_next;

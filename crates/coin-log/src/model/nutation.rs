@@ -44,19 +44,16 @@ const EXTREME_SCAN: usize = 257;
 
 /// Why the quadrature cannot be done.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum NutationError {
     /// The state is not finite or leans flat.
     #[error("the state is not a rolling coin: θ = {theta} must satisfy |θ| < π/2 − flat_margin = {limit}, and every ω must be finite")]
-    BadState {
-        /// θ given.
-        theta: f64,
-        /// π/2 − flat_margin.
-        limit: f64,
-    },
+    BadState { theta: f64, limit: f64 },
 }
 
 /// What the motion does.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "FlatLanding's doc names its fields")]
 pub enum Motion {
     /// ω_X = 0 and the steady family holds (to `STEADY_TOLERANCE`): θ stays where it is.
     Steady,
@@ -69,41 +66,34 @@ pub enum Motion {
         /// The spin advance per period ΔΨ = 2∫ψ̇ dθ/|θ̇| \[rad\].
         spin_advance: f64,
     },
-    /// θ reaches the flat margin: the coin lands flat (physics §7).
-    FlatLanding {
-        /// The lean it lands at, ±(π/2 − flat_margin).
-        theta: f64,
-        /// When, from t = 0.
-        time: f64,
-    },
+    /// θ reaches the flat margin: the coin lands flat (physics §7) at the lean `theta` = ±(π/2 −
+    /// flat_margin), at `time` from t = 0.
+    FlatLanding { theta: f64, time: f64 },
 }
 
-/// A lean and the time the motion first reaches it.
+/// A lean `theta` \[rad\] and the `time` from t = 0 at which the motion first reaches it.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct Event {
-    /// θ \[rad\].
     pub theta: f64,
-    /// Time from t = 0.
     pub time: f64,
 }
 
-/// An extreme value over the motion and where it is.
+/// An extreme `value` over the motion and the lean `theta` \[rad\] where it is attained.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names each field")]
 pub struct Extremum {
-    /// The value.
     pub value: f64,
-    /// The lean where it is attained \[rad\].
     pub theta: f64,
 }
 
-/// The motion from one state, by quadrature (physics §10).
+/// The motion from one state, by quadrature (physics §10), with the state's `energy` E (physics §3),
+/// `c1` and `c2` (physics §6).
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs, reason = "the struct's doc names the fields without one")]
 pub struct Orbit {
-    /// E of the state (physics §3).
     pub energy: f64,
-    /// C1 (physics §6).
     pub c1: f64,
-    /// C2 (physics §6).
     pub c2: f64,
     /// What the motion does.
     pub motion: Motion,
@@ -125,7 +115,8 @@ pub struct Orbit {
 }
 
 impl Orbit {
-    /// The motion of `state` for `coin`, with the flat landing at |θ| = π/2 − `flat_margin`.
+    /// The motion of `state` for `coin`, with the flat landing at |θ| = π/2 − `flat_margin`; fails
+    /// ([`NutationError::BadState`]) for a non-finite state or one at or beyond the flat margin.
     ///
     /// ```
     /// use coin_log::model::{Chaplygin, Coin, CoinParams, State};
@@ -137,9 +128,6 @@ impl Orbit {
     /// assert!(matches!(orbit.motion, Motion::Periodic { .. }));
     /// assert!(orbit.theta_min < 0.5 && 0.5 < orbit.theta_max);
     /// ```
-    ///
-    /// # Errors
-    /// [`NutationError::BadState`] for a non-finite state or one at or beyond the flat margin.
     pub fn new(
         coin: &Coin,
         chaplygin: &Chaplygin,
@@ -396,24 +384,23 @@ impl<'a> Reduced<'a> {
         let limit = direction * self.limit;
         let inside = |theta: f64| self.theta_dot_squared(theta) > 0.0;
         let (mut last_inside, mut step, mut offset) = (self.theta0, FIRST_STEP, 0.0);
-        loop {
+        let outside = loop {
             offset += step;
             step = (2.0 * step).min(LARGEST_STEP);
             let theta = self.theta0 + direction * offset;
             if direction * (theta - limit) >= 0.0 {
-                return if inside(limit) {
-                    End::Flat(limit)
-                } else {
-                    let (a, b) = bisect(inside, last_inside, limit);
-                    End::Turn(0.5 * (a + b))
-                };
+                if inside(limit) {
+                    return End::Flat(limit);
+                }
+                break limit;
             }
             if !inside(theta) {
-                let (a, b) = bisect(inside, last_inside, theta);
-                return End::Turn(0.5 * (a + b));
+                break theta;
             }
             last_inside = theta;
-        }
+        };
+        let (a, b) = bisect(inside, last_inside, outside);
+        End::Turn(0.5 * (a + b))
     }
 
     /// Classifies the motion and computes everything else.
@@ -586,12 +573,7 @@ impl<'a> Reduced<'a> {
             let converged = change <= CONVERGED || noisy;
             if converged || n >= MOST_NODES {
                 let rounding = self.rounding(lo, hi, next.4);
-                return (
-                    next.0,
-                    next.1,
-                    next.2,
-                    change_t.max(change_phi).max(rounding),
-                );
+                return (next.0, next.1, next.2, change.max(rounding));
             }
             previous = next;
         }

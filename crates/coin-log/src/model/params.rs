@@ -47,7 +47,8 @@ fn positive(name: &'static str, value: f64, errors: &mut Vec<ParamError>) {
 }
 
 impl CoinParams {
-    /// Validates M, a, g and the inertia; reports every bad field at once.
+    /// Validates M, a, g and the inertia; reports every bad field at once: one [`ParamError`] per field
+    /// that is not a finite positive number.
     ///
     /// ```
     /// use coin_log::model::{CoinParams, Inertia};
@@ -55,9 +56,6 @@ impl CoinParams {
     /// assert_eq!(p.inertia_z(), 0.5);
     /// assert!(CoinParams::new(-1.0, 1.0, 1.0, Inertia::Hoop).is_err());
     /// ```
-    ///
-    /// # Errors
-    /// One [`ParamError`] per field that is not a finite positive number.
     pub fn new(
         mass: f64,
         radius: f64,

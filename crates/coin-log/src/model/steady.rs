@@ -44,35 +44,24 @@ coin_log_names::named_enum! {
     }
 }
 
-/// A steady motion to build.
+/// A steady motion to build, from its lean `theta` \[rad\] (0 < |θ| < π/2), its spin about the normal
+/// `omega_z` or its rate Ω = `omega_y` [rad/time], and the `branch`: the root of the steady quadratic, or
+/// for the centre-fixed motion the sign of ω_Y (`Plus` gives ω_Y > 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs, reason = "the enum's doc names each field")]
 pub enum SteadyKind {
     /// Upright, rolling straight: θ = ω_X = ω_Y = 0, ω_Z constant (physics §4.1).
-    Straight {
-        /// Spin about the normal [rad/time].
-        omega_z: f64,
-    },
+    Straight { omega_z: f64 },
     /// Centre at rest, the coin rolling round it: ω_Z = 0, ω_Y² = Mga cos θ / I_X (physics §4.2).
-    CentreFixed {
-        /// Lean \[rad\], 0 < |θ| < π/2.
-        theta: f64,
-        /// Sign of ω_Y: `Plus` gives ω_Y > 0.
-        branch: Branch,
-    },
+    CentreFixed { theta: f64, branch: Branch },
     /// Circular rolling on either branch (physics §4.3).
     Circle {
-        /// Lean \[rad\], 0 < |θ| < π/2.
         theta: f64,
-        /// Spin about the normal [rad/time].
         omega_z: f64,
-        /// Root of the steady quadratic.
         branch: Branch,
     },
     /// Spinning upright in place about the vertical diameter: θ = 0, ω_Z = 0, ω_Y = Ω (physics §5).
-    SpinUpright {
-        /// Ω [rad/time].
-        omega_y: f64,
-    },
+    SpinUpright { omega_y: f64 },
 }
 
 impl SteadyKind {
@@ -99,25 +88,20 @@ impl SteadyKind {
 
 /// A steady motion that cannot be built, with the reason and the allowed range.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[allow(missing_docs, reason = "each field is named in its variant's message")]
 pub enum SteadyError {
     /// θ outside the open interval where the motion exists.
     #[error("steady `{kind}`: theta = {theta} is outside the allowed range {range}")]
     Theta {
-        /// The steady kind.
         kind: &'static str,
-        /// The value given.
         theta: f64,
-        /// The allowed range, in words.
         range: &'static str,
     },
     /// A non-finite rate.
     #[error("steady `{kind}`: `{name}` = {value} must be a finite number")]
     NotFinite {
-        /// The steady kind.
         kind: &'static str,
-        /// The field.
         name: &'static str,
-        /// The value given.
         value: f64,
     },
 }
@@ -178,7 +162,8 @@ fn check_lean(kind: &'static str, theta: f64) -> Result<(), SteadyError> {
 }
 
 impl Steady {
-    /// Builds the steady motion `kind` for `coin`.
+    /// Builds the steady motion `kind` for `coin`; fails when θ is outside the range where the motion
+    /// exists, or a rate is not finite.
     ///
     /// ```
     /// use coin_log::model::{Branch, Coin, CoinParams, Steady, SteadyKind};
@@ -186,9 +171,6 @@ impl Steady {
     /// let s = Steady::new(&coin, SteadyKind::Circle { theta: 0.3, omega_z: 1.0, branch: Branch::Plus }).unwrap();
     /// assert!((s.r_g.unwrap() - 4.897855).abs() < 1e-6); // physics §4 example
     /// ```
-    ///
-    /// # Errors
-    /// [`SteadyError`] when θ is outside the range where the motion exists, or a rate is not finite.
     pub fn new(coin: &Coin, kind: SteadyKind) -> Result<Self, SteadyError> {
         let p = coin.params();
         let name = kind.family().name();
